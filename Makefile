@@ -1,0 +1,63 @@
+# motorbus developer entry points.  `make demo` and `make test` set up everything
+# they need on a fresh Debian/Ubuntu machine (system packages, a venv, the build).
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+BUILD  := build/dev
+JOBS   ?= $(shell nproc)
+APT_PACKAGES := cmake g++ libeigen3-dev libgtest-dev clang libclang-rt-14-dev
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+.PHONY: demo test deps venv build cpp-test py-test sanitize fuzz fuzz-smoke bench stubs clean
+
+demo: build
+	$(PY) -m motorbus demo
+
+test: build cpp-test py-test sanitize fuzz-smoke stubs-check
+	@echo "== all test stages passed"
+
+deps: $(VENV)/.deps
+$(VENV)/.deps: requirements-dev.txt
+	@missing=$$(for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	if [ -n "$$missing" ]; then echo "installing: $$missing"; \
+	  $(SUDO) apt-get update -qq && $(SUDO) DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; fi
+	[ -x $(PY) ] || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -r requirements-dev.txt
+	touch $@
+
+# One CMake build serves pip (the extension, installed editable into the venv
+# with the python-can entry point) and ctest (the GoogleTest suites).
+build: deps
+	$(PY) -m pip install -q --no-build-isolation --no-deps -e . \
+	  -Cbuild-dir=$(BUILD) -Ccmake.define.MOTORBUS_TESTS=ON -Ccmake.define.MOTORBUS_BENCH=ON \
+	  -Cbuild.tool-args=-j$(JOBS)
+
+cpp-test: build
+	ctest --test-dir $(BUILD) --output-on-failure
+
+py-test: build
+	$(PY) -m pytest -q -p no:cacheprovider
+
+# C++ suites and the threaded Python tests under ASan+UBSan; C++ suites under TSan.
+sanitize: deps
+	bash tools/sanitize.sh $(PY)
+
+fuzz: deps
+	bash tools/fuzz.sh run 60
+
+fuzz-smoke: deps
+	bash tools/fuzz.sh run 5
+
+bench: build
+	bash tools/bench.sh $(PY)
+
+stubs: build
+	$(PY) tools/gen_stubs.py write
+
+stubs-check: build
+	$(PY) tools/gen_stubs.py check
+
+clean:
+	rm -rf build $(VENV) python/motorbus/_core*.so

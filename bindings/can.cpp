@@ -1,0 +1,154 @@
+// Bindings for cpp/motorbus/can: Frame, Filter, Bus and the bus backends.
+#include <pybind11/functional.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "common.hpp"
+#include "motorbus/can/bus.hpp"
+#include "motorbus/can/frame.hpp"
+#include "motorbus/errors.hpp"
+
+namespace py = pybind11;
+using namespace motorbus;
+using namespace motorbus::can;
+using motorbus::py_helpers::PyCallable;
+using motorbus::py_helpers::seconds_to_ns;
+
+namespace {
+
+py::bytes frame_data(const Frame& f) {
+    auto p = f.payload();
+    return py::bytes(reinterpret_cast<const char*>(p.data()), p.size());
+}
+
+Frame frame_from_py(std::uint32_t id, const py::object& data, bool extended, bool rtr,
+                    const py::object& dlc) {
+    std::string bytes;
+    if (!data.is_none()) {
+        if (py::isinstance<py::bytes>(data) || py::isinstance<py::bytearray>(data) ||
+            py::hasattr(data, "__buffer__") || py::isinstance<py::memoryview>(data)) {
+            bytes = py::bytes(data).cast<std::string>();
+        } else {
+            // any iterable of ints 0..255
+            for (auto item : data) {
+                int v = item.cast<int>();
+                if (v < 0 || v > 255)
+                    throw InvalidArgument("frame data: byte value " + std::to_string(v) +
+                                          " is outside 0-255");
+                bytes.push_back(static_cast<char>(v));
+            }
+        }
+    }
+    int rtr_dlc = dlc.is_none() ? -1 : dlc.cast<int>();
+    if (!rtr && rtr_dlc >= 0 && static_cast<std::size_t>(rtr_dlc) != bytes.size())
+        throw InvalidArgument("frame dlc: " + std::to_string(rtr_dlc) + " does not match " +
+                              std::to_string(bytes.size()) + " data bytes");
+    return Frame::make(id,
+                       std::span(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()),
+                       extended, rtr, rtr_dlc);
+}
+
+py::dict counters_dict(const BusCounters& c) {
+    py::dict d;
+    d["rx_frames"] = c.rx_frames;
+    d["tx_frames"] = c.tx_frames;
+    d["rx_dropped"] = c.rx_dropped;
+    d["tx_dropped"] = c.tx_dropped;
+    d["overruns"] = c.overruns;
+    d["parse_errors"] = c.parse_errors;
+    d["bus_errors"] = c.bus_errors;
+    d["ignored"] = c.ignored;
+    return d;
+}
+
+Filter filter_from_py(const py::handle& h) {
+    // python-can style: {"can_id": .., "can_mask": .., "extended": ..}
+    py::dict d = py::reinterpret_borrow<py::dict>(h);
+    Filter f;
+    f.id = d["can_id"].cast<std::uint32_t>();
+    f.mask = d.contains("can_mask") ? d["can_mask"].cast<std::uint32_t>() : 0x1FFFFFFF;
+    if (d.contains("extended") && !d["extended"].is_none()) {
+        f.match_extended = true;
+        f.extended = d["extended"].cast<bool>();
+    }
+    return f;
+}
+
+}  // namespace
+
+void bind_can(py::module_& m) {
+    py::class_<Frame>(m, "Frame", "A CAN frame. Invalid fields are refused at construction.")
+        .def(py::init(&frame_from_py), py::arg("id"), py::arg("data") = py::bytes(),
+             py::arg("extended") = false, py::arg("rtr") = false, py::arg("dlc") = py::none())
+        .def_readonly("id", &Frame::id)
+        .def_readonly("extended", &Frame::extended)
+        .def_readonly("rtr", &Frame::rtr)
+        .def_property_readonly("dlc", [](const Frame& f) { return f.len; })
+        .def_property_readonly("data", &frame_data)
+        .def_readwrite("timestamp_ns", &Frame::timestamp_ns)
+        .def_readonly("flags", &Frame::flags)
+        .def_property_readonly("is_fd", &Frame::is_fd)
+        .def_property_readonly("is_error", [](const Frame& f) { return bool(f.flags & kFlagError); })
+        .def_property_readonly("is_loopback",
+                               [](const Frame& f) { return bool(f.flags & kFlagLoopback); })
+        .def("__eq__", [](const Frame& a, const Frame& b) { return a.same_content(b); })
+        .def("__hash__", [](const Frame& f) {
+            return py::hash(py::make_tuple(f.id, f.extended, f.rtr, frame_data(f)));
+        })
+        .def("__str__", &Frame::to_string)
+        .def("__repr__", [](const Frame& f) {
+            return "Frame(" + f.to_string() + (f.extended ? ", extended" : "") + ")";
+        });
+    m.def("wire_bits_worst_case", &wire_bits_worst_case, py::arg("frame"),
+          "Bits a classic frame occupies on the wire with worst-case stuffing, incl. intermission.");
+
+    py::class_<Bus, std::shared_ptr<Bus>>(m, "Bus", "A CAN bus endpoint (open one with open_bus).")
+        .def("send",
+             [](Bus& b, const Frame& f, const py::object& timeout) {
+                 auto t = seconds_to_ns(timeout);
+                 py::gil_scoped_release nogil;
+                 b.send(f, t.count() < 0 ? std::chrono::hours(24 * 365) : t);
+             },
+             py::arg("frame"), py::arg("timeout") = 1.0)
+        .def("recv",
+             [](Bus& b, const py::object& timeout) {
+                 auto t = seconds_to_ns(timeout);
+                 py::gil_scoped_release nogil;
+                 return b.recv(t);
+             },
+             py::arg("timeout") = py::none())
+        .def("set_filters",
+             [](Bus& b, const py::object& filters) {
+                 std::vector<Filter> v;
+                 if (!filters.is_none())
+                     for (auto h : filters) v.push_back(filter_from_py(h));
+                 b.set_filters(std::move(v));
+             },
+             py::arg("filters") = py::none())
+        .def("subscribe",
+             [](Bus& b, py::function cb, const py::object& id, const py::object& mask,
+                bool extended) {
+                 PyCallable call(std::move(cb));
+                 FrameCallback fn = [call](const Frame& f) { call(f); };
+                 if (id.is_none()) return b.subscribe(Filter{}, std::move(fn));
+                 if (mask.is_none()) return b.subscribe_id(id.cast<std::uint32_t>(), extended, std::move(fn));
+                 return b.subscribe(Filter{id.cast<std::uint32_t>(), mask.cast<std::uint32_t>(),
+                                           extended, true},
+                                    std::move(fn));
+             },
+             py::arg("callback"), py::arg("id") = py::none(), py::arg("mask") = py::none(),
+             py::arg("extended") = false,
+             "Call callback(frame) on the bus thread for matching frames; returns a handle.")
+        .def("unsubscribe", &Bus::unsubscribe, py::arg("handle"),
+             py::call_guard<py::gil_scoped_release>())
+        .def_property_readonly("state", [](const Bus& b) { return to_string(b.state()); })
+        .def_property_readonly("counters", [](const Bus& b) { return counters_dict(b.counters()); })
+        .def_property_readonly("channel", &Bus::channel)
+        .def_property_readonly("closed", &Bus::closed)
+        .def("close", &Bus::close, py::call_guard<py::gil_scoped_release>())
+        .def("__enter__", [](py::object self) { return self; })
+        .def("__exit__", [](Bus& b, py::args) {
+            py::gil_scoped_release nogil;
+            b.close();
+        });
+}

@@ -1,0 +1,26 @@
+// motorbus._core: one bindings file per C++ area; this file only wires them up.
+// Bindings stay thin: argument conversion, GIL release, nothing else.
+#include <pybind11/pybind11.h>
+
+namespace py = pybind11;
+
+void bind_errors(py::module_& m);
+void bind_runtime(py::module_& m);
+void bind_can(py::module_& m);
+void bind_serial(py::module_& m);
+void bind_canopen(py::module_& m);
+void bind_motion(py::module_& m);
+void bind_arcus(py::module_& m);
+void bind_dmac(py::module_& m);
+
+PYBIND11_MODULE(_core, m) {
+    m.doc() = "motorbus C++ core";
+    bind_errors(m);
+    bind_runtime(m);
+    bind_can(m);
+    bind_serial(m);
+    bind_canopen(m);
+    bind_motion(m);
+    bind_arcus(m);
+    bind_dmac(m);
+}

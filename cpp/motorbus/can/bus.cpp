@@ -1,0 +1,162 @@
+#include "motorbus/can/bus.hpp"
+
+#include <algorithm>
+
+#include "motorbus/errors.hpp"
+
+namespace motorbus::can {
+
+const char* to_string(BusState s) {
+    switch (s) {
+        case BusState::Active: return "active";
+        case BusState::ErrorWarning: return "error-warning";
+        case BusState::ErrorPassive: return "error-passive";
+        case BusState::BusOff: return "bus-off";
+        case BusState::Closed: return "closed";
+    }
+    return "unknown";
+}
+
+Bus::Bus(std::string channel, BusOptions options)
+    : options_(options), channel_(std::move(channel)) {}
+
+Bus::~Bus() {
+    // Derived classes must have called close() in their own destructor, while
+    // their members still exist; this is only a safety net for the base state.
+    closed_.store(true);
+    rx_cv_.notify_all();
+}
+
+void Bus::send(const Frame& frame, Duration timeout) {
+    if (closed_.load()) throw ClosedError("bus " + channel_ + " is closed");
+    if (auto p = frame.problem()) throw InvalidArgument(*p);
+    if (state_.load() == BusState::BusOff)
+        throw LinkDown("bus " + channel_ + " is bus-off: frame not sent");
+    do_send(frame, deadline_after(timeout));
+    tx_frames_.fetch_add(1, std::memory_order_relaxed);
+    if (options_.receive_own) {
+        Frame own = frame;
+        own.flags |= kFlagLoopback;
+        if (own.timestamp_ns == 0) own.timestamp_ns = monotonic_ns();
+        dispatch(own);
+    }
+}
+
+std::optional<Frame> Bus::recv(Duration timeout) {
+    std::unique_lock lock(rx_mutex_);
+    auto ready = [&] { return !rx_queue_.empty() || closed_.load(); };
+    if (timeout.count() < 0) {
+        rx_cv_.wait(lock, ready);
+    } else if (!rx_cv_.wait_for(lock, timeout, ready)) {
+        return std::nullopt;
+    }
+    if (rx_queue_.empty()) throw ClosedError("bus " + channel_ + " is closed");
+    Frame f = rx_queue_.front();
+    rx_queue_.pop_front();
+    return f;
+}
+
+void Bus::set_filters(std::vector<Filter> filters) {
+    std::lock_guard lock(rx_mutex_);
+    filters_ = std::move(filters);
+}
+
+SubscriptionId Bus::add_subscriber(std::shared_ptr<Subscriber> s, bool exact) {
+    std::lock_guard lock(table_mutex_);
+    auto t = std::make_shared<Table>(*table_);
+    if (exact)
+        t->by_id[id_key(s->filter.id, s->filter.extended)].push_back(s);
+    else
+        t->masked.push_back(s);
+    table_ = std::move(t);
+    return s->id;
+}
+
+SubscriptionId Bus::subscribe(const Filter& filter, FrameCallback cb) {
+    auto s = std::make_shared<Subscriber>(Subscriber{next_sub_++, filter, std::move(cb)});
+    const bool exact = filter.match_extended &&
+                       filter.mask == (filter.extended ? kMaxExtendedId : kMaxStandardId);
+    return add_subscriber(std::move(s), exact);
+}
+
+SubscriptionId Bus::subscribe_id(std::uint32_t id, bool extended, FrameCallback cb) {
+    Filter f{id, extended ? kMaxExtendedId : kMaxStandardId, extended, true};
+    return subscribe(f, std::move(cb));
+}
+
+void Bus::unsubscribe(SubscriptionId sid) {
+    {
+        std::lock_guard lock(table_mutex_);
+        auto t = std::make_shared<Table>(*table_);
+        auto drop = [&](std::vector<std::shared_ptr<Subscriber>>& v) {
+            v.erase(std::remove_if(v.begin(), v.end(), [&](auto& s) { return s->id == sid; }),
+                    v.end());
+        };
+        for (auto it = t->by_id.begin(); it != t->by_id.end();) {
+            drop(it->second);
+            it = it->second.empty() ? t->by_id.erase(it) : std::next(it);
+        }
+        drop(t->masked);
+        table_ = std::move(t);
+    }
+    // Wait for an in-flight dispatch on another thread to finish, so the
+    // caller may destroy whatever the callback captured.
+    if (dispatch_thread_.load() != std::this_thread::get_id()) {
+        std::lock_guard wait(dispatch_mutex_);
+    }
+}
+
+void Bus::dispatch(const Frame& frame) {
+    rx_frames_.fetch_add(1, std::memory_order_relaxed);
+    std::shared_ptr<const Table> table;
+    {
+        std::lock_guard lock(table_mutex_);
+        table = table_;
+    }
+    if (!table->by_id.empty() || !table->masked.empty()) {
+        std::lock_guard running(dispatch_mutex_);
+        dispatch_thread_.store(std::this_thread::get_id());
+        if (auto it = table->by_id.find(id_key(frame.id, frame.extended)); it != table->by_id.end())
+            for (auto& s : it->second) s->cb(frame);
+        for (auto& s : table->masked)
+            if (s->filter.matches(frame)) s->cb(frame);
+        dispatch_thread_.store(std::thread::id{});
+    }
+    {
+        std::lock_guard lock(rx_mutex_);
+        if (!filters_.empty() &&
+            std::none_of(filters_.begin(), filters_.end(),
+                         [&](const Filter& f) { return f.matches(frame); }))
+            return;
+        if (rx_queue_.size() >= options_.rx_queue_size) {
+            rx_queue_.pop_front();
+            rx_dropped_.fetch_add(1, std::memory_order_relaxed);
+        }
+        rx_queue_.push_back(frame);
+    }
+    rx_cv_.notify_one();
+}
+
+BusCounters Bus::counters() const {
+    BusCounters c;
+    c.rx_frames = rx_frames_.load();
+    c.tx_frames = tx_frames_.load();
+    c.rx_dropped = rx_dropped_.load();
+    c.tx_dropped = tx_dropped_.load();
+    c.overruns = overruns_.load();
+    c.parse_errors = parse_errors_.load();
+    c.bus_errors = bus_errors_.load();
+    c.ignored = ignored_.load();
+    return c;
+}
+
+void Bus::close() {
+    std::call_once(close_once_, [&] {
+        closed_.store(true);
+        do_close();
+        state_.store(BusState::Closed);
+        rx_cv_.notify_all();
+    });
+}
+
+}  // namespace motorbus::can

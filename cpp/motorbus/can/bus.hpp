@@ -1,0 +1,148 @@
+// The bus every backend implements.
+//
+// A backend (virtual, SLCAN, socketcand, SocketCAN, bridge) only has to
+//   * put frames on its medium in do_send(), blocking until `deadline` when
+//     the medium is full (back-pressure, never a silent drop), and
+//   * call dispatch() from its single receive thread for every frame it gets.
+// The base class owns everything else: acceptance filters, the bounded queue
+// behind recv(), subscribers dispatched by CAN id, counters and bus state.
+#pragma once
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "motorbus/can/frame.hpp"
+
+namespace motorbus::can {
+
+using Duration = std::chrono::nanoseconds;
+using Deadline = std::chrono::steady_clock::time_point;
+inline Deadline deadline_after(Duration d) { return std::chrono::steady_clock::now() + d; }
+
+enum class BusState { Active, ErrorWarning, ErrorPassive, BusOff, Closed };
+const char* to_string(BusState s);
+
+struct BusCounters {
+    std::uint64_t rx_frames = 0;     // frames received from the medium
+    std::uint64_t tx_frames = 0;     // frames handed to the medium
+    std::uint64_t rx_dropped = 0;    // received frames dropped because recv() queue was full
+    std::uint64_t tx_dropped = 0;    // frames the medium lost (fault injection, adapter NACK)
+    std::uint64_t overruns = 0;      // adapter/medium reported overrun or line too long
+    std::uint64_t parse_errors = 0;  // malformed input from the medium, discarded
+    std::uint64_t bus_errors = 0;    // error frames / BEL / error states reported
+    std::uint64_t ignored = 0;       // well-formed input we do not use (status lines etc.)
+};
+
+using FrameCallback = std::function<void(const Frame&)>;
+using SubscriptionId = std::uint64_t;
+
+struct BusOptions {
+    std::size_t rx_queue_size = 65536;  // frames kept for recv(); the oldest is dropped past this
+    bool receive_own = false;           // deliver frames we sent back to recv()/subscribers
+};
+
+class Bus {
+public:
+    explicit Bus(std::string channel, BusOptions options = {});
+    virtual ~Bus();
+    Bus(const Bus&) = delete;
+    Bus& operator=(const Bus&) = delete;
+
+    // Puts `frame` on the bus.  Blocks while the medium is full; throws
+    // TimeoutError when it is still full after `timeout`, InvalidArgument for an
+    // invalid frame, ClosedError after close(), LinkDown when the medium is gone.
+    void send(const Frame& frame, Duration timeout = std::chrono::seconds(1));
+
+    // Next frame that passed the filters, or nullopt after `timeout`
+    // (a negative timeout waits forever).  Throws ClosedError once closed and drained.
+    std::optional<Frame> recv(Duration timeout);
+
+    // Acceptance filters for recv() (subscribers have their own).  Empty = all.
+    void set_filters(std::vector<Filter> filters);
+
+    // Calls `cb` on the bus's receive thread for each frame passing `filter`.
+    // Subscriptions to one exact id are found by hash lookup, so many clients on
+    // one bus cost O(1) per frame.  Callbacks must not block for long.
+    SubscriptionId subscribe(const Filter& filter, FrameCallback cb);
+    SubscriptionId subscribe_id(std::uint32_t id, bool extended, FrameCallback cb);
+    // After it returns, the callback is not running and will not run again
+    // (unless called from inside that very callback).
+    void unsubscribe(SubscriptionId id);
+
+    BusState state() const { return state_.load(); }
+    BusCounters counters() const;
+    const std::string& channel() const { return channel_; }
+    bool closed() const { return closed_.load(); }
+
+    // Stops the backend, wakes every waiter.  Idempotent.
+    void close();
+
+protected:
+    // Backend hooks ----------------------------------------------------------
+    virtual void do_send(const Frame& frame, Deadline deadline) = 0;
+    // Stop I/O and join the receive thread.  Called once, from close().
+    virtual void do_close() = 0;
+
+    // Called from the receive thread for each received frame.
+    void dispatch(const Frame& frame);
+    // Backends must call this at the end of their destructor-initiated close
+    // path; derived destructors call close() themselves (virtual dispatch).
+    void set_state(BusState s) { state_.store(s); }
+
+    // Counter bumps for backends.
+    void count_parse_error() { parse_errors_.fetch_add(1, std::memory_order_relaxed); }
+    void count_overrun() { overruns_.fetch_add(1, std::memory_order_relaxed); }
+    void count_bus_error() { bus_errors_.fetch_add(1, std::memory_order_relaxed); }
+    void count_tx_dropped() { tx_dropped_.fetch_add(1, std::memory_order_relaxed); }
+    void count_ignored() { ignored_.fetch_add(1, std::memory_order_relaxed); }
+
+    const BusOptions options_;
+
+private:
+    struct Subscriber {
+        SubscriptionId id;
+        Filter filter;
+        FrameCallback cb;
+    };
+    struct Table {
+        std::unordered_map<std::uint64_t, std::vector<std::shared_ptr<Subscriber>>> by_id;
+        std::vector<std::shared_ptr<Subscriber>> masked;
+    };
+    static std::uint64_t id_key(std::uint32_t id, bool extended) {
+        return (static_cast<std::uint64_t>(extended) << 32) | id;
+    }
+    SubscriptionId add_subscriber(std::shared_ptr<Subscriber> s, bool exact);
+
+    std::string channel_;
+    std::atomic<BusState> state_{BusState::Active};
+    std::atomic<bool> closed_{false};
+    std::once_flag close_once_;
+
+    // recv() queue
+    std::mutex rx_mutex_;
+    std::condition_variable rx_cv_;
+    std::deque<Frame> rx_queue_;
+    std::vector<Filter> filters_;
+
+    // subscribers: copy-on-write table, read under table_mutex_ by dispatch()
+    std::mutex table_mutex_;
+    std::shared_ptr<const Table> table_ = std::make_shared<Table>();
+    std::recursive_mutex dispatch_mutex_;  // held while callbacks run
+    std::atomic<std::thread::id> dispatch_thread_{};
+    std::atomic<SubscriptionId> next_sub_{1};
+
+    std::atomic<std::uint64_t> rx_frames_{0}, tx_frames_{0}, rx_dropped_{0}, tx_dropped_{0},
+        overruns_{0}, parse_errors_{0}, bus_errors_{0}, ignored_{0};
+};
+
+}  // namespace motorbus::can
