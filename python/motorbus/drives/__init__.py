@@ -1,0 +1,1 @@
+"""Vendor drive clients and simulators, one module per vendor."""
