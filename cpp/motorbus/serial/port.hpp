@@ -118,6 +118,19 @@ struct LineOptions {
     Duration turnaround = Duration::zero();           // RS-485: wait after the request before listening
 };
 
+// What a LineLink has seen since it was created.
+struct LineCounters {
+    std::uint64_t bytes_in = 0;        // read from the port (echo and stale bytes included)
+    std::uint64_t bytes_out = 0;       // written, terminators included
+    std::uint64_t requests = 0;        // transact() + send() calls that wrote
+    std::uint64_t replies = 0;         // lines returned by transact()/read_line()
+    std::uint64_t timeouts = 0;        // transact() calls that got no complete reply
+    std::uint64_t stale_bytes = 0;     // discarded by the flush before a request
+    std::uint64_t overlong_lines = 0;  // replies longer than max_line (ReplyTooLong)
+    std::uint64_t echo_bytes = 0;      // own bytes skipped by echo suppression
+    std::uint64_t echo_mismatches = 0; // expected echo did not arrive as sent
+};
+
 // Request/reply framing on a Port.  One transaction at a time (internally serialized).
 class LineLink {
 public:
@@ -132,6 +145,7 @@ public:
     std::optional<std::string> read_line(Duration timeout);
     const LineOptions& options() const;
     Port& port();
+    LineCounters counters() const;
 
 private:
     struct Impl;
