@@ -149,6 +149,12 @@ std::optional<ErrorCode> classify_error(std::string_view body) {
 // ---- requests ------------------------------------------------------------------
 
 std::string build_request(int address, std::string_view command) {
+    std::string out = format_command(address, command);
+    out += kRequestTerminator;
+    return out;
+}
+
+std::string format_command(int address, std::string_view command) {
     if (address < 0 || address > kMaxAddress)
         throw InvalidArgument("arcus address: " + std::to_string(address) + " not in 0..99");
     if (command.empty() || command.size() > kMaxRequest)
@@ -163,7 +169,6 @@ std::string build_request(int address, std::string_view command) {
     out += static_cast<char>('0' + address / 10);
     out += static_cast<char>('0' + address % 10);
     out += command;
-    out += kRequestTerminator;
     return out;
 }
 

@@ -82,6 +82,8 @@ struct ArcusError : DriveFault {
 // Validates address (0..99) and command (printable ASCII, no CR/NUL/'@', length
 // <= kMaxRequest) and returns "@NN<command>\r".  Throws InvalidArgument.
 std::string build_request(int address, std::string_view command);
+// The same without the terminator (LineLink appends its own).
+std::string format_command(int address, std::string_view command);
 std::string build_query(int address, std::string_view name);
 std::string build_set(int address, std::string_view name, std::int64_t value);
 std::string build_action(int address, std::string_view name);
