@@ -11,6 +11,13 @@ std::string glued(std::string_view name, std::int64_t value) {
     s += std::to_string(value);
     return s;
 }
+// A line no DMX-CAN would send: empty, or holding bytes outside printable ASCII.
+bool is_noise(std::string_view raw) {
+    if (raw.empty()) return true;
+    for (char c : raw)
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) return true;
+    return false;
+}
 }  // namespace
 
 std::string_view home_command(HomeMethod m, int direction) {
@@ -49,20 +56,35 @@ std::string Client::transact(std::string_view command, bool idempotent) {
     for (int i = 0;; ++i) {
         ++counters_.requests;
         std::string raw;
+        Reply reply;
         try {
+            auto timeout = options_.timeout.value_or(link_->options().reply_timeout);
+            auto deadline = std::chrono::steady_clock::now() + timeout;
             raw = link_->transact(request, options_.timeout);
+            // Line noise (baud mismatch, a glitch) ends at some NUL like a reply
+            // does: skip such lines and keep listening for the real reply.
+            for (;;) {
+                if (is_noise(raw)) {
+                    ++counters_.noise_lines;
+                    auto left = deadline - std::chrono::steady_clock::now();
+                    auto next = left.count() > 0 ? link_->read_line(left) : std::nullopt;
+                    if (!next) throw TimeoutError("arcus: no reply to '" + request + "' (only line noise)");
+                    raw = std::move(*next);
+                    continue;
+                }
+                break;
+            }
+            try {
+                reply = parse_reply(raw);
+            } catch (const ProtocolError&) {
+                ++counters_.protocol_errors;
+                throw;
+            }
         } catch (const TimeoutError&) {
             ++counters_.timeouts;
             if (i + 1 >= attempts) throw;
             ++counters_.retries;
             continue;
-        }
-        Reply reply;
-        try {
-            reply = parse_reply(raw);
-        } catch (const ProtocolError&) {
-            ++counters_.protocol_errors;
-            throw;
         }
         if (reply.address && *reply.address != options_.address) {
             // A reply for another device (a late one, or a duplicate address on the line).

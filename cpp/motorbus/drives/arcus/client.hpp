@@ -33,7 +33,8 @@ enum class HomeMethod { H, HL, ZH, Z, L };
 std::string_view home_command(HomeMethod m, int direction);  // "HL+", "Z-", ...
 
 struct ClientCounters {
-    std::uint64_t requests = 0, timeouts = 0, retries = 0, protocol_errors = 0, device_errors = 0;
+    std::uint64_t requests = 0, timeouts = 0, retries = 0, protocol_errors = 0, device_errors = 0,
+                  noise_lines = 0;  // lines of non-printable bytes skipped (A10)
 };
 
 class Client {

@@ -20,9 +20,9 @@ inline constexpr char kRequestTerminator = '\r';
 inline constexpr char kReplyTerminator = '\0';
 inline constexpr int kBroadcast = 0;
 inline constexpr int kMaxAddress = 99;
-// Longest reply the device produces is "?Enable RS-485 Mode" plus a prefix; a
-// reply longer than this is noise, not a slow device.
-inline constexpr std::size_t kMaxReply = 64;
+// Longest reply the device produces is "#NN?" + an echoed command of at most
+// kMaxRequest bytes; a reply longer than this is noise, not a slow device.
+inline constexpr std::size_t kMaxReply = 72;
 // The device echoes unknown commands back in "?<cmd>"; cap what we keep.
 inline constexpr std::size_t kMaxRequest = 64;
 // Largest relative move the controller accepts (Table 11.0, X).

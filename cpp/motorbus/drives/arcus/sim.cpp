@@ -127,7 +127,7 @@ bool plus_in(const State& s, const SimWorld& w, double p) {
 }
 bool latch_in(const State& s) { return bool(s.inputs & 2u) != bool(s.cfg.pol & 64); }
 bool z_in(const SimWorld& w, double p) {
-    double m = std::fmod(p, kStepsPerRev);
+    double m = std::fmod(p - w.z_position, kStepsPerRev);
     if (m < 0) m += kStepsPerRev;
     return m < w.z_width;
 }
@@ -147,9 +147,10 @@ std::optional<double> first_true(double a, double b, F level) {
 }
 
 // Z index crossing (the window is narrow enough to be jumped over in one step).
-std::optional<double> z_fraction(const SimWorld& w, double a, double b) {
-    if (z_in(w, a)) return 0.0;
-    if (b == a) return std::nullopt;
+std::optional<double> z_fraction(const SimWorld& w, double a0, double b0) {
+    if (z_in(w, a0)) return 0.0;
+    if (b0 == a0) return std::nullopt;
+    double a = a0 - w.z_position, b = b0 - w.z_position;
     if (b > a) {
         double m = std::ceil(a / kStepsPerRev) * kStepsPerRev;
         if (m <= b) return (m - a) / (b - a);
@@ -649,7 +650,7 @@ std::string Sim::handle(const Request& req) {
     const std::string& cmd = req.command;
     auto unknown = [&] {
         bool clean = std::all_of(cmd.begin(), cmd.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
-        return clean ? "?" + cmd : std::string("?");
+        return clean && cmd.size() <= kMaxRequest ? "?" + cmd : std::string("?");
     };
     auto pc = parse_command(cmd);
     if (!pc) return unknown();

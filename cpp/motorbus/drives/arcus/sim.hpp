@@ -24,7 +24,8 @@ struct SimWorld {
     double home_lo = 8000, home_hi = 8400;       // home switch actuated inside [lo, hi]
     std::optional<double> minus_limit = -400000;  // actuated at or below
     std::optional<double> plus_limit = 400000;    // actuated at or above
-    double z_width = 1.0;                         // Z index: first z_width steps of each rev
+    double z_position = 1600;                     // a Z index pulse here and every 3200 steps
+    double z_width = 1.0;                         // Z is high for z_width steps from each index
     double start_position = 0;
 };
 
