@@ -82,6 +82,11 @@ Sim::Sim(Clock& clock, SimOptions options)
     power_cycle();
 }
 
+Sim::Sim(std::shared_ptr<Clock> clock, SimOptions options)
+    : Sim((clock ? *clock : throw InvalidArgument("arcus sim: clock is null")), std::move(options)) {
+    clock_owner_ = std::move(clock);
+}
+
 Sim::~Sim() = default;
 
 // ------------------------------------------------------------------------------

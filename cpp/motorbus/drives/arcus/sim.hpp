@@ -42,6 +42,8 @@ struct SimOptions {
 class Sim : public serial::LineDevice {
 public:
     Sim(Clock& clock, SimOptions options = {});
+    // Shares ownership of the clock (bindings, servers that outlive the caller).
+    Sim(std::shared_ptr<Clock> clock, SimOptions options = {});
     ~Sim() override;
 
     std::string on_line(std::string_view line) override;
@@ -71,6 +73,7 @@ public:
 private:
     std::string handle(const Request& req);
     mutable std::mutex mutex_;
+    std::shared_ptr<Clock> clock_owner_;
     Clock& clock_;
     SimOptions options_;
     std::unique_ptr<State> s_;
