@@ -97,7 +97,6 @@ Profile plan_jerk_limited(const State& start, double target, const Limits& lim) 
     // Release any initial acceleration first (not time-optimal when a0 != 0).
     if (start.a != 0) {
         const double t = std::fabs(start.a) / jmax;
-        prof = Profile(State{start.p, start.v, 0, 0});
         prof.append_jump(t, start.v, start.a, start.a > 0 ? -jmax : jmax);
     }
     const State s0 = prof.final_state();
