@@ -14,6 +14,8 @@ void append_ramp(Profile& prof, double dv, double duration, RampShape shape) {
     const State s = prof.final_state();
     if (shape == RampShape::Trapezoid) {
         prof.append_jump(duration, s.v, dv / duration, 0.0);
+    } else if (shape == RampShape::Sin2) {
+        prof.append_sin_ramp(duration, dv);
     } else {
         // Triangular acceleration: same Δv and same distance as the linear ramp.
         const double half = duration / 2;
@@ -69,34 +71,12 @@ Profile stepper_profile(const State& start, double target, double vmax, double a
         const double t_acc = vp >= u ? (vp - u) / accel : (u - vp) / decel;
         const double t_dec = (vp - v_end) / decel;
         const std::size_t n_before = prof.segments().size();
-        if (t_acc > 0) {
-            if (shape == RampShape::Trapezoid) {
-                prof.append_jump(t_acc, s * u, s * (vp - u) / t_acc, 0.0);
-            } else {
-                const double half = t_acc / 2;
-                const double jerk = s * (vp - u) / (half * half);
-                prof.append_jump(half, s * u, 0.0, jerk);
-                prof.append_cubic(half, -jerk);
-            }
-        } else if (cruise > 0) {
-            prof.append_jump(cruise, s * vp, 0.0, 0.0);
-            cruise = 0;
-        } else if (t_dec > 0) {
-            // Neither accelerating nor cruising: the ramp down starts from the jump.
-            if (shape == RampShape::Trapezoid) {
-                prof.append_jump(t_dec, s * vp, -s * (vp - v_end) / t_dec, 0.0);
-            } else {
-                const double half = t_dec / 2;
-                const double jerk = -s * (vp - v_end) / (half * half);
-                prof.append_jump(half, s * vp, 0.0, jerk);
-                prof.append_cubic(half, -jerk);
-            }
-            prof.finish(target, 0.0);
-            return prof;
-        }
+        // The start speed is a jump (a stepper starts at it): set the end state, then ramp.
+        prof.finish(prof.final_state().p, s * u);
+        if (t_acc > 0) append_ramp(prof, s * (vp - u), t_acc, shape);
         if (cruise > 0) prof.append_jump(cruise, s * vp, 0.0, 0.0);
         append_ramp(prof, -s * (vp - v_end), t_dec, shape);
-        if (prof.segments().size() == n_before && vp > 0 && x > 0) {
+        if (prof.segments().size() == n_before && vp > 0 && x > 0 && cruise == 0) {
             // Only a start-speed hop remains (x tiny, no ramps): cover it at vp.
             prof.append_jump(x / vp, s * vp, 0.0, 0.0);
         }
