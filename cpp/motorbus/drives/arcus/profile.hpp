@@ -1,155 +1,122 @@
-// Minimal DMX velocity-profile stepper used by the simulator.
-//
-// ADAPTER: the project's Arcus profile model belongs in motion/ (motion helper);
-// it had not been published when this sim was written, so this is the smallest
-// thing the sim needs: starting at LSPD, ramping to HSPD in ACC ms (linear or
-// S-shaped velocity with the same ramp time, hence the same distance), braking
-// from the current speed to LSPD so a target move ends at LSPD, on-the-fly
-// target (T) and speed (SSPD) changes.  Replace with motion/ when it exists.
+// The simulator's axis: motion::ArcusMotion (the project's DMX profile model:
+// LSPD start, ACC/DEC ramps, S-curve, T and SSPD on the fly, STOP/ABORT,
+// Appendix A adjustment) stepped on the sim's clock, plus what the sim needs
+// on top: a position that counter resets can move, and a "stop here" for
+// events found inside a tick.
 #pragma once
 #include <algorithm>
 #include <cmath>
+
+#include "motorbus/motion/arcus_profile.hpp"
 
 namespace motorbus::arcus::detail {
 
 class Axis {
 public:
     struct Params {
-        double lspd = 100, hspd = 1000;  // units/s
-        double acc_s = 0.3, dec_s = 0.3; // full LSPD<->HSPD swing time
+        double lspd = 100, hspd = 1000;   // units/s (pulses, or counts under StepNLoop)
+        double acc_ms = 300, dec_ms = 300;
+        bool edec = false;
         bool scurve = false;
+        double snl_ratio = 1.0;           // pulses per unit, for the Appendix A windows
+        int sspdm = 0;
     };
-    enum class Mode { Idle, Run, Target };
 
-    double pos = 0;   // units
-    double vel = 0;   // magnitude, units/s
-    int dir = 1;
-    double target = 0;
+    bool busy() const { return active_; }
+    bool accelerating() const { return active_ && m_.phase(t_) == motion::ArcusPhase::Accel; }
+    bool decelerating() const { return active_ && m_.phase(t_) == motion::ArcusPhase::Decel; }
+    bool constant() const { return active_ && m_.phase(t_) == motion::ArcusPhase::Const; }
+    bool stopping() const { return active_ && stopping_; }
+    bool target_move() const { return active_ && m_.target_move(); }
 
-    Mode mode() const { return mode_; }
-    bool busy() const { return mode_ != Mode::Idle; }
-    bool accelerating() const { return busy() && ramping_ && v1_ > v0_; }
-    bool decelerating() const { return busy() && ramping_ && v1_ < v0_; }
-    bool constant() const { return busy() && !ramping_; }
-    bool stopping() const { return stop_after_ramp_; }
-    const Params& params() const { return p_; }
+    double position() const { return active_ ? m_.profile().position(t_) + offset_ : idle_pos_; }
+    double speed() const { return active_ ? std::fabs(m_.profile().velocity(t_)) : 0.0; }
+    // Moves the counter frame (PX=, EX= under StepNLoop, homing zero): the motor stays put.
+    void set_position(double p) {
+        if (active_) offset_ += p - position();
+        else idle_pos_ = p;
+    }
 
     void configure(const Params& p) {
-        p_ = p;
-        double span = std::max(0.0, p_.hspd - p_.lspd);
-        acc_rate_ = p_.acc_s > 0 ? span / p_.acc_s : 0;
-        dec_rate_ = p_.dec_s > 0 ? span / p_.dec_s : 0;
+        motion::ArcusProfileParams ap;
+        ap.snl_ratio = p.snl_ratio > 0 ? p.snl_ratio : 1.0;
+        // arcus_effective refuses speeds outside 1..6 000 000 PPS; the sim
+        // validates HSPD/LSPD itself, so only clamp what unit conversion moved.
+        const double min_units = 1.0 / ap.snl_ratio;
+        const double max_units = 6'000'000.0 / ap.snl_ratio;
+        ap.hspd = std::clamp(p.hspd, min_units, max_units);
+        ap.lspd = std::clamp(p.lspd, 1e-6, ap.hspd);
+        ap.acc_ms = std::max(p.acc_ms, 1e-3);
+        ap.dec_ms = std::max(p.dec_ms, 1e-3);
+        ap.edec = p.edec;
+        ap.scv = p.scurve;
+        m_.set_params(ap);
+        m_.set_sspdm(std::clamp(p.sspdm, 0, 9));
     }
 
-    void run(int d, bool high) {
-        start(d);
-        mode_ = Mode::Run;
-        if (high) ramp_to(p_.hspd, acc_rate_);
-    }
-    void move_to(double t) {
-        if (t == pos) { halt(); return; }
-        start(t > pos ? 1 : -1);
-        mode_ = Mode::Target;
-        target = t;
-        ramp_to(p_.hspd, acc_rate_);
-    }
-    // On-the-fly target change (T): a target behind us means stop, then go back.
-    void retarget(double t) {
-        target = t;
-        if ((t - pos) * dir < 0) {
-            reverse_pending_ = true;
-            decel_stop();
-        } else {
-            reverse_pending_ = false;
-            stop_after_ramp_ = false;
+    // X: returns false when the model refuses the move (above 262143).
+    bool move_to(double target) {
+        double from = position();
+        begin();
+        if (m_.move(from, target) != motion::ArcusReply::Ok) {
+            idle_pos_ = from;
+            return false;
         }
+        active_ = m_.moving(0);
+        if (!active_) idle_pos_ = target;
+        return true;
     }
-    // On-the-fly speed change (SSPD).
-    void change_speed(double new_hspd) {
-        p_.hspd = new_hspd;
-        ramp_to(new_hspd, new_hspd > vel ? acc_rate_ : dec_rate_);
+    // J+/J- (high) or a constant low-speed search (homing).
+    void run(int dir, bool high) {
+        double from = position();
+        begin();
+        if (!high) {
+            motion::ArcusProfileParams ap = m_.effective().params;
+            ap.hspd = ap.lspd;
+            m_.set_params(ap);
+        }
+        m_.jog(from, dir);
+        active_ = true;
     }
+    void set_sspdm(int sspdm) { m_.set_sspdm(std::clamp(sspdm, 0, 9)); }
+    motion::ArcusReply retarget(double target) { return m_.change_target(t_, target - offset_); }
+    motion::ArcusReply change_speed(double hspd) { return m_.change_speed(t_, hspd); }
     void decel_stop() {
-        if (!busy()) return;
-        stop_after_ramp_ = true;
-        ramp_to(p_.lspd, dec_rate_);
+        if (!active_) return;
+        m_.stop(t_);
+        stopping_ = true;
+        if (!m_.moving(t_)) finish();
     }
     void halt() {
-        mode_ = Mode::Idle;
-        vel = 0;
-        ramping_ = false;
-        stop_after_ramp_ = false;
-        reverse_pending_ = false;
+        if (!active_) return;
+        m_.abort(t_);
+        finish();
     }
-
-    // Advances dt seconds.  Returns true when the axis went idle in this step.
+    // Advances dt seconds; true when the motion ended in this step.
     bool step(double dt) {
-        if (!busy()) return false;
-        if (mode_ == Mode::Target && !stop_after_ramp_) {
-            double remaining = (target - pos) * dir;
-            if (remaining <= 0) return finish_at_target();
-            if (!decelerating() && vel > p_.lspd && remaining <= braking_distance() + vel * dt)
-                ramp_to(p_.lspd, dec_rate_);
-        }
-        double v_start = vel;
-        if (ramping_) {
-            tau_ += dt;
-            double u = T_ > 0 ? std::min(1.0, tau_ / T_) : 1.0;
-            double shape = p_.scurve ? u * u * (3 - 2 * u) : u;
-            vel = v0_ + (v1_ - v0_) * shape;
-            if (u >= 1.0) ramping_ = false;
-        }
-        pos += dir * 0.5 * (v_start + vel) * dt;
-        if (mode_ == Mode::Target && !reverse_pending_ && (target - pos) * dir <= 0)
-            return finish_at_target();
-        if (stop_after_ramp_ && !ramping_) {
-            if (reverse_pending_) {
-                double t = target;
-                halt();
-                move_to(t);
-                return !busy();
-            }
-            halt();
-            return true;
-        }
-        return false;
-    }
-
-    double braking_distance() const {
-        if (vel <= p_.lspd || dec_rate_ <= 0) return 0;
-        double t = (vel - p_.lspd) / dec_rate_;
-        return 0.5 * (vel + p_.lspd) * t;
-    }
-
-private:
-    void start(int d) {
-        halt();
-        dir = d >= 0 ? 1 : -1;
-        vel = p_.lspd;
-    }
-    void ramp_to(double v, double rate) {
-        if (rate <= 0 || v == vel) {
-            vel = v;
-            ramping_ = false;
-            return;
-        }
-        v0_ = vel;
-        v1_ = v;
-        T_ = std::abs(v1_ - v0_) / rate;
-        tau_ = 0;
-        ramping_ = true;
-    }
-    bool finish_at_target() {
-        pos = target;
-        halt();
+        if (!active_) return false;
+        t_ += dt;
+        if (m_.moving(t_)) return false;
+        finish();
         return true;
     }
 
-    Params p_;
-    Mode mode_ = Mode::Idle;
-    double acc_rate_ = 0, dec_rate_ = 0;
-    bool ramping_ = false, stop_after_ramp_ = false, reverse_pending_ = false;
-    double v0_ = 0, v1_ = 0, T_ = 0, tau_ = 0;
+private:
+    void begin() {
+        t_ = 0;
+        offset_ = 0;
+        stopping_ = false;
+        active_ = false;
+    }
+    void finish() {
+        idle_pos_ = m_.profile().final_state().p + offset_;
+        active_ = false;
+        stopping_ = false;
+    }
+
+    motion::ArcusMotion m_;
+    double t_ = 0, offset_ = 0, idle_pos_ = 0;
+    bool active_ = false, stopping_ = false;
 };
 
 }  // namespace motorbus::arcus::detail

@@ -103,7 +103,7 @@ int dir_sign(const State& s) { return (s.cfg.pol & 2) ? -1 : 1; }
 std::int64_t encoder(const State& s) {
     return std::llround(s.phys * kCountsPerStep) + s.enc_offset;
 }
-std::int64_t pulse(const State& s) { return std::llround(s.axis.pos); }
+std::int64_t pulse(const State& s) { return std::llround(s.axis.position()); }
 std::int64_t delta(const State& s) { return snl_on(s) ? pulse(s) - encoder(s) : 0; }
 
 bool in_interval(double x, double lo, double hi) { return x >= lo && x <= hi; }
@@ -181,21 +181,21 @@ public:
         detail::Axis::Params p;
         p.hspd = static_cast<double>(hspd_override > 0 ? hspd_override : s.hspd);
         p.lspd = static_cast<double>(std::min(s.lspd, s.hspd));
-        std::int64_t acc = clamp_acc_ms(s.acc, s.hspd, s.lspd);
-        std::int64_t dec = s.edec ? clamp_acc_ms(s.dec, s.hspd, s.lspd) : acc;
-        p.acc_s = acc / 1000.0;
-        p.dec_s = dec / 1000.0;
+        p.acc_ms = static_cast<double>(s.acc);
+        p.dec_ms = static_cast<double>(s.dec);
+        p.edec = s.edec != 0;
         p.scurve = s.scv != 0;
+        p.snl_ratio = snl_on(s) ? 1.0 / kCountsPerStep : 1.0;
+        p.sspdm = static_cast<int>(s.sspdm);
         s.axis.configure(p);
     }
 
     void zero_counters_at(double cmd_at, double phys_at) {
-        s.axis.pos -= cmd_at;
-        s.axis.target -= cmd_at;
+        s.axis.set_position(s.axis.position() - cmd_at);
         s.move_target -= cmd_at;
         s.enc_offset = -std::llround(phys_at * kCountsPerStep);
     }
-    void zero_here() { zero_counters_at(s.axis.pos, s.phys); }
+    void zero_here() { zero_counters_at(s.axis.position(), s.phys); }
 
     void set_error_limit(int dir) {
         (dir > 0 ? s.plus_err : s.minus_err) = true;
@@ -283,8 +283,8 @@ public:
         ++s.attempts;
         // Correction: re-run the remaining distance at low speed from where the
         // encoder says we are.
-        double target = s.axis.pos;
-        s.axis.pos = static_cast<double>(encoder(s));
+        double target = s.axis.position();
+        s.axis.set_position(static_cast<double>(encoder(s)));
         configure_axis(static_cast<double>(std::min(s.lspd, s.hspd)));
         s.job = Job::Correct;
         s.axis.move_to(target);
@@ -293,18 +293,18 @@ public:
 
     // ---- one integration step ----
     void tick(double dt, Nanos now) {
-        double cmd_prev = s.axis.pos, phys_prev = s.phys;
+        double cmd_prev = s.axis.position(), phys_prev = s.phys;
         std::int64_t enc_prev = encoder(s);
         bool stopped = s.axis.step(dt);
-        double dcmd = s.axis.pos - cmd_prev;
+        double dcmd = s.axis.position() - cmd_prev;
         if (s.eo && !s.blocked) s.phys += dcmd * steps_per_unit(s) * dir_sign(s);
         double dphys = s.phys - phys_prev;
         auto cmd_at = [&](double f) { return cmd_prev + f * dcmd; };
         auto phys_at = [&](double f) { return phys_prev + f * dphys; };
         auto stop_at = [&](double f) {
-            s.axis.pos = cmd_at(f);
-            s.phys = phys_at(f);
             s.axis.halt();
+            s.axis.set_position(cmd_at(f));
+            s.phys = phys_at(f);
         };
         const SimWorld& w = o.world;
         int travel = dcmd > 0 ? 1 : (dcmd < 0 ? -1 : 0);
@@ -320,7 +320,7 @@ public:
                     // Limit homing: back off by LCA at high speed, that is zero.
                     s.phase = 1;
                     configure_axis();
-                    s.axis.move_to(s.axis.pos - travel * static_cast<double>(s.cfg.lca));
+                    s.axis.move_to(s.axis.position() - travel * static_cast<double>(s.cfg.lca));
                     if (!s.axis.busy()) finish_limit_homing();
                 } else {
                     set_error_limit(travel);
@@ -345,15 +345,13 @@ public:
                     if (f) {
                         s.phase = 3;  // through the switch at high speed
                         configure_axis();
-                        double here = s.axis.pos;
-                        s.axis.pos = here;
                         s.axis.run(-s.home_dir, true);
                     }
                 } else if (s.job == Job::HomeHL && s.phase == 3) {
                     if (!home_in(s, w, s.phys)) {
                         s.phase = 4;  // then HCA further
                         configure_axis();
-                        s.axis.move_to(s.axis.pos - s.home_dir * static_cast<double>(s.hca));
+                        s.axis.move_to(s.axis.position() - s.home_dir * static_cast<double>(s.hca));
                     }
                 } else if (s.job == Job::HomeHL && s.phase == 5) {
                     auto f = first_true(phys_prev, s.phys, [&](double p) { return home_in(s, w, p); });
@@ -736,7 +734,7 @@ std::string Sim::handle(const Request& req) {
         if (name == "MST") return num(e.mst());
         if (name == "NID") return num(s.cfg.nid);
         if (name == "POL") return num(s.cfg.pol);
-        if (name == "PS") return num(std::llround(s.axis.vel));
+        if (name == "PS") return num(std::llround(s.axis.speed()));
         if (name == "PX") return num(pulse(s));
         if (name == "RT") return num(s.cfg.rt);
         if (name == "RZ") return num(s.rz);
@@ -813,11 +811,11 @@ std::string Sim::handle(const Request& req) {
         if (name == "EOBOOT") return set(s.cfg.eoboot, 0, 1);
         if (name == "EX") {
             s.enc_offset = *v - std::llround(s.phys * kCountsPerStep);
-            if (snl_on(s)) s.axis.pos = static_cast<double>(*v);
+            if (snl_on(s)) s.axis.set_position(static_cast<double>(*v));
             return ok;
         }
         if (name == "PX") {
-            s.axis.pos = static_cast<double>(*v);
+            s.axis.set_position(static_cast<double>(*v));
             if (snl_on(s)) s.enc_offset = *v - std::llround(s.phys * kCountsPerStep);
             return ok;
         }
@@ -842,7 +840,7 @@ std::string Sim::handle(const Request& req) {
             if (*v != s.cfg.sl) {
                 // Position units change: counts with SNL, pulses without.
                 std::int64_t ex = encoder(s);
-                s.axis.pos = *v ? static_cast<double>(ex) : std::round(ex / kCountsPerStep);
+                s.axis.set_position(*v ? static_cast<double>(ex) : std::round(ex / kCountsPerStep));
                 s.snl_err = 0;
             }
             s.cfg.sl = *v;
@@ -862,7 +860,7 @@ std::string Sim::handle(const Request& req) {
         if (name == "X") {
             if (!v) return unknown();
             if (s.minus_err || s.plus_err || s.snl_err) return std::string(error_text(ErrorCode::StateError));
-            double from = s.axis.pos;
+            double from = s.axis.position();
             double target = s.inc_mode ? from + static_cast<double>(*v) : static_cast<double>(*v);
             if (std::abs(target - from) > static_cast<double>(kMaxIncrement)) return unknown();
             e.configure_axis();
@@ -880,18 +878,23 @@ std::string Sim::handle(const Request& req) {
             if (!v) return unknown();
             if (!busy || s.job != Job::Target || s.axis.stopping())
                 return std::string(error_text(ErrorCode::MotorNotMoving));
+            auto r = s.axis.retarget(static_cast<double>(*v));
+            if (r != motion::ArcusReply::Ok) return motion::arcus_reply_text(r);
             s.move_target = static_cast<double>(*v);
-            s.axis.retarget(s.move_target);
             return ok;
         }
         if (name == "SSPD") {
             if (!v || *v <= 0) return std::string(error_text(ErrorCode::BadSspd));
             if (s.scv) return std::string(error_text(ErrorCode::ScvOn));
+            // The window is in PPS; under StepNLoop the value is in counts/s.
+            double pps = static_cast<double>(*v) * (snl_on(s) ? 1.0 / kCountsPerStep : 1.0);
             auto wdw = window_for_sspdm(s.sspdm);
-            if (!wdw || *v < wdw->hspd_min || *v > wdw->hspd_max)
+            if (!wdw || pps < static_cast<double>(wdw->hspd_min) || pps > static_cast<double>(wdw->hspd_max))
                 return std::string(error_text(ErrorCode::SpeedOutOfRange));
             if (!busy || s.axis.stopping()) return std::string(error_text(ErrorCode::BadSspd));
-            s.axis.change_speed(static_cast<double>(*v));
+            s.axis.set_sspdm(static_cast<int>(s.sspdm));
+            auto r = s.axis.change_speed(static_cast<double>(*v));
+            if (r != motion::ArcusReply::Ok) return motion::arcus_reply_text(r);
             return ok;
         }
         return unknown();
