@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "motorbus/drives/arcus/profile.hpp"
+#include "motorbus/motion/stepnloop.hpp"
 
 namespace motorbus::arcus {
 
@@ -56,9 +57,8 @@ struct Sim::State {
     int phase = 0;
     int home_dir = 1;
     double move_target = 0;
-    int snl_err = 0;  // 0 or 8..11
+    motion::StepNLoop snl{motion::SnlConfig{}};  // the position verification state machine (errors 8..11)
     bool minus_err = false, plus_err = false;
-    int attempts = 0;
 
     // The motor and its world.
     double phys = 0;
@@ -199,13 +199,13 @@ public:
 
     void set_error_limit(int dir) {
         (dir > 0 ? s.plus_err : s.minus_err) = true;
-        if (snl_on(s)) s.snl_err = 11;
+        s.snl.limit_hit();
         s.job = Job::None;
     }
 
     int sls() const {
         if (!snl_on(s)) return 12;
-        if (s.snl_err) return s.snl_err;
+        if (s.snl.in_error()) return static_cast<int>(s.snl.status());
         switch (s.job) {
             case Job::None: return 0;
             case Job::Target: return s.axis.stopping() ? 3 : 1;
@@ -237,7 +237,7 @@ public:
     }
 
     bool in_position() const {
-        return snl_on(s) && !s.axis.busy() && !s.snl_err &&
+        return snl_on(s) && !s.axis.busy() && !s.snl.in_error() &&
                std::llabs(delta(s)) <= s.cfg.slt;
     }
 
@@ -245,7 +245,7 @@ public:
         std::int64_t v = s.user_do & 7;
         bool dedicated = snl_on(s) && s.cfg.edo;
         if (dedicated) {
-            v = (v & ~std::int64_t{5}) | (in_position() ? 1 : 0) | (s.snl_err ? 4 : 0);
+            v = (v & ~std::int64_t{5}) | (in_position() ? 1 : 0) | (s.snl.in_error() ? 4 : 0);
         }
         if (s.sync_on) v = (v & ~std::int64_t{2}) | (s.sync_hit ? 2 : 0);
         return v;
@@ -258,33 +258,26 @@ public:
     }
 
     // ---- SNL position verification at the end of a target move / when idle ----
-    void verify_position() {
-        if (!snl_on(s) || s.snl_err) return;
-        std::int64_t d = std::llabs(pulse(s) - encoder(s));
-        bool after_correction = s.attempts > 0;
-        if (d <= s.cfg.slt && !(after_correction && d > s.cfg.slm)) {
-            s.attempts = 0;
-            return;
-        }
-        if (d <= s.cfg.slt && after_correction && d <= s.cfg.slm) {
-            s.attempts = 0;
-            return;
-        }
-        if (d > s.cfg.sle) {
-            s.snl_err = 8;
-            s.attempts = 0;
-            return;
-        }
-        if (s.attempts >= s.cfg.sla) {
-            s.snl_err = 9;
-            s.attempts = 0;
-            return;
-        }
-        ++s.attempts;
-        // Correction: re-run the remaining distance at low speed from where the
-        // encoder says we are.
+    void configure_snl() {
+        motion::SnlConfig c;
+        c.enabled = snl_on(s);
+        c.tolerance = static_cast<std::uint32_t>(s.cfg.slt);
+        c.error_range = static_cast<std::uint32_t>(s.cfg.sle);
+        c.max_attempts = static_cast<std::uint32_t>(s.cfg.sla);
+        c.idle_tolerance = static_cast<std::uint32_t>(s.cfg.slm);
+        c.ratio = 1.0 / kCountsPerStep;
+        s.snl.configure(c);
+    }
+
+    // Table 7.7, motor idle: in position, a correction move, or an error.
+    void verify_position(bool idle = false) {
+        if (!snl_on(s)) return;
+        double delta = static_cast<double>(pulse(s) - encoder(s));
+        auto d = idle ? s.snl.idle_check(delta) : s.snl.motion_done(delta);
+        if (d.action != motion::SnlAction::Correct) return;
+        // Re-run the remaining distance at low speed from where the encoder says we are.
         double target = s.axis.position();
-        s.axis.set_position(static_cast<double>(encoder(s)));
+        s.axis.set_position(target - d.correction);
         configure_axis(static_cast<double>(std::min(s.lspd, s.hspd)));
         s.job = Job::Correct;
         s.axis.move_to(target);
@@ -384,10 +377,9 @@ public:
         if (s.sync_on && !s.sync_hit) check_sync(enc_prev, encoder(s));
 
         // Delta monitoring while moving.
-        if (snl_on(s) && s.axis.busy() && !s.snl_err &&
-            std::llabs(pulse(s) - encoder(s)) > s.cfg.sle) {
-            s.axis.halt();
-            s.snl_err = 10;
+        if (snl_on(s) && s.axis.busy() &&
+            s.snl.monitor(static_cast<double>(pulse(s) - encoder(s))).action == motion::SnlAction::StopNow) {
+            s.axis.halt();  // stall error (10)
             s.job = Job::None;
         }
         if (stopped || !s.axis.busy()) after_motion(now);
@@ -422,6 +414,12 @@ public:
     void after_motion(Nanos now) {
         if (s.axis.busy()) return;
         s.idle_since = now;
+        const bool verifying = s.job == Job::Target || s.job == Job::Correct;
+        dispatch_stop();
+        if (s.job == Job::None && !verifying) s.snl.end_without_verification();
+    }
+
+    void dispatch_stop() {
         switch (s.job) {
             case Job::None:
                 break;
@@ -550,6 +548,7 @@ void Sim::power_cycle() {
     s.user_do = s.cfg.doboot & 7;
     s.enc_offset = -std::llround(s.phys * kCountsPerStep);  // counters start at 0
     s.t = clock_.now();
+    SimEngine(s, options_).configure_snl();
     s.idle_since = s.t - s.cfg.curt * 1'000'000 - 1;
 }
 
@@ -596,7 +595,7 @@ void Sim::set_blocked(bool blocked) {
 void Sim::disturb(double steps) {
     MOTORBUS_ARCUS_SYNC();
     s_->phys += steps;
-    if (!s_->axis.busy() && s_->job == Job::None) e.verify_position();
+    if (!s_->axis.busy() && s_->job == Job::None) e.verify_position(/*idle=*/true);
 }
 
 double Sim::physical_position() const {
@@ -672,12 +671,15 @@ std::string Sim::handle(const Request& req) {
     auto in = [&](std::int64_t lo, std::int64_t hi) { return v && *v >= lo && *v <= hi; };
 
     auto start_move = [&](Job job, int dir) -> std::string {
-        if (s.minus_err || s.plus_err || s.snl_err) return std::string(error_text(ErrorCode::StateError));
+        if (s.minus_err || s.plus_err || s.snl.in_error()) return std::string(error_text(ErrorCode::StateError));
         e.configure_axis();
         s.job = job;
         s.phase = 0;
         s.home_dir = dir;
-        s.attempts = 0;
+        s.snl.begin(job == Job::Jog     ? motion::SnlActivity::Jog
+                    : job == Job::HomeZ ? motion::SnlActivity::ZHome
+                    : job == Job::HomeL ? motion::SnlActivity::LimitHome
+                                        : motion::SnlActivity::Home);
         switch (job) {
             case Job::Jog:
             case Job::HomeH:
@@ -841,15 +843,32 @@ std::string Sim::handle(const Request& req) {
                 // Position units change: counts with SNL, pulses without.
                 std::int64_t ex = encoder(s);
                 s.axis.set_position(*v ? static_cast<double>(ex) : std::round(ex / kCountsPerStep));
-                s.snl_err = 0;
             }
             s.cfg.sl = *v;
+            e.configure_snl();
+            s.snl.clear();
             return ok;
         }
-        if (name == "SLA") return set(s.cfg.sla, 0, INT32_MAX);
-        if (name == "SLE") return set(s.cfg.sle, 0, INT32_MAX);
-        if (name == "SLM") return set(s.cfg.slm, 0, INT32_MAX);
-        if (name == "SLT") return set(s.cfg.slt, 0, INT32_MAX);
+        if (name == "SLA") {
+            auto r = set(s.cfg.sla, 0, INT32_MAX);
+            e.configure_snl();
+            return r;
+        }
+        if (name == "SLE") {
+            auto r = set(s.cfg.sle, 0, INT32_MAX);
+            e.configure_snl();
+            return r;
+        }
+        if (name == "SLM") {
+            auto r = set(s.cfg.slm, 0, INT32_MAX);
+            e.configure_snl();
+            return r;
+        }
+        if (name == "SLT") {
+            auto r = set(s.cfg.slt, 0, INT32_MAX);
+            e.configure_snl();
+            return r;
+        }
         if (name == "SSPDM") return set(s.sspdm, 0, 9);
         if (name == "SYNC") return set(s.sync_cond, 1, 3);
         if (name == "SYNP") return set(s.synp, -kSyncMax - 1, kSyncMax);
@@ -859,13 +878,13 @@ std::string Sim::handle(const Request& req) {
     if (pc->op == Op::Argument) {
         if (name == "X") {
             if (!v) return unknown();
-            if (s.minus_err || s.plus_err || s.snl_err) return std::string(error_text(ErrorCode::StateError));
+            if (s.minus_err || s.plus_err || s.snl.in_error()) return std::string(error_text(ErrorCode::StateError));
             double from = s.axis.position();
             double target = s.inc_mode ? from + static_cast<double>(*v) : static_cast<double>(*v);
             if (std::abs(target - from) > static_cast<double>(kMaxIncrement)) return unknown();
             e.configure_axis();
             s.job = Job::Target;
-            s.attempts = 0;
+            s.snl.begin(motion::SnlActivity::Move);
             s.move_target = target;
             s.axis.move_to(target);
             if (!s.axis.busy()) {
@@ -904,8 +923,7 @@ std::string Sim::handle(const Request& req) {
     if (name == "ABORT") {
         s.axis.halt();
         s.job = Job::None;
-        if (s.snl_err != 11) s.snl_err = 0;
-        s.attempts = 0;
+        if (s.snl.status() != motion::SnlStatus::LimitError) s.snl.clear();
         s.idle_since = now;
         return ok;
     }
@@ -919,13 +937,11 @@ std::string Sim::handle(const Request& req) {
     }
     if (name == "CLR") {
         s.minus_err = s.plus_err = false;
-        s.snl_err = 0;
-        s.attempts = 0;
+        s.snl.clear();
         return ok;
     }
     if (name == "CLRS") {
-        if (s.snl_err != 11) s.snl_err = 0;
-        s.attempts = 0;
+        if (s.snl.status() != motion::SnlStatus::LimitError) s.snl.clear();
         return ok;
     }
     if (name == "ABS") { s.inc_mode = 0; return ok; }
