@@ -147,8 +147,13 @@ void bind_arcus(py::module_& m) {
             return out;
         },
         "The command table (Table 11.0 plus the commands the sections describe).");
-    m.def("arcus_max_acc_ms", &max_acc_ms, py::arg("hspd"), py::arg("lspd"));
-    m.def("arcus_min_acc_ms", &min_acc_ms, py::arg("hspd"));
+    m.def(
+        "arcus_acc_range", [](std::int64_t hspd, std::int64_t lspd) {
+            return std::make_pair(min_acc_ms(hspd), max_acc_ms(hspd, lspd));
+        },
+        py::arg("hspd"), py::arg("lspd"),
+        "(min, max) ACC in ms the drive accepts for HSPD/LSPD (Table A.0; max truncated to 10 ms like the "
+        "manual's examples).");
 
     py::class_<Sim, serial::LineDevice, std::shared_ptr<Sim>>(
         m, "ArcusSim", "A simulated Arcus DMX-CAN answering ASCII lines (a LineDevice for PtyLineServer).")

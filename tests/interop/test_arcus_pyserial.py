@@ -136,3 +136,58 @@ def test_a1_half_a_request_then_a_full_one(line):
     # "@01P" is an unknown command: the device answers "?P" first.
     assert read_reply(port) == b"?P\0"
     assert read_reply(port) == b"DriveMax-CAN\0"
+
+
+def _mst(port) -> int:
+    port.write(b"@01MST\r")
+    return int(read_reply(port)[:-1])
+
+
+def test_mst_examples_of_the_manual(line):
+    """0 idle; 2 accelerating; 9 constant speed with the home input on; 64 minus limit error."""
+    sim, clock, port = line
+    examples = {int(k): v for k, v in ARCUS["mst_examples"].items()}
+    assert set(examples) == {0, 2, 9, 64}
+    for cmd in (b"@01SL=0\r", b"@01EO=1\r", b"@01HSPD=1000\r", b"@01ACC=100\r"):
+        port.write(cmd)
+        assert read_reply(port) == b"OK\0"
+    assert _mst(port) == 0
+    port.write(b"@01J+\r")
+    assert read_reply(port) == b"OK\0"
+    clock.advance(50_000_000)
+    assert _mst(port) == 2
+    clock.advance(8_100_000_000)  # about 8100 steps: inside the home switch (8000..8400)
+    assert _mst(port) == 9
+    port.write(b"@01ABORT\r")
+    assert read_reply(port) == b"OK\0"
+    sim.force_home(False)  # stopped on the switch; 64 is the limit error alone
+    sim.force_limit(-1, True)
+    port.write(b"@01J-\r")
+    assert read_reply(port) == b"OK\0"
+    clock.advance(1_000_000)
+    sim.force_limit(-1, False)
+    assert _mst(port) == 64
+
+
+@pytest.mark.parametrize("ex", ARCUS["accel_limits_examples"], ids=lambda e: f"HSPD{e['HSPD']}")
+def test_appendix_a_accel_examples(line, ex):
+    assert core.arcus_acc_range(ex["HSPD"], ex["LSPD"]) == (ex["min_acc_ms"], ex["max_acc_ms"])
+    # The simulator adjusts ACC into that range, as the manual says.
+    _, _, port = line
+    for cmd in (f"@01HSPD={ex['HSPD']}\r", f"@01LSPD={ex['LSPD']}\r", "@01ACC=999999\r"):
+        port.write(cmd.encode())
+        assert read_reply(port) == b"OK\0"
+    port.write(b"@01ACC\r")
+    assert read_reply(port) == f"{ex['max_acc_ms']}\0".encode()
+
+
+@pytest.mark.parametrize("w", ARCUS["speed_windows_appendix_a"], ids=lambda w: w["hspd_pps"])
+def test_appendix_a_windows(w):
+    lo_text = w["hspd_pps"].split("-")[0]
+    scale = {"K": 1_000, "M": 1_000_000}
+    lo = float(lo_text[:-1]) * scale[lo_text[-1]] if lo_text[-1] in scale else float(lo_text)
+    hspd = int(lo) + 1
+    lo_ms, hi_ms = core.arcus_acc_range(hspd, w["min_lspd"])
+    assert lo_ms == w["min_acc_ms"]
+    # max ACC = ((HSPD - LSPD) / delta) x 1000 ms (truncated to 10 ms, as the manual's example).
+    assert hi_ms == max(lo_ms, (hspd - w["min_lspd"]) * 100 // w["delta"] * 10)
