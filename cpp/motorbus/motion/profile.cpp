@@ -49,6 +49,7 @@ State Segment::at(double t) const {
 Profile::Profile(State initial) : initial_(initial), final_(initial) {
     initial_.j = 0;
     final_.j = 0;
+    segments_.reserve(8);  // one allocation covers every planner's usual 3-9 segments
 }
 
 State Profile::end_state_() const {
@@ -70,7 +71,6 @@ Profile& Profile::append_jump(double duration, double v, double a, double jerk) 
     seg.duration = duration;
     seg.start = State{final_.p, v, a, jerk};
     segments_.push_back(seg);
-    starts_.push_back(seg.t0);
     duration_ += duration;
     final_ = seg.end();
     final_.j = 0;
@@ -88,7 +88,6 @@ Profile& Profile::append_exp_approach(double duration, double target, double tau
     seg.p_end = target;
     seg.start = seg.at(0);
     segments_.push_back(seg);
-    starts_.push_back(seg.t0);
     duration_ += duration;
     final_ = seg.end();
     final_.j = 0;
@@ -106,7 +105,6 @@ Profile& Profile::append_sin_ramp(double duration, double dv) {
     seg.tau = duration;  // the ramp's own length: truncation must not reshape it
     seg.start = State{e.p, e.v, 0, 0};
     segments_.push_back(seg);
-    starts_.push_back(seg.t0);
     duration_ += duration;
     final_ = seg.end();
     final_.j = 0;
@@ -131,7 +129,6 @@ Profile& Profile::append(const Profile& tail) {
         c.start.p += shift;
         if (c.kind == Segment::Kind::ExpApproach) c.p_end += shift;
         segments_.push_back(c);
-        starts_.push_back(c.t0);
         duration_ += c.duration;
     }
     final_ = tail.final_;
@@ -148,7 +145,6 @@ Profile Profile::truncated(double t) const {
         Segment c = s;
         if (c.t0 + c.duration > t) c.duration = t - c.t0;
         out.segments_.push_back(c);
-        out.starts_.push_back(c.t0);
         out.duration_ = c.t0 + c.duration;
     }
     if (out.segments_.empty()) {
@@ -174,9 +170,10 @@ Profile Profile::shifted_position(double dp) const {
 
 std::size_t Profile::segment_index(double t) const {
     if (segments_.empty() || t >= duration_) return segments_.size();
-    auto it = std::upper_bound(starts_.begin(), starts_.end(), t);
-    if (it == starts_.begin()) return 0;
-    return static_cast<std::size_t>(it - starts_.begin()) - 1;
+    auto it = std::upper_bound(segments_.begin(), segments_.end(), t,
+                               [](double x, const Segment& s) { return x < s.t0; });
+    if (it == segments_.begin()) return 0;
+    return static_cast<std::size_t>(it - segments_.begin()) - 1;
 }
 
 State Profile::at(double t) const {
