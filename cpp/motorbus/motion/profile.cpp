@@ -49,7 +49,7 @@ State Segment::at(double t) const {
 Profile::Profile(State initial) : initial_(initial), final_(initial) {
     initial_.j = 0;
     final_.j = 0;
-    segments_.reserve(8);  // one allocation covers every planner's usual 3-9 segments
+    segments_.reserve(8);  // one allocation covers the usual 3-9 segments
 }
 
 State Profile::end_state_() const {
