@@ -127,7 +127,9 @@ int main() {
         // 1e6 microsteps: trapezoid (closed-form segments) and jerk-limited (cubic segments).
         Profile trap = plan_trapezoid(State{0, 0, 0, 0}, 1e6, Limits{50000, 200000, 0, 0});
         Profile jerk = plan_jerk_limited(State{0, 0, 0, 0}, 1e6, Limits{50000, 200000, 0, 2e6});
-        for (auto [name, prof] : {std::pair{"trapezoid", &trap}, std::pair{"jerk-limited", &jerk}}) {
+        for (auto item : {std::pair{"trapezoid", &trap}, std::pair{"jerk-limited", &jerk}}) {
+            const char* name = item.first;
+            const Profile* prof = item.second;
             double best = 1e30;
             std::size_t n = 0;
             for (int rep = 0; rep < 3; ++rep)
