@@ -41,9 +41,11 @@ State Segment::at(double t) const {
         return State{start.p + start.v * t + A / 2 * (t * t / 2 + (cwt - 1) / (w * w)),
                      start.v + A / 2 * (t - swt / w), A / 2 * (1 - cwt), A / 2 * w * swt};
     }
+    // Multiplications by constants: a division here would be the planners' hottest instruction.
+    constexpr double kSixth = 1.0 / 6.0;
     const double j = start.j;
-    return State{start.p + t * (start.v + t * (start.a / 2 + t * j / 6)),
-                 start.v + t * (start.a + t * j / 2), start.a + t * j, j};
+    return State{start.p + t * (start.v + t * (start.a * 0.5 + t * j * kSixth)),
+                 start.v + t * (start.a + t * j * 0.5), start.a + t * j, j};
 }
 
 Profile::Profile(State initial) : initial_(initial), final_(initial) {
