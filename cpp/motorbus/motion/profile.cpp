@@ -172,6 +172,13 @@ Profile Profile::shifted_position(double dp) const {
 
 std::size_t Profile::segment_index(double t) const {
     if (segments_.empty() || t >= duration_) return segments_.size();
+    if (segments_.size() <= 16) {
+        // Short profiles (every planner's): a branch-free count beats a
+        // binary search whose branches a random t mispredicts.
+        std::size_t n = 0;
+        for (std::size_t i = 1; i < segments_.size(); ++i) n += static_cast<std::size_t>(t >= segments_[i].t0);
+        return n;
+    }
     auto it = std::upper_bound(segments_.begin(), segments_.end(), t,
                                [](double x, const Segment& s) { return x < s.t0; });
     if (it == segments_.begin()) return 0;
