@@ -156,4 +156,70 @@ Profile plan_jerk_limited(const State& start, double target, const Limits& lim) 
     return prof;
 }
 
+std::vector<Profile> plan_synchronized_jerk_limited(const std::vector<double>& start,
+                                                    const std::vector<double>& target,
+                                                    const std::vector<Limits>& limits) {
+    if (start.size() != target.size() || start.size() != limits.size() || start.empty())
+        throw InvalidArgument("multi-axis: start, target and limits need the same non-zero length");
+    std::vector<Profile> out;
+    out.reserve(start.size());
+    double T = 0;
+    for (std::size_t i = 0; i < start.size(); ++i) {
+        out.push_back(plan_jerk_limited(State{start[i], 0, 0, 0}, target[i], limits[i]));
+        T = std::max(T, out.back().duration());
+    }
+    for (std::size_t i = 0; i < start.size(); ++i) {
+        const double D = std::fabs(target[i] - start[i]);
+        if (out[i].duration() >= T) continue;
+        const double a = limits[i].max_acceleration, j = limits[i].max_jerk;
+        const Shape sh{a, j, a * a / j};
+        if (D == 0) {
+            Profile p(State{start[i], 0, 0, 0});
+            p.append_cubic(T, 0.0);
+            p.finish(target[i], 0);
+            out[i] = p;
+            continue;
+        }
+        // Rest to rest with peak vp: duration T(vp) + D/vp (two ramps, cruise (D - vp T(vp))/vp).
+        // Take the slow root (cruise >= 0), decreasing in vp.
+        double vp;
+        {
+            // Ramps reaching amax: vp^2/a + (a/j - T) vp + D = 0.
+            const double b = a / j - T;
+            const double disc = b * b - 4 * D / a;
+            const double q = disc >= 0 ? (-b - std::sqrt(disc)) * a / 2 : -1;  // smaller root
+            if (q >= sh.dv_full) {
+                vp = q;
+            } else {
+                // Ramps below amax: 2 sqrt(vp/j) + D/vp = T, vp < dv_full: Newton from the left.
+                double lo = 0, hi = std::min(sh.dv_full, std::max(q, sh.dv_full));
+                double v = std::min(D / T, hi * 0.5);
+                for (int it = 0; it < 100; ++it) {
+                    const double g = sh.T(v) + D / v - T;  // > 0 below the root
+                    if (g > 0) lo = v;
+                    else hi = v;
+                    const double dg = 1 / std::sqrt(j * v) - D / (v * v);
+                    double vn = dg < 0 ? v - g / dg : 0.5 * (lo + hi);
+                    if (!(vn > lo && vn < hi)) vn = 0.5 * (lo + hi);
+                    if (std::fabs(vn - v) <= 1e-15 * v) {
+                        v = vn;
+                        break;
+                    }
+                    v = vn;
+                }
+                vp = v;
+            }
+        }
+        const double s = target[i] >= start[i] ? 1.0 : -1.0;
+        Profile p(State{start[i], 0, 0, 0});
+        append_ramp(p, 0, s * vp, a, j);
+        const double cruise = T - 2 * sh.T(vp);
+        if (cruise > 0) p.append_cubic(cruise, 0.0);
+        append_ramp(p, s * vp, 0, a, j);
+        p.finish(target[i], 0);
+        out[i] = p;
+    }
+    return out;
+}
+
 }  // namespace motorbus::motion
