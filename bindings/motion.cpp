@@ -9,6 +9,9 @@
 #include <pybind11/stl.h>
 
 #include "motorbus/motion/arcus_profile.hpp"
+#include "motorbus/motion/cia402_profile.hpp"
+#include "motorbus/motion/pmc007_profile.hpp"
+#include "motorbus/motion/unitek_profile.hpp"
 #include "motorbus/motion/dmac_profile.hpp"
 #include "motorbus/motion/homing.hpp"
 #include "motorbus/motion/motor_model.hpp"
@@ -278,4 +281,175 @@ class LimitExceeded(InvalidArgument):
         .def_property_readonly("status", [](const StepNLoop& s) { return static_cast<int>(s.status()); })
         .def_property_readonly("status_name", [](const StepNLoop& s) { return snl_status_name(s.status()); })
         .def_property_readonly("attempts", &StepNLoop::attempts);
+
+    // ---- PMC007, CiA 402, UNITEK ------------------------------------------------
+    m.def("pmc007_gear_acceleration", &pmc007_gear_acceleration, py::arg("gear"));
+    m.def("pmc007_microsteps", &pmc007_microsteps, py::arg("setting"));
+    m.def("pmc007_convert_position", &pmc007_convert_position, py::arg("position"), py::arg("from_setting"),
+          py::arg("to_setting"));
+    py::class_<Pmc007ProfileParams>(m, "Pmc007ProfileParams")
+        .def(py::init([](double speed, double start_speed, double stop_speed, int ag, int dg, int micro) {
+                 Pmc007ProfileParams p{speed, start_speed, stop_speed, ag, dg, micro};
+                 p.validate();
+                 return p;
+             }),
+             py::arg("speed") = 1000.0, py::arg("start_speed") = 400.0, py::arg("stop_speed") = 0.0,
+             py::arg("accel_gear") = 0, py::arg("decel_gear") = 0, py::arg("microstepping") = 0)
+        .def_readwrite("speed", &Pmc007ProfileParams::speed)
+        .def_readwrite("start_speed", &Pmc007ProfileParams::start_speed)
+        .def_readwrite("stop_speed", &Pmc007ProfileParams::stop_speed)
+        .def_readwrite("accel_gear", &Pmc007ProfileParams::accel_gear)
+        .def_readwrite("decel_gear", &Pmc007ProfileParams::decel_gear)
+        .def_readwrite("microstepping", &Pmc007ProfileParams::microstepping);
+    m.def("pmc007_position_profile", &pmc007_position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
+    m.def("pmc007_speed_profile", &pmc007_speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
+          py::arg("hold") = 0.0);
+
+    py::class_<Cia402ProfileParams>(m, "Cia402ProfileParams")
+        .def(py::init([](double v, double a, double d, double qs, int type, double vmax) {
+                 Cia402ProfileParams p;
+                 p.profile_velocity = v;
+                 p.profile_acceleration = a;
+                 p.profile_deceleration = d;
+                 p.quick_stop_deceleration = qs;
+                 p.motion_profile_type = static_cast<std::int16_t>(type);
+                 p.max_profile_velocity = vmax;
+                 p.validate();
+                 return p;
+             }),
+             py::arg("profile_velocity") = 1000.0, py::arg("profile_acceleration") = 10000.0,
+             py::arg("profile_deceleration") = 10000.0, py::arg("quick_stop_deceleration") = 100000.0,
+             py::arg("motion_profile_type") = 0, py::arg("max_profile_velocity") = 0.0)
+        .def_readwrite("profile_velocity", &Cia402ProfileParams::profile_velocity)
+        .def_readwrite("profile_acceleration", &Cia402ProfileParams::profile_acceleration)
+        .def_readwrite("profile_deceleration", &Cia402ProfileParams::profile_deceleration)
+        .def_readwrite("quick_stop_deceleration", &Cia402ProfileParams::quick_stop_deceleration)
+        .def_readwrite("motion_profile_type", &Cia402ProfileParams::motion_profile_type)
+        .def_readwrite("max_profile_velocity", &Cia402ProfileParams::max_profile_velocity);
+    m.def("cia402_position_profile", &cia402_position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
+    m.def("cia402_velocity_profile", &cia402_velocity_profile, py::arg("start"), py::arg("target_velocity"),
+          py::arg("params"), py::arg("hold") = 0.0);
+    m.def("cia402_quick_stop_profile", &cia402_quick_stop_profile, py::arg("start"), py::arg("params"));
+    py::class_<Cia402ProfilePosition>(m, "Cia402ProfilePosition")
+        .def(py::init<Cia402ProfileParams, double>(), py::arg("params") = Cia402ProfileParams{}, py::arg("position") = 0.0)
+        .def("new_setpoint", &Cia402ProfilePosition::new_setpoint, py::arg("t"), py::arg("target"),
+             py::arg("relative") = false, py::arg("change_immediately") = false, py::arg("change_on_setpoint") = false)
+        .def("halt", &Cia402ProfilePosition::halt, py::arg("t"))
+        .def_property_readonly("profile", &Cia402ProfilePosition::profile, py::return_value_policy::copy)
+        .def("target_reached", &Cia402ProfilePosition::target_reached, py::arg("t"))
+        .def_property_readonly("setpoint_pending", &Cia402ProfilePosition::setpoint_pending);
+
+    py::class_<UnitekRampParams>(m, "UnitekRampParams")
+        .def(py::init([](double nmax, double acc, double dec) {
+                 UnitekRampParams p{nmax, acc, dec};
+                 p.validate();
+                 return p;
+             }),
+             py::arg("n_max_rpm") = 3000.0, py::arg("acc_ramp_ms") = 1000.0, py::arg("dec_ramp_ms") = 1000.0)
+        .def_readwrite("n_max_rpm", &UnitekRampParams::n_max_rpm)
+        .def_readwrite("acc_ramp_ms", &UnitekRampParams::acc_ramp_ms)
+        .def_readwrite("dec_ramp_ms", &UnitekRampParams::dec_ramp_ms);
+    m.def("unitek_speed_profile", &unitek_speed_profile, py::arg("start"), py::arg("speed_num"), py::arg("params"),
+          py::arg("hold") = 0.0);
+
+    // ---- motor model and homing -------------------------------------------------
+    py::class_<SwitchConfig>(m, "SwitchConfig")
+        .def(py::init([](bool present, double lo, double hi, bool active_low) { return SwitchConfig{present, lo, hi, active_low}; }),
+             py::arg("present") = true, py::arg("lo") = 0.0, py::arg("hi") = 0.0, py::arg("active_low") = true)
+        .def_readwrite("present", &SwitchConfig::present)
+        .def_readwrite("lo", &SwitchConfig::lo)
+        .def_readwrite("hi", &SwitchConfig::hi)
+        .def_readwrite("active_low", &SwitchConfig::active_low);
+    py::class_<MotorConfig>(m, "MotorConfig")
+        .def(py::init<>())
+        .def_readwrite("steps_per_rev", &MotorConfig::steps_per_rev)
+        .def_readwrite("counts_per_rev", &MotorConfig::counts_per_rev)
+        .def_readwrite("index_position", &MotorConfig::index_position)
+        .def_readwrite("index_width_steps", &MotorConfig::index_width_steps)
+        .def_readwrite("home", &MotorConfig::home)
+        .def_readwrite("minus_limit", &MotorConfig::minus_limit)
+        .def_readwrite("plus_limit", &MotorConfig::plus_limit)
+        .def_readwrite("pull_out_speed", &MotorConfig::pull_out_speed)
+        .def_readwrite("max_acceleration", &MotorConfig::max_acceleration)
+        .def_readwrite("tick_ns", &MotorConfig::tick_ns);
+    py::class_<MotorModel>(m, "MotorModel")
+        .def(py::init([](std::shared_ptr<Clock> clock, MotorConfig cfg) {
+                 if (!clock) throw InvalidArgument("MotorModel needs a clock");
+                 return std::make_unique<MotorModel>(*clock, cfg);
+             }),
+             py::arg("clock"), py::arg("config") = MotorConfig{}, py::keep_alive<1, 2>())
+        .def("command", [](MotorModel& mm, const Profile& p, std::optional<Nanos> start) { mm.command(p, start); },
+             py::arg("profile"), py::arg("start_ns") = py::none())
+        .def("halt", [](MotorModel& mm) { mm.halt(); })
+        .def("update", &MotorModel::update)
+        .def("advance_to", &MotorModel::advance_to, py::arg("t_ns"))
+        .def("add_listener", [](MotorModel& mm, std::function<void(py::dict)> cb) {
+            return mm.add_listener([cb](const MotorEvent& e) {
+                static const char* names[] = {"home_on", "home_off", "minus_limit_on", "minus_limit_off",
+                                              "plus_limit_on", "plus_limit_off", "index", "stalled",
+                                              "recovered", "latched", "profile_done"};
+                py::dict d;
+                d["kind"] = names[static_cast<int>(e.kind)];
+                d["t_ns"] = e.t;
+                d["physical"] = e.physical;
+                d["pulse"] = e.pulse;
+                d["encoder"] = e.encoder;
+                d["direction"] = e.direction;
+                cb(d);
+            });
+        }, py::arg("callback"), "callback(dict) for every event, called from update().")
+        .def("remove_listener", &MotorModel::remove_listener)
+        .def_property_readonly("moving", &MotorModel::moving)
+        .def_property_readonly("pulse_position", &MotorModel::pulse_position)
+        .def_property_readonly("pulse_count", &MotorModel::pulse_count)
+        .def_property_readonly("physical_position", &MotorModel::physical_position)
+        .def_property_readonly("encoder", &MotorModel::encoder)
+        .def_property_readonly("velocity", &MotorModel::velocity)
+        .def_property_readonly("commanded_velocity", &MotorModel::commanded_velocity)
+        .def_property_readonly("stalled", &MotorModel::stalled)
+        .def_property_readonly("slip", &MotorModel::slip)
+        .def("set_pulse_position", &MotorModel::set_pulse_position)
+        .def("set_encoder", &MotorModel::set_encoder)
+        .def_property_readonly("home_active", &MotorModel::home_active)
+        .def_property_readonly("minus_limit_active", &MotorModel::minus_limit_active)
+        .def_property_readonly("plus_limit_active", &MotorModel::plus_limit_active)
+        .def_property_readonly("index_active", &MotorModel::index_active)
+        .def("set_jammed", &MotorModel::set_jammed)
+        .def("arm_latch", &MotorModel::arm_latch)
+        .def("trigger_latch", &MotorModel::trigger_latch)
+        .def_property_readonly("latch_state", [](const MotorModel& mm) { return static_cast<int>(mm.latch_state()); })
+        .def_property_readonly("latched_pulse", &MotorModel::latched_pulse)
+        .def_property_readonly("latched_encoder", &MotorModel::latched_encoder);
+    py::class_<ArcusHomingOptions>(m, "ArcusHomingOptions")
+        .def(py::init([](double hca, double lca, bool rz) { return ArcusHomingOptions{hca, lca, rz}; }),
+             py::arg("hca") = 0.0, py::arg("lca") = 1000.0, py::arg("rz") = false);
+    py::class_<ArcusHoming>(m, "ArcusHoming")
+        .def(py::init<MotorModel&, ArcusProfileParams, ArcusHomingOptions>(), py::arg("motor"), py::arg("params"),
+             py::arg("options") = ArcusHomingOptions{}, py::keep_alive<1, 2>())
+        .def("start", [](ArcusHoming& h, const std::string& method, int dir) {
+            static const std::pair<const char*, ArcusHoming::Method> map[] = {
+                {"H", ArcusHoming::Method::H}, {"HL", ArcusHoming::Method::HL}, {"L", ArcusHoming::Method::L},
+                {"Z", ArcusHoming::Method::Z}, {"ZH", ArcusHoming::Method::ZH}};
+            for (const auto& [n, mm] : map)
+                if (method == n) return h.start(mm, dir);
+            throw InvalidArgument("ArcusHoming.start: method is H, HL, L, Z or ZH, not '" + method + "'");
+        }, py::arg("method"), py::arg("direction"))
+        .def("abort", &ArcusHoming::abort)
+        .def_property_readonly("running", &ArcusHoming::running)
+        .def_property_readonly("result", [](const ArcusHoming& h) { return static_cast<int>(h.result()); })
+        .def_property_readonly("snl_status", &ArcusHoming::snl_status);
+    py::class_<Cia402HomingParams>(m, "Cia402HomingParams")
+        .def(py::init([](int method, double s1, double s2, double acc, double off) {
+                 return Cia402HomingParams{method, s1, s2, acc, off};
+             }),
+             py::arg("method") = 17, py::arg("speed_switch") = 1000.0, py::arg("speed_zero") = 100.0,
+             py::arg("acceleration") = 10000.0, py::arg("home_offset") = 0.0);
+    py::class_<Cia402Homing>(m, "Cia402Homing")
+        .def(py::init<MotorModel&, Cia402HomingParams>(), py::arg("motor"), py::arg("params"), py::keep_alive<1, 2>())
+        .def("start", &Cia402Homing::start)
+        .def("abort", &Cia402Homing::abort)
+        .def_property_readonly("attained", &Cia402Homing::attained)
+        .def_property_readonly("error", &Cia402Homing::error)
+        .def_property_readonly("result", [](const Cia402Homing& h) { return static_cast<int>(h.result()); })
+        .def_static("supported", &Cia402Homing::supported);
 }

@@ -97,3 +97,46 @@ def test_stepnloop_from_python():
     action, corr, idle = s.motion_done(300)
     assert (action, corr, idle) == (2, 300.0, False)
     assert s.status_name == "CORRECTING"
+
+
+def test_pmc007_cia402_unitek_models():
+    assert motion.pmc007_gear_acceleration(1) == 77440
+    p = motion.pmc007_position_profile(motion.MotionState(), 20000,
+                                       motion.Pmc007ProfileParams(speed=5610, accel_gear=8, decel_gear=8))
+    assert p.end_position == 20000
+    c = motion.Cia402ProfilePosition(motion.Cia402ProfileParams(1000, 10000, 10000))
+    assert c.new_setpoint(0.0, 5000)
+    assert c.new_setpoint(1.0, 0)
+    assert not c.new_setpoint(1.5, 7)
+    assert c.profile.end_position == 0
+    u = motion.unitek_speed_profile(motion.MotionState(), 3277, motion.UnitekRampParams(3000, 1000, 500), 1.0)
+    assert u.final_velocity == pytest.approx(3277 / 32767 * 3000 / 60 * 65536)
+    with pytest.raises(motion.LimitExceeded):
+        motion.Cia402ProfileParams(motion_profile_type=5)
+
+
+def test_motor_model_and_homing_on_sim_clock():
+    from motorbus._core import SimClock
+
+    clk = SimClock()
+    cfg = motion.MotorConfig()
+    cfg.home = motion.SwitchConfig(True, 5000, 5400)
+    cfg.plus_limit = motion.SwitchConfig(True, 20000)
+    m = motion.MotorModel(clk, cfg)
+    events = []
+    m.add_listener(lambda e: events.append(e["kind"]))
+    h = motion.ArcusHoming(m, motion.ArcusProfileParams(hspd=3200, lspd=100, acc_ms=100),
+                           motion.ArcusHomingOptions(rz=True))
+    h.start("H", 1)
+    for _ in range(1000):
+        if not h.running:
+            break
+        clk.advance(10_000_000)
+        m.update()
+    assert h.result == 1  # Done
+    assert m.pulse_count == 0
+    assert m.physical_position == pytest.approx(5000, abs=1e-3)
+    assert "home_on" in events
+    assert m.encoder == round(5000 * 4000 / 3200)
+    with pytest.raises(ValueError):
+        h.start("X", 1)

@@ -74,6 +74,16 @@ std::vector<Profile> plan_synchronized(const std::vector<double>& start,
                                        const std::vector<Limits>& limits,
                                        RampShape shape = RampShape::Trapezoid);
 
+// Jerk-limited time synchronisation for axes starting at rest (a = 0, v = 0):
+// each axis is planned time-optimally (plan_jerk_limited), the slowest sets T,
+// and every other axis gets the same 7-phase shape with the lower cruise
+// velocity that makes it last exactly T (closed form when the ramps reach
+// max_acceleration, Newton otherwise).  Durations equal ruckig's synchronised
+// duration for such moves.  Throws InvalidArgument for a moving start.
+std::vector<Profile> plan_synchronized_jerk_limited(const std::vector<double>& start,
+                                                    const std::vector<double>& target,
+                                                    const std::vector<Limits>& limits);
+
 // Straight-line (phase-synchronised) move: one scalar path parameter s in
 // [0, 1] is planned under the tightest per-axis limit scaled by each axis's
 // share of the move, so every axis starts, accelerates, cruises and stops

@@ -41,14 +41,17 @@ State Segment::at(double t) const {
         return State{start.p + start.v * t + A / 2 * (t * t / 2 + (cwt - 1) / (w * w)),
                      start.v + A / 2 * (t - swt / w), A / 2 * (1 - cwt), A / 2 * w * swt};
     }
+    // Multiplications by constants: a division here would be the planners' hottest instruction.
+    constexpr double kSixth = 1.0 / 6.0;
     const double j = start.j;
-    return State{start.p + t * (start.v + t * (start.a / 2 + t * j / 6)),
-                 start.v + t * (start.a + t * j / 2), start.a + t * j, j};
+    return State{start.p + t * (start.v + t * (start.a * 0.5 + t * j * kSixth)),
+                 start.v + t * (start.a + t * j * 0.5), start.a + t * j, j};
 }
 
 Profile::Profile(State initial) : initial_(initial), final_(initial) {
     initial_.j = 0;
     final_.j = 0;
+    segments_.reserve(8);  // one allocation covers the usual 3-9 segments
 }
 
 State Profile::end_state_() const {
@@ -70,7 +73,6 @@ Profile& Profile::append_jump(double duration, double v, double a, double jerk) 
     seg.duration = duration;
     seg.start = State{final_.p, v, a, jerk};
     segments_.push_back(seg);
-    starts_.push_back(seg.t0);
     duration_ += duration;
     final_ = seg.end();
     final_.j = 0;
@@ -88,7 +90,6 @@ Profile& Profile::append_exp_approach(double duration, double target, double tau
     seg.p_end = target;
     seg.start = seg.at(0);
     segments_.push_back(seg);
-    starts_.push_back(seg.t0);
     duration_ += duration;
     final_ = seg.end();
     final_.j = 0;
@@ -106,7 +107,6 @@ Profile& Profile::append_sin_ramp(double duration, double dv) {
     seg.tau = duration;  // the ramp's own length: truncation must not reshape it
     seg.start = State{e.p, e.v, 0, 0};
     segments_.push_back(seg);
-    starts_.push_back(seg.t0);
     duration_ += duration;
     final_ = seg.end();
     final_.j = 0;
@@ -131,7 +131,6 @@ Profile& Profile::append(const Profile& tail) {
         c.start.p += shift;
         if (c.kind == Segment::Kind::ExpApproach) c.p_end += shift;
         segments_.push_back(c);
-        starts_.push_back(c.t0);
         duration_ += c.duration;
     }
     final_ = tail.final_;
@@ -148,7 +147,6 @@ Profile Profile::truncated(double t) const {
         Segment c = s;
         if (c.t0 + c.duration > t) c.duration = t - c.t0;
         out.segments_.push_back(c);
-        out.starts_.push_back(c.t0);
         out.duration_ = c.t0 + c.duration;
     }
     if (out.segments_.empty()) {
@@ -174,9 +172,17 @@ Profile Profile::shifted_position(double dp) const {
 
 std::size_t Profile::segment_index(double t) const {
     if (segments_.empty() || t >= duration_) return segments_.size();
-    auto it = std::upper_bound(starts_.begin(), starts_.end(), t);
-    if (it == starts_.begin()) return 0;
-    return static_cast<std::size_t>(it - starts_.begin()) - 1;
+    if (segments_.size() <= 16) {
+        // Short profiles (every planner's): a branch-free count beats a
+        // binary search whose branches a random t mispredicts.
+        std::size_t n = 0;
+        for (std::size_t i = 1; i < segments_.size(); ++i) n += static_cast<std::size_t>(t >= segments_[i].t0);
+        return n;
+    }
+    auto it = std::upper_bound(segments_.begin(), segments_.end(), t,
+                               [](double x, const Segment& s) { return x < s.t0; });
+    if (it == segments_.begin()) return 0;
+    return static_cast<std::size_t>(it - segments_.begin()) - 1;
 }
 
 State Profile::at(double t) const {

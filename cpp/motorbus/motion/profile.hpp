@@ -129,7 +129,6 @@ private:
     State final_{};
     double duration_ = 0;
     std::vector<Segment> segments_;
-    std::vector<double> starts_;  // segments_[i].t0, for the search
     State end_state_() const;
 };
 

@@ -120,3 +120,33 @@ TEST(MultiAxis, InterpolationSplitReachesTargetsExactly) {
     EXPECT_THROW(split_interpolation(one, 1), LimitExceeded);
     EXPECT_THROW(split_interpolation(one, 139), LimitExceeded);
 }
+
+TEST(MultiAxis, JerkLimitedSynchronized) {
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int i = 0; i < 500; ++i) {
+        std::vector<double> s, t;
+        std::vector<Limits> lim;
+        for (int k = 0; k < 3; ++k) {
+            s.push_back(100 * (u(rng) - 0.5));
+            t.push_back(s.back() + (u(rng) < 0.1 ? 0.0 : 100 * (u(rng) - 0.5)));
+            lim.push_back(Limits{0.1 + 10 * u(rng), 0.1 + 10 * u(rng), 0, 0.1 + 100 * u(rng)});
+        }
+        auto ps = plan_synchronized_jerk_limited(s, t, lim);
+        double T = 0;
+        for (int k = 0; k < 3; ++k) T = std::max(T, plan_jerk_limited(State{s[k], 0, 0, 0}, t[k], lim[k]).duration());
+        for (int k = 0; k < 3; ++k) {
+            ASSERT_NEAR(ps[k].duration(), T, 1e-9 * std::max(1.0, T)) << i << " axis " << k;
+            ASSERT_EQ(ps[k].end_position(), t[k]);
+            EXPECT_LE(ps[k].max_abs_velocity(), lim[k].max_velocity * (1 + 1e-9));
+            EXPECT_LE(ps[k].max_abs_acceleration(), lim[k].max_acceleration * (1 + 1e-9));
+            if (ps[k].segments().empty()) {
+                EXPECT_EQ(s[k], t[k]);  // nothing moves at all
+                continue;
+            }
+            const State e = ps[k].segments().back().end();
+            EXPECT_NEAR(e.p, t[k], 1e-6 * std::max(1.0, std::fabs(t[k]))) << i << " axis " << k;
+            EXPECT_NEAR(e.v, 0, 1e-9 * std::max(1.0, lim[k].max_velocity));
+        }
+    }
+}
