@@ -278,3 +278,22 @@ def test_make_sim_arguments():
         make_sim("01", nonsense=1)
     sim = make_sim("03", response_type=1)
     assert sim.on_line(b"@03EX") == b"#030\0"
+
+
+def test_real_time_sim_and_wait_idle():
+    """The default (real-time) simulator, as `motorbus sim serve` runs it."""
+    sim = make_sim("01", snl=False, eo_boot=True)
+    with core.PtyLineServer([sim], 0, None) as server:
+        with ArcusClient(server.slave_path, 1, baud=0) as d:
+            d.set_high_speed(100000)
+            d.set_low_speed(1000)
+            d.set_acceleration(10)
+            d.move(2000)  # about 30 ms
+            d.wait_idle(timeout=5)
+            assert d.position() == 2000
+            assert d.encoder() == 2500
+            with pytest.raises(motorbus.TimeoutError):
+                d.jog(1)
+                d.wait_idle(timeout=0.05)
+            d.abort()
+            assert not d.moving()
