@@ -86,6 +86,8 @@ private:
     Profile profile_;
     bool speed_mode_ = false;
     std::int64_t target_ = 0;
+    double motion_end_ = 0;  // time the motor comes to rest (infinity while a speed holds)
+    void splice(double t, const Profile& tail);
 };
 
 // The core position plan, exposed for reuse: from `start` to `target`
