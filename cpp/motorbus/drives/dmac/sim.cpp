@@ -124,7 +124,9 @@ motion::State DmacSim::motion_state() const {
         s.v = interp_speed_;
         return s;
     }
-    return motion_->at(motion_t());
+    motion::State s = motion_->at(motion_t());
+    s.p += static_cast<double>(pos_offset_);
+    return s;
 }
 
 std::int32_t DmacSim::position_locked() const { return wrap_i32(std::llround(motion_state().p)); }
@@ -194,7 +196,14 @@ void DmacSim::tick_locked() {
             case WaitKind::None:
                 break;
         }
-        wait_ = WaitKind::None;
+        if (wait_ != WaitKind::None) {
+            wait_ = WaitKind::None;
+            line_ = resume_line_;
+            if (line_ < 1 || line_ > kSeqLines) {
+                seq_stop();
+                return;
+            }
+        }
         seq_execute_line(line_);
     }
 }
@@ -206,6 +215,7 @@ void DmacSim::poll() {
 
 // ---- motion -----------------------------------------------------------------
 void DmacSim::restart_motion_at(double position) {
+    pos_offset_ = 0;
     motion_ = std::make_unique<motion::DmacMotion>(params(), position);
     motion_t0_ms_ = now_ms_;
     position_mode_ = false;
@@ -232,6 +242,7 @@ bool DmacSim::start_move(Cmd kind, std::int32_t value) {
     if (kind == Cmd::MoveTo) dir = (value > p) - (value < p);
     else dir = (value > 0) - (value < 0);
     // An end-stop that is hit only lets the axis move back.
+    update_end_flags();
     if (dir > 0 && (hard_pos_hit_ || soft_pos_hit_)) {
         flag(error::kLimit);
         return false;
@@ -244,9 +255,18 @@ bool DmacSim::start_move(Cmd kind, std::int32_t value) {
     try {
         motion_->set_params(params());
         const double t = motion_t();
-        if (kind == Cmd::MoveTo) motion_->move_to(t, value);
-        else if (kind == Cmd::MoveOn) motion_->move_on(t, value);
-        else motion_->move_speed(t, value);
+        // Targets are in the user's frame; the profile runs in its own (see pos_offset_).
+        if (kind == Cmd::MoveTo) {
+            motion_->move_to(t, static_cast<std::int64_t>(value) - pos_offset_);
+        } else if (kind == Cmd::MoveOn) {
+            // Relative to the target of a position move in progress, else to where the axis is.
+            const std::int64_t base = (position_mode_ && motion_->moving(t))
+                                          ? motion_->target()
+                                          : std::llround(p) - pos_offset_;
+            motion_->move_to(t, base + value);
+        } else {
+            motion_->move_speed(t, value);
+        }
     } catch (const std::exception&) {
         flag(error::kLimit);
         restart_motion_at(p);
@@ -258,7 +278,7 @@ bool DmacSim::start_move(Cmd kind, std::int32_t value) {
     return true;
 }
 
-void DmacSim::check_end_stops() {
+void DmacSim::update_end_flags() {
     const motion::State s = motion_state();
     const auto pen = static_cast<double>(vars_[static_cast<std::size_t>(Var::PositiveEnd)]);
     const auto nen = static_cast<double>(vars_[static_cast<std::size_t>(Var::NegativeEnd)]);
@@ -269,6 +289,13 @@ void DmacSim::check_end_stops() {
     hard_neg_hit_ = hard_neg_ && (in & in_neg);
     soft_pos_hit_ = soft_ends_ && s.p >= pen;
     soft_neg_hit_ = soft_ends_ && s.p <= nen;
+}
+
+void DmacSim::check_end_stops() {
+    update_end_flags();
+    const motion::State s = motion_state();
+    const auto pen = static_cast<double>(vars_[static_cast<std::size_t>(Var::PositiveEnd)]);
+    const auto nen = static_cast<double>(vars_[static_cast<std::size_t>(Var::NegativeEnd)]);
     const bool moving = moving_locked();
     if (!moving) return;
     if (soft_pos_hit_ && s.v > 0) {
@@ -292,6 +319,8 @@ void DmacSim::reset_locked(bool factory) {
     for (std::size_t i = 0; i < kVarCount; ++i) {
         const VarInfo& vi = var_info(static_cast<Var>(i));
         if (vi.read_only) continue;
+        // Serial line configuration (#LINE_DELAY) survives even MODULE_RESET ALL.
+        if (static_cast<Var>(i) == Var::LineDelay && factory && !first_reset_) continue;
         if (!vi.stored || factory) vars_[i] = vi.factory;
     }
     if (factory) {
@@ -314,6 +343,7 @@ void DmacSim::reset_locked(bool factory) {
     wait_ = WaitKind::None;
     // Position is stored (kept across a reset) unless factory settings are restored.
     restart_motion_at(factory ? 0.0 : std::round(p));
+    first_reset_ = false;
     const std::int32_t on_reset = vars_[static_cast<std::size_t>(Var::OnReset)];
     if (on_reset >= 1 && on_reset <= kSeqLines) seq_start(on_reset);
 }
@@ -326,6 +356,7 @@ void DmacSim::power_cycle() {
 
 // ---- variables ----------------------------------------------------------------
 std::uint32_t DmacSim::status_locked() {
+    update_end_flags();
     std::uint32_t s = 0;
     auto set = [&](int bit, bool on) {
         if (on) s |= bit_mask(bit);
@@ -350,7 +381,7 @@ std::uint32_t DmacSim::status_locked() {
     set(status::kPowerOn, power_);
     set(status::kMovement, moving);
     if (moving && position_mode_ && !interpolating_) {
-        const double err = static_cast<double>(motion_->target()) - motion_state().p;
+        const double err = static_cast<double>(motion_->target() + pos_offset_) - motion_state().p;
         set(status::kPositionControl, std::fabs(err) <= motion::kDmacApproachIncrements);
     }
     set(status::kBusy, moving);
@@ -400,10 +431,13 @@ int DmacSim::write_var_locked(Var v, int bit, std::int32_t value) {
     switch (v) {
         case Var::Position: {
             // Re-home: the current motion continues from the new origin.
-            const double shift = static_cast<double>(value) - motion_state().p;
+            const double p = motion_state().p;
             if (interpolating_) {
+                const double shift = static_cast<double>(value) - p;
                 interp_pos_ += shift;
                 seg_start_pos_ += shift;
+            } else if (motion_->moving(motion_t())) {
+                pos_offset_ += static_cast<std::int64_t>(value) - std::llround(p);
             } else {
                 restart_motion_at(value);
             }
@@ -565,6 +599,10 @@ void DmacSim::seq_execute_line(int n) {
     }
     if (!seq_running_) return;  // the line itself stopped the sequencer (STOP, HALT, #LINE:=0)
     if (line_ != n) return;     // the line wrote #LINE: that is the next line
+    if (wait_ != WaitKind::None) {
+        resume_line_ = next;     // #LINE shows the WAIT line while it waits
+        return;
+    }
     if (next < 1 || next > kSeqLines) seq_stop();
     else line_ = next;
 }
@@ -729,7 +767,7 @@ std::string DmacSim::execute_locked(const Command& c, bool from_sequencer, bool 
             // Debug mode: one line now, the sequencer itself stays stopped.
             seq_running_ = true;
             seq_execute_line(*n);
-            const int next = line_;
+            const int next = wait_ != WaitKind::None ? resume_line_ : line_;
             seq_running_ = false;
             wait_ = WaitKind::None;
             line_ = next;
@@ -799,10 +837,15 @@ std::string DmacSim::handle_locked(std::string_view line) {
             flag(error::kSyntax);  // ":n" only means something while editing
             rejected = true;
         } else {
-            for (const Command& c : req.commands) {
-                if (c.cmd == Cmd::Invalid) rejected = true;
-                reply += execute_locked(c, false, global);
-            }
+            for (const Command& c : req.commands)
+                if (c.cmd == Cmd::Invalid) {
+                    // A frame with a syntax error runs none of its commands:
+                    // half a frame could start a move the host never meant.
+                    flag(c.error_bit);
+                    rejected = true;
+                }
+            if (!rejected)
+                for (const Command& c : req.commands) reply += execute_locked(c, false, global);
         }
     }
     if (rejected) ++lines_rejected_;

@@ -118,6 +118,7 @@ private:
     void halt_motion();
     bool start_move(Cmd kind, std::int32_t value);
     void check_end_stops();
+    void update_end_flags();
     void reset_locked(bool factory);
     motion::DmacProfileParams params() const;
 
@@ -151,6 +152,9 @@ private:
     std::unique_ptr<motion::DmacMotion> motion_;
     std::int64_t motion_t0_ms_ = 0;
     bool position_mode_ = false;
+    // #POSITION written during a move re-homes without disturbing it: the
+    // profile keeps its own frame and the user frame is shifted by this.
+    std::int64_t pos_offset_ = 0;
     std::unique_ptr<Pending> pending_;
 
     // interpolation
@@ -174,6 +178,8 @@ private:
     std::vector<int> call_stack_;
     enum class WaitKind { None, Time, Motion, MotionTimeout } wait_ = WaitKind::None;
     std::int64_t wait_until_ms_ = 0;
+    int resume_line_ = 0;             // line after the WAIT in progress
+    bool first_reset_ = true;
 
     std::uint64_t lines_handled_ = 0, lines_rejected_ = 0;
 };
