@@ -66,10 +66,10 @@ struct ErrorWord {
 struct ClientOptions {
     int address = 0;
     bool verify = true;                               // append READ #ERROR to commands
-    std::optional<Duration> timeout;                  // per transaction; default: the link's
+    std::optional<Duration> timeout{};                // per transaction; default: the link's
     // How the client waits (polling, FIFO back-pressure).  Default: real sleep.
     // Tests on a SimClock pass a function that advances the clock instead.
-    std::function<void(Duration)> sleep;
+    std::function<void(Duration)> sleep{};
 };
 
 enum class StopWhat : std::uint8_t { All, Movement, Sequence };

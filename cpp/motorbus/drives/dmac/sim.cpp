@@ -839,13 +839,14 @@ std::string DmacSim::handle_locked(std::string_view line) {
         } else {
             for (const Command& c : req.commands)
                 if (c.cmd == Cmd::Invalid) {
-                    // A frame with a syntax error runs none of its commands:
-                    // half a frame could start a move the host never meant.
+                    // A frame with a syntax error changes nothing (half a frame
+                    // could start a move the host never meant); its READs still
+                    // answer, so "cmd, READ #ERROR" reports the rejection.
                     flag(c.error_bit);
                     rejected = true;
                 }
-            if (!rejected)
-                for (const Command& c : req.commands) reply += execute_locked(c, false, global);
+            for (const Command& c : req.commands)
+                if (!rejected || c.cmd == Cmd::Read) reply += execute_locked(c, false, global);
         }
     }
     if (rejected) ++lines_rejected_;
