@@ -257,7 +257,17 @@ class CommandRejected(DriveFault):
              py::arg("value"), rel)
         .def("write_bit", [](C& c, const std::string& v, int bit, bool x) { c.write_bit(var_arg(v), bit, x); },
              py::arg("variable"), py::arg("bit"), py::arg("value"), rel)
-        .def_property("position", &C::position, &C::set_position)
+        .def_property(
+            "position",
+            [](C& c) {
+                py::gil_scoped_release nogil;
+                return c.position();
+            },
+            [](C& c, std::int32_t p) {
+                py::gil_scoped_release nogil;
+                c.set_position(p);
+            },
+            "#POSITION (1/10000 rev); assigning re-homes the axis.")
         .def("set_position", &C::set_position, py::arg("position"), rel)
         .def("speed", &C::speed, rel)
         .def("profile_speed", &C::profile_speed, rel)

@@ -123,8 +123,9 @@ class DmacClient(_core.DmacClient):
         if not getattr(self, "_open", False):
             return
         try:
-            # A bare STOP frame: no verification round trip that could itself fail.
-            self.raw(f"{self.address:02d}STOP", expect_reply=False)
+            # STOP plus a READ, so we know the module took it before we go on;
+            # no error checking that could itself raise.
+            self.raw(f"{self.address:02d}STOP, READ #STATUS", expect_reply=True)
         except Exception:  # the link may already be gone; nothing more to do
             pass
 

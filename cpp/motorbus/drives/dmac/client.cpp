@@ -111,7 +111,7 @@ void DmacClient::command(std::string_view cmd) {
     const std::uint32_t hardware = err & ~command_bits;
     // Acknowledge a command error so the next command starts clean, unless a
     // hardware fault is latched too: that one is the user's to acknowledge.
-    if (!hardware) await(frame("#ERROR:=0"), nullptr, true);
+    if (!hardware) read_reply(frame("#ERROR:=0, READ #ERROR"), Var::Error, 0);
     const std::string what = "DMAC " + std::to_string(options_.address) + " rejected '" + std::string(cmd) +
                              "': #ERROR " + describe_error(err);
     if (err & bit_mask(error::kSyntax)) throw UnknownCommand(what);
