@@ -122,13 +122,18 @@ void MotorModel::emit(MotorEvent::Kind k, Nanos t) {
     const MotorEvent e = make_event(k, t);
     const bool nested = in_dispatch_;
     in_dispatch_ = true;
+    // A throwing listener must not leave the model believing it is still dispatching.
+    struct Restore {
+        bool& flag;
+        bool value;
+        ~Restore() { flag = value; }
+    } restore{in_dispatch_, nested};
     for (std::size_t i = 0; i < listeners_.size(); ++i) {
         auto cb = listeners_[i].cb;  // copy: the callback may add listeners
         if (cb) cb(e);
     }
-    in_dispatch_ = nested;
-    if (!nested)
-        listeners_.erase(std::remove_if(listeners_.begin(), listeners_.end(), [](const Listener& l) { return !l.cb; }),
+    if (nested) return;
+    listeners_.erase(std::remove_if(listeners_.begin(), listeners_.end(), [](const Listener& l) { return !l.cb; }),
                          listeners_.end());
 }
 

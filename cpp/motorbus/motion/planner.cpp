@@ -14,6 +14,8 @@ void append_ramp(Profile& prof, double dv, double duration, RampShape shape) {
     const State s = prof.final_state();
     if (shape == RampShape::Trapezoid) {
         prof.append_jump(duration, s.v, dv / duration, 0.0);
+    } else if (shape == RampShape::Sin2) {
+        prof.append_sin_ramp(duration, dv);
     } else {
         // Triangular acceleration: same Δv and same distance as the linear ramp.
         const double half = duration / 2;
@@ -29,6 +31,8 @@ Profile stepper_profile(const State& start, double target, double vmax, double a
                         double v_start, double v_end, RampShape shape) {
     Profile prof(State{start.p, start.v, 0, 0});
     State cur{start.p, start.v, 0, 0};
+    // Divisions dominate this planner's cost: take the two inverses once.
+    const double inv_a = 1 / accel, inv_d = 1 / decel;
     for (int pass = 0; pass < 3; ++pass) {
         const double x_signed = target - cur.p;
         double s = sgn(x_signed);
@@ -36,12 +40,12 @@ Profile stepper_profile(const State& start, double target, double vmax, double a
         if (s == 0) break;            // at rest on target
         const double x = s * x_signed;
         const double u0 = s * cur.v;
-        const double stop_dist = u0 > v_end ? (u0 * u0 - v_end * v_end) / (2 * decel) : 0.0;
+        const double stop_dist = u0 > v_end ? (u0 * u0 - v_end * v_end) * 0.5 * inv_d : 0.0;
         if (u0 < 0 || stop_dist > x || (x == 0 && u0 != 0)) {
             // Moving away, or too fast to stop in time: stop first, then come back.
             const double dir = sgn(cur.v);
             const double w = std::fabs(cur.v);
-            if (w > v_end) append_ramp(prof, -dir * (w - v_end), (w - v_end) / decel, shape);
+            if (w > v_end) append_ramp(prof, -dir * (w - v_end), (w - v_end) * inv_d, shape);
             cur = prof.final_state();
             cur.v = 0;  // the stop is a jump from v_end to 0
             cur.a = 0;
@@ -55,48 +59,36 @@ Profile stepper_profile(const State& start, double target, double vmax, double a
         if (u > vmax) {
             vp = vmax;
         } else {
-            const double k = 1 / (2 * accel) + 1 / (2 * decel);
-            const double vp2 = (x + u * u / (2 * accel) + v_end * v_end / (2 * decel)) / k;
+            const double k = 0.5 * (inv_a + inv_d);
+            const double vp2 = (x + 0.5 * (u * u * inv_a + v_end * v_end * inv_d)) / k;
             vp = std::sqrt(std::max(vp2, 0.0));
             if (vp < u) vp = u;
             if (vp < v_end) vp = v_end;
             if (vp > vmax) vp = std::max(vmax, v_end);
         }
-        const double d_acc = vp >= u ? (vp * vp - u * u) / (2 * accel) : (u * u - vp * vp) / (2 * decel);
-        const double d_dec = (vp * vp - v_end * v_end) / (2 * decel);
+        const double d_acc = vp >= u ? (vp * vp - u * u) * 0.5 * inv_a : (u * u - vp * vp) * 0.5 * inv_d;
+        const double d_dec = (vp * vp - v_end * v_end) * 0.5 * inv_d;
         if (vp > 0) cruise = std::max(0.0, (x - d_acc - d_dec) / vp);
         // Build: optional jump to u, ramp u->vp, cruise, ramp vp->v_end.
-        const double t_acc = vp >= u ? (vp - u) / accel : (u - vp) / decel;
-        const double t_dec = (vp - v_end) / decel;
+        const double t_acc = vp >= u ? (vp - u) * inv_a : (u - vp) * inv_d;
+        const double t_dec = (vp - v_end) * inv_d;
         const std::size_t n_before = prof.segments().size();
+        // The start speed is a jump (a stepper starts at it): set the end state, then ramp.
+        prof.finish(prof.final_state().p, s * u);
         if (t_acc > 0) {
-            if (shape == RampShape::Trapezoid) {
-                prof.append_jump(t_acc, s * u, s * (vp - u) / t_acc, 0.0);
-            } else {
-                const double half = t_acc / 2;
-                const double jerk = s * (vp - u) / (half * half);
-                prof.append_jump(half, s * u, 0.0, jerk);
-                prof.append_cubic(half, -jerk);
-            }
-        } else if (cruise > 0) {
-            prof.append_jump(cruise, s * vp, 0.0, 0.0);
-            cruise = 0;
-        } else if (t_dec > 0) {
-            // Neither accelerating nor cruising: the ramp down starts from the jump.
-            if (shape == RampShape::Trapezoid) {
-                prof.append_jump(t_dec, s * vp, -s * (vp - v_end) / t_dec, 0.0);
-            } else {
-                const double half = t_dec / 2;
-                const double jerk = -s * (vp - v_end) / (half * half);
-                prof.append_jump(half, s * vp, 0.0, jerk);
-                prof.append_cubic(half, -jerk);
-            }
-            prof.finish(target, 0.0);
-            return prof;
+            if (shape == RampShape::Trapezoid)
+                prof.append_jump(t_acc, s * u, vp >= u ? s * accel : -s * decel, 0.0);
+            else
+                append_ramp(prof, s * (vp - u), t_acc, shape);
         }
         if (cruise > 0) prof.append_jump(cruise, s * vp, 0.0, 0.0);
-        append_ramp(prof, -s * (vp - v_end), t_dec, shape);
-        if (prof.segments().size() == n_before && vp > 0 && x > 0) {
+        if (t_dec > 0) {
+            if (shape == RampShape::Trapezoid)
+                prof.append_jump(t_dec, s * vp, -s * decel, 0.0);
+            else
+                append_ramp(prof, -s * (vp - v_end), t_dec, shape);
+        }
+        if (prof.segments().size() == n_before && vp > 0 && x > 0 && cruise == 0) {
             // Only a start-speed hop remains (x tiny, no ramps): cover it at vp.
             prof.append_jump(x / vp, s * vp, 0.0, 0.0);
         }

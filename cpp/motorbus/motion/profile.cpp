@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 
 namespace motorbus::motion {
 
@@ -33,14 +34,24 @@ State Segment::at(double t) const {
         const double k = std::exp(-t / tau);
         return State{p_end - e0 * k, e0 * k / tau, -e0 * k / (tau * tau), e0 * k / (tau * tau * tau)};
     }
+    if (kind == Kind::SinRamp) {
+        // a = A sin^2(pi t/T) = A/2 (1 - cos(w t)), w = 2 pi / T
+        const double T = tau, A = amp, w = 2 * std::numbers::pi / T;
+        const double swt = std::sin(w * t), cwt = std::cos(w * t);
+        return State{start.p + start.v * t + A / 2 * (t * t / 2 + (cwt - 1) / (w * w)),
+                     start.v + A / 2 * (t - swt / w), A / 2 * (1 - cwt), A / 2 * w * swt};
+    }
+    // Multiplications by constants: a division here would be the planners' hottest instruction.
+    constexpr double kSixth = 1.0 / 6.0;
     const double j = start.j;
-    return State{start.p + t * (start.v + t * (start.a / 2 + t * j / 6)),
-                 start.v + t * (start.a + t * j / 2), start.a + t * j, j};
+    return State{start.p + t * (start.v + t * (start.a * 0.5 + t * j * kSixth)),
+                 start.v + t * (start.a + t * j * 0.5), start.a + t * j, j};
 }
 
 Profile::Profile(State initial) : initial_(initial), final_(initial) {
     initial_.j = 0;
     final_.j = 0;
+    segments_.reserve(8);  // one allocation covers the usual 3-9 segments
 }
 
 State Profile::end_state_() const {
@@ -51,8 +62,7 @@ State Profile::end_state_() const {
 
 Profile& Profile::append_cubic(double duration, double jerk) {
     if (!(duration > 0)) return *this;
-    State s = segments_.empty() ? final_ : segments_.back().end();
-    return append_jump(duration, s.v, s.a, jerk);
+    return append_jump(duration, final_.v, final_.a, jerk);
 }
 
 Profile& Profile::append_jump(double duration, double v, double a, double jerk) {
@@ -61,9 +71,8 @@ Profile& Profile::append_jump(double duration, double v, double a, double jerk) 
     seg.kind = Segment::Kind::Cubic;
     seg.t0 = duration_;
     seg.duration = duration;
-    seg.start = State{segments_.empty() ? final_.p : segments_.back().end().p, v, a, jerk};
+    seg.start = State{final_.p, v, a, jerk};
     segments_.push_back(seg);
-    starts_.push_back(seg.t0);
     duration_ += duration;
     final_ = seg.end();
     final_.j = 0;
@@ -76,12 +85,28 @@ Profile& Profile::append_exp_approach(double duration, double target, double tau
     seg.kind = Segment::Kind::ExpApproach;
     seg.t0 = duration_;
     seg.duration = duration;
-    seg.start = State{segments_.empty() ? final_.p : segments_.back().end().p, 0, 0, 0};
+    seg.start = State{final_.p, 0, 0, 0};
     seg.tau = tau;
     seg.p_end = target;
     seg.start = seg.at(0);
     segments_.push_back(seg);
-    starts_.push_back(seg.t0);
+    duration_ += duration;
+    final_ = seg.end();
+    final_.j = 0;
+    return *this;
+}
+
+Profile& Profile::append_sin_ramp(double duration, double dv) {
+    if (!(duration > 0)) return *this;
+    const State e = final_;
+    Segment seg;
+    seg.kind = Segment::Kind::SinRamp;
+    seg.t0 = duration_;
+    seg.duration = duration;
+    seg.amp = 2 * dv / duration;
+    seg.tau = duration;  // the ramp's own length: truncation must not reshape it
+    seg.start = State{e.p, e.v, 0, 0};
+    segments_.push_back(seg);
     duration_ += duration;
     final_ = seg.end();
     final_.j = 0;
@@ -106,7 +131,6 @@ Profile& Profile::append(const Profile& tail) {
         c.start.p += shift;
         if (c.kind == Segment::Kind::ExpApproach) c.p_end += shift;
         segments_.push_back(c);
-        starts_.push_back(c.t0);
         duration_ += c.duration;
     }
     final_ = tail.final_;
@@ -123,7 +147,6 @@ Profile Profile::truncated(double t) const {
         Segment c = s;
         if (c.t0 + c.duration > t) c.duration = t - c.t0;
         out.segments_.push_back(c);
-        out.starts_.push_back(c.t0);
         out.duration_ = c.t0 + c.duration;
     }
     if (out.segments_.empty()) {
@@ -149,9 +172,17 @@ Profile Profile::shifted_position(double dp) const {
 
 std::size_t Profile::segment_index(double t) const {
     if (segments_.empty() || t >= duration_) return segments_.size();
-    auto it = std::upper_bound(starts_.begin(), starts_.end(), t);
-    if (it == starts_.begin()) return 0;
-    return static_cast<std::size_t>(it - starts_.begin()) - 1;
+    if (segments_.size() <= 16) {
+        // Short profiles (every planner's): a branch-free count beats a
+        // binary search whose branches a random t mispredicts.
+        std::size_t n = 0;
+        for (std::size_t i = 1; i < segments_.size(); ++i) n += static_cast<std::size_t>(t >= segments_[i].t0);
+        return n;
+    }
+    auto it = std::upper_bound(segments_.begin(), segments_.end(), t,
+                               [](double x, const Segment& s) { return x < s.t0; });
+    if (it == segments_.begin()) return 0;
+    return static_cast<std::size_t>(it - segments_.begin()) - 1;
 }
 
 State Profile::at(double t) const {
@@ -225,7 +256,10 @@ double Profile::max_abs_velocity() const {
 
 double Profile::max_abs_acceleration() const {
     double m = 0;
-    for (const Segment& s : segments_) m = std::max({m, std::fabs(s.start.a), std::fabs(s.end().a)});
+    for (const Segment& s : segments_) {
+        m = std::max({m, std::fabs(s.start.a), std::fabs(s.end().a)});
+        if (s.kind == Segment::Kind::SinRamp) m = std::max(m, std::fabs(s.amp));
+    }
     return m;
 }
 
@@ -234,10 +268,25 @@ double Profile::max_abs_jerk() const {
     for (const Segment& s : segments_) {
         if (s.kind == Segment::Kind::Cubic)
             m = std::max(m, std::fabs(s.start.j));
+        else if (s.kind == Segment::Kind::SinRamp)
+            m = std::max(m, std::fabs(s.amp) * std::numbers::pi / s.tau);
         else
             m = std::max({m, std::fabs(s.start.j), std::fabs(s.end().j)});
     }
     return m;
+}
+
+// Where a sin^2 ramp's velocity crosses zero (velocity is monotone in it), or -1.
+double detail_sin_velocity_zero(const Segment& seg) {
+    const double v0 = seg.start.v, v1 = seg.end().v;
+    if (v0 == 0 || v1 == 0 || (v0 < 0) == (v1 < 0)) return -1;
+    double lo = 0, hi = seg.duration;
+    for (int i = 0; i < 80; ++i) {
+        const double m = 0.5 * (lo + hi);
+        if ((seg.at(m).v < 0) == (v0 < 0)) lo = m;
+        else hi = m;
+    }
+    return 0.5 * (lo + hi);
 }
 
 namespace {
@@ -293,6 +342,9 @@ double Profile::first_crossing(double level, double t_from) const {
             std::sort(r, r + nr);
             for (int k = 0; k < nr; ++k)
                 if (r[k] > lo && r[k] < hi) cuts[n++] = r[k];
+        } else if (seg.kind == Segment::Kind::SinRamp) {
+            const double tz = detail_sin_velocity_zero(seg);
+            if (tz > lo && tz < hi) cuts[n++] = tz;
         }
         cuts[n++] = hi;
         for (int k = 0; k + 1 < n; ++k) {

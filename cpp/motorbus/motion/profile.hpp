@@ -41,18 +41,23 @@ struct LimitExceeded : InvalidArgument {
 struct Segment {
     enum class Kind : unsigned char {
         Cubic,       // p(t) = p + v t + a t^2/2 + j t^3/6
-        ExpApproach  // p(t) = p_end - (p_end - p) e^{-t/tau}: velocity proportional to error
+        ExpApproach, // p(t) = p_end - (p_end - p) e^{-t/tau}: velocity proportional to error
+        SinRamp      // a(t) = amp sin^2(pi t / tau): CiA 402 sin^2 ramp (6086h = 1)
     };
     Kind kind = Kind::Cubic;
     double t0 = 0;        // start time within the profile (s)
     double duration = 0;  // s, >= 0
     State start;          // state at t0 (j is the segment's constant jerk for Cubic)
-    double tau = 0;       // ExpApproach only: time constant (s)
+    double tau = 0;       // ExpApproach: time constant (s); SinRamp: full ramp length (s)
     double p_end = 0;     // ExpApproach only: the asymptote (the target)
+    double amp = 0;       // SinRamp only: peak acceleration
 
     State at(double t_in_segment) const;  // t_in_segment in [0, duration]
     State end() const { return at(duration); }
 };
+
+// Where a SinRamp segment's velocity crosses zero (-1 if it does not).
+double detail_sin_velocity_zero(const Segment& seg);
 
 // An ordered list of segments starting at t = 0, plus the exact final state.
 // Query before 0 gives the initial state (at rest at p0 unless v0 was given);
@@ -64,13 +69,17 @@ public:
     // Starts at `initial`; segments are appended with append_*.
     explicit Profile(State initial);
 
-    // Appends a constant-jerk segment from the current end state.  Zero-length
+    // Appends a constant-jerk segment from the current end state (final_state():
+    // finish() can set it, which is how a velocity jump is made).  Zero-length
     // segments are dropped.  Returns *this for chaining.
     Profile& append_cubic(double duration, double jerk);
     // Appends a segment with a velocity/acceleration jump at its start: it
     // starts at the current end position with (v, a) and constant jerk j.
     Profile& append_jump(double duration, double v, double a, double jerk);
     Profile& append_exp_approach(double duration, double target, double tau);
+    // Appends a sin^2 acceleration ramp changing the velocity by dv over
+    // `duration` (peak acceleration 2 dv / duration, zero at both ends).
+    Profile& append_sin_ramp(double duration, double dv);
     // Sets the velocity/acceleration the profile rests with after its end
     // (normally 0: a stepper stops from LSPD with a jump), and optionally snaps
     // the final position to `exact_end` (the target) to remove rounding.
@@ -120,7 +129,6 @@ private:
     State final_{};
     double duration_ = 0;
     std::vector<Segment> segments_;
-    std::vector<double> starts_;  // segments_[i].t0, for the search
     State end_state_() const;
 };
 

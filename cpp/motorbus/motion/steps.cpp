@@ -39,6 +39,9 @@ void for_each_step(const Profile& prof, std::size_t max_steps, Emit&& emit) {
             std::sort(r, r + nr);
             for (int k = 0; k < nr; ++k)
                 if (r[k] > 0 && r[k] < seg.duration) cuts[n++] = r[k];
+        } else if (seg.kind == Segment::Kind::SinRamp) {
+            const double tz = detail_sin_velocity_zero(seg);
+            if (tz > 0 && tz < seg.duration) cuts[n++] = tz;
         }
         cuts[n++] = seg.duration;
         for (int k = 0; k + 1 < n; ++k) {
@@ -69,7 +72,7 @@ void for_each_step(const Profile& prof, std::size_t max_steps, Emit&& emit) {
                     t = std::clamp(t, ta, tb);
                     emit(seg.t0 + t, dir);
                 }
-            } else if (seg.start.j == 0) {
+            } else if (seg.kind == Segment::Kind::Cubic && seg.start.j == 0) {
                 // p = p0 + v t + a t^2/2: closed form, no cancellation.
                 const double p0 = seg.start.p, v = seg.start.v, a = seg.start.a;
                 const double s = dir;
@@ -87,7 +90,7 @@ void for_each_step(const Profile& prof, std::size_t max_steps, Emit&& emit) {
                     emit(seg.t0 + t, dir);
                 }
             } else {
-                // Cubic: safeguarded Newton from the previous step's time.
+                // Cubic or sin^2 ramp: safeguarded Newton from the previous step's time.
                 for (std::size_t i = 0; i < levels; ++i, h += dir) {
                     double lo = t_prev, hi = tb;
                     State st = seg.at(lo);
