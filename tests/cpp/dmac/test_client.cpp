@@ -4,6 +4,7 @@
 
 #include "motorbus/drives/dmac/client.hpp"
 #include "motorbus/drives/dmac/sim.hpp"
+#include "motorbus/motion/planner.hpp"
 #include "motorbus/serial/line_server.hpp"
 #include "sim_port.hpp"
 
@@ -385,4 +386,22 @@ TEST(DmacClient, A14MotionCommandIsNeverRetriedOnTimeout) {
     EXPECT_EQ(count(b.port->written(), "MOVE_TO 1000"), 1u);
     b.port->tamper = nullptr;
     EXPECT_TRUE(b.c().status().moving());  // the move did start: query, don't resend
+}
+
+TEST(DmacClient, StreamsAPlannedStraightLineSplitByTheMotionPackage) {
+    Bench b({0, 1});
+    std::vector<motion::Limits> lim(2, motion::Limits{50000, 100000, 100000, 0});
+    auto profiles = motion::plan_straight_line({0, 0}, {30000, -12000}, lim);
+    auto segs = motion::split_interpolation(profiles, 10);
+    ASSERT_GT(segs.size(), 32u);
+    StreamOptions so;
+    so.interpol_time_ms = 10;
+    so.fifo_size = 32;
+    so.sleep = [c = b.clock](Duration d) { c->advance(d.count()); };
+    auto st = stream_interpolation({&b.c(0), &b.c(1)}, segs, so);
+    EXPECT_EQ(st.underruns, 0u);
+    // The splitter makes the offsets sum exactly to each target.
+    b.ms(static_cast<std::int64_t>(segs.size()) * 10 + 20);
+    EXPECT_EQ(b.sim(0).state().position, 30000);
+    EXPECT_EQ(b.sim(1).state().position, -12000);
 }
