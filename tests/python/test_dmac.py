@@ -16,7 +16,7 @@ from motorbus._core import SimClock
 from motorbus.drives import dmac
 from motorbus.drives.dmac import (CommandRejected, DmacClient, UnknownCommand, make_sim, open_link,
                                   stream_interpolation, synchro)
-from motorbus.serial import PtyLineServer
+from motorbus.serial import LineDevice, PtyLineServer
 
 MS = 1_000_000
 
@@ -204,7 +204,9 @@ def test_exit_time_stop_from_another_process():
 
 
 # ---- HOSTILE_INPUTS 2.9 (A-rows) from Python --------------------------------------------
-class Tamper(dmac.DmacSim.__mro__[1]):  # a LineDevice that rewrites the sim's replies
+class Tamper(LineDevice):
+    """Wraps the simulator and rewrites its replies: a hostile or broken module."""
+
     def __init__(self, inner, fn):
         super().__init__()
         self.inner, self.fn = inner, fn
