@@ -286,6 +286,21 @@ class CommandRejected(DriveFault):
         .def("set_profile", &C::set_profile, py::arg("high_speed") = py::none(), py::arg("low_speed") = py::none(),
              py::arg("accel_ms") = py::none(), py::arg("decel_ms") = py::none(), rel,
              "#HIGH_SPEED / #LOW_SPEED (0.01 rpm), #ACCEL_TIME / #DECEL_TIME (ms) in one frame.")
+        .def("torque_ratio", &C::torque_ratio, rel)
+        .def("set_torque_ratio", &C::set_torque_ratio, py::arg("percent"), rel)
+        .def("soft_limits", &C::soft_limits, rel, "(#NEGATIVE_END, #POSITIVE_END)")
+        .def("set_soft_limits", &C::set_soft_limits, py::arg("negative"), py::arg("positive"), rel)
+        .def("output_config", &C::output_config, rel)
+        .def("set_output_config", &C::set_output_config, py::arg("bits"), rel)
+        .def("line_delay", &C::line_delay, rel)
+        .def("set_line_delay", &C::set_line_delay, py::arg("us"), rel)
+        .def("on_reset", &C::on_reset, rel)
+        .def("set_interpolation", &C::set_interpolation, py::arg("time_ms"), py::arg("fifo_size"),
+             py::arg("mode") = 0, rel)
+        .def("analog_input", &C::analog_input, py::arg("channel"), rel)
+        .def("set_analog_output", &C::set_analog_output, py::arg("channel"), py::arg("mv"), rel)
+        .def("driver_temperature", &C::driver_temperature, rel)
+        .def("motor_temperature", &C::motor_temperature, rel)
         .def("user_var", &C::user_var, py::arg("n"), rel)
         .def("set_user_var", &C::set_user_var, py::arg("n"), py::arg("value"), rel)
         .def("memorized_var", &C::memorized_var, py::arg("n"), rel)

@@ -405,3 +405,34 @@ TEST(DmacClient, StreamsAPlannedStraightLineSplitByTheMotionPackage) {
     EXPECT_EQ(b.sim(0).state().position, 30000);
     EXPECT_EQ(b.sim(1).state().position, -12000);
 }
+
+TEST(DmacClient, MoreTypedVariables) {
+    Bench b;
+    auto& c = b.c();
+    c.set_torque_ratio(70);
+    EXPECT_EQ(c.torque_ratio(), 70);
+    c.set_soft_limits(-80000, 100000);
+    EXPECT_EQ(c.soft_limits(), (std::pair<std::int32_t, std::int32_t>{-80000, 100000}));
+    EXPECT_THROW(c.set_soft_limits(5, -5), InvalidArgument);
+    c.set_output_config(1);
+    EXPECT_EQ(c.output_config(), 1);
+    c.set_line_delay(1000);
+    EXPECT_EQ(c.line_delay(), 1000);
+    EXPECT_THROW(c.set_line_delay(99), InvalidArgument);
+    c.set_interpolation(50, 16, -1);
+    EXPECT_EQ(c.read(Var::InterpolTime), 50);
+    EXPECT_EQ(c.read(Var::InterpolFifosize), 16);
+    EXPECT_EQ(c.read(Var::InterpolMode), -1);
+    EXPECT_THROW(c.set_interpolation(1, 16), InvalidArgument);
+    b.sim().set_analog(1, -3200);  // the manual's 02#IAN=-3200
+    b.sim().set_analog(2, 1500);   // 04#IA2=1500
+    EXPECT_EQ(c.analog_input(1), -3200);
+    EXPECT_EQ(c.analog_input(2), 1500);
+    c.set_analog_output(1, 4520);
+    EXPECT_EQ(c.read(Var::OutputA1), 4520);
+    EXPECT_THROW(c.set_analog_output(2, 10001), InvalidArgument);
+    EXPECT_EQ(c.motor_temperature(), 650);
+    EXPECT_EQ(c.driver_temperature(), 450);
+    c.set_on_reset(12);
+    EXPECT_EQ(c.on_reset(), 12);
+}

@@ -175,6 +175,42 @@ void DmacClient::set_profile(std::optional<std::int32_t> hs, std::optional<std::
     if (!f.empty()) command(f);
 }
 
+void DmacClient::set_soft_limits(std::int32_t negative, std::int32_t positive) {
+    if (negative > positive)
+        throw InvalidArgument("soft limits: #NEGATIVE_END " + std::to_string(negative) + " is above #POSITIVE_END " +
+                              std::to_string(positive));
+    command(encode_write(kGlobal, Var::NegativeEnd, negative) + ", " + encode_write(kGlobal, Var::PositiveEnd, positive));
+}
+
+void DmacClient::set_interpolation(std::int32_t time_ms, std::int32_t fifo_size, std::int32_t mode) {
+    auto check = [](Var v, std::int32_t x) {
+        const VarInfo& vi = var_info(v);
+        if (x < vi.min || x > vi.max)
+            throw InvalidArgument(vi.name + ": " + std::to_string(x) + " is outside " + std::to_string(vi.min) + ".." +
+                                  std::to_string(vi.max));
+    };
+    check(Var::InterpolTime, time_ms);
+    check(Var::InterpolFifosize, fifo_size);
+    check(Var::InterpolMode, mode);
+    command(encode_write(kGlobal, Var::InterpolTime, time_ms) + ", " +
+            encode_write(kGlobal, Var::InterpolFifosize, fifo_size) + ", " +
+            encode_write(kGlobal, Var::InterpolMode, mode));
+}
+
+std::int32_t DmacClient::analog_input(int channel) {
+    // A module answers nothing for a variable it lacks, so pick by name:
+    // #INPUT_ANALOG (DMAC17/23) for channel 1, #INPUT_A2 (DMAC34) for channel 2.
+    if (channel == 1) return read(Var::InputAnalog);
+    if (channel == 2) return read(Var::InputA2);
+    throw InvalidArgument("analog input: channel " + std::to_string(channel) + " is not 1 or 2");
+}
+
+void DmacClient::set_analog_output(int channel, std::int32_t mv) {
+    if (channel != 1 && channel != 2)
+        throw InvalidArgument("analog output: channel " + std::to_string(channel) + " is not 1 or 2");
+    write(channel == 1 ? Var::OutputA1 : Var::OutputA2, mv);
+}
+
 // ---- commands -------------------------------------------------------------------------
 void DmacClient::move_to(std::int32_t p) { command("MOVE_TO " + std::to_string(p)); }
 void DmacClient::move_on(std::int32_t d) { command("MOVE_ON " + std::to_string(d)); }

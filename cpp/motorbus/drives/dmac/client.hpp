@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "motorbus/drives/dmac/codec.hpp"
@@ -121,6 +122,27 @@ public:
     std::int32_t line() { return read(Var::Line); }
     void set_profile(std::optional<std::int32_t> high_speed, std::optional<std::int32_t> low_speed,
                      std::optional<std::int32_t> accel_ms, std::optional<std::int32_t> decel_ms);
+    std::int32_t torque_ratio() { return read(Var::TorqueRatio); }
+    void set_torque_ratio(std::int32_t percent) { write(Var::TorqueRatio, percent); }
+    // Soft end-stop positions (#NEGATIVE_END, #POSITIVE_END); enable with soft_ends(true).
+    std::pair<std::int32_t, std::int32_t> soft_limits() {
+        return {read(Var::NegativeEnd), read(Var::PositiveEnd)};
+    }
+    void set_soft_limits(std::int32_t negative, std::int32_t positive);
+    std::int32_t output_config() { return read(Var::OutputConfig); }
+    void set_output_config(std::int32_t bits) { write(Var::OutputConfig, bits); }
+    std::int32_t line_delay() { return read(Var::LineDelay); }
+    void set_line_delay(std::int32_t us) { write(Var::LineDelay, us); }
+    std::int32_t on_reset() { return read(Var::OnReset); }
+    // #INTERPOL_TIME (ms), #INTERPOL_FIFOSIZE (segments), #INTERPOL_MODE (0 SimpleSYNC, -1 UltraSYNC).
+    void set_interpolation(std::int32_t time_ms, std::int32_t fifo_size, std::int32_t mode = 0);
+    // Analog input in mV: channel 1 = #INPUT_ANALOG, channel 2 = #INPUT_A2 (DMAC34).
+    // On a DMAC34 read("#INPUT_A1") names the first input the way the manual does.
+    std::int32_t analog_input(int channel);
+    // DMAC34 analog outputs (#OUTPUT_A1/#OUTPUT_A2), 0..10000 mV.
+    void set_analog_output(int channel, std::int32_t mv);
+    std::int32_t driver_temperature() { return read(Var::DriverTemperature); }
+    std::int32_t motor_temperature() { return read(Var::MotorTemperature); }
     std::int32_t user_var(int n) { return read(v_var(check_family(n, 32, "#V"))); }
     void set_user_var(int n, std::int32_t v) { write(v_var(check_family(n, 32, "#V")), v); }
     std::int32_t memorized_var(int n) { return read(m_var(check_family(n, 8, "#M"))); }
