@@ -115,6 +115,13 @@ def test_client_variables_and_bits(bus):
     assert c0.timer(2) == 200
     sims[0].set_input(3, True)
     assert c0.inputs() == 4
+    c0.set_soft_limits(-80000, 100000)
+    assert c0.soft_limits() == (-80000, 100000)
+    c0.set_interpolation(time_ms=50, fifo_size=16)
+    assert (c0.read("#ITI"), c0.read("#IFI"), c0.read("#IMO")) == (50, 16, 0)
+    sims[0].set_analog(2, 1500)
+    assert c0.analog_input(2) == 1500
+    assert (c0.motor_temperature(), c0.cpu_temperature()) == (650, 520)
     with pytest.raises(motorbus.InvalidArgument):
         c0.write("#STATUS", 1)
     with pytest.raises(motorbus.InvalidArgument):
