@@ -103,20 +103,10 @@ void SlcanBus::command_inline(serial::Port& port, const std::string& line, bool 
 void SlcanBus::do_send(const Frame& frame, Deadline deadline) {
     char line[slcan::kMtu];
     const std::size_t n = slcan::encode_frame_into(frame, line);
-    std::unique_lock wl(write_mutex_, std::defer_lock);
-    if (!wl.try_lock_until(deadline))
-        throw TimeoutError("slcan " + channel() + ": port busy until the send deadline");
     std::shared_ptr<serial::Port> port;
     {
         std::unique_lock lock(mutex_);
-        if (opts_.wait_for_acks &&
-            !cv_.wait_until(lock, deadline, [&] {
-                return stop_ || !link_up_ || pending_.size() < opts_.tx_window;
-            }))
-            throw TimeoutError("slcan " + channel() + ": " + std::to_string(pending_.size()) +
-                               " commands unanswered by the adapter (tx window full)");
-        if (stop_) throw ClosedError("slcan " + channel() + " is closed");
-        if (!link_up_) throw LinkDown("slcan " + channel() + ": link down (reconnecting)");
+        claim_writer(lock, deadline);
         if (opts_.wait_for_acks)
             pending_.push_back(Pending{frame.extended ? 'T' : 't', Clock::now() + opts_.ack_timeout,
                                        true, frame.to_string()});
@@ -126,6 +116,7 @@ void SlcanBus::do_send(const Frame& frame, Deadline deadline) {
         }
         port = port_;
     }
+    WriterRelease release{this};
     try {
         port->write(as_bytes(line, n));
     } catch (const LinkDown& e) {
@@ -136,24 +127,40 @@ void SlcanBus::do_send(const Frame& frame, Deadline deadline) {
     }
 }
 
+void SlcanBus::claim_writer(std::unique_lock<std::mutex>& lock, Deadline deadline) {
+    // One whole line at a time on the port, and (with acks) at most tx_window
+    // unanswered commands: back-pressure instead of an adapter FIFO overflow.
+    const bool ok = cv_.wait_until(lock, deadline, [&] {
+        return stop_ || !link_up_ ||
+               (!writing_ && (!opts_.wait_for_acks || pending_.size() < opts_.tx_window));
+    });
+    if (stop_) throw ClosedError("slcan " + channel() + " is closed");
+    if (!link_up_) throw LinkDown("slcan " + channel() + ": link down (reconnecting)");
+    if (!ok)
+        throw TimeoutError("slcan " + channel() + ": " + std::to_string(pending_.size()) +
+                           " commands unanswered by the adapter (tx window full)");
+    writing_ = true;
+}
+
+void SlcanBus::release_writer() {
+    {
+        std::lock_guard lock(mutex_);
+        writing_ = false;
+    }
+    cv_.notify_all();
+}
+
 void SlcanBus::write_command(const std::string& text, char kind, Deadline deadline) {
     const std::string line = text + "\r";
-    std::unique_lock wl(write_mutex_, std::defer_lock);
-    if (!wl.try_lock_until(deadline)) throw TimeoutError("slcan " + channel() + ": port busy");
     std::shared_ptr<serial::Port> port;
     {
         std::unique_lock lock(mutex_);
-        if (opts_.wait_for_acks &&
-            !cv_.wait_until(lock, deadline, [&] {
-                return stop_ || !link_up_ || pending_.size() < opts_.tx_window;
-            }))
-            throw TimeoutError("slcan " + channel() + ": tx window full");
-        if (stop_) throw ClosedError("slcan " + channel() + " is closed");
-        if (!link_up_) throw LinkDown("slcan " + channel() + ": link down");
+        claim_writer(lock, deadline);
         if (opts_.wait_for_acks)
             pending_.push_back(Pending{kind, Clock::now() + opts_.ack_timeout, false, {}});
         port = port_;
     }
+    WriterRelease release{this};
     try {
         port->write(as_bytes(line.data(), line.size()));
     } catch (const LinkDown& e) {
@@ -355,7 +362,18 @@ bool SlcanBus::reopen() {
         if (!port) return false;
         if (auto* tty = dynamic_cast<serial::TtyPort*>(port.get()))
             tty->set_write_timeout(std::chrono::seconds(2));
-        std::lock_guard wl(write_mutex_);
+        {
+            // Senders bail out while the link is down; wait for one still
+            // inside write() on the dead port to leave.
+            std::unique_lock lock(mutex_);
+            cv_.wait(lock, [&] { return !writing_ || stop_; });
+            if (stop_) {
+                port->close();
+                return false;
+            }
+            writing_ = true;
+        }
+        WriterRelease release{this};
         open_sequence(*port);
         {
             std::lock_guard lock(mutex_);
@@ -431,21 +449,21 @@ void SlcanBus::run() {
         if (opts_.status_poll > Duration::zero() && now >= next_poll) {
             next_poll = now + opts_.status_poll;
             // Never block the receive thread behind a sender waiting for acks
-            // that only this thread can deliver.
-            std::unique_lock wl(write_mutex_, std::try_to_lock);
-            if (wl.owns_lock()) {
-                bool room = true;
-                {
-                    std::lock_guard lock(mutex_);
-                    room = pending_.size() < opts_.tx_window;
-                    if (room && opts_.wait_for_acks)
+            // that only this thread can deliver: skip the poll when busy.
+            bool claimed = false;
+            {
+                std::lock_guard lock(mutex_);
+                if (!writing_ && link_up_ && (!opts_.wait_for_acks || pending_.size() < opts_.tx_window)) {
+                    writing_ = claimed = true;
+                    if (opts_.wait_for_acks)
                         pending_.push_back(Pending{'F', now + opts_.ack_timeout, false, {}});
                 }
-                if (room) {
-                    try {
-                        port->write(as_bytes("F\r", 2));
-                    } catch (const Error&) {
-                    }
+            }
+            if (claimed) {
+                WriterRelease release{this};
+                try {
+                    port->write(as_bytes("F\r", 2));
+                } catch (const Error&) {
                 }
             }
         }
@@ -463,9 +481,15 @@ void SlcanBus::do_close() {
     }
     cv_.notify_all();
     if (port && up) {
-        // Leave the adapter closed, as python-can does; best effort.
-        std::unique_lock wl(write_mutex_, std::defer_lock);
-        if (wl.try_lock_for(std::chrono::milliseconds(200))) {
+        // Leave the adapter closed, as python-can does; best effort, bounded.
+        bool claimed = false;
+        {
+            std::unique_lock lock(mutex_);
+            claimed = cv_.wait_for(lock, std::chrono::milliseconds(200), [&] { return !writing_; });
+            if (claimed) writing_ = true;
+        }
+        if (claimed) {
+            WriterRelease release{this};
             try {
                 port->write(as_bytes("C\r", 2));
             } catch (const std::exception&) {

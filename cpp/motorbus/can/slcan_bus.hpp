@@ -113,13 +113,21 @@ private:
     // while no receive thread reads the port (open sequence).
     void command_inline(serial::Port& port, const std::string& line, bool bel_ok);
     void write_command(const std::string& line, char kind, Deadline deadline);
+    // Waits (mutex_ held) until this thread may write one line; throws
+    // ClosedError / LinkDown / TimeoutError.  release_writer() ends the claim.
+    void claim_writer(std::unique_lock<std::mutex>& lock, Deadline deadline);
+    void release_writer();
+    struct WriterRelease {
+        SlcanBus* bus;
+        ~WriterRelease() { bus->release_writer(); }
+    };
 
     SlcanOptions opts_;
     PortFactory factory_;
     slcan::StreamDecoder decoder_;  // receive thread (or the opener before it starts)
 
-    std::timed_mutex write_mutex_;  // serializes whole lines on the port
     mutable std::mutex mutex_;      // everything below
+    bool writing_ = false;          // a thread owns the port for one whole line
     std::condition_variable cv_;
     std::shared_ptr<serial::Port> port_;
     std::deque<Pending> pending_;
