@@ -135,18 +135,27 @@ void bind_slcan(py::module_& m) {
         m, "SlcanServer",
         "Serve a Bus as an SLCAN adapter on a new pty; SLCAN tools open `pty_path`.")
         .def(py::init([](std::shared_ptr<Bus> bus, std::size_t queue_size, const std::string& version,
-                         const std::string& serial_number, double bus_send_timeout) {
+                         const std::string& serial_number, double bus_send_timeout,
+                         const py::object& port, unsigned baud) {
                  SlcanServerOptions o;
                  o.queue_size = queue_size;
                  o.identity.version = version;
                  o.identity.serial = serial_number;
                  o.bus_send_timeout = secs(bus_send_timeout);
+                 std::string path = port.is_none() ? std::string() : port.cast<std::string>();
                  py::gil_scoped_release nogil;
-                 return std::make_shared<SlcanServer>(std::move(bus), o);
+                 if (path.empty()) return std::make_shared<SlcanServer>(std::move(bus), o);
+                 return std::make_shared<SlcanServer>(std::move(bus), serial::open_port(path, baud), o);
              }),
              py::arg("bus"), py::arg("queue_size") = 65536, py::arg("version") = "V1013",
-             py::arg("serial_number") = "NMB01", py::arg("bus_send_timeout") = 0.1)
-        .def_property_readonly("pty_path", &SlcanServer::pty_path)
+             py::arg("serial_number") = "NMB01", py::arg("bus_send_timeout") = 0.1,
+             py::arg("port") = py::none(), py::arg("baud") = 115200,
+             "Serve `bus` on a new pty, or on the serial device `port` (a UART wired to an SLCAN host).")
+        .def_property_readonly("pty_path",
+                               [](const SlcanServer& s) -> py::object {
+                                   if (s.pty_path().empty()) return py::none();  // serving a real port
+                                   return py::str(s.pty_path());
+                               })
         .def_property_readonly("is_open", &SlcanServer::is_open)
         .def_property_readonly("stats", [](const SlcanServer& s) { return server_stats_dict(s.stats()); })
         .def("close", &SlcanServer::close, py::call_guard<py::gil_scoped_release>())

@@ -39,6 +39,7 @@ def test_decoder_hostile_rows_and_recovery():
     assert d.discard_partial() and d.pending == 0
 
 
+@pytest.mark.threaded
 def test_server_with_pyserial_peer_answers_and_forwards():
     inner = _core.open_virtual(_hub("a"))
     peer = _core.open_virtual(_hub("a"))
@@ -57,6 +58,7 @@ def test_server_with_pyserial_peer_answers_and_forwards():
         assert server.stats["transmitted"] == 1
 
 
+@pytest.mark.threaded
 def test_open_slcan_through_server_both_directions():
     inner = _core.open_virtual(_hub("b"))
     peer = _core.open_virtual(_hub("b"))
@@ -77,6 +79,7 @@ def test_open_slcan_through_server_both_directions():
             assert bus.stats["nacks"] == 0
 
 
+@pytest.mark.threaded
 def test_open_bus_spec_reaches_open_slcan():
     inner = _core.open_virtual(_hub("c"))
     with SlcanServer(inner) as server:
@@ -91,3 +94,27 @@ def test_open_slcan_errors_are_typed():
     with SlcanServer(inner) as server:
         with pytest.raises(motorbus.InvalidArgument):
             open_slcan(server.pty_path, 83333)
+
+
+@pytest.mark.threaded
+def test_server_on_an_existing_serial_port():
+    """SlcanServer(bus, port=...) serves a given device; here the slave of our own pty."""
+    import os
+    import select
+    import tty as ttymod
+    master, slave = os.openpty()
+    ttymod.setraw(slave)
+    inner = _core.open_virtual(_hub("e"))
+    try:
+        with SlcanServer(inner, port=os.ttyname(slave), baud=0) as server:
+            assert server.pty_path is None
+            os.write(master, b"V\r")
+            deadline = time.monotonic() + 3
+            got = b""
+            while not got.endswith(b"\r") and time.monotonic() < deadline:
+                if select.select([master], [], [], 0.1)[0]:
+                    got += os.read(master, 64)
+            assert got == b"V1013\r"
+    finally:
+        os.close(master)
+        os.close(slave)
