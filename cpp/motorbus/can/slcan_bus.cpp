@@ -109,7 +109,7 @@ void SlcanBus::do_send(const Frame& frame, Deadline deadline) {
         claim_writer(lock, deadline);
         if (opts_.wait_for_acks)
             pending_.push_back(Pending{frame.extended ? 'T' : 't', Clock::now() + opts_.ack_timeout,
-                                       true, frame.to_string()});
+                                       true, frame});
         if (opts_.echo_suppression) {
             if (echoes_.size() >= 1024) echoes_.pop_front();
             echoes_.push_back(Echo{frame, Clock::now() + opts_.echo_window});
@@ -319,7 +319,7 @@ bool SlcanBus::complete_oldest(bool ok, char reply_kind) {
         if (p.is_frame) {
             count_tx_dropped();
             ++nacked_frames_since_flush_;
-            last_nacked_ = p.frame_text;
+            last_nacked_ = p.frame.to_string();  // rendered only when refused
         }
     }
     cv_.notify_all();

@@ -95,7 +95,7 @@ private:
         char cmd;                 // 't','T','F','V','N',...
         Deadline expires;
         bool is_frame;
-        std::string frame_text;   // for NACK reports
+        Frame frame{};            // for NACK reports
     };
     struct Echo {
         Frame frame;

@@ -479,3 +479,28 @@ TEST(SlcanBus, L14_PtyHangupIsLinkDownWithoutReconnectFactory) {
     bus.close();  // returns promptly: the receive thread waits, it does not spin
     EXPECT_EQ(bus.state(), BusState::Closed);
 }
+
+TEST(SlcanServer, TimestampedLinesReachSlcanBusIntact) {
+    auto hub = "slcan-test-" + std::to_string(::getpid()) + "-c";
+    auto inner = open_virtual(hub);
+    auto peer = open_virtual(hub);
+    SlcanServer server(inner);
+    auto o = fast_opts();
+    o.timestamps = true;  // Z1: the server appends ssss to every forwarded line (L7 accepts 4)
+    auto bus = open_slcan(server.pty_path(), 125000, o);
+    for (std::uint32_t id : {0x1u, 0x7FFu}) peer->send(Frame::make(id, std::vector<std::uint8_t>{0x5A, 0xA5}));
+    peer->send(Frame::make(0x1ABCDEF, std::vector<std::uint8_t>{}, true, true, 2));
+    for (std::uint32_t id : {0x1u, 0x7FFu}) {
+        auto got = bus->recv(2s);
+        ASSERT_TRUE(got);
+        EXPECT_EQ(got->id, id);
+        EXPECT_EQ(got->len, 2);
+        EXPECT_EQ(got->data[0], 0x5A);
+        EXPECT_EQ(got->data[1], 0xA5);
+    }
+    auto rtr = bus->recv(2s);
+    ASSERT_TRUE(rtr);
+    EXPECT_TRUE(rtr->rtr && rtr->extended);
+    EXPECT_EQ(rtr->id, 0x1ABCDEFu);
+    EXPECT_EQ(bus->counters().parse_errors, 0u);
+}
