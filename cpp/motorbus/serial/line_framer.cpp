@@ -69,7 +69,8 @@ std::optional<FramedLine> LineFramer::push(std::span<const std::uint8_t> in, std
             out.length = count_ - match->size();
             if (discarding_ || out.length > max_line_) {
                 out.kind = FramedLine::Kind::Overlong;
-                out.text = discarding_ ? prefix_ : buf_.substr(0, std::min(out.length, kOverlongPrefix));
+                const std::string& seen = discarding_ ? prefix_ : buf_;
+                out.text = seen.substr(0, std::min({out.length, kOverlongPrefix, seen.size()}));
             } else {
                 out.kind = FramedLine::Kind::Line;
                 out.text = buf_.substr(0, out.length);

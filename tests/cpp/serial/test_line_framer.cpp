@@ -82,6 +82,17 @@ TEST(LineFramer, OverlongPrefixKept) {
     EXPECT_EQ(used, in.size());
 }
 
+TEST(LineFramer, OverlongPrefixNeverIncludesTheTerminator) {
+    LineFramer f({"\r\n"}, 4);
+    std::string in = "toolongreply\r\n";
+    std::span<const std::uint8_t> s(reinterpret_cast<const std::uint8_t*>(in.data()), in.size());
+    std::size_t used = 0;
+    auto line = f.push(s, used);
+    ASSERT_TRUE(line);
+    EXPECT_EQ(line->text, "toolongreply");
+    EXPECT_EQ(line->length, 12u);
+}
+
 TEST(LineFramer, A10_NoiseBurstsThenValidLine) {
     LineFramer f({"\r\n"}, 16);
     std::string noise(200, '\xff');

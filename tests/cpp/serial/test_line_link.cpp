@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "motorbus/serial/port.hpp"
@@ -41,6 +42,12 @@ public:
         return requests_;
     }
     Port& port() { return *port_; }
+    // Blocks until the peer has written every chunk of `n` replies, then lets
+    // the pty hand the bytes over (deterministic "the late tail has landed").
+    void wait_replies(int n) {
+        while (done_.load() < n) std::this_thread::sleep_for(1ms);
+        std::this_thread::sleep_for(20ms);
+    }
 
 private:
     void run() {
@@ -64,6 +71,7 @@ private:
                         if (c.delay_before > Duration::zero()) std::this_thread::sleep_for(c.delay_before);
                         port_->write(as_bytes(c.bytes));
                     }
+                    ++done_;
                 }
             }
         } catch (const ClosedError&) {
@@ -74,6 +82,7 @@ private:
     bool echo_;
     std::mutex m_;
     std::vector<std::string> requests_;
+    std::atomic<int> done_{0};
     std::thread thread_;
 };
 
@@ -124,7 +133,7 @@ TEST(LineLink, A1_LateTailIsFlushedBeforeNextRequest) {
     });
     LineLink link(pty.port(), opts({"\r\n"}, 64, 30ms));
     EXPECT_THROW(link.transact("A"), TimeoutError);
-    std::this_thread::sleep_for(120ms);  // let the tail land in the input queue
+    peer.wait_replies(1);  // the tail is in our input queue now
     EXPECT_EQ(link.transact("B"), "ok:B");
     EXPECT_EQ(link.counters().stale_bytes, 4u);  // "34\r\n"
 }
@@ -138,10 +147,12 @@ TEST(LineLink, A8_LateReplyAfterTimeoutIsDiscarded) {
     });
     LineLink link(pty.port(), opts({"\r\n"}, 64, 30ms));
     EXPECT_THROW(link.transact("A"), TimeoutError);
-    std::this_thread::sleep_for(120ms);
+    peer.wait_replies(1);
     EXPECT_EQ(link.transact("B"), "ok:B");
     EXPECT_EQ(link.counters().stale_bytes, 8u);  // "late:A\r\n"
 }
+
+static_assert(std::is_base_of_v<ProtocolError, ReplyTooLong>, "ReplyTooLong must be catchable as ProtocolError");
 
 TEST(LineLink, A3_OverlongReplyIsReplyTooLongThenNextWorks) {
     PtyPair pty;
@@ -189,7 +200,7 @@ TEST(LineLink, A10_NoiseBurstsNeverCrashAndResync) {
     LineLink link(pty.port(), opts({"\r\n"}, 64));
     // Noise that arrived before the request is stale and flushed.
     peer.port().write(as_bytes(noise));
-    std::this_thread::sleep_for(20ms);
+    std::this_thread::sleep_for(50ms);
     EXPECT_THROW(link.transact("A"), ReplyTooLong);
     EXPECT_EQ(link.transact("B"), std::string("\xff\xff\x00" "7", 4));  // the link returns exact bytes
     EXPECT_EQ(link.transact("C"), "42");
@@ -263,7 +274,7 @@ TEST(LineLink, NoFlushKeepsEarlyBytes) {
     o.flush_before_request = false;
     LineLink link(pty.port(), o);
     peer->write(as_bytes("early\r\n"));
-    std::this_thread::sleep_for(10ms);
+    std::this_thread::sleep_for(50ms);
     EXPECT_EQ(link.transact("X"), "early");
 }
 

@@ -80,7 +80,7 @@ TEST(PtyPair, FlushInputDropsStaleBytes) {
     PtyPair pty;
     auto peer = pty.open_slave();
     peer->write(as_bytes("stale"));
-    std::this_thread::sleep_for(10ms);
+    std::this_thread::sleep_for(50ms);
     pty.port()->flush_input();
     peer->write(as_bytes("new"));
     EXPECT_EQ(read_exact(*pty.port(), 3), "new");
