@@ -504,3 +504,33 @@ TEST(SlcanServer, TimestampedLinesReachSlcanBusIntact) {
     EXPECT_EQ(rtr->id, 0x1ABCDEFu);
     EXPECT_EQ(bus->counters().parse_errors, 0u);
 }
+
+TEST(SlcanBus, BurstsAreBatchedInOrderAndIsolatedFramesStillGoStraightOut) {
+    auto hub = "slcan-test-" + std::to_string(::getpid()) + "-d";
+    auto inner = open_virtual(hub);
+    VirtualOptions vo;
+    vo.rx_queue_size = 100000;
+    auto peer = open_virtual(hub, vo);
+    SlcanServer server(inner);
+    auto o = fast_opts();
+    o.wait_for_acks = false;  // no window: the burst goes as fast as it can
+    auto bus = open_slcan(server.pty_path(), 500000, o);
+    ASSERT_TRUE(eventually([&] { return server.is_open(); }));
+    constexpr std::uint32_t kN = 5000;
+    for (std::uint32_t i = 0; i < kN; ++i)
+        bus->send(Frame::make(i % 0x800, std::vector<std::uint8_t>{static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8)}));
+    bus->flush_tx(5s);
+    for (std::uint32_t i = 0; i < kN; ++i) {
+        auto got = peer->recv(5s);
+        ASSERT_TRUE(got) << "frame " << i;
+        ASSERT_EQ(got->id, i % 0x800);
+        ASSERT_EQ(got->data[0] | (got->data[1] << 8), static_cast<int>(i & 0xFFFF));
+    }
+    EXPECT_EQ(bus->counters().tx_dropped, 0u);
+    // A lone frame after a pause is written directly and still arrives.
+    std::this_thread::sleep_for(5ms);
+    bus->send(Frame::make(0x7AB, std::vector<std::uint8_t>{0x01}));
+    auto got = peer->recv(2s);
+    ASSERT_TRUE(got);
+    EXPECT_EQ(got->id, 0x7ABu);
+}
