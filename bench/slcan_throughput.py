@@ -7,7 +7,7 @@ protocol, so the very same harness times both libraries:
 * rx:  the harness writes N data frames (id 0x200) as fast as the pty takes
        them, then a sync frame 0x201; the agent answers 0x202 with its count.
 * tx:  the harness sends 0x300 with N; the agent sends N frames (0x400) as
-       fast as it can; the harness times the first to the last line.
+       fast as it can; the harness times its command to the agent's last line.
 * rtt: the harness sends 0x100 and waits for the agent's echo 0x101, K times.
 
     PYTHONPATH=python python3 bench/slcan_throughput.py [--n 20000] [--k 500]
@@ -172,26 +172,23 @@ def harness(fd: int, n: int, k: int) -> dict:
     got = struct.unpack("<I", bytes.fromhex(reply[5:13].decode()))[0]
     # tx
     w.buf = b""
+    t_first = time.perf_counter()  # from the command: includes the agent's reaction time
     w.write(frame_line(TX_CMD, struct.pack("<I", n)))
     # the agent sends nothing else meanwhile: count line ends in raw chunks
     import select
     seen = 0
-    t_first = None
     end = time.monotonic() + 120
     while seen < n and time.monotonic() < end:
         r, _, _ = select.select([fd], [], [], 1.0)
         if not r:
             continue
-        chunk = os.read(fd, 1 << 16)
-        if t_first is None:
-            t_first = time.perf_counter()
-        seen += chunk.count(b"\r")
+        seen += os.read(fd, 1 << 16).count(b"\r")
     tx_elapsed = time.perf_counter() - t_first
     w.write(frame_line(STOP_ID, b""))
     rtts.sort()
     return {
         "rx_fps": got / rx_elapsed, "rx_received": got, "n": n,
-        "tx_fps": (n - 1) / tx_elapsed if tx_elapsed > 0 else float("inf"),
+        "tx_fps": n / tx_elapsed,
         "rtt_median_us": statistics.median(rtts) / 1e3,
         "rtt_p99_us": rtts[min(len(rtts) - 1, int(len(rtts) * 0.99))] / 1e3,
     }

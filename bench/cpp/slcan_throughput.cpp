@@ -126,17 +126,17 @@ public:
         r.rx_received = got;
         // tx: count the agent's lines (it sends nothing else meanwhile)
         drain();
+        // timed from the command, so the agent's reaction time is included
+        const Steady::time_point first = Steady::now();
         write(line_for(kTxCmd, le32(static_cast<std::uint32_t>(n))));
         std::size_t seen = 0;
-        Steady::time_point first{};
         std::uint8_t buf[65536];
         const auto end = Steady::now() + 300s;
         while (seen < n && Steady::now() < end) {
             std::size_t m = port_->read(buf, 1s);
-            if (m && seen == 0) first = Steady::now();
             seen += static_cast<std::size_t>(std::count(buf, buf + m, '\r'));
         }
-        r.tx_fps = (n - 1) / std::chrono::duration<double>(Steady::now() - first).count();
+        r.tx_fps = n / std::chrono::duration<double>(Steady::now() - first).count();
         write(line_for(kStop, {}));
         return r;
     }
