@@ -102,7 +102,7 @@ void bind_slcan(py::module_& m) {
           [](const std::string& path, unsigned bitrate, bool timestamps, bool echo_suppression,
              bool listen_only, bool wait_for_acks, std::size_t tx_window, double ack_timeout,
              double open_timeout, double status_poll, unsigned tty_baud, const py::object& btr,
-             bool receive_own, std::size_t rx_queue_size) {
+             bool receive_own, std::size_t rx_queue_size, double tx_coalesce) {
               SlcanOptions o;
               o.timestamps = timestamps;
               o.echo_suppression = echo_suppression;
@@ -113,6 +113,7 @@ void bind_slcan(py::module_& m) {
               o.open_timeout = secs(open_timeout);
               o.status_poll = secs(status_poll);
               o.tty_baud = tty_baud;
+              o.tx_coalesce = secs(tx_coalesce);
               if (!btr.is_none()) {
                   auto v = btr.cast<unsigned>();
                   if (v > 0xFFFF) throw InvalidArgument("btr: BTR0<<8|BTR1 must be 0-0xFFFF");
@@ -128,7 +129,7 @@ void bind_slcan(py::module_& m) {
           py::arg("wait_for_acks") = true, py::arg("tx_window") = 16, py::arg("ack_timeout") = 1.0,
           py::arg("open_timeout") = 1.0, py::arg("status_poll") = 0.0, py::arg("tty_baud") = 115200,
           py::arg("btr") = py::none(), py::arg("receive_own") = false,
-          py::arg("rx_queue_size") = 65536,
+          py::arg("rx_queue_size") = 65536, py::arg("tx_coalesce") = 20e-6,
           "Open an SLCAN adapter at `path` (C, Sn, [Z1], O) as a Bus; reconnects after unplug.");
 
     py::class_<SlcanServer, std::shared_ptr<SlcanServer>>(
