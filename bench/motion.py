@@ -61,10 +61,24 @@ def main():
     for _ in range(5):
         motion.jerk_limited_durations(c)
     batch = (time.process_time_ns() - t0) / (5 * n)
+    # Per-call binding overhead, measured with a request that needs no planning
+    # (already at rest on the target) on both sides.
+    idle = ruckig.InputParameter(1)
+    idle.current_position = [1.0]
+    idle.target_position = [1.0]
+    idle.max_velocity = [1.0]
+    idle.max_acceleration = [1.0]
+    idle.max_jerk = [1.0]
+    rk_idle = min(per_call(lambda i: otg.calculate(i, traj), [idle] * n) for _ in range(3))
+    ours_idle_args = (motion.MotionState(1.0, 0.0, 0.0), 1.0, motion.Limits(1.0, 1.0, 0.0, 1.0))
+    us_idle = min(per_call(lambda a: motion.plan_jerk_limited(*a), [ours_idle_args] * n) for _ in range(3))
     print(f"jerk-limited 1-DoF plan, {n} random cases (half from rest, half moving):")
+    print(f"  overhead (call that plans nothing): ruckig {rk_idle:.1f} ns, motorbus {us_idle:.1f} ns")
     print(f"  ruckig per call from Python      {rk:9.1f} ns")
     print(f"  motorbus per call from Python    {us:9.1f} ns   ratio ruckig/motorbus = {rk / us:.2f}")
     print(f"  motorbus in a C++ loop (batch)   {batch:9.1f} ns   vs ruckig C++ anchor 360 ns: {360 / batch:.2f}x")
+    print(f"  minus each side's overhead: ruckig {rk - rk_idle:.1f} ns, motorbus {us - us_idle:.1f} ns, "
+          f"ratio {(rk - rk_idle) / (us - us_idle):.2f}")
 
     # Trapezoidal: ruckig with infinite jerk vs our trapezoid.
     for inp in inputs:

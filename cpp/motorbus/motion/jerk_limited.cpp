@@ -101,22 +101,25 @@ void append_ramp(Profile& prof, double v_from, double v_to, double amax, double 
 // The time-optimal peak velocity (and cruise time) to cover D from v0 and stop.
 void peak_for_distance(const Shape& sh, double v0, double D, double vmax, double& vp, double& cruise) {
     cruise = 0;
-    const double f_hi = dist(sh, v0, vmax), f_lo = dist(sh, v0, -vmax);
-    if (D >= f_hi) {
-        // Far enough to cruise at +vmax: nothing is faster.
-        vp = vmax;
-        cruise = (D - f_hi) / vmax;
-    } else if (D <= f_lo) {
-        vp = -vmax;
-        cruise = (D - f_lo) / -vmax;
+    // The stopping distance f0 = dist(0) = dist(v0) tells which side the peak is on;
+    // dist(vp) increases with vp on [max(v0,0), vmax] and on [-vmax, min(v0,0)].
+    const double f0 = 0.5 * v0 * sh.T(v0);
+    if (D >= f0) {
+        const double f_hi = dist(sh, v0, vmax);
+        if (D >= f_hi) {  // far enough to cruise at +vmax: nothing is faster
+            vp = vmax;
+            cruise = (D - f_hi) / vmax;
+        } else {
+            vp = solve(sh, v0, D, v0 > vmax ? 0.0 : std::max(v0, 0.0), vmax);  // v0 above the limit: whole side
+        }
     } else {
-        // dist(vp) increases with vp on [max(v0,0), vmax] and on [-vmax, min(v0,0)];
-        // the stopping distance f0 = dist(0) = dist(v0) tells which side holds the root.
-        const double f0 = dist(sh, v0, 0.0);
-        if (D >= f0)
-            vp = solve(sh, v0, D, std::max(v0, 0.0), vmax);
-        else
-            vp = solve(sh, v0, D, -vmax, std::min(v0, 0.0));
+        const double f_lo = dist(sh, v0, -vmax);
+        if (D <= f_lo) {
+            vp = -vmax;
+            cruise = (D - f_lo) / -vmax;
+        } else {
+            vp = solve(sh, v0, D, -vmax, v0 < -vmax ? 0.0 : std::min(v0, 0.0));
+        }
     }
 }
 
