@@ -133,8 +133,12 @@ class LimitExceeded(InvalidArgument):
              [](const Profile& p, std::size_t max_steps) { return vec_to_array(step_times_seconds(p, max_steps)); },
              py::arg("max_steps") = 100'000'000);
 
+    // The 3-argument overload first: converting a defaulted enum argument costs
+    // more than the plan itself.
+    m.def("plan_trapezoid", [](const State& s, double t, const Limits& l) { return plan_trapezoid(s, t, l); },
+          py::arg("start"), py::arg("target"), py::arg("limits"));
     m.def("plan_trapezoid", &plan_trapezoid, py::arg("start"), py::arg("target"), py::arg("limits"),
-          py::arg("shape") = RampShape::Trapezoid);
+          py::arg("shape"));
     m.def("plan_velocity", &plan_velocity, py::arg("start"), py::arg("target_velocity"), py::arg("limits"),
           py::arg("hold") = 0.0, py::arg("shape") = RampShape::Trapezoid);
     m.def("plan_jerk_limited", &plan_jerk_limited, py::arg("start"), py::arg("target"), py::arg("limits"));
