@@ -141,6 +141,8 @@ class LimitExceeded(InvalidArgument):
           py::arg("shape"));
     m.def("plan_velocity", &plan_velocity, py::arg("start"), py::arg("target_velocity"), py::arg("limits"),
           py::arg("hold") = 0.0, py::arg("shape") = RampShape::Trapezoid);
+    m.def("plan_jerk_limited_velocity", &plan_jerk_limited_velocity, py::arg("start"), py::arg("target_velocity"),
+          py::arg("limits"), py::arg("hold") = 0.0);
     m.def("plan_jerk_limited", &plan_jerk_limited, py::arg("start"), py::arg("target"), py::arg("limits"));
     m.def("plan_synchronized", &plan_synchronized, py::arg("start"), py::arg("target"), py::arg("limits"),
           py::arg("shape") = RampShape::Trapezoid);

@@ -60,6 +60,7 @@ from ._core import (  # noqa: F401
     dmac_speed_profile,
     jerk_limited_durations,
     plan_jerk_limited,
+    plan_jerk_limited_velocity,
     plan_straight_line,
     plan_synchronized,
     plan_synchronized_jerk_limited,
@@ -79,7 +80,7 @@ __all__ = [
     "DmacProfileParams", "LimitExceeded", "Limits", "MotionState", "Profile", "RampShape", "SnlConfig",
     "StepNLoop", "arcus_check_strict", "arcus_effective", "arcus_max_acc_ms", "arcus_speed_windows",
     "arcus_window_for_hspd", "arcus_window_for_sspdm", "dmac_position_profile", "dmac_ramp_time",
-    "dmac_speed_profile", "jerk_limited_durations", "plan", "plan_jerk_limited", "plan_straight_line",
+    "dmac_speed_profile", "jerk_limited_durations", "plan", "plan_jerk_limited", "plan_jerk_limited_velocity", "plan_straight_line",
     "plan_synchronized", "plan_synchronized_jerk_limited", "synchronized_jerk_limited_durations", "plan_trapezoid", "plan_velocity", "sample", "split_interpolation", "step_times",
     "dmac_interpolation",
 ]

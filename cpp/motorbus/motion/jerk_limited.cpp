@@ -164,6 +164,26 @@ Profile plan_jerk_limited(const State& start, double target, const Limits& lim) 
     return prof;
 }
 
+Profile plan_jerk_limited_velocity(const State& start, double vt, const Limits& lim, double hold) {
+    check_jerk_limits(lim);
+    if (!std::isfinite(start.p) || !std::isfinite(start.v) || !std::isfinite(start.a) || !std::isfinite(vt))
+        throw InvalidArgument("plan_jerk_limited_velocity: start state and target must be finite");
+    if (std::fabs(vt) > lim.max_velocity)
+        throw LimitExceeded("max_velocity", std::fabs(vt), lim.max_velocity, "target velocity");
+    if (std::fabs(start.a) > lim.max_acceleration * (1 + 1e-12))
+        throw LimitExceeded("max_acceleration", std::fabs(start.a), lim.max_acceleration, "initial acceleration");
+    if (!(hold >= 0) || !std::isfinite(hold)) throw InvalidArgument("plan_jerk_limited_velocity: hold must be >= 0");
+    Profile prof(State{start.p, start.v, start.a, 0});
+    if (start.a != 0) {
+        const double t = std::fabs(start.a) / lim.max_jerk;
+        prof.append_jump(t, start.v, start.a, start.a > 0 ? -lim.max_jerk : lim.max_jerk);
+    }
+    append_ramp(prof, prof.final_state().v, vt, lim.max_acceleration, lim.max_jerk);
+    if (hold > 0) prof.append_cubic(hold, 0.0);
+    prof.finish(prof.final_state().p, vt);
+    return prof;
+}
+
 std::vector<Profile> plan_synchronized_jerk_limited(const std::vector<double>& start,
                                                     const std::vector<double>& target,
                                                     const std::vector<Limits>& limits) {
