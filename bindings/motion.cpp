@@ -86,7 +86,8 @@ class LimitExceeded(InvalidArgument):
         .def_readwrite("max_jerk", &Limits::max_jerk);
     py::enum_<RampShape>(m, "RampShape")
         .value("TRAPEZOID", RampShape::Trapezoid)
-        .value("SCURVE", RampShape::SCurve);
+        .value("SCURVE", RampShape::SCurve)
+        .value("SIN2", RampShape::Sin2);
 
     py::class_<Profile>(m, "Profile", "A planned motion: position/velocity/acceleration/jerk at any time.")
         .def_property_readonly("duration", &Profile::duration)

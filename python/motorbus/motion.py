@@ -85,7 +85,8 @@ __all__ = [
     "dmac_interpolation",
 ]
 
-_SHAPES = {"trapezoid": RampShape.TRAPEZOID, "s_curve": RampShape.SCURVE, "scurve": RampShape.SCURVE}
+_SHAPES = {"trapezoid": RampShape.TRAPEZOID, "s_curve": RampShape.SCURVE, "scurve": RampShape.SCURVE,
+           "sin2": RampShape.SIN2}
 
 
 def _shape(shape: str | RampShape) -> RampShape:
@@ -103,8 +104,9 @@ def plan(target: float, *, start: float = 0.0, v0: float = 0.0, a0: float = 0.0,
     """Plan a move to rest at ``target``.
 
     With ``max_jerk`` the jerk-limited time-optimal (7-phase) planner is used
-    (same durations as ruckig); otherwise a trapezoid, or an S-curve with the
-    same ramp times when ``shape="s_curve"``.  Raises ``LimitExceeded``.
+    (same durations as ruckig); otherwise a trapezoid, or with the same ramp
+    times an S-curve (``shape="s_curve"``) or sin^2 ramps (``shape="sin2"``).
+    Raises ``LimitExceeded``.
     """
     if max_jerk is not None:
         return plan_jerk_limited(MotionState(start, v0, a0), target,
