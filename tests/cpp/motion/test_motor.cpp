@@ -326,3 +326,45 @@ TEST(Cia402Homing, Methods) {
     Cia402Homing h(m, p);
     EXPECT_THROW(h.start(), motorbus::InvalidArgument);
 }
+
+// A host wrapping an open-loop drive with an encoder in StepNLoop: a jam loses
+// steps, verification at the end of the move corrects them (Table 7.7).
+TEST(StepNLoop, WrapsOpenLoopMotorAndCorrectsLostSteps) {
+    SimClock clk;
+    MotorModel m(clk);
+    StepNLoop snl;  // SLT 20, SLE 1000 counts, ratio 0.8 steps/count
+    const double target_counts = 4000;  // one rev
+    ASSERT_TRUE(snl.begin(SnlActivity::Move));
+    m.command(move_profile(0, m.counts_to_steps(target_counts)));
+    clk.advance(200 * kMs);
+    m.update();
+    m.set_jammed(true);  // the load blocks the rotor for a while: steps are lost
+    clk.advance(100 * kMs);
+    m.update();
+    m.set_jammed(false);
+    for (int i = 0; i < 300 && m.moving(); ++i) {
+        clk.advance(10 * kMs);
+        m.update();
+        // While moving, delta is the real-time target minus the encoder.
+        const double delta_now = snl.pulses_to_counts(m.pulse_position()) - static_cast<double>(m.encoder());
+        ASSERT_EQ(snl.monitor(delta_now).action, SnlAction::None) << delta_now;  // < SLE
+    }
+    ASSERT_FALSE(m.moving());
+    double delta = target_counts - static_cast<double>(m.encoder());
+    ASSERT_GT(delta, 20);  // out of position
+    SnlDecision d = snl.motion_done(delta);
+    int corrections = 0;
+    while (d.action == SnlAction::Correct) {
+        ++corrections;
+        m.command(move_profile(m.pulse_position(), m.pulse_position() + snl.counts_to_pulses(d.correction)));
+        for (int i = 0; i < 300 && m.moving(); ++i) {
+            clk.advance(10 * kMs);
+            m.update();
+        }
+        d = snl.motion_done(target_counts - static_cast<double>(m.encoder()));
+    }
+    EXPECT_EQ(d.action, SnlAction::InPosition);
+    EXPECT_GE(corrections, 1);
+    EXPECT_LE(std::abs(target_counts - static_cast<double>(m.encoder())), 5);
+    EXPECT_EQ(snl.status(), SnlStatus::Idle);
+}
