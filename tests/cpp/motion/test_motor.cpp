@@ -368,3 +368,29 @@ TEST(StepNLoop, WrapsOpenLoopMotorAndCorrectsLostSteps) {
     EXPECT_LE(std::abs(target_counts - static_cast<double>(m.encoder())), 5);
     EXPECT_EQ(snl.status(), SnlStatus::Idle);
 }
+
+TEST(MotorModel, LongJogOnSimClockIsCheapAndExact) {
+    SimClock clk;
+    MotorConfig cfg;
+    cfg.home = SwitchConfig{true, 1e6, 1e6 + 2, true};  // a 2-step window far away
+    MotorModel m(clk, cfg);
+    int index = 0, home_on = 0;
+    Nanos home_t = 0;
+    m.add_listener([&](const MotorEvent& e) {
+        index += e.kind == MotorEvent::Kind::IndexPulse;
+        if (e.kind == MotorEvent::Kind::HomeOn) {
+            ++home_on;
+            home_t = e.t;
+        }
+    });
+    ArcusMotion a(ArcusProfileParams{3200, 100, 100, 100, false, false, 1.0});
+    a.jog(0, 1);
+    m.command(a.profile());
+    clk.advance(3600 * kSec);  // one simulated hour of jogging
+    m.update();
+    EXPECT_NEAR(m.pulse_position(), a.profile().position(3600.0), 1e-3);
+    EXPECT_EQ(home_on, 1);
+    EXPECT_NEAR(static_cast<double>(home_t), a.profile().first_crossing(1e6) * 1e9, 2.0);
+    // Index once per rev: floor((p - 0) / 3200) + 1 rising edges from 0 (the first at 0 itself is not crossed).
+    EXPECT_EQ(index, static_cast<int>(std::floor(m.physical_position() / 3200.0)));
+}
