@@ -232,6 +232,9 @@ TEST(SlcanServer, AnswersRawCommandsAndForwardsOnlyWhileOpen) {
         return out;
     };
     peer->send(Frame::make(0x100, std::vector<std::uint8_t>{1}));  // closed: not forwarded
+    // Delivery to the server's endpoint is asynchronous: let it land before opening.
+    for (int i = 0; i < 200 && inner->counters().rx_frames < 1; ++i) std::this_thread::sleep_for(5ms);
+    ASSERT_EQ(inner->counters().rx_frames, 1u);
     tty->write(bytes_of("V\rN\rt1230\rS6\rZ1\rO\r"));
     EXPECT_EQ(read_until(6), "V1013\rNMB01\r\a\r\r\r");
     peer->send(Frame::make(0x101, std::vector<std::uint8_t>{0xAB}));
