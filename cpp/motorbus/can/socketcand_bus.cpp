@@ -1,0 +1,342 @@
+#include "motorbus/can/socketcand_bus.hpp"
+
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <vector>
+
+#include "motorbus/errors.hpp"
+
+namespace motorbus::can {
+
+using socketcand::Element;
+using socketcand::ElementKind;
+using socketcand::ParseError;
+
+namespace {
+
+Nanos to_ns(Duration d) { return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count(); }
+
+// Blocking write for the handshake (the socket is non-blocking).
+void write_all(int fd, const std::string& s, Deadline deadline) {
+    std::size_t off = 0;
+    while (off < s.size()) {
+        ssize_t r = ::send(fd, s.data() + off, s.size() - off, MSG_NOSIGNAL);
+        if (r > 0) {
+            off += static_cast<std::size_t>(r);
+            continue;
+        }
+        if (r < 0 && errno == EINTR) continue;
+        if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            pollfd p{fd, POLLOUT, 0};
+            if (::poll(&p, 1, net::poll_ms_until(deadline)) == 0 &&
+                std::chrono::steady_clock::now() >= deadline)
+                throw TimeoutError("socketcand: handshake write timed out");
+            continue;
+        }
+        throw LinkDown(std::string("socketcand: write failed: ") + std::strerror(errno));
+    }
+}
+
+}  // namespace
+
+SocketcandBus::SocketcandBus(const std::string& host, std::uint16_t port, const std::string& channel,
+                             const SocketcandOptions& options)
+    : Bus("socketcand:" + host + ":" + std::to_string(port) + "/" + channel, options),
+      opts_(options),
+      host_(host),
+      port_(port),
+      parser_(options.max_element) {
+    if (channel.empty() || channel.size() > socketcand::kMaxChannelName)
+        throw InvalidArgument("socketcand channel: '" + channel + "' must be 1-16 characters");
+    for (char c : channel)
+        if (c == '<' || c == '>' || c == ' ' || static_cast<unsigned char>(c) < 0x21)
+            throw InvalidArgument("socketcand channel: '" + channel + "' contains a blank or < >");
+    if (options.keepalive_misses < 1) throw InvalidArgument("keepalive_misses: must be >= 1");
+    sock_ = net::tcp_connect(host, port, deadline_after(options.connect_timeout));
+    net::set_nodelay(sock_.get());
+    if (options.tcp_keepalive) {
+        // Kernel probes are a backstop for when echo is off; seconds granularity.
+        auto period = std::chrono::duration_cast<std::chrono::seconds>(options.keepalive_period);
+        if (period.count() < 1) period = std::chrono::seconds(1);
+        net::set_tcp_keepalive(sock_.get(), period, period, options.keepalive_misses);
+    }
+    handshake(channel, deadline_after(options.handshake_timeout));
+    last_rx_ns_.store(monotonic_ns());
+    for (const Frame& f : early_frames_) dispatch(f);
+    early_frames_.clear();
+    rx_thread_ = std::thread([this] { rx_loop(); });
+}
+
+SocketcandBus::~SocketcandBus() { close(); }
+
+void SocketcandBus::handshake(const std::string& channel, Deadline deadline) {
+    enum { WantHi, WantOpenOk, WantRawOk, Done } step = WantHi;
+    std::vector<Element> got;
+    char buf[4096];
+    while (step != Done) {
+        pollfd p{sock_.get(), POLLIN, 0};
+        int n = ::poll(&p, 1, net::poll_ms_until(deadline));
+        if (n < 0 && errno == EINTR) continue;
+        if (n == 0) {
+            if (std::chrono::steady_clock::now() >= deadline)
+                throw TimeoutError(std::string("socketcand: no ") +
+                                   (step == WantHi ? "< hi >" : "< ok >") + " from " + host_ +
+                                   " within the handshake timeout");
+            continue;
+        }
+        ssize_t r = ::recv(sock_.get(), buf, sizeof buf, 0);
+        if (r == 0) throw LinkDown("socketcand: server closed the connection during the handshake");
+        if (r < 0) {
+            if (errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK) continue;
+            throw LinkDown(std::string("socketcand: handshake read failed: ") + std::strerror(errno));
+        }
+        const Nanos now = monotonic_ns();
+        got.clear();
+        parser_.feed(std::span<const char>(buf, static_cast<std::size_t>(r)),
+                     [&](const Element& e) { got.push_back(e); },
+                     [&](const ParseError&) { count_parse_error(); });
+        for (const Element& e : got) {
+            if (step == Done) {  // frames that raced the final < ok >
+                if (e.kind == ElementKind::Frame || e.kind == ElementKind::FdFrame ||
+                    e.kind == ElementKind::Rtr) {
+                    Frame f = e.frame;
+                    f.timestamp_ns = now;
+                    early_frames_.push_back(f);
+                }
+                continue;
+            }
+            if (e.kind == ElementKind::ErrorText) {
+                throw LinkDown("socketcand: server refused " +
+                               std::string(step == WantOpenOk ? "channel '" + channel + "'" : "rawmode") +
+                               ": " + e.text);
+            }
+            std::string out;
+            if (step == WantHi && e.kind == ElementKind::Hi) {
+                socketcand::encode_open(channel, out);
+                write_all(sock_.get(), out, deadline);
+                step = WantOpenOk;
+            } else if (step == WantOpenOk && e.kind == ElementKind::Ok) {
+                socketcand::encode_command(ElementKind::RawMode, out);
+                write_all(sock_.get(), out, deadline);
+                step = WantRawOk;
+            } else if (step == WantRawOk && e.kind == ElementKind::Ok) {
+                step = Done;
+            } else {
+                count_ignored();
+            }
+        }
+    }
+    account_parser();
+}
+
+void SocketcandBus::do_close() {
+    stop_.store(true);
+    wake_.signal();
+    if (rx_thread_.joinable()) rx_thread_.join();
+    {
+        // Best effort: hand over what is already committed, without blocking.
+        std::unique_lock lk(tx_mutex_, std::defer_lock);
+        if (lk.try_lock_for(std::chrono::milliseconds(100)) && !link_down_.load()) flush_locked();
+    }
+    if (sock_) ::shutdown(sock_.get(), SHUT_RDWR);
+    sock_.reset();
+}
+
+std::string SocketcandBus::link_down_reason() const {
+    std::lock_guard lk(info_mutex_);
+    return link_down_reason_;
+}
+
+std::string SocketcandBus::last_server_error() const {
+    std::lock_guard lk(info_mutex_);
+    return last_server_error_;
+}
+
+socketcand::ParserStats SocketcandBus::parser_stats() const {
+    std::lock_guard lk(stats_mutex_);
+    return stats_snapshot_;
+}
+
+void SocketcandBus::mark_link_down(const std::string& why) {
+    {
+        std::lock_guard lk(info_mutex_);
+        if (link_down_.load()) return;
+        link_down_reason_ = why;
+    }
+    link_down_.store(true);
+    // No medium any more: Bus::send() refuses with LinkDown and state() shows it.
+    set_state(BusState::BusOff);
+}
+
+void SocketcandBus::account_parser() {
+    const auto& s = parser_.stats();
+    for (auto i = parser_seen_.overlong; i < s.overlong; ++i) count_overrun();
+    for (auto i = parser_seen_.interrupted; i < s.interrupted; ++i) count_parse_error();
+    parser_seen_ = s;
+    std::lock_guard lk(stats_mutex_);
+    stats_snapshot_ = s;
+}
+
+bool SocketcandBus::flush_locked() {
+    while (tx_off_ < tx_buf_.size()) {
+        ssize_t r = ::send(sock_.get(), tx_buf_.data() + tx_off_, tx_buf_.size() - tx_off_,
+                           MSG_NOSIGNAL | MSG_DONTWAIT);
+        if (r > 0) {
+            tx_off_ += static_cast<std::size_t>(r);
+        } else if (r < 0 && errno == EINTR) {
+            continue;
+        } else if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            break;
+        } else {
+            mark_link_down(std::string("socketcand: write failed: ") + std::strerror(errno));
+            return false;
+        }
+    }
+    if (tx_off_ == tx_buf_.size()) {
+        tx_buf_.clear();
+        tx_off_ = 0;
+        tx_pending_.store(false);
+    } else {
+        if (tx_off_ > 65536) {
+            tx_buf_.erase(0, tx_off_);
+            tx_off_ = 0;
+        }
+        // Let the receive thread finish the write when the socket drains.
+        if (!tx_pending_.exchange(true)) wake_.signal();
+    }
+    return true;
+}
+
+void SocketcandBus::do_send(const Frame& frame, Deadline deadline) {
+    std::unique_lock lk(tx_mutex_, std::defer_lock);
+    if (!lk.try_lock_until(deadline))
+        throw TimeoutError("socketcand: send timed out behind another sender");
+    for (;;) {
+        if (link_down_.load()) throw LinkDown(link_down_reason());
+        if (tx_buf_.size() - tx_off_ < opts_.tx_buffer_bytes) {
+            // The element goes in whole or not at all, so the stream never carries half a frame.
+            socketcand::encode_send(frame, tx_buf_);
+            if (!flush_locked()) throw LinkDown(link_down_reason());
+            return;
+        }
+        if (!flush_locked()) throw LinkDown(link_down_reason());
+        if (tx_buf_.size() - tx_off_ < opts_.tx_buffer_bytes) continue;
+        if (std::chrono::steady_clock::now() >= deadline)
+            throw TimeoutError("socketcand: the server is not reading; " +
+                               std::to_string(tx_buf_.size() - tx_off_) + " bytes still unsent");
+        pollfd p{sock_.get(), POLLOUT, 0};
+        ::poll(&p, 1, net::poll_ms_until(deadline, 50));
+    }
+}
+
+void SocketcandBus::handle(const Element& e, Nanos now) {
+    switch (e.kind) {
+        case ElementKind::Frame:
+        case ElementKind::FdFrame:
+        case ElementKind::Rtr: {
+            Frame f = e.frame;
+            f.timestamp_ns = now;
+            dispatch(f);
+            break;
+        }
+        case ElementKind::ErrorFrame: {
+            count_bus_error();
+            Frame f = e.frame;
+            f.timestamp_ns = now;
+            dispatch(f);
+            break;
+        }
+        case ElementKind::ErrorText: {
+            // The server refused something we sent (socketcand only does this for
+            // unknown commands; our server also for bad or undeliverable sends).
+            count_tx_dropped();
+            std::lock_guard lk(info_mutex_);
+            last_server_error_ = e.text;
+            break;
+        }
+        case ElementKind::Echo:  // keepalive reply: arrival already refreshed last_rx
+            break;
+        default:
+            count_ignored();
+            break;
+    }
+}
+
+void SocketcandBus::rx_loop() {
+    std::vector<char> buf(64 * 1024);
+    const Nanos period = to_ns(opts_.keepalive_period);
+    const Nanos dead_after = period * opts_.keepalive_misses;
+    int tick_ms = 1000;
+    if (period > 0) {
+        tick_ms = static_cast<int>(period / 4'000'000);
+        if (tick_ms < 1) tick_ms = 1;
+        if (tick_ms > 1000) tick_ms = 1000;
+    }
+    Nanos last_echo = monotonic_ns();
+    while (!stop_.load()) {
+        pollfd fds[2] = {
+            {sock_.get(), static_cast<short>(POLLIN | (tx_pending_.load() ? POLLOUT : 0)), 0},
+            {wake_.fd(), POLLIN, 0},
+        };
+        int n = ::poll(fds, 2, tick_ms);
+        if (n < 0 && errno != EINTR) {
+            mark_link_down(std::string("socketcand: poll failed: ") + std::strerror(errno));
+            return;
+        }
+        if (stop_.load()) return;
+        if (n > 0 && (fds[1].revents & POLLIN)) wake_.drain();
+        const Nanos now = monotonic_ns();
+        if (n > 0 && (fds[0].revents & (POLLIN | POLLHUP | POLLERR))) {
+            ssize_t r = ::recv(sock_.get(), buf.data(), buf.size(), MSG_DONTWAIT);
+            if (r == 0) {
+                mark_link_down("socketcand: the server closed the connection");
+                return;
+            }
+            if (r < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
+                mark_link_down(std::string("socketcand: read failed: ") + std::strerror(errno));
+                return;
+            }
+            if (r > 0) {
+                last_rx_ns_.store(now);
+                parser_.feed(std::span<const char>(buf.data(), static_cast<std::size_t>(r)),
+                             [&](const Element& e) { handle(e, now); },
+                             [&](const ParseError&) { count_parse_error(); });
+                account_parser();
+            }
+        }
+        if (n > 0 && (fds[0].revents & POLLOUT)) {
+            std::unique_lock lk(tx_mutex_, std::try_to_lock);
+            if (lk.owns_lock() && !flush_locked()) return;
+        }
+        if (period > 0) {
+            const Nanos silent = now - last_rx_ns_.load();
+            if (silent >= dead_after) {  // K13: the peer vanished without a FIN
+                mark_link_down("socketcand: no data from the server for " +
+                               std::to_string(silent / 1'000'000) + " ms (" +
+                               std::to_string(opts_.keepalive_misses) +
+                               " keepalive periods): peer gone or half-open TCP");
+                return;
+            }
+            if (silent >= period && now - last_echo >= period) {
+                std::unique_lock lk(tx_mutex_, std::try_to_lock);
+                if (lk.owns_lock()) {
+                    socketcand::encode_command(ElementKind::Echo, tx_buf_);
+                    last_echo = now;
+                    if (!flush_locked()) return;
+                }
+            }
+        }
+    }
+}
+
+std::shared_ptr<SocketcandBus> open_socketcand(const std::string& host, std::uint16_t port,
+                                               const std::string& channel,
+                                               const SocketcandOptions& options) {
+    return std::make_shared<SocketcandBus>(host, port, channel, options);
+}
+
+}  // namespace motorbus::can
