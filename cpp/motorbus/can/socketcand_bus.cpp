@@ -18,6 +18,9 @@ using socketcand::ParseError;
 
 namespace {
 
+// Sends closer together than this are a burst: batch them (see do_send).
+constexpr Nanos kBurstGapNs = 20'000;
+
 Nanos to_ns(Duration d) { return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count(); }
 
 // Blocking write for the handshake (the socket is non-blocking).
@@ -220,6 +223,16 @@ void SocketcandBus::do_send(const Frame& frame, Deadline deadline) {
         if (tx_buf_.size() - tx_off_ < opts_.tx_buffer_bytes) {
             // The element goes in whole or not at all, so the stream never carries half a frame.
             socketcand::encode_send(frame, tx_buf_);
+            // An isolated frame is written at once (lowest latency).  In a burst
+            // the receive thread writes whole batches, one system call for many
+            // frames, so the sender only pays for encoding.
+            const Nanos now = monotonic_ns();
+            const bool burst = now - last_send_ns_ < kBurstGapNs;
+            last_send_ns_ = now;
+            if (burst || tx_pending_.load()) {
+                if (!tx_pending_.exchange(true)) wake_.signal();
+                return;
+            }
             if (!flush_locked()) throw LinkDown(link_down_reason());
             return;
         }
@@ -308,9 +321,9 @@ void SocketcandBus::rx_loop() {
                 account_parser();
             }
         }
-        if (n > 0 && (fds[0].revents & POLLOUT)) {
-            std::unique_lock lk(tx_mutex_, std::try_to_lock);
-            if (lk.owns_lock() && !flush_locked()) return;
+        if (tx_pending_.load()) {
+            std::unique_lock lk(tx_mutex_);
+            if (!flush_locked()) return;
         }
         if (period > 0) {
             const Nanos silent = now - last_rx_ns_.load();

@@ -81,7 +81,8 @@ private:
     std::timed_mutex tx_mutex_;
     std::string tx_buf_;
     std::size_t tx_off_ = 0;
-    std::atomic<bool> tx_pending_{false};
+    std::atomic<bool> tx_pending_{false};  // bytes wait in tx_buf_ for the receive thread
+    Nanos last_send_ns_ = 0;               // tx_mutex_
 
     socketcand::ElementParser parser_;  // receive thread only (and the handshake before it)
     socketcand::ParserStats parser_seen_;  // what has been counted into Bus counters

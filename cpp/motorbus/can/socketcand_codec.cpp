@@ -267,7 +267,6 @@ const char* parse_element(std::string_view element, Element& out) {
     if (word == "error") {
         // `< error CLASS SEC.USEC >` is a bus error frame; anything else is a message.
         if (n == 3) {
-            Frame e;
             Nanos ts = 0;
             std::string_view cls = t[1];
             if (!cls.empty() && cls.size() <= 8 && !parse_time(t[2], ts)) {

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstring>
 #include <deque>
+#include <vector>
 
 #include "motorbus/errors.hpp"
 
@@ -89,10 +90,15 @@ void SocketcandServer::close() {
 
 SocketcandServerStats SocketcandServer::stats() const {
     SocketcandServerStats s;
-    {
-        std::lock_guard lk(stats_mutex_);
-        s = stats_;
-    }
+    s.clients_accepted = counters_.clients_accepted.load();
+    s.clients_refused = counters_.clients_refused.load();
+    s.timeouts = counters_.timeouts.load();
+    s.frames_to_bus = counters_.frames_to_bus.load();
+    s.frames_to_clients = counters_.frames_to_clients.load();
+    s.bus_send_retries = counters_.bus_send_retries.load();
+    s.bus_send_failures = counters_.bus_send_failures.load();
+    s.error_replies = counters_.error_replies.load();
+    s.bad_elements = counters_.bad_elements.load();
     s.queue_drops = queue_drops_.load();
     std::lock_guard lk(conns_mutex_);
     s.clients_active = conns_.size();
@@ -125,15 +131,18 @@ void SocketcandServer::broadcast(const Frame& f, const Conn* except) {
             c->queue.push_back(f);
         }
     }
-    if (wake && except == nullptr) wake_.signal();
+    if (!wake || except != nullptr) return;  // the I/O thread itself is the caller
+    // Only a sleeping I/O thread needs the system call; a busy one will look
+    // at the queues again before it sleeps (Dekker-style handshake with io_loop).
+    work_pending_.store(true);
+    if (io_sleeping_.load()) wake_.signal();
 }
 
 void SocketcandServer::reply(Conn& c, std::string_view element) { c.out.append(element); }
 
 void SocketcandServer::reply_error(Conn& c, std::string_view message) {
     socketcand::encode_error_text(message, c.out);
-    std::lock_guard lk(stats_mutex_);
-    ++stats_.error_replies;
+    ++counters_.error_replies;
 }
 
 void SocketcandServer::client_send(Conn& c, const Frame& frame) {
@@ -151,32 +160,20 @@ void SocketcandServer::client_send(Conn& c, const Frame& frame) {
             break;
         } catch (const TimeoutError&) {
             if (std::chrono::steady_clock::now() + backoff >= give_up) {
-                {
-                    std::lock_guard lk(stats_mutex_);
-                    ++stats_.bus_send_failures;
-                }
+                ++counters_.bus_send_failures;
                 reply_error(c, "send failed: bus busy, frame " + f.to_string() + " not sent");
                 return;
             }
-            {
-                std::lock_guard lk(stats_mutex_);
-                ++stats_.bus_send_retries;
-            }
+            ++counters_.bus_send_retries;
             std::this_thread::sleep_for(backoff);
             backoff *= 2;
         } catch (const Error& e) {  // LinkDown, ClosedError, InvalidArgument
-            {
-                std::lock_guard lk(stats_mutex_);
-                ++stats_.bus_send_failures;
-            }
+            ++counters_.bus_send_failures;
             reply_error(c, std::string("send failed: ") + e.what());
             return;
         }
     }
-    {
-        std::lock_guard lk(stats_mutex_);
-        ++stats_.frames_to_bus;
-    }
+    ++counters_.frames_to_bus;
     broadcast(f, &c);  // the other clients are nodes on the same bus
 }
 
@@ -192,8 +189,7 @@ void SocketcandServer::handle(Conn& c, const Element& e) {
                 // protocol.md: an error is returned and the connection is terminated.
                 reply_error(c, "unknown bus " + e.text);
                 c.closing = true;
-                std::lock_guard lk(stats_mutex_);
-                ++stats_.clients_refused;
+                ++counters_.clients_refused;
                 return;
             }
             c.mode = Mode::Bcm;
@@ -223,8 +219,9 @@ void SocketcandServer::handle(Conn& c, const Element& e) {
 }
 
 bool SocketcandServer::service_input(Conn& c, Nanos now) {
-    char buf[16 * 1024];
-    ssize_t r = ::recv(c.fd.get(), buf, sizeof buf, MSG_DONTWAIT);
+    static thread_local std::vector<char> storage(64 * 1024);  // the I/O thread's read buffer
+    char* buf = storage.data();
+    ssize_t r = ::recv(c.fd.get(), buf, storage.size(), MSG_DONTWAIT);
     if (r == 0) return false;
     if (r < 0) return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR;
     c.last_rx = now;
@@ -241,10 +238,7 @@ bool SocketcandServer::service_input(Conn& c, Nanos now) {
                   });
     const auto done_after = c.parser.stats().elements + c.parser.stats().bad_elements;
     if (c.parser.mid_element() && (!was_mid || done_after != done_before)) c.element_started = now;
-    if (bad) {
-        std::lock_guard lk(stats_mutex_);
-        stats_.bad_elements += bad;
-    }
+    if (bad) counters_.bad_elements += bad;
     return true;
 }
 
@@ -261,8 +255,7 @@ void SocketcandServer::fill_output(Conn& c) {
     const Nanos wall_now = realtime_ns();
     for (const Frame& f : batch)
         socketcand::encode_frame(f, f.timestamp_ns ? f.timestamp_ns + wall_offset_ns_ : wall_now, c.out);
-    std::lock_guard lk(stats_mutex_);
-    stats_.frames_to_clients += batch.size();
+    counters_.frames_to_clients += batch.size();
 }
 
 bool SocketcandServer::flush(Conn& c) {
@@ -302,8 +295,7 @@ void SocketcandServer::accept_clients() {
         if (active >= opts_.max_clients) {
             static constexpr char kBusy[] = "< error too many clients >";
             [[maybe_unused]] auto r = ::send(fd, kBusy, sizeof kBusy - 1, MSG_NOSIGNAL | MSG_DONTWAIT);
-            std::lock_guard lk(stats_mutex_);
-            ++stats_.clients_refused;
+            ++counters_.clients_refused;
             continue;
         }
         net::set_nodelay(fd);
@@ -315,10 +307,7 @@ void SocketcandServer::accept_clients() {
         c->connected_at = c->last_rx = monotonic_ns();
         c->out = "< hi >";
         flush(*c);
-        {
-            std::lock_guard lk(stats_mutex_);
-            ++stats_.clients_accepted;
-        }
+        ++counters_.clients_accepted;
         std::lock_guard lk(conns_mutex_);
         conns_.push_back(std::move(c));
     }
@@ -343,7 +332,10 @@ void SocketcandServer::io_loop() {
             if (c.hold_frames_until) timeout_ms = 1;
             fds[2 + i] = {c.fd.get(), ev, 0};
         }
+        io_sleeping_.store(true);
+        if (work_pending_.exchange(false)) timeout_ms = 0;
         int n = ::poll(fds.data(), fds.size(), timeout_ms);
+        io_sleeping_.store(false);
         if (n < 0 && errno != EINTR) break;
         if (stop_.load()) break;
         if (n > 0 && (fds[1].revents & POLLIN)) wake_.drain();
@@ -367,8 +359,7 @@ void SocketcandServer::io_loop() {
                 timed_out = true;
             if (timed_out) {
                 alive = false;
-                std::lock_guard lk(stats_mutex_);
-                ++stats_.timeouts;
+                ++counters_.timeouts;
             }
             if (alive && c.closing && c.out_off == c.out.size()) alive = false;
             if (!alive) dead.push_back(&c);

@@ -98,6 +98,8 @@ private:
     net::Fd listen_;
     net::Wakeup wake_;
     std::atomic<bool> stop_{false};
+    std::atomic<bool> io_sleeping_{false};   // the I/O thread is (about to be) in poll()
+    std::atomic<bool> work_pending_{false};  // a client queue got frames since the last look
     std::once_flag close_once_;
     SubscriptionId sub_ = 0;
     Nanos wall_offset_ns_ = 0;  // realtime - monotonic, for socketcand's wall-clock timestamps
@@ -105,8 +107,11 @@ private:
     mutable std::mutex conns_mutex_;  // guards the list; the I/O thread alone changes it
     std::vector<std::shared_ptr<Conn>> conns_;
 
-    mutable std::mutex stats_mutex_;
-    SocketcandServerStats stats_;
+    struct Counters {
+        std::atomic<std::uint64_t> clients_accepted{0}, clients_refused{0}, timeouts{0},
+            frames_to_bus{0}, frames_to_clients{0}, bus_send_retries{0}, bus_send_failures{0},
+            error_replies{0}, bad_elements{0};
+    } counters_;
     std::atomic<std::uint64_t> queue_drops_{0};
     std::thread io_thread_;
 };
