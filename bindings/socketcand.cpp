@@ -72,6 +72,30 @@ py::dict server_stats_dict(const SocketcandServerStats& s) {
 void bind_socketcand(py::module_& m) {
     py::class_<SocketcandBus, Bus, std::shared_ptr<SocketcandBus>>(
         m, "SocketcandBus", "A CAN bus reached through a socketcand server (raw mode).")
+        // Fast paths: try without giving up the GIL first (a frame is usually
+        // already queued, and a send usually fits the buffer); release it only
+        // when the call really has to wait.
+        .def("send",
+             [](SocketcandBus& b, const Frame& f, const py::object& timeout) {
+                 auto t = seconds_to_ns(timeout);
+                 try {
+                     b.send(f, Duration::zero());
+                     return;
+                 } catch (const motorbus::TimeoutError&) {
+                 }
+                 py::gil_scoped_release nogil;
+                 b.send(f, t.count() < 0 ? std::chrono::hours(24 * 365) : t);
+             },
+             py::arg("frame"), py::arg("timeout") = 1.0)
+        .def("recv",
+             [](SocketcandBus& b, const py::object& timeout) -> std::optional<Frame> {
+                 if (auto f = b.recv(Duration::zero())) return f;
+                 auto t = seconds_to_ns(timeout);
+                 if (t.count() == 0) return std::nullopt;
+                 py::gil_scoped_release nogil;
+                 return b.recv(t);
+             },
+             py::arg("timeout") = py::none())
         .def_property_readonly("link_up", &SocketcandBus::link_up)
         .def_property_readonly("link_down_reason", &SocketcandBus::link_down_reason)
         .def_property_readonly("last_server_error", &SocketcandBus::last_server_error)

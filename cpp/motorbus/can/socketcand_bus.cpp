@@ -4,6 +4,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <vector>
@@ -142,8 +143,7 @@ void SocketcandBus::do_close() {
     if (rx_thread_.joinable()) rx_thread_.join();
     {
         // Best effort: hand over what is already committed, without blocking.
-        std::unique_lock lk(tx_mutex_, std::defer_lock);
-        if (lk.try_lock_for(std::chrono::milliseconds(100)) && !link_down_.load()) flush_locked();
+        if (!link_down_.load()) write_some(false);
     }
     if (sock_) ::shutdown(sock_.get(), SHUT_RDWR);
     sock_.reset();
@@ -171,6 +171,7 @@ void SocketcandBus::mark_link_down(const std::string& why) {
         link_down_reason_ = why;
     }
     link_down_.store(true);
+    tx_space_cv_.notify_all();
     // No medium any more: Bus::send() refuses with LinkDown and state() shows it.
     set_state(BusState::BusOff);
 }
@@ -184,66 +185,92 @@ void SocketcandBus::account_parser() {
     stats_snapshot_ = s;
 }
 
-bool SocketcandBus::flush_locked() {
-    while (tx_off_ < tx_buf_.size()) {
-        ssize_t r = ::send(sock_.get(), tx_buf_.data() + tx_off_, tx_buf_.size() - tx_off_,
+void SocketcandBus::enqueue(std::string_view element) {
+    std::lock_guard lk(tx_mutex_);
+    pending_.append(element);
+    unsent_.fetch_add(element.size());
+}
+
+bool SocketcandBus::write_some(bool wait_turn) {
+    std::unique_lock w(write_mutex_, std::defer_lock);
+    if (wait_turn) {
+        w.lock();
+    } else if (!w.try_lock()) {
+        // The current writer may be just finishing; make sure somebody looks again.
+        if (!tx_pending_.exchange(true)) wake_.signal();
+        return true;
+    }
+    bool ok = true;
+    for (;;) {
+        if (writing_off_ == writing_.size()) {
+            writing_.clear();
+            writing_off_ = 0;
+            std::lock_guard lk(tx_mutex_);
+            writing_.swap(pending_);
+            if (writing_.empty()) {
+                // Cleared only here, under tx_mutex_, where no append can slip past.
+                tx_pending_.store(false);
+                break;
+            }
+        }
+        ssize_t r = ::send(sock_.get(), writing_.data() + writing_off_, writing_.size() - writing_off_,
                            MSG_NOSIGNAL | MSG_DONTWAIT);
         if (r > 0) {
-            tx_off_ += static_cast<std::size_t>(r);
+            writing_off_ += static_cast<std::size_t>(r);
+            unsent_.fetch_sub(static_cast<std::size_t>(r));
+            tx_space_cv_.notify_all();
         } else if (r < 0 && errno == EINTR) {
             continue;
         } else if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            // The receive thread finishes the job when the socket drains (POLLOUT).
+            if (!tx_pending_.exchange(true)) wake_.signal();
             break;
         } else {
             mark_link_down(std::string("socketcand: write failed: ") + std::strerror(errno));
-            return false;
+            ok = false;
+            break;
         }
     }
-    if (tx_off_ == tx_buf_.size()) {
-        tx_buf_.clear();
-        tx_off_ = 0;
-        tx_pending_.store(false);
-    } else {
-        if (tx_off_ > 65536) {
-            tx_buf_.erase(0, tx_off_);
-            tx_off_ = 0;
-        }
-        // Let the receive thread finish the write when the socket drains.
-        if (!tx_pending_.exchange(true)) wake_.signal();
-    }
-    return true;
+    w.unlock();
+    if (!ok) tx_space_cv_.notify_all();
+    return ok;
 }
 
 void SocketcandBus::do_send(const Frame& frame, Deadline deadline) {
-    std::unique_lock lk(tx_mutex_, std::defer_lock);
-    if (!lk.try_lock_until(deadline))
-        throw TimeoutError("socketcand: send timed out behind another sender");
-    for (;;) {
-        if (link_down_.load()) throw LinkDown(link_down_reason());
-        if (tx_buf_.size() - tx_off_ < opts_.tx_buffer_bytes) {
-            // The element goes in whole or not at all, so the stream never carries half a frame.
-            socketcand::encode_send(frame, tx_buf_);
-            // An isolated frame is written at once (lowest latency).  In a burst
-            // the receive thread writes whole batches, one system call for many
-            // frames, so the sender only pays for encoding.
-            const Nanos now = monotonic_ns();
-            const bool burst = now - last_send_ns_ < kBurstGapNs;
-            last_send_ns_ = now;
-            if (burst || tx_pending_.load()) {
-                if (!tx_pending_.exchange(true)) wake_.signal();
-                return;
-            }
-            if (!flush_locked()) throw LinkDown(link_down_reason());
-            return;
+    static thread_local std::string encoded;  // no allocation per frame
+    encoded.clear();
+    socketcand::encode_send(frame, encoded);
+    bool burst;
+    {
+        std::unique_lock lk(tx_mutex_);
+        // Back-pressure: a peer that stops reading makes send() wait, then time out.
+        while (unsent_.load() >= opts_.tx_buffer_bytes && !link_down_.load()) {
+            lk.unlock();
+            if (!write_some(false)) throw LinkDown(link_down_reason());
+            lk.lock();
+            if (unsent_.load() < opts_.tx_buffer_bytes) break;
+            if (std::chrono::steady_clock::now() >= deadline)
+                throw TimeoutError("socketcand: the server is not reading; " +
+                                   std::to_string(unsent_.load()) + " bytes still unsent");
+            tx_space_cv_.wait_until(lk, std::min(deadline, std::chrono::steady_clock::now() +
+                                                               std::chrono::milliseconds(5)));
         }
-        if (!flush_locked()) throw LinkDown(link_down_reason());
-        if (tx_buf_.size() - tx_off_ < opts_.tx_buffer_bytes) continue;
-        if (std::chrono::steady_clock::now() >= deadline)
-            throw TimeoutError("socketcand: the server is not reading; " +
-                               std::to_string(tx_buf_.size() - tx_off_) + " bytes still unsent");
-        pollfd p{sock_.get(), POLLOUT, 0};
-        ::poll(&p, 1, net::poll_ms_until(deadline, 50));
+        if (link_down_.load()) throw LinkDown(link_down_reason());
+        // The element goes in whole or not at all, so the stream never carries half a frame.
+        pending_.append(encoded);
+        unsent_.fetch_add(encoded.size());
+        const Nanos now = monotonic_ns();
+        burst = now - last_send_ns_ < kBurstGapNs;
+        last_send_ns_ = now;
     }
+    // An isolated frame is written at once (lowest latency).  In a burst the
+    // receive thread writes whole batches, one system call for many frames, and
+    // the sender only pays for encoding.
+    if (burst || tx_pending_.load()) {
+        if (!tx_pending_.exchange(true)) wake_.signal();
+        return;
+    }
+    if (!write_some(false)) throw LinkDown(link_down_reason());
 }
 
 void SocketcandBus::handle(const Element& e, Nanos now) {
@@ -321,10 +348,7 @@ void SocketcandBus::rx_loop() {
                 account_parser();
             }
         }
-        if (tx_pending_.load()) {
-            std::unique_lock lk(tx_mutex_);
-            if (!flush_locked()) return;
-        }
+        if (tx_pending_.load() && !write_some(true)) return;
         if (period > 0) {
             const Nanos silent = now - last_rx_ns_.load();
             if (silent >= dead_after) {  // K13: the peer vanished without a FIN
@@ -335,12 +359,11 @@ void SocketcandBus::rx_loop() {
                 return;
             }
             if (silent >= period && now - last_echo >= period) {
-                std::unique_lock lk(tx_mutex_, std::try_to_lock);
-                if (lk.owns_lock()) {
-                    socketcand::encode_command(ElementKind::Echo, tx_buf_);
-                    last_echo = now;
-                    if (!flush_locked()) return;
-                }
+                std::string echo;
+                socketcand::encode_command(ElementKind::Echo, echo);
+                enqueue(echo);
+                last_echo = now;
+                if (!write_some(true)) return;
             }
         }
     }

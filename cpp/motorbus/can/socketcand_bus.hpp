@@ -13,6 +13,7 @@
 // LinkDown.  EOF or a socket error does the same at once.
 #pragma once
 #include <atomic>
+#include <condition_variable>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -62,8 +63,11 @@ private:
     void handshake(const std::string& channel, Deadline deadline);
     void rx_loop();
     void handle(const socketcand::Element& e, Nanos now);
-    // Writes what the socket takes now.  tx_mutex_ held.  Returns false on a socket error.
-    bool flush_locked();
+    // Appends one encoded element to the unsent bytes.
+    void enqueue(const std::string_view element);
+    // Writes what the socket takes now, as the one writer.  `wait_turn`: block
+    // for another writer instead of leaving the bytes to it.  False on a socket error.
+    bool write_some(bool wait_turn);
     void mark_link_down(const std::string& why);
     void account_parser();
 
@@ -78,11 +82,18 @@ private:
     std::string link_down_reason_;
     std::string last_server_error_;
 
-    std::timed_mutex tx_mutex_;
-    std::string tx_buf_;
-    std::size_t tx_off_ = 0;
-    std::atomic<bool> tx_pending_{false};  // bytes wait in tx_buf_ for the receive thread
+    // Transmit path.  Senders append to pending_ under tx_mutex_ (held only
+    // for the append); the socket is written by one writer at a time, under
+    // write_mutex_, from writing_, so a sender never waits behind a system call.
+    std::mutex tx_mutex_;
+    std::condition_variable tx_space_cv_;  // unsent bytes went out
+    std::string pending_;                  // tx_mutex_
     Nanos last_send_ns_ = 0;               // tx_mutex_
+    std::mutex write_mutex_;
+    std::string writing_;                  // write_mutex_
+    std::size_t writing_off_ = 0;          // write_mutex_
+    std::atomic<std::size_t> unsent_{0};   // bytes in pending_ and writing_
+    std::atomic<bool> tx_pending_{false};  // unsent bytes wait for the receive thread
 
     socketcand::ElementParser parser_;  // receive thread only (and the handshake before it)
     socketcand::ParserStats parser_seen_;  // what has been counted into Bus counters

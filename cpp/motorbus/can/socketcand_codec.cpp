@@ -8,7 +8,17 @@ namespace motorbus::can::socketcand {
 namespace {
 
 constexpr std::size_t kMaxTokens = 72;  // fdsend: word id flags len + 64 bytes, with room
-using Tokens = std::array<std::string_view, kMaxTokens>;
+
+// Token positions inside one element.  Deliberately left uninitialised (trivial
+// members): zeroing 72 string_views per element cost more than parsing a frame.
+struct Tokens {
+    struct Span {
+        std::uint16_t off, len;
+    };
+    std::string_view src;
+    Span spans[kMaxTokens];
+    std::string_view operator[](int i) const { return src.substr(spans[i].off, spans[i].len); }
+};
 
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
 
@@ -21,6 +31,7 @@ int hex_digit(char c) {
 
 // Splits the inside of `< ... >` on blanks.  Returns the count, or -1 when there are too many.
 int tokenize(std::string_view inner, Tokens& t) {
+    t.src = inner;
     int n = 0;
     std::size_t i = 0;
     while (i < inner.size()) {
@@ -29,7 +40,7 @@ int tokenize(std::string_view inner, Tokens& t) {
         std::size_t start = i;
         while (i < inner.size() && !is_blank(inner[i])) ++i;
         if (n == static_cast<int>(kMaxTokens)) return -1;
-        t[n++] = inner.substr(start, i - start);
+        t.spans[n++] = {static_cast<std::uint16_t>(start), static_cast<std::uint16_t>(i - start)};
     }
     return n;
 }
@@ -217,6 +228,7 @@ const char* to_string(ElementKind k) {
 const char* parse_element(std::string_view element, Element& out) {
     if (element.size() < 2 || element.front() != '<' || element.back() != '>')
         return "element: not enclosed in < >";
+    if (element.size() > 65535) return "element: too long";
     Tokens t;
     int n = tokenize(element.substr(1, element.size() - 2), t);
     if (n < 0) return "element: too many items";
@@ -228,13 +240,6 @@ const char* parse_element(std::string_view element, Element& out) {
     Frame& f = out.frame;
     const char* why = nullptr;
 
-    for (const Word& w : kBareWords) {
-        if (word == w.name) {
-            if (n != 1) return "element: command takes no arguments";
-            out.kind = w.kind;
-            return nullptr;
-        }
-    }
     if (word == "frame") {  // < frame ID SEC.USEC [DATA]* >
         out.kind = ElementKind::Frame;
         if (n < 3) return "frame: needs id and timestamp";
@@ -335,13 +340,20 @@ const char* parse_element(std::string_view element, Element& out) {
         if (f.problem()) return "fdsend: len is not a CAN FD length";
         return nullptr;
     }
+    for (const Word& w : kBareWords) {
+        if (word == w.name) {
+            if (n != 1) return "element: command takes no arguments";
+            out.kind = w.kind;
+            return nullptr;
+        }
+    }
     out.kind = ElementKind::Unknown;
     out.text.assign(word.substr(0, 32));
     return nullptr;
 }
 
 ElementParser::ElementParser(std::size_t max_element)
-    : max_element_(max_element < 8 ? 8 : max_element) {
+    : max_element_(std::clamp<std::size_t>(max_element, 8, 65535)) {
     buffer_.reserve(max_element_);
 }
 

@@ -151,14 +151,20 @@ void SocketcandServer::client_send(Conn& c, const Frame& frame) {
     // K11: a full medium (ENOBUFS on a raw socket, a full virtual queue) is a
     // transient condition.  Retry with backoff inside a small budget, then tell
     // the client, but never drop its session for it (socketcand does).
-    const auto give_up = std::chrono::steady_clock::now() + opts_.bus_send_budget;
+    std::chrono::steady_clock::time_point give_up{};  // computed on the first refusal only
     auto backoff = std::chrono::microseconds(100);
     for (;;) {
         try {
-            auto left = give_up - std::chrono::steady_clock::now();
-            bus_->send(f, left.count() > 0 ? std::chrono::duration_cast<Duration>(left) : Duration::zero());
+            Duration left = opts_.bus_send_budget;
+            if (give_up != std::chrono::steady_clock::time_point{}) {
+                left = std::chrono::duration_cast<Duration>(give_up - std::chrono::steady_clock::now());
+                if (left.count() < 0) left = Duration::zero();
+            }
+            bus_->send(f, left);
             break;
         } catch (const TimeoutError&) {
+            if (give_up == std::chrono::steady_clock::time_point{})
+                give_up = std::chrono::steady_clock::now() + opts_.bus_send_budget;
             if (std::chrono::steady_clock::now() + backoff >= give_up) {
                 ++counters_.bus_send_failures;
                 reply_error(c, "send failed: bus busy, frame " + f.to_string() + " not sent");
