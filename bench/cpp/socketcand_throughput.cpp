@@ -18,7 +18,9 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <condition_variable>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -99,24 +101,47 @@ std::string peer_script(const char* argv0) {
     return {};
 }
 
+// Counts frames arriving at "the rest of the bus" and lets the main thread
+// sleep until enough came (a spinning main thread would steal one of the two
+// cores from the threads being measured).
+struct Arrivals {
+    std::mutex mu;
+    std::condition_variable cv;
+    std::atomic<std::uint64_t> count{0};
+    std::atomic<std::uint64_t> want{~0ull};
+    void add() {
+        if (count.fetch_add(1, std::memory_order_relaxed) + 1 >= want.load(std::memory_order_relaxed)) {
+            std::lock_guard lk(mu);
+            cv.notify_all();
+        }
+    }
+    bool wait(std::uint64_t n, std::chrono::milliseconds limit) {
+        std::unique_lock lk(mu);
+        want = n;
+        bool ok = cv.wait_for(lk, limit, [&] { return count.load() >= n; });
+        want = ~0ull;
+        return ok;
+    }
+    void reset() { count = 0; }
+};
+
 // A medium that costs nothing: counts sends, injects frames from the caller's thread.
 class CountingBus final : public Bus {
 public:
     CountingBus() : Bus("counting") {}
     ~CountingBus() override { close(); }
-    std::atomic<std::uint64_t> sent{0};
+    Arrivals arrivals;
     void inject(const Frame& f) { dispatch(f); }
 
 protected:
-    void do_send(const Frame&, Deadline) override { sent.fetch_add(1, std::memory_order_relaxed); }
+    void do_send(const Frame&, Deadline) override { arrivals.add(); }
     void do_close() override {}
 };
 
 struct Medium {
     std::shared_ptr<Bus> served;
     std::function<void(const Frame&)> to_clients;  // a frame from the rest of the bus
-    std::function<std::uint64_t()> arrived;        // frames the rest of the bus got
-    std::function<void()> reset;
+    Arrivals* arrivals = nullptr;                  // frames the rest of the bus got
 };
 
 struct Result {
@@ -137,13 +162,11 @@ Result run(Medium& m, int frames, int pc_frames, const std::string& script) {
         std::this_thread::sleep_for(10ms);
 
         // C++ client -> bus: from the first send until the bus has them all.
-        m.reset();
+        m.arrivals->reset();
         auto t0 = std::chrono::steady_clock::now();
         for (int i = 0; i < frames; ++i) client->send(f8, 5s);
-        auto end = std::chrono::steady_clock::now() + 60s;
-        while (m.arrived() < static_cast<std::uint64_t>(frames) && std::chrono::steady_clock::now() < end)
-            std::this_thread::yield();
-        res.tx = m.arrived() / seconds_since(t0);
+        m.arrivals->wait(frames, 60000ms);
+        res.tx = m.arrivals->count.load() / seconds_since(t0);
 
         // bus -> C++ client: from the first frame received to the last.
         std::thread sender([&] {
@@ -162,12 +185,10 @@ Result run(Medium& m, int frames, int pc_frames, const std::string& script) {
         // One-way latency with one frame in flight: client -> bus, bus -> client.
         std::vector<double> up, down;
         for (int i = 0; i < 2000; ++i) {
-            m.reset();
+            m.arrivals->reset();
             auto t = monotonic_ns();
             client->send(f8);
-            while (m.arrived() == 0 && monotonic_ns() - t < 1'000'000'000) {
-            }
-            up.push_back(static_cast<double>(monotonic_ns() - t));
+            if (m.arrivals->wait(1, 1000ms)) up.push_back(static_cast<double>(monotonic_ns() - t));
             t = monotonic_ns();
             m.to_clients(f8);
             if (client->recv(1s)) down.push_back(static_cast<double>(monotonic_ns() - t));
@@ -182,13 +203,11 @@ Result run(Medium& m, int frames, int pc_frames, const std::string& script) {
     {  // python-can -> bus
         Peer p;
         if (!p.start(script, server.port(), "tx", pc_frames)) return res;
-        m.reset();
+        m.arrivals->reset();
         auto t0 = std::chrono::steady_clock::now();
         p.go();
-        auto end = std::chrono::steady_clock::now() + 60s;
-        while (m.arrived() < static_cast<std::uint64_t>(pc_frames) && std::chrono::steady_clock::now() < end)
-            std::this_thread::sleep_for(100us);
-        res.pc_tx = m.arrived() / seconds_since(t0);
+        m.arrivals->wait(pc_frames, 60000ms);
+        res.pc_tx = m.arrivals->count.load() / seconds_since(t0);
         p.line();
         p.finish();
     }
@@ -235,8 +254,7 @@ int main(int argc, char** argv) {
         Medium m;
         m.served = counting;
         m.to_clients = [&](const Frame& f) { counting->inject(f); };
-        m.arrived = [&] { return counting->sent.load(); };
-        m.reset = [&] { counting->sent = 0; };
+        m.arrivals = &counting->arrivals;
         print("counting", run(m, frames, pc_frames, script));
     }
     {
@@ -246,13 +264,12 @@ int main(int argc, char** argv) {
         vo.tx_queue = 4096;
         auto served = open_virtual(hub, vo);
         auto node = open_virtual(hub, vo);
-        std::atomic<std::uint64_t> at_node{0};
-        node->subscribe(Filter{}, [&](const Frame&) { at_node.fetch_add(1, std::memory_order_relaxed); });
+        Arrivals at_node;
+        node->subscribe(Filter{}, [&](const Frame&) { at_node.add(); });
         Medium m;
         m.served = served;
         m.to_clients = [&](const Frame& f) { node->send(f, 5s); };
-        m.arrived = [&] { return at_node.load(); };
-        m.reset = [&] { at_node = 0; };
+        m.arrivals = &at_node;
         print("virtual", run(m, frames, pc_frames, script));
     }
     return 0;
