@@ -77,7 +77,7 @@ def test_pythoncan_sends_every_id_width_and_dlc_to_the_bus(served):
             assert got is not None
             assert (got.id, got.extended, got.data) == (can_id, ext, payload(n))
         assert server.stats["bad_elements"] == 0
-        assert server.stats["frames_to_bus"] == len(CASES)
+        assert wait_for(lambda: server.stats["frames_to_bus"] == len(CASES))
     finally:
         pc.shutdown()
 
