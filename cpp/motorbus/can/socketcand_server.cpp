@@ -147,7 +147,7 @@ void SocketcandServer::reply_error(Conn& c, std::string_view message) {
 
 void SocketcandServer::client_send(Conn& c, const Frame& frame) {
     Frame f = frame;
-    f.timestamp_ns = monotonic_ns();
+    f.timestamp_ns = c.last_rx;  // arrival of the bytes that carried it
     // K11: a full medium (ENOBUFS on a raw socket, a full virtual queue) is a
     // transient condition.  Retry with backoff inside a small budget, then tell
     // the client, but never drop its session for it (socketcand does).
@@ -180,7 +180,9 @@ void SocketcandServer::client_send(Conn& c, const Frame& frame) {
         }
     }
     ++counters_.frames_to_bus;
-    broadcast(f, &c);  // the other clients are nodes on the same bus
+    // The other clients are nodes on the same bus.  Only this thread changes
+    // conns_, so it may look at its size without the lock.
+    if (conns_.size() > 1) broadcast(f, &c);
 }
 
 void SocketcandServer::handle(Conn& c, const Element& e) {
