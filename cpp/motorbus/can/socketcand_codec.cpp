@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 
 namespace motorbus::can::socketcand {
 
@@ -158,46 +159,64 @@ constexpr Word kBareWords[] = {
     {"isotpmode", ElementKind::IsotpMode},
 };
 
-void append_hex(std::string& out, std::uint32_t v, int digits) {
+// Builds one element in a stack buffer and appends it to the output once: the
+// server encodes every frame for every client, so this is a hot path.
+// The longest element we write is an fdframe with 64 bytes (~170 chars).
+class Writer {
+public:
+    void text(std::string_view t) {
+        std::memcpy(p_, t.data(), t.size());
+        p_ += t.size();
+    }
+    void ch(char c) { *p_++ = c; }
+    void hex(std::uint32_t v, int digits) {
+        for (int i = digits - 1; i >= 0; --i) {
+            p_[i] = kHex[v & 0xF];
+            v >>= 4;
+        }
+        p_ += digits;
+    }
+    void byte(std::uint8_t b) {
+        p_[0] = kHex[b >> 4];
+        p_[1] = kHex[b & 0xF];
+        p_ += 2;
+    }
+    void uint(std::uint64_t v) {
+        char tmp[20];
+        int n = 0;
+        do {
+            tmp[n++] = static_cast<char>('0' + v % 10);
+            v /= 10;
+        } while (v);
+        while (n) *p_++ = tmp[--n];
+    }
+    void id(const Frame& f) {
+        if (f.extended)
+            hex(f.id & kMaxExtendedId, 8);
+        else
+            hex(f.id & kMaxStandardId, 3);
+    }
+    void time(Nanos ns) {  // SEC.USEC, six fraction digits like socketcand
+        if (ns < 0) ns = 0;
+        uint(static_cast<std::uint64_t>(ns / 1'000'000'000));
+        ch('.');
+        auto usec = static_cast<std::uint32_t>((ns % 1'000'000'000) / 1000);
+        for (int i = 5; i >= 0; --i) {
+            p_[i] = static_cast<char>('0' + usec % 10);
+            usec /= 10;
+        }
+        p_ += 6;
+    }
+    void flush_to(std::string& out) { out.append(buf_, static_cast<std::size_t>(p_ - buf_)); }
+
+private:
     static constexpr char kHex[] = "0123456789ABCDEF";
-    char buf[8];
-    for (int i = digits - 1; i >= 0; --i) {
-        buf[i] = kHex[v & 0xF];
-        v >>= 4;
-    }
-    out.append(buf, static_cast<std::size_t>(digits));
-}
+    char buf_[256];
+    char* p_ = buf_;
+};
 
-void append_byte(std::string& out, std::uint8_t b) { append_hex(out, b, 2); }
-
-void append_uint(std::string& out, std::uint64_t v) {
-    char buf[24];
-    int n = 0;
-    do {
-        buf[n++] = static_cast<char>('0' + v % 10);
-        v /= 10;
-    } while (v);
-    while (n) out.push_back(buf[--n]);
-}
-
-void append_id(std::string& out, const Frame& f) {
-    if (f.extended)
-        append_hex(out, f.id & kMaxExtendedId, 8);
-    else
-        append_hex(out, f.id & kMaxStandardId, 3);
-}
-
-void append_time(std::string& out, Nanos ns) {
-    if (ns < 0) ns = 0;
-    append_uint(out, static_cast<std::uint64_t>(ns / 1'000'000'000));
-    out.push_back('.');
-    auto usec = static_cast<std::uint32_t>((ns % 1'000'000'000) / 1000);
-    char buf[6];
-    for (int i = 5; i >= 0; --i) {
-        buf[i] = static_cast<char>('0' + usec % 10);
-        usec /= 10;
-    }
-    out.append(buf, 6);
+std::uint8_t fd_flags_byte(const Frame& f) {
+    return static_cast<std::uint8_t>(((f.flags & kFlagBrs) ? 1 : 0) | ((f.flags & kFlagEsi) ? 2 : 0));
 }
 
 }  // namespace
@@ -364,6 +383,35 @@ void ElementParser::reset() {
     ready_ = false;
 }
 
+ElementParser::Next ElementParser::find_element(std::span<const char> bytes, std::size_t from) {
+    const char* p = bytes.data();
+    const std::size_t n = bytes.size();
+    std::size_t i = from;
+    while (i < n && p[i] != '<') {
+        if (!skipping_ && !is_blank(p[i])) ++stats_.discarded_bytes;
+        ++i;
+    }
+    if (i == n) return {n, false, {}};
+    skipping_ = false;
+    const std::size_t start = i;
+    const std::size_t limit = std::min(n, start + max_element_);
+    std::size_t j = start + 1;
+    while (j < limit && p[j] != '>' && p[j] != '<') ++j;
+    if (j < limit && p[j] == '>') return {j + 1, true, std::string_view(p + start, j + 1 - start)};
+    if (j < limit) {  // '<' again before '>': resync there
+        ++stats_.interrupted;
+        return {j, false, {}};
+    }
+    if (n - start < max_element_) {  // runs past the chunk: keep it for the next feed
+        buffer_.assign(p + start, n - start);
+        in_element_ = true;
+        return {n, false, {}};
+    }
+    ++stats_.overlong;  // K2: the cap is reached without '>'
+    skipping_ = true;
+    return {limit, false, {}};
+}
+
 std::size_t ElementParser::scan(std::span<const char> bytes) {
     const std::size_t n = bytes.size();
     std::size_t i = 0;
@@ -414,42 +462,41 @@ std::size_t ElementParser::scan(std::span<const char> bytes) {
 // ---- encoders ----------------------------------------------------------------
 
 void encode_frame(const Frame& f, Nanos time_ns, std::string& out) {
+    Writer w;
     if (f.flags & kFlagError) {
-        out.append("< error ");
-        append_hex(out, f.id & kMaxExtendedId, f.id > 0xFFF ? 8 : 3);
-        out.push_back(' ');
-        append_time(out, time_ns);
-        out.append(" >");
-        return;
-    }
-    if (f.rtr) {
-        out.append("< rtr ");
-        append_id(out, f);
-        out.push_back(' ');
-        append_time(out, time_ns);
-        out.push_back(' ');
-        append_uint(out, f.len);
-        out.append(" >");
-        return;
-    }
-    if (f.is_fd()) {
-        out.append("< fdframe ");
-        append_id(out, f);
-        out.push_back(' ');
-        append_byte(out, static_cast<std::uint8_t>(((f.flags & kFlagBrs) ? 1 : 0) |
-                                                   ((f.flags & kFlagEsi) ? 2 : 0)));
+        w.text("< error ");
+        w.hex(f.id & kMaxExtendedId, f.id > 0xFFF ? 8 : 3);
+        w.ch(' ');
+        w.time(time_ns);
+        w.text(" >");
+    } else if (f.rtr) {
+        w.text("< rtr ");
+        w.id(f);
+        w.ch(' ');
+        w.time(time_ns);
+        w.ch(' ');
+        w.uint(f.len);
+        w.text(" >");
     } else {
-        out.append("< frame ");
-        append_id(out, f);
+        if (f.is_fd()) {
+            w.text("< fdframe ");
+            w.id(f);
+            w.ch(' ');
+            w.byte(fd_flags_byte(f));
+        } else {
+            w.text("< frame ");
+            w.id(f);
+        }
+        w.ch(' ');
+        w.time(time_ns);
+        // Always a blank after the timestamp, even without data: socketcand writes
+        // "< frame 123 1.000000  >" and python-can needs that empty data field.
+        w.ch(' ');
+        const std::size_t len = f.len > kMaxFdLen ? kMaxFdLen : f.len;
+        for (std::size_t i = 0; i < len; ++i) w.byte(f.data[i]);
+        w.text(" >");
     }
-    out.push_back(' ');
-    append_time(out, time_ns);
-    // Always a blank after the timestamp, even without data: socketcand writes
-    // "< frame 123 1.000000  >" and python-can needs that empty data field.
-    out.push_back(' ');
-    const std::size_t len = f.len > kMaxFdLen ? kMaxFdLen : f.len;
-    for (std::size_t i = 0; i < len; ++i) append_byte(out, f.data[i]);
-    out.append(" >");
+    w.flush_to(out);
 }
 
 void encode_error_text(std::string_view message, std::string& out) {
@@ -459,33 +506,35 @@ void encode_error_text(std::string_view message, std::string& out) {
 }
 
 void encode_send(const Frame& f, std::string& out) {
+    Writer w;
     const std::size_t len = f.len > kMaxFdLen ? kMaxFdLen : f.len;
     if (f.rtr) {
-        out.append("< sendrtr ");
-        append_id(out, f);
-        out.push_back(' ');
-        append_uint(out, f.len);
-        out.append(" >");
+        w.text("< sendrtr ");
+        w.id(f);
+        w.ch(' ');
+        w.uint(f.len);
+        w.text(" >");
+        w.flush_to(out);
         return;
     }
     if (f.is_fd()) {
-        out.append("< fdsend ");
-        append_id(out, f);
-        out.push_back(' ');
-        append_byte(out, static_cast<std::uint8_t>(((f.flags & kFlagBrs) ? 1 : 0) |
-                                                   ((f.flags & kFlagEsi) ? 2 : 0)));
-        out.push_back(' ');
+        w.text("< fdsend ");
+        w.id(f);
+        w.ch(' ');
+        w.byte(fd_flags_byte(f));
+        w.ch(' ');
     } else {
-        out.append("< send ");
-        append_id(out, f);
-        out.push_back(' ');
+        w.text("< send ");
+        w.id(f);
+        w.ch(' ');
     }
-    append_uint(out, len);
+    w.uint(len);
     for (std::size_t i = 0; i < len; ++i) {
-        out.push_back(' ');
-        append_byte(out, f.data[i]);
+        w.ch(' ');
+        w.byte(f.data[i]);
     }
-    out.append(" >");
+    w.text(" >");
+    w.flush_to(out);
 }
 
 void encode_command(ElementKind k, std::string& out) {

@@ -84,23 +84,33 @@ public:
     // Element&) or on_error(const ParseError&).  Never throws on any input.
     template <class OnElement, class OnError>
     void feed(std::span<const char> bytes, OnElement&& on_element, OnError&& on_error) {
-        for (std::size_t i = 0; i < bytes.size();) {
-            i += scan(bytes.subspan(i));
-            if (ready_) {
-                ready_ = false;
-                const char* why = parse_element(buffer_, element_);
-                if (why) {
-                    ++stats_.bad_elements;
-                    on_error(ParseError{why, buffer_});
-                } else {
-                    ++stats_.elements;
-                    on_element(static_cast<const Element&>(element_));
-                }
-                buffer_.clear();
+        auto deliver = [&](std::string_view text) {
+            const char* why = parse_element(text, element_);
+            if (why) {
+                ++stats_.bad_elements;
+                on_error(ParseError{why, text});
+            } else {
+                ++stats_.elements;
+                on_element(static_cast<const Element&>(element_));
             }
+        };
+        std::size_t i = 0;
+        while (i < bytes.size()) {
+            if (in_element_) {  // the rest of an element that began in an earlier chunk
+                i += scan(bytes.subspan(i));
+                if (ready_) {
+                    ready_ = false;
+                    deliver(buffer_);
+                    buffer_.clear();
+                }
+                continue;
+            }
+            // Whole elements inside this chunk are parsed where they lie, without a copy.
+            Next next = find_element(bytes, i);
+            i = next.resume;
+            if (next.complete) deliver(next.element);
         }
     }
-
     // True while a `<` has been seen and its `>` has not (for element timeouts, K14).
     bool mid_element() const { return in_element_; }
     const ParserStats& stats() const { return stats_; }
@@ -110,6 +120,14 @@ public:
 private:
     // Consumes bytes up to and including the end of one element; sets ready_.
     std::size_t scan(std::span<const char> bytes);
+    struct Next {
+        std::size_t resume;        // where to continue in the chunk
+        bool complete;             // `element` is a whole element to parse
+        std::string_view element;
+    };
+    // Outside an element: skips noise (K1, K3), then takes one element that
+    // ends inside the chunk, or buffers its beginning, or abandons it (K2).
+    Next find_element(std::span<const char> bytes, std::size_t from);
 
     std::size_t max_element_;
     std::string buffer_;
