@@ -333,9 +333,9 @@ TEST(SocketcandLive, K13_EchoKeepsAnIdleButHealthyLinkUp) {
     SocketcandServer server(served);
     SocketcandOptions o = fast_client();
     o.keepalive_period = 10ms;
-    o.keepalive_misses = 3;
+    o.keepalive_misses = 10;  // 100 ms of silence would be fatal; the echo replies prevent it
     auto bus = open_socketcand("127.0.0.1", server.port(), "can0", o);
-    std::this_thread::sleep_for(150ms);  // 15 periods with no traffic but echo
+    std::this_thread::sleep_for(300ms);  // 30 periods with no traffic but echo
     EXPECT_TRUE(bus->link_up()) << bus->link_down_reason();
 }
 
