@@ -192,7 +192,8 @@ void SocketCanBus::do_close() {
     stop_.store(true);
     wake_.signal();
     if (rx_thread_.joinable()) rx_thread_.join();
-    sock_.reset();
+    // The descriptor stays open until *this is destroyed, so a send racing with
+    // close() can never write to a descriptor number the process has reused.
 }
 
 void SocketCanBus::do_send(const Frame& frame, Deadline deadline) {

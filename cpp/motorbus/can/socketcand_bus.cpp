@@ -145,8 +145,9 @@ void SocketcandBus::do_close() {
         // Best effort: hand over what is already committed, without blocking.
         if (!link_down_.load()) write_some(false);
     }
+    // shutdown, not close: a sender racing with close() must hit a dead socket,
+    // never a descriptor number the process has reused.  The Fd closes with *this.
     if (sock_) ::shutdown(sock_.get(), SHUT_RDWR);
-    sock_.reset();
 }
 
 std::string SocketcandBus::link_down_reason() const {
@@ -173,7 +174,8 @@ void SocketcandBus::mark_link_down(const std::string& why) {
     link_down_.store(true);
     tx_space_cv_.notify_all();
     // No medium any more: Bus::send() refuses with LinkDown and state() shows it.
-    set_state(BusState::BusOff);
+    // (After close() the state stays Closed: our own shutdown is not a link failure.)
+    if (!closed()) set_state(BusState::BusOff);
 }
 
 void SocketcandBus::account_parser() {

@@ -518,3 +518,36 @@ TEST(SocketcandLive, ClientSurvivesGarbageFromTheServer) {
     EXPECT_EQ(bus->parser_stats().discarded_bytes, 10u);  // "noise", "junk" and the stray ">"
     fake.join();
 }
+
+TEST(SocketcandLive, CloseWhileOtherThreadsSendEndsTheirSendsWithTypedErrors) {
+    auto hub = unique_hub();
+    auto served = open_virtual(hub);
+    auto node = open_virtual(hub);
+    SocketcandServer server(served);
+    auto bus = open_socketcand("127.0.0.1", server.port(), "can0", fast_client());
+    std::atomic<int> sent{0}, refused{0};
+    std::vector<std::thread> senders;
+    for (int t = 0; t < 3; ++t)
+        senders.emplace_back([&] {
+            std::uint8_t b[4] = {1, 2, 3, 4};
+            for (;;) {
+                try {
+                    bus->send(Frame::make(0x100, b), 50ms);
+                    ++sent;
+                } catch (const ClosedError&) {
+                    ++refused;
+                    return;
+                } catch (const LinkDown&) {
+                    ++refused;
+                    return;
+                } catch (const motorbus::TimeoutError&) {
+                }
+            }
+        });
+    ASSERT_TRUE(wait_for([&] { return sent.load() > 1000; }));
+    bus->close();
+    for (auto& t : senders) t.join();
+    EXPECT_EQ(refused.load(), 3);
+    EXPECT_EQ(bus->state(), BusState::Closed);
+    EXPECT_THROW(bus->send(Frame::make(0x1, {})), ClosedError);
+}
