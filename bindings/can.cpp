@@ -6,6 +6,7 @@
 #include "common.hpp"
 #include "motorbus/can/bus.hpp"
 #include "motorbus/can/external_bus.hpp"
+#include "motorbus/can/log.hpp"
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/can/frame.hpp"
 #include "motorbus/errors.hpp"
@@ -210,4 +211,44 @@ void bind_can(py::module_& m) {
              py::arg("receive_own") = false)
         .def("feed", &ExternalBus::feed, py::arg("frame"), py::call_guard<py::gil_scoped_release>())
         .def("feed_parse_error", &ExternalBus::feed_parse_error);
+
+    // ---- logs -------------------------------------------------------------
+    py::class_<LogEntry>(m, "LogEntry", "One logged frame: time (s), channel, direction.")
+        .def_readonly("frame", &LogEntry::frame)
+        .def_readonly("time", &LogEntry::time)
+        .def_readonly("channel", &LogEntry::channel)
+        .def_readonly("rx", &LogEntry::rx)
+        .def("__repr__", [](const LogEntry& e) { return "LogEntry(" + format_candump_line(e) + ")"; });
+    auto fmt = [](const py::object& f) -> std::optional<LogFormat> {
+        if (f.is_none()) return std::nullopt;
+        auto s = f.cast<std::string>();
+        if (s == "candump" || s == "log") return LogFormat::Candump;
+        if (s == "asc") return LogFormat::Asc;
+        throw InvalidArgument("log format: '" + s + "' (expected 'candump' or 'asc')");
+    };
+    py::class_<Recorder>(m, "Recorder", "Writes every frame a bus receives to a candump or ASC log.")
+        .def(py::init([fmt](std::shared_ptr<Bus> bus, const std::string& path, const py::object& format,
+                            const std::string& channel) {
+                 return std::make_unique<Recorder>(std::move(bus), path, fmt(format), channel);
+             }),
+             py::arg("bus"), py::arg("path"), py::arg("format") = py::none(), py::arg("channel") = "can0")
+        .def("log_sent", &Recorder::log_sent, py::arg("frame"))
+        .def("stop", &Recorder::stop, py::call_guard<py::gil_scoped_release>())
+        .def_property_readonly("count", &Recorder::count)
+        .def("__enter__", [](py::object self) { return self; })
+        .def("__exit__", [](Recorder& r, py::args) {
+            py::gil_scoped_release nogil;
+            r.stop();
+        });
+    m.def("read_log", [](const std::string& path) {
+        std::size_t bad = 0;
+        auto v = read_log(path, &bad);
+        return py::make_tuple(v, bad);
+    }, py::arg("path"), "Reads a candump (.log) or ASC (.asc) file: (entries, bad_line_count).");
+    m.def("parse_candump_line", &parse_candump_line, py::arg("line"));
+    m.def("play", [](Bus& bus, const std::vector<LogEntry>& entries, double speed) {
+        py::gil_scoped_release nogil;
+        return play(bus, entries, speed);
+    }, py::arg("bus"), py::arg("entries"), py::arg("speed") = 1.0,
+       "Replays entries onto bus: speed 1.0 = original timing, 0 = as fast as possible.");
 }
