@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "can_filters.hpp"
 #include "common.hpp"
 #include "motorbus/can/socketcan_bus.hpp"
 #include "motorbus/can/socketcand_bus.hpp"
@@ -23,23 +24,6 @@ Duration seconds_or(const py::object& t, Duration none_value) {
     return ns.count() < 0 ? std::chrono::hours(24 * 365) : ns;
 }
 
-std::vector<Filter> filters_from_py(const py::object& filters) {
-    std::vector<Filter> out;
-    if (filters.is_none()) return out;
-    for (auto h : filters) {
-        // python-can style: {"can_id": .., "can_mask": .., "extended": ..}
-        auto d = py::reinterpret_borrow<py::dict>(h);
-        Filter f;
-        f.id = d["can_id"].cast<std::uint32_t>();
-        f.mask = d.contains("can_mask") ? d["can_mask"].cast<std::uint32_t>() : 0x1FFFFFFF;
-        if (d.contains("extended") && !d["extended"].is_none()) {
-            f.match_extended = true;
-            f.extended = d["extended"].cast<bool>();
-        }
-        out.push_back(f);
-    }
-    return out;
-}
 
 py::dict parser_stats_dict(const socketcand::ParserStats& s) {
     py::dict d;
@@ -181,7 +165,7 @@ void bind_socketcand(py::module_& m) {
             SocketCanOptions o;
             o.receive_own = receive_own;
             o.rx_queue_size = rx_queue_size;
-            o.kernel_filters = filters_from_py(kernel_filters);
+            o.kernel_filters = motorbus::py_helpers::filters_from_py(kernel_filters);
             o.error_frames = error_frames;
             o.fd = fd;
             py::gil_scoped_release nogil;
