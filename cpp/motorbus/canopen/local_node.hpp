@@ -137,7 +137,7 @@ private:
     SdoServerMachine server_;
     SdoServerMachine::Outbox sdo_out_;
 
-    std::mutex mutex_;  // mailbox, services, listeners, worker control
+    mutable std::mutex mutex_;  // mailbox, services, listeners, worker control
     std::condition_variable cv_;
     std::optional<can::Frame> mailbox_;
     bool woken_ = false;
@@ -150,7 +150,7 @@ private:
     std::vector<ServiceSlot> services_;
     std::vector<std::pair<std::uint64_t, std::function<void(NmtState, NmtState)>>> listeners_;
     std::uint64_t next_listener_ = 1;
-    std::mutex transition_mutex_;  // serializes transitions and their callbacks
+    std::recursive_mutex transition_mutex_;  // serializes transitions and their callbacks
 
     std::vector<can::SubscriptionId> subs_;
     std::thread thread_;

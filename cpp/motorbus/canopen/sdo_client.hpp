@@ -88,6 +88,7 @@ public:
     bool busy() const { return status_ == Status::Running; }
     Nanos next_deadline() const;
     const Bytes& result() const { return data_; }           // uploaded bytes (Done)
+    Bytes take_result() { Bytes b; b.swap(data_); return b; }
     std::exception_ptr error() const { return error_; }      // Failed
     const SdoClientCounters& counters() const { return counters_; }
     const SdoClientConfig& config() const { return config_; }
@@ -103,7 +104,9 @@ private:
     };
     void fail_abort(std::uint32_t code, Outbox& out, std::span<const std::uint8_t> frame,
                     const std::string& why);
-    void fail_peer_abort(std::span<const std::uint8_t> frame);
+    void fail_peer_abort(std::span<const std::uint8_t> frame, Outbox& out);
+    void touch(Nanos now);
+    bool check_mux(std::span<const std::uint8_t> p, Outbox& out);
     void finish();
     void send_next_download_segment(Outbox& out);
     void send_block_download_subblock(Outbox& out);
@@ -128,11 +131,8 @@ private:
     bool crc_ = false;
     std::uint8_t blksize_ = 0;
     std::uint8_t seq_ = 0;       // block: last in-order seqno received / sent
-    std::size_t sub_start_ = 0;  // block download: data offset of the current sub-block
-    std::size_t sub_sent_ = 0;   // block download: bytes sent in the current sub-block
-    bool last_seen_ = false;     // block: the segment with c=1 arrived/sent
-    std::array<std::uint8_t, 7> last_seg_{};  // block upload: data of the c=1 segment
-    std::uint16_t crc_acc_ = 0;
+    std::size_t sent_segments_ = 0;  // block download: segments in the current sub-block
+    bool sent_last_ = false;         // block download: the current sub-block ends the data
     Nanos deadline_ = kNoDeadline;
     Nanos sub_deadline_ = kNoDeadline;
     Nanos started_ = 0;
@@ -216,7 +216,7 @@ private:
     SdoClientOptions options_;
     std::uint32_t request_id_, response_id_;
     std::mutex transfer_mutex_;   // one transfer per channel
-    std::mutex mutex_;            // guards machine_ and outbox_
+    mutable std::mutex mutex_;    // guards machine_ and outbox_
     std::condition_variable cv_;
     SdoClientMachine machine_;
     SdoClientMachine::Outbox outbox_;

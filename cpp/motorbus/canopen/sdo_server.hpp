@@ -51,7 +51,7 @@ public:
 
     void on_request(std::span<const std::uint8_t> payload, Nanos now, Outbox& out);
     void on_timer(Nanos now, Outbox& out);
-    Nanos next_deadline() const { return deadline_; }
+    Nanos next_deadline() const { return deadline_ < sub_deadline_ ? deadline_ : sub_deadline_; }
     bool idle() const { return phase_ == Phase::Idle; }
     // True while a block download sub-block is streaming in: those frames are
     // consumed straight from the receive thread (no mailbox) so none is lost.
@@ -59,7 +59,7 @@ public:
     // Drop any transfer without a word (NMT reset, stop).
     void reset();
     // Bytes currently held for a transfer (bounded; 0 when idle).
-    std::size_t buffered() const { return buffer_.capacity(); }
+    std::size_t buffered() const { return buffer_.capacity() + pending_.capacity() * 7; }
 
     const SdoServerCounters& counters() const { return counters_; }
     SdoServerCounters& counters() { return counters_; }
@@ -85,6 +85,7 @@ private:
     void on_block_download(std::span<const std::uint8_t> p, Nanos now, Outbox& out);
     void on_block_upload(std::span<const std::uint8_t> p, Nanos now, Outbox& out);
     void send_upload_subblock(Outbox& out);
+    void touch(Nanos now);
     // Fetch up to `max` more bytes of the upload source; returns 0 or an abort code.
     std::uint32_t pull(std::size_t max, Bytes& chunk, bool& last);
     void release();
@@ -105,14 +106,15 @@ private:
     bool stream_done_ = false;
     std::uint8_t blksize_ = 0;
     std::uint8_t seq_ = 0;         // block download: last in-order seqno
-    bool last_seen_ = false;
-    std::array<std::uint8_t, 7> last_seg_{};
-    std::uint16_t crc_acc_ = 0;
-    // block upload: the sub-block in flight (kept for retransmission)
-    std::vector<std::array<std::uint8_t, 7>> sub_segs_;
-    std::uint8_t sub_last_len_ = 7;  // data bytes in the final segment
-    bool sub_has_last_ = false;
+    std::uint16_t crc_acc_ = 0;    // block upload: CRC of the data produced so far
+    // block upload: segments produced but not yet acknowledged (kept for retransmission)
+    std::vector<std::array<std::uint8_t, 7>> pending_;
+    std::size_t sent_count_ = 0;       // of pending_, sent in the current sub-block
+    std::uint8_t last_len_ = 7;        // data bytes in the final segment
+    bool has_last_ = false;            // pending_.back() is the final segment
+    std::size_t limit_ = 0;            // download: most bytes accepted
     Nanos deadline_ = kNoDeadline;
+    Nanos sub_deadline_ = kNoDeadline; // block download: ack a stalled sub-block (B12)
 };
 
 }  // namespace motorbus::canopen
