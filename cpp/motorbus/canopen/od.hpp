@@ -89,7 +89,7 @@ struct VariableSpec {
     std::string default_expr{};
 };
 
-class Variable {
+class Variable : public std::enable_shared_from_this<Variable> {
 public:
     explicit Variable(VariableSpec spec, std::size_t dictionary_max_size);
 
