@@ -64,20 +64,11 @@ public:
         if (p[0] == 0x80 || (sdo::ccs_of(p[0]) == sdo::Ccs::Abort && phase_ != Phase::BlkDnSub)) return true;
         return phase_ == Phase::BlkUpEnd && (p[0] & 0xE3) == 0xA1;
     }
-    // True when handling `p` is O(1) bookkeeping that runs no application hook
-    // (mid-transfer segments, acks, silent frames): LocalNode handles these on
-    // the receive thread.  Initiates and final commits (hooks) go to its worker.
-    bool handles_inline(std::span<const std::uint8_t> p) const {
-        if (consumes_silently(p)) return true;
-        switch (phase_) {
-            case Phase::BlkDnSub: return true;
-            case Phase::DnSegment: return (p[0] & 0xE1) == 0x00;  // a segment, not the last
-            case Phase::UpSegment: return !streaming_;
-            case Phase::BlkUpStart:
-            case Phase::BlkUpSub: return !streaming_;
-            default: return false;
-        }
-    }
+    // True when handling `p` runs no application code (no hook, no listener):
+    // LocalNode answers these on the receive thread.  Requests that may run
+    // hooks, and anything unexpected while idle, go through its single-slot
+    // mailbox to the worker thread (so a flood is dropped and counted).
+    bool handles_inline(std::span<const std::uint8_t> p) const;
     // Drop any transfer without a word (NMT reset, stop).
     void reset();
     // Bytes currently held for a transfer (bounded; 0 when idle).

@@ -225,6 +225,8 @@ TEST_F(NodeFixture, NmtCommandsAndListeners) {
 }
 
 TEST_F(NodeFixture, S18_FloodIsBoundedOneResponsePerProcessedRequest) {
+    // A hooked object: its requests go through the single-slot mailbox.
+    od->at(0x6001, 0)->set_read_hook([](const Variable&, Bytes&) { return 0u; });
     hub->clear();
     const int n = 10000;
     auto req = H("40 01 60 00 00 00 00 00");
