@@ -105,6 +105,14 @@ int main(int argc, char** argv) {
         throughput([&] { (void)sdo.upload(0x2001, 0, TransferMode::Block); }, blk.size(), seconds);
     ours["block_download_Bps"] =
         throughput([&] { sdo.download(0x2001, 0, blk, TransferMode::Block); }, blk.size(), seconds);
+    const auto cc = sdo.counters();
+    const auto nc = node.counters();
+    std::printf("# client: transfers %llu, retransmit requests %llu, timeouts %llu; server: ignored %llu, "
+                "timeouts %llu; bus overruns host %llu dev %llu\n",
+                (unsigned long long)cc.transfers, (unsigned long long)cc.retransmit_requests,
+                (unsigned long long)cc.timeouts, (unsigned long long)nc.sdo.ignored,
+                (unsigned long long)nc.sdo.timeouts, (unsigned long long)host->counters().overruns,
+                (unsigned long long)dev->counters().overruns);
     node.close();
 
     std::map<std::string, double> ref;
