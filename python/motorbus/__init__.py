@@ -30,6 +30,8 @@ from .socketcand import (  # noqa: E402,F401
     open_socketcand,
     socketcan_unavailable_reason,
 )
+from . import canopen  # noqa: E402,F401
+from ._core import SdoAbortError, SdoProtocolError, SdoTimeout  # noqa: E402,F401
 from .drives import arcus, dmac  # noqa: E402,F401
 from .drives.arcus import ArcusClient, ArcusSim  # noqa: E402,F401
 from .drives.dmac import DmacClient, DmacSim  # noqa: E402,F401
