@@ -120,13 +120,16 @@ private:
         while (!stopping_) {
             const Nanos now = monotonic_ns();
             // 1. frames whose delay elapsed
-            while (!delayed_.empty() && delayed_.top().due <= now) {
+            // Every branch that drops the lock to deliver starts the loop over,
+            // so nothing that changed meanwhile (a stop, a new frame) is slept through.
+            if (!delayed_.empty() && delayed_.top().due <= now) {
                 Due d = delayed_.top();
                 delayed_.pop();
                 d.frame.timestamp_ns = d.due;
                 lock.unlock();
                 deliver(d.frame, d.sender);
                 lock.lock();
+                continue;
             }
             // 2. end of the frame on the wire
             if (on_wire && on_wire->due <= now) {
@@ -141,6 +144,7 @@ private:
                     deliver(d.frame, d.sender);
                     lock.lock();
                 }
+                continue;
             }
             // 3. arbitration for the next frame: the wire is next free at
             // t_start; every head queued by then competes, lowest id wins.
