@@ -76,6 +76,8 @@ TEST(PtyLineServer, EchoesThroughTheSlavePath) {
     LineLink link(open_port(server.slave_path(), 115200), opts());
     EXPECT_EQ(link.transact("1PX"), "1:PX");
     EXPECT_EQ(link.transact("1V=5"), "1:V=5");
+    // The server counts a reply after writing it: the client may read it first.
+    for (int i = 0; i < 200 && server.counters().replies < 2; ++i) std::this_thread::sleep_for(5ms);
     auto c = server.counters();
     EXPECT_EQ(c.lines, 2u);
     EXPECT_EQ(c.replies, 2u);
