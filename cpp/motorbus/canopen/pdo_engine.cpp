@@ -469,10 +469,16 @@ bool PdoEngine::on_frame(const can::Frame& f) {
                 }
                 break;
             }
-            if (!used && f.rtr) {
+            if (!used) {
                 for (auto& p : tpdos_) {
                     if (!p.valid() || p.can_id() != f.id || p.extended() != f.extended) continue;
                     used = true;
+                    if (!f.rtr) {  // N15: someone else transmits on our COB-ID
+                        ++counters_.collisions;
+                        if (!collision_) out.emcy.emplace_back(pdo_emcy::kCollision, true);
+                        collision_ = true;
+                        break;
+                    }
                     if (!operational_ || (p.cob & kPdoNoRtr)) {
                         ++counters_.rtr_ignored;
                         break;

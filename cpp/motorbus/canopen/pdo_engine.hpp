@@ -43,6 +43,7 @@ constexpr std::uint16_t kLengthError = 0x8210;     // P1
 constexpr std::uint16_t kLengthExceeded = 0x8220;  // P2
 constexpr std::uint16_t kUnexpectedSync = 0x8240;  // N16
 constexpr std::uint16_t kRpdoTimeout = 0x8250;     // P11
+constexpr std::uint16_t kCollision = 0x8150;       // N15
 }  // namespace pdo_emcy
 
 class PdoObjectAccess {
@@ -117,6 +118,7 @@ public:
     void set_operational(bool operational);
     bool operational() const;
     // Routes a frame (RPDO data, RTR on a TPDO, SYNC); returns true when used.
+    // A data frame on one of our own TPDO COB-IDs is a node-id collision (N15).
     bool on_frame(const can::Frame& f);
     // The application changed index:sub: event-driven TPDOs mapping it are sent
     // (subject to the inhibit time), acyclic synchronous ones at the next SYNC.
@@ -133,7 +135,7 @@ public:
 
     struct Counters {
         std::uint64_t tpdo_sent = 0, rpdo_applied = 0, rpdo_ignored = 0, rpdo_length_errors = 0,
-                      sync_received = 0, sync_errors = 0, rtr_ignored = 0;
+                      sync_received = 0, sync_errors = 0, rtr_ignored = 0, collisions = 0;
     };
     Counters counters() const;
     // The compiled mapping of a PDO (empty when not complete).
@@ -193,6 +195,7 @@ private:
     bool operational_ = false;
     Nanos last_sync_ = -1;
     bool sync_error_ = false;
+    bool collision_ = false;
     Counters counters_;
 };
 
