@@ -215,7 +215,13 @@ void Ds402Host::go_to(Ds402State target) {
         } else {
             write_controlword(step->controlword);
         }
-        wait_leave(cur, step->transition);
+        try {
+            wait_leave(cur, step->transition);
+        } catch (const TimeoutError&) {
+            if (cur == Ds402State::Fault)
+                throw DriveFault("CiA 402 node " + std::to_string(node_) + ": fault reset did not clear the fault");
+            throw;
+        }
     }
     throw TimeoutError("CiA 402: state machine did not settle");
 }
