@@ -6,8 +6,9 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 BUILD  := build/dev
 JOBS   ?= $(shell nproc)
-APT_PACKAGES := cmake g++ libeigen3-dev libgtest-dev clang libclang-rt-14-dev
+APT_PACKAGES := cmake ninja-build g++ libeigen3-dev libgtest-dev clang libclang-rt-14-dev ccache
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+CCACHE := $(shell command -v ccache >/dev/null && echo -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache)
 
 .PHONY: demo test deps venv build cpp-test py-test sanitize fuzz fuzz-smoke bench stubs clean
 
@@ -32,7 +33,7 @@ $(VENV)/.deps: requirements-dev.txt
 build: deps
 	$(PY) -m pip install -q --no-build-isolation --no-deps -e . \
 	  -Cbuild-dir=$(BUILD) -Ccmake.define.MOTORBUS_TESTS=ON -Ccmake.define.MOTORBUS_BENCH=ON \
-	  -Cbuild.tool-args=-j$(JOBS)
+	  -Cbuild.tool-args=-j$(JOBS) $(CCACHE)
 
 cpp-test: build
 	ctest --test-dir $(BUILD) --output-on-failure

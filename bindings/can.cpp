@@ -5,6 +5,9 @@
 
 #include "common.hpp"
 #include "motorbus/can/bus.hpp"
+#include "motorbus/can/external_bus.hpp"
+#include "motorbus/can/log.hpp"
+#include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/can/frame.hpp"
 #include "motorbus/errors.hpp"
 
@@ -151,4 +154,101 @@ void bind_can(py::module_& m) {
             py::gil_scoped_release nogil;
             b.close();
         });
+
+    py::class_<VirtualBus, Bus, std::shared_ptr<VirtualBus>>(m, "VirtualBus",
+                                                           "Endpoint on an in-process virtual CAN bus.")
+        .def("set_faults",
+             [](VirtualBus& b, unsigned drop_every, double drop_probability,
+                double corrupt_probability, double delay, std::uint64_t seed) {
+                 FaultOptions f;
+                 f.drop_every = drop_every;
+                 f.drop_probability = drop_probability;
+                 f.corrupt_probability = corrupt_probability;
+                 f.delay_ns = static_cast<Nanos>(delay * 1e9);
+                 f.seed = seed;
+                 b.set_faults(f);
+             },
+             py::arg("drop_every") = 0, py::arg("drop_probability") = 0.0,
+             py::arg("corrupt_probability") = 0.0, py::arg("delay") = 0.0,
+             py::arg("seed") = 0x5eed,
+             "Faults applied to frames this endpoint sends (delay in seconds).")
+        .def("set_bus_off", &VirtualBus::set_bus_off, py::arg("off") = true)
+        .def_property_readonly("bitrate", &VirtualBus::bitrate);
+
+    m.def("open_virtual",
+          [](const std::string& name, double bitrate, std::size_t tx_queue, std::size_t rx_queue_size,
+             bool receive_own) {
+              VirtualOptions o;
+              o.bitrate = bitrate;
+              o.tx_queue = tx_queue;
+              o.rx_queue_size = rx_queue_size;
+              o.receive_own = receive_own;
+              return open_virtual(name, o);
+          },
+          py::arg("name"), py::arg("bitrate") = 0.0, py::arg("tx_queue") = 64,
+          py::arg("rx_queue_size") = 65536, py::arg("receive_own") = false);
+
+    py::class_<ExternalBus, Bus, std::shared_ptr<ExternalBus>>(
+        m, "ExternalBus", "A bus fed by Python code (the python-can bridge is built on it).")
+        .def(py::init([](const std::string& channel, py::function send, py::object close,
+                         bool receive_own) {
+                 PyCallable send_call(std::move(send));
+                 ExternalBus::SendFn fn = [send_call](const Frame& f, Deadline d) {
+                     py::gil_scoped_acquire gil;
+                     double left = std::chrono::duration<double>(d - std::chrono::steady_clock::now()).count();
+                     send_call.call(f, left > 0 ? left : 0.0);  // Python exceptions reach the sender
+                 };
+                 ExternalBus::CloseFn cfn;
+                 if (!close.is_none()) {
+                     PyCallable c(close.cast<py::function>());
+                     cfn = [c]() { c(); };
+                 }
+                 BusOptions o;
+                 o.receive_own = receive_own;
+                 return std::make_shared<ExternalBus>(channel, std::move(fn), std::move(cfn), o);
+             }),
+             py::arg("channel"), py::arg("send"), py::arg("close") = py::none(),
+             py::arg("receive_own") = false)
+        .def("feed", &ExternalBus::feed, py::arg("frame"), py::call_guard<py::gil_scoped_release>())
+        .def("feed_parse_error", &ExternalBus::feed_parse_error);
+
+    // ---- logs -------------------------------------------------------------
+    py::class_<LogEntry>(m, "LogEntry", "One logged frame: time (s), channel, direction.")
+        .def_readonly("frame", &LogEntry::frame)
+        .def_readonly("time", &LogEntry::time)
+        .def_readonly("channel", &LogEntry::channel)
+        .def_readonly("rx", &LogEntry::rx)
+        .def("__repr__", [](const LogEntry& e) { return "LogEntry(" + format_candump_line(e) + ")"; });
+    auto fmt = [](const py::object& f) -> std::optional<LogFormat> {
+        if (f.is_none()) return std::nullopt;
+        auto s = f.cast<std::string>();
+        if (s == "candump" || s == "log") return LogFormat::Candump;
+        if (s == "asc") return LogFormat::Asc;
+        throw InvalidArgument("log format: '" + s + "' (expected 'candump' or 'asc')");
+    };
+    py::class_<Recorder>(m, "Recorder", "Writes every frame a bus receives to a candump or ASC log.")
+        .def(py::init([fmt](std::shared_ptr<Bus> bus, const std::string& path, const py::object& format,
+                            const std::string& channel) {
+                 return std::make_unique<Recorder>(std::move(bus), path, fmt(format), channel);
+             }),
+             py::arg("bus"), py::arg("path"), py::arg("format") = py::none(), py::arg("channel") = "can0")
+        .def("log_sent", &Recorder::log_sent, py::arg("frame"))
+        .def("stop", &Recorder::stop, py::call_guard<py::gil_scoped_release>())
+        .def_property_readonly("count", &Recorder::count)
+        .def("__enter__", [](py::object self) { return self; })
+        .def("__exit__", [](Recorder& r, py::args) {
+            py::gil_scoped_release nogil;
+            r.stop();
+        });
+    m.def("read_log", [](const std::string& path) {
+        std::size_t bad = 0;
+        auto v = read_log(path, &bad);
+        return py::make_tuple(v, bad);
+    }, py::arg("path"), "Reads a candump (.log) or ASC (.asc) file: (entries, bad_line_count).");
+    m.def("parse_candump_line", &parse_candump_line, py::arg("line"));
+    m.def("play", [](Bus& bus, const std::vector<LogEntry>& entries, double speed) {
+        py::gil_scoped_release nogil;
+        return play(bus, entries, speed);
+    }, py::arg("bus"), py::arg("entries"), py::arg("speed") = 1.0,
+       "Replays entries onto bus: speed 1.0 = original timing, 0 = as fast as possible.");
 }

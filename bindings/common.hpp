@@ -36,6 +36,13 @@ public:
         }
     }
 
+    // Calls with the GIL held by the caller; Python exceptions propagate as
+    // error_already_set (for paths where the C++ caller must see the failure).
+    template <class... A>
+    py::object call(A&&... args) const {
+        return (*f_)(std::forward<A>(args)...);
+    }
+
 private:
     struct Release {
         void operator()(py::function* p) const {

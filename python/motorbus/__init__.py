@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from ._core import (  # noqa: F401
     Bus,
+    ExternalBus,
+    VirtualBus,
     ClosedError,
     DriveFault,
     Frame,
@@ -13,5 +15,8 @@ from ._core import (  # noqa: F401
     TimeoutError,
     monotonic_ns,
 )
+
+from .bus import open_bus  # noqa: E402,F401
+from .log import LogEntry, Recorder, play, read_log  # noqa: E402,F401
 
 __version__ = "0.1.0"

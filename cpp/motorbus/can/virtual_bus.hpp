@@ -1,0 +1,59 @@
+// In-process CAN bus: any number of endpoints joined by hub name.
+//
+// Without a bit rate a frame reaches the other endpoints at once.  With one,
+// the hub models the wire: frames wait in each endpoint's transmit queue,
+// the lowest id wins arbitration, and each occupies the wire for its
+// worst-case-stuffed bit count, so bus load and latency are what a real bus
+// at that rate would show.  Faults (drop, corrupt, delay, bus-off) are set per
+// sending endpoint, for tests that need a bad cable.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "motorbus/can/bus.hpp"
+
+namespace motorbus::can {
+
+struct FaultOptions {
+    unsigned drop_every = 0;           // drop every n-th frame sent (0 = never)
+    double drop_probability = 0.0;     // drop each frame with this probability
+    double corrupt_probability = 0.0;  // flip one random data bit with this probability
+    Nanos delay_ns = 0;                // extra latency before delivery
+    std::uint64_t seed = 0x5eed;       // for the probabilistic faults (reproducible)
+};
+
+struct VirtualOptions : BusOptions {
+    double bitrate = 0.0;         // bit/s; 0 = no wire time.  All endpoints of a hub must agree.
+    std::size_t tx_queue = 64;    // frames waiting for the wire before send() blocks
+    FaultOptions faults;
+};
+
+class VirtualHub;
+
+class VirtualBus final : public Bus {
+public:
+    VirtualBus(std::shared_ptr<VirtualHub> hub, std::string channel, const VirtualOptions& opts);
+    ~VirtualBus() override;
+
+    void set_faults(const FaultOptions& f);
+    // Simulates the controller going bus-off (sends fail with LinkDown, nothing
+    // is received) and recovering.
+    void set_bus_off(bool off);
+    double bitrate() const;
+
+protected:
+    void do_send(const Frame& frame, Deadline deadline) override;
+    void do_close() override;
+
+private:
+    friend class VirtualHub;
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    void enqueue_rx(const Frame& f);  // called by the hub
+};
+
+// Opens an endpoint on hub `name` (created on first use, gone with its last endpoint).
+std::shared_ptr<VirtualBus> open_virtual(const std::string& name, const VirtualOptions& opts = {});
+
+}  // namespace motorbus::can

@@ -1,0 +1,189 @@
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <thread>
+#include <vector>
+
+#include "motorbus/can/virtual_bus.hpp"
+#include "motorbus/errors.hpp"
+
+using namespace motorbus;
+using namespace motorbus::can;
+using namespace std::chrono_literals;
+
+namespace {
+Frame fr(std::uint32_t id, std::vector<std::uint8_t> d = {}, bool ext = false) {
+    return Frame::make(id, d, ext);
+}
+}  // namespace
+
+TEST(VirtualBus, FramesReachEveryOtherEndpointNotTheSender) {
+    auto a = open_virtual("t-basic"), b = open_virtual("t-basic"), c = open_virtual("t-basic");
+    a->send(fr(0x123, {1, 2, 3}));
+    auto rb = b->recv(1s), rc = c->recv(1s);
+    ASSERT_TRUE(rb && rc);
+    EXPECT_EQ(rb->to_string(), "123#010203");
+    EXPECT_EQ(rc->to_string(), "123#010203");
+    EXPECT_GT(rb->timestamp_ns, 0);
+    EXPECT_FALSE(a->recv(20ms));
+    EXPECT_EQ(a->counters().tx_frames, 1u);
+    EXPECT_EQ(b->counters().rx_frames, 1u);
+}
+
+TEST(VirtualBus, HubsAreIsolatedByName) {
+    auto a = open_virtual("t-iso-1"), b = open_virtual("t-iso-2");
+    a->send(fr(1));
+    EXPECT_FALSE(b->recv(20ms));
+}
+
+TEST(VirtualBus, ReceiveOwnAndFilters) {
+    VirtualOptions o;
+    o.receive_own = true;
+    auto a = open_virtual("t-own", o), b = open_virtual("t-own");
+    b->set_filters({Filter{0x100, 0x700, false, false}});
+    a->send(fr(0x123));
+    a->send(fr(0x223));
+    auto own = a->recv(1s);
+    ASSERT_TRUE(own);
+    EXPECT_TRUE(own->flags & kFlagLoopback);
+    auto got = b->recv(1s);
+    ASSERT_TRUE(got);
+    EXPECT_EQ(got->id, 0x123u);
+    EXPECT_FALSE(b->recv(30ms));  // 0x223 filtered out
+}
+
+TEST(VirtualBus, SubscribersByIdAndMask) {
+    auto a = open_virtual("t-sub"), b = open_virtual("t-sub");
+    std::atomic<int> exact{0}, masked{0};
+    auto s1 = b->subscribe_id(0x581, false, [&](const Frame&) { exact++; });
+    b->subscribe(Filter{0x580, 0x780, false, false}, [&](const Frame&) { masked++; });
+    a->send(fr(0x581));
+    a->send(fr(0x582));
+    a->send(fr(0x581, {}, true));  // extended 0x581 is a different id
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(b->recv(1s));
+    EXPECT_EQ(exact.load(), 1);
+    EXPECT_EQ(masked.load(), 3);
+    b->unsubscribe(s1);
+    a->send(fr(0x581));
+    ASSERT_TRUE(b->recv(1s));
+    EXPECT_EQ(exact.load(), 1);
+}
+
+TEST(VirtualBus, DropEveryNthAndCorrupt) {
+    auto a = open_virtual("t-fault"), b = open_virtual("t-fault");
+    FaultOptions f;
+    f.drop_every = 3;
+    a->set_faults(f);
+    for (int i = 0; i < 9; ++i) a->send(fr(0x10 + i, {0}));
+    std::vector<std::uint32_t> ids;
+    while (auto r = b->recv(30ms)) ids.push_back(r->id);
+    EXPECT_EQ(ids, (std::vector<std::uint32_t>{0x10, 0x11, 0x13, 0x14, 0x16, 0x17}));
+    EXPECT_EQ(a->counters().tx_dropped, 3u);
+    FaultOptions c;
+    c.corrupt_probability = 1.0;
+    a->set_faults(c);
+    a->send(fr(0x20, {0, 0, 0, 0}));
+    auto r = b->recv(1s);
+    ASSERT_TRUE(r);
+    int ones = 0;
+    for (int i = 0; i < 4; ++i) ones += __builtin_popcount(r->data[i]);
+    EXPECT_EQ(ones, 1);  // exactly one bit flipped
+}
+
+TEST(VirtualBus, DelayFault) {
+    auto a = open_virtual("t-delay"), b = open_virtual("t-delay");
+    FaultOptions f;
+    f.delay_ns = 30'000'000;
+    a->set_faults(f);
+    const Nanos t0 = monotonic_ns();
+    a->send(fr(0x1));
+    auto r = b->recv(1s);
+    ASSERT_TRUE(r);
+    EXPECT_GE(r->timestamp_ns - t0, 30'000'000);
+    EXPECT_GE(monotonic_ns() - t0, 30'000'000);
+}
+
+TEST(VirtualBus, BusOffRefusesToSend) {
+    auto a = open_virtual("t-off"), b = open_virtual("t-off");
+    a->set_bus_off(true);
+    EXPECT_EQ(a->state(), BusState::BusOff);
+    EXPECT_THROW(a->send(fr(1)), LinkDown);
+    b->send(fr(2));
+    EXPECT_FALSE(a->recv(20ms));  // a bus-off controller receives nothing
+    a->set_bus_off(false);
+    a->send(fr(3));
+    auto r = b->recv(1s);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->id, 3u);
+}
+
+TEST(VirtualBus, WireTimeTimestampsFollowBitTimes) {
+    VirtualOptions o;
+    o.bitrate = 125000;  // 8 us per bit
+    auto a = open_virtual("t-wire", o), b = open_virtual("t-wire", o);
+    for (int i = 0; i < 20; ++i) a->send(fr(0x100, {1, 2, 3, 4, 5, 6, 7, 8}));
+    std::vector<Nanos> ts;
+    while (ts.size() < 20) {
+        auto r = b->recv(2s);
+        ASSERT_TRUE(r);
+        ts.push_back(r->timestamp_ns);
+    }
+    // back-to-back frames: consecutive deliveries exactly one frame time apart
+    for (std::size_t i = 1; i < ts.size(); ++i) EXPECT_EQ(ts[i] - ts[i - 1], 135 * 8000);
+}
+
+TEST(VirtualBus, WireArbitrationLowestIdFirst) {
+    VirtualOptions o;
+    o.bitrate = 50000;
+    auto a = open_virtual("t-arb", o), b = open_virtual("t-arb", o), c = open_virtual("t-arb", o),
+         rx = open_virtual("t-arb", o);
+    a->send(fr(0x700, {1}));  // occupies the wire first
+    b->send(fr(0x300, {2}));
+    c->send(fr(0x100, {3}));  // queued later but wins arbitration over 0x300
+    std::vector<std::uint32_t> order;
+    while (order.size() < 3) order.push_back(rx->recv(2s).value().id);
+    EXPECT_EQ(order, (std::vector<std::uint32_t>{0x700, 0x100, 0x300}));
+}
+
+TEST(VirtualBus, BackPressureTimesOutWhenWireIsFull) {
+    VirtualOptions o;
+    o.bitrate = 10000;  // 13.5 ms per 8-byte frame
+    o.tx_queue = 2;
+    auto a = open_virtual("t-bp", o), b = open_virtual("t-bp", o);
+    std::vector<std::uint8_t> d(8, 0);
+    a->send(fr(1, d));
+    a->send(fr(1, d));
+    a->send(fr(1, d));
+    EXPECT_THROW(a->send(fr(1, d), 1ms), TimeoutError);
+}
+
+TEST(VirtualBus, BitrateMismatchIsRefused) {
+    VirtualOptions o;
+    o.bitrate = 500000;
+    auto a = open_virtual("t-mismatch", o);
+    EXPECT_THROW(open_virtual("t-mismatch"), InvalidArgument);
+}
+
+TEST(VirtualBus, ManyThreadsSendConcurrently) {
+    auto rx = open_virtual("t-mt");
+    std::vector<std::thread> ts;
+    std::vector<std::shared_ptr<VirtualBus>> eps;
+    for (int t = 0; t < 4; ++t) eps.push_back(open_virtual("t-mt"));
+    for (int t = 0; t < 4; ++t)
+        ts.emplace_back([&, t] {
+            for (int i = 0; i < 1000; ++i) eps[t]->send(fr(t, {std::uint8_t(i & 0xFF)}));
+        });
+    for (auto& t : ts) t.join();
+    int n = 0;
+    while (rx->recv(100ms)) ++n;
+    EXPECT_EQ(n, 4000);
+}
+
+TEST(VirtualBus, CloseWakesRecvAndRefusesSend) {
+    auto a = open_virtual("t-close");
+    std::thread t([&] { std::this_thread::sleep_for(20ms); a->close(); });
+    EXPECT_THROW(a->recv(-1ns), ClosedError);
+    t.join();
+    EXPECT_THROW(a->send(fr(1)), ClosedError);
+    EXPECT_EQ(a->state(), BusState::Closed);
+}

@@ -1,0 +1,115 @@
+import threading
+import time
+
+import pytest
+
+import motorbus
+from motorbus import Frame
+
+
+def test_open_bus_virtual_roundtrip_and_counters():
+    with motorbus.open_bus("virtual:py-basic") as a, motorbus.open_bus("virtual:py-basic") as b:
+        a.send(Frame(0x123, b"\x01\x02"))
+        f = b.recv(1.0)
+        assert f == Frame(0x123, b"\x01\x02")
+        assert f.timestamp_ns > 0
+        assert b.recv(0.01) is None
+        assert a.counters["tx_frames"] == 1 and b.counters["rx_frames"] == 1
+        assert a.state == "active"
+    assert a.closed and a.state == "closed"
+
+
+def test_bad_specs_name_the_problem():
+    with pytest.raises(motorbus.InvalidArgument, match="unknown scheme"):
+        motorbus.open_bus("nope:x")
+    with pytest.raises(motorbus.InvalidArgument, match="SCHEME:ARGS"):
+        motorbus.open_bus("virtual")
+    with pytest.raises(motorbus.InvalidArgument, match="port"):
+        motorbus.open_bus("socketcand:localhost:abc/can0")
+
+
+@pytest.mark.threaded
+def test_subscriber_callback_runs_on_bus_thread():
+    seen = []
+    done = threading.Event()
+    with motorbus.open_bus("virtual:py-sub") as a, motorbus.open_bus("virtual:py-sub") as b:
+        def cb(frame):
+            seen.append((frame.id, frame.data, threading.current_thread() is threading.main_thread()))
+            if len(seen) == 2:
+                done.set()
+
+        h = b.subscribe(cb, id=0x581)
+        a.send(Frame(0x581, b"\xAA"))
+        a.send(Frame(0x582, b"\xBB"))
+        a.send(Frame(0x581, b"\xCC"))
+        assert done.wait(2.0)
+        assert seen == [(0x581, b"\xAA", False), (0x581, b"\xCC", False)]
+        b.unsubscribe(h)
+
+
+@pytest.mark.threaded
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_callback_exception_does_not_kill_the_bus():
+    with motorbus.open_bus("virtual:py-exc") as a, motorbus.open_bus("virtual:py-exc") as b:
+        b.subscribe(lambda f: 1 / 0)
+        a.send(Frame(1))
+        a.send(Frame(2))
+        assert b.recv(1.0).id == 1
+        assert b.recv(1.0).id == 2
+
+
+def test_filters_python_can_style():
+    with motorbus.open_bus("virtual:py-filt") as a, motorbus.open_bus("virtual:py-filt") as b:
+        b.set_filters([{"can_id": 0x100, "can_mask": 0x700, "extended": False}])
+        for i in (0x123, 0x223, 0x1FF):
+            a.send(Frame(i))
+        a.send(Frame(0x123, extended=True))
+        assert [b.recv(1.0).id, b.recv(1.0).id] == [0x123, 0x1FF]
+        assert b.recv(0.02) is None
+
+
+def test_faults_drop_every_nth():
+    with motorbus.open_bus("virtual:py-fault") as a, motorbus.open_bus("virtual:py-fault") as b:
+        a.set_faults(drop_every=2)
+        for i in range(6):
+            a.send(Frame(i))
+        got = []
+        while (f := b.recv(0.05)) is not None:
+            got.append(f.id)
+        assert got == [0, 2, 4]
+        assert a.counters["tx_dropped"] == 3
+
+
+def test_wire_time_mode_paces_frames():
+    with motorbus.open_bus("virtual:py-wire", bitrate=125000) as a, \
+            motorbus.open_bus("virtual:py-wire", bitrate=125000) as b:
+        assert a.bitrate == 125000
+        for _ in range(10):
+            a.send(Frame(0x10, bytes(8)))
+        ts = [b.recv(2.0).timestamp_ns for _ in range(10)]
+        # 135 bits worst case at 8 us/bit
+        assert all(t2 - t1 == 135 * 8000 for t1, t2 in zip(ts, ts[1:]))
+
+
+@pytest.mark.threaded
+def test_recv_releases_the_gil():
+    with motorbus.open_bus("virtual:py-gil") as a, motorbus.open_bus("virtual:py-gil") as b:
+        def later():
+            time.sleep(0.05)
+            a.send(Frame(7))
+
+        t = threading.Thread(target=later)
+        t.start()
+        f = b.recv(2.0)  # would deadlock if recv held the GIL
+        t.join()
+        assert f.id == 7
+
+
+def test_bus_off_raises_link_down():
+    with motorbus.open_bus("virtual:py-off") as a:
+        a.set_bus_off(True)
+        assert a.state == "bus-off"
+        with pytest.raises(motorbus.LinkDown):
+            a.send(Frame(1))
+        with pytest.raises(ConnectionError):
+            a.send(Frame(1))
