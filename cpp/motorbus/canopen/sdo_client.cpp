@@ -1,0 +1,623 @@
+#include "motorbus/canopen/sdo_client.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+
+namespace motorbus::canopen {
+
+using namespace sdo;
+namespace ac = abort_code;
+
+namespace {
+std::string hexdump(std::span<const std::uint8_t> p) {
+    std::string s;
+    char b[4];
+    for (auto x : p) {
+        std::snprintf(b, sizeof b, "%s%02X", s.empty() ? "" : " ", x);
+        s += b;
+    }
+    return s;
+}
+}  // namespace
+
+SdoClientMachine::SdoClientMachine(SdoClientConfig config) : config_(config) {
+    if (config_.block_size == 0 || config_.block_size > kMaxBlockSize) config_.block_size = kMaxBlockSize;
+}
+
+void SdoClientMachine::reset() {
+    status_ = Status::Idle;
+    phase_ = Phase::None;
+    Bytes().swap(data_);
+    pos_ = 0;
+    indicated_.reset();
+    toggle_ = crc_ = sent_last_ = false;
+    seq_ = 0;
+    sent_segments_ = 0;
+    deadline_ = sub_deadline_ = kNoDeadline;
+    error_ = nullptr;
+}
+
+Nanos SdoClientMachine::next_deadline() const {
+    if (status_ != Status::Running) return kNoDeadline;
+    return std::min(deadline_, sub_deadline_);
+}
+
+void SdoClientMachine::touch(Nanos now) {
+    deadline_ = now > kNoDeadline - config_.timeout_ns ? kNoDeadline : now + config_.timeout_ns;
+}
+
+void SdoClientMachine::start_upload(std::uint16_t index, std::uint8_t subindex, TransferMode mode,
+                                    Nanos now, Outbox& out) {
+    reset();
+    status_ = Status::Running;
+    mode_ = mode;
+    mux_ = {index, subindex};
+    started_ = now;
+    ++counters_.transfers;
+    touch(now);
+    if (mode == TransferMode::Block) {
+        phase_ = Phase::BlkUpInitiate;
+        out.push_back(block_upload_initiate(mux_, config_.block_crc, config_.block_size,
+                                            config_.protocol_switch));
+    } else {
+        start_plain_upload(out);
+    }
+}
+
+void SdoClientMachine::start_plain_upload(Outbox& out) {
+    phase_ = Phase::UpInitiate;
+    out.push_back(initiate_upload(mux_));
+}
+
+void SdoClientMachine::start_download(std::uint16_t index, std::uint8_t subindex,
+                                      std::span<const std::uint8_t> data, TransferMode mode,
+                                      Nanos now, Outbox& out) {
+    reset();
+    status_ = Status::Running;
+    mode_ = mode;
+    mux_ = {index, subindex};
+    data_.assign(data.begin(), data.end());
+    started_ = now;
+    ++counters_.transfers;
+    touch(now);
+    if (mode == TransferMode::Block) {
+        phase_ = Phase::BlkDnInitiate;
+        out.push_back(block_download_initiate(mux_, config_.block_crc,
+                                              static_cast<std::uint32_t>(data_.size())));
+    } else {
+        start_segmented_download(out);
+    }
+}
+
+void SdoClientMachine::start_segmented_download(Outbox& out) {
+    phase_ = Phase::DnInitiate;
+    pos_ = 0;
+    if (mode_ != TransferMode::Segmented && !data_.empty() && data_.size() <= 4)
+        out.push_back(initiate_download_expedited(mux_, data_));
+    else
+        out.push_back(initiate_download_segmented(mux_, static_cast<std::uint32_t>(data_.size())));
+}
+
+void SdoClientMachine::fail_abort(std::uint32_t code, Outbox& out, std::span<const std::uint8_t> frame,
+                                  const std::string& why) {
+    out.push_back(abort_transfer(mux_, code));
+    ++counters_.aborts_sent;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "SDO 0x%04X:%02X: ", mux_.index, mux_.subindex);
+    error_ = std::make_exception_ptr(SdoProtocolError(
+        std::string(buf) + why + " [" + hexdump(frame) + "]; sent abort " + describe_abort(code),
+        Bytes(frame.begin(), frame.end()), code, mux_.index, mux_.subindex));
+    status_ = Status::Failed;
+    phase_ = Phase::None;
+    Bytes().swap(data_);
+}
+
+void SdoClientMachine::fail_peer_abort(std::span<const std::uint8_t> frame, Outbox& out) {
+    const std::uint32_t code = abort_code_of(frame);  // C4, C5: short or zero -> 0x08000000
+    ++counters_.aborts_received;
+    const bool initiating = phase_ == Phase::BlkUpInitiate || phase_ == Phase::BlkDnInitiate;
+    if (initiating && config_.fallback_to_segmented &&
+        (code == ac::kCommandSpecifier || code == ac::kUnsupportedAccess)) {
+        // B16: the server has no block mode; the same transfer, segmented.
+        ++counters_.fallbacks;
+        if (phase_ == Phase::BlkUpInitiate) {
+            start_plain_upload(out);
+        } else {
+            mode_ = TransferMode::Auto;
+            start_segmented_download(out);
+        }
+        return;
+    }
+    error_ = std::make_exception_ptr(SdoAbortError(code, mux_.index, mux_.subindex));
+    status_ = Status::Failed;
+    phase_ = Phase::None;
+    Bytes().swap(data_);
+}
+
+void SdoClientMachine::finish() {
+    status_ = Status::Done;
+    phase_ = Phase::None;
+    deadline_ = sub_deadline_ = kNoDeadline;
+}
+
+bool SdoClientMachine::check_mux(std::span<const std::uint8_t> p, Outbox& out) {
+    auto m = multiplexer_of(p);
+    if (!m) {
+        fail_abort(ac::kCommandSpecifier, out, p, "response too short for its multiplexer");  // C15
+        return false;
+    }
+    if (*m != mux_) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "response names 0x%04X:%02X (mismatch)", m->index, m->subindex);
+        fail_abort(ac::kParamIncompatible, out, p, buf);  // C2
+        return false;
+    }
+    return true;
+}
+
+void SdoClientMachine::on_frame(std::span<const std::uint8_t> p, Nanos now, Outbox& out) {
+    if (status_ != Status::Running) {  // C8: stray response, nothing to queue
+        ++counters_.ignored_frames;
+        return;
+    }
+    if (p.empty()) return fail_abort(ac::kCommandSpecifier, out, p, "empty response");
+    const bool in_segments = phase_ == Phase::BlkUpSub;
+    if ((in_segments && p[0] == 0x80) || (!in_segments && scs_of(p[0]) == Scs::Abort))
+        return fail_peer_abort(p, out);  // C3: unconfirmed, no reply
+    touch(now);
+    switch (phase_) {
+        case Phase::UpInitiate:
+        case Phase::UpSegment:
+            return on_upload(p, out);
+        case Phase::DnInitiate:
+        case Phase::DnSegment:
+            return on_download(p, out);
+        case Phase::BlkUpInitiate:
+        case Phase::BlkUpSub:
+        case Phase::BlkUpEnd:
+            return on_block_upload(p, now, out);
+        case Phase::BlkDnInitiate:
+        case Phase::BlkDnSub:
+        case Phase::BlkDnEnd:
+            return on_block_download(p, out);
+        case Phase::None: break;
+    }
+}
+
+void SdoClientMachine::on_upload(std::span<const std::uint8_t> p, Outbox& out) {
+    if (phase_ == Phase::UpInitiate) {
+        if (scs_of(p[0]) != Scs::InitiateUpload)
+            return fail_abort(ac::kCommandSpecifier, out, p, "unexpected command specifier");  // C6
+        if (!check_mux(p, out)) return;
+        const auto f = initiate_flags(p[0]);
+        if (f.expedited) {
+            std::size_t n = f.size_indicated ? 4u - f.unused : std::min<std::size_t>(4, p.size() - 4);
+            if (p.size() < 4 + n)
+                return fail_abort(ac::kCommandSpecifier, out, p, "expedited data missing (short frame)");
+            data_.assign(p.begin() + 4, p.begin() + 4 + static_cast<std::ptrdiff_t>(n));
+            return finish();
+        }
+        if (f.size_indicated) {
+            if (p.size() < 8) return fail_abort(ac::kCommandSpecifier, out, p, "size missing (short frame)");
+            const std::uint32_t size = get_le32(&p[4]);
+            if (size > config_.max_transfer)  // C10: refuse before allocating
+                return fail_abort(ac::kOutOfMemory, out, p,
+                                  "indicated size " + std::to_string(size) + " exceeds max_transfer");
+            indicated_ = size;
+            data_.reserve(std::min<std::size_t>(size, 65536));
+        }
+        phase_ = Phase::UpSegment;
+        toggle_ = false;
+        out.push_back(upload_segment(toggle_));
+        return;
+    }
+    if (scs_of(p[0]) != Scs::UploadSegment)
+        return fail_abort(ac::kCommandSpecifier, out, p, "unexpected command specifier");
+    const auto f = segment_flags(p[0]);
+    if (f.toggle != toggle_) return fail_abort(ac::kToggleBit, out, p, "toggle bit not alternated");  // C7
+    const std::size_t n = kSegmentData - f.unused;
+    if (p.size() < 1 + n) return fail_abort(ac::kCommandSpecifier, out, p, "segment shorter than its n");
+    if (indicated_ && data_.size() + n > *indicated_)  // C11
+        return fail_abort(ac::kTooLong, out, p, "more data than indicated");
+    if (data_.size() + n > config_.max_transfer)  // C13
+        return fail_abort(ac::kOutOfMemory, out, p, "upload exceeds max_transfer");
+    data_.insert(data_.end(), p.begin() + 1, p.begin() + 1 + static_cast<std::ptrdiff_t>(n));
+    if (f.last) {
+        if (indicated_ && data_.size() < *indicated_)  // C12
+            return fail_abort(ac::kTooShort, out, p, "less data than indicated");
+        return finish();
+    }
+    toggle_ = !toggle_;
+    out.push_back(upload_segment(toggle_));
+}
+
+void SdoClientMachine::send_next_download_segment(Outbox& out) {
+    const std::size_t n = std::min(kSegmentData, data_.size() - pos_);
+    const bool last = pos_ + n >= data_.size();
+    out.push_back(download_segment(toggle_, std::span(data_).subspan(pos_, n), last));
+    pos_ += n;
+}
+
+void SdoClientMachine::on_download(std::span<const std::uint8_t> p, Outbox& out) {
+    if (phase_ == Phase::DnInitiate) {
+        if (scs_of(p[0]) != Scs::InitiateDownload)
+            return fail_abort(ac::kCommandSpecifier, out, p, "unexpected command specifier");
+        if (!check_mux(p, out)) return;
+        const bool expedited = mode_ != TransferMode::Segmented && !data_.empty() && data_.size() <= 4;
+        if (expedited) return finish();
+        phase_ = Phase::DnSegment;
+        toggle_ = false;
+        pos_ = 0;
+        return send_next_download_segment(out);
+    }
+    if (scs_of(p[0]) != Scs::DownloadSegment)
+        return fail_abort(ac::kCommandSpecifier, out, p, "unexpected command specifier");
+    if (bool(p[0] & 0x10) != toggle_) return fail_abort(ac::kToggleBit, out, p, "toggle bit not alternated");
+    if (pos_ >= data_.size()) return finish();
+    toggle_ = !toggle_;
+    send_next_download_segment(out);
+}
+
+void SdoClientMachine::block_upload_ack(Outbox& out) {
+    out.push_back(sdo::block_upload_ack(seq_, blksize_));
+    seq_ = 0;
+}
+
+void SdoClientMachine::on_block_upload(std::span<const std::uint8_t> p, Nanos now, Outbox& out) {
+    const auto arm_sub = [&] {
+        sub_deadline_ = now + static_cast<Nanos>(static_cast<double>(config_.timeout_ns) *
+                                                 config_.subblock_timer_fraction);
+    };
+    if (phase_ == Phase::BlkUpInitiate) {
+        if (scs_of(p[0]) == Scs::InitiateUpload) {  // protocol switch by the server
+            phase_ = Phase::UpInitiate;
+            return on_upload(p, out);
+        }
+        if ((p[0] & 0xE1) != 0xC0)
+            return fail_abort(ac::kCommandSpecifier, out, p, "unexpected command specifier");
+        if (!check_mux(p, out)) return;
+        if (p[0] & 0x02) {
+            if (p.size() < 8) return fail_abort(ac::kCommandSpecifier, out, p, "size missing (short frame)");
+            const std::uint32_t size = get_le32(&p[4]);
+            if (size > config_.max_transfer)  // C10
+                return fail_abort(ac::kOutOfMemory, out, p,
+                                  "indicated size " + std::to_string(size) + " exceeds max_transfer");
+            indicated_ = size;
+            data_.reserve(std::min<std::size_t>(size + 7, 1u << 20));
+        }
+        crc_ = config_.block_crc && (p[0] & 0x04);
+        blksize_ = config_.block_size;
+        seq_ = 0;
+        phase_ = Phase::BlkUpSub;
+        out.push_back(block_upload_start());
+        arm_sub();
+        return;
+    }
+    if (phase_ == Phase::BlkUpEnd) {
+        if ((p[0] & 0xE3) != 0xC1) {
+            if (p.size() == 8 && (p[0] & 0x7F) != 0) {  // a late retransmission: harmless
+                ++counters_.ignored_frames;
+                return;
+            }
+            return fail_abort(ac::kCommandSpecifier, out, p, "unexpected command specifier");
+        }
+        if (p.size() < 3) return fail_abort(ac::kCommandSpecifier, out, p, "end frame without CRC");
+        const std::size_t unused = (p[0] >> 2) & 7;
+        if (unused > data_.size() || (unused == 7 && data_.size() > 7))  // B10
+            return fail_abort(ac::kCommandSpecifier, out, p, "end frame n inconsistent with the data");
+        data_.resize(data_.size() - unused);
+        if (indicated_ && data_.size() != *indicated_)  // B11
+            return fail_abort(data_.size() > *indicated_ ? ac::kTooLong : ac::kTooShort, out, p,
+                              "received " + std::to_string(data_.size()) + " bytes, indicated " +
+                                  std::to_string(*indicated_));
+        if (crc_ && crc16(data_) != get_le16(&p[1])) return fail_abort(ac::kCrc, out, p, "CRC mismatch");  // B9
+        out.push_back(block_upload_end_response());
+        return finish();
+    }
+    // BlkUpSub: segments c|seqno + 7 bytes.
+    if (p.size() < 8) return fail_abort(ac::kCommandSpecifier, out, p, "block segment shorter than 8 bytes");
+    const std::uint8_t seqno = p[0] & 0x7F;
+    const bool last = p[0] & 0x80;
+    if (seqno == 0) return fail_abort(ac::kSequenceNumber, out, p, "sequence number 0");
+    arm_sub();
+    if (seqno == seq_ + 1) {
+        if (indicated_ && data_.size() >= *indicated_ + (*indicated_ == 0 ? 1 : 0))  // C11
+            return fail_abort(ac::kTooLong, out, p, "more data than indicated");
+        if (data_.size() >= config_.max_transfer)  // C13
+            return fail_abort(ac::kOutOfMemory, out, p, "upload exceeds max_transfer");
+        data_.insert(data_.end(), p.begin() + 1, p.begin() + 8);
+        seq_ = seqno;
+        if (last) {
+            block_upload_ack(out);
+            phase_ = Phase::BlkUpEnd;
+            sub_deadline_ = kNoDeadline;
+        } else if (seq_ >= blksize_) {
+            block_upload_ack(out);
+        }
+        return;
+    }
+    if (seqno <= seq_) {  // B6: overlap of a retransmission
+        ++counters_.ignored_frames;
+        return;
+    }
+    // A gap (B13): at the end of the sub-block, ask for the rest again.
+    if (last || seqno >= blksize_) {
+        ++counters_.retransmit_requests;
+        block_upload_ack(out);
+    }
+}
+
+void SdoClientMachine::send_block_download_subblock(Outbox& out) {
+    sent_segments_ = 0;
+    sent_last_ = false;
+    std::size_t off = pos_;
+    while (sent_segments_ < blksize_) {
+        const std::size_t n = std::min(kSegmentData, data_.size() - off);
+        const bool last = off + n >= data_.size();
+        out.push_back(block_segment(static_cast<std::uint8_t>(sent_segments_ + 1),
+                                    std::span(data_).subspan(off, n), last));
+        ++sent_segments_;
+        off += n;
+        if (last) {
+            sent_last_ = true;
+            break;
+        }
+    }
+}
+
+void SdoClientMachine::on_block_download(std::span<const std::uint8_t> p, Outbox& out) {
+    if (phase_ == Phase::BlkDnInitiate) {
+        if (scs_of(p[0]) == Scs::InitiateDownload || (p[0] & 0xE3) != 0xA0)
+            return fail_abort(ac::kCommandSpecifier, out, p, "unexpected command specifier");
+        if (!check_mux(p, out)) return;
+        if (p.size() < 5) return fail_abort(ac::kCommandSpecifier, out, p, "block size missing");
+        if (p[4] == 0 || p[4] > kMaxBlockSize)  // B8
+            return fail_abort(ac::kBlockSize, out, p, "invalid block size " + std::to_string(p[4]));
+        crc_ = config_.block_crc && (p[0] & 0x04);
+        blksize_ = p[4];
+        pos_ = 0;
+        phase_ = Phase::BlkDnSub;
+        return send_block_download_subblock(out);
+    }
+    if (phase_ == Phase::BlkDnEnd) {
+        if ((p[0] & 0xE3) != 0xA1) return fail_abort(ac::kCommandSpecifier, out, p, "unexpected command specifier");
+        return finish();
+    }
+    if ((p[0] & 0xE3) != 0xA2) return fail_abort(ac::kCommandSpecifier, out, p, "unexpected command specifier");
+    if (p.size() < 3) return fail_abort(ac::kCommandSpecifier, out, p, "acknowledgement too short");
+    const std::uint8_t ackseq = p[1], blksize = p[2];
+    if (ackseq > sent_segments_) return fail_abort(ac::kSequenceNumber, out, p, "ackseq beyond the sub-block");
+    if (blksize == 0 || blksize > kMaxBlockSize)  // B8
+        return fail_abort(ac::kBlockSize, out, p, "invalid block size " + std::to_string(blksize));
+    const bool all = ackseq == sent_segments_;
+    pos_ = std::min(data_.size(), pos_ + std::size_t{ackseq} * kSegmentData);
+    blksize_ = blksize;
+    if (all && sent_last_) {
+        const std::size_t rem = data_.size() % kSegmentData;
+        const auto unused = static_cast<std::uint8_t>(data_.empty() ? 7 : rem ? kSegmentData - rem : 0);
+        out.push_back(block_download_end(unused, crc_ ? crc16(data_) : 0));
+        phase_ = Phase::BlkDnEnd;
+        return;
+    }
+    if (!all) ++counters_.retransmit_requests;
+    send_block_download_subblock(out);
+}
+
+void SdoClientMachine::on_timer(Nanos now, Outbox& out) {
+    if (status_ != Status::Running) return;
+    if (now >= deadline_) {  // C1: abort WITH the multiplexer, then report
+        out.push_back(abort_transfer(mux_, ac::kTimeout));
+        ++counters_.aborts_sent;
+        ++counters_.timeouts;
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "SDO 0x%04X:%02X: no response within %.3f s", mux_.index,
+                      mux_.subindex, static_cast<double>(config_.timeout_ns) / 1e9);
+        error_ = std::make_exception_ptr(SdoTimeout(buf, mux_.index, mux_.subindex));
+        status_ = Status::Failed;
+        phase_ = Phase::None;
+        Bytes().swap(data_);
+        return;
+    }
+    if (phase_ == Phase::BlkUpSub && now >= sub_deadline_) {
+        // B12: the server stalled mid sub-block; ack what arrived so it resends the rest.
+        ++counters_.retransmit_requests;
+        block_upload_ack(out);
+        sub_deadline_ = kNoDeadline;
+    }
+}
+
+// ===========================================================================
+
+SdoClient::SdoClient(can::Bus& bus, std::uint8_t node_id, SdoClientOptions options)
+    : bus_(bus), node_id_(node_id), options_(options) {
+    if ((node_id == 0 || node_id > 127) && (!options.request_id || !options.response_id))
+        throw InvalidArgument("SdoClient node_id: " + std::to_string(node_id) + ", must be 1-127");
+    request_id_ = options.request_id ? options.request_id : kDefaultRequestBase + node_id;
+    response_id_ = options.response_id ? options.response_id : kDefaultResponseBase + node_id;
+    if (request_id_ > can::kMaxStandardId || response_id_ > can::kMaxStandardId)
+        throw InvalidArgument("SdoClient COB-IDs must be 11-bit");
+    SdoClientConfig c;
+    c.timeout_ns = options.timeout.count() > 0 ? options.timeout.count() : 1;
+    c.max_transfer = options.max_transfer;
+    c.block_size = options.block_size;
+    c.block_crc = options.block_crc;
+    c.fallback_to_segmented = options.fallback_to_segmented;
+    machine_.set_config(c);
+    sub_ = bus_.subscribe_id(response_id_, false, [this](const can::Frame& f) { on_frame(f); });
+}
+
+SdoClient::~SdoClient() { bus_.unsubscribe(sub_); }
+
+void SdoClient::set_timeout(std::chrono::nanoseconds t) {
+    std::lock_guard tl(transfer_mutex_);
+    std::lock_guard lock(mutex_);
+    options_.timeout = t;
+    auto c = machine_.config();
+    c.timeout_ns = t.count() > 0 ? t.count() : 1;
+    machine_.set_config(c);
+}
+
+SdoClientCounters SdoClient::counters() const {
+    std::lock_guard lock(mutex_);
+    return machine_.counters();
+}
+
+void SdoClient::send_out() {
+    for (const auto& p : outbox_) {
+        can::Frame f;
+        f.id = request_id_;
+        f.len = 8;
+        std::memcpy(f.data.data(), p.data(), 8);
+        bus_.send(f, options_.timeout);
+    }
+    outbox_.clear();
+}
+
+void SdoClient::on_frame(const can::Frame& f) {
+    if (f.rtr || (f.flags & (can::kFlagError | can::kFlagLoopback))) return;
+    std::lock_guard lock(mutex_);
+    machine_.on_frame(f.payload(), monotonic_ns(), outbox_);
+    try {
+        send_out();
+    } catch (const std::exception&) {
+        // The medium refused (full, closed): the transfer runs into its timeout.
+        outbox_.clear();
+    }
+    if (!machine_.busy()) cv_.notify_all();
+}
+
+void SdoClient::run(std::unique_lock<std::mutex>& lock) {
+    try {
+        send_out();
+    } catch (...) {
+        machine_.reset();
+        throw;
+    }
+    while (machine_.busy()) {
+        const Nanos dl = machine_.next_deadline();
+        cv_.wait_until(lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dl)),
+                       [&] { return !machine_.busy() || monotonic_ns() >= machine_.next_deadline(); });
+        if (machine_.busy() && monotonic_ns() >= machine_.next_deadline()) {
+            machine_.on_timer(monotonic_ns(), outbox_);
+            try {
+                send_out();
+            } catch (const std::exception&) {
+                outbox_.clear();
+            }
+        }
+    }
+    if (machine_.status() == SdoClientMachine::Status::Failed) {
+        auto e = machine_.error();
+        machine_.reset();
+        std::rethrow_exception(e);
+    }
+}
+
+Bytes SdoClient::upload(std::uint16_t index, std::uint8_t subindex, TransferMode mode) {
+    std::lock_guard tl(transfer_mutex_);
+    for (unsigned attempt = 0;; ++attempt) {
+        std::unique_lock lock(mutex_);
+        machine_.start_upload(index, subindex, mode, monotonic_ns(), outbox_);
+        try {
+            run(lock);
+        } catch (const SdoTimeout&) {
+            if (attempt < options_.read_retries) continue;  // reads are idempotent
+            throw;
+        }
+        Bytes out = machine_.take_result();
+        machine_.reset();
+        return out;
+    }
+}
+
+void SdoClient::download(std::uint16_t index, std::uint8_t subindex,
+                         std::span<const std::uint8_t> data, TransferMode mode) {
+    std::lock_guard tl(transfer_mutex_);
+    std::unique_lock lock(mutex_);
+    machine_.start_download(index, subindex, data, mode, monotonic_ns(), outbox_);
+    run(lock);
+    machine_.reset();
+}
+
+template <class T>
+T SdoClient::read_le(std::uint16_t i, std::uint8_t s) {
+    Bytes b = upload(i, s);
+    if (b.size() != sizeof(T)) {  // C14: decode by indicated size, refuse the type
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "SDO 0x%04X:%02X: value has %zu bytes, expected %zu", i, s,
+                      b.size(), sizeof(T));
+        throw InvalidArgument(buf);
+    }
+    T v;
+    if constexpr (sizeof(T) == 1) {
+        std::memcpy(&v, b.data(), 1);
+    } else {
+        std::uint64_t u = 0;
+        for (std::size_t k = 0; k < sizeof(T); ++k) u |= std::uint64_t{b[k]} << (8 * k);
+        if constexpr (std::is_floating_point_v<T>) {
+            if constexpr (sizeof(T) == 4) {
+                auto u32 = static_cast<std::uint32_t>(u);
+                std::memcpy(&v, &u32, 4);
+            } else {
+                std::memcpy(&v, &u, 8);
+            }
+        } else {
+            v = static_cast<T>(u);
+        }
+    }
+    return v;
+}
+
+template <class T>
+void SdoClient::write_le(std::uint16_t i, std::uint8_t s, T v) {
+    std::uint8_t b[sizeof(T)];
+    std::uint64_t u = 0;
+    if constexpr (std::is_floating_point_v<T>) {
+        if constexpr (sizeof(T) == 4) {
+            std::uint32_t u32;
+            std::memcpy(&u32, &v, 4);
+            u = u32;
+        } else {
+            std::memcpy(&u, &v, 8);
+        }
+    } else {
+        u = static_cast<std::uint64_t>(v);
+    }
+    for (std::size_t k = 0; k < sizeof(T); ++k) b[k] = static_cast<std::uint8_t>(u >> (8 * k));
+    download(i, s, std::span<const std::uint8_t>(b, sizeof(T)));
+}
+
+std::uint8_t SdoClient::read_u8(std::uint16_t i, std::uint8_t s) { return read_le<std::uint8_t>(i, s); }
+std::uint16_t SdoClient::read_u16(std::uint16_t i, std::uint8_t s) { return read_le<std::uint16_t>(i, s); }
+std::uint32_t SdoClient::read_u32(std::uint16_t i, std::uint8_t s) { return read_le<std::uint32_t>(i, s); }
+std::uint64_t SdoClient::read_u64(std::uint16_t i, std::uint8_t s) { return read_le<std::uint64_t>(i, s); }
+std::int8_t SdoClient::read_i8(std::uint16_t i, std::uint8_t s) { return read_le<std::int8_t>(i, s); }
+std::int16_t SdoClient::read_i16(std::uint16_t i, std::uint8_t s) { return read_le<std::int16_t>(i, s); }
+std::int32_t SdoClient::read_i32(std::uint16_t i, std::uint8_t s) { return read_le<std::int32_t>(i, s); }
+std::int64_t SdoClient::read_i64(std::uint16_t i, std::uint8_t s) { return read_le<std::int64_t>(i, s); }
+float SdoClient::read_f32(std::uint16_t i, std::uint8_t s) { return read_le<float>(i, s); }
+double SdoClient::read_f64(std::uint16_t i, std::uint8_t s) { return read_le<double>(i, s); }
+
+std::string SdoClient::read_string(std::uint16_t i, std::uint8_t s) {
+    Bytes b = upload(i, s);
+    while (!b.empty() && b.back() == 0) b.pop_back();
+    return std::string(b.begin(), b.end());
+}
+
+void SdoClient::write_u8(std::uint16_t i, std::uint8_t s, std::uint8_t v) { write_le(i, s, v); }
+void SdoClient::write_u16(std::uint16_t i, std::uint8_t s, std::uint16_t v) { write_le(i, s, v); }
+void SdoClient::write_u32(std::uint16_t i, std::uint8_t s, std::uint32_t v) { write_le(i, s, v); }
+void SdoClient::write_u64(std::uint16_t i, std::uint8_t s, std::uint64_t v) { write_le(i, s, v); }
+void SdoClient::write_i8(std::uint16_t i, std::uint8_t s, std::int8_t v) { write_le(i, s, v); }
+void SdoClient::write_i16(std::uint16_t i, std::uint8_t s, std::int16_t v) { write_le(i, s, v); }
+void SdoClient::write_i32(std::uint16_t i, std::uint8_t s, std::int32_t v) { write_le(i, s, v); }
+void SdoClient::write_i64(std::uint16_t i, std::uint8_t s, std::int64_t v) { write_le(i, s, v); }
+void SdoClient::write_f32(std::uint16_t i, std::uint8_t s, float v) { write_le(i, s, v); }
+void SdoClient::write_f64(std::uint16_t i, std::uint8_t s, double v) { write_le(i, s, v); }
+
+void SdoClient::write_string(std::uint16_t i, std::uint8_t s, std::string_view v) {
+    download(i, s, std::span(reinterpret_cast<const std::uint8_t*>(v.data()), v.size()));
+}
+
+}  // namespace motorbus::canopen
