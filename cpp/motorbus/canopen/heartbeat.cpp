@@ -6,10 +6,10 @@
 
 namespace motorbus::canopen {
 
-can::Frame encode_heartbeat(std::uint8_t node_id, NmtState state) {
+can::Frame encode_heartbeat(std::uint8_t node_id, NodeState state) {
     if (node_id == 0 || node_id > kMaxNodeId)
         throw InvalidArgument("heartbeat node id " + std::to_string(node_id) + " is outside 1-127");
-    if (state == NmtState::Unknown) throw InvalidArgument("heartbeat state: UNKNOWN cannot be sent");
+    if (state == NodeState::Unknown) throw InvalidArgument("heartbeat state: UNKNOWN cannot be sent");
     can::Frame f;
     f.id = kHeartbeatBase + node_id;
     f.len = 1;
@@ -24,7 +24,7 @@ std::optional<HeartbeatMessage> decode_heartbeat(const can::Frame& f) {
     // reserved, so 0x85 is UNKNOWN rather than "operational" (N7).
     const std::uint8_t raw = f.data[0];
     return HeartbeatMessage{static_cast<std::uint8_t>(f.id - kHeartbeatBase), raw,
-                            nmt_state_from_byte(raw)};
+                            node_state_from_byte(raw)};
 }
 
 std::optional<ConsumerEntry> decode_consumer_entry(std::uint32_t v) {
@@ -110,7 +110,7 @@ void HeartbeatConsumer::on_frame(const can::Frame& f) {
     {
         std::lock_guard l(mutex_);
         auto& n = nodes_[hb->node_id];
-        const NmtState old = n.h.state;
+        const NodeState old = n.h.state;
         const std::uint8_t old_raw = n.h.raw_state;
         const bool was_lost = n.h.lost, was_alive = n.h.alive;
         n.h.last_seen = now;
@@ -129,7 +129,7 @@ void HeartbeatConsumer::on_frame(const can::Frame& f) {
         } else if (!was_alive) {
             evs[nev++] = HeartbeatEvent::Started;
         }
-        if (hb->state == NmtState::Unknown && old_raw != hb->raw_state)
+        if (hb->state == NodeState::Unknown && old_raw != hb->raw_state)
             evs[nev++] = HeartbeatEvent::UnknownState;
         else if (was_alive && old != hb->state && !hb->is_boot_up())
             evs[nev++] = HeartbeatEvent::StateChanged;
@@ -139,7 +139,7 @@ void HeartbeatConsumer::on_frame(const can::Frame& f) {
 }
 
 Nanos HeartbeatConsumer::process(Nanos now) {
-    std::vector<std::pair<std::uint8_t, NmtState>> lost;
+    std::vector<std::pair<std::uint8_t, NodeState>> lost;
     Nanos next = -1;
     {
         std::lock_guard l(mutex_);
@@ -170,7 +170,7 @@ void HeartbeatConsumer::stop() { timer_.stop(); }
 // ---- producer ---------------------------------------------------------------
 
 HeartbeatProducer::HeartbeatProducer(can::Bus& bus, Clock& clock, std::uint8_t node_id,
-                                     std::chrono::nanoseconds period, std::function<NmtState()> state)
+                                     std::chrono::nanoseconds period, std::function<NodeState()> state)
     : bus_(bus), clock_(clock), node_(node_id), period_(period.count()), state_(std::move(state)) {
     if (node_id == 0 || node_id > kMaxNodeId) throw InvalidArgument("heartbeat producer: node id must be 1-127");
     if (period_ < 0) throw InvalidArgument("heartbeat producer: period must be >= 0");
@@ -180,7 +180,7 @@ HeartbeatProducer::HeartbeatProducer(can::Bus& bus, Clock& clock, std::uint8_t n
 HeartbeatProducer::~HeartbeatProducer() { timer_.stop(); }
 
 void HeartbeatProducer::send_boot_up() {
-    bus_.send(encode_heartbeat(node_, NmtState::Initialising));
+    bus_.send(encode_heartbeat(node_, NodeState::Initialising));
     sent_.fetch_add(1);
 }
 
@@ -210,8 +210,8 @@ Nanos HeartbeatProducer::process(Nanos now) {
         next = next_;
     }
     if (due) {
-        NmtState s = state_();
-        if (s != NmtState::Unknown) {
+        NodeState s = state_();
+        if (s != NodeState::Unknown) {
             bus_.send(encode_heartbeat(node_, s));
             sent_.fetch_add(1);
         }

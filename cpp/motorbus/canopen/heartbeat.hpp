@@ -24,11 +24,11 @@ constexpr std::uint32_t kHeartbeatBase = 0x700;
 struct HeartbeatMessage {
     std::uint8_t node_id;
     std::uint8_t raw_state;  // as received
-    NmtState state;          // Unknown for bytes outside {0, 4, 5, 0x7F} (N7)
+    NodeState state;          // Unknown for bytes outside {0, 4, 5, 0x7F} (N7)
     bool is_boot_up() const { return raw_state == 0; }
 };
 
-can::Frame encode_heartbeat(std::uint8_t node_id, NmtState state);
+can::Frame encode_heartbeat(std::uint8_t node_id, NodeState state);
 // nullopt unless id is 0x701-0x77F, not RTR, DLC == 1 (N6).
 std::optional<HeartbeatMessage> decode_heartbeat(const can::Frame& f);
 
@@ -58,7 +58,7 @@ const char* to_string(HeartbeatEvent e);
 
 struct NodeHealth {
     std::uint8_t node_id = 0;
-    NmtState state = NmtState::Unknown;
+    NodeState state = NodeState::Unknown;
     std::uint8_t raw_state = 0xFF;
     bool alive = false;   // heard within the consumer time
     bool lost = false;    // timed out and not heard since
@@ -89,7 +89,7 @@ public:
     void stop();
 
     // Called on the bus thread (events from frames) or the timer thread (Lost).
-    std::function<void(std::uint8_t node, HeartbeatEvent ev, NmtState state)> on_event;
+    std::function<void(std::uint8_t node, HeartbeatEvent ev, NodeState state)> on_event;
 
     std::uint64_t ignored_frames() const { return ignored_.load(); }
 
@@ -114,7 +114,7 @@ class HeartbeatProducer {
 public:
     // Sends 0x700+node with state() every `period`; a period of 0 disables it.
     HeartbeatProducer(can::Bus& bus, Clock& clock, std::uint8_t node_id,
-                      std::chrono::nanoseconds period, std::function<NmtState()> state);
+                      std::chrono::nanoseconds period, std::function<NodeState()> state);
     ~HeartbeatProducer();
     HeartbeatProducer(const HeartbeatProducer&) = delete;
     HeartbeatProducer& operator=(const HeartbeatProducer&) = delete;
@@ -134,7 +134,7 @@ private:
     std::mutex mutex_;
     Nanos period_;
     Nanos next_ = -1;
-    std::function<NmtState()> state_;
+    std::function<NodeState()> state_;
     std::atomic<std::uint64_t> sent_{0};
     TimerThread timer_;
 };

@@ -20,24 +20,24 @@ bool is_known_nmt_command(std::uint8_t cs) {
     return cs == 0x01 || cs == 0x02 || cs == 0x80 || cs == 0x81 || cs == 0x82;
 }
 
-const char* to_string(NmtState s) {
+const char* to_string(NodeState s) {
     switch (s) {
-        case NmtState::Initialising: return "INITIALISING";
-        case NmtState::Stopped: return "STOPPED";
-        case NmtState::Operational: return "OPERATIONAL";
-        case NmtState::PreOperational: return "PRE-OPERATIONAL";
-        case NmtState::Unknown: return "UNKNOWN";
+        case NodeState::Initialising: return "INITIALISING";
+        case NodeState::Stopped: return "STOPPED";
+        case NodeState::Operational: return "OPERATIONAL";
+        case NodeState::PreOperational: return "PRE-OPERATIONAL";
+        case NodeState::Unknown: return "UNKNOWN";
     }
     return "UNKNOWN";
 }
 
-NmtState nmt_state_from_byte(std::uint8_t b) {
+NodeState node_state_from_byte(std::uint8_t b) {
     switch (b) {
-        case 0x00: return NmtState::Initialising;
-        case 0x04: return NmtState::Stopped;
-        case 0x05: return NmtState::Operational;
-        case 0x7F: return NmtState::PreOperational;
-        default: return NmtState::Unknown;
+        case 0x00: return NodeState::Initialising;
+        case 0x04: return NodeState::Stopped;
+        case 0x05: return NodeState::Operational;
+        case 0x7F: return NodeState::PreOperational;
+        default: return NodeState::Unknown;
     }
 }
 
@@ -67,8 +67,8 @@ NmtSlave::NmtSlave(std::uint8_t node_id) : node_id_(node_id) {
         throw InvalidArgument("node id " + std::to_string(node_id) + " is outside 1-127");
 }
 
-void NmtSlave::set(NmtState s) {
-    NmtState old = state_;
+void NmtSlave::set(NodeState s) {
+    NodeState old = state_;
     state_ = s;
     if (old != s && on_state_change) on_state_change(old, s);
 }
@@ -80,12 +80,12 @@ std::optional<NmtCommand> NmtSlave::on_frame(const can::Frame& f) {
         return std::nullopt;
     }
     switch (m->command) {
-        case NmtCommand::Start: set(NmtState::Operational); break;
-        case NmtCommand::Stop: set(NmtState::Stopped); break;
-        case NmtCommand::EnterPreOperational: set(NmtState::PreOperational); break;
+        case NmtCommand::Start: set(NodeState::Operational); break;
+        case NmtCommand::Stop: set(NodeState::Stopped); break;
+        case NmtCommand::EnterPreOperational: set(NodeState::PreOperational); break;
         case NmtCommand::ResetNode:
         case NmtCommand::ResetCommunication:
-            set(NmtState::Initialising);
+            set(NodeState::Initialising);
             if (on_reset) on_reset(m->command);
             break;
     }
@@ -120,11 +120,11 @@ void NmtMaster::send(NmtCommand c, std::uint8_t node_id) { bus_.send(encode_nmt(
 void NmtMaster::on_heartbeat(const can::Frame& f) {
     auto hb = decode_heartbeat(f);
     if (!hb) return;
-    NmtState old, now;
+    NodeState old, now;
     {
         std::lock_guard l(mutex_);
         std::int16_t prev = raw_[hb->node_id];
-        old = prev < 0 ? NmtState::Unknown : nmt_state_from_byte(static_cast<std::uint8_t>(prev));
+        old = prev < 0 ? NodeState::Unknown : node_state_from_byte(static_cast<std::uint8_t>(prev));
         raw_[hb->node_id] = hb->raw_state;
         if (hb->is_boot_up()) ++boots_[hb->node_id];
         now = hb->state;
@@ -134,10 +134,10 @@ void NmtMaster::on_heartbeat(const can::Frame& f) {
     if (on_state_change) on_state_change(hb->node_id, old, now);
 }
 
-NmtState NmtMaster::state(std::uint8_t node) const {
-    if (node == 0 || node > kMaxNodeId) return NmtState::Unknown;
+NodeState NmtMaster::state(std::uint8_t node) const {
+    if (node == 0 || node > kMaxNodeId) return NodeState::Unknown;
     std::lock_guard l(mutex_);
-    return raw_[node] < 0 ? NmtState::Unknown : nmt_state_from_byte(static_cast<std::uint8_t>(raw_[node]));
+    return raw_[node] < 0 ? NodeState::Unknown : node_state_from_byte(static_cast<std::uint8_t>(raw_[node]));
 }
 
 std::optional<std::uint8_t> NmtMaster::raw_state(std::uint8_t node) const {
@@ -147,11 +147,11 @@ std::optional<std::uint8_t> NmtMaster::raw_state(std::uint8_t node) const {
     return static_cast<std::uint8_t>(raw_[node]);
 }
 
-bool NmtMaster::wait_for_state(std::uint8_t node, NmtState want, std::chrono::nanoseconds timeout) {
+bool NmtMaster::wait_for_state(std::uint8_t node, NodeState want, std::chrono::nanoseconds timeout) {
     if (node == 0 || node > kMaxNodeId) throw InvalidArgument("node id must be 1-127");
     std::unique_lock l(mutex_);
     return cv_.wait_for(l, timeout, [&] {
-        return raw_[node] >= 0 && nmt_state_from_byte(static_cast<std::uint8_t>(raw_[node])) == want;
+        return raw_[node] >= 0 && node_state_from_byte(static_cast<std::uint8_t>(raw_[node])) == want;
     });
 }
 

@@ -14,34 +14,31 @@
 
 #include "motorbus/can/bus.hpp"
 #include "motorbus/can/frame.hpp"
+// NmtCommand and the LocalNode's NmtState (without UNKNOWN) come from here.
+#include "motorbus/canopen/local_node.hpp"
 
 namespace motorbus::canopen {
 
 constexpr std::uint32_t kNmtCobId = 0x000;
 constexpr std::uint8_t kMaxNodeId = 127;
 
-enum class NmtCommand : std::uint8_t {
-    Start = 0x01,
-    Stop = 0x02,
-    EnterPreOperational = 0x80,
-    ResetNode = 0x81,
-    ResetCommunication = 0x82,
-};
 const char* to_string(NmtCommand c);
 bool is_known_nmt_command(std::uint8_t cs);
 
-// The states a heartbeat can carry.  Anything else is kept raw as Unknown:
-// a node reporting 0x42 is never assumed to be operational (N7).
-enum class NmtState : std::uint8_t {
+// The state a remote node reported in its heartbeat.  Like NmtState but with
+// Unknown: a byte outside the valid set (0x42...) or nothing heard yet is never
+// assumed to be operational (N7).
+enum class NodeState : std::uint8_t {
     Initialising = 0x00,  // the boot-up message
     Stopped = 0x04,
     Operational = 0x05,
     PreOperational = 0x7F,
     Unknown = 0xFF,  // nothing heard yet, or a byte outside the set above
 };
-const char* to_string(NmtState s);
+const char* to_string(NodeState s);
 // Maps the raw heartbeat byte; the toggle bit (node guarding) is not part of it.
-NmtState nmt_state_from_byte(std::uint8_t b);
+NodeState node_state_from_byte(std::uint8_t b);
+inline NodeState to_node_state(NmtState s) { return static_cast<NodeState>(s); }
 
 struct NmtMessage {
     NmtCommand command;
@@ -60,10 +57,10 @@ public:
     // Throws InvalidArgument for node ids 0 or > 127 (N14: refuse to start).
     explicit NmtSlave(std::uint8_t node_id);
     std::uint8_t node_id() const { return node_id_; }
-    NmtState state() const { return state_; }
+    NodeState state() const { return state_; }
 
     // After boot-up (power-on or reset) a node is pre-operational.
-    void boot() { set(NmtState::PreOperational); }
+    void boot() { set(NodeState::PreOperational); }
     // Returns the command applied, nullopt when the frame was ignored
     // (not for us, malformed, unknown: N1-N4) -- ignored frames are counted.
     std::optional<NmtCommand> on_frame(const can::Frame& f);
@@ -71,13 +68,13 @@ public:
 
     // Reset commands leave the node in Initialising; the owner re-inits its
     // application / communication area and then calls boot().
-    std::function<void(NmtState old_state, NmtState new_state)> on_state_change;
+    std::function<void(NodeState old_state, NodeState new_state)> on_state_change;
     std::function<void(NmtCommand)> on_reset;
 
 private:
-    void set(NmtState s);
+    void set(NodeState s);
     std::uint8_t node_id_;
-    NmtState state_ = NmtState::Initialising;
+    NodeState state_ = NodeState::Initialising;
     std::uint64_t ignored_ = 0;
 };
 
@@ -101,16 +98,16 @@ public:
     void reset_communication(std::uint8_t node) { send(NmtCommand::ResetCommunication, node); }
 
     // Last state heard from `node` (Unknown when never heard).
-    NmtState state(std::uint8_t node) const;
+    NodeState state(std::uint8_t node) const;
     std::optional<std::uint8_t> raw_state(std::uint8_t node) const;
     // Blocks until `node` reports `want` (heartbeat or boot-up); false on timeout.
-    bool wait_for_state(std::uint8_t node, NmtState want, std::chrono::nanoseconds timeout);
+    bool wait_for_state(std::uint8_t node, NodeState want, std::chrono::nanoseconds timeout);
     // Blocks until `node` sends its boot-up message; false on timeout.
     bool wait_for_boot(std::uint8_t node, std::chrono::nanoseconds timeout);
 
     // Called on the bus thread when a node's reported state changes, and for
     // every boot-up message (old state may equal new state then).
-    std::function<void(std::uint8_t node, NmtState old_state, NmtState new_state)> on_state_change;
+    std::function<void(std::uint8_t node, NodeState old_state, NodeState new_state)> on_state_change;
 
     std::uint64_t foreign_commands_ignored() const { return foreign_ignored_.load(); }
 

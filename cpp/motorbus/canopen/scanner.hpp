@@ -29,7 +29,7 @@ struct ScanResult {
     bool sdo_answered = false;   // any SDO reply (value or abort)
     bool heard_heartbeat = false;
     bool heard_boot_up = false;
-    NmtState state = NmtState::Unknown;  // from the last heartbeat heard
+    NodeState state = NodeState::Unknown;  // from the last heartbeat heard
     std::optional<std::uint32_t> device_type;      // 0x1000
     std::optional<std::uint32_t> vendor_id;        // 0x1018:1
     std::optional<std::uint32_t> product_code;     // 0x1018:2

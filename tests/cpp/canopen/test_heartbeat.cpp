@@ -12,13 +12,13 @@ using svc_test::frame;
 using namespace std::chrono_literals;
 
 TEST(HeartbeatCodec, EncodeDecode) {
-    auto f = encode_heartbeat(5, NmtState::Operational);
+    auto f = encode_heartbeat(5, NodeState::Operational);
     EXPECT_EQ(f.id, 0x705u);
     EXPECT_EQ(bytes(f), std::vector<std::uint8_t>{0x05});
     auto m = decode_heartbeat(f);
     ASSERT_TRUE(m);
     EXPECT_EQ(m->node_id, 5);
-    EXPECT_EQ(m->state, NmtState::Operational);
+    EXPECT_EQ(m->state, NodeState::Operational);
     EXPECT_TRUE(decode_heartbeat(frame(0x77F, {0x00}))->is_boot_up());
     EXPECT_FALSE(decode_heartbeat(frame(0x700, {0x05})));  // node 0
     EXPECT_FALSE(decode_heartbeat(frame(0x705, {}, true)));  // node-guarding RTR
@@ -34,7 +34,7 @@ TEST(HeartbeatCodec, N7_UnknownStatesAreUnknown) {
     for (std::uint8_t b : {0x42, 0x01, 0x85, 0xFF, 0x7E}) {
         auto m = decode_heartbeat(frame(0x705, {b}));
         ASSERT_TRUE(m);
-        EXPECT_EQ(m->state, NmtState::Unknown) << int(b);
+        EXPECT_EQ(m->state, NodeState::Unknown) << int(b);
         EXPECT_EQ(m->raw_state, b);
     }
 }
@@ -66,14 +66,14 @@ struct ConsumerFixture : ::testing::Test {
     HeartbeatConsumer hc{*host, clock};
     std::vector<std::pair<int, HeartbeatEvent>> events;
     void SetUp() override {
-        hc.on_event = [this](std::uint8_t n, HeartbeatEvent e, NmtState) { events.emplace_back(n, e); };
+        hc.on_event = [this](std::uint8_t n, HeartbeatEvent e, NodeState) { events.emplace_back(n, e); };
     }
     void beat(std::uint8_t node, std::uint8_t state) { dev->send(frame(0x700u + node, {state})); }
 };
 
 TEST_F(ConsumerFixture, N10_LostWithinConsumerTimePlusOneTick_ThenBack) {
     EmcyProducer emcy(*host, clock, 1);
-    hc.on_event = [&](std::uint8_t n, HeartbeatEvent e, NmtState) {
+    hc.on_event = [&](std::uint8_t n, HeartbeatEvent e, NodeState) {
         events.emplace_back(n, e);
         if (e == HeartbeatEvent::Lost) emcy.report(0x8130, 0x11);
     };
@@ -115,7 +115,7 @@ TEST_F(ConsumerFixture, N6_BadDlcCountedAndNextValidWorks) {
     EXPECT_EQ(hc.ignored_frames(), 2u);
     EXPECT_EQ(hc.health(5).heartbeats, 0u);
     beat(5, 0x7F);
-    EXPECT_EQ(hc.health(5).state, NmtState::PreOperational);
+    EXPECT_EQ(hc.health(5).state, NodeState::PreOperational);
 }
 
 TEST_F(ConsumerFixture, N7_UnknownStateEventAndTimerRefreshed) {
@@ -124,7 +124,7 @@ TEST_F(ConsumerFixture, N7_UnknownStateEventAndTimerRefreshed) {
     clock.advance(90'000'000);
     beat(5, 0x42);
     EXPECT_EQ(events.back(), std::make_pair(5, HeartbeatEvent::UnknownState));
-    EXPECT_EQ(hc.health(5).state, NmtState::Unknown);
+    EXPECT_EQ(hc.health(5).state, NodeState::Unknown);
     EXPECT_EQ(hc.health(5).raw_state, 0x42);
     clock.advance(90'000'000);  // 180 ms after the first beat but 90 after the odd one
     hc.process(clock.now());
@@ -146,13 +146,13 @@ TEST(HeartbeatProducer, SendsOnGridWithState) {
     auto dev = hub.open("dev");
     auto host = hub.open("host");
     SimClock clock{0};
-    NmtState st = NmtState::PreOperational;
+    NodeState st = NodeState::PreOperational;
     HeartbeatProducer p(*dev, clock, 9, 100ms, [&] { return st; });
     p.send_boot_up();
     EXPECT_EQ(p.process(0), 100'000'000);
     clock.advance(50'000'000);
     EXPECT_EQ(p.process(clock.now()), 100'000'000);
-    st = NmtState::Operational;
+    st = NodeState::Operational;
     clock.advance(50'000'000);
     p.process(clock.now());
     ASSERT_EQ(hub.log.size(), 3u);
@@ -180,7 +180,7 @@ TEST(HeartbeatConsumerThread, DetectsLossOnRealClock) {
     std::mutex m;
     std::condition_variable cv;
     bool lost = false;
-    hc.on_event = [&](std::uint8_t, HeartbeatEvent e, NmtState) {
+    hc.on_event = [&](std::uint8_t, HeartbeatEvent e, NodeState) {
         if (e == HeartbeatEvent::Lost) {
             std::lock_guard l(m);
             lost = true;

@@ -30,7 +30,7 @@ TEST(NmtCodec, N1_DlcNotTwoIgnored) {
 TEST(NmtSlave, N1_N2_N3_N4_IgnoreMalformedApplyBroadcast) {
     NmtSlave s(5);
     s.boot();
-    EXPECT_EQ(s.state(), NmtState::PreOperational);
+    EXPECT_EQ(s.state(), NodeState::PreOperational);
     EXPECT_FALSE(s.on_frame(frame(0, {0x01})));             // N1: DLC 1
     EXPECT_FALSE(s.on_frame(frame(0, {0x01, 0x05, 0})));    // N1: DLC 3
     EXPECT_FALSE(s.on_frame(frame(0, {0x01, 0x85})));       // N2: node 133
@@ -38,19 +38,19 @@ TEST(NmtSlave, N1_N2_N3_N4_IgnoreMalformedApplyBroadcast) {
     EXPECT_FALSE(s.on_frame(frame(0, {0x03, 0x05})));       // N4: unknown CS
     EXPECT_FALSE(s.on_frame(frame(0, {0xFF, 0x00})));       // N4
     EXPECT_FALSE(s.on_frame(frame(0, {0x01, 0x06})));       // another node
-    EXPECT_EQ(s.state(), NmtState::PreOperational);
+    EXPECT_EQ(s.state(), NodeState::PreOperational);
     EXPECT_EQ(s.ignored(), 7u);
     // N3: node 0 applies to us.
     EXPECT_EQ(s.on_frame(frame(0, {0x01, 0x00})), NmtCommand::Start);
-    EXPECT_EQ(s.state(), NmtState::Operational);
+    EXPECT_EQ(s.state(), NodeState::Operational);
     // Next valid input still works.
     EXPECT_EQ(s.on_frame(frame(0, {0x02, 0x05})), NmtCommand::Stop);
-    EXPECT_EQ(s.state(), NmtState::Stopped);
+    EXPECT_EQ(s.state(), NodeState::Stopped);
     int resets = 0;
     s.on_reset = [&](NmtCommand c) { resets += c == NmtCommand::ResetCommunication; };
     s.on_frame(frame(0, {0x82, 0x05}));
     EXPECT_EQ(resets, 1);
-    EXPECT_EQ(s.state(), NmtState::Initialising);
+    EXPECT_EQ(s.state(), NodeState::Initialising);
 }
 
 TEST(NmtSlave, N14_RefusesNodeIdZeroOrAbove127) {
@@ -73,22 +73,22 @@ TEST(NmtMaster, SendsCommandsAndTracksStates) {
     EXPECT_EQ(bytes(hub.log[1]), (std::vector<std::uint8_t>{0x81, 0x00}));
     EXPECT_EQ(bytes(hub.log[2]), (std::vector<std::uint8_t>{0x80, 0x03}));
 
-    std::vector<std::tuple<int, NmtState, NmtState>> changes;
-    m.on_state_change = [&](std::uint8_t n, NmtState a, NmtState b) { changes.emplace_back(n, a, b); };
-    EXPECT_EQ(m.state(5), NmtState::Unknown);
-    dev->send(encode_heartbeat(5, NmtState::Initialising));  // boot-up
-    EXPECT_EQ(m.state(5), NmtState::Initialising);
-    dev->send(encode_heartbeat(5, NmtState::PreOperational));
-    dev->send(encode_heartbeat(5, NmtState::PreOperational));  // no change, no callback
-    dev->send(encode_heartbeat(5, NmtState::Operational));
-    EXPECT_EQ(m.state(5), NmtState::Operational);
+    std::vector<std::tuple<int, NodeState, NodeState>> changes;
+    m.on_state_change = [&](std::uint8_t n, NodeState a, NodeState b) { changes.emplace_back(n, a, b); };
+    EXPECT_EQ(m.state(5), NodeState::Unknown);
+    dev->send(encode_heartbeat(5, NodeState::Initialising));  // boot-up
+    EXPECT_EQ(m.state(5), NodeState::Initialising);
+    dev->send(encode_heartbeat(5, NodeState::PreOperational));
+    dev->send(encode_heartbeat(5, NodeState::PreOperational));  // no change, no callback
+    dev->send(encode_heartbeat(5, NodeState::Operational));
+    EXPECT_EQ(m.state(5), NodeState::Operational);
     ASSERT_EQ(changes.size(), 3u);
-    EXPECT_EQ(changes[2], std::make_tuple(5, NmtState::PreOperational, NmtState::Operational));
-    EXPECT_TRUE(m.wait_for_state(5, NmtState::Operational, std::chrono::milliseconds(1)));
-    EXPECT_FALSE(m.wait_for_state(5, NmtState::Stopped, std::chrono::milliseconds(1)));
+    EXPECT_EQ(changes[2], std::make_tuple(5, NodeState::PreOperational, NodeState::Operational));
+    EXPECT_TRUE(m.wait_for_state(5, NodeState::Operational, std::chrono::milliseconds(1)));
+    EXPECT_FALSE(m.wait_for_state(5, NodeState::Stopped, std::chrono::milliseconds(1)));
     // N7 on the master: an odd state byte is UNKNOWN, never operational.
     dev->send(frame(0x705, {0x42}));
-    EXPECT_EQ(m.state(5), NmtState::Unknown);
+    EXPECT_EQ(m.state(5), NodeState::Unknown);
     EXPECT_EQ(m.raw_state(5), 0x42);
 }
 

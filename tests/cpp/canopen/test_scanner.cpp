@@ -50,7 +50,7 @@ TEST(Scanner, FindsNodesByProbeAndHeartbeat) {
     auto silent = hub.open("hb-only");
     // A node that only sends heartbeats (SDO disabled, e.g. stopped).
     silent->subscribe_id(0x600 + 77, false, [&](const can::Frame&) {
-        silent->send(encode_heartbeat(77, NmtState::Stopped));
+        silent->send(encode_heartbeat(77, NodeState::Stopped));
     });
     // Garbage on the SDO response range must not confuse the scan.
     auto noise = hub.open("noise");
@@ -76,7 +76,7 @@ TEST(Scanner, FindsNodesByProbeAndHeartbeat) {
     EXPECT_EQ(res[2].node_id, 77);
     EXPECT_TRUE(res[2].heard_heartbeat);
     EXPECT_FALSE(res[2].sdo_answered);
-    EXPECT_EQ(res[2].state, NmtState::Stopped);
+    EXPECT_EQ(res[2].state, NodeState::Stopped);
     // Every node id was probed once for 0x1000: 127 requests.
     int probes = 0;
     for (auto& f : hub.log)
