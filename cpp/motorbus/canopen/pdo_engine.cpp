@@ -174,13 +174,13 @@ void PdoEngine::rebuild(Pdo& p) {
     }
 }
 
-std::uint32_t PdoEngine::validate_map_count(const Pdo& p, unsigned n) const {
+std::uint32_t PdoEngine::validate_map_count(const Pdo& p, unsigned n, bool strict) const {
     if (n > opt_.max_mapped) return kMappingTooLong;  // P7: sub0 > max
     unsigned bits = 0;
     for (unsigned i = 0; i < n; ++i) {
         const auto e = PdoMapEntry::from_mapping_word(p.words[i]);
         if (e.bits == 0) {
-            if (opt_.strict) return kNotMappable;
+            if (strict) return kNotMappable;
             continue;  // lenient: entries may follow sub0
         }
         bits += e.bits;
@@ -191,11 +191,20 @@ std::uint32_t PdoEngine::validate_map_count(const Pdo& p, unsigned n) const {
 
 std::uint32_t PdoEngine::write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data) {
     std::lock_guard l(m_);
+    return write_locked(index, sub, data, opt_.strict);
+}
+
+std::uint32_t PdoEngine::load(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data) {
+    std::lock_guard l(m_);
+    return write_locked(index, sub, data, false);
+}
+
+std::uint32_t PdoEngine::write_locked(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
+                                      bool strict) {
     bool is_map = false;
     Pdo* pp = find(index, is_map);
     if (!pp) return kNoObject;
     Pdo& p = *pp;
-    const bool strict = opt_.strict;
 
     if (is_map) {
         if (sub > opt_.max_mapped) return kNoSubIndex;
@@ -203,7 +212,7 @@ std::uint32_t PdoEngine::write(std::uint16_t index, std::uint8_t sub, std::span<
             if (auto e = size_check(data, 1)) return e;
             const unsigned n = data[0];
             if (strict && p.valid()) return kUnsupportedAccess;  // P8
-            if (auto e = validate_map_count(p, n)) return e;
+            if (auto e = validate_map_count(p, n, strict)) return e;
             p.count = static_cast<std::uint8_t>(n);
             rebuild(p);
             return 0;
@@ -221,7 +230,7 @@ std::uint32_t PdoEngine::write(std::uint16_t index, std::uint8_t sub, std::span<
         const std::uint32_t old = p.words[sub - 1];
         p.words[sub - 1] = w;
         if (sub <= p.count) {
-            if (auto c = validate_map_count(p, p.count)) {
+            if (auto c = validate_map_count(p, p.count, strict)) {
                 p.words[sub - 1] = old;
                 return c;
             }
@@ -372,7 +381,7 @@ void PdoEngine::apply_rpdo(Pdo& p, const can::Frame& f, Out& out) {
     if (!p.layout.unpack(f.data.data(), f.len, v)) return;
     for (std::size_t i = 0; i < p.layout.size(); ++i) {
         const auto& e = p.layout.entry(i);
-        if (!e.is_dummy()) objects_.write_value(e.index, e.sub, e.bits, v[i]);
+        if (!e.is_dummy()) out.writes.push_back({e.index, e.sub, e.bits, v[i]});
     }
     ++counters_.rpdo_applied;
     out.rpdo_applied.push_back(p.number);
@@ -554,6 +563,8 @@ Nanos PdoEngine::process(Nanos now) {
 }
 
 void PdoEngine::flush(Out& out) {
+    // Outside the lock: writing an object may notify listeners that call back in.
+    for (auto& w : out.writes) objects_.write_value(w.index, w.sub, w.bits, w.raw);
     for (auto& f : out.frames) send_(f);
     if (emcy_)
         for (auto& [code, active] : out.emcy) emcy_(code, active);

@@ -111,6 +111,9 @@ public:
     // SDO write to a PDO parameter: 0 or the abort code.
     std::uint32_t write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data);
     std::uint32_t read(std::uint16_t index, std::uint8_t sub, std::vector<std::uint8_t>& out) const;
+    // Loads a stored value (EDS default, saved parameters) without the
+    // "no change while valid" procedure checks; value checks still apply.
+    std::uint32_t load(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data);
     // Restores the predefined connection set (reset communication).
     void reset_communication();
 
@@ -170,15 +173,24 @@ private:
         std::uint32_t can_id() const { return cob & can::kMaxExtendedId; }
         bool extended() const { return cob & kPdoExtended; }
     };
+    struct Write {
+        std::uint16_t index;
+        std::uint8_t sub;
+        std::uint8_t bits;
+        std::uint64_t raw;
+    };
     struct Out {
+        std::vector<Write> writes;
         std::vector<can::Frame> frames;
         std::vector<std::pair<std::uint16_t, bool>> emcy;
         std::vector<unsigned> rpdo_applied, rpdo_timeout;
     };
+    std::uint32_t write_locked(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> data,
+                               bool strict);
     Pdo* find(std::uint16_t index, bool& is_map);
     const Pdo* find(std::uint16_t index, bool& is_map) const;
     void rebuild(Pdo& p);
-    std::uint32_t validate_map_count(const Pdo& p, unsigned n) const;
+    std::uint32_t validate_map_count(const Pdo& p, unsigned n, bool strict) const;
     void send_tpdo(Pdo& p, Nanos now, Out& out);
     void apply_rpdo(Pdo& p, const can::Frame& f, Out& out);
     void handle_sync(const can::Frame& f, Nanos now, Out& out);
