@@ -98,8 +98,8 @@ void EmcyConsumer::on_frame(const can::Frame& f) {
         } else if (std::find(n.active.begin(), n.active.end(), m->code) == n.active.end()) {
             if (n.active.size() < 64) n.active.push_back(m->code);
         }
-        ++seq_;
-        last_ = *m;
+        unclaimed_.push_back(*m);
+        if (unclaimed_.size() > 256) unclaimed_.pop_front();
     }
     received_.fetch_add(1, std::memory_order_relaxed);
     cv_.notify_all();
@@ -126,13 +126,18 @@ void EmcyConsumer::clear(std::uint8_t node) {
 
 std::optional<EmcyMessage> EmcyConsumer::wait(std::uint8_t node, std::chrono::nanoseconds timeout) {
     std::unique_lock l(mutex_);
-    auto seen = seq_;
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (true) {
-        if (!cv_.wait_until(l, deadline, [&] { return seq_ != seen; })) return std::nullopt;
-        seen = seq_;
-        if (node == 0 || last_.node_id == node) return last_;
-    }
+    std::optional<EmcyMessage> found;
+    auto take = [&] {
+        for (auto it = unclaimed_.begin(); it != unclaimed_.end(); ++it)
+            if (node == 0 || it->node_id == node) {
+                found = *it;
+                unclaimed_.erase(it);
+                return true;
+            }
+        return false;
+    };
+    cv_.wait_for(l, timeout, take);
+    return found;
 }
 
 // ---- producer ---------------------------------------------------------------

@@ -54,7 +54,9 @@ public:
     // Codes currently active (cleared by EEC 0x0000, E3).
     std::vector<std::uint16_t> active(std::uint8_t node) const;
     void clear(std::uint8_t node);
-    // Blocks until an EMCY from `node` (0 = any) arrives; nullopt on timeout.
+    // The oldest EMCY from `node` (0 = any) not yet returned by wait(), waiting
+    // for one up to `timeout`; nullopt on timeout.  Unclaimed messages are kept
+    // in a bounded queue (256, oldest dropped), so report-then-wait never races.
     std::optional<EmcyMessage> wait(std::uint8_t node, std::chrono::nanoseconds timeout);
 
     std::function<void(const EmcyMessage&)> on_emcy;
@@ -72,8 +74,7 @@ private:
     mutable std::mutex mutex_;
     std::condition_variable cv_;
     std::array<NodeLog, 128> nodes_;
-    std::uint64_t seq_ = 0;
-    EmcyMessage last_{};
+    std::deque<EmcyMessage> unclaimed_;
     std::atomic<std::uint64_t> ignored_{0}, received_{0};
     can::SubscriptionId sub_ = 0;
 };

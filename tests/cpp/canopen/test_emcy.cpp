@@ -88,8 +88,13 @@ TEST(EmcyConsumer, HistoryBoundedActiveSetAndE3Reset) {
     EXPECT_EQ(c.ignored_frames(), 1u);
     dev->send(encode_emcy(5, 0x4210, 8));
     EXPECT_EQ(c.active(5), std::vector<std::uint16_t>{0x4210});
-    // Wait returns a message already consumed? No: only new ones.
-    EXPECT_FALSE(c.wait(5, 1ms));
+    // wait() hands out unclaimed messages in order, each once.
+    auto first = c.wait(6, 1ms);
+    ASSERT_TRUE(first);
+    EXPECT_EQ(first->code, 0x3210);
+    EXPECT_FALSE(c.wait(6, 1ms));
+    EXPECT_EQ(c.wait(5, 1ms)->code, 0x1000);
+    EXPECT_EQ(c.wait(0, 1ms)->code, 0x1001);
 }
 
 TEST(EmcyProducer, E6_InhibitEnforcedQueueBounded) {
