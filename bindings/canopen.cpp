@@ -1,8 +1,557 @@
-// Bindings for cpp/motorbus/canopen (filled in by the canopen work).
+// Bindings for cpp/motorbus/canopen: object dictionary, EDS, SDO client,
+// LocalNode, and the SDO errors (SdoAbortError, SdoTimeout, SdoProtocolError).
+#include <pybind11/eval.h>
+#include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "common.hpp"
+#include "motorbus/can/bus.hpp"
+#include "motorbus/canopen/abort_codes.hpp"
+#include "motorbus/canopen/eds.hpp"
+#include "motorbus/canopen/local_node.hpp"
+#include "motorbus/canopen/od.hpp"
+#include "motorbus/canopen/sdo_client.hpp"
+#include "motorbus/errors.hpp"
 
 namespace py = pybind11;
+using namespace motorbus;
+using namespace motorbus::canopen;
+using motorbus::py_helpers::seconds_to_ns;
+
+namespace {
+
+py::handle g_abort, g_timeout, g_protocol;
+
+py::bytes to_bytes(const Bytes& b) { return py::bytes(reinterpret_cast<const char*>(b.data()), b.size()); }
+
+Bytes from_buffer(const py::object& o) {
+    if (py::isinstance<py::str>(o)) {
+        auto s = o.cast<std::string>();
+        return Bytes(s.begin(), s.end());
+    }
+    std::string s = py::bytes(o).cast<std::string>();
+    return Bytes(s.begin(), s.end());
+}
+
+DataType type_from_py(const py::object& o) {
+    if (py::isinstance<DataType>(o)) return o.cast<DataType>();
+    if (py::isinstance<py::int_>(o)) {
+        auto c = o.cast<unsigned>();
+        if (!is_known_type(static_cast<std::uint16_t>(c)))
+            throw InvalidArgument("data type: 0x" + std::to_string(c) + " is not a CiA 301 basic type");
+        return static_cast<DataType>(c);
+    }
+    std::string n = o.cast<std::string>();
+    std::string u;
+    for (char c : n) u.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+    static const std::pair<const char*, DataType> aliases[] = {
+        {"BOOL", DataType::Boolean},       {"I8", DataType::Integer8},     {"I16", DataType::Integer16},
+        {"I32", DataType::Integer32},      {"I64", DataType::Integer64},   {"U8", DataType::Unsigned8},
+        {"U16", DataType::Unsigned16},     {"U32", DataType::Unsigned32},  {"U64", DataType::Unsigned64},
+        {"F32", DataType::Real32},         {"F64", DataType::Real64},      {"STR", DataType::VisibleString},
+        {"BYTES", DataType::OctetString},
+    };
+    for (auto& [a, t] : aliases)
+        if (u == a) return t;
+    for (unsigned c = 1; c <= 0x1B; ++c)
+        if (is_known_type(static_cast<std::uint16_t>(c)) && u == type_name(static_cast<DataType>(c)))
+            return static_cast<DataType>(c);
+    throw InvalidArgument("data type: '" + n + "' unknown (e.g. 'u32', 'UNSIGNED32', DataType.UNSIGNED32)");
+}
+
+Access access_from_py(const std::string& s) {
+    if (auto a = access_from_name(s)) return *a;
+    throw InvalidArgument("access: '" + s + "' unknown (ro, wo, rw, rwr, rww, const)");
+}
+
+std::optional<Scalar> scalar_from_py(const py::object& o) {
+    if (o.is_none()) return std::nullopt;
+    if (py::isinstance<py::float_>(o)) return Scalar{o.cast<double>()};
+    py::int_ i = o;
+    if (i < py::int_(0)) return Scalar{o.cast<std::int64_t>()};
+    return Scalar{o.cast<std::uint64_t>()};
+}
+
+py::object scalar_to_py(const Scalar& s) {
+    return std::visit([](auto v) -> py::object { return py::cast(v); }, s);
+}
+
+// A Python value for a variable's raw bytes, by its type.
+py::object value_to_py(const Variable& v, const Bytes& raw) {
+    const DataType t = v.type();
+    if (t == DataType::Boolean && raw.size() == 1) return py::bool_(raw[0] != 0);
+    if (is_numeric(t)) {
+        if (auto s = decode_scalar(t, raw)) return scalar_to_py(*s);
+        return to_bytes(raw);
+    }
+    if (t == DataType::VisibleString) {
+        std::string s(raw.begin(), raw.end());
+        return py::reinterpret_steal<py::object>(PyUnicode_DecodeLatin1(s.data(), static_cast<Py_ssize_t>(s.size()), nullptr));
+    }
+    return to_bytes(raw);
+}
+
+Bytes value_from_py(const Variable& v, const py::object& o) {
+    const DataType t = v.type();
+    if (is_numeric(t) && !py::isinstance<py::bytes>(o) && !py::isinstance<py::bytearray>(o)) {
+        auto s = scalar_from_py(o);
+        auto b = s ? encode_scalar(t, *s) : std::nullopt;
+        if (!b) throw InvalidArgument(v.name() + ": " + py::str(o).cast<std::string>() + " does not fit " + type_name(t));
+        return *b;
+    }
+    return from_buffer(o);
+}
+
+VariableSpec spec_from_py(std::uint16_t index, std::uint8_t sub, std::string name, const py::object& type,
+                          const std::string& access, bool pdo, const py::object& low, const py::object& high,
+                          const py::object& def, std::size_t max_size) {
+    VariableSpec s;
+    s.index = index;
+    s.subindex = sub;
+    s.name = std::move(name);
+    s.type = type_from_py(type);
+    s.access = access_from_py(access);
+    s.pdo_mappable = pdo;
+    s.low_limit = scalar_from_py(low);
+    s.high_limit = scalar_from_py(high);
+    s.max_size = max_size;
+    if (!def.is_none()) {
+        if (is_numeric(s.type) && !py::isinstance<py::bytes>(def)) {
+            auto sc = *scalar_from_py(def);
+            std::visit([&](auto x) { s.default_value = x; }, sc);
+        } else {
+            s.default_value = from_buffer(def);
+        }
+    }
+    return s;
+}
+
+// Python callables called from C++ threads, with the GIL, returning an abort code.
+std::uint32_t call_hook(const std::shared_ptr<py::function>& f, const py::object& a, const py::object& b) {
+    py::gil_scoped_acquire gil;
+    try {
+        py::object r = (*f)(a, b);
+        if (r.is_none()) return 0;
+        return r.cast<std::uint32_t>();
+    } catch (py::error_already_set& e) {
+        if (e.matches(g_abort)) {
+            try {
+                return e.value().attr("code").cast<std::uint32_t>();
+            } catch (...) {
+            }
+        }
+        e.discard_as_unraisable("motorbus OD hook");
+        return abort_code::kGeneral;
+    }
+}
+
+std::shared_ptr<py::function> hold(py::function f) {
+    return std::shared_ptr<py::function>(new py::function(std::move(f)), [](py::function* p) {
+        if (!Py_IsInitialized()) return;
+        py::gil_scoped_acquire gil;
+        delete p;
+    });
+}
+
+py::dict counters_dict(const SdoClientCounters& c) {
+    py::dict d;
+    d["transfers"] = c.transfers;
+    d["aborts_received"] = c.aborts_received;
+    d["aborts_sent"] = c.aborts_sent;
+    d["timeouts"] = c.timeouts;
+    d["ignored_frames"] = c.ignored_frames;
+    d["retransmit_requests"] = c.retransmit_requests;
+    d["fallbacks"] = c.fallbacks;
+    return d;
+}
+
+py::dict node_counters_dict(const LocalNodeCounters& c) {
+    py::dict d;
+    d["sdo_requests"] = c.sdo.requests;
+    d["sdo_responses"] = c.sdo.responses;
+    d["sdo_aborts_sent"] = c.sdo.aborts_sent;
+    d["sdo_aborts_received"] = c.sdo.aborts_received;
+    d["sdo_ignored"] = c.sdo.ignored;
+    d["sdo_timeouts"] = c.sdo.timeouts;
+    d["sdo_dropped"] = c.sdo.dropped;
+    d["sdo_transfers_completed"] = c.sdo.transfers_completed;
+    d["nmt_commands"] = c.nmt_commands;
+    d["nmt_ignored"] = c.nmt_ignored;
+    d["sdo_while_stopped"] = c.sdo_while_stopped;
+    return d;
+}
+
+NmtState nmt_from_py(const std::string& s) {
+    std::string u;
+    for (char c : s)
+        if (c != '-' && c != '_' && c != ' ') u.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+    if (u == "OPERATIONAL") return NmtState::Operational;
+    if (u == "STOPPED") return NmtState::Stopped;
+    if (u == "PREOPERATIONAL") return NmtState::PreOperational;
+    if (u == "INITIALISING" || u == "INITIALIZING") return NmtState::Initialising;
+    throw InvalidArgument("NMT state: '" + s + "' unknown (OPERATIONAL, STOPPED, PRE-OPERATIONAL)");
+}
+
+TransferMode mode_of(bool block, bool segmented) {
+    return block ? TransferMode::Block : segmented ? TransferMode::Segmented : TransferMode::Auto;
+}
+
+}  // namespace
 
 void bind_canopen(py::module_& m) {
-    (void)m;
+    // ---- errors -------------------------------------------------------------
+    py::dict ns;
+    ns["MotorbusError"] = m.attr("MotorbusError");
+    ns["TimeoutError_"] = m.attr("TimeoutError");
+    ns["ProtocolError"] = m.attr("ProtocolError");
+    py::exec(R"(
+class SdoAbortError(MotorbusError):
+    "An SDO transfer was aborted: .code (CiA 301 abort code), .text, .index, .subindex."
+    code = 0
+    text = ""
+    index = 0
+    subindex = 0
+class SdoTimeout(TimeoutError_):
+    "No SDO response in time; the client sent abort 0x05040000 with the index and sub-index."
+    index = 0
+    subindex = 0
+class SdoProtocolError(ProtocolError):
+    "The server broke the SDO protocol; .data is its frame, .code the abort code we sent."
+    code = 0
+    index = 0
+    subindex = 0
+)", ns, ns);
+    for (const char* n : {"SdoAbortError", "SdoTimeout", "SdoProtocolError"}) {
+        py::object cls = ns[n];
+        cls.attr("__module__") = "motorbus.canopen";
+        m.attr(n) = cls;
+    }
+    g_abort = py::object(ns["SdoAbortError"]).release();
+    g_timeout = py::object(ns["SdoTimeout"]).release();
+    g_protocol = py::object(ns["SdoProtocolError"]).release();
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const SdoAbortError& e) {
+            py::object exc = py::reinterpret_borrow<py::object>(g_abort)(e.what());
+            exc.attr("code") = e.code;
+            exc.attr("text") = e.text();
+            exc.attr("index") = e.index;
+            exc.attr("subindex") = e.subindex;
+            PyErr_SetObject(g_abort.ptr(), exc.ptr());
+        } catch (const SdoTimeout& e) {
+            py::object exc = py::reinterpret_borrow<py::object>(g_timeout)(e.what());
+            exc.attr("index") = e.index;
+            exc.attr("subindex") = e.subindex;
+            PyErr_SetObject(g_timeout.ptr(), exc.ptr());
+        } catch (const SdoProtocolError& e) {
+            py::object exc = py::reinterpret_borrow<py::object>(g_protocol)(e.what());
+            exc.attr("data") = py::bytes(reinterpret_cast<const char*>(e.bytes.data()), e.bytes.size());
+            exc.attr("code") = e.code;
+            exc.attr("index") = e.index;
+            exc.attr("subindex") = e.subindex;
+            PyErr_SetObject(g_protocol.ptr(), exc.ptr());
+        }
+    });
+
+    m.def("abort_text", [](std::uint32_t c) -> py::object {
+        const char* t = abort_text(c);
+        return t ? py::object(py::str(t)) : py::none();
+    }, py::arg("code"), "CiA 301 text for an SDO abort code (None if unknown).");
+    py::dict codes;
+    for (auto& e : abort_table()) codes[py::int_(e.code)] = e.text;
+    m.attr("ABORT_CODES") = codes;
+
+    // ---- data types ---------------------------------------------------------
+    py::enum_<DataType> dt(m, "DataType", "CiA 301 basic data types (codes as in EDS files).");
+    for (unsigned c = 1; c <= 0x1B; ++c)
+        if (is_known_type(static_cast<std::uint16_t>(c)))
+            dt.value(type_name(static_cast<DataType>(c)), static_cast<DataType>(c));
+
+    // ---- variables and the dictionary --------------------------------------
+    py::class_<Variable, std::shared_ptr<Variable>>(m, "Variable", "One object-dictionary entry.")
+        .def_property_readonly("index", &Variable::index)
+        .def_property_readonly("subindex", &Variable::subindex)
+        .def_property_readonly("name", &Variable::name)
+        .def_property_readonly("data_type", &Variable::type)
+        .def_property_readonly("access", [](const Variable& v) { return access_name(v.access()); })
+        .def_property_readonly("pdo_mappable", &Variable::pdo_mappable)
+        .def_property_readonly("size", &Variable::size, "fixed size in bytes; 0 for strings/domains")
+        .def_property_readonly("low_limit", [](const Variable& v) -> py::object {
+            return v.spec().low_limit ? scalar_to_py(*v.spec().low_limit) : py::none();
+        })
+        .def_property_readonly("high_limit", [](const Variable& v) -> py::object {
+            return v.spec().high_limit ? scalar_to_py(*v.spec().high_limit) : py::none();
+        })
+        .def_property_readonly("default", [](const Variable& v) { return value_to_py(v, v.default_bytes()); })
+        .def_property("raw", [](const Variable& v) { return to_bytes(v.get()); },
+                      [](Variable& v, const py::object& o) { v.set(from_buffer(o)); },
+                      "value as little-endian bytes")
+        .def_property("value", [](const Variable& v) { return value_to_py(v, v.get()); },
+                      [](Variable& v, const py::object& o) { v.set(value_from_py(v, o)); },
+                      "value as int/float/bool/str/bytes by type (local write: limits checked, no hooks)")
+        .def("reset", &Variable::reset_to_default)
+        .def("set_write_hook", [](Variable& v, py::object f) {
+            if (f.is_none()) return v.set_write_hook(nullptr);
+            auto h = hold(f.cast<py::function>());
+            v.set_write_hook([h](const Variable& var, std::span<const std::uint8_t> d) {
+                py::gil_scoped_acquire gil;
+                auto self = py::cast(std::const_pointer_cast<Variable>(var.shared_from_this()));
+                return call_hook(h, self, py::bytes(reinterpret_cast<const char*>(d.data()), d.size()));
+            });
+        }, py::arg("hook"),
+             "hook(variable, data: bytes) -> None | abort code; called before a remote write commits.")
+        .def("set_read_hook", [](Variable& v, py::object f) {
+            if (f.is_none()) return v.set_read_hook(nullptr);
+            auto h = hold(f.cast<py::function>());
+            v.set_read_hook([h](const Variable& var, Bytes& out) -> std::uint32_t {
+                py::gil_scoped_acquire gil;
+                try {
+                    py::object r = (*h)(py::cast(std::const_pointer_cast<Variable>(var.shared_from_this())),
+                                        to_bytes(out));
+                    if (r.is_none()) return 0;
+                    if (py::isinstance<py::int_>(r)) return r.cast<std::uint32_t>();
+                    out = value_from_py(var, r);
+                    return 0;
+                } catch (py::error_already_set& e) {
+                    if (e.matches(g_abort)) return e.value().attr("code").cast<std::uint32_t>();
+                    e.discard_as_unraisable("motorbus OD read hook");
+                    return abort_code::kGeneral;
+                }
+            });
+        }, py::arg("hook"),
+             "hook(variable, current: bytes) -> None | new value | abort code; called on a remote read.")
+        .def("add_change_listener", [](Variable& v, py::function f) {
+            auto h = hold(std::move(f));
+            return v.add_change_listener([h](const Variable& var) {
+                py::gil_scoped_acquire gil;
+                try {
+                    (*h)(py::cast(std::const_pointer_cast<Variable>(var.shared_from_this())));
+                } catch (py::error_already_set& e) {
+                    e.discard_as_unraisable("motorbus OD listener");
+                }
+            });
+        }, py::arg("callback"))
+        .def("remove_change_listener", &Variable::remove_change_listener, py::arg("handle"))
+        .def("__repr__", [](const Variable& v) {
+            char b[96];
+            std::snprintf(b, sizeof b, "<Variable 0x%04X:%02X %s %s>", v.index(), v.subindex(),
+                          type_name(v.type()), access_name(v.access()));
+            return std::string(b) + " '" + v.name() + "'";
+        });
+
+    py::class_<ObjectDictionary, std::shared_ptr<ObjectDictionary>>(m, "ObjectDictionary",
+        "Objects addressed by (index, subindex) or by name ('Record.Member', '0x1018:1').")
+        .def(py::init<>())
+        .def("add_variable",
+             [](ObjectDictionary& od, std::uint16_t index, std::string name, const py::object& type,
+                const std::string& access, bool pdo, const py::object& low, const py::object& high,
+                const py::object& def, std::size_t max_size) {
+                 return od.add_variable(spec_from_py(index, 0, std::move(name), type, access, pdo, low, high,
+                                                     def, max_size));
+             },
+             py::arg("index"), py::arg("name"), py::arg("data_type"), py::arg("access") = "rw",
+             py::arg("pdo_mappable") = false, py::arg("low") = py::none(), py::arg("high") = py::none(),
+             py::arg("default") = py::none(), py::arg("max_size") = 0)
+        .def("add_record", [](ObjectDictionary& od, std::uint16_t index, std::string name, bool array) {
+                 od.add_record(index, std::move(name), array ? ObjectCode::Array : ObjectCode::Record);
+             },
+             py::arg("index"), py::arg("name"), py::arg("array") = false)
+        .def("add_member",
+             [](ObjectDictionary& od, std::uint16_t index, std::uint8_t sub, std::string name,
+                const py::object& type, const std::string& access, bool pdo, const py::object& low,
+                const py::object& high, const py::object& def, std::size_t max_size) {
+                 return od.add_member(index, spec_from_py(index, sub, std::move(name), type, access, pdo,
+                                                          low, high, def, max_size));
+             },
+             py::arg("index"), py::arg("subindex"), py::arg("name"), py::arg("data_type"),
+             py::arg("access") = "rw", py::arg("pdo_mappable") = false, py::arg("low") = py::none(),
+             py::arg("high") = py::none(), py::arg("default") = py::none(), py::arg("max_size") = 0)
+        .def("__getitem__", [](const ObjectDictionary& od, const py::object& key) {
+            if (py::isinstance<py::tuple>(key)) {
+                auto t = key.cast<std::pair<std::uint16_t, std::uint8_t>>();
+                return od.at(t.first, t.second);
+            }
+            if (py::isinstance<py::int_>(key)) return od.at(key.cast<std::uint16_t>(), 0);
+            return od.at(key.cast<std::string>());
+        })
+        .def("__contains__", [](const ObjectDictionary& od, const py::object& key) {
+            if (py::isinstance<py::tuple>(key)) {
+                auto t = key.cast<std::pair<std::uint16_t, std::uint8_t>>();
+                return od.find(t.first, t.second) != nullptr;
+            }
+            if (py::isinstance<py::int_>(key)) return od.object(key.cast<std::uint16_t>()).has_value();
+            return od.find(key.cast<std::string>()) != nullptr;
+        })
+        .def("__len__", &ObjectDictionary::size)
+        .def("indices", &ObjectDictionary::indices)
+        .def("subindices", [](const ObjectDictionary& od, std::uint16_t i) {
+            std::vector<std::uint8_t> v;
+            if (auto o = od.object(i))
+                for (auto& [s, var] : o->subs) v.push_back(s);
+            return v;
+        })
+        .def("object_name", [](const ObjectDictionary& od, std::uint16_t i) -> py::object {
+            auto o = od.object(i);
+            return o ? py::object(py::str(o->name)) : py::none();
+        })
+        .def_property("node_id", &ObjectDictionary::node_id, &ObjectDictionary::set_node_id)
+        .def_property("max_variable_size", &ObjectDictionary::max_variable_size,
+                      &ObjectDictionary::set_max_variable_size)
+        .def_static("from_eds",
+                    [](const std::string& path, std::uint8_t node_id, const py::object& warnings) {
+                        std::vector<std::string> w;
+                        EdsImportOptions o;
+                        o.node_id = node_id;
+                        auto od = load_eds(path, o, &w);
+                        if (!warnings.is_none())
+                            for (auto& s : w) warnings.attr("append")(s);
+                        return od;
+                    },
+                    py::arg("path"), py::arg("node_id") = 0, py::arg("warnings") = py::none(),
+                    "Load an EDS/DCF file; entries it cannot represent are appended to `warnings`.")
+        .def_static("from_eds_text",
+                    [](const std::string& text, std::uint8_t node_id, const py::object& warnings) {
+                        std::vector<std::string> w;
+                        EdsImportOptions o;
+                        o.node_id = node_id;
+                        auto od = parse_eds(text, o, &w);
+                        if (!warnings.is_none())
+                            for (auto& s : w) warnings.attr("append")(s);
+                        return od;
+                    },
+                    py::arg("text"), py::arg("node_id") = 0, py::arg("warnings") = py::none())
+        .def("to_eds", [](const ObjectDictionary& od, bool dcf) {
+                 EdsExportOptions o;
+                 o.dcf = dcf;
+                 return to_eds(od, o);
+             },
+             py::arg("dcf") = false)
+        .def("save_eds", [](const ObjectDictionary& od, const std::string& path, bool dcf) {
+                 EdsExportOptions o;
+                 o.dcf = dcf;
+                 save_eds(od, path, o);
+             },
+             py::arg("path"), py::arg("dcf") = false);
+
+    // ---- SDO client --------------------------------------------------------------
+    py::class_<SdoClient>(m, "SdoClient", "SDO client for one node (requests 0x600+n, responses 0x580+n).")
+        .def(py::init([](can::Bus& bus, std::uint8_t node_id, double timeout, std::size_t max_transfer,
+                         std::uint8_t block_size, unsigned read_retries, std::uint32_t request_id,
+                         std::uint32_t response_id) {
+                 SdoClientOptions o;
+                 o.timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9));
+                 o.max_transfer = max_transfer;
+                 o.block_size = block_size;
+                 o.read_retries = read_retries;
+                 o.request_id = request_id;
+                 o.response_id = response_id;
+                 return std::make_unique<SdoClient>(bus, node_id, o);
+             }),
+             py::arg("bus"), py::arg("node_id"), py::arg("timeout") = 1.0, py::arg("max_transfer") = 1u << 20,
+             py::arg("block_size") = 127, py::arg("read_retries") = 0, py::arg("request_id") = 0,
+             py::arg("response_id") = 0, py::keep_alive<1, 2>())
+        .def("upload", [](SdoClient& c, std::uint16_t i, std::uint8_t s, bool block) {
+                 Bytes b;
+                 {
+                     py::gil_scoped_release nogil;
+                     b = c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto);
+                 }
+                 return to_bytes(b);
+             },
+             py::arg("index"), py::arg("subindex") = 0, py::arg("block") = false)
+        .def("download", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const py::object& data, bool block,
+                            bool segmented) {
+                 Bytes b = from_buffer(data);
+                 py::gil_scoped_release nogil;
+                 c.download(i, s, b, mode_of(block, segmented));
+             },
+             py::arg("index"), py::arg("subindex"), py::arg("data"), py::arg("block") = false,
+             py::arg("segmented") = false)
+#define MB_RW(T, name)                                                                         \
+    .def("read_" #name, &SdoClient::read_##name, py::arg("index"), py::arg("subindex") = 0,    \
+         py::call_guard<py::gil_scoped_release>())                                             \
+    .def("write_" #name, &SdoClient::write_##name, py::arg("index"), py::arg("subindex"),      \
+         py::arg("value"), py::call_guard<py::gil_scoped_release>())
+        MB_RW(std::uint8_t, u8) MB_RW(std::uint16_t, u16) MB_RW(std::uint32_t, u32) MB_RW(std::uint64_t, u64)
+        MB_RW(std::int8_t, i8) MB_RW(std::int16_t, i16) MB_RW(std::int32_t, i32) MB_RW(std::int64_t, i64)
+        MB_RW(float, f32) MB_RW(double, f64)
+#undef MB_RW
+        .def("read_string", &SdoClient::read_string, py::arg("index"), py::arg("subindex") = 0,
+             py::call_guard<py::gil_scoped_release>())
+        .def("write_string", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const std::string& v) {
+                 py::gil_scoped_release nogil;
+                 c.write_string(i, s, v);
+             },
+             py::arg("index"), py::arg("subindex"), py::arg("value"))
+        .def("read_domain", [](SdoClient& c, std::uint16_t i, std::uint8_t s, bool block) {
+                 Bytes b;
+                 {
+                     py::gil_scoped_release nogil;
+                     b = c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto);
+                 }
+                 return to_bytes(b);
+             },
+             py::arg("index"), py::arg("subindex") = 0, py::arg("block") = false)
+        .def("write_domain", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const py::object& data, bool block) {
+                 Bytes b = from_buffer(data);
+                 py::gil_scoped_release nogil;
+                 c.download(i, s, b, block ? TransferMode::Block : TransferMode::Auto);
+             },
+             py::arg("index"), py::arg("subindex"), py::arg("data"), py::arg("block") = false)
+        .def_property("timeout",
+                      [](const SdoClient& c) { return static_cast<double>(c.options().timeout.count()) / 1e9; },
+                      [](SdoClient& c, double t) {
+                          py::gil_scoped_release nogil;
+                          c.set_timeout(std::chrono::nanoseconds(static_cast<std::int64_t>(t * 1e9)));
+                      })
+        .def_property_readonly("node_id", &SdoClient::node_id)
+        .def_property_readonly("request_id", &SdoClient::request_id)
+        .def_property_readonly("response_id", &SdoClient::response_id)
+        .def_property_readonly("counters", [](const SdoClient& c) { return counters_dict(c.counters()); });
+
+    // ---- LocalNode ---------------------------------------------------------------
+    py::class_<LocalNode>(m, "LocalNode",
+        "A node we serve: SDO server on 0x600+n/0x580+n, boot-up, NMT slave.")
+        .def(py::init([](can::Bus& bus, std::uint8_t node_id, std::shared_ptr<ObjectDictionary> od,
+                         double sdo_timeout, bool block_transfer, bool send_boot_up) {
+                 LocalNodeOptions o;
+                 o.sdo.timeout_ns = static_cast<Nanos>(sdo_timeout * 1e9);
+                 o.sdo.block_transfer = block_transfer;
+                 o.send_boot_up = send_boot_up;
+                 py::gil_scoped_release nogil;
+                 return std::make_unique<LocalNode>(bus, node_id, std::move(od), o);
+             }),
+             py::arg("bus"), py::arg("node_id"), py::arg("od"), py::arg("sdo_timeout") = 1.0,
+             py::arg("block_transfer") = true, py::arg("send_boot_up") = true, py::keep_alive<1, 2>())
+        .def_property_readonly("node_id", &LocalNode::node_id)
+        .def_property_readonly("od", &LocalNode::od_ptr)
+        .def_property("nmt_state", [](const LocalNode& n) { return to_string(n.nmt_state()); },
+                      [](LocalNode& n, const std::string& s) {
+                          auto st = nmt_from_py(s);
+                          py::gil_scoped_release nogil;
+                          n.set_nmt_state(st);
+                      })
+        .def("add_state_listener", [](LocalNode& n, py::function f) {
+                 auto h = hold(std::move(f));
+                 return n.add_state_listener([h](NmtState a, NmtState b) {
+                     py::gil_scoped_acquire gil;
+                     try {
+                         (*h)(to_string(a), to_string(b));
+                     } catch (py::error_already_set& e) {
+                         e.discard_as_unraisable("motorbus NMT listener");
+                     }
+                 });
+             },
+             py::arg("callback"), "callback(previous: str, now: str) on every NMT transition")
+        .def("remove_state_listener", &LocalNode::remove_state_listener, py::arg("handle"))
+        .def("send_boot_up", &LocalNode::send_boot_up, py::call_guard<py::gil_scoped_release>())
+        .def_property_readonly("counters", [](const LocalNode& n) { return node_counters_dict(n.counters()); })
+        .def("close", &LocalNode::close, py::call_guard<py::gil_scoped_release>())
+        .def("__enter__", [](py::object self) { return self; })
+        .def("__exit__", [](LocalNode& n, py::args) {
+            py::gil_scoped_release nogil;
+            n.close();
+        });
 }

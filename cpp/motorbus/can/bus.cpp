@@ -69,6 +69,7 @@ SubscriptionId Bus::add_subscriber(std::shared_ptr<Subscriber> s, bool exact) {
     else
         t->masked.push_back(s);
     table_ = std::move(t);
+    subscriber_count_.fetch_add(1, std::memory_order_release);
     return s->id;
 }
 
@@ -97,6 +98,9 @@ void Bus::unsubscribe(SubscriptionId sid) {
             it = it->second.empty() ? t->by_id.erase(it) : std::next(it);
         }
         drop(t->masked);
+        std::size_t n = t->masked.size();
+        for (auto& [k, v] : t->by_id) n += v.size();
+        subscriber_count_.store(static_cast<int>(n), std::memory_order_release);
         table_ = std::move(t);
     }
     // Wait for an in-flight dispatch on another thread to finish, so the

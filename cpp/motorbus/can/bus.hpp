@@ -99,6 +99,10 @@ protected:
     // path; derived destructors call close() themselves (virtual dispatch).
     void set_state(BusState s) { state_.store(s); }
 
+    // True while anyone is subscribed; lets a backend skip its thread hop
+    // when there is no callback to run (frames then go straight to recv()).
+    bool has_subscribers() const { return subscriber_count_.load(std::memory_order_acquire) > 0; }
+
     // Counter bumps for backends.
     void count_parse_error() { parse_errors_.fetch_add(1, std::memory_order_relaxed); }
     void count_overrun() { overruns_.fetch_add(1, std::memory_order_relaxed); }
@@ -140,6 +144,7 @@ private:
     std::recursive_mutex dispatch_mutex_;  // held while callbacks run
     std::atomic<std::thread::id> dispatch_thread_{};
     std::atomic<SubscriptionId> next_sub_{1};
+    std::atomic<int> subscriber_count_{0};
 
     std::atomic<std::uint64_t> rx_frames_{0}, tx_frames_{0}, rx_dropped_{0}, tx_dropped_{0},
         overruns_{0}, parse_errors_{0}, bus_errors_{0}, ignored_{0};

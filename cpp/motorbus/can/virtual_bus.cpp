@@ -216,6 +216,7 @@ struct VirtualBus::Impl {
     std::vector<Frame> inbox;
     bool stop = false;
     bool bus_off = false;
+    bool dispatching = false;  // the receive thread is working through a batch
     FaultOptions faults;
     std::mt19937_64 rng;
     std::uint64_t sent_count = 0;
@@ -238,9 +239,12 @@ VirtualBus::VirtualBus(std::shared_ptr<VirtualHub> hub, std::string channel,
                 impl_->cv.wait(lock, [&] { return impl_->stop || !impl_->inbox.empty(); });
                 if (impl_->stop) return;
                 batch.swap(impl_->inbox);
+                impl_->dispatching = true;
             }
             for (const Frame& f : batch) dispatch(f);
             batch.clear();
+            std::lock_guard lock(impl_->mutex);
+            impl_->dispatching = false;
         }
     });
     impl_->hub->attach(this);
@@ -263,7 +267,18 @@ void VirtualBus::do_close() {
 }
 
 void VirtualBus::enqueue_rx(const Frame& f) {
-    bool wake;
+    bool wake = false, direct = false;
+    {
+        std::lock_guard lock(impl_->mutex);
+        if (impl_->stop || impl_->bus_off) return;
+        // No callback to run and nothing older in flight: hand the frame to
+        // recv() directly and save two thread wake-ups per frame.
+        if (impl_->inbox.empty() && !impl_->dispatching && !has_subscribers()) direct = true;
+    }
+    if (direct) {
+        dispatch(f);
+        return;
+    }
     {
         std::lock_guard lock(impl_->mutex);
         if (impl_->stop || impl_->bus_off) return;

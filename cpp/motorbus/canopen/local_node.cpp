@@ -197,8 +197,10 @@ void LocalNode::on_sdo_frame(const can::Frame& f) {
     }
     {
         std::lock_guard lock(sdo_mutex_);
-        if (server_.receiving_subblock()) {
-            // Block download segments arrive back to back; a mailbox would drop them.
+        if (server_.handles_inline(f.payload())) {
+            // Mid-transfer frames are cheap and come back to back (block
+            // sub-blocks), and a silent frame is followed at once by the next
+            // request: a mailbox would add latency or drop them.
             sdo_out_.clear();
             server_.on_request(f.payload(), monotonic_ns(), sdo_out_);
             send_sdo(sdo_out_);

@@ -10,9 +10,11 @@
 // bus, the dictionary and the node-id through the LocalNode& they are given.
 //
 // Threading: NMT frames are handled on the bus receive thread.  SDO requests
-// go through a single-slot mailbox to the node's worker thread (a flood is
-// dropped and counted, S18), except the segments of a block download, which
-// are consumed straight from the receive thread so a sub-block is not lost.
+// that may run application hooks (initiates, the final segment that commits a
+// value) go through a single-slot mailbox to the node's worker thread, so a
+// flood is dropped and counted (S18) and a slow hook never stalls the bus.
+// Mid-transfer frames (segments, block acks, aborts) are O(1) and handled
+// straight from the receive thread, so a sub-block is never lost.
 #pragma once
 #include <atomic>
 #include <condition_variable>

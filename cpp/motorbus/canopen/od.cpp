@@ -226,6 +226,11 @@ ChunkReadHook Variable::chunk_read_hook() const {
     std::lock_guard lock(mutex_);
     return chunk_hook_;
 }
+bool Variable::has_hooks() const {
+    std::lock_guard lock(mutex_);
+    return read_hook_ || write_hook_ || chunk_hook_ || !listeners_.empty();
+}
+
 std::uint64_t Variable::add_change_listener(ChangeListener cb) {
     std::lock_guard lock(mutex_);
     listeners_.emplace_back(next_listener_, std::move(cb));

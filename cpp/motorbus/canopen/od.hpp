@@ -89,7 +89,7 @@ struct VariableSpec {
     std::string default_expr{};
 };
 
-class Variable {
+class Variable : public std::enable_shared_from_this<Variable> {
 public:
     explicit Variable(VariableSpec spec, std::size_t dictionary_max_size);
 
@@ -141,6 +141,9 @@ public:
     void set_write_hook(WriteHook h);
     void set_chunk_read_hook(ChunkReadHook h);
     ChunkReadHook chunk_read_hook() const;
+    // True when any read/write/chunk hook or change listener is set, i.e. a
+    // remote access may run application code.
+    bool has_hooks() const;
     // Returns a handle for remove_change_listener().
     std::uint64_t add_change_listener(ChangeListener cb);
     void remove_change_listener(std::uint64_t handle);

@@ -43,6 +43,31 @@ void SdoServerMachine::release() {
 
 void SdoServerMachine::reset() { release(); }
 
+bool SdoServerMachine::handles_inline(std::span<const std::uint8_t> p) const {
+    if (consumes_silently(p)) return true;
+    switch (phase_) {
+        case Phase::Idle: {
+            auto m = multiplexer_of(p);
+            const Ccs c = ccs_of(p[0]);
+            if (!m || !(c == Ccs::InitiateUpload || c == Ccs::InitiateDownload || c == Ccs::BlockUpload ||
+                        c == Ccs::BlockDownload))
+                return false;
+            VariablePtr var;
+            if (od_.lookup(m->index, m->subindex, var)) return true;  // the answer is an abort
+            return !var->has_hooks();
+        }
+        case Phase::BlkDnSub: return true;
+        case Phase::DnSegment:  // only the last segment commits (and may run hooks)
+            return (p[0] & 0xE1) == 0x00 || !var_ || !var_->has_hooks();
+        case Phase::BlkDnEnd: return !var_ || !var_->has_hooks();
+        case Phase::UpSegment:
+        case Phase::BlkUpStart:
+        case Phase::BlkUpSub: return !streaming_;
+        case Phase::BlkUpEnd: return true;
+    }
+    return false;
+}
+
 void SdoServerMachine::touch(Nanos now) {
     deadline_ = now > kNoDeadline - config_.timeout_ns ? kNoDeadline : now + config_.timeout_ns;
 }

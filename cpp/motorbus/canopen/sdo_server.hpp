@@ -56,6 +56,19 @@ public:
     // True while a block download sub-block is streaming in: those frames are
     // consumed straight from the receive thread (no mailbox) so none is lost.
     bool receiving_subblock() const { return phase_ == Phase::BlkDnSub; }
+    // True for a request that gets no response (an abort, the client's final
+    // block-upload confirmation): the client does not wait before its next
+    // request, so LocalNode consumes these at once instead of via its mailbox.
+    bool consumes_silently(std::span<const std::uint8_t> p) const {
+        if (p.empty()) return true;
+        if (p[0] == 0x80 || (sdo::ccs_of(p[0]) == sdo::Ccs::Abort && phase_ != Phase::BlkDnSub)) return true;
+        return phase_ == Phase::BlkUpEnd && (p[0] & 0xE3) == 0xA1;
+    }
+    // True when handling `p` runs no application code (no hook, no listener):
+    // LocalNode answers these on the receive thread.  Requests that may run
+    // hooks, and anything unexpected while idle, go through its single-slot
+    // mailbox to the worker thread (so a flood is dropped and counted).
+    bool handles_inline(std::span<const std::uint8_t> p) const;
     // Drop any transfer without a word (NMT reset, stop).
     void reset();
     // Bytes currently held for a transfer (bounded; 0 when idle).

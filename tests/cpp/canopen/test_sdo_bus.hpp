@@ -31,8 +31,8 @@ public:
 
 protected:
     void do_send(const can::Frame& frame, can::Deadline deadline) override;
-    void do_close() override {
-        hub_->leave(this);
+    void do_close() override;
+    void do_close_impl() {
         {
             std::lock_guard l(m_);
             stop_ = true;
@@ -100,6 +100,11 @@ private:
 inline LoopBus::LoopBus(std::shared_ptr<LoopHub> hub, std::string name)
     : Bus(std::move(name)), hub_(std::move(hub)) {
     t_ = std::thread([this] { run(); });
+}
+
+inline void LoopBus::do_close() {
+    hub_->leave(this);
+    do_close_impl();
 }
 
 inline void LoopBus::do_send(const can::Frame& frame, can::Deadline) {

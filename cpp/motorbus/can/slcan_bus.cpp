@@ -1,0 +1,487 @@
+#include "motorbus/can/slcan_bus.hpp"
+
+#include <algorithm>
+#include <array>
+
+#include "motorbus/errors.hpp"
+
+namespace motorbus::can {
+
+using slcan::Event;
+using slcan::EventKind;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+// The receive thread wakes at least this often to expire acks and partial lines.
+constexpr auto kReadSlice = std::chrono::milliseconds(50);
+
+std::span<const std::uint8_t> as_bytes(const char* p, std::size_t n) {
+    return {reinterpret_cast<const std::uint8_t*>(p), n};
+}
+}  // namespace
+
+SlcanBus::SlcanBus(std::shared_ptr<serial::Port> port, SlcanOptions options, PortFactory reconnect)
+    : Bus(port ? "slcan:" + port->name() : "slcan", options.bus),
+      opts_(std::move(options)),
+      factory_(std::move(reconnect)) {
+    if (!port) throw InvalidArgument("slcan: no port");
+    if (opts_.bitrate != 0 && !opts_.btr && !slcan::bitrate_code(opts_.bitrate))
+        throw InvalidArgument("slcan bitrate: " + std::to_string(opts_.bitrate) +
+                              " has no Sn code (10k 20k 50k 100k 125k 250k 500k 750k/800k 1M); "
+                              "use btr for other rates");
+    if (opts_.tx_window == 0) throw InvalidArgument("slcan tx_window: must be >= 1");
+    if (auto* tty = dynamic_cast<serial::TtyPort*>(port.get()))
+        tty->set_write_timeout(std::chrono::seconds(2));
+    try {
+        open_sequence(*port);
+    } catch (...) {
+        port->close();
+        throw;
+    }
+    port_ = std::move(port);
+    link_up_ = true;
+    stats_.link_up = true;
+    thread_ = std::thread([this] { run(); });
+}
+
+SlcanBus::~SlcanBus() { close(); }
+
+// ------------------------------------------------------------ open sequence --
+
+void SlcanBus::open_sequence(serial::Port& port) {
+    port.flush_input();
+    decoder_.discard_partial();
+    // C first: a previous session may have left the channel open, and the
+    // adapter refuses configuration while open.  BEL just means "was closed".
+    command_inline(port, "C", true);
+    if (opts_.btr) {
+        char buf[8];
+        std::snprintf(buf, sizeof buf, "s%04X", *opts_.btr);
+        command_inline(port, buf, false);
+    } else if (opts_.bitrate != 0) {
+        command_inline(port, std::string("S") + *slcan::bitrate_code(opts_.bitrate), false);
+    }
+    if (opts_.timestamps) command_inline(port, "Z1", false);
+    command_inline(port, opts_.listen_only ? "L" : "O", false);
+}
+
+void SlcanBus::command_inline(serial::Port& port, const std::string& line, bool bel_ok) {
+    const std::string bytes = line + "\r";
+    awaiting_ = opts_.wait_for_acks;
+    awaited_done_ = false;
+    awaited_ok_ = false;
+    port.write(as_bytes(bytes.data(), bytes.size()));
+    if (!opts_.wait_for_acks) return;
+    const auto deadline = Clock::now() + opts_.open_timeout;
+    std::array<std::uint8_t, 512> buf;
+    while (!awaited_done_) {
+        {
+            std::lock_guard lock(mutex_);
+            if (stop_) {
+                awaiting_ = false;
+                throw ClosedError("slcan " + channel() + ": closed while opening");
+            }
+        }
+        const auto now = Clock::now();
+        if (now >= deadline) {
+            awaiting_ = false;
+            throw TimeoutError("slcan " + channel() + ": no answer to '" + line +
+                               "' (an adapter that never answers needs wait_for_acks=False)");
+        }
+        auto slice = std::min<Duration>(deadline - now, kReadSlice);
+        std::size_t n = port.read(buf, slice);
+        if (n) decoder_.feed(std::span(buf.data(), n), [&](const Event& e) { handle(e); });
+    }
+    awaiting_ = false;
+    if (!awaited_ok_ && !bel_ok)
+        throw ProtocolError("slcan " + channel() + ": adapter refused '" + line + "' (BEL)",
+                            std::vector<std::uint8_t>(line.begin(), line.end()));
+}
+
+// ------------------------------------------------------------------ sending --
+
+void SlcanBus::do_send(const Frame& frame, Deadline deadline) {
+    char line[slcan::kMtu];
+    const std::size_t n = slcan::encode_frame_into(frame, line);
+    std::unique_lock wl(write_mutex_, std::defer_lock);
+    if (!wl.try_lock_until(deadline))
+        throw TimeoutError("slcan " + channel() + ": port busy until the send deadline");
+    std::shared_ptr<serial::Port> port;
+    {
+        std::unique_lock lock(mutex_);
+        if (opts_.wait_for_acks &&
+            !cv_.wait_until(lock, deadline, [&] {
+                return stop_ || !link_up_ || pending_.size() < opts_.tx_window;
+            }))
+            throw TimeoutError("slcan " + channel() + ": " + std::to_string(pending_.size()) +
+                               " commands unanswered by the adapter (tx window full)");
+        if (stop_) throw ClosedError("slcan " + channel() + " is closed");
+        if (!link_up_) throw LinkDown("slcan " + channel() + ": link down (reconnecting)");
+        if (opts_.wait_for_acks)
+            pending_.push_back(Pending{frame.extended ? 'T' : 't', Clock::now() + opts_.ack_timeout,
+                                       true, frame.to_string()});
+        if (opts_.echo_suppression) {
+            if (echoes_.size() >= 1024) echoes_.pop_front();
+            echoes_.push_back(Echo{frame, Clock::now() + opts_.echo_window});
+        }
+        port = port_;
+    }
+    try {
+        port->write(as_bytes(line, n));
+    } catch (const LinkDown& e) {
+        link_lost(e.what());
+        throw;
+    } catch (const ClosedError&) {
+        throw LinkDown("slcan " + channel() + ": port closed under the send");
+    }
+}
+
+void SlcanBus::write_command(const std::string& text, char kind, Deadline deadline) {
+    const std::string line = text + "\r";
+    std::unique_lock wl(write_mutex_, std::defer_lock);
+    if (!wl.try_lock_until(deadline)) throw TimeoutError("slcan " + channel() + ": port busy");
+    std::shared_ptr<serial::Port> port;
+    {
+        std::unique_lock lock(mutex_);
+        if (opts_.wait_for_acks &&
+            !cv_.wait_until(lock, deadline, [&] {
+                return stop_ || !link_up_ || pending_.size() < opts_.tx_window;
+            }))
+            throw TimeoutError("slcan " + channel() + ": tx window full");
+        if (stop_) throw ClosedError("slcan " + channel() + " is closed");
+        if (!link_up_) throw LinkDown("slcan " + channel() + ": link down");
+        if (opts_.wait_for_acks)
+            pending_.push_back(Pending{kind, Clock::now() + opts_.ack_timeout, false, {}});
+        port = port_;
+    }
+    try {
+        port->write(as_bytes(line.data(), line.size()));
+    } catch (const LinkDown& e) {
+        link_lost(e.what());
+        throw;
+    }
+}
+
+void SlcanBus::flush_tx(Duration timeout) {
+    std::unique_lock lock(mutex_);
+    if (!cv_.wait_for(lock, timeout, [&] { return stop_ || !link_up_ || pending_.empty(); }))
+        throw TimeoutError("slcan " + channel() + ": " + std::to_string(pending_.size()) +
+                           " commands still unanswered");
+    if (stop_) throw ClosedError("slcan " + channel() + " is closed");
+    if (!link_up_) throw LinkDown("slcan " + channel() + ": link down");
+    if (nacked_frames_since_flush_) {
+        auto n = nacked_frames_since_flush_;
+        nacked_frames_since_flush_ = 0;
+        std::string last = last_nacked_;
+        throw ProtocolError("slcan " + channel() + ": adapter refused " + std::to_string(n) +
+                                " frame(s) (BEL); last " + last,
+                            std::vector<std::uint8_t>(last.begin(), last.end()));
+    }
+}
+
+std::uint8_t SlcanBus::query_status(Duration timeout) {
+    if (!opts_.wait_for_acks)
+        throw InvalidArgument("slcan query_status: needs wait_for_acks (the reply is matched)");
+    std::uint64_t before;
+    {
+        std::lock_guard lock(mutex_);
+        before = stats_.status_replies;
+    }
+    const auto deadline = deadline_after(timeout);
+    write_command("F", 'F', deadline);
+    std::unique_lock lock(mutex_);
+    if (!cv_.wait_until(lock, deadline, [&] { return stop_ || stats_.status_replies != before; }))
+        throw TimeoutError("slcan " + channel() + ": no answer to 'F'");
+    if (stop_) throw ClosedError("slcan " + channel() + " is closed");
+    return stats_.last_status;
+}
+
+SlcanStats SlcanBus::stats() const {
+    std::lock_guard lock(mutex_);
+    SlcanStats s = stats_;
+    s.partial_lines_dropped = stats_.partial_lines_dropped;
+    return s;
+}
+
+bool SlcanBus::link_up() const {
+    std::lock_guard lock(mutex_);
+    return link_up_;
+}
+
+// ---------------------------------------------------------------- receiving --
+
+void SlcanBus::handle(const Event& e) {
+    switch (e.kind) {
+        case EventKind::Frame: {
+            if (opts_.echo_suppression) {
+                std::lock_guard lock(mutex_);
+                const auto now = Clock::now();
+                while (!echoes_.empty() && echoes_.front().expires < now) echoes_.pop_front();
+                auto it = std::find_if(echoes_.begin(), echoes_.end(),
+                                       [&](const Echo& x) { return x.frame.same_content(e.frame); });
+                if (it != echoes_.end()) {
+                    echoes_.erase(it);
+                    ++stats_.echoes_suppressed;
+                    return;
+                }
+            }
+            Frame f = e.frame;
+            f.timestamp_ns = monotonic_ns();
+            dispatch(f);
+            return;
+        }
+        case EventKind::Ok:
+        case EventKind::TxAck:
+            if (awaiting_) {
+                awaited_done_ = true;
+                awaited_ok_ = true;
+            } else {
+                complete_oldest(true, 0);
+            }
+            return;
+        case EventKind::Nack:
+            if (awaiting_) {
+                awaited_done_ = true;
+                awaited_ok_ = false;
+            } else {
+                complete_oldest(false, 0);
+            }
+            return;
+        case EventKind::Status: {
+            if (e.status & slcan::kStatusDataOverrun) count_overrun();
+            if (e.status & slcan::kStatusBusError) count_bus_error();
+            if (state() != BusState::Closed) set_state(e.state);
+            {
+                std::lock_guard lock(mutex_);
+                stats_.last_status = e.status;
+                ++stats_.status_replies;
+            }
+            if (awaiting_) {
+                awaited_done_ = awaited_ok_ = true;
+            } else {
+                complete_oldest(true, 'F');
+            }
+            cv_.notify_all();
+            return;
+        }
+        case EventKind::Version:
+        case EventKind::Serial: {
+            {
+                std::lock_guard lock(mutex_);
+                (e.kind == EventKind::Version ? stats_.version : stats_.serial_number) = std::string(e.text);
+            }
+            if (awaiting_) {
+                awaited_done_ = awaited_ok_ = true;
+            } else {
+                complete_oldest(true, e.kind == EventKind::Version ? 'V' : 'N');
+            }
+            return;
+        }
+        case EventKind::ErrorReport:
+            count_bus_error();
+            if (e.error_bits & (slcan::kErrRxOverrun | slcan::kErrTxOverrun)) count_overrun();
+            return;
+        case EventKind::StateReport:
+            if (state() != BusState::Closed) set_state(e.state);
+            return;
+        case EventKind::Unknown: count_ignored(); return;
+        case EventKind::Malformed: count_parse_error(); return;
+        case EventKind::Overflow: count_overrun(); return;
+    }
+}
+
+bool SlcanBus::complete_oldest(bool ok, char reply_kind) {
+    std::lock_guard lock(mutex_);
+    if (pending_.empty() || (reply_kind != 0 && pending_.front().cmd != reply_kind)) {
+        // Unsolicited: a status/version line nobody asked for is just
+        // information; a stray CR is ignored; a stray BEL is an adapter error.
+        if (!ok) {
+            ++stats_.nacks;
+            count_bus_error();
+        } else if (reply_kind == 0) {
+            count_ignored();
+        }
+        return false;
+    }
+    Pending p = std::move(pending_.front());
+    pending_.pop_front();
+    if (ok) {
+        ++stats_.acks;
+    } else {
+        ++stats_.nacks;
+        if (p.is_frame) {
+            count_tx_dropped();
+            ++nacked_frames_since_flush_;
+            last_nacked_ = p.frame_text;
+        }
+    }
+    cv_.notify_all();
+    return true;
+}
+
+void SlcanBus::expire_pending(Deadline now) {
+    std::lock_guard lock(mutex_);
+    bool any = false;
+    while (!pending_.empty() && pending_.front().expires <= now) {
+        pending_.pop_front();
+        ++stats_.ack_timeouts;
+        any = true;
+    }
+    if (any) cv_.notify_all();
+}
+
+void SlcanBus::link_lost(const std::string&) {
+    std::shared_ptr<serial::Port> port;
+    {
+        std::lock_guard lock(mutex_);
+        if (!link_up_) return;
+        link_up_ = false;
+        stats_.link_up = false;
+        ++stats_.link_downs;
+        stats_.ack_timeouts += pending_.size();
+        pending_.clear();
+        echoes_.clear();
+        port = port_;
+    }
+    cv_.notify_all();
+    // Wakes a writer blocked on the dead port; the receive thread reconnects.
+    if (port) port->close();
+}
+
+bool SlcanBus::reopen() {
+    std::shared_ptr<serial::Port> port;
+    try {
+        port = factory_();
+        if (!port) return false;
+        if (auto* tty = dynamic_cast<serial::TtyPort*>(port.get()))
+            tty->set_write_timeout(std::chrono::seconds(2));
+        std::lock_guard wl(write_mutex_);
+        open_sequence(*port);
+        {
+            std::lock_guard lock(mutex_);
+            if (stop_) {
+                port->close();
+                return false;
+            }
+            port_ = port;
+            link_up_ = true;
+            stats_.link_up = true;
+            ++stats_.reconnects;
+        }
+        cv_.notify_all();
+        return true;
+    } catch (const std::exception&) {
+        if (port) port->close();
+        return false;
+    }
+}
+
+void SlcanBus::run() {
+    std::array<std::uint8_t, 4096> buf;
+    auto last_rx = Clock::now();
+    auto next_poll = Clock::now() + opts_.status_poll;
+    Duration backoff = opts_.reconnect_min;
+    for (;;) {
+        std::shared_ptr<serial::Port> port;
+        {
+            std::unique_lock lock(mutex_);
+            if (stop_) return;
+            if (!link_up_) {
+                if (!factory_) {
+                    // Nothing to reconnect with: stay down until closed.
+                    cv_.wait(lock, [&] { return stop_; });
+                    return;
+                }
+                // Backoff first, so an adapter that dies right after opening
+                // cannot make this loop spin (L14).
+                cv_.wait_for(lock, backoff, [&] { return stop_; });
+                if (stop_) return;
+                lock.unlock();
+                const bool ok = reopen();
+                backoff = std::min<Duration>(backoff * 2, opts_.reconnect_max);
+                if (ok) last_rx = Clock::now();
+                continue;
+            }
+            port = port_;
+        }
+        std::size_t n = 0;
+        try {
+            n = port->read(buf, kReadSlice);
+        } catch (const LinkDown& e) {
+            decoder_.discard_partial();
+            link_lost(e.what());
+            continue;
+        } catch (const ClosedError& e) {
+            decoder_.discard_partial();
+            link_lost(e.what());
+            continue;
+        }
+        const auto now = Clock::now();
+        if (n) {
+            decoder_.feed(std::span(buf.data(), n), [&](const Event& e) { handle(e); });
+            last_rx = now;
+            backoff = opts_.reconnect_min;  // the link carried data: it is healthy again
+        } else if (decoder_.pending() && now - last_rx > opts_.partial_line_timeout) {
+            decoder_.discard_partial();  // L2
+            count_parse_error();
+            std::lock_guard lock(mutex_);
+            ++stats_.partial_lines_dropped;
+        }
+        expire_pending(now);
+        if (opts_.status_poll > Duration::zero() && now >= next_poll) {
+            next_poll = now + opts_.status_poll;
+            // Never block the receive thread behind a sender waiting for acks
+            // that only this thread can deliver.
+            std::unique_lock wl(write_mutex_, std::try_to_lock);
+            if (wl.owns_lock()) {
+                bool room = true;
+                {
+                    std::lock_guard lock(mutex_);
+                    room = pending_.size() < opts_.tx_window;
+                    if (room && opts_.wait_for_acks)
+                        pending_.push_back(Pending{'F', now + opts_.ack_timeout, false, {}});
+                }
+                if (room) {
+                    try {
+                        port->write(as_bytes("F\r", 2));
+                    } catch (const Error&) {
+                    }
+                }
+            }
+        }
+    }
+}
+
+void SlcanBus::do_close() {
+    std::shared_ptr<serial::Port> port;
+    bool up;
+    {
+        std::lock_guard lock(mutex_);
+        stop_ = true;
+        port = port_;
+        up = link_up_;
+    }
+    cv_.notify_all();
+    if (port && up) {
+        // Leave the adapter closed, as python-can does; best effort.
+        std::unique_lock wl(write_mutex_, std::defer_lock);
+        if (wl.try_lock_for(std::chrono::milliseconds(200))) {
+            try {
+                port->write(as_bytes("C\r", 2));
+            } catch (const std::exception&) {
+            }
+        }
+    }
+    if (port) port->close();
+    if (thread_.joinable()) thread_.join();
+}
+
+std::shared_ptr<SlcanBus> open_slcan(const std::string& path, unsigned bitrate, SlcanOptions options) {
+    options.bitrate = bitrate;
+    const unsigned baud = options.tty_baud;
+    auto port = serial::open_port(path, baud);
+    return std::make_shared<SlcanBus>(std::move(port), std::move(options),
+                                      [path, baud] { return serial::open_port(path, baud); });
+}
+
+}  // namespace motorbus::can

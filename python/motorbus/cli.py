@@ -1,0 +1,188 @@
+"""The ``motorbus`` command line (also ``python -m motorbus``).
+
+    motorbus bus serve SPEC [--socketcand HOST:PORT] [--slcan-pty] [--channel NAME]
+    motorbus bus dump SPEC [--count N] [--log FILE]
+    motorbus bus play FILE SPEC [--speed X]
+    motorbus sim serve --pty --drive KIND:ADDR[,ADDR...] [--drive ...] [--baud N]
+    motorbus demo
+"""
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+from typing import Any, Callable, Optional, Sequence
+
+from . import _core
+from .bus import open_bus
+
+
+def _wait_for_signal() -> None:
+    """Blocks until SIGINT or SIGTERM, then returns (so servers close cleanly)."""
+    stop = threading.Event()
+
+    def handler(signum: int, frame: Any) -> None:
+        stop.set()
+
+    old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        while not stop.wait(0.2):
+            pass
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
+def _say(line: str) -> None:
+    print(line, flush=True)
+
+
+def _need(name: str) -> Callable[..., Any]:
+    fn = getattr(_core, name, None)
+    if fn is None:
+        raise SystemExit(f"motorbus: this build has no {name}")
+    return fn
+
+
+# ---------------------------------------------------------------------------
+def cmd_bus_serve(args: argparse.Namespace) -> int:
+    """Serves one bus to other processes until SIGINT/SIGTERM.
+
+    Each server gets its own endpoint on a virtual bus, so a frame from an SLCAN
+    client reaches socketcand clients and the reverse, as on a real bus.
+    """
+    if not args.socketcand and not args.slcan_pty:
+        args.socketcand = ["127.0.0.1:0"]
+    shared = None if args.spec.startswith("virtual:") else open_bus(args.spec)
+    endpoint = (lambda: open_bus(args.spec)) if shared is None else (lambda: shared)
+    servers: list[Any] = []
+    buses: list[Any] = []
+    try:
+        for hp in args.socketcand or []:
+            host, _, port = hp.rpartition(":")
+            bus = endpoint()
+            buses.append(bus)
+            srv = _need("SocketcandServer")(bus, host=host or "127.0.0.1", port=int(port))
+            servers.append(srv)
+            _say(f"socketcand {srv.host}:{srv.port} {args.channel}")
+        for _ in range(args.slcan_pty):
+            bus = endpoint()
+            buses.append(bus)
+            srv = _need("SlcanServer")(bus)
+            servers.append(srv)
+            _say(f"slcan {srv.pty_path}")
+        _wait_for_signal()
+    finally:
+        for s in servers:
+            s.close()
+        for b in buses:
+            b.close()
+        if shared is not None:
+            shared.close()
+    return 0
+
+
+def cmd_bus_dump(args: argparse.Namespace) -> int:
+    bus = open_bus(args.spec)
+    rec = _core.Recorder(bus, args.log) if args.log else None
+    n = 0
+    try:
+        while args.count == 0 or n < args.count:
+            f = bus.recv(0.2)
+            if f is None:
+                continue
+            _say(f"({f.timestamp_ns / 1e9:.6f}) {args.spec} {f}")
+            n += 1
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if rec:
+            rec.stop()
+        bus.close()
+    return 0
+
+
+def cmd_bus_play(args: argparse.Namespace) -> int:
+    entries, bad = _core.read_log(args.file)
+    with open_bus(args.spec) as bus:
+        n = _core.play(bus, entries, args.speed)
+    _say(f"played {n} frames ({bad} unreadable lines skipped)")
+    return 0
+
+
+# ---------------------------------------------------------------------------
+def cmd_sim_serve(args: argparse.Namespace) -> int:
+    from . import sim
+
+    if not args.pty:
+        raise SystemExit("motorbus sim serve: only --pty is supported (serial lines on pseudo-terminals)")
+    lines = sim.serve_lines(args.drive, baud=args.baud, store_dir=args.store_dir)
+    try:
+        for line in lines:
+            _say(f"{line.label} {line.pty_path}")
+        _wait_for_signal()
+    finally:
+        for line in lines:
+            line.close()
+    return 0
+
+
+def cmd_demo(args: argparse.Namespace) -> int:
+    from . import demo
+
+    return demo.main(quick=args.quick)
+
+
+# ---------------------------------------------------------------------------
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="motorbus", description="Drive integrated motor controllers over CAN, "
+                                "CANopen and serial lines; serve buses and simulated drives.")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    bus = sub.add_parser("bus", help="serve, dump or replay a CAN bus").add_subparsers(dest="bus_cmd", required=True)
+    s = bus.add_parser("serve", help="serve a bus over socketcand (TCP) and/or SLCAN (pty)")
+    s.add_argument("spec", help="bus spec, e.g. virtual:bench")
+    s.add_argument("--socketcand", action="append", metavar="HOST:PORT",
+                   help="socketcand server address (port 0 picks a free port); repeatable")
+    s.add_argument("--slcan-pty", action="count", default=0, help="serve an SLCAN adapter on a new pty; repeatable")
+    s.add_argument("--channel", default="can0", help="channel name announced to socketcand clients")
+    s.set_defaults(func=cmd_bus_serve)
+    d = bus.add_parser("dump", help="print frames (candump style), optionally logging them")
+    d.add_argument("spec")
+    d.add_argument("--count", type=int, default=0, help="stop after N frames (0 = until Ctrl-C)")
+    d.add_argument("--log", help="also write a candump (.log) or ASC (.asc) file")
+    d.set_defaults(func=cmd_bus_dump)
+    pl = bus.add_parser("play", help="replay a candump/ASC log onto a bus")
+    pl.add_argument("file")
+    pl.add_argument("spec")
+    pl.add_argument("--speed", type=float, default=1.0, help="1 = original timing, 0 = as fast as possible")
+    pl.set_defaults(func=cmd_bus_play)
+
+    sim = sub.add_parser("sim", help="simulated drives").add_subparsers(dest="sim_cmd", required=True)
+    ss = sim.add_parser("serve", help="serve simulated serial drives on ptys")
+    ss.add_argument("--pty", action="store_true", help="serve each serial line on a new pseudo-terminal")
+    ss.add_argument("--drive", action="append", required=True, metavar="KIND:ADDR[,ADDR...]",
+                    help="a line with one or more drives of one kind, e.g. arcus:01 or arcus:01,02 (RS-485 "
+                         "multi-drop); repeat for more lines")
+    ss.add_argument("--baud", type=int, default=0, help="pace replies at this baud rate (0 = unthrottled)")
+    ss.add_argument("--store-dir", default=None, help="where drives persist STORE'd settings")
+    ss.set_defaults(func=cmd_sim_serve)
+
+    dm = sub.add_parser("demo", help="run the simulated bench demo")
+    dm.add_argument("--quick", action="store_true", help="shorter run (used by the tests)")
+    dm.set_defaults(func=cmd_demo)
+    return p
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except _core.MotorbusError as e:
+        print(f"motorbus: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

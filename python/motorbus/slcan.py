@@ -1,0 +1,27 @@
+"""SLCAN (Lawicel ASCII over a serial line: CANable, USBtin, CANUSB...).
+
+* ``open_slcan(path, bitrate=500000, ...)`` -> :class:`SlcanBus`, a motorbus Bus
+  through an adapter (also reachable as ``open_bus("slcan:/dev/ttyACM0@500000")``).
+* ``SlcanServer(bus)`` serves any motorbus Bus as an SLCAN adapter on a new pty;
+  python-can's ``slcan`` interface (or slcand) joins it through ``.pty_path``.
+* ``slcan_encode`` / ``SlcanDecoder``: the pure codec, for tests and tools.
+
+See docs/slcan.md.
+"""
+from __future__ import annotations
+
+from ._core import SlcanBus, SlcanDecoder, SlcanServer, open_slcan, slcan_encode
+
+__all__ = ["SlcanBus", "SlcanDecoder", "SlcanServer", "open_slcan", "slcan_encode",
+           "STATUS_FLAGS"]
+
+#: Bits of the ``F`` status reply (Lawicel CAN232/CANUSB manual, SJA1000 based).
+STATUS_FLAGS = {
+    "rx_fifo_full": 0x01,
+    "tx_fifo_full": 0x02,
+    "error_warning": 0x04,
+    "data_overrun": 0x08,
+    "error_passive": 0x20,
+    "arbitration_lost": 0x40,
+    "bus_error": 0x80,
+}

@@ -1,0 +1,93 @@
+"""motorbus SLCAN from Python: codec, SlcanServer on a pty, open_slcan through it."""
+from __future__ import annotations
+
+import os
+import time
+
+import pytest
+import serial  # pyserial
+
+import motorbus
+from motorbus import _core
+from motorbus.slcan import SlcanDecoder, SlcanServer, open_slcan, slcan_encode
+
+
+def _hub(tag: str) -> str:
+    return f"slcan-py-{os.getpid()}-{tag}"
+
+
+def test_encode_every_kind():
+    assert slcan_encode(_core.Frame(0x123, b"\xde\xad")) == b"t1232DEAD\r"
+    assert slcan_encode(_core.Frame(0x1FFFFFFF, b"", extended=True)) == b"T1FFFFFFF0\r"
+    assert slcan_encode(_core.Frame(0x7FF, rtr=True, dlc=8)) == b"r7FF8\r"
+    assert slcan_encode(_core.Frame(1, b"\x01"), timestamp_ms=0xEA5F) == b"t001101EA5F\r"
+    with pytest.raises(motorbus.InvalidArgument):
+        slcan_encode(_core.Frame(1), timestamp_ms=60000)
+
+
+def test_decoder_hostile_rows_and_recovery():
+    d = SlcanDecoder()
+    events = d.feed(b"t8000\rt1239\rt12G0\rt1230EA60\r" + b"7" * 100 + b"\r\az\rF24\rt7ff1ab\r")
+    kinds = [e["kind"] for e in events]
+    assert kinds == ["malformed"] * 4 + ["overflow", "nack", "tx_ack", "status", "frame"]
+    assert events[7]["state"] == "error-passive"
+    f = events[8]["frame"]
+    assert (f.id, f.data) == (0x7FF, b"\xab")  # lowercase accepted (L9)
+    c = d.counters
+    assert (c["rx_errors"], c["rx_over_errors"], c["frames"]) == (4, 1, 1)
+    assert d.feed(b"t12") == [] and d.pending == 3
+    assert d.discard_partial() and d.pending == 0
+
+
+def test_server_with_pyserial_peer_answers_and_forwards():
+    inner = _core.open_virtual(_hub("a"))
+    peer = _core.open_virtual(_hub("a"))
+    with SlcanServer(inner) as server, serial.Serial(server.pty_path, timeout=2) as tty:
+        tty.write(b"V\rS6\rO\r")
+        assert tty.read_until(b"\r") == b"V1013\r"
+        assert tty.read(2) == b"\r\r"
+        peer.send(motorbus.Frame(0x321, b"\x01\x02"))
+        assert tty.read_until(b"\r") == b"t32120102\r"
+        tty.write(b"T000001232BEEF\r")
+        assert tty.read_until(b"\r") == b"Z\r"
+        got = peer.recv(timeout=2)
+        assert (got.id, got.extended, got.data) == (0x123, True, b"\xbe\xef")
+        tty.write(b"t8000\r")  # L8 on the adapter side: refused
+        assert tty.read(1) == b"\a"
+        assert server.stats["transmitted"] == 1
+
+
+def test_open_slcan_through_server_both_directions():
+    inner = _core.open_virtual(_hub("b"))
+    peer = _core.open_virtual(_hub("b"))
+    with SlcanServer(inner) as server:
+        with open_slcan(server.pty_path, 500000) as bus:
+            assert isinstance(bus, motorbus.Bus) and bus.link_up
+            frames = [motorbus.Frame(i, bytes(range(i % 9))) for i in range(0, 0x7FF, 97)]
+            frames += [motorbus.Frame(0x1FFFFFFF, b"\xff" * 8, extended=True),
+                       motorbus.Frame(0x7FF, rtr=True, dlc=3)]
+            for f in frames:
+                bus.send(f)
+            bus.flush_tx(2.0)
+            assert [peer.recv(timeout=2) for _ in frames] == frames
+            for f in frames:
+                peer.send(f)
+            assert [bus.recv(timeout=2) for _ in frames] == frames
+            assert bus.query_status(1.0) == 0
+            assert bus.stats["nacks"] == 0
+
+
+def test_open_bus_spec_reaches_open_slcan():
+    inner = _core.open_virtual(_hub("c"))
+    with SlcanServer(inner) as server:
+        with motorbus.open_bus(f"slcan:{server.pty_path}@250000") as bus:
+            assert bus.channel.startswith("slcan:")
+
+
+def test_open_slcan_errors_are_typed():
+    with pytest.raises(motorbus.InvalidArgument):
+        open_slcan("/nonexistent/tty", 500000)
+    inner = _core.open_virtual(_hub("d"))
+    with SlcanServer(inner) as server:
+        with pytest.raises(motorbus.InvalidArgument):
+            open_slcan(server.pty_path, 83333)
