@@ -32,7 +32,7 @@ $(VENV)/.deps: requirements-dev.txt
 # with the python-can entry point) and ctest (the GoogleTest suites).
 build: deps
 	$(PY) -m pip install -q --no-build-isolation --no-deps -e . \
-	  -Cbuild-dir=$(BUILD) -Ccmake.define.MOTORBUS_TESTS=ON -Ccmake.define.MOTORBUS_BENCH=ON \
+	  -Cbuild-dir=$(BUILD) -Ccmake.define.MOTORBUS_TESTS=ON -Ccmake.define.MOTORBUS_BENCH=ON -Ccmake.define.MOTORBUS_EXAMPLES=ON \
 	  -Cbuild.tool-args=-j$(JOBS) $(CCACHE)
 
 cpp-test: build

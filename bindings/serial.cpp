@@ -7,6 +7,7 @@
 
 #include "common.hpp"
 #include "motorbus/errors.hpp"
+#include "motorbus/serial/echo_device.hpp"
 #include "motorbus/serial/line_device.hpp"
 #include "motorbus/serial/line_server.hpp"
 #include "motorbus/serial/port.hpp"
@@ -338,6 +339,16 @@ class ReplyTooLong(ProtocolError):
         .def("request_terminator", [](const LineDevice& d) { return to_py(d.request_terminator()); })
         .def("max_request", &LineDevice::max_request)
         .def("on_overlong", [](LineDevice& d) { return to_py(d.on_overlong()); });
+
+    py::class_<EchoLineDevice, LineDevice, std::shared_ptr<EchoLineDevice>>(
+        m, "EchoLineDevice", "C++ device answering prefix + line + reply_terminator (benchmarks, smoke tests).")
+        .def(py::init([](const py::object& prefix, const py::object& reply_terminator,
+                         const py::object& request_terminator) {
+                 return std::make_shared<EchoLineDevice>(bytes_arg(prefix, "prefix"),
+                                                         bytes_arg(reply_terminator, "reply_terminator"),
+                                                         bytes_arg(request_terminator, "request_terminator"));
+             }),
+             py::arg("prefix") = "", py::arg("reply_terminator") = "\r\n", py::arg("request_terminator") = "\r");
 
     py::class_<PyLineServer>(m, "PtyLineServer",
                              "Serves LineDevices on a pty (multi-drop); clients open .slave_path.")

@@ -18,5 +18,6 @@ from ._core import (  # noqa: F401
 
 from .bus import open_bus  # noqa: E402,F401
 from .log import LogEntry, Recorder, play, read_log  # noqa: E402,F401
+from . import serial  # noqa: E402,F401
 
 __version__ = "0.1.0"

@@ -20,6 +20,7 @@ adapter is gone), ``ClosedError`` and ``InvalidArgument``.
 from __future__ import annotations
 
 from ._core import (  # noqa: F401
+    EchoLineDevice,
     LineDevice,
     LineLink,
     Port,
@@ -31,6 +32,7 @@ from ._core import (  # noqa: F401
 )
 
 __all__ = [
+    "EchoLineDevice",
     "LineDevice",
     "LineLink",
     "Port",

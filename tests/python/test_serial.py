@@ -247,3 +247,15 @@ def test_bad_arguments():
         link = LineLink(pty.port)
         with pytest.raises(motorbus.InvalidArgument):
             link.transact(123)
+
+
+def test_server_on_an_existing_port_and_echo_device():
+    from motorbus.serial import EchoLineDevice
+
+    with PtyPair() as pty:
+        server = PtyLineServer([EchoLineDevice(prefix=b"P:")], port=pty.open_slave())
+        assert server.slave_path == ""
+        link = LineLink(pty.port, reply_timeout=1.0)
+        assert link.transact("abc") == b"P:abc"
+        assert EchoLineDevice().on_line(b"x") == b"x\r\n"
+        server.close()

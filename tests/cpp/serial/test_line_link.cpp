@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "motorbus/serial/port.hpp"
@@ -150,6 +151,8 @@ TEST(LineLink, A8_LateReplyAfterTimeoutIsDiscarded) {
     EXPECT_EQ(link.transact("B"), "ok:B");
     EXPECT_EQ(link.counters().stale_bytes, 8u);  // "late:A\r\n"
 }
+
+static_assert(std::is_base_of_v<ProtocolError, ReplyTooLong>, "ReplyTooLong must be catchable as ProtocolError");
 
 TEST(LineLink, A3_OverlongReplyIsReplyTooLongThenNextWorks) {
     PtyPair pty;
