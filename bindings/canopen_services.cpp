@@ -16,6 +16,8 @@
 #include "motorbus/canopen/nmt.hpp"
 #include "motorbus/canopen/pdo.hpp"
 #include "motorbus/canopen/pdo_engine.hpp"
+#include "motorbus/canopen/pdo_service.hpp"
+#include "motorbus/canopen/sdo_client.hpp"
 #include "motorbus/canopen/scanner.hpp"
 #include "motorbus/canopen/services_sdo_adapter.hpp"
 #include "motorbus/canopen/sync.hpp"
@@ -125,11 +127,16 @@ private:
 // Either a Bus (an SdoClient per node is made) or a duck-typed client.
 struct SdoBox {
     BusPtr bus;
+    py::object client;  // keeps a bound SdoClient alive
     std::shared_ptr<SdoAccess> access;
 };
-SdoBox make_sdo(const py::object& o) {
+SdoBox make_sdo(const py::object& o, int node) {
     SdoBox b;
-    if (py::isinstance<can::Bus>(o)) {
+    if (py::isinstance<SdoClient>(o)) {
+        // canopen-sdo's client: called directly in C++, no GIL round trip.
+        b.client = o;
+        b.access = std::make_shared<ClientSdoAccess>(o.cast<SdoClient&>(), static_cast<std::uint8_t>(node));
+    } else if (py::isinstance<can::Bus>(o)) {
         b.bus = o.cast<BusPtr>();
         b.access = std::make_shared<BusSdoAccess>(*b.bus);
     } else if (py::hasattr(o, "upload") && py::hasattr(o, "download")) {
@@ -551,7 +558,7 @@ void bind_canopen_services(py::module_& m) {
              bool enabled, std::optional<int> ttype, std::optional<int> inhibit, std::optional<int> timer,
              std::optional<int> sync_start, std::optional<py::iterable> mapping, const std::string& procedure) {
               check_node(node, false);
-              auto box = make_sdo(sdo);
+              auto box = make_sdo(sdo, node);
               PdoConfig c;
               c.tpdo = tpdo;
               c.number = number;
@@ -585,7 +592,7 @@ void bind_canopen_services(py::module_& m) {
           py::arg("procedure") = "cia301");
     m.def("pdo_read_config", [](const py::object& sdo, int node, bool tpdo, unsigned number) {
               check_node(node, false);
-              auto box = make_sdo(sdo);
+              auto box = make_sdo(sdo, node);
               PdoConfig c;
               {
                   py::gil_scoped_release nogil;
@@ -618,7 +625,7 @@ void bind_canopen_services(py::module_& m) {
         .def(py::init([](const py::object& sdo, int node, double timeout, double poll) {
                  check_node(node, false);
                  auto b = std::make_shared<Ds402HostBox>();
-                 b->sdo = make_sdo(sdo);
+                 b->sdo = make_sdo(sdo, node);
                  Ds402HostOptions o;
                  o.timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9));
                  o.sdo_poll = std::chrono::nanoseconds(static_cast<std::int64_t>(poll * 1e9));
@@ -696,6 +703,49 @@ void bind_canopen_services(py::module_& m) {
         .def("set_status_bits", &Ds402Device::set_status_bits, py::arg("mask"), py::arg("value"))
         .def_property_readonly("last_error_code", &Ds402Device::last_error_code)
         .def_property_readonly("drive_enabled", &Ds402Device::drive_enabled);
+
+    // ---- PDO engine on a LocalNode -----------------------------------------------------
+    py::class_<PdoService, std::shared_ptr<PdoService>>(m, "PdoService",
+        "The PDO engine of a LocalNode: 0x1400-0x1BFF in its dictionary, TPDOs/RPDOs on its bus.")
+        .def(py::init([](LocalNode& node, unsigned rpdos, unsigned tpdos, unsigned max_mapped, bool strict,
+                         std::uint32_t sync_window_us) {
+                 PdoServiceOptions o;
+                 o.rpdo_count = rpdos;
+                 o.tpdo_count = tpdos;
+                 o.max_mapped = max_mapped;
+                 o.strict = strict;
+                 o.sync_window_us = sync_window_us;
+                 py::gil_scoped_release nogil;
+                 return PdoService::attach(node, o);
+             }), py::arg("node"), py::arg("rpdos") = 4, py::arg("tpdos") = 4, py::arg("max_mapped") = 8,
+             py::arg("strict") = true, py::arg("sync_window_us") = 0, py::keep_alive<1, 2>())
+        .def("mapping", [](PdoService& s, bool tpdo, unsigned n) { return entries_to(s.engine().mapping(tpdo, n)); },
+             py::arg("tpdo"), py::arg("number"))
+        .def("cob_id", [](PdoService& s, bool tpdo, unsigned n) { return s.engine().cob_id(tpdo, n); },
+             py::arg("tpdo"), py::arg("number"))
+        .def("trigger_tpdo", [](PdoService& s, unsigned n) { py::gil_scoped_release nogil; s.engine().trigger_tpdo(n); })
+        .def("notify_change", [](PdoService& s, std::uint16_t i, std::uint8_t sub) {
+                 py::gil_scoped_release nogil;
+                 s.engine().notify_change(i, sub);
+             }, py::arg("index"), py::arg("subindex") = 0)
+        .def("set_rpdo_timeout_callback", [](PdoService& s, py::object cb) {
+                 if (cb.is_none()) { s.engine().on_rpdo_timeout = nullptr; return; }
+                 PyCallable call(cb.cast<py::function>());
+                 s.engine().on_rpdo_timeout = [call](unsigned n) { call(n); };
+             }, py::arg("callback"), "callback(rpdo_number) when an RPDO's event timer expires (P11).")
+        .def_property_readonly("counters", [](PdoService& s) {
+                 auto c = s.engine().counters();
+                 py::dict d;
+                 d["tpdo_sent"] = c.tpdo_sent;
+                 d["rpdo_applied"] = c.rpdo_applied;
+                 d["rpdo_ignored"] = c.rpdo_ignored;
+                 d["rpdo_length_errors"] = c.rpdo_length_errors;
+                 d["sync_received"] = c.sync_received;
+                 d["sync_errors"] = c.sync_errors;
+                 d["rtr_ignored"] = c.rtr_ignored;
+                 d["collisions"] = c.collisions;
+                 return d;
+             });
 
     // ---- scanner ------------------------------------------------------------------
     m.def("scan_network", [](BusPtr bus, int first, int last, double sdo_timeout, double listen, bool probe_sdo,

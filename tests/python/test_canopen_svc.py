@@ -291,3 +291,34 @@ def test_scan_network_finds_a_responder():
     n = found[0]
     assert n.device_type == 0x00040192 and n.profile == 402
     assert (n.vendor_id, n.product_code, n.revision, n.serial_number) == (0x12E, 7, 1, 99)
+
+
+# ---- end to end with canopen-sdo's LocalNode and SdoClient ------------------------------
+
+def test_pmc007_end_to_end_on_local_node():
+    from motorbus.canopen.services import PdoService
+    from motorbus.canopen import LocalNode, ObjectDictionary, SdoClient
+
+    seq = VECTORS["pmc007_canopen"]["pdo_config_sequence"]
+    name = f"svc-py-{next(_hub)}"
+    dev, host, sniff = _core.open_virtual(name), _core.open_virtual(name), _core.open_virtual(name)
+    od = ObjectDictionary()
+    od.add_variable(0x6012, "GPIO value", "U16", access="rw", pdo_mappable=True, default=3)
+    node = LocalNode(dev, 5, od)
+    pdo = PdoService(node, strict=False)
+    sdo = SdoClient(host, 5)
+    configure_pdo(sdo, 5, tpdo=1, cob_id=0x187, transmission_type=255, inhibit_100us=50,
+                  event_timer_ms=1000, mapping=[(0x6012, 0, 16)], procedure="direct")
+    reqs = []
+    while len(reqs) < 6:
+        f = sniff.recv(1.0)
+        assert f is not None
+        if f.id == 0x605:
+            reqs.append(f.data)
+    assert reqs == [bytes.fromhex(r["data"]) for r in seq["requests"]]
+    assert pdo.mapping(True, 1) == [(0x6012, 0, 16)]
+    NmtMaster(host).start(5)
+    f = recv_id(sniff, 0x187, timeout=2.0)
+    assert f is not None and f.data == bytes.fromhex(seq["resulting_pdo"]["data"])
+    assert pdo.counters["tpdo_sent"] >= 1
+    node.close()

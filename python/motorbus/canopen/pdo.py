@@ -17,12 +17,15 @@ from typing import Iterable, List, Optional, Sequence, Tuple, Union
 
 from .. import _core
 
-__all__ = ["PdoMap", "pack", "unpack", "configure_pdo", "read_pdo_config", "PdoReceiver",
+__all__ = ["PdoMap", "pack", "unpack", "configure_pdo", "read_pdo_config", "PdoReceiver", "PdoService",
            "PdoSender", "SyncProducer", "sync_encode", "time_encode", "time_decode"]
 
 Entry = Union[Tuple[int, int, int], Tuple[int, int, int, bool]]
 
 PdoReceiver = _core.PdoReceiver
+#: PdoService(local_node, strict=True): the PDO engine of a served LocalNode.
+#: strict=False accepts parameter changes while a PDO is valid (as the PMC007 does).
+PdoService = _core.PdoService
 PdoSender = _core.PdoSender
 SyncProducer = _core.SyncProducer
 sync_encode = _core.sync_encode
