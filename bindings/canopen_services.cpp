@@ -13,6 +13,7 @@
 #include "motorbus/canopen/ds402.hpp"
 #include "motorbus/canopen/emcy.hpp"
 #include "motorbus/canopen/heartbeat.hpp"
+#include "motorbus/canopen/heartbeat_service.hpp"
 #include "motorbus/canopen/nmt.hpp"
 #include "motorbus/canopen/pdo.hpp"
 #include "motorbus/canopen/pdo_engine.hpp"
@@ -746,6 +747,24 @@ void bind_canopen_services(py::module_& m) {
                  d["collisions"] = c.collisions;
                  return d;
              });
+
+    py::class_<HeartbeatService, std::shared_ptr<HeartbeatService>>(m, "HeartbeatService",
+        "Heartbeat producer (0x1017) and consumer (0x1016) of a LocalNode; EMCY 0x8130 and 0x1029 on loss.")
+        .def(py::init([](LocalNode& node, unsigned entries, std::uint16_t producer_ms) {
+                 HeartbeatServiceOptions o;
+                 o.consumer_entries = entries;
+                 o.producer_ms = producer_ms;
+                 py::gil_scoped_release nogil;
+                 return HeartbeatService::attach(node, o);
+             }), py::arg("node"), py::arg("consumer_entries") = 4, py::arg("producer_ms") = 0,
+             py::keep_alive<1, 2>())
+        .def("health", [](HeartbeatService& s, int node) { check_node(node, false); return health_dict(s.health(static_cast<std::uint8_t>(node))); })
+        .def_property_readonly("heartbeats_sent", &HeartbeatService::heartbeats_sent)
+        .def("set_lost_callback", [](HeartbeatService& s, py::object cb) {
+                 if (cb.is_none()) { s.on_lost = nullptr; return; }
+                 PyCallable call(cb.cast<py::function>());
+                 s.on_lost = [call](std::uint8_t n) { call(n); };
+             }, py::arg("callback"), "callback(node) when a consumed heartbeat is lost (e.g. Ds402Device.loss_of_master).");
 
     // ---- scanner ------------------------------------------------------------------
     m.def("scan_network", [](BusPtr bus, int first, int last, double sdo_timeout, double listen, bool probe_sdo,

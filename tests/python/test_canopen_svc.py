@@ -322,3 +322,29 @@ def test_pmc007_end_to_end_on_local_node():
     assert f is not None and f.data == bytes.fromhex(seq["resulting_pdo"]["data"])
     assert pdo.counters["tpdo_sent"] >= 1
     node.close()
+
+
+def test_heartbeat_service_on_local_node_applies_loss_of_master():
+    from motorbus.canopen.services import HeartbeatService
+    from motorbus.canopen import LocalNode, ObjectDictionary, SdoClient
+
+    name = f"svc-py-{next(_hub)}"
+    dev, host = _core.open_virtual(name), _core.open_virtual(name)
+    node = LocalNode(dev, 5, ObjectDictionary())
+    hb = HeartbeatService(node, consumer_entries=2)
+    drive = Ds402Device()
+    drive.set_abort_connection_option(2)
+    drive.on_controlword(0x06)
+    drive.on_controlword(0x0F)
+    lost = threading.Event()
+    hb.set_lost_callback(lambda n: (drive.loss_of_master(), lost.set()))
+    sdo = SdoClient(host, 5)
+    sdo.download(0x1016, 1, (0x00010028).to_bytes(4, "little"))   # node 1, 40 ms
+    with pytest.raises(Exception) as exc:
+        sdo.download(0x1016, 2, (0x00010050).to_bytes(4, "little"))  # N12 duplicate
+    assert getattr(exc.value, "code", None) == 0x06040043
+    host.send(nmt_mod.heartbeat_encode(1, "OPERATIONAL"))
+    assert lost.wait(2.0)
+    assert drive.state == "SWITCH ON DISABLED"   # 0x6007 = 2 (D5)
+    assert hb.health(1)["lost"]
+    node.close()

@@ -55,7 +55,10 @@ void HeartbeatService::install() {
         var->add_change_listener([this](const Variable&) { apply_consumers(); });
     }
     consumer_.on_event = [this](std::uint8_t n, HeartbeatEvent ev, NodeState st) {
-        if (ev == HeartbeatEvent::Lost) lost(n);
+        if (ev == HeartbeatEvent::Lost)
+            lost(n);
+        else if (ev == HeartbeatEvent::Started || ev == HeartbeatEvent::Back || ev == HeartbeatEvent::Reset)
+            node_.wake();  // a deadline was armed: the node's timer must know
         if (on_event) on_event(n, ev, st);
     };
     apply_consumers();

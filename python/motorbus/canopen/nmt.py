@@ -20,7 +20,7 @@ from typing import Callable, Optional
 
 from .. import _core
 
-__all__ = ["NmtCommand", "NmtMaster", "HeartbeatConsumer", "HeartbeatProducer",
+__all__ = ["NmtCommand", "NmtMaster", "HeartbeatConsumer", "HeartbeatProducer", "HeartbeatService",
            "NMT_STATES", "nmt_encode", "nmt_decode", "heartbeat_encode", "heartbeat_decode"]
 
 NMT_STATES = ("INITIALISING", "STOPPED", "OPERATIONAL", "PRE-OPERATIONAL", "UNKNOWN")
@@ -135,3 +135,7 @@ class HeartbeatConsumer:
 
 
 HeartbeatProducer = _core.HeartbeatProducer
+
+#: HeartbeatService(local_node, consumer_entries=4, producer_ms=0): 0x1017/0x1016 of a served
+#: node; set_lost_callback(cb) for the loss-of-master reaction.
+HeartbeatService = _core.HeartbeatService
