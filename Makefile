@@ -8,6 +8,10 @@ BUILD  := build/dev
 JOBS   ?= $(shell nproc)
 APT_PACKAGES := cmake ninja-build g++ libeigen3-dev libgtest-dev clang libclang-rt-14-dev ccache
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+# ccache (when installed) with paths relative to the checkout, so a fresh clone
+# in another directory reuses earlier compilations.
+export CCACHE_BASEDIR := $(CURDIR)
+export CCACHE_NOHASHDIR := 1
 CCACHE := $(shell command -v ccache >/dev/null && echo -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache)
 
 .PHONY: demo test deps venv build cpp-test py-test sanitize fuzz fuzz-smoke bench stubs clean

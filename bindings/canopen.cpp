@@ -193,6 +193,20 @@ NmtState nmt_from_py(const std::string& s) {
     throw InvalidArgument("NMT state: '" + s + "' unknown (OPERATIONAL, STOPPED, PRE-OPERATIONAL)");
 }
 
+// A LocalNode joins its worker on destruction, and the worker may be waiting
+// for the GIL inside a Python hook: never destroy it while holding the GIL.
+struct ReleaseGilDelete {
+    void operator()(LocalNode* n) const {
+        if (Py_IsInitialized() && PyGILState_Check()) {
+            py::gil_scoped_release nogil;
+            delete n;
+        } else {
+            delete n;
+        }
+    }
+};
+using LocalNodeHolder = std::unique_ptr<LocalNode, ReleaseGilDelete>;
+
 TransferMode mode_of(bool block, bool segmented) {
     return block ? TransferMode::Block : segmented ? TransferMode::Segmented : TransferMode::Auto;
 }
@@ -512,7 +526,7 @@ class SdoProtocolError(ProtocolError):
         .def_property_readonly("counters", [](const SdoClient& c) { return counters_dict(c.counters()); });
 
     // ---- LocalNode ---------------------------------------------------------------
-    py::class_<LocalNode>(m, "LocalNode",
+    py::class_<LocalNode, LocalNodeHolder>(m, "LocalNode",
         "A node we serve: SDO server on 0x600+n/0x580+n, boot-up, NMT slave.")
         .def(py::init([](can::Bus& bus, std::uint8_t node_id, std::shared_ptr<ObjectDictionary> od,
                          double sdo_timeout, bool block_transfer, bool send_boot_up) {
@@ -521,7 +535,7 @@ class SdoProtocolError(ProtocolError):
                  o.sdo.block_transfer = block_transfer;
                  o.send_boot_up = send_boot_up;
                  py::gil_scoped_release nogil;
-                 return std::make_unique<LocalNode>(bus, node_id, std::move(od), o);
+                 return LocalNodeHolder(new LocalNode(bus, node_id, std::move(od), o));
              }),
              py::arg("bus"), py::arg("node_id"), py::arg("od"), py::arg("sdo_timeout") = 1.0,
              py::arg("block_transfer") = true, py::arg("send_boot_up") = true, py::keep_alive<1, 2>())

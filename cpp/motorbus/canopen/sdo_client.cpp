@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <thread>
 
 namespace motorbus::canopen {
 
@@ -476,15 +477,24 @@ void SdoClient::send_out() {
 
 void SdoClient::on_frame(const can::Frame& f) {
     if (f.rtr || (f.flags & (can::kFlagError | can::kFlagLoopback))) return;
-    std::lock_guard lock(mutex_);
-    machine_.on_frame(f.payload(), monotonic_ns(), outbox_);
-    try {
-        send_out();
-    } catch (const std::exception&) {
-        // The medium refused (full, closed): the transfer runs into its timeout.
-        outbox_.clear();
+    bool done;
+    {
+        std::lock_guard lock(mutex_);
+        machine_.on_frame(f.payload(), monotonic_ns(), outbox_);
+        try {
+            send_out();
+        } catch (const std::exception&) {
+            // The medium refused (full, closed): the transfer runs into its timeout.
+            outbox_.clear();
+        }
+        done = !machine_.busy();
     }
-    if (!machine_.busy()) cv_.notify_all();
+    // Tell the caller after unlocking, so a spinning caller does not then
+    // block on the mutex this thread still holds.
+    if (done) {
+        idle_.store(true, std::memory_order_release);
+        cv_.notify_all();
+    }
 }
 
 void SdoClient::run(std::unique_lock<std::mutex>& lock) {
@@ -493,6 +503,14 @@ void SdoClient::run(std::unique_lock<std::mutex>& lock) {
     } catch (...) {
         machine_.reset();
         throw;
+    }
+    if (options_.spin.count() > 0 && machine_.busy()) {
+        idle_.store(false, std::memory_order_relaxed);
+        lock.unlock();
+        const auto until = std::chrono::steady_clock::now() + options_.spin;
+        while (!idle_.load(std::memory_order_acquire) && std::chrono::steady_clock::now() < until)
+            std::this_thread::yield();
+        lock.lock();
     }
     while (machine_.busy()) {
         const Nanos dl = machine_.next_deadline();

@@ -15,6 +15,7 @@
 // sharing a client are serialized in arrival order.  Clients for different
 // nodes (or channels) run concurrently; each costs one O(1) subscription.
 #pragma once
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -147,6 +148,9 @@ struct SdoClientOptions {
     bool fallback_to_segmented = true;
     // Idempotent reads are retried this many times after a timeout (writes never are).
     unsigned read_retries = 0;
+    // Before sleeping, the caller polls (yielding the CPU) this long for the
+    // response: saves a thread wake-up per round trip on fast links.  0 = sleep at once.
+    std::chrono::microseconds spin{50};
     // COB-IDs; 0 = the default channel 0x600+n / 0x580+n.
     std::uint32_t request_id = 0;
     std::uint32_t response_id = 0;
@@ -221,6 +225,7 @@ private:
     SdoClientMachine machine_;
     SdoClientMachine::Outbox outbox_;
     can::SubscriptionId sub_ = 0;
+    std::atomic<bool> idle_{true};  // the machine is not Running (for the spin-wait)
 };
 
 }  // namespace motorbus::canopen

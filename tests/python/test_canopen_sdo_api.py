@@ -255,3 +255,54 @@ def test_eds_import_export(tmp_path, setup):
     assert back.indices() == od.indices()
     assert back["Baud index"].high_limit == 8
     assert back[0x1008].value == "PMC007"
+
+
+def test_dropping_a_node_with_python_hooks_does_not_hang():
+    name = f"virtual:sdo-py-{next(_hub)}"
+    with motorbus.open_bus(name) as host, motorbus.open_bus(name) as dev:
+        od = ObjectDictionary()
+        slow = od.add_variable(0x2000, "Slow", "u32", "rw")
+        slow.set_read_hook(lambda var, cur: (time.sleep(0.01), None)[1])
+        node = LocalNode(dev, 5, od)
+        sdo = SdoClient(host, 5, timeout=0.5)
+        outcomes = []
+
+        def reads():
+            for _ in range(5):
+                try:
+                    sdo.upload(0x2000, 0)
+                    outcomes.append("ok")
+                except SdoTimeout:  # the node is gone: the client times out cleanly
+                    outcomes.append("timeout")
+
+        t = threading.Thread(target=reads, daemon=True)
+        t.start()
+        time.sleep(0.02)
+        del node  # the worker may be inside the hook, waiting for the GIL we hold
+        import gc
+        gc.collect()
+        t.join(5)
+        assert not t.is_alive()
+        assert len(outcomes) == 5
+
+
+def test_od_building_and_lookup():
+    od = ObjectDictionary()
+    od.add_variable(0x6040, "Controlword", "u16", "rw", pdo_mappable=True)
+    od.add_record(0x1018, "Identity object")
+    od.add_member(0x1018, 1, "Vendor-ID", "u32", "ro", default=0xAB)
+    assert (0x1018, 1) in od and 0x6040 in od and "Controlword" in od and (0x1018, 2) not in od
+    assert od["0x1018:1"].value == 0xAB and od[0x1018, 0].value == 1
+    assert od.subindices(0x1018) == [0, 1]
+    assert od.object_name(0x1018) == "Identity object"
+    v = od["Controlword"]
+    assert (v.index, v.subindex, v.data_type, v.access, v.pdo_mappable, v.size) == (
+        0x6040, 0, DataType.UNSIGNED16, "rw", True, 2)
+    v.value = 0x0F
+    assert v.raw == b"\x0f\x00"
+    with pytest.raises(motorbus.InvalidArgument):
+        v.value = 70000
+    with pytest.raises(motorbus.InvalidArgument):
+        od.add_variable(0x6040, "again", "u8")
+    with pytest.raises(motorbus.InvalidArgument):
+        od.add_variable(0x6041, "bad", "u7")

@@ -1,0 +1,327 @@
+#include "motorbus/motion/homing.hpp"
+
+#include <cmath>
+
+#include "motorbus/motion/planner_detail.hpp"
+#include "motorbus/motion/stepnloop.hpp"
+
+namespace motorbus::motion {
+
+namespace {
+constexpr double kHoldSeconds = 1e7;  // a search runs until an event stops it
+
+// From the motor's current commanded state, ramp to `velocity` at `accel` and hold.
+Profile ramp_and_hold(double p, double v, double velocity, double accel, RampShape shape, double start_speed = 0) {
+    Profile prof(State{p, v, 0, 0});
+    double v0 = v;
+    if (v0 * velocity <= 0 && start_speed > 0) v0 = 0;  // a stepper starts at its start speed
+    if (v0 == 0 && start_speed > 0) v0 = std::copysign(std::min(start_speed, std::fabs(velocity)), velocity);
+    const double dv = velocity - v0;
+    if (dv != 0 && std::isfinite(accel) && accel > 0) {
+        const double dur = std::fabs(dv) / accel;
+        if (shape == RampShape::SCurve) {
+            const double half = dur / 2, jerk = dv / (half * half);
+            prof.append_jump(half, v0, 0, jerk);
+            prof.append_cubic(half, -jerk);
+        } else {
+            prof.append_jump(dur, v0, dv / dur, 0);
+        }
+    }
+    prof.append_jump(kHoldSeconds, velocity, 0, 0);
+    prof.finish(prof.final_state().p, velocity);
+    return prof;
+}
+}  // namespace
+
+// ---- DMX-CAN -------------------------------------------------------------------
+
+ArcusHoming::ArcusHoming(MotorModel& motor, ArcusProfileParams params, Options opt)
+    : motor_(motor), params_(arcus_effective(params).params), opt_(opt) {
+    listener_ = motor_.add_listener([this](const MotorEvent& e) { on_event(e); });
+}
+
+ArcusHoming::~ArcusHoming() { motor_.remove_listener(listener_); }
+
+int ArcusHoming::snl_status() const {
+    switch (method_) {
+        case Method::Z:
+        case Method::ZH: return static_cast<int>(SnlStatus::ZHoming);
+        case Method::L: return static_cast<int>(SnlStatus::LimitHoming);
+        default: return static_cast<int>(SnlStatus::Homing);
+    }
+}
+
+namespace {
+double arcus_accel(const ArcusProfileParams& p) {
+    return std::max(p.hspd - p.lspd, 1e-9) / (p.acc_ms / 1000.0);
+}
+double arcus_decel(const ArcusProfileParams& p) {
+    return std::max(p.hspd - p.lspd, 1e-9) / ((p.edec ? p.dec_ms : p.acc_ms) / 1000.0);
+}
+}  // namespace
+
+void ArcusHoming::jog(int direction, double speed) {
+    const RampShape shape = params_.scv ? RampShape::SCurve : RampShape::Trapezoid;
+    motor_.command(ramp_and_hold(motor_.pulse_position(), motor_.commanded_velocity(), direction * speed,
+                                 arcus_accel(params_), shape, params_.lspd));
+}
+
+void ArcusHoming::decel_stop(Nanos) {
+    // Ramp down to LSPD, then stop (a jump from LSPD to 0).
+    const double v = motor_.commanded_velocity();
+    Profile tail(State{motor_.pulse_position(), v, 0, 0});
+    const double w = std::fabs(v);
+    if (w > params_.lspd)
+        detail::append_ramp(tail, -detail::sgn(v) * (w - params_.lspd), (w - params_.lspd) / arcus_decel(params_),
+                            params_.scv ? RampShape::SCurve : RampShape::Trapezoid);
+    tail.finish(tail.final_state().p, 0);
+    if (tail.empty()) {
+        motor_.halt();
+        return;
+    }
+    motor_.command(tail);
+}
+
+void ArcusHoming::run(double target, double, bool) {
+    const RampShape shape = params_.scv ? RampShape::SCurve : RampShape::Trapezoid;
+    Profile p = arcus_stepper_profile(State{motor_.pulse_position(), motor_.commanded_velocity(), 0, 0}, target,
+                                      params_.hspd, params_.lspd, arcus_accel(params_), arcus_decel(params_), shape);
+    if (p.empty()) {
+        motor_.halt();
+        return;
+    }
+    motor_.command(p);
+}
+
+void ArcusHoming::start(Method m, int direction) {
+    motor_.update();
+    method_ = m;
+    dir_ = direction >= 0 ? 1 : -1;
+    stage_ = 0;
+    result_ = HomingResult::Running;
+    if (m == Method::Z) {
+        jog(dir_, params_.lspd);
+    } else {
+        jog(dir_, params_.hspd);
+    }
+}
+
+void ArcusHoming::abort() {
+    if (result_ != HomingResult::Running) return;
+    motor_.halt();
+    result_ = HomingResult::Aborted;
+}
+
+void ArcusHoming::finish(HomingResult r) {
+    result_ = r;
+    stage_ = -1;
+}
+
+void ArcusHoming::on_event(const MotorEvent& e) {
+    using K = MotorEvent::Kind;
+    if (result_ != HomingResult::Running) return;
+    const bool limit_ahead = (e.kind == K::PlusLimitOn && e.direction > 0) || (e.kind == K::MinusLimitOn && e.direction < 0);
+    if (method_ != Method::L && limit_ahead) {
+        motor_.halt();
+        finish(HomingResult::LimitError);
+        return;
+    }
+    switch (method_) {
+        case Method::H:
+            if (stage_ == 0 && e.kind == K::HomeOn) {
+                motor_.set_pulse_position(0);
+                decel_stop(e.t);
+                stage_ = 1;
+                if (!motor_.moving()) on_event(MotorEvent{K::ProfileDone, e.t, e.physical, 0, e.encoder, 0});
+            } else if (stage_ == 1 && e.kind == K::ProfileDone) {
+                if (opt_.rz && std::llround(motor_.pulse_position()) != 0) {
+                    run(0, params_.hspd, false);
+                    stage_ = 2;
+                } else {
+                    finish(HomingResult::Done);
+                }
+            } else if (stage_ == 2 && e.kind == K::ProfileDone) {
+                finish(HomingResult::Done);
+            }
+            break;
+        case Method::HL:
+            if (stage_ == 0 && e.kind == K::HomeOn) {
+                motor_.set_pulse_position(0);
+                decel_stop(e.t);
+                stage_ = 1;
+            } else if (stage_ == 1 && e.kind == K::ProfileDone) {
+                stage_ = 2;
+                if (motor_.home_active()) {
+                    // Stopped inside the switch: it is "reached" already.
+                    run(motor_.pulse_position() - dir_ * opt_.hca, params_.hspd, true);
+                    stage_ = 3;
+                } else {
+                    jog(-dir_, params_.lspd);
+                }
+            } else if (stage_ == 2 && e.kind == K::HomeOn) {
+                run(motor_.pulse_position() - dir_ * opt_.hca, params_.hspd, true);
+                stage_ = 3;
+            } else if (stage_ == 3 && e.kind == K::ProfileDone) {
+                stage_ = 4;
+                if (motor_.home_active()) {
+                    motor_.halt();
+                    motor_.set_pulse_position(0);
+                    finish(HomingResult::Done);
+                } else {
+                    jog(dir_, params_.lspd);
+                }
+            } else if (stage_ == 4 && e.kind == K::HomeOn) {
+                motor_.halt();
+                motor_.set_pulse_position(0);
+                finish(HomingResult::Done);
+            }
+            break;
+        case Method::L:
+            if (stage_ == 0 && limit_ahead) {
+                motor_.halt();
+                run(motor_.pulse_position() - dir_ * opt_.lca, params_.hspd, true);
+                stage_ = 1;
+                if (!motor_.moving()) {
+                    motor_.set_pulse_position(0);
+                    finish(HomingResult::Done);
+                }
+            } else if (stage_ == 1 && e.kind == K::ProfileDone) {
+                motor_.set_pulse_position(0);
+                finish(HomingResult::Done);
+            }
+            break;
+        case Method::Z:
+            if (stage_ == 0 && e.kind == K::IndexPulse) {
+                motor_.halt();
+                motor_.set_pulse_position(0);
+                finish(HomingResult::Done);
+            }
+            break;
+        case Method::ZH:
+            if (stage_ == 0 && e.kind == K::HomeOn) {
+                // Decelerate to LSPD and keep going at LSPD to find Z.
+                jog(dir_, params_.lspd);
+                stage_ = 1;
+            } else if (stage_ == 1 && e.kind == K::IndexPulse &&
+                       std::fabs(motor_.commanded_velocity()) <= params_.lspd * (1 + 1e-9)) {
+                motor_.halt();
+                motor_.set_pulse_position(0);
+                finish(HomingResult::Done);
+            }
+            break;
+    }
+}
+
+// ---- CiA 402 -------------------------------------------------------------------
+
+Cia402Homing::Cia402Homing(MotorModel& motor, Params p) : motor_(motor), p_(p) {
+    listener_ = motor_.add_listener([this](const MotorEvent& e) { on_event(e); });
+}
+
+Cia402Homing::~Cia402Homing() { motor_.remove_listener(listener_); }
+
+bool Cia402Homing::supported(int m) {
+    switch (m) {
+        case 7: case 11: case 17: case 18: case 19: case 20: case 33: case 34: case 35: return true;
+        default: return false;
+    }
+}
+
+void Cia402Homing::run_at(double velocity) {
+    motor_.command(ramp_and_hold(motor_.pulse_position(), motor_.commanded_velocity(), velocity, p_.acceleration,
+                                 RampShape::Trapezoid));
+}
+
+void Cia402Homing::finish(HomingResult r, bool set_home) {
+    motor_.halt();
+    if (set_home) motor_.set_pulse_position(p_.home_offset);
+    result_ = r;
+    stage_ = -1;
+}
+
+// Stages: 0 = search the switch at speed_switch, 1 = leave/find the edge at
+// speed_zero, 2 = search the index at speed_zero, 3 = (method 20) come back
+// to the rising edge.
+void Cia402Homing::start() {
+    if (!supported(p_.method))
+        throw InvalidArgument("CiA 402 homing method " + std::to_string(p_.method) +
+                              " is not supported (7, 11, 17, 18, 19, 20, 33, 34, 35)");
+    if (!(p_.speed_switch > 0) || !(p_.speed_zero > 0) || !(p_.acceleration > 0))
+        throw InvalidArgument("CiA 402 homing: speeds (6099h) and acceleration (609Ah) must be positive");
+    motor_.update();
+    result_ = HomingResult::Running;
+    switch (p_.method) {
+        case 35: finish(HomingResult::Done, true); return;
+        case 33: stage_ = 2; run_at(-p_.speed_zero); return;
+        case 34: stage_ = 2; run_at(p_.speed_zero); return;
+        case 17: stage_ = 0; run_at(-p_.speed_switch); return;
+        case 18: stage_ = 0; run_at(p_.speed_switch); return;
+        default: break;
+    }
+    // 7, 19, 20: search in + ; 11: search in -.
+    const double dir = p_.method == 11 ? -1.0 : 1.0;
+    if (motor_.home_active()) {
+        // Already on the switch: leave it backwards at zero speed.
+        stage_ = 1;
+        run_at(-dir * p_.speed_zero);
+    } else {
+        stage_ = 0;
+        run_at(dir * p_.speed_switch);
+    }
+}
+
+void Cia402Homing::abort() {
+    if (result_ != HomingResult::Running) return;
+    motor_.halt();
+    result_ = HomingResult::Aborted;
+}
+
+void Cia402Homing::on_event(const MotorEvent& e) {
+    using K = MotorEvent::Kind;
+    if (result_ != HomingResult::Running) return;
+    const int m = p_.method;
+    // A limit switch that is not the homing target is a homing error.
+    const bool is_limit = e.kind == K::PlusLimitOn || e.kind == K::MinusLimitOn;
+    if (is_limit && !((m == 17 && e.kind == K::MinusLimitOn) || (m == 18 && e.kind == K::PlusLimitOn))) {
+        finish(HomingResult::Failed, false);
+        return;
+    }
+    if (m == 17 || m == 18) {
+        if (stage_ == 0 && is_limit) {
+            stage_ = 1;
+            run_at(m == 17 ? p_.speed_zero : -p_.speed_zero);
+        } else if (stage_ == 1 && (e.kind == K::MinusLimitOff || e.kind == K::PlusLimitOff)) {
+            finish(HomingResult::Done, true);
+        }
+        return;
+    }
+    if (m == 33 || m == 34) {
+        if (stage_ == 2 && e.kind == K::IndexPulse) finish(HomingResult::Done, true);
+        return;
+    }
+    const double dir = m == 11 ? -1.0 : 1.0;
+    if (stage_ == 0 && e.kind == K::HomeOn) {
+        if (m == 20) {
+            stage_ = 1;
+            run_at(-dir * p_.speed_switch);
+        } else {
+            stage_ = 1;
+            run_at(-dir * p_.speed_zero);
+        }
+    } else if (stage_ == 1 && e.kind == K::HomeOff) {
+        if (m == 19) {
+            finish(HomingResult::Done, true);
+        } else if (m == 20) {
+            stage_ = 3;
+            run_at(dir * p_.speed_zero);
+        } else {  // 7, 11: continue to the next index pulse
+            stage_ = 2;
+        }
+    } else if (stage_ == 2 && e.kind == K::IndexPulse) {
+        finish(HomingResult::Done, true);
+    } else if (stage_ == 3 && e.kind == K::HomeOn) {
+        finish(HomingResult::Done, true);
+    }
+}
+
+}  // namespace motorbus::motion

@@ -1,0 +1,113 @@
+// Homing routines on the MotorModel.
+//
+// DMX-CAN (000 manual, "Homing", Figures 7.2-7.6):
+//   H+/H-   run at HSPD toward home; on the home edge the position counter is
+//           reset to 0 and the motor decelerates to LSPD and stops (the final
+//           position is not 0).  RZ=1: then return to 0.
+//   HL+/HL- as H, then reverse at LSPD to find home again, continue past it
+//           by HCA at HSPD, come back at LSPD, and on the home edge reset to
+//           0 and stop immediately.  RZ=1: return to 0 (already there).
+//   L+/L-   run toward the limit; stop immediately on it; move back by LCA at
+//           HSPD; that point is zero.
+//   Z+/Z-   run at LSPD until the Z index; stop, position = 0.
+//   ZH+/ZH- run toward home; on home decelerate to LSPD, then search Z at
+//           LSPD; on Z stop, position = 0.
+//   A limit met in the search direction before the home switch ends homing
+//   with a limit error (the DMX-CAN latches a limit error; it does not
+//   reverse).
+//
+// CiA 402 (methods 7, 11, 17, 18, 19, 20, 33, 34, 35), with 6099h:01 speed
+// during search for switch, 6099h:02 speed during search for zero, 609Ah
+// acceleration, 607Ch home offset.  Methods with an index pulse finish on the
+// index; 17-20 finish on the switch edge; 33/34 on the next index in the
+// negative/positive direction; 35 sets the current position as home.
+// At the end the position counter is set to the home offset (the manual's
+// 607Ch convention: home position = offset).
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "motorbus/motion/arcus_profile.hpp"
+#include "motorbus/motion/motor_model.hpp"
+
+namespace motorbus::motion {
+
+enum class HomingResult { Running, Done, LimitError, Aborted, Failed };
+
+struct ArcusHomingOptions {
+    double hca = 0;      // HCA, pulses
+    double lca = 1000;   // LCA, pulses (factory 1000)
+    bool rz = false;     // RZ: return to zero after H/HL
+};
+
+struct Cia402HomingParams {
+    int method = 17;               // 6098h
+    double speed_switch = 1000;    // 6099h:01, steps/s
+    double speed_zero = 100;       // 6099h:02, steps/s
+    double acceleration = 10000;   // 609Ah, steps/s^2
+    double home_offset = 0;        // 607Ch, steps
+};
+
+class ArcusHoming {
+public:
+    enum class Method { H, HL, L, Z, ZH };
+    using Options = ArcusHomingOptions;
+    ArcusHoming(MotorModel& motor, ArcusProfileParams params, Options opt = {});
+    ~ArcusHoming();
+    ArcusHoming(const ArcusHoming&) = delete;
+    ArcusHoming& operator=(const ArcusHoming&) = delete;
+
+    // Starts homing now (motor.time()); direction +1 or -1.
+    void start(Method m, int direction);
+    void abort();
+    HomingResult result() const { return result_; }
+    bool running() const { return result_ == HomingResult::Running; }
+    Method method() const { return method_; }
+    // The StepNLoop status to show while it runs: Homing, Z-Homing or Limit homing.
+    int snl_status() const;
+
+private:
+    MotorModel& motor_;
+    ArcusProfileParams params_;
+    Options opt_;
+    Method method_ = Method::H;
+    int dir_ = 1;
+    int stage_ = 0;
+    HomingResult result_ = HomingResult::Done;
+    int listener_ = 0;
+    void on_event(const MotorEvent& e);
+    void run(double target_offset, double speed_pps, bool from_current);
+    void jog(int direction, double hspd);
+    void decel_stop(Nanos t);
+    void finish(HomingResult r);
+};
+
+class Cia402Homing {
+public:
+    using Params = Cia402HomingParams;
+    Cia402Homing(MotorModel& motor, Params p);
+    ~Cia402Homing();
+    Cia402Homing(const Cia402Homing&) = delete;
+    Cia402Homing& operator=(const Cia402Homing&) = delete;
+
+    static bool supported(int method);  // 7, 11, 17, 18, 19, 20, 33, 34, 35
+    // Throws InvalidArgument for an unsupported method (the sim answers 0x06090030).
+    void start();
+    void abort();
+    HomingResult result() const { return result_; }
+    // Statusword bits of homing mode: bit 12 homing attained, bit 13 homing error.
+    bool attained() const { return result_ == HomingResult::Done; }
+    bool error() const { return result_ == HomingResult::LimitError || result_ == HomingResult::Failed; }
+
+private:
+    MotorModel& motor_;
+    Params p_;
+    int stage_ = 0;
+    HomingResult result_ = HomingResult::Done;
+    int listener_ = 0;
+    void on_event(const MotorEvent& e);
+    void run_at(double velocity);
+    void finish(HomingResult r, bool set_home);
+};
+
+}  // namespace motorbus::motion

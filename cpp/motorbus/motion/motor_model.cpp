@@ -1,0 +1,260 @@
+#include "motorbus/motion/motor_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace motorbus::motion {
+
+namespace {
+bool home_on(const SwitchConfig& c, double p) { return c.present && p >= c.lo && p <= c.hi; }
+bool minus_on(const SwitchConfig& c, double p) { return c.present && p <= c.lo; }
+bool plus_on(const SwitchConfig& c, double p) { return c.present && p >= c.lo; }
+constexpr int kMaxIndexPerTick = 64;  // bounded work on absurd speeds
+}  // namespace
+
+MotorModel::MotorModel(Clock& clock, MotorConfig cfg) : clock_(clock), cfg_(cfg), profile_(State{0, 0, 0, 0}) {
+    if (!(cfg_.steps_per_rev > 0) || !(cfg_.counts_per_rev > 0))
+        throw InvalidArgument("MotorModel: steps_per_rev and counts_per_rev must be positive");
+    if (cfg_.tick_ns <= 0) throw InvalidArgument("MotorModel: tick_ns must be positive");
+    if (!(cfg_.index_width_steps > 0)) cfg_.index_width_steps = cfg_.steps_per_rev / cfg_.counts_per_rev;
+    now_ = clock_.now();
+    profile_start_ = now_;
+}
+
+double MotorModel::profile_time(Nanos t) const { return static_cast<double>(t - profile_start_) * 1e-9; }
+
+State MotorModel::command_state(Nanos t) const {
+    State s = profile_.at(profile_time(t));
+    s.p -= profile_offset_;
+    return s;
+}
+
+bool MotorModel::moving() const { return running_; }
+
+void MotorModel::command(const Profile& profile, std::optional<Nanos> start) {
+    Nanos t = start.value_or(now_);
+    if (t < now_) t = now_;
+    if (t > now_ && !in_dispatch_) advance_to(t);
+    const double cp = command_state(t).p;
+    profile_ = profile;
+    profile_start_ = t;
+    profile_offset_ = profile.start_position() - cp;
+    running_ = profile.duration() > 0;
+}
+
+void MotorModel::halt(std::optional<Nanos> at) {
+    Nanos t = at.value_or(now_);
+    if (t < now_) t = now_;
+    if (t > now_ && !in_dispatch_) advance_to(t);
+    const double pulse = command_state(t).p + pulse_offset_;
+    Profile hold(State{pulse, 0, 0, 0});
+    command(hold, t);
+}
+
+int MotorModel::add_listener(std::function<void(const MotorEvent&)> cb) {
+    listeners_.push_back({next_listener_, std::move(cb)});
+    return next_listener_++;
+}
+
+void MotorModel::remove_listener(int id) {
+    for (auto& l : listeners_)
+        if (l.id == id) l.cb = nullptr;  // erased later: we may be inside a dispatch
+}
+
+double MotorModel::commanded_position() const { return command_state(now_).p; }
+double MotorModel::pulse_position() const { return commanded_position() + pulse_offset_; }
+std::int64_t MotorModel::pulse_count() const { return std::llround(pulse_position()); }
+std::int64_t MotorModel::encoder() const {
+    return std::llround(steps_to_counts(physical_)) + static_cast<std::int64_t>(encoder_offset_);
+}
+double MotorModel::commanded_velocity() const { return command_state(now_).v; }
+double MotorModel::velocity() const { return stalled_ ? 0.0 : commanded_velocity(); }
+double MotorModel::commanded_acceleration() const { return command_state(now_).a; }
+
+void MotorModel::set_pulse_position(double pulses) { pulse_offset_ = pulses - commanded_position(); }
+void MotorModel::set_encoder(std::int64_t counts) {
+    encoder_offset_ = static_cast<double>(counts - std::llround(steps_to_counts(physical_)));
+}
+
+bool MotorModel::home_active() const { return home_on(cfg_.home, physical_); }
+bool MotorModel::minus_limit_active() const { return minus_on(cfg_.minus_limit, physical_); }
+bool MotorModel::plus_limit_active() const { return plus_on(cfg_.plus_limit, physical_); }
+bool MotorModel::minus_limit_input() const {
+    return cfg_.minus_limit.active_low ? !minus_limit_active() : minus_limit_active();
+}
+bool MotorModel::plus_limit_input() const {
+    return cfg_.plus_limit.active_low ? !plus_limit_active() : plus_limit_active();
+}
+bool MotorModel::index_active() const {
+    const double rel = physical_ - cfg_.index_position;
+    const double m = rel - std::floor(rel / cfg_.steps_per_rev) * cfg_.steps_per_rev;
+    return m >= 0 && m < cfg_.index_width_steps;
+}
+
+void MotorModel::set_jammed(bool jammed) {
+    update();
+    jammed_ = jammed;
+}
+void MotorModel::set_pull_out_speed(double s) {
+    update();
+    cfg_.pull_out_speed = s;
+}
+
+void MotorModel::arm_latch() { latch_ = LatchState::Armed; }
+void MotorModel::disarm_latch() { latch_ = LatchState::Off; }
+void MotorModel::trigger_latch() {
+    update();
+    if (latch_ != LatchState::Armed) return;
+    latch_ = LatchState::Triggered;
+    latched_pulse_ = pulse_position();
+    latched_encoder_ = encoder();
+    emit(MotorEvent::Kind::Latched, now_);
+}
+
+MotorEvent MotorModel::make_event(MotorEvent::Kind k, Nanos t) const {
+    const State s = command_state(t);
+    return MotorEvent{k, t, physical_, s.p + pulse_offset_, encoder(),
+                      s.v > 0 ? 1 : (s.v < 0 ? -1 : 0)};
+}
+
+void MotorModel::emit(MotorEvent::Kind k, Nanos t) {
+    const MotorEvent e = make_event(k, t);
+    const bool nested = in_dispatch_;
+    in_dispatch_ = true;
+    // A throwing listener must not leave the model believing it is still dispatching.
+    struct Restore {
+        bool& flag;
+        bool value;
+        ~Restore() { flag = value; }
+    } restore{in_dispatch_, nested};
+    for (std::size_t i = 0; i < listeners_.size(); ++i) {
+        auto cb = listeners_[i].cb;  // copy: the callback may add listeners
+        if (cb) cb(e);
+    }
+    if (nested) return;
+    listeners_.erase(std::remove_if(listeners_.begin(), listeners_.end(), [](const Listener& l) { return !l.cb; }),
+                         listeners_.end());
+}
+
+void MotorModel::update() { advance_to(clock_.now()); }
+
+void MotorModel::advance_to(Nanos t) {
+    if (in_dispatch_) return;  // a listener's query must not re-enter the integration
+    while (now_ < t) step_to(std::min<Nanos>(t, now_ + cfg_.tick_ns));
+}
+
+// Advances from now_ to at most t_end, stopping early at the first event
+// (whose listeners then run with now_ at the event's time).
+void MotorModel::step_to(Nanos t_end) {
+    const Nanos t0 = now_;
+    const Nanos profile_end =
+        profile_start_ + static_cast<Nanos>(std::ceil(profile_.duration() * 1e9));
+    if (!running_ && !stalled_) {
+        // At rest nothing changes: skip the interval.
+        now_ = t_end;
+        return;
+    }
+    const State cs = command_state(t_end);
+    // Load: does the rotor keep up over this tick?
+    const bool over_speed = cfg_.pull_out_speed > 0 && std::fabs(cs.v) > cfg_.pull_out_speed;
+    const bool over_accel = cfg_.max_acceleration > 0 && std::fabs(cs.a) > cfg_.max_acceleration;
+    const bool commanded_motion = running_ && cs.v != 0;
+    if (!stalled_ && commanded_motion && (jammed_ || over_speed || over_accel)) {
+        stalled_ = true;
+        slip_ = cs.p - physical_;
+        now_ = t_end;
+        emit(MotorEvent::Kind::Stalled, t_end);
+        return;
+    }
+    if (stalled_) {
+        if (!jammed_ && !over_speed && !over_accel) {
+            stalled_ = false;
+            slip_ = cs.p - physical_;
+            now_ = t_end;
+            emit(MotorEvent::Kind::Recovered, t_end);
+        } else {
+            slip_ = cs.p - physical_;
+            now_ = t_end;
+            if (running_ && t_end >= profile_end) {
+                running_ = false;
+                emit(MotorEvent::Kind::ProfileDone, t_end);
+            }
+        }
+        return;
+    }
+    const double p_prev = physical_;
+    const double p_new = cs.p - slip_;
+    auto phys_at = [&](Nanos t) { return command_state(t).p - slip_; };
+    // Earliest event in (t0, t_end].
+    Nanos best_t = std::numeric_limits<Nanos>::max();
+    MotorEvent::Kind best_k = MotorEvent::Kind::ProfileDone;
+    auto consider_switch = [&](bool (*pred)(const SwitchConfig&, double), const SwitchConfig& c,
+                               MotorEvent::Kind on, MotorEvent::Kind off) {
+        const bool a = pred(c, p_prev), b = pred(c, p_new);
+        bool first_edge_seen = false;
+        Nanos lo = t0, hi = t_end;
+        bool target_state = b;
+        if (a == b) {
+            // A fast pass through a narrow home window inside one tick: sample the middle.
+            if (!c.present) return;
+            const Nanos mid = t0 + (t_end - t0) / 2;
+            if (pred(c, phys_at(mid)) == a) return;
+            hi = mid;
+            target_state = !a;
+            first_edge_seen = true;
+        }
+        (void)first_edge_seen;
+        while (hi - lo > 1) {
+            const Nanos m = lo + (hi - lo) / 2;
+            if (pred(c, phys_at(m)) == target_state) hi = m;
+            else lo = m;
+        }
+        if (hi < best_t) {
+            best_t = hi;
+            best_k = target_state ? on : off;
+        }
+    };
+    consider_switch(home_on, cfg_.home, MotorEvent::Kind::HomeOn, MotorEvent::Kind::HomeOff);
+    consider_switch(minus_on, cfg_.minus_limit, MotorEvent::Kind::MinusLimitOn, MotorEvent::Kind::MinusLimitOff);
+    consider_switch(plus_on, cfg_.plus_limit, MotorEvent::Kind::PlusLimitOn, MotorEvent::Kind::PlusLimitOff);
+    // Z index rising edges: entering [idx + k*rev, idx + k*rev + width).
+    if (p_new != p_prev) {
+        const double spr = cfg_.steps_per_rev;
+        const bool up = p_new > p_prev;
+        const double edge0 = cfg_.index_position + (up ? 0.0 : cfg_.index_width_steps);
+        // Levels L = edge0 + k*spr strictly after p_prev and reached by p_new.
+        const double kf = up ? std::floor((p_prev - edge0) / spr) + 1 : std::ceil((p_prev - edge0) / spr) - 1;
+        const double level = edge0 + kf * spr;
+        const bool hit = up ? (level > p_prev && level <= p_new) : (level < p_prev && level >= p_new);
+        if (hit) {
+            Nanos lo = t0, hi = t_end;
+            while (hi - lo > 1) {
+                const Nanos m = lo + (hi - lo) / 2;
+                const double pm = phys_at(m);
+                if (up ? pm >= level : pm <= level) hi = m;
+                else lo = m;
+            }
+            if (hi < best_t) {
+                best_t = hi;
+                best_k = MotorEvent::Kind::IndexPulse;
+            }
+        }
+        (void)kMaxIndexPerTick;
+    }
+    if (running_ && profile_end > t0 && profile_end <= t_end && profile_end < best_t) {
+        best_t = profile_end;
+        best_k = MotorEvent::Kind::ProfileDone;
+    }
+    if (best_t == std::numeric_limits<Nanos>::max()) {
+        physical_ = p_new;
+        now_ = t_end;
+        return;
+    }
+    now_ = best_t;
+    physical_ = phys_at(best_t);
+    if (best_k == MotorEvent::Kind::ProfileDone) running_ = false;
+    emit(best_k, best_t);
+}
+
+}  // namespace motorbus::motion

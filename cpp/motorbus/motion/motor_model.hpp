@@ -1,0 +1,177 @@
+// A discrete-time model of an integrated motor: what every drive simulator
+// runs on.
+//
+// Coordinates:
+//  - physical position (steps): where the rotor is; switches and the Z index
+//    live in this frame, fixed to the machine.
+//  - commanded position (steps, physical frame): where the step generator
+//    says the rotor should be, following the commanded Profile.
+//  - pulse position = commanded + pulse offset (PX, the drive's counter; set_pulse_position
+//    moves the offset, never the rotor).
+//  - encoder counts = round(physical * counts_per_rev / steps_per_rev) + encoder offset.
+// The rotor follows the command exactly unless the load stalls it; a stalled
+// rotor stays put while the command runs on, and recovers (with the lost steps
+// as a permanent slip) once the commanded speed is back under the pull-out speed.
+//
+// Time: Nanos on a motorbus::Clock.  update() advances the model to
+// clock.now() in ticks of MotorConfig::tick_ns; edges of switches, index and
+// latch found inside a tick are refined to ~1 ns by bisection on the profile,
+// and listeners see them in time order with the exact time.  A listener may
+// command a new profile from inside the callback; it takes effect at the
+// event's time, so homing stops happen where a real drive would stop.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "motorbus/motion/profile.hpp"
+#include "motorbus/runtime/clock.hpp"
+
+namespace motorbus::motion {
+
+// A switch at a physical position.  Home: active for lo <= p <= hi.  Minus
+// limit: active for p <= position.  Plus limit: active for p >= position.
+// active_low: the electrical input reads 0 when the switch is active (the
+// DMX-CAN default polarity).
+struct SwitchConfig {
+    bool present = false;
+    double lo = 0, hi = 0;  // home window / limit position (use lo for limits)
+    bool active_low = true;
+};
+
+struct MotorConfig {
+    double steps_per_rev = 3200;   // DMX-CAN: 16 microsteps x 200
+    double counts_per_rev = 4000;  // DMX-CAN: 1000 lines, quadrature
+    double index_position = 0;     // physical steps of one Z index (repeats each rev)
+    double index_width_steps = 0.8;  // Z is high within [index, index + width)
+    SwitchConfig home;
+    SwitchConfig minus_limit;
+    SwitchConfig plus_limit;
+    // Load: the rotor stalls when |commanded velocity| > pull_out_speed or
+    // |commanded acceleration| > max_acceleration (0 = no such limit), or
+    // while the test jams it (set_jammed).
+    double pull_out_speed = 0;    // steps/s
+    double max_acceleration = 0;  // steps/s^2
+    Nanos tick_ns = 100'000;      // integration step (100 us)
+};
+
+struct MotorEvent {
+    enum class Kind {
+        HomeOn, HomeOff,
+        MinusLimitOn, MinusLimitOff,
+        PlusLimitOn, PlusLimitOff,
+        IndexPulse,   // rising edge of Z
+        Stalled, Recovered,
+        Latched,      // latch armed and triggered: latched_* hold the capture
+        ProfileDone   // the commanded profile reached its end
+    };
+    Kind kind;
+    Nanos t;            // exact time of the event
+    double physical;    // rotor position at t (steps)
+    double pulse;       // pulse position at t
+    std::int64_t encoder;
+    int direction;      // sign of the commanded velocity at t (0 at rest)
+};
+
+class MotorModel {
+public:
+    MotorModel(Clock& clock, MotorConfig cfg = {});
+
+    const MotorConfig& config() const { return cfg_; }
+    Clock& clock() { return clock_; }
+
+    // Commands `profile` (positions in the pulse frame, the drive's counter)
+    // starting at time `start` (default: now).  The current motion is replaced
+    // from `start` on; a profile whose start position differs from the
+    // current pulse position is shifted to start there (the step generator
+    // cannot jump).
+    void command(const Profile& profile, std::optional<Nanos> start = std::nullopt);
+    // Stops the step generator at time t (default now) where it is (ABORT).
+    void halt(std::optional<Nanos> at = std::nullopt);
+    bool moving() const;                 // a commanded profile is still running
+    const Profile& profile() const { return profile_; }
+    Nanos profile_start() const { return profile_start_; }
+    // Time within the current profile (s) at time t.
+    double profile_time(Nanos t) const;
+
+    // Advance to clock.now() (or to t, never backwards), delivering events.
+    void update();
+    void advance_to(Nanos t);
+    Nanos time() const { return now_; }
+
+    // Listeners get every event in time order; returns an id for remove_listener.
+    int add_listener(std::function<void(const MotorEvent&)> cb);
+    void remove_listener(int id);
+
+    // State at the model's current time.
+    double commanded_position() const;          // steps, physical frame
+    double pulse_position() const;              // PX (continuous)
+    std::int64_t pulse_count() const;           // PX as the drive reports it (rounded)
+    double physical_position() const { return physical_; }
+    std::int64_t encoder() const;               // EX
+    double commanded_velocity() const;          // steps/s
+    double velocity() const;                    // rotor velocity, steps/s (0 while stalled)
+    double commanded_acceleration() const;
+    bool stalled() const { return stalled_; }
+    double slip() const { return slip_; }       // commanded - physical, steps
+
+    void set_pulse_position(double pulses);     // PX=...
+    void set_encoder(std::int64_t counts);      // EX=...
+
+    // Switches: logical (true = switch active) and electrical (after polarity).
+    bool home_active() const;
+    bool minus_limit_active() const;
+    bool plus_limit_active() const;
+    bool index_active() const;
+    bool home_input() const { return cfg_.home.active_low ? !home_active() : home_active(); }
+    bool minus_limit_input() const;
+    bool plus_limit_input() const;
+
+    // Load.
+    void set_jammed(bool jammed);               // a load that blocks the rotor
+    void set_pull_out_speed(double steps_per_s);
+
+    // Latch: arm, then the next trigger (a rising edge of the latch input,
+    // or trigger_latch()) captures pulse and encoder positions.
+    void arm_latch();
+    void disarm_latch();
+    void trigger_latch();
+    enum class LatchState { Off = 0, Armed = 1, Triggered = 2 };  // LTS values
+    LatchState latch_state() const { return latch_; }
+    double latched_pulse() const { return latched_pulse_; }
+    std::int64_t latched_encoder() const { return latched_encoder_; }
+
+    // Physical position (steps) -> encoder counts without offset.
+    double steps_to_counts(double steps) const { return steps * cfg_.counts_per_rev / cfg_.steps_per_rev; }
+    double counts_to_steps(double counts) const { return counts * cfg_.steps_per_rev / cfg_.counts_per_rev; }
+
+private:
+    Clock& clock_;
+    MotorConfig cfg_;
+    Profile profile_;
+    Nanos profile_start_ = 0;
+    double profile_offset_ = 0;  // physical = profile position - profile_offset_
+    bool running_ = false;
+    Nanos now_ = 0;
+    double physical_ = 0;
+    double slip_ = 0;
+    bool stalled_ = false;
+    bool jammed_ = false;
+    double pulse_offset_ = 0;  // pulse = commanded + pulse_offset_
+    double encoder_offset_ = 0;
+    LatchState latch_ = LatchState::Off;
+    double latched_pulse_ = 0;
+    std::int64_t latched_encoder_ = 0;
+    struct Listener { int id; std::function<void(const MotorEvent&)> cb; };
+    std::vector<Listener> listeners_;
+    int next_listener_ = 1;
+    bool in_dispatch_ = false;
+
+    State command_state(Nanos t) const;  // physical frame
+    void step_to(Nanos t);
+    void emit(MotorEvent::Kind k, Nanos t);
+    MotorEvent make_event(MotorEvent::Kind k, Nanos t) const;
+};
+
+}  // namespace motorbus::motion

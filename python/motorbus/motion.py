@@ -1,0 +1,132 @@
+"""Motion profiles: plan, preview and sample moves the way each drive makes them.
+
+Planners return a :class:`Profile`; ``Profile.sample(n)`` gives an ``n x 5`` numpy
+array (t, p, v, a, j) ready to plot, and ``Profile.step_times()`` the exact
+integer step times (ns) of a stepper following it.
+
+>>> from motorbus import motion
+>>> p = motion.plan(1000, max_velocity=100, max_acceleration=1000)
+>>> round(p.duration, 6)
+10.1
+"""
+from __future__ import annotations
+
+from typing import Optional, Sequence
+
+import numpy as np
+
+from ._core import (  # noqa: F401
+    ARCUS_MAX_MOVE_DISTANCE,
+    ArcusHoming,
+    ArcusHomingOptions,
+    ArcusMotion,
+    ArcusProfileParams,
+    Cia402Homing,
+    Cia402HomingParams,
+    Cia402ProfileParams,
+    Cia402ProfilePosition,
+    MotorConfig,
+    MotorModel,
+    Pmc007ProfileParams,
+    SwitchConfig,
+    UnitekRampParams,
+    cia402_position_profile,
+    cia402_quick_stop_profile,
+    cia402_velocity_profile,
+    pmc007_convert_position,
+    pmc007_gear_acceleration,
+    pmc007_microsteps,
+    pmc007_position_profile,
+    pmc007_speed_profile,
+    unitek_speed_profile,
+    ArcusSpeedWindow,
+    DmacMotion,
+    DmacProfileParams,
+    LimitExceeded,
+    Limits,
+    MotionState,
+    Profile,
+    RampShape,
+    SnlConfig,
+    StepNLoop,
+    arcus_check_strict,
+    arcus_effective,
+    arcus_max_acc_ms,
+    arcus_speed_windows,
+    arcus_window_for_hspd,
+    arcus_window_for_sspdm,
+    dmac_position_profile,
+    dmac_ramp_time,
+    dmac_speed_profile,
+    jerk_limited_durations,
+    plan_jerk_limited,
+    plan_straight_line,
+    plan_synchronized,
+    plan_trapezoid,
+    plan_velocity,
+    split_interpolation,
+)
+
+__all__ = [
+    "ArcusHoming", "ArcusHomingOptions", "Cia402Homing", "Cia402HomingParams", "Cia402ProfileParams",
+    "Cia402ProfilePosition", "MotorConfig", "MotorModel", "Pmc007ProfileParams", "SwitchConfig",
+    "UnitekRampParams", "cia402_position_profile", "cia402_quick_stop_profile", "cia402_velocity_profile",
+    "pmc007_convert_position", "pmc007_gear_acceleration", "pmc007_microsteps", "pmc007_position_profile",
+    "pmc007_speed_profile", "unitek_speed_profile",
+    "ARCUS_MAX_MOVE_DISTANCE", "ArcusMotion", "ArcusProfileParams", "ArcusSpeedWindow", "DmacMotion",
+    "DmacProfileParams", "LimitExceeded", "Limits", "MotionState", "Profile", "RampShape", "SnlConfig",
+    "StepNLoop", "arcus_check_strict", "arcus_effective", "arcus_max_acc_ms", "arcus_speed_windows",
+    "arcus_window_for_hspd", "arcus_window_for_sspdm", "dmac_position_profile", "dmac_ramp_time",
+    "dmac_speed_profile", "jerk_limited_durations", "plan", "plan_jerk_limited", "plan_straight_line",
+    "plan_synchronized", "plan_trapezoid", "plan_velocity", "sample", "split_interpolation", "step_times",
+    "dmac_interpolation",
+]
+
+_SHAPES = {"trapezoid": RampShape.TRAPEZOID, "s_curve": RampShape.SCURVE, "scurve": RampShape.SCURVE}
+
+
+def _shape(shape: str | RampShape) -> RampShape:
+    if isinstance(shape, RampShape):
+        return shape
+    try:
+        return _SHAPES[shape.lower()]
+    except KeyError:
+        raise ValueError(f"shape must be one of {sorted(_SHAPES)}, not {shape!r}") from None
+
+
+def plan(target: float, *, start: float = 0.0, v0: float = 0.0, a0: float = 0.0,
+         max_velocity: float, max_acceleration: float, max_deceleration: float = 0.0,
+         max_jerk: Optional[float] = None, shape: str | RampShape = "trapezoid") -> Profile:
+    """Plan a move to rest at ``target``.
+
+    With ``max_jerk`` the jerk-limited time-optimal (7-phase) planner is used
+    (same durations as ruckig); otherwise a trapezoid, or an S-curve with the
+    same ramp times when ``shape="s_curve"``.  Raises ``LimitExceeded``.
+    """
+    if max_jerk is not None:
+        return plan_jerk_limited(MotionState(start, v0, a0), target,
+                                 Limits(max_velocity, max_acceleration, max_deceleration, max_jerk))
+    return plan_trapezoid(MotionState(start, v0, 0.0), target,
+                          Limits(max_velocity, max_acceleration, max_deceleration), _shape(shape))
+
+
+def sample(profile: Profile, n: int = 500, t: Optional[Sequence[float]] = None) -> dict[str, np.ndarray]:
+    """Sample a profile: a dict of numpy arrays ``t, p, v, a, j`` (n equally spaced points, or at ``t``)."""
+    m = profile.sample(n) if t is None else profile.sample_at(np.asarray(t, dtype=float))
+    return {k: m[:, i] for i, k in enumerate("tpvaj")}
+
+
+def step_times(profile: Profile, t0_ns: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Exact step times (int64 ns) and directions (int8, +1/-1) for a profile in steps."""
+    return profile.step_times(t0_ns)
+
+
+def dmac_interpolation(start: Sequence[float], target: Sequence[float], limits: Sequence[Limits],
+                       period_ms: int = 100, straight_line: bool = True) -> np.ndarray:
+    """Plan a synchronised multi-axis move and split it into DMAC MOVE_INTERPOL offsets.
+
+    Returns an int64 array ``[segment, axis]`` whose column sums reach ``target - start``.
+    """
+    planner = plan_straight_line if straight_line else plan_synchronized
+    axes = planner(list(map(float, start)), list(map(float, target)), list(limits))
+    return np.asarray(split_interpolation(axes, int(period_ms)), dtype=np.int64).reshape(-1, len(start))

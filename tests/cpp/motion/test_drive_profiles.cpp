@@ -1,0 +1,329 @@
+// Arcus DMX-CAN and Midi DMAC profile models: the manuals' numbers as tests.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "motorbus/motion/arcus_profile.hpp"
+#include "motorbus/motion/dmac_profile.hpp"
+#include "motorbus/motion/steps.hpp"
+
+using namespace motorbus::motion;
+
+// ---- Arcus Appendix A ------------------------------------------------------------
+
+TEST(ArcusAppendixA, ExampleA_20000_100) {
+    // HSPD 20,000 pps, LSPD 100: min ACC 1 ms, max ((20000 - 100) / 1000) x 1000 = 19900 ms.
+    const auto& w = arcus_window_for_hspd(20000);
+    EXPECT_EQ(w.number, 2);
+    EXPECT_EQ(w.min_acc_ms, 1);
+    EXPECT_DOUBLE_EQ(arcus_max_acc_ms(20000, 100), 19900.0);
+}
+
+TEST(ArcusAppendixA, ExampleB_900000_1000) {
+    // HSPD 900,000, LSPD 1000: min 1 ms; max (899000 / 39000) x 1000 = 23051.3 ms.
+    // The manual prints 23050 ms (23.05 s): it truncated to 4 significant digits.
+    const auto& w = arcus_window_for_hspd(900000);
+    EXPECT_EQ(w.number, 7);
+    EXPECT_EQ(w.min_acc_ms, 1);
+    EXPECT_NEAR(arcus_max_acc_ms(900000, 1000), 23050.0, 2.0);
+    EXPECT_NEAR(arcus_max_acc_ms(900000, 1000), 899000.0 / 39000.0 * 1000.0, 1e-9);
+}
+
+TEST(ArcusAppendixA, WindowsAndMinimums) {
+    struct Row { double hspd; int number; double min_lspd; double min_acc; };
+    for (Row r : {Row{1, 1, 10, 2}, Row{16000, 1, 10, 2}, Row{16001, 2, 10, 1}, Row{50000, 3, 15, 1},
+                  Row{100000, 4, 25, 1}, Row{200000, 5, 50, 1}, Row{500000, 6, 100, 1}, Row{1e6, 7, 200, 1},
+                  Row{2e6, 8, 400, 1}, Row{6e6, 9, 500, 1}}) {
+        const auto& w = arcus_window_for_hspd(r.hspd);
+        EXPECT_EQ(w.number, r.number) << r.hspd;
+        EXPECT_EQ(w.min_lspd, r.min_lspd) << r.hspd;
+        EXPECT_EQ(w.min_acc_ms, r.min_acc) << r.hspd;
+    }
+    try {
+        arcus_window_for_hspd(6.5e6);
+        FAIL();
+    } catch (const LimitExceeded& e) {
+        EXPECT_EQ(e.limit, "HSPD");
+        EXPECT_DOUBLE_EQ(e.excess(), 0.5e6);
+    }
+    EXPECT_EQ(arcus_window_for_sspdm(0).number, 1);
+    EXPECT_EQ(arcus_window_for_sspdm(1).number, 1);
+    EXPECT_EQ(arcus_window_for_sspdm(9).number, 9);
+    EXPECT_THROW(arcus_window_for_sspdm(10), LimitExceeded);
+}
+
+TEST(ArcusAppendixA, AutomaticAdjustment) {
+    ArcusProfileParams p;
+    p.hspd = 1000;
+    p.lspd = 5;       // below window 1's minimum 10
+    p.acc_ms = 0.5;   // below 2 ms
+    auto e = arcus_effective(p);
+    EXPECT_EQ(e.params.lspd, 10);
+    EXPECT_EQ(e.params.acc_ms, 2);
+    EXPECT_EQ(e.adjustments.size(), 2u);
+    p.lspd = 100;
+    p.acc_ms = 5000;  // max = (1000 - 100) / 500 x 1000 = 1800 ms
+    e = arcus_effective(p);
+    EXPECT_EQ(e.params.acc_ms, 1800);
+    // The strict check names the limit and the excess instead.
+    try {
+        arcus_check_strict(p);
+        FAIL();
+    } catch (const LimitExceeded& ex) {
+        EXPECT_EQ(ex.limit, "ACC");
+        EXPECT_DOUBLE_EQ(ex.excess(), 3200.0);
+    }
+    // StepNLoop on: speeds in encoder counts/s, the window is found in PPS.
+    p.acc_ms = 100;
+    p.hspd = 18000;      // EPS; x 0.8 = 14400 PPS -> window 1
+    p.snl_ratio = 0.8;
+    EXPECT_EQ(arcus_effective(p).window->number, 1);
+}
+
+// ---- Arcus moves --------------------------------------------------------------------
+
+namespace {
+ArcusProfileParams base_params() {
+    ArcusProfileParams p;
+    p.hspd = 1000;
+    p.lspd = 100;
+    p.acc_ms = 100;
+    return p;
+}
+}  // namespace
+
+TEST(ArcusMotion, TrapezoidFromLspd) {
+    ArcusMotion m(base_params());
+    ASSERT_EQ(m.move(0, 10000), ArcusReply::Ok);
+    const Profile& p = m.profile();
+    // Jump to LSPD, ramp 100 -> 1000 in 0.1 s (55 pulses), cruise, ramp down, jump to 0.
+    EXPECT_DOUBLE_EQ(p.velocity(1e-12), 100.0 + 9000.0 * 1e-12);
+    EXPECT_NEAR(p.position(0.1), 55.0, 1e-9);
+    EXPECT_NEAR(p.velocity(0.1), 1000.0, 1e-9);
+    EXPECT_NEAR(p.duration(), 0.1 + (10000 - 110) / 1000.0 + 0.1, 1e-9);
+    EXPECT_EQ(p.end_position(), 10000);
+    EXPECT_NEAR(p.segments().back().end().v, 100.0, 1e-9);  // ends from LSPD
+    EXPECT_EQ(m.phase(0.05), ArcusPhase::Accel);
+    EXPECT_EQ(m.phase(5.0), ArcusPhase::Const);
+    EXPECT_EQ(m.phase(p.duration() - 0.05), ArcusPhase::Decel);
+    EXPECT_EQ(m.phase(p.duration() + 1), ArcusPhase::Idle);
+    auto st = step_times(p);
+    EXPECT_EQ(st.size(), 10000u);
+}
+
+TEST(ArcusMotion, EdecUsesDec) {
+    auto prm = base_params();
+    prm.edec = true;
+    prm.dec_ms = 200;
+    ArcusMotion m(prm);
+    m.move(0, 10000);
+    const Profile& p = m.profile();
+    // Decel ramp 1000 -> 100 over 0.2 s covers 110 pulses.
+    EXPECT_NEAR(p.duration(), 0.1 + (10000 - 55 - 110) / 1000.0 + 0.2, 1e-9);
+}
+
+TEST(ArcusMotion, IncrementalLimit262143) {
+    ArcusMotion m(base_params());
+    EXPECT_EQ(m.move(100000, 362143), ArcusReply::Ok);
+    EXPECT_EQ(m.move(100000, 362144), ArcusReply::MoveTooFar);
+    EXPECT_EQ(m.move(100000, -162143), ArcusReply::Ok);
+    EXPECT_EQ(m.move(100000, -162144), ArcusReply::MoveTooFar);
+}
+
+TEST(ArcusMotion, OnTheFlyTargetAhead) {
+    ArcusMotion m(base_params());
+    m.move(0, 10000);
+    ASSERT_EQ(m.change_target(2.0, 20000), ArcusReply::Ok);
+    const Profile& p = m.profile();
+    EXPECT_EQ(p.end_position(), 20000);
+    EXPECT_NEAR(p.velocity(9.0), 1000, 1e-9);  // still cruising past the old target
+    EXPECT_LE(p.max_abs_velocity(), 1000 * (1 + 1e-12));
+    EXPECT_EQ(step_times(p).size(), 20000u);
+}
+
+TEST(ArcusMotion, OnTheFlyTargetAlreadyPassedReverses) {
+    ArcusMotion m(base_params());
+    m.move(0, 10000);
+    const double pos_at_5 = m.profile().position(5.0);  // about 4945
+    ASSERT_EQ(m.change_target(5.0, 1000), ArcusReply::Ok);
+    const Profile& p = m.profile();
+    EXPECT_EQ(p.end_position(), 1000);
+    // Decelerates to LSPD (0.1 s, 55 pulses), stops, then runs back.
+    EXPECT_NEAR(p.position(5.1), pos_at_5 + 55, 1e-6);
+    bool reversed = false;
+    for (double t = 5.1; t < p.duration(); t += 0.01) reversed |= p.velocity(t) < 0;
+    EXPECT_TRUE(reversed);
+    auto st = step_times(p);
+    long net = 0;
+    for (auto d : st.dir) net += d;
+    EXPECT_EQ(net, 1000);
+}
+
+TEST(ArcusMotion, OnTheFlyTargetErrors) {
+    ArcusMotion m(base_params());
+    EXPECT_EQ(m.change_target(0, 10), ArcusReply::MotorNotMoving);
+    m.move(0, 100);
+    EXPECT_EQ(m.change_target(100.0, 10), ArcusReply::MotorNotMoving);  // finished
+    m.jog(0, 1);
+    EXPECT_EQ(m.change_target(1.0, 10), ArcusReply::MotorNotMoving);    // not a target move
+    EXPECT_STREQ(arcus_reply_text(ArcusReply::MotorNotMoving), "?Motor is not moving");
+}
+
+TEST(ArcusMotion, OnTheFlySpeed) {
+    ArcusMotion m(base_params(), 0);
+    m.move(0, 100000);
+    EXPECT_EQ(m.change_speed(1.0, 20000), ArcusReply::SpeedOutOfRange);  // SSPDM 0: 1..16K
+    ASSERT_EQ(m.change_speed(1.0, 2000), ArcusReply::Ok);
+    const Profile& p = m.profile();
+    // Same acceleration (9000 pps/s): 1000 -> 2000 takes 1/9 s.
+    EXPECT_NEAR(p.velocity(1.0 + 1.0 / 9.0 + 0.01), 2000, 1e-9);
+    EXPECT_EQ(p.end_position(), 100000);
+    auto s = base_params();
+    s.scv = true;
+    ArcusMotion sc(s);
+    sc.move(0, 10000);
+    EXPECT_EQ(sc.change_speed(1.0, 500), ArcusReply::ScvOn);
+    ArcusMotion idle(base_params());
+    EXPECT_EQ(idle.change_speed(0, 500), ArcusReply::BadSspd);
+}
+
+TEST(ArcusMotion, JogSpeedChangeAndStop) {
+    ArcusMotion m(base_params());
+    m.jog(0, -1);
+    EXPECT_NEAR(m.profile().velocity(1.0), -1000, 1e-9);
+    ASSERT_EQ(m.change_speed(1.0, 500), ArcusReply::Ok);
+    EXPECT_NEAR(m.profile().velocity(2.0), -500, 1e-9);
+    m.stop(3.0);
+    const Profile& p = m.profile();
+    // 500 -> 100 at 9000 pps/s: 0.0444 s, then stop.
+    EXPECT_NEAR(p.duration(), 3.0 + 400.0 / 9000.0, 1e-9);
+    EXPECT_FALSE(m.moving(3.1));
+}
+
+TEST(ArcusMotion, SCurveSameDuration) {
+    auto s = base_params();
+    ArcusMotion t(s);
+    s.scv = true;
+    ArcusMotion c(s);
+    t.move(0, 5000);
+    c.move(0, 5000);
+    EXPECT_NEAR(t.profile().duration(), c.profile().duration(), 1e-9);
+    EXPECT_NEAR(c.profile().acceleration(0.0), 0.0, 1e-9);
+    EXPECT_EQ(c.profile().end_position(), 5000);
+}
+
+TEST(ArcusMotion, RandomOnTheFlyChangesEndOnTarget) {
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (int i = 0; i < 500; ++i) {
+        ArcusProfileParams p;
+        p.hspd = 200 + 15000 * u(rng);
+        p.lspd = 10 + 100 * u(rng);
+        p.acc_ms = 2 + 500 * u(rng);
+        ArcusMotion m(p);
+        const double target = std::round(-50000 + 100000 * u(rng));
+        ASSERT_EQ(m.move(0, target), ArcusReply::Ok);
+        const double t = m.profile().duration() * u(rng);
+        const double t2 = std::round(-50000 + 100000 * u(rng));
+        if (m.change_target(t, t2) == ArcusReply::Ok) {
+            EXPECT_EQ(m.profile().end_position(), t2);
+            EXPECT_LE(m.profile().max_abs_velocity(), m.effective().params.hspd * (1 + 1e-9));
+            auto st = step_times(m.profile());
+            long net = 0;
+            for (auto d : st.dir) net += d;
+            EXPECT_EQ(net, static_cast<long>(t2));
+        }
+    }
+}
+
+// ---- DMAC ---------------------------------------------------------------------------
+
+TEST(Dmac, HalfSecondExample) {
+    // #ACCEL_TIME 1000 ms, #HIGH_SPEED 60000 (600 rpm): MOVE_SPEED 30000 -> 0.5 s.
+    DmacProfileParams p;
+    p.accel_time_ms = 1000;
+    p.high_speed = 60000;
+    EXPECT_DOUBLE_EQ(dmac_ramp_time(p, 0, 30000), 0.5);
+    Profile s = dmac_speed_profile(State{}, 30000, p, 1.0);
+    EXPECT_NEAR(s.duration(), 1.5, 1e-12);
+    EXPECT_NEAR(s.velocity(0.5), dmac_speed_to_inc_per_s(30000), 1e-9);  // 300 rpm = 50000 inc/s
+    EXPECT_NEAR(s.velocity(0.5), 50000, 1e-9);
+    // Proportional in the other direction and for partial changes.
+    EXPECT_DOUBLE_EQ(dmac_ramp_time(p, 60000, 30000), 0.5);
+    EXPECT_DOUBLE_EQ(dmac_ramp_time(p, 30000, -30000), 1.0);
+}
+
+TEST(Dmac, MoveSpeedClampedToHighSpeed) {
+    DmacMotion m;
+    m.move_speed(0, 400000);
+    EXPECT_NEAR(m.profile().velocity(5.0), dmac_speed_to_inc_per_s(60000), 1e-9);
+    EXPECT_TRUE(m.moving(100.0));
+    m.stop(10.0);
+    EXPECT_NEAR(m.profile().duration(), 11.0, 1e-9);  // DECEL_TIME 1 s from HIGH_SPEED
+    EXPECT_FALSE(m.moving(11.0));
+}
+
+TEST(Dmac, PositionMoveLowSpeedAtLastTenthTurn) {
+    DmacProfileParams p;  // factory: HS 60000, LS 6000, 1000 ms ramps
+    Profile prof = dmac_position_profile(State{}, 100000, p);
+    EXPECT_EQ(prof.end_position(), 100000);
+    const double t_via = prof.first_crossing(99000);
+    ASSERT_GT(t_via, 0);
+    EXPECT_NEAR(prof.velocity(t_via), dmac_speed_to_inc_per_s(6000), 1e-6);  // 10000 inc/s
+    // Velocity proportional to the error inside the last 0.1 turn.
+    const double t_half = prof.first_crossing(99500);
+    EXPECT_NEAR(prof.velocity(t_half), 5000, 1e-6);
+    // Approach time: tau (ln 1000 + 1), tau = 1000 / 10000 s.
+    EXPECT_NEAR(prof.duration() - t_via, 0.1 * (std::log(1000.0) + 1), 1e-9);
+    EXPECT_LE(prof.max_abs_velocity(), 100000 * (1 + 1e-12));
+    auto st = step_times(prof);
+    EXPECT_EQ(st.size(), 100000u);
+    for (std::size_t k = 1; k < st.size(); ++k) ASSERT_LT(st.t_ns[k - 1], st.t_ns[k]);
+}
+
+TEST(Dmac, ShortMoveIsApproachOnly) {
+    DmacProfileParams p;
+    Profile prof = dmac_position_profile(State{0, 0, 0, 0}, -500, p);
+    EXPECT_EQ(prof.end_position(), -500);
+    EXPECT_NEAR(prof.velocity(1e-9), -5000, 1e-3);
+}
+
+TEST(Dmac, MoveWhileMovingAndLimits) {
+    DmacMotion m;
+    m.move_to(0, 200000);
+    m.move_to(1.0, 0);  // reverse mid-move
+    EXPECT_EQ(m.profile().end_position(), 0);
+    m.move_on(m.profile().duration() + 1, -5000);  // the manual's MOVE_ON -5000: half a turn CCW
+    EXPECT_EQ(m.profile().end_position(), -5000);
+    DmacProfileParams bad;
+    bad.high_speed = 400001;
+    try {
+        bad.validate();
+        FAIL();
+    } catch (const LimitExceeded& e) {
+        EXPECT_EQ(e.limit, "#HIGH_SPEED");
+        EXPECT_DOUBLE_EQ(e.excess(), 1.0);
+    }
+    bad = DmacProfileParams{};
+    bad.accel_time_ms = 12001;
+    EXPECT_THROW(bad.validate(), LimitExceeded);
+}
+
+TEST(Dmac, SCurveSameTimes) {
+    DmacProfileParams p;
+    Profile t = dmac_position_profile(State{}, 50000, p);
+    p.s_curve = true;
+    Profile s = dmac_position_profile(State{}, 50000, p);
+    EXPECT_NEAR(t.duration(), s.duration(), 1e-9);
+    EXPECT_EQ(s.end_position(), 50000);
+}
+
+TEST(Dmac, StartStopWithZeroRampTimes) {
+    DmacProfileParams p;
+    p.accel_time_ms = 0;
+    p.decel_time_ms = 0;
+    Profile prof = dmac_position_profile(State{}, 20000, p);
+    EXPECT_EQ(prof.end_position(), 20000);
+    EXPECT_NEAR(prof.velocity(1e-6), 100000, 1e-6);
+}

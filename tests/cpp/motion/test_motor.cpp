@@ -1,0 +1,328 @@
+// StepNLoop (Tables 7.6, 7.7, 8.14), the motor model on a SimClock, and homing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "motorbus/motion/arcus_profile.hpp"
+#include "motorbus/motion/homing.hpp"
+#include "motorbus/motion/motor_model.hpp"
+#include "motorbus/motion/planner.hpp"
+#include "motorbus/motion/stepnloop.hpp"
+
+using namespace motorbus::motion;
+using motorbus::Nanos;
+using motorbus::SimClock;
+
+constexpr Nanos kMs = 1'000'000;
+constexpr Nanos kSec = 1'000'000'000;
+
+// ---- StepNLoop -------------------------------------------------------------------
+
+TEST(StepNLoop, StatusValuesMatchTables) {
+    EXPECT_EQ(static_cast<int>(SnlStatus::Idle), 0);
+    EXPECT_EQ(static_cast<int>(SnlStatus::StallError), 10);
+    EXPECT_EQ(static_cast<int>(SnlStatus::Disabled), 12);
+    EXPECT_EQ(static_cast<int>(SnlStatus::LimitHoming), 13);
+    EXPECT_STREQ(snl_status_name(SnlStatus::AttemptError), "ERR-ATMPT");
+    EXPECT_EQ(SnlConfig::ascii_defaults().tolerance, 20u);   // Table 7.11
+    EXPECT_EQ(SnlConfig::canopen_defaults().tolerance, 10u); // Table 8.11
+}
+
+TEST(StepNLoop, Table77Moving) {
+    StepNLoop s;
+    ASSERT_TRUE(s.begin(SnlActivity::Move));
+    EXPECT_EQ(s.status(), SnlStatus::Moving);
+    EXPECT_EQ(s.monitor(20).action, SnlAction::None);    // <= SLT
+    EXPECT_EQ(s.monitor(999).action, SnlAction::None);   // SLT < d < SLE
+    EXPECT_EQ(s.monitor(-1001).action, SnlAction::StopNow);  // > SLE
+    EXPECT_EQ(s.status(), SnlStatus::StallError);
+    EXPECT_FALSE(s.begin(SnlActivity::Move));  // "?State Error" until cleared
+    s.clear();
+    EXPECT_EQ(s.status(), SnlStatus::Idle);
+    EXPECT_TRUE(s.begin(SnlActivity::Jog));
+    EXPECT_EQ(s.status(), SnlStatus::Jogging);
+}
+
+TEST(StepNLoop, Table77IdleAndCorrections) {
+    StepNLoop s;
+    s.begin(SnlActivity::Move);
+    EXPECT_EQ(s.motion_done(15).action, SnlAction::InPosition);  // <= SLT 20
+    EXPECT_EQ(s.status(), SnlStatus::Idle);
+    s.begin(SnlActivity::Move);
+    SnlDecision d = s.motion_done(300);
+    EXPECT_EQ(d.action, SnlAction::Correct);
+    EXPECT_EQ(d.correction, 300);
+    EXPECT_FALSE(d.idle_current);
+    EXPECT_EQ(s.status(), SnlStatus::Correcting);
+    // After a correction the idle tolerance SLM = 5 applies, with idle current.
+    d = s.motion_done(8);
+    EXPECT_EQ(d.action, SnlAction::Correct);
+    EXPECT_TRUE(d.idle_current);
+    EXPECT_EQ(s.motion_done(4).action, SnlAction::InPosition);
+    // Out of range at the end: Correction Range Error (8).
+    s.begin(SnlActivity::Move);
+    EXPECT_EQ(s.motion_done(5000).action, SnlAction::StopNow);
+    EXPECT_EQ(s.status(), SnlStatus::RangeError);
+    s.clear();
+    // Attempts: SLA = 2 -> the third needed correction is an Attempt Error (9).
+    SnlConfig c;
+    c.max_attempts = 2;
+    s.configure(c);
+    s.begin(SnlActivity::Move);
+    EXPECT_EQ(s.motion_done(100).action, SnlAction::Correct);
+    EXPECT_EQ(s.motion_done(100).action, SnlAction::Correct);
+    EXPECT_EQ(s.motion_done(100).action, SnlAction::StopNow);
+    EXPECT_EQ(s.status(), SnlStatus::AttemptError);
+    EXPECT_EQ(s.attempts(), 2u);
+}
+
+TEST(StepNLoop, IdleDisturbanceAndLimitAndDisabled) {
+    StepNLoop s;
+    EXPECT_EQ(s.idle_check(10).action, SnlAction::None);
+    EXPECT_EQ(s.idle_check(50).action, SnlAction::Correct);
+    s.clear();
+    EXPECT_EQ(s.idle_check(2000).action, SnlAction::StopNow);
+    EXPECT_EQ(s.status(), SnlStatus::RangeError);
+    s.clear();
+    s.begin(SnlActivity::Move);
+    s.limit_hit();
+    EXPECT_EQ(s.status(), SnlStatus::LimitError);
+    SnlConfig off;
+    off.enabled = false;
+    s.configure(off);
+    EXPECT_EQ(s.status(), SnlStatus::Disabled);
+    EXPECT_EQ(s.motion_done(1e6).action, SnlAction::InPosition);
+    EXPECT_DOUBLE_EQ(s.counts_to_pulses(4000), 3200);
+}
+
+// ---- Motor model -----------------------------------------------------------------
+
+namespace {
+Profile move_profile(double from, double to, double v = 3200, double a = 32000) {
+    return plan_trapezoid(State{from, 0, 0, 0}, to, Limits{v, a, 0, 0});
+}
+}  // namespace
+
+TEST(MotorModel, FollowsProfileAndEncoderRatio) {
+    SimClock clk;
+    MotorModel m(clk);
+    m.command(move_profile(0, 3200));
+    EXPECT_TRUE(m.moving());
+    clk.advance(2 * kSec);
+    m.update();
+    EXPECT_FALSE(m.moving());
+    EXPECT_EQ(m.pulse_count(), 3200);
+    EXPECT_EQ(m.encoder(), 4000);  // 3200 steps = 4000 counts
+    m.set_encoder(0);
+    m.set_pulse_position(100);
+    EXPECT_EQ(m.encoder(), 0);
+    EXPECT_EQ(m.pulse_count(), 100);
+    EXPECT_DOUBLE_EQ(m.physical_position(), 3200);
+}
+
+TEST(MotorModel, IndexOncePerRevAndExactEdgeTimes) {
+    SimClock clk;
+    MotorConfig cfg;
+    cfg.index_position = 100;
+    cfg.home = SwitchConfig{true, 1000, 1200, true};
+    MotorModel m(clk, cfg);
+    std::vector<MotorEvent> ev;
+    m.add_listener([&](const MotorEvent& e) { ev.push_back(e); });
+    const Profile p = move_profile(0, 3 * 3200 + 50);
+    m.command(p);
+    clk.advance(10 * kSec);
+    m.update();
+    int index = 0;
+    Nanos home_on = -1, home_off = -1;
+    for (const auto& e : ev) {
+        if (e.kind == MotorEvent::Kind::IndexPulse) ++index;
+        if (e.kind == MotorEvent::Kind::HomeOn) home_on = e.t;
+        if (e.kind == MotorEvent::Kind::HomeOff) home_off = e.t;
+    }
+    EXPECT_EQ(index, 3);  // 100, 3300, 6500 (9700 is past 9650)
+    EXPECT_NEAR(static_cast<double>(home_on), p.first_crossing(1000) * 1e9, 2.0);
+    EXPECT_NEAR(static_cast<double>(home_off), p.first_crossing(1200) * 1e9, 2.0);
+    EXPECT_EQ(ev.back().kind, MotorEvent::Kind::ProfileDone);
+    EXPECT_TRUE(m.home_input());  // active low: idle high off the switch
+}
+
+TEST(MotorModel, StallLosesStepsEncoderShowsIt) {
+    SimClock clk;
+    MotorConfig cfg;
+    cfg.pull_out_speed = 2000;  // the profile asks 3200 steps/s
+    MotorModel m(clk, cfg);
+    int stalls = 0;
+    m.add_listener([&](const MotorEvent& e) { stalls += e.kind == MotorEvent::Kind::Stalled; });
+    m.command(move_profile(0, 6400));
+    clk.advance(5 * kSec);
+    m.update();
+    EXPECT_EQ(stalls, 1);
+    EXPECT_EQ(m.pulse_count(), 6400);          // the step generator finished
+    EXPECT_LT(m.encoder(), m.steps_to_counts(6400) - 100);  // the rotor did not
+    EXPECT_GT(m.slip(), 100);
+}
+
+TEST(MotorModel, JamAndLatch) {
+    SimClock clk;
+    MotorModel m(clk);
+    m.set_jammed(true);
+    m.command(move_profile(0, 1000));
+    clk.advance(kSec);
+    m.update();
+    EXPECT_TRUE(m.stalled());
+    EXPECT_EQ(m.encoder(), 0);
+    m.set_jammed(false);
+    m.arm_latch();
+    EXPECT_EQ(m.latch_state(), MotorModel::LatchState::Armed);
+    m.command(move_profile(m.pulse_position(), 2000));
+    clk.advance(100 * kMs);
+    m.trigger_latch();
+    EXPECT_EQ(m.latch_state(), MotorModel::LatchState::Triggered);
+    EXPECT_NEAR(m.latched_pulse(), m.pulse_position(), 1e-9);
+    EXPECT_EQ(m.latched_encoder(), m.encoder());
+}
+
+// ---- Homing ----------------------------------------------------------------------
+
+namespace {
+ArcusProfileParams homing_params() {
+    ArcusProfileParams p;
+    p.hspd = 3200;
+    p.lspd = 100;
+    p.acc_ms = 100;
+    return p;
+}
+MotorConfig bench_cfg() {
+    MotorConfig c;
+    c.home = SwitchConfig{true, 5000, 5400, true};
+    c.minus_limit = SwitchConfig{true, -20000, 0, true};
+    c.plus_limit = SwitchConfig{true, 20000, 0, true};
+    c.index_position = 37;
+    return c;
+}
+void run_until_done(SimClock& clk, MotorModel& m, const std::function<bool()>& running) {
+    for (int i = 0; i < 10000 && running(); ++i) {
+        clk.advance(10 * kMs);
+        m.update();
+    }
+}
+}  // namespace
+
+TEST(ArcusHoming, HomeOnlyResetsAtSwitchThenDecelerates) {
+    SimClock clk;
+    MotorModel m(clk, bench_cfg());
+    ArcusHoming h(m, homing_params());
+    h.start(ArcusHoming::Method::H, +1);
+    EXPECT_EQ(h.snl_status(), 6);
+    run_until_done(clk, m, [&] { return h.running(); });
+    ASSERT_EQ(h.result(), HomingResult::Done);
+    // Reset to 0 at the switch edge (physical 5000), then 3200 -> 100 in 0.1 s = 165 steps.
+    EXPECT_NEAR(m.pulse_position(), 165, 1e-3);
+    EXPECT_NEAR(m.physical_position(), 5165, 1e-3);
+}
+
+TEST(ArcusHoming, HomeReturnToZero) {
+    SimClock clk;
+    MotorModel m(clk, bench_cfg());
+    ArcusHomingOptions o;
+    o.rz = true;
+    ArcusHoming h(m, homing_params(), o);
+    h.start(ArcusHoming::Method::H, +1);
+    run_until_done(clk, m, [&] { return h.running(); });
+    ASSERT_EQ(h.result(), HomingResult::Done);
+    EXPECT_EQ(m.pulse_count(), 0);
+    EXPECT_NEAR(m.physical_position(), 5000, 1e-3);
+}
+
+TEST(ArcusHoming, HighLowFindsSwitchFromSameSide) {
+    SimClock clk;
+    MotorModel m(clk, bench_cfg());
+    ArcusHomingOptions o;
+    o.hca = 600;  // past the switch (400 wide) by 600 at high speed, back at low speed
+    ArcusHoming h(m, homing_params(), o);
+    h.start(ArcusHoming::Method::HL, +1);
+    run_until_done(clk, m, [&] { return h.running(); });
+    ASSERT_EQ(h.result(), HomingResult::Done);
+    EXPECT_EQ(m.pulse_count(), 0);
+    // Final approach in + at LSPD: stops on the low edge of the window.
+    EXPECT_NEAR(m.physical_position(), 5000, 0.01);
+}
+
+TEST(ArcusHoming, LimitHoming) {
+    SimClock clk;
+    MotorModel m(clk, bench_cfg());
+    ArcusHoming h(m, homing_params());  // LCA 1000
+    h.start(ArcusHoming::Method::L, -1);
+    EXPECT_EQ(h.snl_status(), 13);
+    run_until_done(clk, m, [&] { return h.running(); });
+    ASSERT_EQ(h.result(), HomingResult::Done);
+    EXPECT_EQ(m.pulse_count(), 0);
+    EXPECT_NEAR(m.physical_position(), -20000 + 1000, 0.01);
+}
+
+TEST(ArcusHoming, ZIndexAndHomeThenZ) {
+    SimClock clk;
+    MotorModel m(clk, bench_cfg());
+    ArcusHoming h(m, homing_params());
+    h.start(ArcusHoming::Method::Z, +1);
+    run_until_done(clk, m, [&] { return h.running(); });
+    ASSERT_EQ(h.result(), HomingResult::Done);
+    EXPECT_NEAR(m.physical_position(), 37, 0.01);
+    EXPECT_EQ(m.pulse_count(), 0);
+
+    h.start(ArcusHoming::Method::ZH, +1);
+    EXPECT_EQ(h.snl_status(), 7);
+    run_until_done(clk, m, [&] { return h.running(); });
+    ASSERT_EQ(h.result(), HomingResult::Done);
+    // Home at 5000, decel to LSPD by ~5165, next index: 37 + 2*3200 = 6437.
+    EXPECT_NEAR(m.physical_position(), 6437, 0.01);
+    EXPECT_EQ(m.pulse_count(), 0);
+}
+
+TEST(ArcusHoming, LimitBeforeHomeIsLimitError) {
+    SimClock clk;
+    MotorModel m(clk, bench_cfg());
+    ArcusHoming h(m, homing_params());
+    h.start(ArcusHoming::Method::H, -1);  // home is the other way
+    run_until_done(clk, m, [&] { return h.running(); });
+    EXPECT_EQ(h.result(), HomingResult::LimitError);
+    EXPECT_NEAR(m.physical_position(), -20000, 0.01);
+}
+
+TEST(Cia402Homing, Methods) {
+    struct Case { int method; double expect_physical; };
+    // Home window [5000, 5400]; index high on [37, 37.8) + k*3200 (its rising edge is
+    // at 37.8 when approached from above); limits at -20000 / +20000.
+    for (Case c : {Case{17, -20000}, Case{18, 20000}, Case{19, 5000}, Case{20, 5000}, Case{7, 3237.8},
+                   Case{11, 6437}, Case{33, 37.8}, Case{34, 3237}, Case{35, 1000}}) {
+        SimClock clk;
+        MotorModel m(clk, bench_cfg());
+        m.command(move_profile(0, 1000));
+        clk.advance(2 * kSec);
+        m.update();
+        if (c.method == 11) {
+            m.command(move_profile(1000, 8000));
+            clk.advance(5 * kSec);
+            m.update();
+        }
+        Cia402HomingParams p;
+        p.method = c.method;
+        p.speed_switch = 2000;
+        p.speed_zero = 200;
+        p.acceleration = 20000;
+        p.home_offset = 7;
+        Cia402Homing h(m, p);
+        h.start();
+        run_until_done(clk, m, [&] { return h.result() == HomingResult::Running; });
+        ASSERT_TRUE(h.attained()) << c.method;
+        EXPECT_NEAR(m.physical_position(), c.expect_physical, 0.05) << c.method;
+        EXPECT_EQ(m.pulse_count(), 7) << c.method;
+    }
+    SimClock clk;
+    MotorModel m(clk, bench_cfg());
+    Cia402HomingParams p;
+    p.method = 1;
+    Cia402Homing h(m, p);
+    EXPECT_THROW(h.start(), motorbus::InvalidArgument);
+}
