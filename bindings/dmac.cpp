@@ -1,8 +1,415 @@
-// Bindings for cpp/motorbus/dmac (filled in by the dmac work).
+// Bindings for cpp/motorbus/drives/dmac: DmacSim (a LineDevice), DmacClient,
+// the global SYNCHRO commands, interpolation streaming and a few codec helpers.
+#include <pybind11/eval.h>
+#include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "common.hpp"
+#include "motorbus/drives/dmac/client.hpp"
+#include "motorbus/drives/dmac/codec.hpp"
+#include "motorbus/drives/dmac/sim.hpp"
+#include "motorbus/serial/line_device.hpp"
+#include "motorbus/serial/port.hpp"
 
 namespace py = pybind11;
+using namespace motorbus;
+using namespace motorbus::dmac;
+
+namespace {
+
+py::handle g_unknown_command;
+py::handle g_command_rejected;
+
+Var var_arg(const std::string& name) {
+    auto v = find_variable(name);
+    if (!v) throw InvalidArgument("DMAC variable: '" + name + "' is not a DMAC variable name or mnemonic");
+    return *v;
+}
+
+Radix radix_arg(const std::string& r) {
+    if (r == "dec" || r == "d" || r.empty()) return Radix::Dec;
+    if (r == "hex" || r == "h") return Radix::Hex;
+    if (r == "bin" || r == "b") return Radix::Bin;
+    throw InvalidArgument("radix: '" + r + "' is not 'dec', 'hex' or 'bin'");
+}
+
+StopWhat stop_arg(const std::string& w) {
+    if (w == "all") return StopWhat::All;
+    if (w == "movement" || w == "MOUV") return StopWhat::Movement;
+    if (w == "sequence" || w == "SEQ") return StopWhat::Sequence;
+    throw InvalidArgument("what: '" + w + "' is not 'all', 'movement' or 'sequence'");
+}
+
+Keyword synchro_arg(const std::string& w) {
+    if (w == "ON" || w == "on") return Keyword::On;
+    if (w == "OFF" || w == "off") return Keyword::Off;
+    if (w == "TOP" || w == "top") return Keyword::Top;
+    if (w == "INTERPOL" || w == "interpol") return Keyword::Interpol;
+    throw InvalidArgument("SYNCHRO: '" + w + "' is not ON, OFF, TOP or INTERPOL");
+}
+
+std::function<void(Duration)> sleep_arg(const py::object& f) {
+    if (f.is_none()) return {};
+    motorbus::py_helpers::PyCallable cb(f.cast<py::function>());
+    return [cb](Duration d) { cb(static_cast<double>(d.count()) / 1e9); };
+}
+
+py::dict state_dict(const SimState& s) {
+    py::dict d;
+    d["now_ms"] = s.now_ms;
+    d["position"] = s.position;
+    d["speed"] = s.speed;
+    d["status"] = s.status;
+    d["error"] = s.error;
+    d["line"] = s.line;
+    d["sequencer_running"] = s.sequencer_running;
+    d["fifo_count"] = s.fifo_count;
+    d["interpolating"] = s.interpolating;
+    d["power"] = s.power;
+    return d;
+}
+
+}  // namespace
 
 void bind_dmac(py::module_& m) {
-    (void)m;
+    // ---- errors ---------------------------------------------------------------
+    py::dict ns;
+    ns["DriveFault"] = m.attr("DriveFault");
+    py::exec(R"(
+class UnknownCommand(DriveFault):
+    "The DMAC rejected a command as undefined (#ERROR bit 12), or a peer answered '?'."
+class CommandRejected(DriveFault):
+    "The DMAC refused a parameter (#ERROR bit 7 limit, bit 8 computation); .error holds #ERROR."
+    error = 0
+)", ns, ns);
+    for (const char* n : {"UnknownCommand", "CommandRejected"}) {
+        py::object cls = ns[n];
+        cls.attr("__module__") = "motorbus.drives.dmac";
+        m.attr((std::string("Dmac") + n).c_str()) = cls;
+    }
+    g_unknown_command = py::object(ns["UnknownCommand"]).release();
+    g_command_rejected = py::object(ns["CommandRejected"]).release();
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const UnknownCommand& e) {
+            PyErr_SetString(g_unknown_command.ptr(), e.what());
+        } catch (const CommandRejected& e) {
+            py::object exc = py::reinterpret_borrow<py::object>(g_command_rejected)(e.what());
+            exc.attr("error") = e.error;
+            PyErr_SetObject(g_command_rejected.ptr(), exc.ptr());
+        }
+    });
+
+    // ---- codec helpers ---------------------------------------------------------------
+    m.def("dmac_format_value", [](std::int32_t v, const std::string& r) { return format_value(v, radix_arg(r)); },
+          py::arg("value"), py::arg("radix") = "dec", "'+123', 'h0000007B' or 'b00000000 ... 01111011'.");
+    m.def(
+        "dmac_parse_read_reply",
+        [](const py::bytes& b) -> py::object {
+            auto r = parse_read_reply(std::string(b));
+            if (!r) return py::none();
+            py::dict d;
+            d["address"] = r->address;
+            d["mnemonic"] = r->mnemonic;
+            d["bit"] = r->bit;
+            d["value"] = r->value;
+            d["radix"] = r->radix == Radix::Dec ? "dec" : r->radix == Radix::Hex ? "hex" : "bin";
+            return d;
+        },
+        py::arg("reply"), "Parses 'aa#MNE[.bit]=value' strictly; None when it breaks the grammar.");
+    m.def("dmac_status_names", [](std::uint32_t s) { return status_names(s); }, py::arg("status"));
+    m.def("dmac_error_names", [](std::uint32_t e) { return error_names(e); }, py::arg("error"));
+    m.def("dmac_variable", [](const std::string& name) {
+        const VarInfo& vi = var_info(var_arg(name));
+        py::dict d;
+        d["name"] = vi.name;
+        d["mnemonic"] = vi.mnemonic;
+        d["stored"] = vi.stored;
+        d["read_only"] = vi.read_only;
+        d["factory"] = vi.factory;
+        d["min"] = vi.min;
+        d["max"] = vi.max;
+        return d;
+    }, py::arg("name"));
+
+    // ---- status words ------------------------------------------------------------
+    py::class_<Status>(m, "DmacStatus", "#STATUS, bits numbered 1..32 from the LSB.")
+        .def(py::init([](std::uint32_t raw) { return Status{raw}; }), py::arg("raw"))
+        .def_readonly("raw", &Status::raw)
+        .def("bit", &Status::bit, py::arg("n"))
+        .def_property_readonly("busy", &Status::busy)
+        .def_property_readonly("moving", &Status::moving)
+        .def_property_readonly("power_on", &Status::power_on)
+        .def_property_readonly("error", &Status::error)
+        .def_property_readonly("sequencer_running", &Status::sequencer_running)
+        .def_property_readonly("sequencer_edit", &Status::sequencer_edit)
+        .def_property_readonly("position_control", &Status::position_control)
+        .def_property_readonly("abnormal_stop", &Status::abnormal_stop)
+        .def_property_readonly("end_stop", &Status::end_stop)
+        .def_property_readonly("names", &Status::names)
+        .def("__int__", [](const Status& s) { return s.raw; })
+        .def("__repr__", [](const Status& s) {
+            std::string r = "DmacStatus(";
+            for (const auto& n : s.names()) r += n + " ";
+            if (r.back() == ' ') r.pop_back();
+            return r + ")";
+        });
+    py::class_<ErrorWord>(m, "DmacErrorWord", "#ERROR, bits numbered 1..32 from the LSB.")
+        .def(py::init([](std::uint32_t raw) { return ErrorWord{raw}; }), py::arg("raw"))
+        .def_readonly("raw", &ErrorWord::raw)
+        .def("bit", &ErrorWord::bit, py::arg("n"))
+        .def_property_readonly("any", &ErrorWord::any)
+        .def_property_readonly("names", &ErrorWord::names)
+        .def("__bool__", &ErrorWord::any)
+        .def("__int__", [](const ErrorWord& e) { return e.raw; });
+
+    // ---- simulator -----------------------------------------------------------------
+    py::class_<DmacSim, serial::LineDevice, std::shared_ptr<DmacSim>>(
+        m, "DmacSim",
+        "A simulated DMAC module (a LineDevice: serve it with PtyLineServer). Device time runs on `clock` "
+        "(a SimClock in tests); nothing runs in the background.")
+        .def(py::init([](std::shared_ptr<Clock> clock, int address, const std::string& model,
+                         const py::bytes& request_terminator, const py::bytes& reply_terminator,
+                         std::int32_t supply_voltage, std::int32_t baudrate) {
+                 SimOptions o;
+                 o.address = address;
+                 auto mdl = parse_model(model);
+                 if (!mdl) throw InvalidArgument("model: '" + model + "' is not DMAC17, DMAC23-1/2 or DMAC34-1/2");
+                 o.model = *mdl;
+                 o.request_terminator = request_terminator;
+                 o.reply_terminator = reply_terminator;
+                 if (o.request_terminator.empty() || o.reply_terminator.empty())
+                     throw InvalidArgument("terminators: must not be empty");
+                 o.supply_voltage_mv = supply_voltage;
+                 o.baudrate = baudrate;
+                 return std::make_shared<DmacSim>(std::move(clock), o);
+             }),
+             py::arg("clock") = nullptr, py::arg("address") = 0, py::arg("model") = "DMAC34-1",
+             py::arg("request_terminator") = py::bytes("\r"), py::arg("reply_terminator") = py::bytes("\r\n"),
+             py::arg("supply_voltage") = 32000, py::arg("baudrate") = 38400)
+        .def("poll", &DmacSim::poll, py::call_guard<py::gil_scoped_release>(), "Catch up with the clock.")
+        .def("state", [](DmacSim& s) {
+            SimState st;
+            {
+                py::gil_scoped_release nogil;
+                st = s.state();
+            }
+            return state_dict(st);
+        })
+        .def("read", [](DmacSim& s, const std::string& var) { return s.read(var_arg(var)); }, py::arg("variable"),
+             py::call_guard<py::gil_scoped_release>())
+        .def_property_readonly("address", &DmacSim::address)
+        .def_property_readonly("baudrate", &DmacSim::baudrate)
+        .def_property_readonly("reply_terminator", [](const DmacSim& s) { return py::bytes(s.options().reply_terminator); })
+        .def("sequence_line", &DmacSim::sequence_line, py::arg("n"))
+        .def("set_input", &DmacSim::set_input, py::arg("n"), py::arg("active"), py::call_guard<py::gil_scoped_release>())
+        .def("set_analog", &DmacSim::set_analog, py::arg("channel"), py::arg("mv"))
+        .def("set_supply_voltage", &DmacSim::set_supply_voltage, py::arg("mv"))
+        .def("inject_error", &DmacSim::inject_error, py::arg("bit"))
+        .def("physical_outputs", &DmacSim::physical_outputs, py::call_guard<py::gil_scoped_release>())
+        .def("power_cycle", &DmacSim::power_cycle, py::call_guard<py::gil_scoped_release>())
+        .def_property_readonly("lines_handled", &DmacSim::lines_handled)
+        .def_property_readonly("lines_rejected", &DmacSim::lines_rejected);
+
+    // ---- client --------------------------------------------------------------------
+    using C = DmacClient;
+    auto rel = py::call_guard<py::gil_scoped_release>();
+    py::class_<C, std::shared_ptr<C>>(m, "DmacClient",
+                                      "Typed DMAC commands over a LineLink (one client per module address).")
+        .def(py::init([](std::shared_ptr<serial::LineLink> link, int address, bool verify, const py::object& timeout,
+                         const py::object& sleep) {
+                 ClientOptions o;
+                 o.address = address;
+                 o.verify = verify;
+                 if (!timeout.is_none()) o.timeout = motorbus::py_helpers::seconds_to_ns(timeout);
+                 o.sleep = sleep_arg(sleep);
+                 return std::make_shared<C>(std::move(link), o);
+             }),
+             py::arg("link"), py::arg("address") = 0, py::arg("verify") = true, py::arg("timeout") = py::none(),
+             py::arg("sleep") = py::none())
+        .def_property_readonly("address", &C::address)
+        .def_property_readonly("counters", [](const C& c) {
+            auto k = c.counters();
+            py::dict d;
+            d["transactions"] = k.transactions;
+            d["stray_lines"] = k.stray_lines;
+            d["xon_errors"] = k.xon_errors;
+            d["device_resets"] = k.device_resets;
+            return d;
+        })
+        .def("command", [](C& c, const std::string& cmd) { c.command(cmd); }, py::arg("command"), rel)
+        .def("raw", [](C& c, const std::string& f, bool expect) {
+            std::string r;
+            {
+                py::gil_scoped_release nogil;
+                r = c.raw(f, expect);
+            }
+            return py::bytes(r);
+        },
+             py::arg("frame"), py::arg("expect_reply") = true)
+        .def("read", [](C& c, const std::string& v, const std::string& r) { return c.read(var_arg(v), radix_arg(r)); },
+             py::arg("variable"), py::arg("radix") = "dec", rel)
+        .def("read_bit", [](C& c, const std::string& v, int bit) { return c.read_bit(var_arg(v), bit); },
+             py::arg("variable"), py::arg("bit"), rel)
+        .def("write", [](C& c, const std::string& v, std::int32_t x) { c.write(var_arg(v), x); }, py::arg("variable"),
+             py::arg("value"), rel)
+        .def("write_bit", [](C& c, const std::string& v, int bit, bool x) { c.write_bit(var_arg(v), bit, x); },
+             py::arg("variable"), py::arg("bit"), py::arg("value"), rel)
+        .def_property(
+            "position",
+            [](C& c) {
+                py::gil_scoped_release nogil;
+                return c.position();
+            },
+            [](C& c, std::int32_t p) {
+                py::gil_scoped_release nogil;
+                c.set_position(p);
+            },
+            "#POSITION (1/10000 rev); assigning re-homes the axis.")
+        .def("set_position", &C::set_position, py::arg("position"), rel)
+        .def("speed", &C::speed, rel)
+        .def("profile_speed", &C::profile_speed, rel)
+        .def("status", &C::status, rel)
+        .def("error", &C::error, rel)
+        .def("clear_error", &C::clear_error, rel)
+        .def("inputs", &C::inputs, rel)
+        .def("outputs", &C::outputs, rel)
+        .def("set_outputs", &C::set_outputs, py::arg("value"), rel)
+        .def("set_output", &C::set_output, py::arg("n"), py::arg("on"), rel)
+        .def("supply_voltage", &C::supply_voltage, rel)
+        .def("cpu_temperature", &C::cpu_temperature, rel)
+        .def("capture", &C::capture, rel)
+        .def("interpol_count", &C::interpol_count, rel)
+        .def("line", &C::line, rel)
+        .def("set_profile", &C::set_profile, py::arg("high_speed") = py::none(), py::arg("low_speed") = py::none(),
+             py::arg("accel_ms") = py::none(), py::arg("decel_ms") = py::none(), rel,
+             "#HIGH_SPEED / #LOW_SPEED (0.01 rpm), #ACCEL_TIME / #DECEL_TIME (ms) in one frame.")
+        .def("torque_ratio", &C::torque_ratio, rel)
+        .def("set_torque_ratio", &C::set_torque_ratio, py::arg("percent"), rel)
+        .def("soft_limits", &C::soft_limits, rel, "(#NEGATIVE_END, #POSITIVE_END)")
+        .def("set_soft_limits", &C::set_soft_limits, py::arg("negative"), py::arg("positive"), rel)
+        .def("output_config", &C::output_config, rel)
+        .def("set_output_config", &C::set_output_config, py::arg("bits"), rel)
+        .def("line_delay", &C::line_delay, rel)
+        .def("set_line_delay", &C::set_line_delay, py::arg("us"), rel)
+        .def("on_reset", &C::on_reset, rel)
+        .def("set_interpolation", &C::set_interpolation, py::arg("time_ms"), py::arg("fifo_size"),
+             py::arg("mode") = 0, rel)
+        .def("analog_input", &C::analog_input, py::arg("channel"), rel)
+        .def("set_analog_output", &C::set_analog_output, py::arg("channel"), py::arg("mv"), rel)
+        .def("driver_temperature", &C::driver_temperature, rel)
+        .def("motor_temperature", &C::motor_temperature, rel)
+        .def("user_var", &C::user_var, py::arg("n"), rel)
+        .def("set_user_var", &C::set_user_var, py::arg("n"), py::arg("value"), rel)
+        .def("memorized_var", &C::memorized_var, py::arg("n"), rel)
+        .def("set_memorized_var", &C::set_memorized_var, py::arg("n"), py::arg("value"), rel)
+        .def("timer", &C::timer, py::arg("n"), rel)
+        .def("set_timer", &C::set_timer, py::arg("n"), py::arg("ms"), rel)
+        .def("move_to", &C::move_to, py::arg("position"), rel)
+        .def("move_on", &C::move_on, py::arg("offset"), rel)
+        .def("move_speed", &C::move_speed, py::arg("speed"), rel)
+        .def("stop", [](C& c, const std::string& w) { c.stop(stop_arg(w)); }, py::arg("what") = "all", rel)
+        .def("halt", [](C& c, const std::string& w) { c.halt(stop_arg(w)); }, py::arg("what") = "all", rel)
+        .def("power", [](C& c, const std::string& mode) {
+            if (mode == "ON" || mode == "on") c.power(PowerMode::On);
+            else if (mode == "OFF" || mode == "off") c.power(PowerMode::Off);
+            else if (mode == "SC" || mode == "sc") c.power(PowerMode::ShortCircuit);
+            else throw InvalidArgument("POWER: '" + mode + "' is not ON, OFF or SC");
+        }, py::arg("mode"), rel)
+        .def("brake", &C::brake, py::arg("on"), rel)
+        .def("hard_ends", [](C& c, const std::string& w) {
+            if (w == "OFF" || w == "off") c.hard_ends(EndStops::Off);
+            else if (w == "ALL" || w == "all") c.hard_ends(EndStops::All);
+            else if (w == "POS" || w == "pos") c.hard_ends(EndStops::Positive);
+            else if (w == "NEG" || w == "neg") c.hard_ends(EndStops::Negative);
+            else throw InvalidArgument("HARD_ENDS: '" + w + "' is not OFF, ALL, POS or NEG");
+        }, py::arg("which"), rel)
+        .def("soft_ends", &C::soft_ends, py::arg("on"), rel)
+        .def("s_curve", &C::s_curve, py::arg("on"), rel)
+        .def("optimized_current", &C::optimized_current, py::arg("on"), rel)
+        .def("inverse_polarity", [](C& c, const std::string& w) {
+            if (w == "OFF" || w == "off") c.inverse_polarity(Polarity::Off);
+            else if (w == "ALL" || w == "all") c.inverse_polarity(Polarity::All);
+            else if (w == "IN" || w == "in") c.inverse_polarity(Polarity::Inputs);
+            else if (w == "OUT" || w == "out") c.inverse_polarity(Polarity::Outputs);
+            else throw InvalidArgument("INVERSE_POLARITY: '" + w + "' is not OFF, ALL, IN or OUT");
+        }, py::arg("which"), rel)
+        .def("reference", &C::reference, py::arg("on"), rel)
+        .def("module_reset", &C::module_reset, py::arg("factory") = false, rel)
+        .def("set_address", &C::set_address, py::arg("address"), rel)
+        .def("set_baudrate", &C::set_baudrate, py::arg("baud"), rel)
+        .def("request_version", [](C& c) {
+            VersionInfo v;
+            {
+                py::gil_scoped_release nogil;
+                v = c.request_version();
+            }
+            py::dict d;
+            d["address"] = v.address;
+            d["version"] = v.version;
+            d["release"] = v.release;
+            d["code"] = v.code;
+            d["model"] = v.model;
+            d["ident"] = v.ident;
+            d["manufacturer"] = v.manufacturer;
+            d["product"] = v.product;
+            d["serial"] = v.serial;
+            d["manufacturing_date"] = v.manufacturing_date;
+            d["revision_date"] = v.revision_date;
+            d["phase"] = v.phase;
+            d["boot"] = v.boot;
+            return d;
+        })
+        .def("wait_idle", [](C& c, double timeout, double poll) {
+            auto t = motorbus::py_helpers::seconds_to_ns(py::float_(timeout));
+            auto p = motorbus::py_helpers::seconds_to_ns(py::float_(poll));
+            py::gil_scoped_release nogil;
+            return c.wait_idle(t, p);
+        }, py::arg("timeout"), py::arg("poll") = 0.01,
+             "Polls #STATUS until not busy; returns the position. TimeoutError after `timeout` s.")
+        .def("upload_sequence", &C::upload_sequence, py::arg("lines"), py::arg("first") = 1,
+             py::arg("verify_readback") = true, rel)
+        .def("read_sequence_line", &C::read_sequence_line, py::arg("n"), rel)
+        .def("read_sequence", &C::read_sequence, py::arg("first"), py::arg("last"), rel)
+        .def("start_sequence", &C::start_sequence, py::arg("line") = 1, rel)
+        .def("stop_sequence", &C::stop_sequence, rel)
+        .def("step", &C::step, py::arg("line") = py::none(), rel)
+        .def("set_on_reset", &C::set_on_reset, py::arg("line"), rel)
+        .def("move_interpol", &C::move_interpol, py::arg("offset"), rel,
+             "Queues one segment; returns the FIFO level, or None when the FIFO was full (XON_ERROR).");
+
+    m.def("dmac_synchro", [](std::shared_ptr<serial::LineLink> link, const std::string& what) {
+        Keyword k = synchro_arg(what);
+        py::gil_scoped_release nogil;
+        synchro(*link, k);
+    }, py::arg("link"), py::arg("what"), "Global SYNCHRO ON|OFF|TOP|INTERPOL (no reply).");
+
+    m.def("dmac_stream_interpolation",
+          [](std::vector<std::shared_ptr<C>> axes, const std::vector<std::vector<long long>>& segments,
+             int interpol_time_ms, int fifo_size, const py::object& sleep, const py::object& backoff) {
+              std::vector<C*> raw;
+              for (auto& a : axes) raw.push_back(a.get());
+              StreamOptions o;
+              o.interpol_time_ms = interpol_time_ms;
+              o.fifo_size = fifo_size;
+              o.sleep = sleep_arg(sleep);
+              if (!backoff.is_none()) o.backoff = motorbus::py_helpers::seconds_to_ns(backoff);
+              StreamStats s;
+              {
+                  py::gil_scoped_release nogil;
+                  s = stream_interpolation(raw, segments, o);
+              }
+              py::dict d;
+              d["segments"] = s.segments;
+              d["frames"] = s.frames;
+              d["xon_errors"] = s.xon_errors;
+              d["min_level_after_start"] = s.min_level_after_start;
+              d["underruns"] = s.underruns;
+              return d;
+          },
+          py::arg("axes"), py::arg("segments"), py::arg("interpol_time_ms") = 100, py::arg("fifo_size") = 64,
+          py::arg("sleep") = py::none(), py::arg("backoff") = py::none(),
+          "Streams segments[k][axis] to every axis, starting them with SYNCHRO INTERPOL.");
 }

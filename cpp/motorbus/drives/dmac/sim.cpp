@@ -1,0 +1,979 @@
+#include "motorbus/drives/dmac/sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace motorbus::dmac {
+
+struct DmacSim::Pending {
+    Cmd kind;
+    std::int32_t value;
+};
+
+namespace {
+
+constexpr std::int64_t kNsPerMs = 1'000'000;
+
+std::int32_t wrap_i32(std::int64_t v) {
+    auto u = static_cast<std::uint32_t>(static_cast<std::uint64_t>(v) & 0xFFFFFFFFu);
+    return u <= 0x7FFFFFFFu ? static_cast<std::int32_t>(u)
+                            : static_cast<std::int32_t>(static_cast<std::int64_t>(u) - 0x100000000LL);
+}
+
+std::int32_t round_i32(double v) {
+    if (!std::isfinite(v)) return 0;
+    double r = std::round(v);
+    if (r > 2147483647.0) return std::numeric_limits<std::int32_t>::max();
+    if (r < -2147483648.0) return std::numeric_limits<std::int32_t>::min();
+    return static_cast<std::int32_t>(r);
+}
+
+// Live-only commands run at once even while a sequence is being edited and
+// are never stored; sequence-only commands are refused in live mode.
+bool live_only(Cmd c) {
+    switch (c) {
+        case Cmd::Read: case Cmd::ReadSeq: case Cmd::OpenSeq: case Cmd::CloseSeq:
+        case Cmd::RequestVersion: case Cmd::SetAddress: case Cmd::SetBaudrate:
+        case Cmd::ModuleReset: case Cmd::Step: case Cmd::Invalid:
+            return true;
+        default:
+            return false;
+    }
+}
+bool sequence_only(Cmd c) {
+    switch (c) {
+        case Cmd::Call: case Cmd::Return: case Cmd::If: case Cmd::Jump: case Cmd::JumpRel:
+        case Cmd::Wait:
+            return true;
+        default:
+            return false;
+    }
+}
+
+}  // namespace
+
+std::optional<Model> parse_model(std::string_view s) {
+    static constexpr std::pair<std::string_view, Model> t[] = {
+        {"DMAC17", Model::Dmac17},     {"DMAC23", Model::Dmac23_1},   {"DMAC23-1", Model::Dmac23_1},
+        {"DMAC23-2", Model::Dmac23_2}, {"DMAC34", Model::Dmac34_1},   {"DMAC34-1", Model::Dmac34_1},
+        {"DMAC34-2", Model::Dmac34_2},
+    };
+    for (const auto& [n, m] : t)
+        if (n == s) return m;
+    return std::nullopt;
+}
+
+std::string_view model_name(Model m) {
+    switch (m) {
+        case Model::Dmac17: return "DMAC17";
+        case Model::Dmac23_1: return "DMAC23-1";
+        case Model::Dmac23_2: return "DMAC23-2";
+        case Model::Dmac34_1: return "DMAC34-1";
+        case Model::Dmac34_2: return "DMAC34-2";
+    }
+    return "DMAC34-1";
+}
+
+DmacSim::DmacSim(std::shared_ptr<Clock> clock, SimOptions options)
+    : clock_(std::move(clock)), options_(std::move(options)) {
+    if (!clock_) clock_ = std::make_shared<RealClock>();
+    if (options_.address < 0 || options_.address > kMaxAddress)
+        throw InvalidArgument("DmacSim address: " + std::to_string(options_.address) +
+                              " is outside 0..63");
+    epoch_ns_ = clock_->now();
+    address_ = options_.address;
+    baudrate_ = options_.baudrate;
+    program_.assign(kSeqLines + 1, std::nullopt);
+    std::lock_guard lock(mutex_);
+    restart_motion_at(0);
+    reset_locked(true);
+}
+
+DmacSim::~DmacSim() = default;
+
+bool DmacSim::dmac34() const {
+    return options_.model == Model::Dmac34_1 || options_.model == Model::Dmac34_2;
+}
+
+std::uint32_t DmacSim::input_mask() const { return dmac34() ? 0x3FFu : 0x3Fu; }
+
+std::uint32_t DmacSim::logical_inputs() const {
+    return (physical_inputs_ ^ (invert_in_ ? input_mask() : 0u)) & input_mask();
+}
+
+bool DmacSim::var_available(Var v) const { return dmac34() || !var_info(v).dmac34_only; }
+
+motion::DmacProfileParams DmacSim::params() const {
+    motion::DmacProfileParams p;
+    p.high_speed = vars_[static_cast<std::size_t>(Var::HighSpeed)];
+    p.low_speed = vars_[static_cast<std::size_t>(Var::LowSpeed)];
+    p.accel_time_ms = vars_[static_cast<std::size_t>(Var::AccelTime)];
+    p.decel_time_ms = vars_[static_cast<std::size_t>(Var::DecelTime)];
+    p.s_curve = s_curve_;
+    return p;
+}
+
+// ---- time -------------------------------------------------------------------
+double DmacSim::motion_t() const { return static_cast<double>(now_ms_ - motion_t0_ms_) / 1000.0; }
+
+motion::State DmacSim::motion_state() const {
+    if (interpolating_) {
+        motion::State s;
+        s.p = interp_pos_;
+        s.v = interp_speed_;
+        return s;
+    }
+    motion::State s = motion_->at(motion_t());
+    s.p += static_cast<double>(pos_offset_);
+    return s;
+}
+
+std::int32_t DmacSim::position_locked() const { return wrap_i32(std::llround(motion_state().p)); }
+
+std::int32_t DmacSim::speed_locked() const {
+    return round_i32(motion::dmac_inc_per_s_to_speed(motion_state().v));
+}
+
+bool DmacSim::moving_locked() const { return interpolating_ || motion_->moving(motion_t()); }
+
+void DmacSim::catch_up_locked() {
+    const std::int64_t target = (clock_->now() - epoch_ns_) / kNsPerMs;
+    while (now_ms_ < target) {
+        const bool timers = vars_[static_cast<std::size_t>(Var::Timer1)] ||
+                            vars_[static_cast<std::size_t>(Var::Timer2)] ||
+                            vars_[static_cast<std::size_t>(Var::Timer3)];
+        if (!seq_running_ && !timers && !moving_locked()) {
+            // Nothing evolves while idle: jump instead of ticking through it.
+            now_ms_ = target;
+            break;
+        }
+        tick_locked();
+    }
+}
+
+void DmacSim::tick_locked() {
+    ++now_ms_;
+    for (int i = 1; i <= 3; ++i) {
+        auto& t = vars_[static_cast<std::size_t>(timer_var(i))];
+        if (t > 0) --t;
+    }
+    if (interpolating_) {
+        if (fifo_.empty()) {
+            interpolating_ = false;
+            restart_motion_at(interp_pos_);
+        } else {
+            const Segment& s = fifo_.front();
+            ++seg_elapsed_ms_;
+            interp_speed_ = static_cast<double>(s.offset) * 1000.0 / s.duration_ms;
+            interp_pos_ = seg_start_pos_ + static_cast<double>(s.offset) * seg_elapsed_ms_ / s.duration_ms;
+            if (seg_elapsed_ms_ >= s.duration_ms) {
+                seg_start_pos_ += s.offset;
+                interp_pos_ = seg_start_pos_;
+                fifo_.pop_front();
+                seg_elapsed_ms_ = 0;
+                if (fifo_.empty()) {
+                    // FIFO ran dry: the movement stops; a new SYNCHRO INTERPOL is needed.
+                    interpolating_ = false;
+                    interp_speed_ = 0;
+                    restart_motion_at(interp_pos_);
+                }
+            }
+        }
+    }
+    check_end_stops();
+    if (seq_running_) {
+        switch (wait_) {
+            case WaitKind::Time:
+                if (now_ms_ < wait_until_ms_) return;
+                break;
+            case WaitKind::Motion:
+                if (moving_locked()) return;
+                break;
+            case WaitKind::MotionTimeout:
+                if (moving_locked() && now_ms_ < wait_until_ms_) return;
+                break;
+            case WaitKind::None:
+                break;
+        }
+        if (wait_ != WaitKind::None) {
+            wait_ = WaitKind::None;
+            line_ = resume_line_;
+            if (line_ < 1 || line_ > kSeqLines) {
+                seq_stop();
+                return;
+            }
+        }
+        seq_execute_line(line_);
+    }
+}
+
+void DmacSim::poll() {
+    std::lock_guard lock(mutex_);
+    catch_up_locked();
+}
+
+// ---- motion -----------------------------------------------------------------
+void DmacSim::restart_motion_at(double position) {
+    pos_offset_ = 0;
+    motion_ = std::make_unique<motion::DmacMotion>(params(), position);
+    motion_t0_ms_ = now_ms_;
+    position_mode_ = false;
+}
+
+void DmacSim::halt_motion() {
+    const double p = motion_state().p;
+    if (interpolating_ || !fifo_.empty()) {
+        interpolating_ = false;
+        fifo_.clear();
+        seg_elapsed_ms_ = 0;
+        interp_speed_ = 0;
+    }
+    restart_motion_at(p);
+}
+
+bool DmacSim::start_move(Cmd kind, std::int32_t value) {
+    if (brake_) {
+        flag(error::kLimit);
+        return false;
+    }
+    const double p = motion_state().p;
+    int dir = 0;
+    if (kind == Cmd::MoveTo) dir = (value > p) - (value < p);
+    else dir = (value > 0) - (value < 0);
+    // An end-stop that is hit only lets the axis move back.
+    update_end_flags();
+    if (dir > 0 && (hard_pos_hit_ || soft_pos_hit_)) {
+        flag(error::kLimit);
+        return false;
+    }
+    if (dir < 0 && (hard_neg_hit_ || soft_neg_hit_)) {
+        flag(error::kLimit);
+        return false;
+    }
+    if (interpolating_) halt_motion();
+    try {
+        motion_->set_params(params());
+        const double t = motion_t();
+        // Targets are in the user's frame; the profile runs in its own (see pos_offset_).
+        if (kind == Cmd::MoveTo) {
+            motion_->move_to(t, static_cast<std::int64_t>(value) - pos_offset_);
+        } else if (kind == Cmd::MoveOn) {
+            // Relative to the target of a position move in progress, else to where the axis is.
+            const std::int64_t base = (position_mode_ && motion_->moving(t))
+                                          ? motion_->target()
+                                          : std::llround(p) - pos_offset_;
+            motion_->move_to(t, base + value);
+        } else {
+            motion_->move_speed(t, value);
+        }
+    } catch (const std::exception&) {
+        flag(error::kLimit);
+        restart_motion_at(p);
+        return false;
+    }
+    position_mode_ = kind != Cmd::MoveSpeed;
+    power_ = true;
+    abnormal_stop_ = false;
+    return true;
+}
+
+void DmacSim::update_end_flags() {
+    const motion::State s = motion_state();
+    const auto pen = static_cast<double>(vars_[static_cast<std::size_t>(Var::PositiveEnd)]);
+    const auto nen = static_cast<double>(vars_[static_cast<std::size_t>(Var::NegativeEnd)]);
+    const std::uint32_t in = logical_inputs();
+    const std::uint32_t in_pos = dmac34() ? bit_mask(9) : bit_mask(1);
+    const std::uint32_t in_neg = dmac34() ? bit_mask(10) : bit_mask(2);
+    hard_pos_hit_ = hard_pos_ && (in & in_pos);
+    hard_neg_hit_ = hard_neg_ && (in & in_neg);
+    soft_pos_hit_ = soft_ends_ && s.p >= pen;
+    soft_neg_hit_ = soft_ends_ && s.p <= nen;
+}
+
+void DmacSim::check_end_stops() {
+    update_end_flags();
+    const motion::State s = motion_state();
+    const auto pen = static_cast<double>(vars_[static_cast<std::size_t>(Var::PositiveEnd)]);
+    const auto nen = static_cast<double>(vars_[static_cast<std::size_t>(Var::NegativeEnd)]);
+    const bool moving = moving_locked();
+    if (!moving) return;
+    if (soft_pos_hit_ && s.v > 0) {
+        // The firmware stops the axis on the virtual end-stop itself.
+        halt_motion();
+        restart_motion_at(pen);
+        abnormal_stop_ = true;
+    } else if (soft_neg_hit_ && s.v < 0) {
+        halt_motion();
+        restart_motion_at(nen);
+        abnormal_stop_ = true;
+    } else if ((hard_pos_hit_ && s.v > 0) || (hard_neg_hit_ && s.v < 0)) {
+        halt_motion();
+        abnormal_stop_ = true;
+    }
+}
+
+// ---- reset --------------------------------------------------------------------
+void DmacSim::reset_locked(bool factory) {
+    const double p = motion_state().p;
+    for (std::size_t i = 0; i < kVarCount; ++i) {
+        const VarInfo& vi = var_info(static_cast<Var>(i));
+        if (vi.read_only) continue;
+        // Serial line configuration (#LINE_DELAY) survives even MODULE_RESET ALL.
+        if (static_cast<Var>(i) == Var::LineDelay && factory && !first_reset_) continue;
+        if (!vi.stored || factory) vars_[i] = vi.factory;
+    }
+    if (factory) {
+        hard_pos_ = hard_neg_ = soft_ends_ = false;
+        invert_in_ = invert_out_ = false;
+        s_curve_ = optimized_current_ = false;
+    }
+    vars_[static_cast<std::size_t>(Var::Capture)] = 0;
+    error_ = 0;
+    power_ = brake_ = reference_ = synchro_ = abnormal_stop_ = false;
+    pending_.reset();
+    interpolating_ = false;
+    fifo_.clear();
+    seg_elapsed_ms_ = 0;
+    interp_speed_ = 0;
+    edit_ = false;
+    seq_running_ = false;
+    line_ = 0;
+    call_stack_.clear();
+    wait_ = WaitKind::None;
+    // Position is stored (kept across a reset) unless factory settings are restored.
+    restart_motion_at(factory ? 0.0 : std::round(p));
+    first_reset_ = false;
+    const std::int32_t on_reset = vars_[static_cast<std::size_t>(Var::OnReset)];
+    if (on_reset >= 1 && on_reset <= kSeqLines) seq_start(on_reset);
+}
+
+void DmacSim::power_cycle() {
+    std::lock_guard lock(mutex_);
+    catch_up_locked();
+    reset_locked(false);
+}
+
+// ---- variables ----------------------------------------------------------------
+std::uint32_t DmacSim::status_locked() {
+    update_end_flags();
+    std::uint32_t s = 0;
+    auto set = [&](int bit, bool on) {
+        if (on) s |= bit_mask(bit);
+    };
+    const bool moving = moving_locked();
+    set(status::kOptimizedCurrent, optimized_current_);
+    set(status::kHardPosEnabled, hard_pos_);
+    set(status::kHardNegEnabled, hard_neg_);
+    set(status::kSoftEndsEnabled, soft_ends_);
+    set(status::kHardEndsInverted, invert_in_);
+    set(status::kSCurve, s_curve_);
+    set(status::kInputsInverted, invert_in_);
+    set(status::kOutputsInverted, invert_out_);
+    set(status::kSeqRun, seq_running_);
+    set(status::kSeqEdit, edit_);
+    set(status::kHardPosEnd, hard_pos_hit_);
+    set(status::kHardNegEnd, hard_neg_hit_);
+    set(status::kSoftPosEnd, soft_pos_hit_);
+    set(status::kSoftNegEnd, soft_neg_hit_);
+    set(status::kBrake, brake_);
+    set(status::kSynchro, synchro_);
+    set(status::kPowerOn, power_);
+    set(status::kMovement, moving);
+    if (moving && position_mode_ && !interpolating_) {
+        const double err = static_cast<double>(motion_->target() + pos_offset_) - motion_state().p;
+        set(status::kPositionControl, std::fabs(err) <= motion::kDmacApproachIncrements);
+    }
+    set(status::kBusy, moving);
+    set(status::kReference, reference_);
+    set(status::kError, error_ != 0);
+    set(status::kAbnormalStop, abnormal_stop_);
+    return s;
+}
+
+std::optional<std::int32_t> DmacSim::read_var_locked(Var v, int bit) {
+    if (!var_available(v)) return std::nullopt;
+    std::int32_t value;
+    switch (v) {
+        case Var::Position: value = position_locked(); break;
+        case Var::Speed:
+        case Var::ProfileSpeed: value = speed_locked(); break;
+        case Var::Status: value = wrap_i32(status_locked()); break;
+        case Var::Error: value = wrap_i32(error_); break;
+        case Var::Input: value = wrap_i32(logical_inputs()); break;
+        case Var::InputAnalog:
+        case Var::InputA1: value = analog_[1]; break;
+        case Var::InputA2: value = analog_[2]; break;
+        case Var::InterpolCount: value = static_cast<std::int32_t>(fifo_.size()); break;
+        case Var::Line: value = seq_running_ ? line_ : 0; break;
+        case Var::CpuTemperature: value = options_.cpu_temperature; break;
+        case Var::DriverTemperature: value = options_.driver_temperature; break;
+        case Var::MotorTemperature: value = options_.motor_temperature; break;
+        case Var::SupplyVoltage: value = options_.supply_voltage_mv; break;
+        default: value = vars_[static_cast<std::size_t>(v)]; break;
+    }
+    if (bit) return (static_cast<std::uint32_t>(value) >> (bit - 1)) & 1u;
+    return value;
+}
+
+int DmacSim::write_var_locked(Var v, int bit, std::int32_t value) {
+    const VarInfo& vi = var_info(v);
+    if (!var_available(v) || vi.read_only) return error::kSyntax;
+    if (bit) {
+        if (value != 0 && value != 1) return error::kLimit;
+        auto cur = read_var_locked(v, 0);
+        if (!cur) return error::kSyntax;
+        auto u = static_cast<std::uint32_t>(*cur);
+        u = value ? (u | bit_mask(bit)) : (u & ~bit_mask(bit));
+        value = wrap_i32(u);
+    }
+    if (value < vi.min || value > vi.max) return error::kLimit;
+    switch (v) {
+        case Var::Position: {
+            // Re-home: the current motion continues from the new origin.
+            const double p = motion_state().p;
+            if (interpolating_) {
+                const double shift = static_cast<double>(value) - p;
+                interp_pos_ += shift;
+                seg_start_pos_ += shift;
+            } else if (motion_->moving(motion_t())) {
+                pos_offset_ += static_cast<std::int64_t>(value) - std::llround(p);
+            } else {
+                restart_motion_at(value);
+            }
+            return 0;
+        }
+        case Var::Error:
+            error_ = 0;
+            return 0;
+        case Var::Line:
+            if (value == 0) seq_stop();
+            else line_ = value;
+            return 0;
+        default:
+            vars_[static_cast<std::size_t>(v)] = value;
+            return 0;
+    }
+}
+
+std::optional<std::int32_t> DmacSim::eval_operand(const Operand& o) {
+    std::int64_t v;
+    if (o.is_var) {
+        auto r = read_var_locked(o.var, o.bit);
+        if (!r) {
+            flag(error::kSyntax);
+            return std::nullopt;
+        }
+        v = *r;
+    } else {
+        v = o.value;
+    }
+    if (o.negate) v = -v;
+    if (o.complement) v = ~v;
+    return wrap_i32(v);
+}
+
+std::optional<std::int32_t> DmacSim::eval(const Expr& e) {
+    auto a = eval_operand(e.lhs);
+    if (!a) return std::nullopt;
+    if (e.op == Op::None) return a;
+    auto b = eval_operand(e.rhs);
+    if (!b) return std::nullopt;
+    const std::int64_t x = *a, y = *b;
+    switch (e.op) {
+        case Op::Add: return wrap_i32(x + y);
+        case Op::Sub: return wrap_i32(x - y);
+        case Op::Mul: return wrap_i32(x * y);
+        case Op::Div:
+            if (y == 0) {
+                flag(error::kComputation);
+                return std::nullopt;
+            }
+            return wrap_i32(x / y);
+        case Op::And: return wrap_i32(x & y);
+        case Op::Or: return wrap_i32(x | y);
+        case Op::Gt: return x > y;
+        case Op::Lt: return x < y;
+        case Op::Ge: return x >= y;
+        case Op::Le: return x <= y;
+        case Op::Ne: return x != y;
+        case Op::Eq: return x == y;
+        case Op::None: break;
+    }
+    return a;
+}
+
+// ---- sequencer ------------------------------------------------------------------
+void DmacSim::seq_start(int line) {
+    seq_running_ = true;
+    line_ = line;
+    call_stack_.clear();
+    wait_ = WaitKind::None;
+}
+
+void DmacSim::seq_stop() {
+    seq_running_ = false;
+    line_ = 0;
+    call_stack_.clear();
+    wait_ = WaitKind::None;
+}
+
+void DmacSim::seq_execute_line(int n) {
+    if (n < 1 || n > kSeqLines) {
+        seq_stop();
+        return;
+    }
+    line_ = n;
+    int next = n + 1;
+    const std::optional<Command>& slot = program_[static_cast<std::size_t>(n)];
+    auto jump_to = [&](Cmd kind, const Expr& target) -> bool {
+        auto t = eval(target);
+        if (!t) return false;
+        std::int64_t dest = *t;
+        if (kind == Cmd::JumpRel) dest = n + static_cast<std::int64_t>(*t);
+        if (kind == Cmd::Jump && dest == 0) {  // JUMP 0 ends the program
+            next = 0;
+            return true;
+        }
+        if (dest < 1 || dest > kSeqLines) {
+            flag(error::kLimit);
+            return false;
+        }
+        if (kind == Cmd::Call) {
+            if (call_stack_.size() >= 5) {  // five nested calls at most
+                flag(error::kLimit);
+                return false;
+            }
+            call_stack_.push_back(n + 1);
+        }
+        next = static_cast<int>(dest);
+        return true;
+    };
+    bool ok = true;
+    if (slot) {
+        const Command& c = *slot;
+        switch (c.cmd) {
+            case Cmd::Jump: case Cmd::JumpRel: case Cmd::Call:
+                ok = jump_to(c.cmd, c.expr);
+                break;
+            case Cmd::Return:
+                if (call_stack_.empty()) {
+                    flag(error::kSyntax);
+                    ok = false;
+                } else {
+                    next = call_stack_.back();
+                    call_stack_.pop_back();
+                }
+                break;
+            case Cmd::If: {
+                auto t = eval(c.expr);
+                if (!t) ok = false;
+                else if (*t != 0) ok = jump_to(c.jump, c.target);
+                break;
+            }
+            case Cmd::Wait: {
+                auto w = eval(c.expr);
+                if (!w || *w < -3600000 || *w > 3600000) {
+                    if (w) flag(error::kLimit);
+                    ok = false;
+                } else if (*w > 0) {
+                    wait_ = WaitKind::Time;
+                    wait_until_ms_ = now_ms_ + *w;
+                } else if (*w == 0) {
+                    wait_ = WaitKind::Motion;
+                } else {
+                    wait_ = WaitKind::MotionTimeout;
+                    wait_until_ms_ = now_ms_ - static_cast<std::int64_t>(*w);
+                }
+                break;
+            }
+            default:
+                execute_locked(c, true, false);
+                break;
+        }
+    }
+    // A failed flow-control line stops the program (the error bit says why).
+    if (!ok) {
+        seq_stop();
+        return;
+    }
+    if (!seq_running_) return;  // the line itself stopped the sequencer (STOP, HALT, #LINE:=0)
+    if (line_ != n) return;     // the line wrote #LINE: that is the next line
+    if (wait_ != WaitKind::None) {
+        resume_line_ = next;     // #LINE shows the WAIT line while it waits
+        return;
+    }
+    if (next < 1 || next > kSeqLines) seq_stop();
+    else line_ = next;
+}
+
+// ---- commands -------------------------------------------------------------------
+std::string DmacSim::execute_locked(const Command& c, bool from_sequencer, bool global) {
+    (void)global;
+    const std::string& term = options_.reply_terminator;
+    if (!from_sequencer && sequence_only(c.cmd)) {
+        flag(error::kSyntax);
+        return "";
+    }
+    if (from_sequencer && live_only(c.cmd)) {
+        flag(error::kSyntax);
+        return "";
+    }
+    auto arg = [&]() -> std::optional<std::int32_t> { return eval(c.expr); };
+    auto in_range = [&](std::optional<std::int32_t> v, std::int64_t lo, std::int64_t hi) {
+        if (!v) return false;
+        if (*v < lo || *v > hi) {
+            flag(error::kLimit);
+            return false;
+        }
+        return true;
+    };
+    switch (c.cmd) {
+        case Cmd::Invalid:
+            flag(c.error_bit ? c.error_bit : error::kSyntax);
+            return "";
+        case Cmd::Assign: {
+            auto v = arg();
+            if (!v) return "";
+            if (int e = write_var_locked(c.var, c.bit, *v)) flag(e);
+            return "";
+        }
+        case Cmd::Brake:
+            if (!dmac34()) {
+                flag(error::kSyntax);
+                return "";
+            }
+            brake_ = c.keyword == Keyword::On;
+            if (brake_) halt_motion();
+            return "";
+        case Cmd::CloseSeq:
+            edit_ = false;
+            return "";
+        case Cmd::OpenSeq:
+            seq_stop();
+            for (auto& l : program_) l.reset();
+            edit_ = true;
+            edit_line_ = 1;
+            return "";
+        case Cmd::Halt:
+            if (c.keyword != Keyword::Seq) halt_motion();
+            if (c.keyword != Keyword::Mouv) seq_stop();
+            return "";
+        case Cmd::Stop:
+            if (c.keyword != Keyword::Seq) {
+                // In interpolation STOP is HALT and empties the FIFO.
+                if (interpolating_) halt_motion();
+                else {
+                    fifo_.clear();
+                    motion_->stop(motion_t());
+                }
+            }
+            if (c.keyword != Keyword::Mouv) seq_stop();
+            return "";
+        case Cmd::HardEnds:
+            hard_pos_ = c.keyword == Keyword::All || c.keyword == Keyword::Pos;
+            hard_neg_ = c.keyword == Keyword::All || c.keyword == Keyword::Neg;
+            return "";
+        case Cmd::InversePolarity:
+            invert_in_ = c.keyword == Keyword::All || c.keyword == Keyword::In;
+            invert_out_ = c.keyword == Keyword::All || c.keyword == Keyword::Out;
+            return "";
+        case Cmd::ModuleReset:
+            reset_locked(c.keyword == Keyword::All);
+            return "";
+        case Cmd::MoveInterpol: {
+            auto v = arg();
+            if (!v) return "";
+            const auto cap = static_cast<std::size_t>(vars_[static_cast<std::size_t>(Var::InterpolFifosize)]);
+            if (fifo_.size() >= cap) return std::string(1, kXonError);
+            fifo_.push_back({*v, vars_[static_cast<std::size_t>(Var::InterpolTime)]});
+            return "";
+        }
+        case Cmd::MoveOn:
+        case Cmd::MoveTo:
+        case Cmd::MoveSpeed: {
+            auto v = arg();
+            if (c.cmd == Cmd::MoveSpeed && !in_range(v, -400000, 400000)) return "";
+            if (!v) return "";
+            if (synchro_) pending_ = std::make_unique<Pending>(Pending{c.cmd, *v});
+            else start_move(c.cmd, *v);
+            return "";
+        }
+        case Cmd::Nop:
+            return "";
+        case Cmd::OptimizedCurrent:
+            optimized_current_ = c.keyword == Keyword::On;
+            return "";
+        case Cmd::SCurve:
+            s_curve_ = c.keyword == Keyword::On;
+            return "";
+        case Cmd::SoftEnds:
+            soft_ends_ = c.keyword == Keyword::On;
+            return "";
+        case Cmd::Power:
+            if (c.keyword == Keyword::On) power_ = true;
+            else {
+                halt_motion();
+                power_ = false;
+            }
+            return "";
+        case Cmd::Read: {
+            auto v = read_var_locked(c.var, c.bit);
+            if (!v) {
+                flag(error::kSyntax);
+                return "";
+            }
+            return format_read_reply(address_, c.var, c.bit, *v, c.radix) + term;
+        }
+        case Cmd::ReadSeq: {
+            auto n = arg();
+            if (!in_range(n, 1, kSeqLines)) return "";
+            const auto& l = program_[static_cast<std::size_t>(*n)];
+            return format_seq_reply(address_, *n, l ? format_command(*l) : "") + term;
+        }
+        case Cmd::Reference:
+            reference_ = c.keyword == Keyword::On;
+            return "";
+        case Cmd::RequestVersion: {
+            std::string code = dmac34() ? "H142" : (options_.model == Model::Dmac17 ? "9148" : "F138");
+            return address_prefix(address_) + "EV " + options_.firmware + " " + code +
+                   " \"MIDI-INGENIERIE_" + std::string(model_name(options_.model)) + "_" +
+                   options_.serial_number + "_" + options_.manufacturing_date + "_" +
+                   options_.revision_date + "\" PHASE:" + options_.phase + " BOOT:" + options_.boot +
+                   term;
+        }
+        case Cmd::SetAddress: {
+            auto n = arg();
+            if (in_range(n, 0, kMaxAddress)) address_ = *n;
+            return "";
+        }
+        case Cmd::SetBaudrate: {
+            auto n = arg();
+            if (!n) return "";
+            if (*n != 9600 && *n != 19200 && *n != 38400 && *n != 115200) flag(error::kLimit);
+            else baudrate_ = *n;
+            return "";
+        }
+        case Cmd::StartSeq: {
+            std::optional<std::int32_t> n = 1;
+            if (c.has_arg) n = arg();
+            if (in_range(n, 1, kSeqLines)) seq_start(*n);
+            return "";
+        }
+        case Cmd::Step: {
+            std::optional<std::int32_t> n = line_ ? line_ : 1;
+            if (c.has_arg) n = arg();
+            if (!in_range(n, 1, kSeqLines)) return "";
+            // Debug mode: one line now, the sequencer itself stays stopped.
+            seq_running_ = true;
+            seq_execute_line(*n);
+            const int next = wait_ != WaitKind::None ? resume_line_ : line_;
+            seq_running_ = false;
+            wait_ = WaitKind::None;
+            line_ = next;
+            return "";
+        }
+        case Cmd::Synchro:
+            switch (c.keyword) {
+                case Keyword::On: synchro_ = true; break;
+                case Keyword::Off:
+                    synchro_ = false;
+                    pending_.reset();
+                    break;
+                case Keyword::Top:
+                    if (pending_) {
+                        Pending p = *pending_;
+                        pending_.reset();
+                        start_move(p.kind, p.value);
+                    }
+                    break;
+                case Keyword::Interpol:
+                    if (!fifo_.empty() && !interpolating_) {
+                        const double p = motion_state().p;
+                        restart_motion_at(p);
+                        interpolating_ = true;
+                        seg_elapsed_ms_ = 0;
+                        seg_start_pos_ = interp_pos_ = p;
+                        interp_speed_ = 0;
+                        power_ = true;
+                        abnormal_stop_ = false;
+                    }
+                    break;
+                default: break;
+            }
+            return "";
+        default:
+            flag(error::kSyntax);
+            return "";
+    }
+}
+
+std::string DmacSim::handle_locked(std::string_view line) {
+    ++lines_handled_;
+    Request req = parse_request(line);
+    if (req.address_error) return "";
+    const bool global = req.address == kGlobal;
+    if (!global && req.address != address_) return "";
+    bool rejected = false;
+    std::string reply;
+    if (edit_) {
+        int at = req.seq_line ? req.seq_line : edit_line_;
+        for (const Command& c : req.commands) {
+            if (c.cmd == Cmd::Invalid) {
+                flag(c.error_bit);
+                rejected = true;
+            } else if (live_only(c.cmd)) {
+                reply += execute_locked(c, false, global);
+            } else if (at > kSeqLines) {
+                flag(error::kLimit);
+                rejected = true;
+            } else {
+                program_[static_cast<std::size_t>(at)] = c;
+                edit_line_ = ++at;
+            }
+        }
+    } else {
+        if (req.seq_line) {
+            flag(error::kSyntax);  // ":n" only means something while editing
+            rejected = true;
+        } else {
+            for (const Command& c : req.commands)
+                if (c.cmd == Cmd::Invalid) {
+                    // A frame with a syntax error changes nothing (half a frame
+                    // could start a move the host never meant); its READs still
+                    // answer, so "cmd, READ #ERROR" reports the rejection.
+                    flag(c.error_bit);
+                    rejected = true;
+                }
+            for (const Command& c : req.commands)
+                if (!rejected || c.cmd == Cmd::Read) reply += execute_locked(c, false, global);
+        }
+    }
+    if (rejected) ++lines_rejected_;
+    // Global frames run everywhere but only module 00 answers them.
+    if (global && address_ != 0) return "";
+    return reply;
+}
+
+std::string DmacSim::on_line(std::string_view line) {
+    std::lock_guard lock(mutex_);
+    try {
+        catch_up_locked();
+        return handle_locked(line);
+    } catch (...) {
+        // Hostile input must never take the device down: flag and stay silent.
+        flag(error::kSyntax);
+        return "";
+    }
+}
+
+std::string DmacSim::on_overlong() {
+    std::lock_guard lock(mutex_);
+    ++lines_rejected_;
+    return "";
+}
+
+// ---- inspection -------------------------------------------------------------------
+SimState DmacSim::state() {
+    std::lock_guard lock(mutex_);
+    catch_up_locked();
+    SimState s;
+    s.now_ms = now_ms_;
+    s.position = position_locked();
+    s.speed = speed_locked();
+    s.status = status_locked();
+    s.error = error_;
+    s.line = seq_running_ ? line_ : 0;
+    s.sequencer_running = seq_running_;
+    s.fifo_count = static_cast<int>(fifo_.size());
+    s.interpolating = interpolating_;
+    s.power = power_;
+    return s;
+}
+
+std::int32_t DmacSim::read(Var v) {
+    std::lock_guard lock(mutex_);
+    catch_up_locked();
+    return read_var_locked(v, 0).value_or(0);
+}
+
+int DmacSim::address() {
+    std::lock_guard lock(mutex_);
+    return address_;
+}
+
+std::int32_t DmacSim::baudrate() {
+    std::lock_guard lock(mutex_);
+    return baudrate_;
+}
+
+std::string DmacSim::sequence_line(int n) {
+    std::lock_guard lock(mutex_);
+    if (n < 1 || n > kSeqLines) return "";
+    const auto& l = program_[static_cast<std::size_t>(n)];
+    return l ? format_command(*l) : "";
+}
+
+void DmacSim::set_input(int n, bool active) {
+    if (n < 1 || n > 10) throw InvalidArgument("DmacSim input: " + std::to_string(n) + " is outside 1..10");
+    std::lock_guard lock(mutex_);
+    catch_up_locked();
+    const bool was = (logical_inputs() & bit_mask(5)) != 0;
+    if (active) physical_inputs_ |= bit_mask(n);
+    else physical_inputs_ &= ~bit_mask(n);
+    const bool is = (logical_inputs() & bit_mask(5)) != 0;
+    if (!was && is) {
+        // IN5 rising edge: capture, and re-home in reference mode when turning CW.
+        const motion::State s = motion_state();
+        vars_[static_cast<std::size_t>(Var::Capture)] = position_locked();
+        if (reference_ && s.v > 0) {
+            write_var_locked(Var::Position, 0, 0);
+            reference_ = false;
+        }
+    }
+    check_end_stops();
+}
+
+void DmacSim::set_analog(int channel, std::int32_t mv) {
+    if (channel < 1 || channel > 2) throw InvalidArgument("DmacSim analog channel: 1 or 2");
+    std::lock_guard lock(mutex_);
+    analog_[channel] = mv;
+}
+
+void DmacSim::set_supply_voltage(std::int32_t mv) {
+    std::lock_guard lock(mutex_);
+    options_.supply_voltage_mv = mv;
+}
+
+void DmacSim::inject_error(int bit) {
+    if (bit < 1 || bit > 32) throw InvalidArgument("DmacSim error bit: 1..32");
+    std::lock_guard lock(mutex_);
+    flag(bit);
+}
+
+std::uint32_t DmacSim::physical_outputs() {
+    std::lock_guard lock(mutex_);
+    catch_up_locked();
+    const std::uint32_t mask = dmac34() ? 0xFFu : 0x0Fu;
+    auto logical = static_cast<std::uint32_t>(vars_[static_cast<std::size_t>(Var::Output)]);
+    const std::int32_t cfg = vars_[static_cast<std::size_t>(Var::OutputConfig)];
+    if (cfg & 1) logical = (logical & ~1u) | (moving_locked() ? 1u : 0u);
+    if (cfg & 2) {
+        const std::uint32_t faults = bit_mask(error::kThermal) | bit_mask(error::kShortCircuit) |
+                                     bit_mask(error::kUndervoltage) | bit_mask(error::kOvervoltage);
+        logical = (logical & ~2u) | ((error_ & faults) ? 2u : 0u);
+    }
+    return (logical ^ (invert_out_ ? mask : 0u)) & mask;
+}
+
+std::uint64_t DmacSim::lines_handled() {
+    std::lock_guard lock(mutex_);
+    return lines_handled_;
+}
+
+std::uint64_t DmacSim::lines_rejected() {
+    std::lock_guard lock(mutex_);
+    return lines_rejected_;
+}
+
+}  // namespace motorbus::dmac

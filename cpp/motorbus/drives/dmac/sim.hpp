@@ -1,0 +1,187 @@
+// A DMAC module as a serial LineDevice: every variable with its stored or
+// volatile behaviour, the DMAC motion profile (motion::DmacMotion), hard and
+// soft end-stops, the 500-line sequencer (one line per millisecond), the
+// interpolation FIFO and MODULE_RESET [ALL].
+//
+// Time: device state lives on a motorbus::Clock.  Nothing runs in the
+// background; each call first brings the device up to clock.now() in 1 ms
+// ticks (sequencer line, timers, FIFO segment progress, end-stop checks), so
+// a SimClock advanced by a test gives exact, repeatable times.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "motorbus/drives/dmac/codec.hpp"
+#include "motorbus/motion/dmac_profile.hpp"
+#include "motorbus/runtime/clock.hpp"
+#include "motorbus/serial/line_device.hpp"
+
+namespace motorbus::dmac {
+
+enum class Model : std::uint8_t { Dmac17, Dmac23_1, Dmac23_2, Dmac34_1, Dmac34_2 };
+std::optional<Model> parse_model(std::string_view s);  // "DMAC17", "DMAC23-1", "DMAC34-1", ...
+std::string_view model_name(Model m);
+
+struct SimOptions {
+    int address = 0;
+    Model model = Model::Dmac34_1;
+    std::string request_terminator = "\r";
+    std::string reply_terminator = "\r\n";
+    std::int32_t supply_voltage_mv = 32000;
+    std::int32_t cpu_temperature = 520;     // 0.1 degC
+    std::int32_t driver_temperature = 450;  // DMAC34
+    std::int32_t motor_temperature = 650;   // DMAC34
+    std::int32_t baudrate = 38400;
+    // REQUEST_VERSION fields (defaults: the manual's example module).
+    std::string firmware = "v1.7";
+    std::string serial_number = "H142-10145";
+    std::string manufacturing_date = "25/01/05";
+    std::string revision_date = "12/04/06";
+    std::string phase = "6A";
+    std::string boot = "v1.1";
+};
+
+// Snapshot of what a test usually asserts on.
+struct SimState {
+    std::int64_t now_ms = 0;
+    std::int32_t position = 0;
+    std::int32_t speed = 0;          // 0.01 rpm
+    std::uint32_t status = 0;
+    std::uint32_t error = 0;
+    int line = 0;
+    bool sequencer_running = false;
+    int fifo_count = 0;
+    bool interpolating = false;
+    bool power = false;
+};
+
+class DmacSim : public serial::LineDevice {
+public:
+    explicit DmacSim(std::shared_ptr<Clock> clock, SimOptions options = {});
+    ~DmacSim() override;
+
+    // ---- LineDevice -------------------------------------------------------
+    std::string on_line(std::string_view line) override;
+    std::string request_terminator() const override { return options_.request_terminator; }
+    std::size_t max_request() const override { return kMaxFrame; }
+    // An over-long frame sets the syntax error bit and is not answered.
+    std::string on_overlong() override;
+
+    // ---- inspection and physical world (tests, demos) --------------------
+    void poll();                      // catch up with the clock
+    SimState state();
+    std::int32_t read(Var v);
+    int address();
+    std::int32_t baudrate();
+    const SimOptions& options() const { return options_; }
+    std::string sequence_line(int n);  // canonical text of stored line n ("" = empty)
+    // Physical input n (1-based) active or not (before INVERSE_POLARITY).
+    void set_input(int n, bool active);
+    void set_analog(int channel, std::int32_t mv);
+    void set_supply_voltage(std::int32_t mv);
+    void inject_error(int bit);       // e.g. error::kOvervoltage
+    std::uint32_t physical_outputs(); // after polarity and OUT1/OUT2 alternate functions
+    void power_cycle();               // same as MODULE_RESET
+    std::uint64_t lines_handled();
+    std::uint64_t lines_rejected();   // frames with at least one invalid command
+
+private:
+    struct Pending;  // a move armed by SYNCHRO ON, started by SYNCHRO TOP
+    void catch_up_locked();
+    void tick_locked();
+    std::string handle_locked(std::string_view line);
+    std::string execute_locked(const Command& c, bool from_sequencer, bool global);
+    void flag(int error_bit) { error_ |= bit_mask(error_bit); }
+
+    std::optional<std::int32_t> read_var_locked(Var v, int bit);
+    std::optional<std::int32_t> eval_operand(const Operand& o);
+    std::optional<std::int32_t> eval(const Expr& e);
+    int write_var_locked(Var v, int bit, std::int32_t value);  // 0 or error bit
+
+    bool var_available(Var v) const;
+    std::uint32_t status_locked();
+    double motion_t() const;
+    motion::State motion_state() const;
+    std::int32_t position_locked() const;
+    std::int32_t speed_locked() const;
+    bool moving_locked() const;
+    bool dmac34() const;
+    std::uint32_t input_mask() const;
+    std::uint32_t logical_inputs() const;
+    void restart_motion_at(double position);
+    void halt_motion();
+    bool start_move(Cmd kind, std::int32_t value);
+    void check_end_stops();
+    void update_end_flags();
+    void reset_locked(bool factory);
+    motion::DmacProfileParams params() const;
+
+    // sequencer
+    void seq_start(int line);
+    void seq_stop();
+    void seq_execute_line(int line);
+
+    std::shared_ptr<Clock> clock_;
+    SimOptions options_;
+    std::mutex mutex_;
+    Nanos epoch_ns_ = 0;
+    std::int64_t now_ms_ = 0;
+
+    std::array<std::int32_t, kVarCount> vars_{};
+    std::uint32_t error_ = 0;
+    std::uint32_t physical_inputs_ = 0;
+    std::int32_t analog_[3] = {0, 0, 0};
+
+    // stored configuration flags
+    bool hard_pos_ = false, hard_neg_ = false, soft_ends_ = false;
+    bool invert_in_ = false, invert_out_ = false, s_curve_ = false, optimized_current_ = false;
+    int address_ = 0;
+    std::int32_t baudrate_ = 38400;
+    // volatile state
+    bool power_ = false, brake_ = false, reference_ = false, synchro_ = false;
+    bool abnormal_stop_ = false;
+    bool hard_pos_hit_ = false, hard_neg_hit_ = false, soft_pos_hit_ = false, soft_neg_hit_ = false;
+
+    // motion
+    std::unique_ptr<motion::DmacMotion> motion_;
+    std::int64_t motion_t0_ms_ = 0;
+    bool position_mode_ = false;
+    // #POSITION written during a move re-homes without disturbing it: the
+    // profile keeps its own frame and the user frame is shifted by this.
+    std::int64_t pos_offset_ = 0;
+    std::unique_ptr<Pending> pending_;
+
+    // interpolation
+    struct Segment {
+        std::int32_t offset;
+        int duration_ms;
+    };
+    std::deque<Segment> fifo_;
+    bool interpolating_ = false;
+    int seg_elapsed_ms_ = 0;
+    double seg_start_pos_ = 0;
+    double interp_pos_ = 0;
+    double interp_speed_ = 0;
+
+    // sequencer
+    std::vector<std::optional<Command>> program_;  // index 1..500
+    bool edit_ = false;
+    int edit_line_ = 1;
+    bool seq_running_ = false;
+    int line_ = 0;                    // next line to execute (0 = stopped)
+    std::vector<int> call_stack_;
+    enum class WaitKind { None, Time, Motion, MotionTimeout } wait_ = WaitKind::None;
+    std::int64_t wait_until_ms_ = 0;
+    int resume_line_ = 0;             // line after the WAIT in progress
+    bool first_reset_ = true;
+
+    std::uint64_t lines_handled_ = 0, lines_rejected_ = 0;
+};
+
+}  // namespace motorbus::dmac
