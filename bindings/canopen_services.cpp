@@ -359,7 +359,12 @@ void bind_canopen_services(py::module_& m) {
                      auto st = node_state_from_name(state.cast<std::string>());
                      fn = [st] { return st; };
                  } else {
-                     auto holder = std::make_shared<py::object>(state);
+                     // Released from a thread without the GIL: take it for the decref.
+                     std::shared_ptr<py::object> holder(new py::object(state), [](py::object* o) {
+                         if (!Py_IsInitialized()) return;
+                         py::gil_scoped_acquire gil;
+                         delete o;
+                     });
                      fn = [holder] {
                          py::gil_scoped_acquire gil;
                          return node_state_from_name((*holder)().cast<std::string>());

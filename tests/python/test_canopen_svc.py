@@ -348,3 +348,18 @@ def test_heartbeat_service_on_local_node_applies_loss_of_master():
     assert drive.state == "SWITCH ON DISABLED"   # 0x6007 = 2 (D5)
     assert hb.health(1)["lost"]
     node.close()
+
+
+def test_heartbeat_producer_with_python_state_function():
+    host, dev = pair()
+    clock = _core.SimClock(0)
+    states = iter(["PRE-OPERATIONAL", "OPERATIONAL"])
+    p = nmt_mod.HeartbeatProducer(dev, 9, 0.1, lambda: next(states), clock=clock)
+    p.send_boot_up()
+    p.process()
+    clock.advance(100_000_000)
+    p.process()
+    got = [recv_id(host, 0x709).data for _ in range(3)]
+    assert got == [b"\x00", b"\x7f", b"\x05"]
+    assert p.sent == 3
+    del p  # the state function is released without the GIL held by the destructor
