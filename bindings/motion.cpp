@@ -86,7 +86,8 @@ class LimitExceeded(InvalidArgument):
         .def_readwrite("max_jerk", &Limits::max_jerk);
     py::enum_<RampShape>(m, "RampShape")
         .value("TRAPEZOID", RampShape::Trapezoid)
-        .value("SCURVE", RampShape::SCurve);
+        .value("SCURVE", RampShape::SCurve)
+        .value("SIN2", RampShape::Sin2);
 
     py::class_<Profile>(m, "Profile", "A planned motion: position/velocity/acceleration/jerk at any time.")
         .def_property_readonly("duration", &Profile::duration)
@@ -133,13 +134,42 @@ class LimitExceeded(InvalidArgument):
              [](const Profile& p, std::size_t max_steps) { return vec_to_array(step_times_seconds(p, max_steps)); },
              py::arg("max_steps") = 100'000'000);
 
+    // The 3-argument overload first: converting a defaulted enum argument costs
+    // more than the plan itself.
+    m.def("plan_trapezoid", [](const State& s, double t, const Limits& l) { return plan_trapezoid(s, t, l); },
+          py::arg("start"), py::arg("target"), py::arg("limits"));
     m.def("plan_trapezoid", &plan_trapezoid, py::arg("start"), py::arg("target"), py::arg("limits"),
-          py::arg("shape") = RampShape::Trapezoid);
+          py::arg("shape"));
     m.def("plan_velocity", &plan_velocity, py::arg("start"), py::arg("target_velocity"), py::arg("limits"),
           py::arg("hold") = 0.0, py::arg("shape") = RampShape::Trapezoid);
+    m.def("plan_jerk_limited_velocity", &plan_jerk_limited_velocity, py::arg("start"), py::arg("target_velocity"),
+          py::arg("limits"), py::arg("hold") = 0.0);
     m.def("plan_jerk_limited", &plan_jerk_limited, py::arg("start"), py::arg("target"), py::arg("limits"));
     m.def("plan_synchronized", &plan_synchronized, py::arg("start"), py::arg("target"), py::arg("limits"),
           py::arg("shape") = RampShape::Trapezoid);
+    m.def("plan_synchronized_jerk_limited", &plan_synchronized_jerk_limited, py::arg("start"), py::arg("target"),
+          py::arg("limits"));
+    m.def(
+        "synchronized_jerk_limited_durations",
+        [](py::array_t<double, py::array::c_style | py::array::forcecast> cases) {
+            // Rows: 3 axes x (p0, target, vmax, amax, jmax) = 15 columns; the common duration.
+            if (cases.ndim() != 2 || cases.shape(1) != 15) throw InvalidArgument("cases must be N x 15");
+            auto c = cases.unchecked<2>();
+            py::array_t<double> out(cases.shape(0));
+            double* o = out.mutable_data();
+            for (py::ssize_t i = 0; i < cases.shape(0); ++i) {
+                std::vector<double> s(3), t(3);
+                std::vector<Limits> l(3);
+                for (int k = 0; k < 3; ++k) {
+                    s[k] = c(i, 5 * k);
+                    t[k] = c(i, 5 * k + 1);
+                    l[k] = Limits{c(i, 5 * k + 2), c(i, 5 * k + 3), 0, c(i, 5 * k + 4)};
+                }
+                o[i] = plan_synchronized_jerk_limited(s, t, l)[0].duration();
+            }
+            return out;
+        },
+        py::arg("cases"));
     m.def("plan_straight_line", &plan_straight_line, py::arg("start"), py::arg("target"), py::arg("limits"),
           py::arg("shape") = RampShape::Trapezoid);
     m.def("split_interpolation", &split_interpolation, py::arg("axes"), py::arg("period_ms"));

@@ -102,7 +102,7 @@ void bind_slcan(py::module_& m) {
           [](const std::string& path, unsigned bitrate, bool timestamps, bool echo_suppression,
              bool listen_only, bool wait_for_acks, std::size_t tx_window, double ack_timeout,
              double open_timeout, double status_poll, unsigned tty_baud, const py::object& btr,
-             bool receive_own, std::size_t rx_queue_size) {
+             bool receive_own, std::size_t rx_queue_size, double tx_coalesce) {
               SlcanOptions o;
               o.timestamps = timestamps;
               o.echo_suppression = echo_suppression;
@@ -113,6 +113,7 @@ void bind_slcan(py::module_& m) {
               o.open_timeout = secs(open_timeout);
               o.status_poll = secs(status_poll);
               o.tty_baud = tty_baud;
+              o.tx_coalesce = secs(tx_coalesce);
               if (!btr.is_none()) {
                   auto v = btr.cast<unsigned>();
                   if (v > 0xFFFF) throw InvalidArgument("btr: BTR0<<8|BTR1 must be 0-0xFFFF");
@@ -128,25 +129,34 @@ void bind_slcan(py::module_& m) {
           py::arg("wait_for_acks") = true, py::arg("tx_window") = 16, py::arg("ack_timeout") = 1.0,
           py::arg("open_timeout") = 1.0, py::arg("status_poll") = 0.0, py::arg("tty_baud") = 115200,
           py::arg("btr") = py::none(), py::arg("receive_own") = false,
-          py::arg("rx_queue_size") = 65536,
+          py::arg("rx_queue_size") = 65536, py::arg("tx_coalesce") = 20e-6,
           "Open an SLCAN adapter at `path` (C, Sn, [Z1], O) as a Bus; reconnects after unplug.");
 
     py::class_<SlcanServer, std::shared_ptr<SlcanServer>>(
         m, "SlcanServer",
         "Serve a Bus as an SLCAN adapter on a new pty; SLCAN tools open `pty_path`.")
         .def(py::init([](std::shared_ptr<Bus> bus, std::size_t queue_size, const std::string& version,
-                         const std::string& serial_number, double bus_send_timeout) {
+                         const std::string& serial_number, double bus_send_timeout,
+                         const py::object& port, unsigned baud) {
                  SlcanServerOptions o;
                  o.queue_size = queue_size;
                  o.identity.version = version;
                  o.identity.serial = serial_number;
                  o.bus_send_timeout = secs(bus_send_timeout);
+                 std::string path = port.is_none() ? std::string() : port.cast<std::string>();
                  py::gil_scoped_release nogil;
-                 return std::make_shared<SlcanServer>(std::move(bus), o);
+                 if (path.empty()) return std::make_shared<SlcanServer>(std::move(bus), o);
+                 return std::make_shared<SlcanServer>(std::move(bus), serial::open_port(path, baud), o);
              }),
              py::arg("bus"), py::arg("queue_size") = 65536, py::arg("version") = "V1013",
-             py::arg("serial_number") = "NMB01", py::arg("bus_send_timeout") = 0.1)
-        .def_property_readonly("pty_path", &SlcanServer::pty_path)
+             py::arg("serial_number") = "NMB01", py::arg("bus_send_timeout") = 0.1,
+             py::arg("port") = py::none(), py::arg("baud") = 115200,
+             "Serve `bus` on a new pty, or on the serial device `port` (a UART wired to an SLCAN host).")
+        .def_property_readonly("pty_path",
+                               [](const SlcanServer& s) -> py::object {
+                                   if (s.pty_path().empty()) return py::none();  // serving a real port
+                                   return py::str(s.pty_path());
+                               })
         .def_property_readonly("is_open", &SlcanServer::is_open)
         .def_property_readonly("stats", [](const SlcanServer& s) { return server_stats_dict(s.stats()); })
         .def("close", &SlcanServer::close, py::call_guard<py::gil_scoped_release>())

@@ -98,8 +98,21 @@ int main() {
                 }
                 g_sink = acc;
             }));
-        std::printf("3-axis time-synchronised (trapezoid) plan: %.1f ns/plan; ruckig 3-DoF jerk-limited anchor 2370 ns "
-                    "(not the same problem: ours is trapezoidal)\n", best);
+        std::printf("3-axis time-synchronised trapezoid plan: %.1f ns/plan\n", best);
+        best = 1e30;
+        for (int rep = 0; rep < 3; ++rep)
+            best = std::min(best, ns_per(20000, [&] {
+                double acc = 0;
+                for (std::size_t i = 0; i < 20000; ++i) {
+                    std::vector<double> s{cs[3 * i].s.p, cs[3 * i + 1].s.p, cs[3 * i + 2].s.p};
+                    std::vector<double> t{cs[3 * i].target, cs[3 * i + 1].target, cs[3 * i + 2].target};
+                    std::vector<Limits> l{cs[3 * i].lim, cs[3 * i + 1].lim, cs[3 * i + 2].lim};
+                    acc += plan_synchronized_jerk_limited(s, t, l)[0].duration();
+                }
+                g_sink = acc;
+            }));
+        std::printf("3-DoF jerk-limited time-synchronised plan (from rest): %.1f ns/plan; ruckig anchor 2370 ns -> %.2fx faster\n",
+                    best, 2370.0 / best);
     }
     {
         Profile p = plan_jerk_limited(State{0, 0, 0, 0}, 100, Limits{10, 5, 0, 10});

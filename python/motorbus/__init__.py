@@ -18,6 +18,11 @@ from ._core import (  # noqa: F401
 
 from .bus import open_bus  # noqa: E402,F401
 from .log import LogEntry, Recorder, play, read_log  # noqa: E402,F401
-from . import serial  # noqa: E402,F401
+from . import motion, serial, slcan  # noqa: E402,F401
+from ._core import LimitExceeded  # noqa: E402,F401
+from .slcan import SlcanBus, SlcanServer, open_slcan  # noqa: E402,F401
+from .drives import arcus, dmac  # noqa: E402,F401
+from .drives.arcus import ArcusClient, ArcusSim  # noqa: E402,F401
+from .drives.dmac import DmacClient, DmacSim  # noqa: E402,F401
 
 __version__ = "0.1.0"

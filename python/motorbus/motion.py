@@ -60,8 +60,11 @@ from ._core import (  # noqa: F401
     dmac_speed_profile,
     jerk_limited_durations,
     plan_jerk_limited,
+    plan_jerk_limited_velocity,
     plan_straight_line,
     plan_synchronized,
+    plan_synchronized_jerk_limited,
+    synchronized_jerk_limited_durations,
     plan_trapezoid,
     plan_velocity,
     split_interpolation,
@@ -77,12 +80,13 @@ __all__ = [
     "DmacProfileParams", "LimitExceeded", "Limits", "MotionState", "Profile", "RampShape", "SnlConfig",
     "StepNLoop", "arcus_check_strict", "arcus_effective", "arcus_max_acc_ms", "arcus_speed_windows",
     "arcus_window_for_hspd", "arcus_window_for_sspdm", "dmac_position_profile", "dmac_ramp_time",
-    "dmac_speed_profile", "jerk_limited_durations", "plan", "plan_jerk_limited", "plan_straight_line",
-    "plan_synchronized", "plan_trapezoid", "plan_velocity", "sample", "split_interpolation", "step_times",
+    "dmac_speed_profile", "jerk_limited_durations", "plan", "plan_jerk_limited", "plan_jerk_limited_velocity", "plan_straight_line",
+    "plan_synchronized", "plan_synchronized_jerk_limited", "synchronized_jerk_limited_durations", "plan_trapezoid", "plan_velocity", "sample", "split_interpolation", "step_times",
     "dmac_interpolation",
 ]
 
-_SHAPES = {"trapezoid": RampShape.TRAPEZOID, "s_curve": RampShape.SCURVE, "scurve": RampShape.SCURVE}
+_SHAPES = {"trapezoid": RampShape.TRAPEZOID, "s_curve": RampShape.SCURVE, "scurve": RampShape.SCURVE,
+           "sin2": RampShape.SIN2}
 
 
 def _shape(shape: str | RampShape) -> RampShape:
@@ -100,8 +104,9 @@ def plan(target: float, *, start: float = 0.0, v0: float = 0.0, a0: float = 0.0,
     """Plan a move to rest at ``target``.
 
     With ``max_jerk`` the jerk-limited time-optimal (7-phase) planner is used
-    (same durations as ruckig); otherwise a trapezoid, or an S-curve with the
-    same ramp times when ``shape="s_curve"``.  Raises ``LimitExceeded``.
+    (same durations as ruckig); otherwise a trapezoid, or with the same ramp
+    times an S-curve (``shape="s_curve"``) or sin^2 ramps (``shape="sin2"``).
+    Raises ``LimitExceeded``.
     """
     if max_jerk is not None:
         return plan_jerk_limited(MotionState(start, v0, a0), target,

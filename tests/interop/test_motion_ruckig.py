@@ -102,3 +102,54 @@ def test_nonzero_initial_acceleration_is_never_faster_than_ruckig():
     diffs = np.array([d - ruckig_duration(*row)[1] for row, d in zip(cases, ours)])
     assert (diffs >= -1e-9).all()  # ruckig is time-optimal; we may only be slower
     print(f"a0 != 0: {np.mean(np.abs(diffs) <= 1e-9) * 100:.1f}% equal, max slower by {diffs.max():.3e} s")
+
+
+def test_three_axis_synchronized_duration_matches_ruckig():
+    """Time-synchronised 3-DoF moves from rest: same common duration as ruckig."""
+    rng = np.random.default_rng(50)
+    n = 1000
+    rows = []
+    for _ in range(n):
+        row = []
+        for _k in range(3):
+            p0 = rng.uniform(-50, 50)
+            row += [p0, p0 + rng.uniform(-50, 50), rng.uniform(0.1, 10), rng.uniform(0.1, 10), rng.uniform(0.1, 100)]
+        rows.append(row)
+    cases = np.array(rows)
+    ours = motion.synchronized_jerk_limited_durations(cases)
+    for row, d in zip(cases, ours):
+        otg = ruckig.Ruckig(3)
+        inp = ruckig.InputParameter(3)
+        out = ruckig.Trajectory(3)
+        r = row.reshape(3, 5)
+        inp.current_position = r[:, 0].tolist()
+        inp.target_position = r[:, 1].tolist()
+        inp.max_velocity = r[:, 2].tolist()
+        inp.max_acceleration = r[:, 3].tolist()
+        inp.max_jerk = r[:, 4].tolist()
+        otg.calculate(inp, out)
+        assert abs(out.duration - d) <= 1e-9, (row.tolist(), out.duration, d)
+
+
+def test_velocity_mode_duration_matches_ruckig():
+    rng = np.random.default_rng(60)
+    for _ in range(2000):
+        vmax, amax, jmax = rng.uniform(0.1, 20), rng.uniform(0.1, 20), rng.uniform(0.1, 200)
+        v0, vt = rng.uniform(-1, 1) * vmax, rng.uniform(-1, 1) * vmax
+        otg = ruckig.Ruckig(1)
+        inp = ruckig.InputParameter(1)
+        out = ruckig.Trajectory(1)
+        inp.control_interface = ruckig.ControlInterface.Velocity
+        inp.current_position = [0.0]
+        inp.current_velocity = [v0]
+        inp.target_velocity = [vt]
+        inp.max_velocity = [vmax]
+        inp.max_acceleration = [amax]
+        inp.max_jerk = [jmax]
+        otg.calculate(inp, out)
+        p = motion.plan_jerk_limited_velocity(motion.MotionState(0.0, v0, 0.0), vt,
+                                              motion.Limits(vmax, amax, 0.0, jmax))
+        assert abs(p.duration - out.duration) <= 1e-9, (v0, vt, vmax, amax, jmax, out.duration, p.duration)
+        t = out.duration * 0.37
+        pos, vel, acc = out.at_time(t)
+        assert p.position(t) == pytest.approx(pos[0], abs=1e-9 * max(1.0, abs(pos[0])))

@@ -78,6 +78,7 @@ def hub():
     peer.close()
 
 
+@pytest.mark.threaded
 def test_pythoncan_host_against_our_server(hub):
     inner, peer = hub
     with SlcanServer(inner) as server:
@@ -138,6 +139,7 @@ class NullModem:
             os.close(fd)
 
 
+@pytest.mark.threaded
 def test_pythoncan_host_against_our_slcanbus():
     modem = NullModem()
     try:

@@ -140,3 +140,19 @@ def test_motor_model_and_homing_on_sim_clock():
     assert m.encoder == round(5000 * 4000 / 3200)
     with pytest.raises(ValueError):
         h.start("X", 1)
+
+
+def test_shapes_and_arrays_for_plotting():
+    t = motion.plan(1000, max_velocity=100, max_acceleration=1000)
+    s = motion.plan(1000, max_velocity=100, max_acceleration=1000, shape="s_curve")
+    q = motion.plan(1000, max_velocity=100, max_acceleration=1000, shape="sin2")
+    assert t.duration == pytest.approx(s.duration) == pytest.approx(q.duration)
+    a = motion.sample(q, 1001)["a"]
+    assert a.max() == pytest.approx(2000, rel=1e-3)  # same ramp time: peak = 2x average
+    with pytest.raises(ValueError):
+        motion.plan(1, max_velocity=1, max_acceleration=1, shape="square")
+    arc = motion.ArcusMotion(motion.ArcusProfileParams(hspd=1000, lspd=100, acc_ms=100))
+    arc.move(0, 5000)
+    arr = motion.sample(arc.profile, 200)
+    assert arr["v"][1] >= 100  # starts from LSPD
+    assert arr["p"][-1] == 5000

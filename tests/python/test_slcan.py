@@ -39,6 +39,7 @@ def test_decoder_hostile_rows_and_recovery():
     assert d.discard_partial() and d.pending == 0
 
 
+@pytest.mark.threaded
 def test_server_with_pyserial_peer_answers_and_forwards():
     inner = _core.open_virtual(_hub("a"))
     peer = _core.open_virtual(_hub("a"))
@@ -57,6 +58,7 @@ def test_server_with_pyserial_peer_answers_and_forwards():
         assert server.stats["transmitted"] == 1
 
 
+@pytest.mark.threaded
 def test_open_slcan_through_server_both_directions():
     inner = _core.open_virtual(_hub("b"))
     peer = _core.open_virtual(_hub("b"))
@@ -77,6 +79,7 @@ def test_open_slcan_through_server_both_directions():
             assert bus.stats["nacks"] == 0
 
 
+@pytest.mark.threaded
 def test_open_bus_spec_reaches_open_slcan():
     inner = _core.open_virtual(_hub("c"))
     with SlcanServer(inner) as server:
@@ -91,3 +94,121 @@ def test_open_slcan_errors_are_typed():
     with SlcanServer(inner) as server:
         with pytest.raises(motorbus.InvalidArgument):
             open_slcan(server.pty_path, 83333)
+
+
+@pytest.mark.threaded
+def test_server_on_an_existing_serial_port():
+    """SlcanServer(bus, port=...) serves a given device; here the slave of our own pty."""
+    import os
+    import select
+    import tty as ttymod
+    master, slave = os.openpty()
+    ttymod.setraw(slave)
+    inner = _core.open_virtual(_hub("e"))
+    try:
+        with SlcanServer(inner, port=os.ttyname(slave), baud=0) as server:
+            assert server.pty_path is None
+            os.write(master, b"V\r")
+            deadline = time.monotonic() + 3
+            got = b""
+            while not got.endswith(b"\r") and time.monotonic() < deadline:
+                if select.select([master], [], [], 0.1)[0]:
+                    got += os.read(master, 64)
+            assert got == b"V1013\r"
+    finally:
+        os.close(master)
+        os.close(slave)
+
+
+class _ScriptedAdapter:
+    """A fake Lawicel adapter on a pty master, answering each command line via `script`."""
+
+    def __init__(self, script):
+        import os
+        import threading
+        import tty as ttymod
+        self.master, self._slave = os.openpty()
+        ttymod.setraw(self._slave)
+        self.path = os.ttyname(self._slave)
+        self.script = script
+        self._stop = False
+        self._t = threading.Thread(target=self._run, daemon=True)
+        self._t.start()
+
+    def _run(self):
+        import os
+        import select
+        buf = b""
+        while not self._stop:
+            if not select.select([self.master], [], [], 0.05)[0]:
+                continue
+            buf += os.read(self.master, 4096)
+            while b"\r" in buf:
+                line, _, buf = buf.partition(b"\r")
+                reply = self.script(line)
+                if reply:
+                    os.write(self.master, reply)
+
+    def inject(self, data: bytes) -> None:
+        import os
+        os.write(self.master, data)
+
+    def close(self):
+        import os
+        self._stop = True
+        self._t.join()
+        os.close(self.master)
+        os.close(self._slave)
+
+
+def _lawicel(line: bytes) -> bytes:
+    if line[:1] in (b"t", b"r"):
+        return b"z\r"
+    if line[:1] in (b"T", b"R"):
+        return b"Z\r"
+    if line == b"F":
+        return b"F20\r"
+    return b"\r"
+
+
+@pytest.mark.threaded
+def test_l10_nack_surfaces_as_protocol_error_with_the_frame():
+    adapter = _ScriptedAdapter(lambda l: b"\a" if l == b"t1230" else _lawicel(l))
+    try:
+        with open_slcan(adapter.path, 500000) as bus:
+            bus.send(motorbus.Frame(0x122))
+            bus.send(motorbus.Frame(0x123))  # refused by the adapter
+            with pytest.raises(motorbus.ProtocolError) as info:
+                bus.flush_tx(2.0)
+            assert "123#" in str(info.value)
+            assert bus.counters["tx_dropped"] == 1
+            assert (bus.stats["acks"], bus.stats["nacks"]) == (1, 1)
+            bus.flush_tx(1.0)  # reported once
+            # L12: F20 = error passive
+            assert bus.query_status(1.0) == 0x20
+            assert bus.state == "error-passive"
+    finally:
+        adapter.close()
+
+
+@pytest.mark.threaded
+def test_bad_lines_are_counted_and_the_next_frame_arrives():
+    adapter = _ScriptedAdapter(_lawicel)
+    try:
+        with open_slcan(adapter.path, 500000) as bus:
+            adapter.inject(b"7" * 100 + b"\rt12G0\rt8000\rt1239\rQ\r" + b"t1232CAFE\r")
+            f = bus.recv(timeout=2)
+            assert (f.id, f.data) == (0x123, b"\xca\xfe")
+            c = bus.counters
+            assert (c["overruns"], c["parse_errors"], c["ignored"]) == (1, 3, 1)
+    finally:
+        adapter.close()
+
+
+def test_silent_adapter_times_out_with_a_hint():
+    adapter = _ScriptedAdapter(lambda l: b"")
+    try:
+        with pytest.raises(motorbus.TimeoutError, match="wait_for_acks"):
+            open_slcan(adapter.path, 500000, open_timeout=0.1)
+    finally:
+        adapter.close()

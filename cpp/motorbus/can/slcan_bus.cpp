@@ -42,6 +42,7 @@ SlcanBus::SlcanBus(std::shared_ptr<serial::Port> port, SlcanOptions options, Por
     link_up_ = true;
     stats_.link_up = true;
     thread_ = std::thread([this] { run(); });
+    tx_thread_ = std::thread([this] { tx_writer(); });
 }
 
 SlcanBus::~SlcanBus() { close(); }
@@ -103,29 +104,42 @@ void SlcanBus::command_inline(serial::Port& port, const std::string& line, bool 
 void SlcanBus::do_send(const Frame& frame, Deadline deadline) {
     char line[slcan::kMtu];
     const std::size_t n = slcan::encode_frame_into(frame, line);
-    std::unique_lock wl(write_mutex_, std::defer_lock);
-    if (!wl.try_lock_until(deadline))
-        throw TimeoutError("slcan " + channel() + ": port busy until the send deadline");
     std::shared_ptr<serial::Port> port;
     {
         std::unique_lock lock(mutex_);
-        if (opts_.wait_for_acks &&
-            !cv_.wait_until(lock, deadline, [&] {
-                return stop_ || !link_up_ || pending_.size() < opts_.tx_window;
-            }))
-            throw TimeoutError("slcan " + channel() + ": " + std::to_string(pending_.size()) +
-                               " commands unanswered by the adapter (tx window full)");
+        const bool ok = cv_.wait_until(lock, deadline, [&] {
+            return stop_ || !link_up_ ||
+                   ((!opts_.wait_for_acks || pending_.size() < opts_.tx_window) &&
+                    txbuf_.size() + n <= kTxBufMax);
+        });
         if (stop_) throw ClosedError("slcan " + channel() + " is closed");
         if (!link_up_) throw LinkDown("slcan " + channel() + ": link down (reconnecting)");
+        if (!ok)
+            throw TimeoutError("slcan " + channel() + ": " + std::to_string(pending_.size()) +
+                               " commands unanswered by the adapter (tx window full)");
         if (opts_.wait_for_acks)
             pending_.push_back(Pending{frame.extended ? 'T' : 't', Clock::now() + opts_.ack_timeout,
-                                       true, frame.to_string()});
+                                       true, frame});
         if (opts_.echo_suppression) {
             if (echoes_.size() >= 1024) echoes_.pop_front();
             echoes_.push_back(Echo{frame, Clock::now() + opts_.echo_window});
         }
+        const auto now = Clock::now();
+        const bool burst = opts_.tx_coalesce > Duration::zero() && now - last_send_ < opts_.tx_coalesce;
+        last_send_ = now;
+        if (burst || writing_ || !txbuf_.empty()) {
+            // Queue behind the line being written; the writer thread sends
+            // the whole batch with one write() (order is preserved).
+            txbuf_.append(line, n);
+            ++txbuf_frames_;
+            if (!writing_) cv_.notify_all();
+            return;
+        }
+        // An isolated frame goes straight out: no thread hand-over latency.
+        writing_ = true;
         port = port_;
     }
+    WriterRelease release{this};
     try {
         port->write(as_bytes(line, n));
     } catch (const LinkDown& e) {
@@ -136,24 +150,81 @@ void SlcanBus::do_send(const Frame& frame, Deadline deadline) {
     }
 }
 
+void SlcanBus::tx_writer() {
+    std::string batch;
+    std::unique_lock lock(mutex_);
+    for (;;) {
+        cv_.wait(lock, [&] { return stop_ || (!txbuf_.empty() && !writing_); });
+        if (txbuf_.empty()) return;  // stopping with nothing left
+        if (!link_up_ || stop_) {
+            // The frames were accepted by send() but never reached the adapter.
+            for (std::size_t i = 0; i < txbuf_frames_; ++i) count_tx_dropped();
+            txbuf_.clear();
+            txbuf_frames_ = 0;
+            cv_.notify_all();
+            if (stop_) return;
+            continue;
+        }
+        writing_ = true;
+        batch.swap(txbuf_);
+        txbuf_.clear();
+        const std::size_t frames = txbuf_frames_;
+        txbuf_frames_ = 0;
+        auto port = port_;
+        lock.unlock();
+        bool lost = false;
+        try {
+            port->write(as_bytes(batch.data(), batch.size()));
+        } catch (const LinkDown& e) {
+            link_lost(e.what());
+            lost = true;
+        } catch (const Error&) {
+            lost = true;  // closed under us, or the peer stopped reading (write timeout)
+        }
+        if (lost)
+            for (std::size_t i = 0; i < frames; ++i) count_tx_dropped();
+        batch.clear();
+        lock.lock();
+        writing_ = false;
+        cv_.notify_all();
+    }
+}
+
+void SlcanBus::claim_writer(std::unique_lock<std::mutex>& lock, Deadline deadline) {
+    // One whole line at a time on the port, and (with acks) at most tx_window
+    // unanswered commands: back-pressure instead of an adapter FIFO overflow.
+    const bool ok = cv_.wait_until(lock, deadline, [&] {
+        return stop_ || !link_up_ ||
+               (!writing_ && txbuf_.empty() &&
+                (!opts_.wait_for_acks || pending_.size() < opts_.tx_window));
+    });
+    if (stop_) throw ClosedError("slcan " + channel() + " is closed");
+    if (!link_up_) throw LinkDown("slcan " + channel() + ": link down (reconnecting)");
+    if (!ok)
+        throw TimeoutError("slcan " + channel() + ": " + std::to_string(pending_.size()) +
+                           " commands unanswered by the adapter (tx window full)");
+    writing_ = true;
+}
+
+void SlcanBus::release_writer() {
+    {
+        std::lock_guard lock(mutex_);
+        writing_ = false;
+    }
+    cv_.notify_all();
+}
+
 void SlcanBus::write_command(const std::string& text, char kind, Deadline deadline) {
     const std::string line = text + "\r";
-    std::unique_lock wl(write_mutex_, std::defer_lock);
-    if (!wl.try_lock_until(deadline)) throw TimeoutError("slcan " + channel() + ": port busy");
     std::shared_ptr<serial::Port> port;
     {
         std::unique_lock lock(mutex_);
-        if (opts_.wait_for_acks &&
-            !cv_.wait_until(lock, deadline, [&] {
-                return stop_ || !link_up_ || pending_.size() < opts_.tx_window;
-            }))
-            throw TimeoutError("slcan " + channel() + ": tx window full");
-        if (stop_) throw ClosedError("slcan " + channel() + " is closed");
-        if (!link_up_) throw LinkDown("slcan " + channel() + ": link down");
+        claim_writer(lock, deadline);
         if (opts_.wait_for_acks)
             pending_.push_back(Pending{kind, Clock::now() + opts_.ack_timeout, false, {}});
         port = port_;
     }
+    WriterRelease release{this};
     try {
         port->write(as_bytes(line.data(), line.size()));
     } catch (const LinkDown& e) {
@@ -164,7 +235,9 @@ void SlcanBus::write_command(const std::string& text, char kind, Deadline deadli
 
 void SlcanBus::flush_tx(Duration timeout) {
     std::unique_lock lock(mutex_);
-    if (!cv_.wait_for(lock, timeout, [&] { return stop_ || !link_up_ || pending_.empty(); }))
+    if (!cv_.wait_for(lock, timeout, [&] {
+            return stop_ || !link_up_ || (pending_.empty() && txbuf_.empty() && !writing_);
+        }))
         throw TimeoutError("slcan " + channel() + ": " + std::to_string(pending_.size()) +
                            " commands still unanswered");
     if (stop_) throw ClosedError("slcan " + channel() + " is closed");
@@ -312,7 +385,7 @@ bool SlcanBus::complete_oldest(bool ok, char reply_kind) {
         if (p.is_frame) {
             count_tx_dropped();
             ++nacked_frames_since_flush_;
-            last_nacked_ = p.frame_text;
+            last_nacked_ = p.frame.to_string();  // rendered only when refused
         }
     }
     cv_.notify_all();
@@ -341,6 +414,9 @@ void SlcanBus::link_lost(const std::string&) {
         stats_.ack_timeouts += pending_.size();
         pending_.clear();
         echoes_.clear();
+        for (std::size_t i = 0; i < txbuf_frames_; ++i) count_tx_dropped();
+        txbuf_.clear();
+        txbuf_frames_ = 0;
         port = port_;
     }
     cv_.notify_all();
@@ -355,7 +431,18 @@ bool SlcanBus::reopen() {
         if (!port) return false;
         if (auto* tty = dynamic_cast<serial::TtyPort*>(port.get()))
             tty->set_write_timeout(std::chrono::seconds(2));
-        std::lock_guard wl(write_mutex_);
+        {
+            // Senders bail out while the link is down; wait for one still
+            // inside write() on the dead port to leave.
+            std::unique_lock lock(mutex_);
+            cv_.wait(lock, [&] { return !writing_ || stop_; });
+            if (stop_) {
+                port->close();
+                return false;
+            }
+            writing_ = true;
+        }
+        WriterRelease release{this};
         open_sequence(*port);
         {
             std::lock_guard lock(mutex_);
@@ -431,21 +518,22 @@ void SlcanBus::run() {
         if (opts_.status_poll > Duration::zero() && now >= next_poll) {
             next_poll = now + opts_.status_poll;
             // Never block the receive thread behind a sender waiting for acks
-            // that only this thread can deliver.
-            std::unique_lock wl(write_mutex_, std::try_to_lock);
-            if (wl.owns_lock()) {
-                bool room = true;
-                {
-                    std::lock_guard lock(mutex_);
-                    room = pending_.size() < opts_.tx_window;
-                    if (room && opts_.wait_for_acks)
+            // that only this thread can deliver: skip the poll when busy.
+            bool claimed = false;
+            {
+                std::lock_guard lock(mutex_);
+                if (!writing_ && txbuf_.empty() && link_up_ &&
+                    (!opts_.wait_for_acks || pending_.size() < opts_.tx_window)) {
+                    writing_ = claimed = true;
+                    if (opts_.wait_for_acks)
                         pending_.push_back(Pending{'F', now + opts_.ack_timeout, false, {}});
                 }
-                if (room) {
-                    try {
-                        port->write(as_bytes("F\r", 2));
-                    } catch (const Error&) {
-                    }
+            }
+            if (claimed) {
+                WriterRelease release{this};
+                try {
+                    port->write(as_bytes("F\r", 2));
+                } catch (const Error&) {
                 }
             }
         }
@@ -456,16 +544,26 @@ void SlcanBus::do_close() {
     std::shared_ptr<serial::Port> port;
     bool up;
     {
-        std::lock_guard lock(mutex_);
+        std::unique_lock lock(mutex_);
+        // Frames already accepted by send() still go out (bounded wait).
+        cv_.wait_for(lock, std::chrono::milliseconds(500),
+                     [&] { return !link_up_ || (txbuf_.empty() && !writing_); });
         stop_ = true;
         port = port_;
         up = link_up_;
     }
     cv_.notify_all();
+    if (tx_thread_.joinable()) tx_thread_.join();
     if (port && up) {
-        // Leave the adapter closed, as python-can does; best effort.
-        std::unique_lock wl(write_mutex_, std::defer_lock);
-        if (wl.try_lock_for(std::chrono::milliseconds(200))) {
+        // Leave the adapter closed, as python-can does; best effort, bounded.
+        bool claimed = false;
+        {
+            std::unique_lock lock(mutex_);
+            claimed = cv_.wait_for(lock, std::chrono::milliseconds(200), [&] { return !writing_; });
+            if (claimed) writing_ = true;
+        }
+        if (claimed) {
+            WriterRelease release{this};
             try {
                 port->write(as_bytes("C\r", 2));
             } catch (const std::exception&) {

@@ -13,7 +13,9 @@
 // NACK completes the oldest outstanding command: for a frame it counts
 // `tx_dropped` (the adapter refused it: channel closed, FIFO full) and the
 // next flush_tx() raises ProtocolError naming it.  send() itself does not
-// wait for its own ack (that would cost a round trip per frame).  Adapters
+// wait for its own ack (that would cost a round trip per frame).  Frames sent
+// in a burst (see tx_coalesce) are written in batches by a writer thread; a
+// batch lost to a dead link is counted in tx_dropped.  Adapters
 // that never answer (early CANable firmware, a python-can peer on a pty) need
 // `wait_for_acks = false`.
 #pragma once
@@ -47,6 +49,11 @@ struct SlcanOptions {
     Duration status_poll = Duration::zero();             // `F` every period (0 = never)
     Duration partial_line_timeout = std::chrono::milliseconds(500);  // L2
     Duration echo_window = std::chrono::seconds(1);      // how long a sent frame may echo
+    // A send() within this time of the previous one is a burst: it is queued
+    // and written in batches by a writer thread (one write() per batch)
+    // instead of one write() per frame.  An isolated frame is written at once.
+    // 0 = always write directly.
+    Duration tx_coalesce = std::chrono::microseconds(20);
     Duration reconnect_min = std::chrono::milliseconds(100);  // L14 backoff start
     Duration reconnect_max = std::chrono::seconds(5);         // L14 backoff cap
     unsigned tty_baud = 115200;           // serial line speed for open_slcan (0 = keep)
@@ -95,7 +102,7 @@ private:
         char cmd;                 // 't','T','F','V','N',...
         Deadline expires;
         bool is_frame;
-        std::string frame_text;   // for NACK reports
+        Frame frame{};            // for NACK reports
     };
     struct Echo {
         Frame frame;
@@ -103,6 +110,7 @@ private:
     };
 
     void run();
+    void tx_writer();
     void handle(const slcan::Event& e);
     bool complete_oldest(bool ok, char reply_kind);
     void expire_pending(Deadline now);
@@ -113,13 +121,25 @@ private:
     // while no receive thread reads the port (open sequence).
     void command_inline(serial::Port& port, const std::string& line, bool bel_ok);
     void write_command(const std::string& line, char kind, Deadline deadline);
+    // Waits (mutex_ held) until this thread may write one line; throws
+    // ClosedError / LinkDown / TimeoutError.  release_writer() ends the claim.
+    void claim_writer(std::unique_lock<std::mutex>& lock, Deadline deadline);
+    void release_writer();
+    struct WriterRelease {
+        SlcanBus* bus;
+        ~WriterRelease() { bus->release_writer(); }
+    };
 
     SlcanOptions opts_;
     PortFactory factory_;
     slcan::StreamDecoder decoder_;  // receive thread (or the opener before it starts)
 
-    std::timed_mutex write_mutex_;  // serializes whole lines on the port
     mutable std::mutex mutex_;      // everything below
+    bool writing_ = false;          // a thread owns the port for one whole line
+    static constexpr std::size_t kTxBufMax = 16384;  // bytes of queued burst lines
+    std::string txbuf_;             // burst lines waiting for the writer thread
+    std::size_t txbuf_frames_ = 0;
+    Deadline last_send_{};
     std::condition_variable cv_;
     std::shared_ptr<serial::Port> port_;
     std::deque<Pending> pending_;
@@ -135,7 +155,8 @@ private:
     bool awaited_ok_ = false;
     bool awaited_done_ = false;
 
-    std::thread thread_;
+    std::thread thread_;     // receive
+    std::thread tx_thread_;  // burst writer
 };
 
 // Opens the serial device at `path` and an SlcanBus on it, with reconnect on.

@@ -117,7 +117,8 @@ Profile dmac_position_profile(const State& start, double target, const DmacProfi
     return prof;
 }
 
-DmacMotion::DmacMotion(DmacProfileParams params, double position) : params_(params), profile_(State{position, 0, 0, 0}) {
+DmacMotion::DmacMotion(DmacProfileParams params, double position)
+    : params_(params), profile_(State{position, 0, 0, 0}), target_(std::llround(position)) {
     params_.validate();
 }
 

@@ -98,15 +98,44 @@ void append_ramp(Profile& prof, double v_from, double v_to, double amax, double 
     prof.append_cubic(r.t3, -s * jmax);
 }
 
-}  // namespace
+// The time-optimal peak velocity (and cruise time) to cover D from v0 and stop.
+void peak_for_distance(const Shape& sh, double v0, double D, double vmax, double& vp, double& cruise) {
+    cruise = 0;
+    // The stopping distance f0 = dist(0) = dist(v0) tells which side the peak is on;
+    // dist(vp) increases with vp on [max(v0,0), vmax] and on [-vmax, min(v0,0)].
+    const double f0 = 0.5 * v0 * sh.T(v0);
+    if (D >= f0) {
+        const double f_hi = dist(sh, v0, vmax);
+        if (D >= f_hi) {  // far enough to cruise at +vmax: nothing is faster
+            vp = vmax;
+            cruise = (D - f_hi) / vmax;
+        } else {
+            vp = solve(sh, v0, D, v0 > vmax ? 0.0 : std::max(v0, 0.0), vmax);  // v0 above the limit: whole side
+        }
+    } else {
+        const double f_lo = dist(sh, v0, -vmax);
+        if (D <= f_lo) {
+            vp = -vmax;
+            cruise = (D - f_lo) / -vmax;
+        } else {
+            vp = solve(sh, v0, D, -vmax, v0 < -vmax ? 0.0 : std::min(v0, 0.0));
+        }
+    }
+}
 
-Profile plan_jerk_limited(const State& start, double target, const Limits& lim) {
+void check_jerk_limits(const Limits& lim) {
     for (double x : {lim.max_velocity, lim.max_acceleration, lim.max_jerk})
         if (!(x > 0) || !std::isfinite(x)) {
             const char* name = x == lim.max_velocity ? "max_velocity"
                                : x == lim.max_acceleration ? "max_acceleration" : "max_jerk";
             throw LimitExceeded(name, x, 0, "must be positive and finite");
         }
+}
+
+}  // namespace
+
+Profile plan_jerk_limited(const State& start, double target, const Limits& lim) {
+    check_jerk_limits(lim);
     if (!std::isfinite(start.p) || !std::isfinite(start.v) || !std::isfinite(start.a) || !std::isfinite(target))
         throw InvalidArgument("plan_jerk_limited: start state and target must be finite");
     if (std::fabs(start.a) > lim.max_acceleration * (1 + 1e-12))
@@ -127,32 +156,31 @@ Profile plan_jerk_limited(const State& start, double target, const Limits& lim) 
     }
     const Shape sh{amax, jmax, amax * amax / jmax};
     double best_vp = 0, best_cruise = 0;
-    const double f_hi = dist(sh, v0, vmax), f_lo = dist(sh, v0, -vmax);
-    if (D >= f_hi) {
-        // Far enough to cruise at +vmax: nothing is faster.
-        best_vp = vmax;
-        best_cruise = (D - f_hi) / vmax;
-    } else if (D <= f_lo) {
-        best_vp = -vmax;
-        best_cruise = (D - f_lo) / -vmax;
-    } else {
-        // dist(vp) increases with vp on [max(v0,0), vmax] and on [-vmax, min(v0,0)];
-        // the stopping distance f0 = dist(0) = dist(v0) tells which side holds the root.
-        const double f0 = dist(sh, v0, 0.0);
-        double lo, hi;
-        if (D >= f0) {
-            lo = std::max(v0, 0.0);
-            hi = vmax;
-        } else {
-            lo = -vmax;
-            hi = std::min(v0, 0.0);
-        }
-        best_vp = solve(sh, v0, D, lo, hi);
-    }
+    peak_for_distance(sh, v0, D, vmax, best_vp, best_cruise);
     append_ramp(prof, v0, best_vp, amax, jmax);
     if (best_cruise > 0) prof.append_cubic(best_cruise, 0.0);
     append_ramp(prof, best_vp, 0.0, amax, jmax);
     prof.finish(target, 0);
+    return prof;
+}
+
+Profile plan_jerk_limited_velocity(const State& start, double vt, const Limits& lim, double hold) {
+    check_jerk_limits(lim);
+    if (!std::isfinite(start.p) || !std::isfinite(start.v) || !std::isfinite(start.a) || !std::isfinite(vt))
+        throw InvalidArgument("plan_jerk_limited_velocity: start state and target must be finite");
+    if (std::fabs(vt) > lim.max_velocity)
+        throw LimitExceeded("max_velocity", std::fabs(vt), lim.max_velocity, "target velocity");
+    if (std::fabs(start.a) > lim.max_acceleration * (1 + 1e-12))
+        throw LimitExceeded("max_acceleration", std::fabs(start.a), lim.max_acceleration, "initial acceleration");
+    if (!(hold >= 0) || !std::isfinite(hold)) throw InvalidArgument("plan_jerk_limited_velocity: hold must be >= 0");
+    Profile prof(State{start.p, start.v, start.a, 0});
+    if (start.a != 0) {
+        const double t = std::fabs(start.a) / lim.max_jerk;
+        prof.append_jump(t, start.v, start.a, start.a > 0 ? -lim.max_jerk : lim.max_jerk);
+    }
+    append_ramp(prof, prof.final_state().v, vt, lim.max_acceleration, lim.max_jerk);
+    if (hold > 0) prof.append_cubic(hold, 0.0);
+    prof.finish(prof.final_state().p, vt);
     return prof;
 }
 
@@ -161,16 +189,29 @@ std::vector<Profile> plan_synchronized_jerk_limited(const std::vector<double>& s
                                                     const std::vector<Limits>& limits) {
     if (start.size() != target.size() || start.size() != limits.size() || start.empty())
         throw InvalidArgument("multi-axis: start, target and limits need the same non-zero length");
-    std::vector<Profile> out;
-    out.reserve(start.size());
+    // Minimum durations first (no profiles built), then one profile per axis.
+    const std::size_t n = start.size();
+    std::vector<double> tmin(n);
     double T = 0;
-    for (std::size_t i = 0; i < start.size(); ++i) {
-        out.push_back(plan_jerk_limited(State{start[i], 0, 0, 0}, target[i], limits[i]));
-        T = std::max(T, out.back().duration());
+    for (std::size_t i = 0; i < n; ++i) {
+        check_jerk_limits(limits[i]);
+        if (!std::isfinite(start[i]) || !std::isfinite(target[i]))
+            throw InvalidArgument("plan_synchronized_jerk_limited: positions must be finite");
+        const Shape sh{limits[i].max_acceleration, limits[i].max_jerk,
+                       limits[i].max_acceleration * limits[i].max_acceleration / limits[i].max_jerk};
+        const double D = std::fabs(target[i] - start[i]);
+        double vp = 0, cruise = 0;
+        if (D > 0) peak_for_distance(sh, 0.0, D, limits[i].max_velocity, vp, cruise);
+        tmin[i] = D > 0 ? 2 * sh.T(vp) + cruise : 0.0;
+        T = std::max(T, tmin[i]);
+    }
+    std::vector<Profile> out(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (tmin[i] >= T) out[i] = plan_jerk_limited(State{start[i], 0, 0, 0}, target[i], limits[i]);
     }
     for (std::size_t i = 0; i < start.size(); ++i) {
         const double D = std::fabs(target[i] - start[i]);
-        if (out[i].duration() >= T) continue;
+        if (tmin[i] >= T) continue;
         const double a = limits[i].max_acceleration, j = limits[i].max_jerk;
         const Shape sh{a, j, a * a / j};
         if (D == 0) {

@@ -141,7 +141,26 @@ void MotorModel::update() { advance_to(clock_.now()); }
 
 void MotorModel::advance_to(Nanos t) {
     if (in_dispatch_) return;  // a listener's query must not re-enter the integration
-    while (now_ < t) step_to(std::min<Nanos>(t, now_ + cfg_.tick_ns));
+    while (now_ < t) {
+        Nanos next = std::min<Nanos>(t, now_ + cfg_.tick_ns);
+        // Cruising at constant velocity nothing can change between events, and
+        // every event is found exactly (the motion is monotone): take the whole
+        // cruise in one step, so a long jog on a simulated clock costs O(events).
+        if (running_ && !stalled_ && !jammed_) {
+            const double pt = profile_time(now_);
+            const std::size_t k = profile_.segment_index(pt);
+            if (k < profile_.segments().size()) {
+                const Segment& seg = profile_.segments()[k];
+                if (seg.kind == Segment::Kind::Cubic && seg.start.a == 0 && seg.start.j == 0) {
+                    const double end_s = seg.t0 + seg.duration;
+                    const double span = std::min(end_s - pt, 1e6);  // stay well inside Nanos
+                    const Nanos seg_end = now_ + static_cast<Nanos>(span * 1e9);
+                    if (seg_end > next) next = std::min<Nanos>(t, seg_end);
+                }
+            }
+        }
+        step_to(next);
+    }
 }
 
 // Advances from now_ to at most t_end, stopping early at the first event
@@ -196,11 +215,29 @@ void MotorModel::step_to(Nanos t_end) {
         Nanos lo = t0, hi = t_end;
         bool target_state = b;
         if (a == b) {
-            // A fast pass through a narrow home window inside one tick: sample the middle.
+            // A pass through a narrow home window inside one step.  Over a monotone
+            // step the window is crossed iff it lies between the two positions;
+            // otherwise sample the middle.
             if (!c.present) return;
-            const Nanos mid = t0 + (t_end - t0) / 2;
-            if (pred(c, phys_at(mid)) == a) return;
-            hi = mid;
+            const double p_lo = std::min(p_prev, p_new), p_hi = std::max(p_prev, p_new);
+            const bool inside_between = !a && c.lo > p_lo && c.hi < p_hi && pred(c, c.lo);
+            Nanos probe;
+            if (inside_between) {
+                // Bisection to the entering edge: the boundary nearer to p_prev.
+                const double edge = p_new > p_prev ? c.lo : c.hi;
+                Nanos l = t0, h = t_end;
+                while (h - l > 1) {
+                    const Nanos m = l + (h - l) / 2;
+                    const double pm = phys_at(m);
+                    if (p_new > p_prev ? pm >= edge : pm <= edge) h = m;
+                    else l = m;
+                }
+                probe = h;
+            } else {
+                probe = t0 + (t_end - t0) / 2;
+            }
+            if (pred(c, phys_at(probe)) == a) return;
+            hi = probe;
             target_state = !a;
             first_edge_seen = true;
         }

@@ -54,6 +54,13 @@ Profile plan_velocity(const State& start, double target_velocity, const Limits& 
 // docs/motion.md).
 Profile plan_jerk_limited(const State& start, double target, const Limits& lim);
 
+// Jerk-limited velocity mode: from start.v (start.a is released first, as in
+// plan_jerk_limited) to `target_velocity` with a = 0 at the end, time-optimal
+// under max_acceleration / max_jerk (|target| <= max_velocity), then holding it
+// for `hold` s.  Same duration as ruckig's velocity interface for a = 0 starts.
+Profile plan_jerk_limited_velocity(const State& start, double target_velocity, const Limits& lim,
+                                   double hold = 0.0);
+
 // Minimum time to change velocity from v0 to v1 (a = 0 at both ends) under
 // (amax, jmax), and the distance covered meanwhile.  Closed form.
 struct Ramp {

@@ -67,14 +67,17 @@ Profile& Profile::append_cubic(double duration, double jerk) {
 
 Profile& Profile::append_jump(double duration, double v, double a, double jerk) {
     if (!(duration > 0)) return *this;
-    Segment seg;
-    seg.kind = Segment::Kind::Cubic;
+    Segment& seg = segments_.emplace_back();
     seg.t0 = duration_;
     seg.duration = duration;
     seg.start = State{final_.p, v, a, jerk};
-    segments_.push_back(seg);
     duration_ += duration;
-    final_ = seg.end();
+    // The end state inline (the planners' hot path): the cubic at t = duration.
+    constexpr double kSixth = 1.0 / 6.0;
+    const double t = duration;
+    final_.p = final_.p + t * (v + t * (a * 0.5 + t * jerk * kSixth));
+    final_.v = v + t * (a + t * jerk * 0.5);
+    final_.a = a + t * jerk;
     final_.j = 0;
     return *this;
 }

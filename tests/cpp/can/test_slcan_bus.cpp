@@ -232,6 +232,9 @@ TEST(SlcanServer, AnswersRawCommandsAndForwardsOnlyWhileOpen) {
         return out;
     };
     peer->send(Frame::make(0x100, std::vector<std::uint8_t>{1}));  // closed: not forwarded
+    // Delivery to the server's endpoint is asynchronous: let it land before opening.
+    for (int i = 0; i < 200 && inner->counters().rx_frames < 1; ++i) std::this_thread::sleep_for(5ms);
+    ASSERT_EQ(inner->counters().rx_frames, 1u);
     tty->write(bytes_of("V\rN\rt1230\rS6\rZ1\rO\r"));
     EXPECT_EQ(read_until(6), "V1013\rNMB01\r\a\r\r\r");
     peer->send(Frame::make(0x101, std::vector<std::uint8_t>{0xAB}));
@@ -478,4 +481,59 @@ TEST(SlcanBus, L14_PtyHangupIsLinkDownWithoutReconnectFactory) {
     EXPECT_THROW(bus.send(Frame::make(1, std::vector<std::uint8_t>{})), LinkDown);
     bus.close();  // returns promptly: the receive thread waits, it does not spin
     EXPECT_EQ(bus.state(), BusState::Closed);
+}
+
+TEST(SlcanServer, TimestampedLinesReachSlcanBusIntact) {
+    auto hub = "slcan-test-" + std::to_string(::getpid()) + "-c";
+    auto inner = open_virtual(hub);
+    auto peer = open_virtual(hub);
+    SlcanServer server(inner);
+    auto o = fast_opts();
+    o.timestamps = true;  // Z1: the server appends ssss to every forwarded line (L7 accepts 4)
+    auto bus = open_slcan(server.pty_path(), 125000, o);
+    for (std::uint32_t id : {0x1u, 0x7FFu}) peer->send(Frame::make(id, std::vector<std::uint8_t>{0x5A, 0xA5}));
+    peer->send(Frame::make(0x1ABCDEF, std::vector<std::uint8_t>{}, true, true, 2));
+    for (std::uint32_t id : {0x1u, 0x7FFu}) {
+        auto got = bus->recv(2s);
+        ASSERT_TRUE(got);
+        EXPECT_EQ(got->id, id);
+        EXPECT_EQ(got->len, 2);
+        EXPECT_EQ(got->data[0], 0x5A);
+        EXPECT_EQ(got->data[1], 0xA5);
+    }
+    auto rtr = bus->recv(2s);
+    ASSERT_TRUE(rtr);
+    EXPECT_TRUE(rtr->rtr && rtr->extended);
+    EXPECT_EQ(rtr->id, 0x1ABCDEFu);
+    EXPECT_EQ(bus->counters().parse_errors, 0u);
+}
+
+TEST(SlcanBus, BurstsAreBatchedInOrderAndIsolatedFramesStillGoStraightOut) {
+    auto hub = "slcan-test-" + std::to_string(::getpid()) + "-d";
+    auto inner = open_virtual(hub);
+    VirtualOptions vo;
+    vo.rx_queue_size = 100000;
+    auto peer = open_virtual(hub, vo);
+    SlcanServer server(inner);
+    auto o = fast_opts();
+    o.wait_for_acks = false;  // no window: the burst goes as fast as it can
+    auto bus = open_slcan(server.pty_path(), 500000, o);
+    ASSERT_TRUE(eventually([&] { return server.is_open(); }));
+    constexpr std::uint32_t kN = 5000;
+    for (std::uint32_t i = 0; i < kN; ++i)
+        bus->send(Frame::make(i % 0x800, std::vector<std::uint8_t>{static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8)}));
+    bus->flush_tx(5s);
+    for (std::uint32_t i = 0; i < kN; ++i) {
+        auto got = peer->recv(5s);
+        ASSERT_TRUE(got) << "frame " << i;
+        ASSERT_EQ(got->id, i % 0x800);
+        ASSERT_EQ(got->data[0] | (got->data[1] << 8), static_cast<int>(i & 0xFFFF));
+    }
+    EXPECT_EQ(bus->counters().tx_dropped, 0u);
+    // A lone frame after a pause is written directly and still arrives.
+    std::this_thread::sleep_for(5ms);
+    bus->send(Frame::make(0x7AB, std::vector<std::uint8_t>{0x01}));
+    auto got = peer->recv(2s);
+    ASSERT_TRUE(got);
+    EXPECT_EQ(got->id, 0x7ABu);
 }

@@ -327,3 +327,10 @@ TEST(Dmac, StartStopWithZeroRampTimes) {
     EXPECT_EQ(prof.end_position(), 20000);
     EXPECT_NEAR(prof.velocity(1e-6), 100000, 1e-6);
 }
+
+TEST(Dmac, MoveOnFromInitialPosition) {
+    DmacMotion m(DmacProfileParams{}, 500);
+    m.move_on(0, 100);
+    EXPECT_EQ(m.profile().end_position(), 600);
+    EXPECT_EQ(m.target(), 600);
+}

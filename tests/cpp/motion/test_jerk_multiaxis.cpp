@@ -150,3 +150,13 @@ TEST(MultiAxis, JerkLimitedSynchronized) {
         }
     }
 }
+
+TEST(JerkLimited, VelocityMode) {
+    Profile p = plan_jerk_limited_velocity(State{0, -2, 0, 0}, 8, Limits{10, 5, 0, 10}, 1.0);
+    // dv = 10 >= a^2/j = 2.5: t1 = 0.5, t2 = 1.5, t3 = 0.5; then 1 s hold.
+    EXPECT_NEAR(p.duration(), 3.5, 1e-12);
+    EXPECT_NEAR(p.velocity(3.0), 8, 1e-12);
+    EXPECT_NEAR(p.acceleration(1.0), 5, 1e-12);
+    EXPECT_EQ(p.final_state().v, 8);
+    EXPECT_THROW(plan_jerk_limited_velocity(State{}, 11, Limits{10, 5, 0, 10}), LimitExceeded);
+}

@@ -326,3 +326,71 @@ TEST(Cia402Homing, Methods) {
     Cia402Homing h(m, p);
     EXPECT_THROW(h.start(), motorbus::InvalidArgument);
 }
+
+// A host wrapping an open-loop drive with an encoder in StepNLoop: a jam loses
+// steps, verification at the end of the move corrects them (Table 7.7).
+TEST(StepNLoop, WrapsOpenLoopMotorAndCorrectsLostSteps) {
+    SimClock clk;
+    MotorModel m(clk);
+    StepNLoop snl;  // SLT 20, SLE 1000 counts, ratio 0.8 steps/count
+    const double target_counts = 4000;  // one rev
+    ASSERT_TRUE(snl.begin(SnlActivity::Move));
+    m.command(move_profile(0, m.counts_to_steps(target_counts)));
+    clk.advance(200 * kMs);
+    m.update();
+    m.set_jammed(true);  // the load blocks the rotor for a while: steps are lost
+    clk.advance(100 * kMs);
+    m.update();
+    m.set_jammed(false);
+    for (int i = 0; i < 300 && m.moving(); ++i) {
+        clk.advance(10 * kMs);
+        m.update();
+        // While moving, delta is the real-time target minus the encoder.
+        const double delta_now = snl.pulses_to_counts(m.pulse_position()) - static_cast<double>(m.encoder());
+        ASSERT_EQ(snl.monitor(delta_now).action, SnlAction::None) << delta_now;  // < SLE
+    }
+    ASSERT_FALSE(m.moving());
+    double delta = target_counts - static_cast<double>(m.encoder());
+    ASSERT_GT(delta, 20);  // out of position
+    SnlDecision d = snl.motion_done(delta);
+    int corrections = 0;
+    while (d.action == SnlAction::Correct) {
+        ++corrections;
+        m.command(move_profile(m.pulse_position(), m.pulse_position() + snl.counts_to_pulses(d.correction)));
+        for (int i = 0; i < 300 && m.moving(); ++i) {
+            clk.advance(10 * kMs);
+            m.update();
+        }
+        d = snl.motion_done(target_counts - static_cast<double>(m.encoder()));
+    }
+    EXPECT_EQ(d.action, SnlAction::InPosition);
+    EXPECT_GE(corrections, 1);
+    EXPECT_LE(std::abs(target_counts - static_cast<double>(m.encoder())), 5);
+    EXPECT_EQ(snl.status(), SnlStatus::Idle);
+}
+
+TEST(MotorModel, LongJogOnSimClockIsCheapAndExact) {
+    SimClock clk;
+    MotorConfig cfg;
+    cfg.home = SwitchConfig{true, 1e6, 1e6 + 2, true};  // a 2-step window far away
+    MotorModel m(clk, cfg);
+    int index = 0, home_on = 0;
+    Nanos home_t = 0;
+    m.add_listener([&](const MotorEvent& e) {
+        index += e.kind == MotorEvent::Kind::IndexPulse;
+        if (e.kind == MotorEvent::Kind::HomeOn) {
+            ++home_on;
+            home_t = e.t;
+        }
+    });
+    ArcusMotion a(ArcusProfileParams{3200, 100, 100, 100, false, false, 1.0});
+    a.jog(0, 1);
+    m.command(a.profile());
+    clk.advance(3600 * kSec);  // one simulated hour of jogging
+    m.update();
+    EXPECT_NEAR(m.pulse_position(), a.profile().position(3600.0), 1e-3);
+    EXPECT_EQ(home_on, 1);
+    EXPECT_NEAR(static_cast<double>(home_t), a.profile().first_crossing(1e6) * 1e9, 2.0);
+    // Index once per rev: floor((p - 0) / 3200) + 1 rising edges from 0 (the first at 0 itself is not crossed).
+    EXPECT_EQ(index, static_cast<int>(std::floor(m.physical_position() / 3200.0)));
+}
