@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 #include "motorbus/can/virtual_bus.hpp"
@@ -33,14 +32,18 @@ std::vector<std::pair<std::uint32_t, Bytes>> pmc007_frames() {
     std::string s = ss.str();
     auto start = s.find("\"pdo_config_sequence\"");
     std::string part = s.substr(start, s.find("\"accel_gears_pps2\"", start) - start);
-    std::regex rx(R"re("id":\s*"([0-9A-Fa-f]+)",\s*"data":\s*"([0-9A-Fa-f ]+)")re");
     std::vector<std::pair<std::uint32_t, Bytes>> out;
-    for (auto it = std::sregex_iterator(part.begin(), part.end(), rx); it != std::sregex_iterator(); ++it) {
+    const std::string idk = "\"id\": \"", datak = "\"data\": \"";
+    for (auto p = part.find(idk); p != std::string::npos; p = part.find(idk, p + 1)) {
+        const auto ib = p + idk.size();
+        const auto d = part.find(datak, ib);
+        if (d == std::string::npos) break;
+        const auto db = d + datak.size();
         Bytes b;
-        std::istringstream hs((*it)[2]);
+        std::istringstream hs(part.substr(db, part.find('"', db) - db));
         std::string tok;
         while (hs >> tok) b.push_back(static_cast<std::uint8_t>(std::stoul(tok, nullptr, 16)));
-        out.emplace_back(std::stoul((*it)[1], nullptr, 16), b);
+        out.emplace_back(std::stoul(part.substr(ib, part.find('"', ib) - ib), nullptr, 16), b);
     }
     return out;
 }
