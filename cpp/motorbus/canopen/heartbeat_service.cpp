@@ -38,7 +38,6 @@ void HeartbeatService::install() {
         next_ = -1;
         return 0;
     });
-    producer->add_change_listener([this](const Variable&) { node_.wake(); });
     auto obj = od.object(0x1016);
     for (auto& [sub, var] : obj->subs) {
         if (sub == 0) continue;
@@ -74,7 +73,9 @@ void HeartbeatService::apply_consumers() {
     for (auto v : entries)
         if (auto e = decode_consumer_entry(v))  // N13: unused entries are never armed
             consumer_.monitor(e->node_id, std::chrono::milliseconds(e->time_ms));
-    node_.wake();
+    // No node_.wake() here: this runs inside the SDO write (the node's SDO lock
+    // held), and wake() takes the node's other lock -- a lock-order inversion.
+    // on_timer() re-checks at least every kRecheck instead.
 }
 
 void HeartbeatService::lost(std::uint8_t n) {
@@ -124,7 +125,10 @@ Nanos HeartbeatService::on_timer(LocalNode& node, Nanos now) {
         } catch (const Error&) {
         }
     }
-    return next < 0 ? kNoDeadline : next;
+    // Configuration written over SDO is picked up within this time (see apply_consumers).
+    constexpr Nanos kRecheck = 50'000'000;
+    if (next < 0 || next > now + kRecheck) next = now + kRecheck;
+    return next;
 }
 
 void HeartbeatService::on_detach(LocalNode&) {

@@ -6,7 +6,8 @@
 //
 // 0x1017 and 0x1016 are created in the dictionary when absent; writes are
 // validated (N12 duplicate node 0x06040043, N13 reserved bits 0x06090030) and
-// take effect at once.  A lost heartbeat sends EMCY 0x8130 (N10) and applies
+// take effect within 50 ms (the service re-checks its configuration on its timer
+// rather than waking the node from inside the SDO write).  A lost heartbeat sends EMCY 0x8130 (N10) and applies
 // 0x1029:1 when present (0 = to PRE-OPERATIONAL, 1 = no change, 2 = STOPPED),
 // else the CiA default 0.
 #pragma once

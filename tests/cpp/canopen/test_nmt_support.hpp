@@ -36,21 +36,40 @@ public:
         eps_.push_back(b);
         return b;
     }
+    // A frame sent from inside a receive callback is queued and delivered after
+    // the current one, so dispatches never nest (as with a real receive thread).
     void route(HubBus* from, const motorbus::can::Frame& f) {
-        std::vector<std::shared_ptr<HubBus>> eps;
         {
             std::lock_guard l(m_);
-            eps = eps_;
             log.push_back(f);
+            pending_.emplace_back(from, f);
+            if (delivering_) return;
+            delivering_ = true;
         }
-        for (auto& e : eps)
-            if (e.get() != from && !e->closed()) e->deliver(f);
+        while (true) {
+            std::pair<HubBus*, motorbus::can::Frame> next;
+            std::vector<std::shared_ptr<HubBus>> eps;
+            {
+                std::lock_guard l(m_);
+                if (pending_.empty()) {
+                    delivering_ = false;
+                    return;
+                }
+                next = pending_.front();
+                pending_.erase(pending_.begin());
+                eps = eps_;
+            }
+            for (auto& e : eps)
+                if (e.get() != next.first && !e->closed()) e->deliver(next.second);
+        }
     }
     std::vector<motorbus::can::Frame> log;  // every frame on the wire
 
 private:
     std::mutex m_;
     std::vector<std::shared_ptr<HubBus>> eps_;
+    std::vector<std::pair<HubBus*, motorbus::can::Frame>> pending_;
+    bool delivering_ = false;
 };
 
 inline void HubBus::do_send(const motorbus::can::Frame& f, motorbus::can::Deadline) {
