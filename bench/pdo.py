@@ -68,14 +68,16 @@ def main() -> None:
 
     name = f"bench-pdo-{time.monotonic_ns()}"
     bus, _sink = _core.open_virtual(name), _core.open_virtual(name)
-    s = SyncProducer(bus, a.period_us / 1e6)
-    s.start()
-    time.sleep(a.sync_seconds)
-    s.stop()
-    j = s.jitter()
-    print(f"SYNC producer {a.period_us} us for {a.sync_seconds} s: {j['count']} periods, error "
-          f"min {j['min_ns'] / 1e3:.1f} us mean {j['mean_ns'] / 1e3:.2f} us max {j['max_ns'] / 1e3:.1f} us "
-          f"p99 |error| {j['p99_abs_ns'] / 1e3:.1f} us")
+    for rt in (False, True):
+        s = SyncProducer(bus, a.period_us / 1e6)
+        s.start(realtime=rt)
+        time.sleep(a.sync_seconds)
+        s.stop()
+        j = s.jitter()
+        label = (" SCHED_FIFO" if s.realtime_granted else " (SCHED_FIFO refused)") if rt else ""
+        print(f"SYNC producer{label} {a.period_us} us for {a.sync_seconds} s: {j['count']} periods, error "
+              f"min {j['min_ns'] / 1e3:.1f} us mean {j['mean_ns'] / 1e3:.2f} us max {j['max_ns'] / 1e3:.1f} us "
+              f"p99 |error| {j['p99_abs_ns'] / 1e3:.1f} us")
 
 
 if __name__ == "__main__":

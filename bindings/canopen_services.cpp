@@ -463,9 +463,11 @@ void bind_canopen_services(py::module_& m) {
                                                    static_cast<std::uint8_t>(overflow), cob_id);
                  return b;
              }), py::arg("bus"), py::arg("period"), py::arg("counter_overflow") = 0, py::arg("cob_id") = kSyncCobId)
-        .def("start", [](SyncProducerBox& b) { b.obj->start(); })
+        .def("start", [](SyncProducerBox& b, bool realtime) { b.obj->start(realtime); }, py::arg("realtime") = false,
+             "realtime=True asks for SCHED_FIFO; see realtime_granted.")
         .def("stop", [](SyncProducerBox& b) { py::gil_scoped_release nogil; b.obj->stop(); })
         .def_property_readonly("running", [](SyncProducerBox& b) { return b.obj->running(); })
+        .def_property_readonly("realtime_granted", [](SyncProducerBox& b) { return b.obj->realtime_granted(); })
         .def_property_readonly("sent", [](SyncProducerBox& b) { return b.obj->sent(); })
         .def("jitter", [](SyncProducerBox& b) {
                  auto j = b.obj->jitter();

@@ -116,14 +116,17 @@ int main(int argc, char** argv) {
     // SYNC jitter on a virtual bus (no wire time): the producer thread alone.
     auto bus = can::open_virtual("bench-sync");
     auto sink = can::open_virtual("bench-sync");
-    SyncProducer p(*bus, std::chrono::microseconds(period_us));
-    p.start();
-    std::this_thread::sleep_for(std::chrono::duration<double>(sync_s));
-    p.stop();
-    auto j = p.jitter();
-    std::printf("SYNC producer, period %d us, %.1f s: %llu periods, error min %.1f us mean %.2f us "
-                "max %.1f us, p99 |error| %.1f us\n",
-                period_us, sync_s, static_cast<unsigned long long>(j.count), j.min_ns / 1e3, j.mean_ns / 1e3,
-                j.max_ns / 1e3, j.p99_abs_ns / 1e3);
+    for (bool rt : {false, true}) {
+        SyncProducer p(*bus, std::chrono::microseconds(period_us));
+        p.start(rt);
+        std::this_thread::sleep_for(std::chrono::duration<double>(sync_s));
+        p.stop();
+        auto j = p.jitter();
+        std::printf("SYNC producer%s, period %d us, %.1f s: %llu periods, error min %.1f us mean %.2f us "
+                    "max %.1f us, p99 |error| %.1f us\n",
+                    rt ? (p.realtime_granted() ? " SCHED_FIFO" : " (SCHED_FIFO refused)") : "", period_us, sync_s,
+                    static_cast<unsigned long long>(j.count), j.min_ns / 1e3, j.mean_ns / 1e3, j.max_ns / 1e3,
+                    j.p99_abs_ns / 1e3);
+    }
     return 0;
 }

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <pthread.h>
+#include <sched.h>
+
 #include "motorbus/errors.hpp"
 
 namespace motorbus::canopen {
@@ -44,14 +47,20 @@ SyncProducer::SyncProducer(can::Bus& bus, std::chrono::nanoseconds period, std::
 
 SyncProducer::~SyncProducer() { stop(); }
 
-void SyncProducer::start() {
+void SyncProducer::start(bool realtime) {
     if (running_.exchange(true)) return;
     {
         std::lock_guard l(stop_m_);
         stop_ = false;
     }
     reset_stats();
+    rt_granted_.store(false);
     thread_ = std::thread([this] { run(); });
+    if (realtime) {
+        sched_param sp{};
+        sp.sched_priority = 50;
+        rt_granted_.store(pthread_setschedparam(thread_.native_handle(), SCHED_FIFO, &sp) == 0);
+    }
 }
 
 void SyncProducer::stop() {

@@ -46,9 +46,13 @@ public:
     SyncProducer(const SyncProducer&) = delete;
     SyncProducer& operator=(const SyncProducer&) = delete;
 
-    void start();
+    // realtime: ask for SCHED_FIFO (priority 50) for the producer thread; when
+    // the process may not (no CAP_SYS_NICE), it runs at normal priority and
+    // realtime_granted() says so.
+    void start(bool realtime = false);
     void stop();
     bool running() const { return running_.load(); }
+    bool realtime_granted() const { return rt_granted_.load(); }
     std::uint64_t sent() const { return sent_.load(); }
     std::uint64_t send_errors() const { return errors_.load(); }
     // Statistics of the period error over the sends since start() (or reset).
@@ -73,6 +77,7 @@ private:
     double sum_ = 0;
     std::int64_t min_ = 0, max_ = 0;
     std::atomic<std::uint64_t> sent_{0}, errors_{0};
+    std::atomic<bool> rt_granted_{false};
     static constexpr std::size_t kWindow = 65536;
 };
 
