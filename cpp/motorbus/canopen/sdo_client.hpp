@@ -202,7 +202,11 @@ public:
     std::uint8_t node_id() const { return node_id_; }
     std::uint32_t request_id() const { return request_id_; }
     std::uint32_t response_id() const { return response_id_; }
-    const SdoClientOptions& options() const { return options_; }
+    // A copy: options may change concurrently (set_timeout).
+    SdoClientOptions options() const {
+        std::lock_guard lock(mutex_);
+        return options_;
+    }
     void set_timeout(std::chrono::nanoseconds t);
     SdoClientCounters counters() const;
 
