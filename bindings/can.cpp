@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "can_filters.hpp"
 #include "common.hpp"
 #include "motorbus/can/bus.hpp"
 #include "motorbus/can/external_bus.hpp"
@@ -64,19 +65,6 @@ py::dict counters_dict(const BusCounters& c) {
     return d;
 }
 
-Filter filter_from_py(const py::handle& h) {
-    // python-can style: {"can_id": .., "can_mask": .., "extended": ..}
-    py::dict d = py::reinterpret_borrow<py::dict>(h);
-    Filter f;
-    f.id = d["can_id"].cast<std::uint32_t>();
-    f.mask = d.contains("can_mask") ? d["can_mask"].cast<std::uint32_t>() : 0x1FFFFFFF;
-    if (d.contains("extended") && !d["extended"].is_none()) {
-        f.match_extended = true;
-        f.extended = d["extended"].cast<bool>();
-    }
-    return f;
-}
-
 }  // namespace
 
 void bind_can(py::module_& m) {
@@ -122,10 +110,7 @@ void bind_can(py::module_& m) {
              py::arg("timeout") = py::none())
         .def("set_filters",
              [](Bus& b, const py::object& filters) {
-                 std::vector<Filter> v;
-                 if (!filters.is_none())
-                     for (auto h : filters) v.push_back(filter_from_py(h));
-                 b.set_filters(std::move(v));
+                 b.set_filters(motorbus::py_helpers::filters_from_py(filters));
              },
              py::arg("filters") = py::none())
         .def("subscribe",

@@ -21,6 +21,17 @@ from .log import LogEntry, Recorder, play, read_log  # noqa: E402,F401
 from . import motion, serial, slcan  # noqa: E402,F401
 from ._core import LimitExceeded  # noqa: E402,F401
 from .slcan import SlcanBus, SlcanServer, open_slcan  # noqa: E402,F401
+from . import socketcand  # noqa: E402,F401
+from .socketcand import (  # noqa: E402,F401
+    SocketCanBus,
+    SocketcandBus,
+    SocketcandServer,
+    open_socketcan,
+    open_socketcand,
+    socketcan_unavailable_reason,
+)
+from . import canopen  # noqa: E402,F401
+from ._core import SdoAbortError, SdoProtocolError, SdoTimeout  # noqa: E402,F401
 from .drives import arcus, dmac  # noqa: E402,F401
 from .drives.arcus import ArcusClient, ArcusSim  # noqa: E402,F401
 from .drives.dmac import DmacClient, DmacSim  # noqa: E402,F401

@@ -7,7 +7,9 @@
 3. CAN: a virtual bus served over SLCAN (a pty) and socketcand (TCP) by
    ``motorbus bus serve``; python-can clients on both exchange frames, and a
    recorder writes the traffic as a candump log.
-4. CANopen: a simulated node on the bus, read and written by the SDO client.
+4. CANopen: a simulated node on a virtual bus served over socketcand, read and
+   written by the SDO client (expedited, segmented, block), its dictionary
+   exported as EDS.
 """
 from __future__ import annotations
 
@@ -141,24 +143,48 @@ def can_bench(quick: bool, workdir: str) -> None:
     print(f"  read back {len(entries)} frames ({bad} bad lines): {entries[0]!r} ...")
 
 
-def canopen_bench(quick: bool) -> None:
-    try:
-        from . import canopen
-    except ImportError:
-        return
-    if not hasattr(canopen, "LocalNode"):
-        return
+def canopen_bench(quick: bool, workdir: str) -> None:
+    from . import canopen
     from .bus import open_bus
 
-    _title("CANopen: a simulated node and the SDO client on one virtual bus")
-    od = canopen.ObjectDictionary.from_eds(canopen.demo_eds_path()) if hasattr(canopen, "demo_eds_path") else None
-    if od is None:
-        return
-    with open_bus("virtual:co-demo") as a, open_bus("virtual:co-demo") as b:
-        node = canopen.LocalNode(a, 5, od)
-        sdo = canopen.SdoClient(b, 5, timeout=1.0)
-        print(f"  0x1000 device type = 0x{sdo.read_u32(0x1000, 0):08X}")
-        node.close()
+    _title("CANopen: a simulated node served over socketcand, read by the SDO client")
+    od = canopen.ObjectDictionary()
+    od.add_variable(0x1000, "Device type", "u32", "ro", default=0x00040192)
+    od.add_variable(0x1008, "Manufacturer device name", "VISIBLE_STRING", "const", default="PMC007 (simulated)")
+    od.add_record(0x1018, "Identity object")
+    od.add_member(0x1018, 1, "Vendor-ID", "u32", "ro", default=0x000000AB)
+    od.add_variable(0x6001, "Controller status", "u8", "ro", default=8)
+    od.add_variable(0x2003, "Baud index", "u8", "rw", low=0, high=8, default=4)
+    od.add_variable(0x1F50, "Program", "DOMAIN", "rw", max_size=256 * 1024)
+    with open_bus("virtual:co-demo") as node_side, open_bus("virtual:co-demo") as server_side:
+        node = canopen.LocalNode(node_side, 5, od)
+        server = _core.SocketcandServer(server_side, host="127.0.0.1", port=0)
+        try:
+            with open_bus(f"socketcand:127.0.0.1:{server.port}/can0") as remote:
+                sdo = canopen.SdoClient(remote, 5, timeout=1.0)
+                print(f"  node 5 over socketcand 127.0.0.1:{server.port}: device type 0x{sdo.read_u32(0x1000):08X}, "
+                      f"name {sdo.read_string(0x1008)!r}, vendor 0x{sdo.read_u32(0x1018, 1):X}")
+                print(f"  0x6001 controller status = {sdo.read_u8(0x6001)} (PMC007 manual: 8 = busy)")
+                sdo.write_u8(0x2003, 0, 7)
+                print(f"  wrote baud index 7 (800 kbit/s); node now holds {od[0x2003].value}")
+                try:
+                    sdo.write_u8(0x2003, 0, 9)
+                except canopen.SdoAbortError as e:
+                    print(f"  baud index 9 refused: abort 0x{e.code:08X} {e.text}")
+                blob = bytes(range(256)) * (16 if quick else 256)
+                t0 = time.monotonic()
+                sdo.download(0x1F50, 0, blob, block=True)
+                back = sdo.upload(0x1F50, 0, block=True)
+                dt = time.monotonic() - t0
+                print(f"  block transfer of {len(blob)} bytes down and up in {dt * 1000:.1f} ms, "
+                      f"identical: {back == blob}")
+            path = os.path.join(workdir, "node5.eds")
+            canopen.save_eds(od, path)
+            again = canopen.load_eds(path)
+            print(f"  exported the node's dictionary to EDS and loaded it back: 0x1008 = {again[0x1008].value!r}")
+        finally:
+            server.close()
+            node.close()
 
 
 def main(quick: bool = False) -> int:
@@ -166,6 +192,6 @@ def main(quick: bool = False) -> int:
     with tempfile.TemporaryDirectory(prefix="motorbus-demo-") as workdir:
         serial_bench(quick)
         can_bench(quick, workdir)
-        canopen_bench(quick)
+        canopen_bench(quick, workdir)
     print("\ndemo finished")
     return 0

@@ -14,4 +14,8 @@ def test_demo_quick_runs_the_whole_bench():
     assert "DMAC 00 MOVE_TO 5000 -> #POSITION=5000" in text
     assert re.search(r"python-can socketcand -> python-can slcan: 5/5 frames", text)
     assert "recorded 100 frames" in text and "read back 100 frames (0 bad lines)" in text
+    assert "device type 0x00040192, name 'PMC007 (simulated)', vendor 0xAB" in text
+    assert "baud index 9 refused: abort 0x06090031" in text
+    assert "block transfer of 4096 bytes down and up" in text and "identical: True" in text
+    assert "loaded it back: 0x1008 = 'PMC007 (simulated)'" in text
     assert text.rstrip().endswith("demo finished")
