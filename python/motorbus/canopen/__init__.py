@@ -1,4 +1,5 @@
-"""CANopen: object dictionary, EDS, SDO client and server (LocalNode).
+"""CANopen: object dictionary, EDS, SDO client and server (LocalNode), NMT, heartbeat, EMCY,
+SYNC, PDO, CiA 402 and a network scanner.
 
     import motorbus
     from motorbus.canopen import SdoClient, ObjectDictionary, LocalNode
@@ -26,4 +27,8 @@ __all__ = [
     "SdoProtocolError", "SdoTimeout", "Variable", "abort_text", "load_eds", "save_eds", "to_eds",
 ]
 
-# ---- canopen-svc exports (NMT, SYNC, EMCY, heartbeat, TIME, PDO, CiA 402, scanner) go below ----
+# NMT, SYNC, EMCY, heartbeat, TIME, PDO, CiA 402 and the scanner
+from .services import *  # noqa: E402,F401,F403
+from .services import __all__ as _services_all  # noqa: E402
+
+__all__ += _services_all
