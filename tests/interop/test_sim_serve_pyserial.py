@@ -27,10 +27,9 @@ def served():
         lines[spec] = path
     yield lines
     proc.send_signal(signal.SIGINT)
-    assert proc.wait(10) == 0
-    # Ctrl-C leaves nothing behind: the ptys are gone with their server.
-    for path in lines.values():
-        assert not pathlib.Path(path).exists()
+    assert proc.wait(10) == 0  # Ctrl-C ends the server cleanly
+    # (The pty numbers may be reused by other processes at once, so their
+    # paths are not checked here; the pty tests of motorbus.serial check fds.)
 
 
 def _arcus(port, send, expect_reply=True, timeout=1.0):
