@@ -1,0 +1,19 @@
+"""Shared pytest configuration.
+
+Every test that drives the C++ core's threads (buses, servers, clients,
+simulators) is marked `threaded`, so tools/sanitize.sh runs it again under
+AddressSanitizer + UBSan.  Modules listed here only spawn subprocesses or do
+single-threaded math, which the sanitizer run would not add anything to.
+"""
+import pytest
+
+NOT_THREADED = {
+    "test_demo", "test_examples", "test_cli_bus_serve", "test_sim_serve_pyserial",  # subprocesses
+    "test_motion", "test_motion_ruckig", "test_frame",  # no threads
+}
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.module.__name__.rsplit(".", 1)[-1] not in NOT_THREADED:
+            item.add_marker(pytest.mark.threaded)
