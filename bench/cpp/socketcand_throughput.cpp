@@ -166,6 +166,23 @@ struct Medium {
 
 bool client_drops_any(const SocketcandServer& s) { return s.stats().queue_drops != 0; }
 
+// The bus sends `n` frames to the clients as fast as it can, but never more
+// than kWindow ahead of what the server has handed to its clients.  The virtual
+// hub models a controller FIFO: it drops (counts an overrun) when the served
+// endpoint falls 65536 frames behind, which the unpaced sender caused with
+// 1 M frames and then the bench counted fewer frames than were sent.
+// The same pacing applies to both clients and both media.
+constexpr std::int64_t kWindow = 32768;
+void feed_clients(Medium& m, const SocketcandServer& server, int n, const Frame& f) {
+    const std::uint64_t base = server.stats().frames_to_clients;
+    for (int i = 0; i < n; ++i) {
+        if ((i & 1023) == 0)
+            while (i - static_cast<std::int64_t>(server.stats().frames_to_clients - base) > kWindow)
+                std::this_thread::sleep_for(20us);
+        m.to_clients(f);
+    }
+}
+
 struct Result {
     double tx, rx, up_med, up_p99, down_med, down_p99, pc_tx, pc_rx;
 };
@@ -196,7 +213,7 @@ Result run(Medium& m, int frames, int pc_frames, int reps, const std::string& sc
 
             // bus -> C++ client: from the first frame received to the last.
             std::thread sender([&] {
-                for (int i = 0; i < frames; ++i) m.to_clients(f8);
+                feed_clients(m, server, frames, f8);
             });
             int got = 0;
             std::chrono::steady_clock::time_point first;
@@ -238,6 +255,7 @@ Result run(Medium& m, int frames, int pc_frames, int reps, const std::string& sc
         res.down_p99 = pd.p99_us;
     }
     if (client_drops_any(server)) fail("the server dropped frames for the C++ client");
+    if (auto o = m.served->counters().overruns) fail("the medium overran " + std::to_string(o) + " frames");
     if (script.empty() || pc_frames <= 0) return res;
     for (int rep = 0; rep < reps; ++rep) {  // python-can -> bus
         Peer p;
@@ -256,7 +274,7 @@ Result run(Medium& m, int frames, int pc_frames, int reps, const std::string& sc
         if (!p.start(script, server.port(), "rx", pc_frames)) fail("python-can peer did not start");
         std::this_thread::sleep_for(10ms);
         p.go();
-        for (int i = 0; i < pc_frames; ++i) m.to_clients(f8);
+        feed_clients(m, server, pc_frames, f8);
         std::string line = p.line();  // RECEIVED n seconds
         unsigned long n = 0;
         double secs = 0;
@@ -265,6 +283,7 @@ Result run(Medium& m, int frames, int pc_frames, int reps, const std::string& sc
         res.pc_rx = std::max(res.pc_rx, secs > 0 && n > 1 ? (n - 1) / secs : 0.0);
         p.finish();
     }
+    if (auto o = m.served->counters().overruns) fail("the medium overran " + std::to_string(o) + " frames");
     return res;
 }
 
