@@ -494,8 +494,15 @@ ElementParser::Next ElementParser::find_element(std::span<const char> bytes, std
     skipping_ = false;
     const std::size_t start = i;
     const std::size_t limit = std::min(n, start + max_element_);
-    std::size_t j = start + 1;
-    while (j < limit && p[j] != '>' && p[j] != '<') ++j;
+    // The first '>' or '<' after start, before limit (two memchr beat a byte loop).
+    std::size_t j = limit;
+    if (start + 1 < limit) {
+        const char* from_p = p + start + 1;
+        const void* gt = std::memchr(from_p, '>', limit - start - 1);
+        const char* stop = gt ? static_cast<const char*>(gt) : p + limit;
+        const void* lt = std::memchr(from_p, '<', static_cast<std::size_t>(stop - from_p));
+        j = static_cast<std::size_t>((lt ? static_cast<const char*>(lt) : stop) - p);
+    }
     if (j < limit && p[j] == '>') return {j + 1, true, std::string_view(p + start, j + 1 - start)};
     if (j < limit) {  // '<' again before '>': resync there
         ++stats_.interrupted;
