@@ -27,6 +27,20 @@ def wait_rx(node, want: int, limit: float = 60.0) -> None:
     end = time.perf_counter() + limit
     while node.counters["rx_frames"] < want and time.perf_counter() < end:
         time.sleep(0.0002)
+    got = node.counters["rx_frames"]
+    if got != want:
+        raise SystemExit(f"FAILED: the bus counted {got} frames, {want} expected")
+
+
+def drain(node) -> None:
+    """Empties the node's recv() queue, so a later recv() waits for a new frame."""
+    while node.recv(0) is not None:
+        pass
+
+
+def check_received(who: str, got: int, n: int) -> None:
+    if got != n:
+        raise SystemExit(f"FAILED: {who} received {got} of {n} frames")
 
 
 def pct(values: list[float]) -> tuple[float, float]:
@@ -54,8 +68,13 @@ def bench_ours(server, node, n: int, pings: int, reps: int) -> dict:
         t0 = time.perf_counter()
         while got < n - 1 and bus.recv(5.0) is not None:
             got += 1
-        rx = max(rx, got / (time.perf_counter() - t0))
+        elapsed = time.perf_counter() - t0
+        check_received("motorbus", got + 1, n)
+        rx = max(rx, got / elapsed)
 
+    # The node's recv() queue still holds every frame of the tx runs: without
+    # this, node.recv() below would return at once and "latency" would be send() alone.
+    drain(node)
     up, down = [], []
     for _ in range(pings):
         t = time.perf_counter_ns()
@@ -91,8 +110,13 @@ def bench_pycan(server, node, n: int, pings: int, reps: int) -> dict:
         t0 = time.perf_counter()
         while got < n - 1 and bus.recv(5.0) is not None:
             got += 1
-        rx = max(rx, got / (time.perf_counter() - t0))
+        elapsed = time.perf_counter() - t0
+        check_received("python-can", got + 1, n)
+        rx = max(rx, got / elapsed)
 
+    # The node's recv() queue still holds every frame of the tx runs: without
+    # this, node.recv() below would return at once and "latency" would be send() alone.
+    drain(node)
     up, down = [], []
     for _ in range(pings):
         t = time.perf_counter_ns()

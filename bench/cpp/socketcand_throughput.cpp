@@ -2,7 +2,11 @@
 // client, and frames/s for python-can's socketcand interface against the same
 // SocketcandServer in the same run (spawned as bench/socketcand_pycan_peer.py).
 //
-//   ./build/h/bench_socketcand_throughput [frames=200000] [pycan_frames=50000] [reps=3]
+//   ./build/h/bench_socketcand_throughput [frames=200000] [pycan_frames=frames] [reps=3] [counting|virtual]
+//
+// Both clients send and receive the same 8-byte frame, through the same server,
+// timed the same way (see run()); every run checks that every frame arrived and
+// exits non-zero otherwise.  pycan_frames=0 skips python-can (for profiling).
 //
 // Two media behind the same SocketcandServer code:
 //   virtual  - the server serves one endpoint of an in-process virtual hub and a
@@ -34,6 +38,18 @@ using namespace motorbus::can;
 using namespace std::chrono_literals;
 
 namespace {
+
+[[noreturn]] void fail(const std::string& why) {
+    std::printf("FAILED: %s\n", why.c_str());
+    std::fflush(stdout);
+    std::_Exit(1);
+}
+
+void expect_count(const char* what, std::uint64_t got, std::uint64_t want) {
+    if (got != want)
+        fail(std::string(what) + ": " + std::to_string(got) + " frames counted, " +
+             std::to_string(want) + " sent");
+}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -148,6 +164,25 @@ struct Medium {
     Arrivals* arrivals = nullptr;                  // frames the rest of the bus got
 };
 
+bool client_drops_any(const SocketcandServer& s) { return s.stats().queue_drops != 0; }
+
+// The bus sends `n` frames to the clients as fast as it can, but never more
+// than kWindow ahead of what the server has handed to its clients.  The virtual
+// hub models a controller FIFO: it drops (counts an overrun) when the served
+// endpoint falls 65536 frames behind, which the unpaced sender caused with
+// 1 M frames and then the bench counted fewer frames than were sent.
+// The same pacing applies to both clients and both media.
+constexpr std::int64_t kWindow = 32768;
+void feed_clients(Medium& m, const SocketcandServer& server, int n, const Frame& f) {
+    const std::uint64_t base = server.stats().frames_to_clients;
+    for (int i = 0; i < n; ++i) {
+        if ((i & 1023) == 0)
+            while (i - static_cast<std::int64_t>(server.stats().frames_to_clients - base) > kWindow)
+                std::this_thread::sleep_for(20us);
+        m.to_clients(f);
+    }
+}
+
 struct Result {
     double tx, rx, up_med, up_p99, down_med, down_p99, pc_tx, pc_rx;
 };
@@ -173,11 +208,12 @@ Result run(Medium& m, int frames, int pc_frames, int reps, const std::string& sc
             auto t0 = std::chrono::steady_clock::now();
             for (int i = 0; i < frames; ++i) client->send(f8, 5s);
             m.arrivals->wait(frames, 60000ms);
+            expect_count("C++ tx", m.arrivals->count.load(), frames);
             res.tx = std::max(res.tx, m.arrivals->count.load() / seconds_since(t0));
 
             // bus -> C++ client: from the first frame received to the last.
             std::thread sender([&] {
-                for (int i = 0; i < frames; ++i) m.to_clients(f8);
+                feed_clients(m, server, frames, f8);
             });
             int got = 0;
             std::chrono::steady_clock::time_point first;
@@ -186,8 +222,19 @@ Result run(Medium& m, int frames, int pc_frames, int reps, const std::string& sc
                 if (!f) break;
                 if (got++ == 0) first = std::chrono::steady_clock::now();
             }
+            const double secs = seconds_since(first);
             sender.join();
-            res.rx = std::max(res.rx, (got - 1) / seconds_since(first));
+            if (got != frames) {
+                auto c = client->counters();
+                auto ss = server.stats();
+                std::printf("client: rx_frames %llu rx_dropped %llu parse_errors %llu overruns %llu;"
+                            " server: to_clients %llu drops %llu\n",
+                            (unsigned long long)c.rx_frames, (unsigned long long)c.rx_dropped,
+                            (unsigned long long)c.parse_errors, (unsigned long long)c.overruns,
+                            (unsigned long long)ss.frames_to_clients, (unsigned long long)ss.queue_drops);
+            }
+            expect_count("C++ rx", got, frames);
+            res.rx = std::max(res.rx, (got - 1) / secs);
         }
 
         // One-way latency with one frame in flight: client -> bus, bus -> client.
@@ -207,31 +254,36 @@ Result run(Medium& m, int frames, int pc_frames, int reps, const std::string& sc
         res.down_med = pd.median_us;
         res.down_p99 = pd.p99_us;
     }
-    if (script.empty()) return res;
+    if (client_drops_any(server)) fail("the server dropped frames for the C++ client");
+    if (auto o = m.served->counters().overruns) fail("the medium overran " + std::to_string(o) + " frames");
+    if (script.empty() || pc_frames <= 0) return res;
     for (int rep = 0; rep < reps; ++rep) {  // python-can -> bus
         Peer p;
-        if (!p.start(script, server.port(), "tx", pc_frames)) return res;
+        if (!p.start(script, server.port(), "tx", pc_frames)) fail("python-can peer did not start");
         m.arrivals->reset();
         auto t0 = std::chrono::steady_clock::now();
         p.go();
         m.arrivals->wait(pc_frames, 60000ms);
+        expect_count("python-can tx", m.arrivals->count.load(), pc_frames);
         res.pc_tx = std::max(res.pc_tx, m.arrivals->count.load() / seconds_since(t0));
         p.line();
         p.finish();
     }
     for (int rep = 0; rep < reps; ++rep) {  // bus -> python-can
         Peer p;
-        if (!p.start(script, server.port(), "rx", pc_frames)) return res;
+        if (!p.start(script, server.port(), "rx", pc_frames)) fail("python-can peer did not start");
         std::this_thread::sleep_for(10ms);
         p.go();
-        for (int i = 0; i < pc_frames; ++i) m.to_clients(f8);
+        feed_clients(m, server, pc_frames, f8);
         std::string line = p.line();  // RECEIVED n seconds
         unsigned long n = 0;
         double secs = 0;
         std::sscanf(line.c_str(), "RECEIVED %lu %lf", &n, &secs);
+        expect_count("python-can rx", n, pc_frames);
         res.pc_rx = std::max(res.pc_rx, secs > 0 && n > 1 ? (n - 1) / secs : 0.0);
         p.finish();
     }
+    if (auto o = m.served->counters().overruns) fail("the medium overran " + std::to_string(o) + " frames");
     return res;
 }
 
@@ -251,14 +303,15 @@ void print(const char* name, const Result& r) {
 
 int main(int argc, char** argv) {
     const int frames = argc > 1 ? std::atoi(argv[1]) : 200000;
-    const int pc_frames = argc > 2 ? std::atoi(argv[2]) : 50000;
+    const int pc_frames = argc > 2 ? std::atoi(argv[2]) : frames;
     const int reps = argc > 3 ? std::max(1, std::atoi(argv[3])) : 3;
+    const std::string only = argc > 4 ? argv[4] : "";
     const std::string script = peer_script(argv[0]);
     if (script.empty()) std::printf("python-can peer script not found (run from the repository root)\n");
     std::printf("socketcand over 127.0.0.1: motorbus SocketcandServer; %d frames (C++), %d (python-can),"
                 " 8-byte payloads, best of %d\n", frames, pc_frames, reps);
 
-    {
+    if (only.empty() || only == "counting") {
         auto counting = std::make_shared<CountingBus>();
         counting->set_filters(kNothing);
         Medium m;
@@ -267,7 +320,7 @@ int main(int argc, char** argv) {
         m.arrivals = &counting->arrivals;
         print("counting", run(m, frames, pc_frames, reps, script));
     }
-    {
+    if (only.empty() || only == "virtual") {
         const std::string hub = "bench-socketcand-" + std::to_string(::getpid());
         VirtualOptions vo;
         vo.tx_queue = 4096;

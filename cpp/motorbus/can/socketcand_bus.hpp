@@ -88,7 +88,7 @@ private:
     std::mutex tx_mutex_;
     std::condition_variable tx_space_cv_;  // unsent bytes went out
     std::string pending_;                  // tx_mutex_
-    Nanos last_send_ns_ = 0;               // tx_mutex_
+    Deadline last_send_deadline_{};        // tx_mutex_
     std::mutex write_mutex_;
     std::string writing_;                  // write_mutex_
     std::size_t writing_off_ = 0;          // write_mutex_

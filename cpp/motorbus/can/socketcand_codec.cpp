@@ -219,6 +219,99 @@ std::uint8_t fd_flags_byte(const Frame& f) {
     return static_cast<std::uint8_t>(((f.flags & kFlagBrs) ? 1 : 0) | ((f.flags & kFlagEsi) ? 2 : 0));
 }
 
+// Fast paths for the two elements a busy link carries, in the exact shape
+// socketcand, python-can and our encoders write them (single blanks):
+//   < frame ID SEC.FRACTION HEXDATA >   (server -> client)
+//   < send ID DLC B0 B1 .. >            (client -> server)
+// They accept only input the general parser accepts with the same result, and
+// return false for anything else, which the general parser then handles (and
+// explains, when it is malformed).  Tokenizing into 72 spans first cost about
+// as much as everything else on the receive path.
+struct Cursor {
+    const char* p;
+    const char* end;
+    bool take(char c) {
+        if (p == end || *p != c) return false;
+        ++p;
+        return true;
+    }
+    // 1..max_digits hex digits; false if none, too many or the value is not followed by a blank.
+    bool hex(int max_digits, std::uint32_t& v, int& digits) {
+        v = 0;
+        digits = 0;
+        while (p != end) {
+            int d = hex_digit(*p);
+            if (d < 0) break;
+            if (++digits > max_digits) return false;
+            v = (v << 4) | static_cast<std::uint32_t>(d);
+            ++p;
+        }
+        return digits > 0;
+    }
+};
+
+bool fast_id(Cursor& c, Frame& f) {
+    std::uint32_t v;
+    int digits;
+    if (!c.hex(8, v, digits)) return false;
+    f.extended = digits > 3;
+    if (f.extended ? v > kMaxExtendedId : v > kMaxStandardId) return false;
+    f.id = v;
+    return true;
+}
+
+bool fast_frame(std::string_view element, Element& out) {
+    Cursor c{element.data() + 8, element.data() + element.size()};  // after "< frame "
+    Frame& f = out.frame;
+    if (!fast_id(c, f) || !c.take(' ')) return false;
+    // SEC.FRACTION: 1-10 decimal digits, '.', 1-9 decimal digits (parse_time's rules).
+    std::int64_t sec = 0, frac = 0;
+    int sd = 0, fd = 0;
+    while (c.p != c.end && *c.p >= '0' && *c.p <= '9') {
+        if (++sd > 10) return false;
+        sec = sec * 10 + (*c.p++ - '0');
+    }
+    if (sd == 0 || sec > 9'000'000'000LL || !c.take('.')) return false;
+    while (c.p != c.end && *c.p >= '0' && *c.p <= '9') {
+        if (++fd > 9) return false;
+        frac = frac * 10 + (*c.p++ - '0');
+    }
+    if (fd == 0 || !c.take(' ')) return false;
+    for (int k = fd; k < 9; ++k) frac *= 10;
+    std::size_t len = 0;
+    while (c.end - c.p >= 2) {
+        int hi = hex_digit(c.p[0]);
+        if (hi < 0) break;
+        int lo = hex_digit(c.p[1]);
+        if (lo < 0 || len == kMaxClassicLen) return false;
+        f.data[len++] = static_cast<std::uint8_t>(hi << 4 | lo);
+        c.p += 2;
+    }
+    if (c.end - c.p != 2 || c.p[0] != ' ' || c.p[1] != '>') return false;
+    f.len = static_cast<std::uint8_t>(len);
+    out.kind = ElementKind::Frame;
+    out.remote_time_ns = sec * 1'000'000'000LL + frac;
+    return true;
+}
+
+bool fast_send(std::string_view element, Element& out) {
+    Cursor c{element.data() + 7, element.data() + element.size()};  // after "< send "
+    Frame& f = out.frame;
+    if (!fast_id(c, f) || !c.take(' ')) return false;
+    if (c.p == c.end || *c.p < '0' || *c.p > '8') return false;
+    const unsigned len = static_cast<unsigned>(*c.p++ - '0');
+    for (unsigned i = 0; i < len; ++i) {
+        std::uint32_t v;
+        int digits;
+        if (!c.take(' ') || !c.hex(2, v, digits)) return false;
+        f.data[i] = static_cast<std::uint8_t>(v);
+    }
+    if (c.end - c.p != 2 || c.p[0] != ' ' || c.p[1] != '>') return false;
+    f.len = static_cast<std::uint8_t>(len);
+    out.kind = ElementKind::Send;
+    return true;
+}
+
 }  // namespace
 
 const char* to_string(ElementKind k) {
@@ -248,6 +341,12 @@ const char* parse_element(std::string_view element, Element& out) {
     if (element.size() < 2 || element.front() != '<' || element.back() != '>')
         return "element: not enclosed in < >";
     if (element.size() > 65535) return "element: too long";
+    if (element.starts_with("< frame ") || element.starts_with("< send ")) {
+        out.frame = Frame{};
+        out.remote_time_ns = 0;
+        out.text.clear();
+        if (element[2] == 'f' ? fast_frame(element, out) : fast_send(element, out)) return nullptr;
+    }
     Tokens t;
     int n = tokenize(element.substr(1, element.size() - 2), t);
     if (n < 0) return "element: too many items";
@@ -395,8 +494,15 @@ ElementParser::Next ElementParser::find_element(std::span<const char> bytes, std
     skipping_ = false;
     const std::size_t start = i;
     const std::size_t limit = std::min(n, start + max_element_);
-    std::size_t j = start + 1;
-    while (j < limit && p[j] != '>' && p[j] != '<') ++j;
+    // The first '>' or '<' after start, before limit (two memchr beat a byte loop).
+    std::size_t j = limit;
+    if (start + 1 < limit) {
+        const char* from_p = p + start + 1;
+        const void* gt = std::memchr(from_p, '>', limit - start - 1);
+        const char* stop = gt ? static_cast<const char*>(gt) : p + limit;
+        const void* lt = std::memchr(from_p, '<', static_cast<std::size_t>(stop - from_p));
+        j = static_cast<std::size_t>((lt ? static_cast<const char*>(lt) : stop) - p);
+    }
     if (j < limit && p[j] == '>') return {j + 1, true, std::string_view(p + start, j + 1 - start)};
     if (j < limit) {  // '<' again before '>': resync there
         ++stats_.interrupted;

@@ -8,7 +8,6 @@
 
 #include <cerrno>
 #include <cstring>
-#include <deque>
 #include <vector>
 
 #include "motorbus/errors.hpp"
@@ -47,7 +46,13 @@ struct SocketcandServer::Conn {
     std::atomic<bool> raw{false};       // read by broadcast() on the bus thread
     Nanos hold_frames_until = 0;        // see kRawModeSettleNs
     std::mutex qmu;
-    std::deque<Frame> queue;            // frames waiting for this client (bounded, K15)
+    // Frames waiting for this client (bounded, K15): queue[queue_head..] under qmu.
+    // Two vectors swapped between the bus thread and the I/O thread keep their
+    // capacity, so a busy link allocates nothing per frame (a deque allocated a
+    // block every few frames on one thread and freed it on the other).
+    std::vector<Frame> queue;
+    std::size_t queue_head = 0;         // frames before it were dropped (K15)
+    std::vector<Frame> draining;        // I/O thread only: the batch being encoded
     std::uint64_t drops = 0;            // guarded by qmu
     std::string out;                    // encoded bytes not yet written
     std::size_t out_off = 0;
@@ -122,12 +127,19 @@ void SocketcandServer::broadcast(const Frame& f, const Conn* except) {
         for (auto& c : conns_) {
             if (c.get() == except || !c->raw.load(std::memory_order_relaxed)) continue;
             std::lock_guard q(c->qmu);
-            if (c->queue.size() >= opts_.client_queue) {  // K15: the newest frames matter most
-                c->queue.pop_front();
+            if (c->queue.size() - c->queue_head >= opts_.client_queue) {  // K15: the newest frames matter most
+                ++c->queue_head;
                 ++c->drops;
                 queue_drops_.fetch_add(1, std::memory_order_relaxed);
+                // Reclaim the dropped prefix now and then: memory stays within
+                // 1.5x client_queue at O(1) amortised cost per frame.
+                if (c->queue_head * 2 >= opts_.client_queue) {
+                    c->queue.erase(c->queue.begin(),
+                                   c->queue.begin() + static_cast<std::ptrdiff_t>(c->queue_head));
+                    c->queue_head = 0;
+                }
             }
-            wake |= c->queue.empty();
+            wake |= c->queue.size() == c->queue_head;
             c->queue.push_back(f);
         }
     }
@@ -179,7 +191,7 @@ void SocketcandServer::client_send(Conn& c, const Frame& frame) {
             return;
         }
     }
-    ++counters_.frames_to_bus;
+    ++frames_to_bus_unpublished_;  // one atomic add per read chunk, not per frame
     // The other clients are nodes on the same bus.  Only this thread changes
     // conns_, so it may look at its size without the lock.
     if (conns_.size() > 1) broadcast(f, &c);
@@ -247,6 +259,10 @@ bool SocketcandServer::service_input(Conn& c, Nanos now) {
     const auto done_after = c.parser.stats().elements + c.parser.stats().bad_elements;
     if (c.parser.mid_element() && (!was_mid || done_after != done_before)) c.element_started = now;
     if (bad) counters_.bad_elements += bad;
+    if (frames_to_bus_unpublished_) {
+        counters_.frames_to_bus.fetch_add(frames_to_bus_unpublished_, std::memory_order_relaxed);
+        frames_to_bus_unpublished_ = 0;
+    }
     return true;
 }
 
@@ -254,16 +270,21 @@ void SocketcandServer::fill_output(Conn& c) {
     if (!c.raw.load() || c.out.size() - c.out_off >= kOutHighWater) return;
     if (c.hold_frames_until && monotonic_ns() < c.hold_frames_until) return;
     c.hold_frames_until = 0;
-    std::deque<Frame> batch;
+    std::size_t head;
     {
         std::lock_guard q(c.qmu);
-        if (c.queue.empty()) return;
-        batch.swap(c.queue);
+        if (c.queue.size() == c.queue_head) return;
+        c.draining.swap(c.queue);  // c.draining was left empty, with its capacity
+        head = c.queue_head;
+        c.queue_head = 0;
     }
     const Nanos wall_now = realtime_ns();
-    for (const Frame& f : batch)
+    for (std::size_t i = head; i < c.draining.size(); ++i) {
+        const Frame& f = c.draining[i];
         socketcand::encode_frame(f, f.timestamp_ns ? f.timestamp_ns + wall_offset_ns_ : wall_now, c.out);
-    counters_.frames_to_clients += batch.size();
+    }
+    counters_.frames_to_clients += c.draining.size() - head;
+    c.draining.clear();
 }
 
 bool SocketcandServer::flush(Conn& c) {

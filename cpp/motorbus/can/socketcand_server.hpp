@@ -113,6 +113,7 @@ private:
             error_replies{0}, bad_elements{0};
     } counters_;
     std::atomic<std::uint64_t> queue_drops_{0};
+    std::uint64_t frames_to_bus_unpublished_ = 0;  // I/O thread only; see service_input
     std::thread io_thread_;
 };
 

@@ -313,3 +313,48 @@ TEST(SocketcandCodec, RoundTripEveryIdWidthAndDlc) {
         }
     }
 }
+
+// parse_element has a fast path for the canonical `< frame ... >` and
+// `< send ... >` shapes; near-misses must still go the general way, with the
+// same result or the same reason.
+TEST(SocketcandCodec, FastPathAndGeneralPathAgreeOnNearMisses) {
+    // Accepted by both paths: canonical shape vs. a variant only the general path takes.
+    struct Pair {
+        const char* canonical;
+        const char* variant;
+    };
+    const Pair same[] = {
+        {"< frame 123 5.000000 1122 >", "< frame 123 5 11 22 >"},
+        {"< frame 1234 5.1 >", "<  frame 00001234  5.100 >"},  // empty data, 29-bit by width
+        {"< frame 7FF 0.000001  >", "< frame 7ff 0.000001 >"},
+        {"< send 123 2 a bc >", "< send 123 02 0a bc >"},
+        {"< send 1FFFFFFF 0 >", "< send  1fffffff  0  >"},
+    };
+    for (const Pair& p : same) {
+        const Element a = one(p.canonical), b = one(p.variant);
+        EXPECT_EQ(a.kind, b.kind) << p.canonical;
+        EXPECT_EQ(a.remote_time_ns, b.remote_time_ns) << p.canonical;
+        EXPECT_EQ(a.frame.id, b.frame.id) << p.canonical;
+        EXPECT_EQ(a.frame.extended, b.frame.extended) << p.canonical;
+        EXPECT_EQ(a.frame.len, b.frame.len) << p.canonical;
+        EXPECT_EQ(a.frame.data, b.frame.data) << p.canonical;
+    }
+    const Element f = one("< frame 12345678 1700000000.123456789 0011223344556677 >");
+    EXPECT_EQ(f.kind, ElementKind::Frame);
+    EXPECT_EQ(f.frame.id, 0x12345678u);
+    EXPECT_TRUE(f.frame.extended);
+    EXPECT_EQ(f.remote_time_ns, 1'700'000'000'123'456'789LL);
+    EXPECT_EQ(f.frame.len, 8);
+    EXPECT_EQ(f.frame.data[7], 0x77);
+    // Near misses of the fast shapes keep the general path's reasons (K5, K6, K7, K10).
+    EXPECT_EQ(refused("< frame 800 1.0 11 >"), "id: above 7FF");
+    EXPECT_EQ(refused("< frame 123 1.0 112 >"), "data: odd number of hex digits");
+    EXPECT_EQ(refused("< frame 123 1.0 001122334455667788 >"), "data: too many bytes");
+    EXPECT_EQ(refused("< frame 123 1.0123456789 11 >"), "timestamp: bad fraction");
+    EXPECT_EQ(refused("< frame 123 99999999999.0 11 >"), "timestamp: bad seconds");
+    EXPECT_EQ(refused("< send 123 3 1 2 >"), "send: byte count differs from dlc");
+    EXPECT_EQ(refused("< send 123 2 1 2 3 >"), "send: byte count differs from dlc");
+    EXPECT_EQ(refused("< send 123 9 1 2 3 4 5 6 7 8 9 >"), "dlc: above 8");
+    EXPECT_EQ(refused("< send 123 1 123 >"), "data: each byte needs 1-2 hex digits");
+    EXPECT_EQ(refused("< send 123 1 1g >"), "data: not hex");
+}
