@@ -16,6 +16,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -94,7 +95,10 @@ protected:
     virtual void do_close() = 0;
 
     // Called from the receive thread for each received frame.
-    void dispatch(const Frame& frame);
+    void dispatch(const Frame& frame) { dispatch_batch({&frame, 1}); }
+    // The same for every frame of one read: one lock and one wake-up for the
+    // batch instead of one per frame (stream backends parse many per read).
+    void dispatch_batch(std::span<const Frame> frames);
     // Backends must call this at the end of their destructor-initiated close
     // path; derived destructors call close() themselves (virtual dispatch).
     void set_state(BusState s) { state_.store(s); }

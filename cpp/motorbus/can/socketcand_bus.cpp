@@ -284,16 +284,14 @@ void SocketcandBus::handle(const Element& e, Nanos now) {
         case ElementKind::Frame:
         case ElementKind::FdFrame:
         case ElementKind::Rtr: {
-            Frame f = e.frame;
-            f.timestamp_ns = now;
-            dispatch(f);
+            rx_batch_.push_back(e.frame);
+            rx_batch_.back().timestamp_ns = now;
             break;
         }
         case ElementKind::ErrorFrame: {
             count_bus_error();
-            Frame f = e.frame;
-            f.timestamp_ns = now;
-            dispatch(f);
+            rx_batch_.push_back(e.frame);
+            rx_batch_.back().timestamp_ns = now;
             break;
         }
         case ElementKind::ErrorText: {
@@ -351,6 +349,9 @@ void SocketcandBus::rx_loop() {
                 parser_.feed(std::span<const char>(buf.data(), static_cast<std::size_t>(r)),
                              [&](const Element& e) { handle(e, now); },
                              [&](const ParseError&) { count_parse_error(); });
+                // Everything this read carried reaches recv()/subscribers at once.
+                dispatch_batch(rx_batch_);
+                rx_batch_.clear();
                 account_parser();
             }
         }

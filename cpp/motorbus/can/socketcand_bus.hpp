@@ -63,6 +63,7 @@ private:
     void handshake(const std::string& channel, Deadline deadline);
     void rx_loop();
     void handle(const socketcand::Element& e, Nanos now);
+    std::vector<Frame> rx_batch_;  // frames parsed from one read, dispatched together
     // Appends one encoded element to the unsent bytes.
     void enqueue(const std::string_view element);
     // Writes what the socket takes now, as the one writer.  `wait_turn`: block
