@@ -39,6 +39,16 @@ class Addressed(LineDevice):
         return self.addr + b"?\r\n"
 
 
+
+def _reply_after_request(peer, reply):
+    """Answers once the request has arrived (a slow, sanitized run must not have
+    the reply flushed as stale input before the request is even sent)."""
+    def run():
+        peer.read(64, timeout=2.0)
+        peer.write(reply)
+
+    threading.Thread(target=run, daemon=True).start()
+
 def test_pty_pair_passes_every_byte_value():
     with PtyPair() as pty:
         assert pty.slave_path.startswith("/dev/pts/")
@@ -101,13 +111,13 @@ def test_a3_reply_too_long_is_protocol_error_with_data():
     with PtyPair() as pty:
         peer = pty.open_slave()
         link = LineLink(pty.port, max_line=8, reply_timeout=1.0)
-        threading.Timer(0.02, lambda: peer.write(b"0123456789ABCDEF\r\n")).start()
+        _reply_after_request(peer, b"0123456789ABCDEF\r\n")
         with pytest.raises(ReplyTooLong) as ei:
             link.transact("Q")
         assert isinstance(ei.value, motorbus.ProtocolError)
         assert ei.value.data == b"0123456789ABCDEF"
         assert link.counters["overlong_lines"] == 1
-        threading.Timer(0.02, lambda: peer.write(b"ok\r\n")).start()
+        _reply_after_request(peer, b"ok\r\n")
         assert link.transact("Q") == b"ok"
 
 
@@ -115,13 +125,17 @@ def test_a1_a8_timeout_then_late_reply_flushed():
     with PtyPair() as pty:
         peer = pty.open_slave()
         link = LineLink(pty.port, reply_timeout=0.15)
-        threading.Timer(0.005, lambda: peer.write(b"12")).start()  # a partial that never ends
+        def partial_reply():  # a partial that never ends, sent once the request is in
+            peer.read(16, timeout=1.0)
+            peer.write(b"12")
+
+        threading.Thread(target=partial_reply).start()
         with pytest.raises(motorbus.TimeoutError):
             link.transact("A")
         assert link.counters["timeouts"] == 1
         peer.write(b"34\r\n")  # the late tail
         time.sleep(0.05)
-        threading.Timer(0.02, lambda: peer.write(b"fresh\r\n")).start()
+        _reply_after_request(peer, b"fresh\r\n")
         assert link.transact("B", timeout=1.0) == b"fresh"
         assert link.counters["stale_bytes"] == 4
 
@@ -131,7 +145,7 @@ def test_a11_terminator_sets():
         peer = pty.open_slave()
         link = LineLink(pty.port, reply_terminators=b"\0", reply_timeout=1.0)
         assert link.reply_terminators == [b"\0"]
-        threading.Timer(0.02, lambda: peer.write(b"12\r\n\0")).start()
+        _reply_after_request(peer, b"12\r\n\0")
         assert link.transact("@0PX") == b"12\r\n"
         link2 = LineLink(pty.port, reply_terminators=["\r", "\r\n"], flush_before_request=False)
         peer.write(b"a\r\nb\r")
