@@ -10,9 +10,12 @@ canopen is measured on python-can's `virtual` interface:
     bridge (canopen's own server has no block mode).
 """
 import argparse
+import threading
 import time
 
 DOMAIN_MAX = 1 << 20
+NODES = 8              # expedited_rate_8_nodes: served nodes = client threads
+DEVICE_TYPE = 0x00020192
 
 
 def _percentile(v, p):
@@ -46,6 +49,45 @@ def _throughput(fn, nbytes, seconds):
             return n * nbytes / dt
 
 
+def _rate_many(read_fns, seconds, label):
+    """One thread per fn, each calling its fn back to back until the shared
+    deadline; returns total calls/s.  Raises if any thread failed a read (timeout
+    or otherwise), read a wrong value or completed none."""
+    n = len(read_fns)
+    reads, errors = [0] * n, [None] * n
+    barrier = threading.Barrier(n + 1)
+    box = {}
+
+    def worker(k):
+        fn = read_fns[k]
+        barrier.wait()
+        end = box["end"]
+        c = 0
+        try:
+            while time.perf_counter() < end:
+                v = fn()
+                if v != DEVICE_TYPE:
+                    raise AssertionError(f"read {v!r}")
+                c += 1
+        except Exception as e:  # noqa: BLE001 - reported below
+            errors[k] = e
+        reads[k] = c
+
+    threads = [threading.Thread(target=worker, args=(k,), daemon=True) for k in range(n)]
+    for t in threads:
+        t.start()
+    t0 = time.perf_counter()
+    box["end"] = t0 + seconds
+    barrier.wait()
+    for t in threads:
+        t.join()
+    dt = time.perf_counter() - t0
+    bad = [(k + 1, reads[k], errors[k]) for k in range(n) if errors[k] is not None or reads[k] == 0]
+    if bad:
+        raise SystemExit(f"{label}: expedited_rate_{n}_nodes FAILED: (node, reads, error) {bad}")
+    return sum(reads) / dt
+
+
 def ours(seconds):
     import motorbus
     from motorbus.canopen import LocalNode, ObjectDictionary, SdoClient
@@ -69,6 +111,22 @@ def ours(seconds):
     node.close()
     host.close()
     dev.close()
+
+    # 8 nodes on one virtual bus, 8 threads each with its own SdoClient.
+    host, dev = motorbus.open_bus("virtual:bench-sdo-py-many"), motorbus.open_bus("virtual:bench-sdo-py-many")
+    nodes, clients = [], []
+    for i in range(1, NODES + 1):
+        od = ObjectDictionary()
+        od.add_variable(0x1000, "Device type", "u32", "ro", default=DEVICE_TYPE)
+        od.add_variable(0x2000, "Value", "u32", "rw", default=0x12345678)
+        nodes.append(LocalNode(dev, i, od))
+        clients.append(SdoClient(host, i, timeout=1.0))
+    r[f"expedited_rate_{NODES}_nodes"] = _rate_many(
+        [(lambda c=c: c.read_u32(0x1000)) for c in clients], seconds, "motorbus")
+    for n in nodes:
+        n.close()
+    host.close()
+    dev.close()
     return r
 
 
@@ -83,6 +141,11 @@ def reference(seconds):
 
     def make_od():
         cod = canopen.ObjectDictionary()
+        t = canopen.objectdictionary.ODVariable("Device type", 0x1000, 0)
+        t.data_type = canopen.objectdictionary.UNSIGNED32
+        t.access_type = "ro"
+        t.default = DEVICE_TYPE
+        cod.add_object(t)
         v = canopen.objectdictionary.ODVariable("Value", 0x2000, 0)
         v.data_type = canopen.objectdictionary.UNSIGNED32
         v.access_type = "rw"
@@ -136,6 +199,22 @@ def reference(seconds):
     net.disconnect()
     node.close()
     bus.close()
+
+    # 8 nodes: canopen's LocalNodes (ids 1..8) on one server Network, 8 RemoteNodes
+    # sharing one client Network, 8 threads (same servers as the single-node
+    # expedited figure above).
+    server_net, client_net = canopen.Network(), canopen.Network()
+    server_net.connect(interface="virtual", channel="bench-sdo-ref-many")
+    client_net.connect(interface="virtual", channel="bench-sdo-ref-many")
+    remotes = []
+    for i in range(1, NODES + 1):
+        server_net.add_node(canopen.LocalNode(i, make_od()))
+        remotes.append(client_net.add_node(i, make_od()))
+    r[f"expedited_rate_{NODES}_nodes"] = _rate_many(
+        [(lambda rn=rn: int.from_bytes(rn.sdo.upload(0x1000, 0), "little")) for rn in remotes],
+        seconds, "canopen")
+    client_net.disconnect()
+    server_net.disconnect()
     return r
 
 

@@ -5,13 +5,17 @@
 //   ./build/h/bench_sdo [seconds-per-measurement]        (default 2)
 //   MOTORBUS_BENCH_NO_REFERENCE=1 ./build/h/bench_sdo    (ours only)
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <memory>
+#include <numeric>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "motorbus/can/virtual_bus.hpp"
@@ -56,6 +60,75 @@ double throughput(const std::function<void()>& fn, std::size_t bytes, double sec
         const double dt = std::chrono::duration<double>(SteadyClock::now() - t0).count();
         if (dt >= seconds) return static_cast<double>(n * bytes) / dt;
     }
+}
+
+// Many transfers in flight: kNodes LocalNodes (ids 1..kNodes) on one virtual
+// bus, each serving its own copy of the same small dictionary; kNodes client
+// threads, each with its own SdoClient reading 0x1000:0 (u32) from its own node
+// back to back for `seconds`.  Returns total reads/s; exits non-zero if any
+// thread failed a read, timed out or completed none.
+constexpr int kNodes = 8;
+
+double expedited_rate_many(double seconds, const SdoClientOptions& copts) {
+    auto host = can::open_virtual("bench-sdo-many"), dev = can::open_virtual("bench-sdo-many");
+    std::vector<std::unique_ptr<LocalNode>> nodes;
+    std::vector<std::unique_ptr<SdoClient>> clients;
+    for (int i = 1; i <= kNodes; ++i) {
+        auto od = std::make_shared<ObjectDictionary>();
+        od->add_variable({.index = 0x1000, .name = "Device type", .type = DataType::Unsigned32,
+                          .default_value = std::uint64_t{0x00020192}});
+        od->add_variable({.index = 0x2000, .name = "Value", .type = DataType::Unsigned32,
+                          .default_value = std::uint64_t{0x12345678}});
+        nodes.push_back(std::make_unique<LocalNode>(*dev, static_cast<std::uint8_t>(i), od));
+        clients.push_back(std::make_unique<SdoClient>(*host, static_cast<std::uint8_t>(i), copts));
+    }
+    std::vector<std::uint64_t> reads(kNodes, 0), errors(kNodes, 0);
+    std::atomic<int> ready{0};
+    std::atomic<bool> go{false};
+    SteadyClock::time_point end;
+    std::vector<std::thread> threads;
+    for (int k = 0; k < kNodes; ++k) {
+        threads.emplace_back([&, k] {
+            ready.fetch_add(1);
+            while (!go.load(std::memory_order_acquire)) std::this_thread::yield();
+            std::uint64_t n = 0, e = 0;
+            while (SteadyClock::now() < end) {
+                try {
+                    if (clients[k]->read_u32(0x1000, 0) != 0x00020192) ++e;
+                    else ++n;
+                } catch (const std::exception& ex) {
+                    if (++e == 1) std::fprintf(stderr, "expedited_rate_8_nodes: node %d: %s\n", k + 1, ex.what());
+                }
+            }
+            reads[k] = n;
+            errors[k] = e;
+        });
+    }
+    while (ready.load() < kNodes) std::this_thread::yield();
+    const auto t0 = SteadyClock::now();
+    end = t0 + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(seconds));
+    go.store(true, std::memory_order_release);
+    for (auto& t : threads) t.join();
+    const double dt = std::chrono::duration<double>(SteadyClock::now() - t0).count();
+    std::uint64_t total = 0, timeouts = 0;
+    bool ok = true;
+    std::printf("# expedited_rate_8_nodes: reads per node");
+    for (int k = 0; k < kNodes; ++k) {
+        const auto c = clients[k]->counters();
+        std::printf(" %llu", (unsigned long long)reads[k]);
+        total += reads[k];
+        timeouts += c.timeouts;
+        if (reads[k] == 0 || errors[k] != 0 || c.timeouts != 0) ok = false;
+    }
+    std::printf("; errors %llu, client timeouts %llu\n",
+                (unsigned long long)std::accumulate(errors.begin(), errors.end(), std::uint64_t{0}),
+                (unsigned long long)timeouts);
+    for (auto& n : nodes) n->close();
+    if (!ok) {
+        std::fprintf(stderr, "expedited_rate_8_nodes: FAILED (a thread had errors, timeouts or no reads)\n");
+        std::exit(1);
+    }
+    return static_cast<double>(total) / dt;
 }
 
 std::map<std::string, double> reference(double seconds) {
@@ -114,12 +187,13 @@ int main(int argc, char** argv) {
                 (unsigned long long)nc.sdo.timeouts, (unsigned long long)host->counters().overruns,
                 (unsigned long long)dev->counters().overruns);
     node.close();
+    ours["expedited_rate_8_nodes"] = expedited_rate_many(seconds, copts);
 
     std::map<std::string, double> ref;
     if (!std::getenv("MOTORBUS_BENCH_NO_REFERENCE")) ref = reference(seconds);
     std::printf("%-28s %14s %14s %8s\n", "SDO from C++", "motorbus", "canopen", "ratio");
     for (auto key : {"expedited_rate", "expedited_median_us", "expedited_p99_us", "segmented_upload_Bps",
-                     "segmented_download_Bps", "block_upload_Bps", "block_download_Bps"}) {
+                     "segmented_download_Bps", "block_upload_Bps", "block_download_Bps", "expedited_rate_8_nodes"}) {
         const double a = ours[key];
         auto it = ref.find(key);
         if (it == ref.end() || it->second <= 0 || a <= 0) {
