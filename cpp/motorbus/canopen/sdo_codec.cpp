@@ -149,26 +149,17 @@ Payload block_upload_start() {
     return p;
 }
 
+// Block acknowledgements and end frames have one layout in both directions
+// in CiA 301: the upload forms are the download ones.
 Payload block_upload_ack(std::uint8_t ackseq, std::uint8_t blksize) {
-    Payload p{};
-    p[0] = 0xA2;
-    p[1] = ackseq;
-    p[2] = blksize;
-    return p;
+    return block_download_ack(ackseq, blksize);
 }
 
 Payload block_upload_end(std::uint8_t unused_in_last, std::uint16_t crc) {
-    Payload p{};
-    p[0] = static_cast<std::uint8_t>(0xC1 | ((unused_in_last & 7) << 2));
-    put_le16(&p[1], crc);
-    return p;
+    return block_download_end(unused_in_last, crc);
 }
 
-Payload block_upload_end_response() {
-    Payload p{};
-    p[0] = 0xA1;
-    return p;
-}
+Payload block_upload_end_response() { return block_download_end_response(); }
 
 std::uint32_t abort_code_of(std::span<const std::uint8_t> p) {
     if (p.size() < 8) return abort_code::kGeneral;
