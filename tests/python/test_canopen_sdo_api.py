@@ -88,6 +88,11 @@ def test_pmc007_pdo_config_sequence_from_our_client(setup):
     sdo.write_u16(0x1800, 5, 1000)
     sdo.write_u8(0x1A00, 0, 1)
     sdo.write_u32(0x1A00, 1, 0x60120010)
+    # The sniffer is another endpoint with its own receive thread: it may still
+    # be handing over the last request when the write has already completed.
+    deadline = time.monotonic() + 2.0
+    while len(sent) < len(seq) and time.monotonic() < deadline:
+        time.sleep(0.001)
     sniff.unsubscribe(sub)
     assert [s.hex(" ").upper() for s in sent] == [r["data"] for r in seq]
     assert od["TPDO1 communication parameter.COB-ID"].value == 0x187
@@ -130,7 +135,9 @@ def test_typed_errors(setup):
     sub = sniff.subscribe(lambda f: frames.append(f), id=0x609)
     with pytest.raises(SdoTimeout) as t:
         lonely.read_u8(0x6001, 0)
-    time.sleep(0.05)
+    deadline = time.monotonic() + 2.0  # the request, then the abort, via the sniffer's thread
+    while len(frames) < 2 and time.monotonic() < deadline:
+        time.sleep(0.001)
     sniff.unsubscribe(sub)
     assert isinstance(t.value, motorbus.TimeoutError) and isinstance(t.value, TimeoutError)
     assert frames[-1].data == h("80 01 60 00 00 00 04 05")  # C1: abort carries the multiplexer
