@@ -2,25 +2,14 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "motorbus/can/external_bus.hpp"
 #include "motorbus/canopen/emcy.hpp"
 
 using namespace motorbus;
 
-namespace {
-class NullBus final : public can::Bus {
-public:
-    NullBus() : Bus("fuzz") {}
-    ~NullBus() override { close(); }
-    void feed(const can::Frame& f) { dispatch(f); }
-
-protected:
-    void do_send(const can::Frame&, can::Deadline) override {}
-    void do_close() override {}
-};
-}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    static NullBus bus;
+    static can::ExternalBus bus("fuzz", [](const can::Frame&, can::Deadline) {});
     canopen::EmcyConsumer consumer(bus, 4);
     std::size_t i = 0;
     while (i + 2 <= size) {

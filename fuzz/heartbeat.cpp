@@ -3,25 +3,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "motorbus/can/external_bus.hpp"
 #include "motorbus/canopen/heartbeat.hpp"
 
 using namespace motorbus;
 
-namespace {
-class NullBus final : public can::Bus {
-public:
-    NullBus() : Bus("fuzz") {}
-    ~NullBus() override { close(); }
-    void feed(const can::Frame& f) { dispatch(f); }
-
-protected:
-    void do_send(const can::Frame&, can::Deadline) override {}
-    void do_close() override {}
-};
-}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    static NullBus bus;
+    static can::ExternalBus bus("fuzz", [](const can::Frame&, can::Deadline) {});
     SimClock clock(0);
     canopen::HeartbeatConsumer hc(bus, clock);
     hc.monitor(5, std::chrono::milliseconds(100));
