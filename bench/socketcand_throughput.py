@@ -48,51 +48,8 @@ def pct(values: list[float]) -> tuple[float, float]:
     return statistics.median(v), v[min(len(v) - 1, len(v) * 99 // 100)]
 
 
-def bench_ours(server, node, n: int, pings: int, reps: int) -> dict:
-    bus = open_socketcand("127.0.0.1", server.port, "vcan0", rx_queue_size=1 << 22)
-    time.sleep(0.01)
-    f = Frame(0x123, bytes(range(8)))
-    tx = rx = 0.0
-    for _ in range(reps):
-        base = node.counters["rx_frames"]
-        t0 = time.perf_counter()
-        for _ in range(n):
-            bus.send(f)
-        wait_rx(node, base + n)
-        tx = max(tx, n / (time.perf_counter() - t0))
-
-        for _ in range(n):
-            node.send(f)
-        got = 0
-        bus.recv(5.0)
-        t0 = time.perf_counter()
-        while got < n - 1 and bus.recv(5.0) is not None:
-            got += 1
-        elapsed = time.perf_counter() - t0
-        check_received("motorbus", got + 1, n)
-        rx = max(rx, got / elapsed)
-
-    # The node's recv() queue still holds every frame of the tx runs: without
-    # this, node.recv() below would return at once and "latency" would be send() alone.
-    drain(node)
-    up, down = [], []
-    for _ in range(pings):
-        t = time.perf_counter_ns()
-        bus.send(f)
-        node.recv(1.0)
-        up.append((time.perf_counter_ns() - t) / 1e3)
-        t = time.perf_counter_ns()
-        node.send(f)
-        bus.recv(1.0)
-        down.append((time.perf_counter_ns() - t) / 1e3)
-    bus.close()
-    return {"tx": tx, "rx": rx, "up": pct(up), "down": pct(down)}
-
-
-def bench_pycan(server, node, n: int, pings: int, reps: int) -> dict:
-    bus = can.Bus(interface="socketcand", host="127.0.0.1", port=server.port, channel="vcan0")
-    time.sleep(0.01)
-    msg = can.Message(arbitration_id=0x123, is_extended_id=False, data=bytes(range(8)))
+def measure(label: str, bus, msg, node, n: int, pings: int, reps: int) -> dict:
+    """One client, measured exactly the same way whichever library it is (fairness by construction)."""
     f = Frame(0x123, bytes(range(8)))
     tx = rx = 0.0
     for _ in range(reps):
@@ -111,7 +68,7 @@ def bench_pycan(server, node, n: int, pings: int, reps: int) -> dict:
         while got < n - 1 and bus.recv(5.0) is not None:
             got += 1
         elapsed = time.perf_counter() - t0
-        check_received("python-can", got + 1, n)
+        check_received(label, got + 1, n)
         rx = max(rx, got / elapsed)
 
     # The node's recv() queue still holds every frame of the tx runs: without
@@ -127,8 +84,26 @@ def bench_pycan(server, node, n: int, pings: int, reps: int) -> dict:
         node.send(f)
         bus.recv(1.0)
         down.append((time.perf_counter_ns() - t) / 1e3)
-    bus.shutdown()
     return {"tx": tx, "rx": rx, "up": pct(up), "down": pct(down)}
+
+
+def bench_ours(server, node, n: int, pings: int, reps: int) -> dict:
+    bus = open_socketcand("127.0.0.1", server.port, "vcan0", rx_queue_size=1 << 22)
+    time.sleep(0.01)
+    try:
+        return measure("motorbus", bus, Frame(0x123, bytes(range(8))), node, n, pings, reps)
+    finally:
+        bus.close()
+
+
+def bench_pycan(server, node, n: int, pings: int, reps: int) -> dict:
+    bus = can.Bus(interface="socketcand", host="127.0.0.1", port=server.port, channel="vcan0")
+    time.sleep(0.01)
+    msg = can.Message(arbitration_id=0x123, is_extended_id=False, data=bytes(range(8)))
+    try:
+        return measure("python-can", bus, msg, node, n, pings, reps)
+    finally:
+        bus.shutdown()
 
 
 def main() -> None:
