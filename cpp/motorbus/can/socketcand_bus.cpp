@@ -297,9 +297,13 @@ void SocketcandBus::handle(const Element& e, Nanos now) {
         case ElementKind::ErrorText: {
             // The server refused something we sent (socketcand only does this for
             // unknown commands; our server also for bad or undeliverable sends).
+            {
+                std::lock_guard lk(info_mutex_);
+                last_server_error_ = e.text;
+            }
+            // Counted after the text is stored: a caller that sees the count
+            // must also see the reason.
             count_tx_dropped();
-            std::lock_guard lk(info_mutex_);
-            last_server_error_ = e.text;
             break;
         }
         case ElementKind::Echo:  // keepalive reply: arrival already refreshed last_rx
