@@ -162,16 +162,21 @@ void bind_can(py::module_& m) {
 
     m.def("open_virtual",
           [](const std::string& name, double bitrate, std::size_t tx_queue, std::size_t rx_queue_size,
-             bool receive_own) {
+             bool receive_own, double rx_spin) {
+              if (!(rx_spin >= 0)) throw InvalidArgument("virtual bus rx_spin: must be >= 0 seconds");
               VirtualOptions o;
               o.bitrate = bitrate;
               o.tx_queue = tx_queue;
               o.rx_queue_size = rx_queue_size;
               o.receive_own = receive_own;
+              o.rx_spin = std::chrono::duration_cast<std::chrono::microseconds>(
+                  std::chrono::duration<double>(rx_spin));
               return open_virtual(name, o);
           },
           py::arg("name"), py::arg("bitrate") = 0.0, py::arg("tx_queue") = 64,
-          py::arg("rx_queue_size") = 65536, py::arg("receive_own") = false);
+          py::arg("rx_queue_size") = 65536, py::arg("receive_own") = false, py::arg("rx_spin") = 20e-6,
+          "Joins the in-process hub NAME.  rx_spin: seconds the endpoint's receive thread polls for "
+          "the next frame before sleeping (0 = always sleep).");
 
     py::class_<ExternalBus, Bus, std::shared_ptr<ExternalBus>>(
         m, "ExternalBus", "A bus fed by Python code (the python-can bridge is built on it).")

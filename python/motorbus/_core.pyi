@@ -2455,8 +2455,10 @@ def open_socketcand(host: str, port: typing.SupportsInt | typing.SupportsIndex, 
     """
     Connect to a socketcand server and open CHANNEL in raw mode. keepalive: seconds between < echo > probes on an idle link (None = off); the link is declared down after keepalive_misses silent periods.
     """
-def open_virtual(name: str, bitrate: typing.SupportsFloat | typing.SupportsIndex = 0.0, tx_queue: typing.SupportsInt | typing.SupportsIndex = 64, rx_queue_size: typing.SupportsInt | typing.SupportsIndex = 65536, receive_own: bool = False) -> VirtualBus:
-    ...
+def open_virtual(name: str, bitrate: typing.SupportsFloat | typing.SupportsIndex = 0.0, tx_queue: typing.SupportsInt | typing.SupportsIndex = 64, rx_queue_size: typing.SupportsInt | typing.SupportsIndex = 65536, receive_own: bool = False, rx_spin: typing.SupportsFloat | typing.SupportsIndex = 2e-05) -> VirtualBus:
+    """
+    Joins the in-process hub NAME.  rx_spin: seconds the endpoint's receive thread polls for the next frame before sleeping (0 = always sleep).
+    """
 def parse_candump_line(line: str) -> LogEntry | None:
     ...
 def pdo_read_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex) -> dict:

@@ -2,7 +2,7 @@
 
 Specs are URL-like strings::
 
-    virtual:NAME                    in-process hub (bitrate=, tx_queue=, receive_own=)
+    virtual:NAME                    in-process hub (bitrate=, tx_queue=, receive_own=, rx_spin=)
     slcan:PATH[@BITRATE]            Lawicel adapter on a serial line (CANable, USBtin, a pty)
     socketcand:HOST:PORT/CHANNEL    socketcand server over TCP
     socketcan:IFACE                 Linux AF_CAN raw socket (can0, vcan0)

@@ -21,7 +21,7 @@ class MotorbusCanBus(can.BusABC):
                  **kwargs: Any) -> None:
         if not isinstance(channel, str):
             raise can.CanInitializationError("motorbus: channel must be a bus spec such as 'virtual:x'")
-        options = {k: v for k, v in kwargs.items() if k in ("bitrate", "tx_queue", "rx_queue_size")}
+        options = {k: v for k, v in kwargs.items() if k in ("bitrate", "tx_queue", "rx_queue_size", "rx_spin")}
         try:
             self._bus = open_bus(channel, receive_own=receive_own_messages, **options)
         except (_core.MotorbusError, TypeError) as e:

@@ -113,3 +113,28 @@ def test_bus_off_raises_link_down():
             a.send(Frame(1))
         with pytest.raises(ConnectionError):
             a.send(Frame(1))
+
+
+@pytest.mark.threaded
+@pytest.mark.parametrize("rx_spin", [0.0, 20e-6])
+def test_receive_polling_option_delivers_every_callback(rx_spin):
+    # rx_spin only changes how the endpoint's receive thread waits, never what it delivers
+    got = []
+    done = threading.Event()
+    name = f"virtual:py-spin{rx_spin}"
+    with motorbus.open_bus(name, rx_spin=rx_spin) as a, motorbus.open_bus(name, rx_spin=rx_spin) as b:
+        def cb(frame):
+            got.append(frame.data[0])
+            if len(got) == 200:
+                done.set()
+
+        b.subscribe(cb, id=0x42)
+        for i in range(200):
+            a.send(Frame(0x42, bytes([i])))
+        assert done.wait(5.0)
+    assert got == list(range(200))
+
+
+def test_receive_polling_must_not_be_negative():
+    with pytest.raises(motorbus.InvalidArgument, match="rx_spin"):
+        motorbus.open_bus("virtual:py-negspin", rx_spin=-1.0)

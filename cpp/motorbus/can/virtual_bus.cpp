@@ -1,6 +1,8 @@
 #include "motorbus/can/virtual_bus.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -221,6 +223,8 @@ struct VirtualBus::Impl {
     bool stop = false;
     bool bus_off = false;
     bool dispatching = false;  // the receive thread is working through a batch
+    bool sleeping = false;     // the receive thread waits on `cv` (needs a notify)
+    std::atomic<bool> pending{false};  // inbox non-empty, read by the spinning receive thread
     FaultOptions faults;
     std::mt19937_64 rng;
     std::uint64_t sent_count = 0;
@@ -237,12 +241,25 @@ VirtualBus::VirtualBus(std::shared_ptr<VirtualHub> hub, std::string channel,
     impl_->rng.seed(opts.faults.seed);
     impl_->rx_thread = std::thread([this] {
         std::vector<Frame> batch;
+        const auto spin = impl_->opts.rx_spin;
         for (;;) {
+            // Request/response traffic (an SDO exchange) brings the next frame
+            // a few microseconds after the last batch: poll for it briefly
+            // before sleeping, so neither side pays a futex wake-up per frame.
+            if (spin.count() > 0 && !impl_->pending.load(std::memory_order_acquire)) {
+                const auto until = std::chrono::steady_clock::now() + spin;
+                while (!impl_->pending.load(std::memory_order_acquire) &&
+                       std::chrono::steady_clock::now() < until)
+                    std::this_thread::yield();
+            }
             {
                 std::unique_lock lock(impl_->mutex);
+                impl_->sleeping = true;
                 impl_->cv.wait(lock, [&] { return impl_->stop || !impl_->inbox.empty(); });
+                impl_->sleeping = false;
                 if (impl_->stop) return;
                 batch.swap(impl_->inbox);
+                impl_->pending.store(false, std::memory_order_relaxed);
                 impl_->dispatching = true;
             }
             for (const Frame& f : batch) dispatch(f);
@@ -262,6 +279,7 @@ void VirtualBus::do_close() {
     {
         std::lock_guard lock(impl_->mutex);
         impl_->stop = true;
+        impl_->pending.store(true, std::memory_order_release);  // ends a spin at once
     }
     impl_->cv.notify_all();
     if (impl_->rx_thread.joinable() && impl_->rx_thread.get_id() != std::this_thread::get_id())
@@ -292,8 +310,9 @@ void VirtualBus::enqueue_rx(const Frame& f) {
             count_overrun();
             return;
         }
-        wake = impl_->inbox.empty();
+        wake = impl_->inbox.empty() && impl_->sleeping;
         impl_->inbox.push_back(f);
+        impl_->pending.store(true, std::memory_order_release);
     }
     if (wake) impl_->cv.notify_one();
 }

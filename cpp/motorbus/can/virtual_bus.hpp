@@ -27,6 +27,10 @@ struct VirtualOptions : BusOptions {
     double bitrate = 0.0;         // bit/s; 0 = no wire time.  All endpoints of a hub must agree.
     std::size_t tx_queue = 64;    // frames waiting for the wire before send() blocks
     FaultOptions faults;
+    // How long an endpoint's receive thread polls for the next frame before it
+    // sleeps.  Saves a thread wake-up per frame in request/response exchanges
+    // (SDO), at the cost of that much CPU after each burst; 0 = always sleep.
+    std::chrono::microseconds rx_spin{20};
 };
 
 class VirtualHub;

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -68,6 +71,50 @@ TEST(VirtualBus, SubscribersByIdAndMask) {
     a->send(fr(0x581));
     ASSERT_TRUE(b->recv(1s));
     EXPECT_EQ(exact.load(), 1);
+}
+
+// A ping-pong between two subscribed endpoints, as an SDO exchange is: every
+// frame must arrive, in order, whether the receive threads poll before they
+// sleep (the default) or sleep at once.  The polling window is where a frame
+// could be missed (it arrives while the thread is neither sleeping nor
+// dispatching), so both settings run many round trips.
+TEST(VirtualBus, PingPongLosesNothingWithAndWithoutReceivePolling) {
+    for (auto spin : {std::chrono::microseconds(0), std::chrono::microseconds(20),
+                      std::chrono::microseconds(2000)}) {
+        std::mutex m;  // declared before the buses: they outlive every callback
+        std::condition_variable cv;
+        std::vector<int> seen;
+        VirtualOptions o;
+        o.rx_spin = spin;
+        const std::string hub = "t-pingpong" + std::to_string(spin.count());
+        auto a = open_virtual(hub, o), b = open_virtual(hub, o);
+        constexpr int kRounds = 2000;
+        // b echoes every request back with the same payload
+        b->subscribe_id(0x601, false, [&](const Frame& f) { b->send(fr(0x581, {f.data[0], f.data[1]})); });
+        a->subscribe_id(0x581, false, [&](const Frame& f) {
+            std::lock_guard lock(m);
+            seen.push_back(f.data[0] | (f.data[1] << 8));
+            cv.notify_all();
+        });
+        for (int i = 0; i < kRounds; ++i) {
+            a->send(fr(0x601, {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8)}));
+            std::unique_lock lock(m);
+            ASSERT_TRUE(cv.wait_for(lock, 5s, [&] { return static_cast<int>(seen.size()) == i + 1; }))
+                << "reply " << i << " lost with rx_spin " << spin.count() << " us";
+            ASSERT_EQ(seen.back(), i);
+        }
+    }
+}
+
+TEST(VirtualBus, NegativeReceivePollingIsTreatedAsNone) {
+    VirtualOptions o;
+    o.rx_spin = std::chrono::microseconds(-5);
+    auto a = open_virtual("t-negspin", o), b = open_virtual("t-negspin", o);
+    std::atomic<int> got{0};
+    b->subscribe_id(0x1, false, [&](const Frame&) { got++; });
+    a->send(fr(0x1));
+    ASSERT_TRUE(b->recv(1s));
+    EXPECT_EQ(got.load(), 1);
 }
 
 TEST(VirtualBus, DropEveryNthAndCorrupt) {
