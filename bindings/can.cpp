@@ -108,6 +108,15 @@ void bind_can(py::module_& m) {
                  return b.recv(t);
              },
              py::arg("timeout") = py::none())
+        .def("recv_many",
+             [](Bus& b, std::size_t max, const py::object& timeout) {
+                 auto t = seconds_to_ns(timeout);
+                 py::gil_scoped_release nogil;
+                 return b.recv_many(max, t);
+             },
+             py::arg("max") = 1024, py::arg("timeout") = py::none(),
+             "Up to max frames, oldest first: waits like recv() for the first, then takes what is "
+             "already queued. An empty list after timeout.")
         .def("set_filters",
              [](Bus& b, const py::object& filters) {
                  b.set_filters(motorbus::py_helpers::filters_from_py(filters));

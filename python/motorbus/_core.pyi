@@ -112,6 +112,10 @@ class Bus:
         ...
     def recv(self, timeout: typing.Any = None) -> Frame | None:
         ...
+    def recv_many(self, max: typing.SupportsInt | typing.SupportsIndex = 1024, timeout: typing.Any = None) -> list[Frame]:
+        """
+        Up to max frames, oldest first: waits like recv() for the first, then takes what is already queued. An empty list after timeout.
+        """
     def send(self, frame: Frame, timeout: typing.Any = 1.0) -> None:
         ...
     def set_filters(self, filters: typing.Any = None) -> None:

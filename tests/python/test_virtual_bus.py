@@ -138,3 +138,16 @@ def test_receive_polling_option_delivers_every_callback(rx_spin):
 def test_receive_polling_must_not_be_negative():
     with pytest.raises(motorbus.InvalidArgument, match="rx_spin"):
         motorbus.open_bus("virtual:py-negspin", rx_spin=-1.0)
+
+
+def test_recv_many_drains_in_order_and_times_out_empty():
+    with motorbus.open_bus("virtual:py-many") as a, motorbus.open_bus("virtual:py-many") as b:
+        assert b.recv_many(10, timeout=0.01) == []
+        for i in range(5):
+            a.send(Frame(0x100 + i, bytes([i])))
+        first = b.recv_many(3, timeout=1.0)
+        rest = b.recv_many(timeout=1.0)
+        assert [f.id for f in first] == [0x100, 0x101, 0x102]
+        assert [(f.id, f.data) for f in rest] == [(0x103, b"\x03"), (0x104, b"\x04")]
+    with pytest.raises(motorbus.ClosedError):
+        b.recv_many(timeout=0.1)

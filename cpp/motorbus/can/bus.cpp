@@ -61,6 +61,25 @@ std::optional<Frame> Bus::recv(Duration timeout) {
     return f;
 }
 
+std::vector<Frame> Bus::recv_many(std::size_t max, Duration timeout) {
+    std::vector<Frame> out;
+    if (max == 0) return out;
+    std::unique_lock lock(rx_mutex_);
+    if (rx_queue_.empty()) {
+        auto ready = [&] { return !rx_queue_.empty() || closed_.load(); };
+        if (timeout.count() < 0) {
+            rx_cv_.wait(lock, ready);
+        } else if (!rx_cv_.wait_for(lock, timeout, ready)) {
+            return out;
+        }
+        if (rx_queue_.empty()) throw ClosedError("bus " + channel_ + " is closed");
+    }
+    const std::size_t n = std::min(max, rx_queue_.size());
+    out.assign(rx_queue_.begin(), rx_queue_.begin() + static_cast<std::ptrdiff_t>(n));
+    rx_queue_.erase(rx_queue_.begin(), rx_queue_.begin() + static_cast<std::ptrdiff_t>(n));
+    return out;
+}
+
 void Bus::set_filters(std::vector<Filter> filters) {
     std::lock_guard lock(rx_mutex_);
     filters_ = std::move(filters);

@@ -68,6 +68,12 @@ public:
     // (a negative timeout waits forever).  Throws ClosedError once closed and drained.
     std::optional<Frame> recv(Duration timeout);
 
+    // Up to `max` frames at once, oldest first: waits like recv() for the
+    // first, then takes whatever else is already queued without waiting.
+    // Empty after `timeout`.  One lock (and, from Python, one GIL release) per
+    // batch instead of per frame, for consumers that drain a busy bus.
+    std::vector<Frame> recv_many(std::size_t max, Duration timeout);
+
     // Acceptance filters for recv() (subscribers have their own).  Empty = all.
     void set_filters(std::vector<Filter> filters);
 

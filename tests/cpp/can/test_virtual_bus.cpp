@@ -117,6 +117,31 @@ TEST(VirtualBus, NegativeReceivePollingIsTreatedAsNone) {
     EXPECT_EQ(got.load(), 1);
 }
 
+TEST(VirtualBus, RecvManyTakesWhatIsQueuedOldestFirst) {
+    auto a = open_virtual("t-many"), b = open_virtual("t-many");
+    EXPECT_TRUE(b->recv_many(10, 20ms).empty());  // nothing queued: empty after the timeout
+    for (int i = 0; i < 5; ++i) a->send(fr(0x100 + i));
+    std::vector<std::uint32_t> ids;
+    // b has no subscribers, so the frames are already queued when send() returns
+    for (auto& f : b->recv_many(3, 1s)) ids.push_back(f.id);
+    EXPECT_EQ(ids, (std::vector<std::uint32_t>{0x100, 0x101, 0x102}));
+    ids.clear();
+    for (auto& f : b->recv_many(10, 1s)) ids.push_back(f.id);  // the rest, no waiting for more
+    EXPECT_EQ(ids, (std::vector<std::uint32_t>{0x103, 0x104}));
+    EXPECT_TRUE(b->recv_many(0, 1s).empty());  // max 0 never waits
+    // a waiting recv_many wakes for a frame sent from another thread
+    std::thread later([&] {
+        std::this_thread::sleep_for(20ms);
+        a->send(fr(0x7));
+    });
+    auto got = b->recv_many(10, 5s);
+    later.join();
+    ASSERT_EQ(got.size(), 1u);
+    EXPECT_EQ(got[0].id, 0x7u);
+    b->close();
+    EXPECT_THROW(b->recv_many(10, 1s), ClosedError);
+}
+
 TEST(VirtualBus, DropEveryNthAndCorrupt) {
     auto a = open_virtual("t-fault"), b = open_virtual("t-fault");
     FaultOptions f;
