@@ -43,6 +43,21 @@ void MotorModel::command(const Profile& profile, std::optional<Nanos> start) {
     running_ = profile.duration() > 0;
 }
 
+void MotorModel::command_from(const Profile& profile, double elapsed, std::optional<Nanos> start) {
+    // Bounded so the time line stays inside Nanos.
+    if (!(elapsed >= 0) || !(elapsed <= 1e9))
+        throw InvalidArgument("MotorModel::command_from: elapsed must be within 0..1e9 s");
+    Nanos t = start.value_or(now_);
+    if (t < now_) t = now_;
+    if (t > now_ && !in_dispatch_) advance_to(t);
+    const double cp = command_state(t).p;
+    profile_ = profile;
+    profile_start_ = t - static_cast<Nanos>(std::llround(elapsed * 1e9));
+    const double pt = profile_time(t);
+    profile_offset_ = profile.at(pt).p - cp;
+    running_ = pt < profile.duration();
+}
+
 void MotorModel::halt(std::optional<Nanos> at) {
     Nanos t = at.value_or(now_);
     if (t < now_) t = now_;

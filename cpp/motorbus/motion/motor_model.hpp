@@ -87,6 +87,10 @@ public:
     // current pulse position is shifted to start there (the step generator
     // cannot jump).
     void command(const Profile& profile, std::optional<Nanos> start = std::nullopt);
+    // Joins `profile` `elapsed` seconds into its own time line at time `start`
+    // (default now): for a planner that keeps one profile across commands and
+    // splices each command into it.  Position continuity as in command().
+    void command_from(const Profile& profile, double elapsed, std::optional<Nanos> start = std::nullopt);
     // Stops the step generator at time t (default now) where it is (ABORT).
     void halt(std::optional<Nanos> at = std::nullopt);
     bool moving() const;                 // a commanded profile is still running
