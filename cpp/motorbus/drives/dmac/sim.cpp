@@ -14,6 +14,21 @@ struct DmacSim::Pending {
 namespace {
 
 constexpr std::int64_t kNsPerMs = 1'000'000;
+// A soft end-stop reached by an exact crossing sits on it to within rounding.
+constexpr double kEndTolerance = 1e-6;
+
+motion::MotorConfig axis_config(const SimOptions& o) {
+    motion::MotorConfig c;
+    // One step = one encoder count = one DMAC increment: every position the
+    // firmware reports is the model's encoder as is.
+    c.steps_per_rev = motion::kDmacIncrementsPerRev;
+    c.counts_per_rev = motion::kDmacIncrementsPerRev;
+    c.index_width_steps = 1;
+    c.plus_limit = o.positive_end_switch;
+    c.minus_limit = o.negative_end_switch;
+    c.tick_ns = kNsPerMs;  // the firmware's own tick; edges inside it are refined anyway
+    return c;
+}
 
 std::int32_t wrap_i32(std::int64_t v) {
     auto u = static_cast<std::uint32_t>(static_cast<std::uint64_t>(v) & 0xFFFFFFFFu);
@@ -85,6 +100,8 @@ DmacSim::DmacSim(std::shared_ptr<Clock> clock, SimOptions options)
     address_ = options_.address;
     baudrate_ = options_.baudrate;
     program_.assign(kSeqLines + 1, std::nullopt);
+    axis_ = std::make_unique<motion::MotorModel>(*clock_, axis_config(options_));
+    axis_->add_listener([this](const motion::MotorEvent& e) { on_axis_event(e); });
     std::lock_guard lock(mutex_);
     restart_motion_at(0);
     reset_locked(true);
@@ -99,7 +116,13 @@ bool DmacSim::dmac34() const {
 std::uint32_t DmacSim::input_mask() const { return dmac34() ? 0x3FFu : 0x3Fu; }
 
 std::uint32_t DmacSim::logical_inputs() const {
-    return (physical_inputs_ ^ (invert_in_ ? input_mask() : 0u)) & input_mask();
+    // The end-stop switches are wired onto the same inputs a test can drive.
+    std::uint32_t electrical = physical_inputs_;
+    if (options_.positive_end_switch.present && axis_->plus_limit_input())
+        electrical |= dmac34() ? bit_mask(9) : bit_mask(1);
+    if (options_.negative_end_switch.present && axis_->minus_limit_input())
+        electrical |= dmac34() ? bit_mask(10) : bit_mask(2);
+    return (electrical ^ (invert_in_ ? input_mask() : 0u)) & input_mask();
 }
 
 bool DmacSim::var_available(Var v) const { return dmac34() || !var_info(v).dmac34_only; }
@@ -117,22 +140,17 @@ motion::DmacProfileParams DmacSim::params() const {
 // ---- time -------------------------------------------------------------------
 double DmacSim::motion_t() const { return static_cast<double>(now_ms_ - motion_t0_ms_) / 1000.0; }
 
-motion::State DmacSim::motion_state() const {
-    if (interpolating_) {
-        motion::State s;
-        s.p = interp_pos_;
-        s.v = interp_speed_;
-        return s;
-    }
-    motion::State s = motion_->at(motion_t());
-    s.p += static_cast<double>(pos_offset_);
-    return s;
+Nanos DmacSim::tick_time() const { return epoch_ns_ + now_ms_ * kNsPerMs; }
+
+double DmacSim::user_position() const {
+    const double counts = axis_->steps_to_counts(axis_->physical_position());
+    return counts + static_cast<double>(axis_->encoder() - std::llround(counts));
 }
 
-std::int32_t DmacSim::position_locked() const { return wrap_i32(std::llround(motion_state().p)); }
+std::int32_t DmacSim::position_locked() const { return wrap_i32(axis_->encoder()); }
 
 std::int32_t DmacSim::speed_locked() const {
-    return round_i32(motion::dmac_inc_per_s_to_speed(motion_state().v));
+    return round_i32(motion::dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->velocity())));
 }
 
 bool DmacSim::moving_locked() const { return interpolating_ || motion_->moving(motion_t()); }
@@ -146,6 +164,7 @@ void DmacSim::catch_up_locked() {
         if (!seq_running_ && !timers && !moving_locked()) {
             // Nothing evolves while idle: jump instead of ticking through it.
             now_ms_ = target;
+            axis_->advance_to(tick_time());
             break;
         }
         tick_locked();
@@ -158,28 +177,17 @@ void DmacSim::tick_locked() {
         auto& t = vars_[static_cast<std::size_t>(timer_var(i))];
         if (t > 0) --t;
     }
-    if (interpolating_) {
-        if (fifo_.empty()) {
-            interpolating_ = false;
-            restart_motion_at(interp_pos_);
-        } else {
-            const Segment& s = fifo_.front();
-            ++seg_elapsed_ms_;
-            interp_speed_ = static_cast<double>(s.offset) * 1000.0 / s.duration_ms;
-            interp_pos_ = seg_start_pos_ + static_cast<double>(s.offset) * seg_elapsed_ms_ / s.duration_ms;
-            if (seg_elapsed_ms_ >= s.duration_ms) {
-                seg_start_pos_ += s.offset;
-                interp_pos_ = seg_start_pos_;
-                fifo_.pop_front();
-                seg_elapsed_ms_ = 0;
-                if (fifo_.empty()) {
-                    // FIFO ran dry: the movement stops; a new SYNCHRO INTERPOL is needed.
-                    interpolating_ = false;
-                    interp_speed_ = 0;
-                    restart_motion_at(interp_pos_);
-                }
-            }
-        }
+    advance_axis(tick_time());
+    if (interpolating_ && !fifo_.empty() && ++seg_elapsed_ms_ >= fifo_.front().duration_ms) {
+        // The segment's profile has just ended on its exact end position.
+        fifo_.pop_front();
+        if (!fifo_.empty()) start_interp_segment();
+    }
+    if (interpolating_ && fifo_.empty()) {
+        // FIFO ran dry: the movement stops; a new SYNCHRO INTERPOL is needed.
+        interpolating_ = false;
+        seg_elapsed_ms_ = 0;
+        restart_motion_at(user_position());
     }
     check_end_stops();
     if (seq_running_) {
@@ -222,14 +230,73 @@ void DmacSim::restart_motion_at(double position) {
 }
 
 void DmacSim::halt_motion() {
-    const double p = motion_state().p;
-    if (interpolating_ || !fifo_.empty()) {
-        interpolating_ = false;
-        fifo_.clear();
-        seg_elapsed_ms_ = 0;
-        interp_speed_ = 0;
+    interpolating_ = false;
+    fifo_.clear();
+    seg_elapsed_ms_ = 0;
+    axis_->halt();
+    restart_motion_at(user_position());
+}
+
+void DmacSim::command_axis() { axis_->command_from(motion_->profile(), motion_t()); }
+
+void DmacSim::start_interp_segment() {
+    // One FIFO entry: #INTERPOL_TIME ms at constant speed, ending exactly on its offset.
+    const Segment& s = fifo_.front();
+    const double v = static_cast<double>(s.offset) * 1000.0 / s.duration_ms;
+    motion::Profile seg(motion::State{0, v, 0, 0});
+    seg.append_jump(s.duration_ms / 1000.0, v, 0, 0).finish(static_cast<double>(s.offset), 0);
+    axis_->command(seg);
+    seg_elapsed_ms_ = 0;
+}
+
+// Advances the axis to t, stopping it where the commanded motion would first
+// go beyond an enabled soft end-stop ("movement is stopped", manual 1.2.3).
+void DmacSim::advance_axis(Nanos t) {
+    if (soft_ends_ && axis_->moving() && t > axis_->time()) {
+        const motion::Profile& prof = axis_->profile();
+        const double t_from = axis_->profile_time(axis_->time());
+        const double t_to = axis_->profile_time(t);
+        // The plan's frame -> the user's: constant while the rotor follows it.
+        const double shift = user_position() - prof.position(t_from);
+        double t_stop = -1;
+        auto consider = [&](Var end, double dir) {
+            const double level = static_cast<double>(vars_[static_cast<std::size_t>(end)]) - shift;
+            // Already at or beyond it: check_end_stops handles that at the tick.
+            if (dir * (prof.position(t_from) - level) >= 0) return;
+            if (dir * (prof.position(t_to) - level) <= 0) return;
+            const double tc = prof.first_crossing(level, t_from);
+            if (tc >= t_from && tc <= t_to && (t_stop < 0 || tc < t_stop)) t_stop = tc;
+        };
+        consider(Var::PositiveEnd, 1.0);
+        consider(Var::NegativeEnd, -1.0);
+        if (t_stop >= 0) {
+            // The first nanosecond on or past the end-stop, so it reads as reached.
+            const auto past = static_cast<Nanos>(std::ceil(t_stop * 1e9));
+            const Nanos at = std::clamp<Nanos>(axis_->profile_start() + past,
+                                               axis_->time(), t);
+            const Nanos before = axis_->profile_start();
+            axis_->advance_to(at);
+            // A hard end-stop may have stopped the axis first.
+            if (axis_->profile_start() == before && axis_->moving()) {
+                halt_motion();
+                abnormal_stop_ = true;
+            }
+        }
     }
-    restart_motion_at(p);
+    axis_->advance_to(t);
+}
+
+void DmacSim::on_axis_event(const motion::MotorEvent& e) {
+    using K = motion::MotorEvent::Kind;
+    if (e.kind != K::PlusLimitOn && e.kind != K::PlusLimitOff && e.kind != K::MinusLimitOn &&
+        e.kind != K::MinusLimitOff)
+        return;
+    // A switch edge (either polarity) may activate an end-stop input: stop at its exact time.
+    update_end_flags();
+    if ((hard_pos_hit_ && e.direction > 0) || (hard_neg_hit_ && e.direction < 0)) {
+        halt_motion();
+        abnormal_stop_ = true;
+    }
 }
 
 bool DmacSim::start_move(Cmd kind, std::int32_t value) {
@@ -237,7 +304,7 @@ bool DmacSim::start_move(Cmd kind, std::int32_t value) {
         flag(error::kLimit);
         return false;
     }
-    const double p = motion_state().p;
+    const double p = user_position();
     int dir = 0;
     if (kind == Cmd::MoveTo) dir = (value > p) - (value < p);
     else dir = (value > 0) - (value < 0);
@@ -267,9 +334,10 @@ bool DmacSim::start_move(Cmd kind, std::int32_t value) {
         } else {
             motion_->move_speed(t, value);
         }
+        command_axis();
     } catch (const std::exception&) {
         flag(error::kLimit);
-        restart_motion_at(p);
+        halt_motion();
         return false;
     }
     position_mode_ = kind != Cmd::MoveSpeed;
@@ -279,7 +347,7 @@ bool DmacSim::start_move(Cmd kind, std::int32_t value) {
 }
 
 void DmacSim::update_end_flags() {
-    const motion::State s = motion_state();
+    const double p = user_position();
     const auto pen = static_cast<double>(vars_[static_cast<std::size_t>(Var::PositiveEnd)]);
     const auto nen = static_cast<double>(vars_[static_cast<std::size_t>(Var::NegativeEnd)]);
     const std::uint32_t in = logical_inputs();
@@ -287,27 +355,17 @@ void DmacSim::update_end_flags() {
     const std::uint32_t in_neg = dmac34() ? bit_mask(10) : bit_mask(2);
     hard_pos_hit_ = hard_pos_ && (in & in_pos);
     hard_neg_hit_ = hard_neg_ && (in & in_neg);
-    soft_pos_hit_ = soft_ends_ && s.p >= pen;
-    soft_neg_hit_ = soft_ends_ && s.p <= nen;
+    soft_pos_hit_ = soft_ends_ && p >= pen - kEndTolerance;
+    soft_neg_hit_ = soft_ends_ && p <= nen + kEndTolerance;
 }
 
+// At a tick: an end-stop already active stops motion towards it (an input
+// set from outside, or a move started beyond a soft end-stop).
 void DmacSim::check_end_stops() {
     update_end_flags();
-    const motion::State s = motion_state();
-    const auto pen = static_cast<double>(vars_[static_cast<std::size_t>(Var::PositiveEnd)]);
-    const auto nen = static_cast<double>(vars_[static_cast<std::size_t>(Var::NegativeEnd)]);
-    const bool moving = moving_locked();
-    if (!moving) return;
-    if (soft_pos_hit_ && s.v > 0) {
-        // The firmware stops the axis on the virtual end-stop itself.
-        halt_motion();
-        restart_motion_at(pen);
-        abnormal_stop_ = true;
-    } else if (soft_neg_hit_ && s.v < 0) {
-        halt_motion();
-        restart_motion_at(nen);
-        abnormal_stop_ = true;
-    } else if ((hard_pos_hit_ && s.v > 0) || (hard_neg_hit_ && s.v < 0)) {
+    if (!moving_locked()) return;
+    const double v = axis_->commanded_velocity();
+    if (((hard_pos_hit_ || soft_pos_hit_) && v > 0) || ((hard_neg_hit_ || soft_neg_hit_) && v < 0)) {
         halt_motion();
         abnormal_stop_ = true;
     }
@@ -315,7 +373,6 @@ void DmacSim::check_end_stops() {
 
 // ---- reset --------------------------------------------------------------------
 void DmacSim::reset_locked(bool factory) {
-    const double p = motion_state().p;
     for (std::size_t i = 0; i < kVarCount; ++i) {
         const VarInfo& vi = var_info(static_cast<Var>(i));
         if (vi.read_only) continue;
@@ -335,14 +392,15 @@ void DmacSim::reset_locked(bool factory) {
     interpolating_ = false;
     fifo_.clear();
     seg_elapsed_ms_ = 0;
-    interp_speed_ = 0;
     edit_ = false;
     seq_running_ = false;
     line_ = 0;
     call_stack_.clear();
     wait_ = WaitKind::None;
     // Position is stored (kept across a reset) unless factory settings are restored.
-    restart_motion_at(factory ? 0.0 : std::round(p));
+    axis_->halt();
+    if (factory) axis_->set_encoder(0);
+    restart_motion_at(user_position());
     first_reset_ = false;
     const std::int32_t on_reset = vars_[static_cast<std::size_t>(Var::OnReset)];
     if (on_reset >= 1 && on_reset <= kSeqLines) seq_start(on_reset);
@@ -381,7 +439,7 @@ std::uint32_t DmacSim::status_locked() {
     set(status::kPowerOn, power_);
     set(status::kMovement, moving);
     if (moving && position_mode_ && !interpolating_) {
-        const double err = static_cast<double>(motion_->target() + pos_offset_) - motion_state().p;
+        const double err = static_cast<double>(motion_->target() + pos_offset_) - user_position();
         set(status::kPositionControl, std::fabs(err) <= motion::kDmacApproachIncrements);
     }
     set(status::kBusy, moving);
@@ -430,17 +488,12 @@ int DmacSim::write_var_locked(Var v, int bit, std::int32_t value) {
     if (value < vi.min || value > vi.max) return error::kLimit;
     switch (v) {
         case Var::Position: {
-            // Re-home: the current motion continues from the new origin.
-            const double p = motion_state().p;
-            if (interpolating_) {
-                const double shift = static_cast<double>(value) - p;
-                interp_pos_ += shift;
-                seg_start_pos_ += shift;
-            } else if (motion_->moving(motion_t())) {
-                pos_offset_ += static_cast<std::int64_t>(value) - std::llround(p);
-            } else {
-                restart_motion_at(value);
-            }
+            // Re-home: the encoder count jumps, the current motion continues from
+            // the new origin (interpolation segments are relative anyway).
+            const std::int64_t shift = static_cast<std::int64_t>(value) - axis_->encoder();
+            axis_->set_encoder(value);
+            if (moving_locked()) pos_offset_ += shift;
+            else restart_motion_at(user_position());
             return 0;
         }
         case Var::Error:
@@ -666,6 +719,7 @@ std::string DmacSim::execute_locked(const Command& c, bool from_sequencer, bool 
                 else {
                     fifo_.clear();
                     motion_->stop(motion_t());
+                    command_axis();
                 }
             }
             if (c.keyword != Keyword::Mouv) seq_stop();
@@ -789,12 +843,11 @@ std::string DmacSim::execute_locked(const Command& c, bool from_sequencer, bool 
                     break;
                 case Keyword::Interpol:
                     if (!fifo_.empty() && !interpolating_) {
-                        const double p = motion_state().p;
-                        restart_motion_at(p);
+                        // Any other motion stops at once; the FIFO takes over.
+                        axis_->halt();
+                        restart_motion_at(user_position());
                         interpolating_ = true;
-                        seg_elapsed_ms_ = 0;
-                        seg_start_pos_ = interp_pos_ = p;
-                        interp_speed_ = 0;
+                        start_interp_segment();
                         power_ = true;
                         abnormal_stop_ = false;
                     }
@@ -924,9 +977,8 @@ void DmacSim::set_input(int n, bool active) {
     const bool is = (logical_inputs() & bit_mask(5)) != 0;
     if (!was && is) {
         // IN5 rising edge: capture, and re-home in reference mode when turning CW.
-        const motion::State s = motion_state();
         vars_[static_cast<std::size_t>(Var::Capture)] = position_locked();
-        if (reference_ && s.v > 0) {
+        if (reference_ && axis_->velocity() > 0) {
             write_var_locked(Var::Position, 0, 0);
             reference_ = false;
         }

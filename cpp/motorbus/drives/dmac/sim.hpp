@@ -3,10 +3,18 @@
 // soft end-stops, the 500-line sequencer (one line per millisecond), the
 // interpolation FIFO and MODULE_RESET [ALL].
 //
+// The axis is a motion::MotorModel: DmacMotion plans, the model plays the plan
+// (and the interpolation segments); #POSITION is the model's encoder and
+// #SPEED its rotor speed.  One step = one count = one increment (1/10000 rev).
+// Hard end-stops are the model's +/- limit switches (SimOptions) or the
+// inputs as set_input() drives them; soft end-stops stop the axis where the
+// commanded motion crosses #POSITIVE_END / #NEGATIVE_END.
+//
 // Time: device state lives on a motorbus::Clock.  Nothing runs in the
 // background; each call first brings the device up to clock.now() in 1 ms
 // ticks (sequencer line, timers, FIFO segment progress, end-stop checks), so
-// a SimClock advanced by a test gives exact, repeatable times.
+// a SimClock advanced by a test gives exact, repeatable times.  Switch edges
+// and soft end-stop crossings inside a tick stop the axis at their exact time.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -19,6 +27,7 @@
 
 #include "motorbus/drives/dmac/codec.hpp"
 #include "motorbus/motion/dmac_profile.hpp"
+#include "motorbus/motion/motor_model.hpp"
 #include "motorbus/runtime/clock.hpp"
 #include "motorbus/serial/line_device.hpp"
 
@@ -45,6 +54,14 @@ struct SimOptions {
     std::string revision_date = "12/04/06";
     std::string phase = "6A";
     std::string boot = "v1.1";
+    // Mechanical end-stop switches on the hard end-stop inputs (IN1/IN2,
+    // DMAC34: IN9/IN10), fixed to the machine: `lo` is the position
+    // (1/10000 rev, the axis frame at power-up) where the switch closes.
+    // active_low = false: a closed switch drives the input active (wire
+    // normally-closed switches as active_low = true with INVERSE_POLARITY IN).
+    // Absent by default; set_input() drives those inputs either way.
+    motion::SwitchConfig positive_end_switch{false, 0, 0, false};
+    motion::SwitchConfig negative_end_switch{false, 0, 0, false};
 };
 
 // Snapshot of what a test usually asserts on.
@@ -107,7 +124,8 @@ private:
     bool var_available(Var v) const;
     std::uint32_t status_locked();
     double motion_t() const;
-    motion::State motion_state() const;
+    Nanos tick_time() const;
+    double user_position() const;  // encoder counts before quantisation
     std::int32_t position_locked() const;
     std::int32_t speed_locked() const;
     bool moving_locked() const;
@@ -116,6 +134,10 @@ private:
     std::uint32_t logical_inputs() const;
     void restart_motion_at(double position);
     void halt_motion();
+    void command_axis();
+    void start_interp_segment();
+    void advance_axis(Nanos t);
+    void on_axis_event(const motion::MotorEvent& e);
     bool start_move(Cmd kind, std::int32_t value);
     void check_end_stops();
     void update_end_flags();
@@ -148,12 +170,13 @@ private:
     bool abnormal_stop_ = false;
     bool hard_pos_hit_ = false, hard_neg_hit_ = false, soft_pos_hit_ = false, soft_neg_hit_ = false;
 
-    // motion
+    // motion: the planner (its own time line from motion_t0_ms_) and the axis
+    std::unique_ptr<motion::MotorModel> axis_;
     std::unique_ptr<motion::DmacMotion> motion_;
     std::int64_t motion_t0_ms_ = 0;
     bool position_mode_ = false;
     // #POSITION written during a move re-homes without disturbing it: the
-    // profile keeps its own frame and the user frame is shifted by this.
+    // plan keeps its own frame and the user (encoder) frame is shifted by this.
     std::int64_t pos_offset_ = 0;
     std::unique_ptr<Pending> pending_;
 
@@ -165,9 +188,6 @@ private:
     std::deque<Segment> fifo_;
     bool interpolating_ = false;
     int seg_elapsed_ms_ = 0;
-    double seg_start_pos_ = 0;
-    double interp_pos_ = 0;
-    double interp_speed_ = 0;
 
     // sequencer
     std::vector<std::optional<Command>> program_;  // index 1..500
