@@ -172,7 +172,8 @@ class CommandRejected(DriveFault):
         "(a SimClock in tests); nothing runs in the background.")
         .def(py::init([](std::shared_ptr<Clock> clock, int address, const std::string& model,
                          const py::bytes& request_terminator, const py::bytes& reply_terminator,
-                         std::int32_t supply_voltage, std::int32_t baudrate) {
+                         std::int32_t supply_voltage, std::int32_t baudrate, std::optional<double> positive_end_switch,
+                         std::optional<double> negative_end_switch, bool end_switch_active_low) {
                  SimOptions o;
                  o.address = address;
                  auto mdl = parse_model(model);
@@ -184,11 +185,17 @@ class CommandRejected(DriveFault):
                      throw InvalidArgument("terminators: must not be empty");
                  o.supply_voltage_mv = supply_voltage;
                  o.baudrate = baudrate;
+                 if (positive_end_switch)
+                     o.positive_end_switch = motion::SwitchConfig{true, *positive_end_switch, 0, end_switch_active_low};
+                 if (negative_end_switch)
+                     o.negative_end_switch = motion::SwitchConfig{true, *negative_end_switch, 0, end_switch_active_low};
                  return std::make_shared<DmacSim>(std::move(clock), o);
              }),
              py::arg("clock") = nullptr, py::arg("address") = 0, py::arg("model") = "DMAC34-1",
              py::arg("request_terminator") = py::bytes("\r"), py::arg("reply_terminator") = py::bytes("\r\n"),
-             py::arg("supply_voltage") = 32000, py::arg("baudrate") = 38400)
+             py::arg("supply_voltage") = 32000, py::arg("baudrate") = 38400,
+             py::arg("positive_end_switch") = py::none(), py::arg("negative_end_switch") = py::none(),
+             py::arg("end_switch_active_low") = false)
         .def("poll", &DmacSim::poll, py::call_guard<py::gil_scoped_release>(), "Catch up with the clock.")
         .def("state", [](DmacSim& s) {
             SimState st;

@@ -64,6 +64,25 @@ def test_sim_profile_times_on_sim_clock():
     assert sim.state()["speed"] == 0
 
 
+def test_sim_end_stop_switches_stop_the_axis_on_the_switch():
+    # The simulated axis is a MotorModel: the switch sits at a machine position
+    # and stops the move exactly there (1/10000 rev = one model step).
+    clock = SimClock()
+    sim = make_sim("00", clock=clock, positive_end_switch=2500, negative_end_switch=-2500)
+    sim.on_line(b"00HARD_ENDS ALL, MOVE_SPEED 6000")
+    clock.advance(2000 * MS)
+    assert sim.on_line(b"00READ #POSITION") == b"00#POS=+2500\r\n"
+    status = sim.state()["status"]
+    assert status & (1 << 16)          # bit 17: hard positive end-stop
+    assert status & (1 << 31)          # bit 32: abnormal stop
+    assert sim.on_line(b"00READ #SPEED") == b"00#SPE=+0\r\n"
+    assert sim.on_line(b"00READ #INPUT.9") == b"00#INP.9=+1\r\n"
+    sim.on_line(b"00MOVE_ON 10")       # further CW is refused (#ERROR bit 7)
+    assert sim.on_line(b"00READ #ERROR") == b"00#ERR=+64\r\n"
+    nc = make_sim("00", positive_end_switch=1000, end_switch_active_low=True)
+    assert nc.on_line(b"00READ #INPUT.9") == b"00#INP.9=+1\r\n"   # away from an active-low switch
+
+
 def test_client_typed_moves_status_and_errors(bus):
     clock, sims, link, (c0, c1, c2) = bus
     c1.set_profile(high_speed=30000, accel_ms=200, decel_ms=200)

@@ -159,10 +159,14 @@ def make_sim(address: Any = "00", clock: Any = None, **options: Any) -> DmacSim:
 
     ``address`` is "00".."63" (or an int).  Options: ``model`` ("DMAC17",
     "DMAC23-1", "DMAC23-2", "DMAC34-1", "DMAC34-2"), ``supply_voltage`` (mV),
-    ``baudrate``, ``request_terminator`` / ``reply_terminator`` (bytes).
+    ``baudrate``, ``request_terminator`` / ``reply_terminator`` (bytes),
+    ``positive_end_switch`` / ``negative_end_switch`` (position in 1/10000 rev
+    where a mechanical end-stop switch on IN1/IN2 or IN9/IN10 closes) and
+    ``end_switch_active_low``.
     ``clock`` is a motorbus Clock (SimClock for tests); None = real time.
     """
-    allowed = {"model", "supply_voltage", "baudrate", "request_terminator", "reply_terminator"}
+    allowed = {"model", "supply_voltage", "baudrate", "request_terminator", "reply_terminator",
+               "positive_end_switch", "negative_end_switch", "end_switch_active_low"}
     unknown = set(options) - allowed
     if unknown:
         raise _core.InvalidArgument(f"make_sim: unknown option(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
