@@ -96,11 +96,11 @@ DmacSim::DmacSim(std::shared_ptr<Clock> clock, SimOptions options)
     if (options_.address < 0 || options_.address > kMaxAddress)
         throw InvalidArgument("DmacSim address: " + std::to_string(options_.address) +
                               " is outside 0..63");
-    epoch_ns_ = clock_->now();
     address_ = options_.address;
     baudrate_ = options_.baudrate;
     program_.assign(kSeqLines + 1, std::nullopt);
     axis_ = std::make_unique<motion::MotorModel>(*clock_, axis_config(options_));
+    epoch_ns_ = axis_->time();  // the model's time is the device's, tick for tick
     axis_->add_listener([this](const motion::MotorEvent& e) { on_axis_event(e); });
     std::lock_guard lock(mutex_);
     restart_motion_at(0);
@@ -237,7 +237,7 @@ void DmacSim::halt_motion() {
     restart_motion_at(user_position());
 }
 
-void DmacSim::command_axis() { axis_->command_from(motion_->profile(), motion_t()); }
+void DmacSim::command_axis() { axis_->command_from(motion_->profile(), motion_t(), tick_time()); }
 
 void DmacSim::start_interp_segment() {
     // One FIFO entry: #INTERPOL_TIME ms at constant speed, ending exactly on its offset.
