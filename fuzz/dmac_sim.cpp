@@ -15,9 +15,18 @@
 using namespace motorbus;
 using namespace motorbus::dmac;
 
+namespace {
+// Either switch polarity, chosen by the input.
+bool data_len_odd(std::size_t size) { return (size & 1u) != 0; }
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     auto clock = std::make_shared<SimClock>();
-    DmacSim sim(clock, SimOptions{.address = 1});
+    SimOptions options{.address = 1};
+    // End-stop switches on the axis, so HARD_ENDS stops at switch edges get fuzzed too.
+    options.positive_end_switch = motion::SwitchConfig{true, 20000, 0, false};
+    options.negative_end_switch = motion::SwitchConfig{true, -20000, 0, data_len_odd(size)};
+    DmacSim sim(clock, options);
     std::string_view in(reinterpret_cast<const char*>(data), size);
     std::size_t start = 0;
     while (start <= in.size()) {
