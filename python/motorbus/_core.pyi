@@ -2142,7 +2142,7 @@ class DmacSim(LineDevice):
     """
     A simulated DMAC module (a LineDevice: serve it with PtyLineServer). Device time runs on `clock` (a SimClock in tests); nothing runs in the background.
     """
-    def __init__(self, clock: Clock = None, address: typing.SupportsInt | typing.SupportsIndex = 0, model: str = 'DMAC34-1', request_terminator: bytes = b'\r', reply_terminator: bytes = b'\r\n', supply_voltage: typing.SupportsInt | typing.SupportsIndex = 32000, baudrate: typing.SupportsInt | typing.SupportsIndex = 38400) -> None:
+    def __init__(self, clock: Clock = None, address: typing.SupportsInt | typing.SupportsIndex = 0, model: str = 'DMAC34-1', request_terminator: bytes = b'\r', reply_terminator: bytes = b'\r\n', supply_voltage: typing.SupportsInt | typing.SupportsIndex = 32000, baudrate: typing.SupportsInt | typing.SupportsIndex = 38400, positive_end_switch: typing.SupportsFloat | typing.SupportsIndex | None = None, negative_end_switch: typing.SupportsFloat | typing.SupportsIndex | None = None, end_switch_active_low: bool = False) -> None:
         ...
     def inject_error(self, bit: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
