@@ -354,8 +354,11 @@ void MotorModel::step_to(Nanos t_end) {
         }
         (void)kMaxIndexPerTick;
     }
-    if (running_ && profile_end > t0 && profile_end <= t_end && profile_end < best_t) {
-        best_t = profile_end;
+    // An event found exactly at the profile's end comes first; the end is then
+    // at t0 of the next step and must still be reported.
+    const Nanos done_t = std::max(profile_end, t0);
+    if (running_ && done_t <= t_end && done_t < best_t) {
+        best_t = done_t;
         best_k = MotorEvent::Kind::ProfileDone;
     }
     if (best_t == std::numeric_limits<Nanos>::max()) {

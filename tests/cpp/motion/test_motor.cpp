@@ -529,3 +529,25 @@ TEST(ArcusHoming, StartingOnTheSwitchFindsItAtOnce) {
     EXPECT_NEAR(m.physical_position(), from + 1000, 0.01);
     EXPECT_EQ(m.pulse_count(), 0);
 }
+
+TEST(MotorModel, MoveEndingExactlyOnTheIndexEdgeStillEnds) {
+    // The index event and the profile's end fall on the same nanosecond.
+    SimClock clk;
+    MotorConfig c;
+    c.index_position = 1600;
+    MotorModel m(clk, c);
+    int done = 0, index = 0;
+    m.add_listener([&](const MotorEvent& e) {
+        done += e.kind == MotorEvent::Kind::ProfileDone;
+        index += e.kind == MotorEvent::Kind::IndexPulse;
+    });
+    ArcusMotion a;  // ends with a jump from LSPD to 0: the edge is reached at the very end
+    a.move(0, 1600);
+    m.command(a.profile());
+    clk.advance(5 * kSec);
+    m.update();
+    EXPECT_FALSE(m.moving());
+    EXPECT_EQ(done, 1);
+    EXPECT_EQ(index, 1);
+    EXPECT_DOUBLE_EQ(m.physical_position(), 1600);
+}
