@@ -44,8 +44,9 @@ ArcusHoming::~ArcusHoming() { motor_.remove_listener(listener_); }
 
 int ArcusHoming::snl_status() const {
     switch (method_) {
-        case Method::Z:
-        case Method::ZH: return static_cast<int>(SnlStatus::ZHoming);
+        case Method::Z: return static_cast<int>(SnlStatus::ZHoming);
+        // Homing while it looks for the switch, Z-Homing once it looks for the index.
+        case Method::ZH: return static_cast<int>(stage_ == 0 ? SnlStatus::Homing : SnlStatus::ZHoming);
         case Method::L: return static_cast<int>(SnlStatus::LimitHoming);
         default: return static_cast<int>(SnlStatus::Homing);
     }
@@ -62,13 +63,13 @@ double arcus_decel(const ArcusProfileParams& p) {
 
 void ArcusHoming::jog(int direction, double speed) {
     const RampShape shape = params_.scv ? RampShape::SCurve : RampShape::Trapezoid;
-    motor_.command(ramp_and_hold(motor_.pulse_position(), motor_.commanded_velocity(), direction * speed,
+    motor_.command(ramp_and_hold(motor_.pulse_position(), motor_.pulse_velocity(), direction * speed,
                                  arcus_accel(params_), shape, params_.lspd));
 }
 
 void ArcusHoming::decel_stop(Nanos) {
     // Ramp down to LSPD, then stop (a jump from LSPD to 0).
-    const double v = motor_.commanded_velocity();
+    const double v = motor_.pulse_velocity();
     Profile tail(State{motor_.pulse_position(), v, 0, 0});
     const double w = std::fabs(v);
     if (w > params_.lspd)
@@ -84,7 +85,7 @@ void ArcusHoming::decel_stop(Nanos) {
 
 void ArcusHoming::run(double target, double, bool) {
     const RampShape shape = params_.scv ? RampShape::SCurve : RampShape::Trapezoid;
-    Profile p = arcus_stepper_profile(State{motor_.pulse_position(), motor_.commanded_velocity(), 0, 0}, target,
+    Profile p = arcus_stepper_profile(State{motor_.pulse_position(), motor_.pulse_velocity(), 0, 0}, target,
                                       params_.hspd, params_.lspd, arcus_accel(params_), arcus_decel(params_), shape);
     if (p.empty()) {
         motor_.halt();
@@ -104,12 +105,34 @@ void ArcusHoming::start(Method m, int direction) {
     } else {
         jog(dir_, params_.hspd);
     }
+    // The inputs are levels: a switch already active when the search starts
+    // is found at once (the event that would announce it never comes).
+    using K = MotorEvent::Kind;
+    const int phys_dir = motor_.steps_per_unit() > 0 ? dir_ : -dir_;
+    auto now_event = [&](K k) {
+        on_event(MotorEvent{k, motor_.time(), motor_.physical_position(), motor_.pulse_position(),
+                            motor_.encoder(), phys_dir});
+    };
+    if (phys_dir > 0 && motor_.plus_limit_active()) now_event(K::PlusLimitOn);
+    else if (phys_dir < 0 && motor_.minus_limit_active()) now_event(K::MinusLimitOn);
+    else if (m != Method::Z && m != Method::L && motor_.home_active()) now_event(K::HomeOn);
 }
 
 void ArcusHoming::abort() {
     if (result_ != HomingResult::Running) return;
     motor_.halt();
     result_ = HomingResult::Aborted;
+}
+
+void ArcusHoming::stop() {
+    if (result_ != HomingResult::Running) return;
+    decel_stop(motor_.time());
+    result_ = HomingResult::Aborted;
+}
+
+void ArcusHoming::set_zero() {
+    motor_.set_pulse_position(0);
+    if (opt_.zero_encoder) motor_.set_encoder(0);
 }
 
 void ArcusHoming::finish(HomingResult r) {
@@ -129,7 +152,7 @@ void ArcusHoming::on_event(const MotorEvent& e) {
     switch (method_) {
         case Method::H:
             if (stage_ == 0 && e.kind == K::HomeOn) {
-                motor_.set_pulse_position(0);
+                set_zero();
                 decel_stop(e.t);
                 stage_ = 1;
                 if (!motor_.moving()) on_event(MotorEvent{K::ProfileDone, e.t, e.physical, 0, e.encoder, 0});
@@ -145,34 +168,42 @@ void ArcusHoming::on_event(const MotorEvent& e) {
             }
             break;
         case Method::HL:
+            // Stages: 0 search at HSPD, 1 decelerate, 2 back at LSPD to the switch,
+            // 3 through the switch at HSPD, 4 HCA past it, 5 forward at LSPD onto it.
             if (stage_ == 0 && e.kind == K::HomeOn) {
-                motor_.set_pulse_position(0);
+                set_zero();
                 decel_stop(e.t);
                 stage_ = 1;
+                if (!motor_.moving()) on_event(MotorEvent{K::ProfileDone, e.t, e.physical, 0, e.encoder, 0});
             } else if (stage_ == 1 && e.kind == K::ProfileDone) {
-                stage_ = 2;
                 if (motor_.home_active()) {
-                    // Stopped inside the switch: it is "reached" already.
-                    run(motor_.pulse_position() - dir_ * opt_.hca, params_.hspd, true);
+                    // Stopped inside the switch: it is reached already.
+                    jog(-dir_, params_.hspd);
                     stage_ = 3;
                 } else {
                     jog(-dir_, params_.lspd);
+                    stage_ = 2;
                 }
             } else if (stage_ == 2 && e.kind == K::HomeOn) {
-                run(motor_.pulse_position() - dir_ * opt_.hca, params_.hspd, true);
+                jog(-dir_, params_.hspd);
                 stage_ = 3;
-            } else if (stage_ == 3 && e.kind == K::ProfileDone) {
+            } else if (stage_ == 3 && e.kind == K::HomeOff) {
+                // The manual (Figure 7.4 E): "past the home input by ... HCA".
+                run(motor_.pulse_position() - dir_ * opt_.hca, params_.hspd, true);
                 stage_ = 4;
+                if (!motor_.moving()) on_event(MotorEvent{K::ProfileDone, e.t, e.physical, 0, e.encoder, 0});
+            } else if (stage_ == 4 && e.kind == K::ProfileDone) {
+                stage_ = 5;
                 if (motor_.home_active()) {
                     motor_.halt();
-                    motor_.set_pulse_position(0);
+                    set_zero();
                     finish(HomingResult::Done);
                 } else {
                     jog(dir_, params_.lspd);
                 }
-            } else if (stage_ == 4 && e.kind == K::HomeOn) {
+            } else if (stage_ == 5 && e.kind == K::HomeOn) {
                 motor_.halt();
-                motor_.set_pulse_position(0);
+                set_zero();
                 finish(HomingResult::Done);
             }
             break;
@@ -182,18 +213,18 @@ void ArcusHoming::on_event(const MotorEvent& e) {
                 run(motor_.pulse_position() - dir_ * opt_.lca, params_.hspd, true);
                 stage_ = 1;
                 if (!motor_.moving()) {
-                    motor_.set_pulse_position(0);
+                    set_zero();
                     finish(HomingResult::Done);
                 }
             } else if (stage_ == 1 && e.kind == K::ProfileDone) {
-                motor_.set_pulse_position(0);
+                set_zero();
                 finish(HomingResult::Done);
             }
             break;
         case Method::Z:
             if (stage_ == 0 && e.kind == K::IndexPulse) {
                 motor_.halt();
-                motor_.set_pulse_position(0);
+                set_zero();
                 finish(HomingResult::Done);
             }
             break;
@@ -203,9 +234,9 @@ void ArcusHoming::on_event(const MotorEvent& e) {
                 jog(dir_, params_.lspd);
                 stage_ = 1;
             } else if (stage_ == 1 && e.kind == K::IndexPulse &&
-                       std::fabs(motor_.commanded_velocity()) <= params_.lspd * (1 + 1e-9)) {
+                       std::fabs(motor_.pulse_velocity()) <= params_.lspd * (1 + 1e-9)) {
                 motor_.halt();
-                motor_.set_pulse_position(0);
+                set_zero();
                 finish(HomingResult::Done);
             }
             break;
@@ -228,7 +259,7 @@ bool Cia402Homing::supported(int m) {
 }
 
 void Cia402Homing::run_at(double velocity) {
-    motor_.command(ramp_and_hold(motor_.pulse_position(), motor_.commanded_velocity(), velocity, p_.acceleration,
+    motor_.command(ramp_and_hold(motor_.pulse_position(), motor_.pulse_velocity(), velocity, p_.acceleration,
                                  RampShape::Trapezoid));
 }
 

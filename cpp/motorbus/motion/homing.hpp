@@ -4,9 +4,11 @@
 //   H+/H-   run at HSPD toward home; on the home edge the position counter is
 //           reset to 0 and the motor decelerates to LSPD and stops (the final
 //           position is not 0).  RZ=1: then return to 0.
-//   HL+/HL- as H, then reverse at LSPD to find home again, continue past it
-//           by HCA at HSPD, come back at LSPD, and on the home edge reset to
-//           0 and stop immediately.  RZ=1: return to 0 (already there).
+//   HL+/HL- as H, then reverse at LSPD to find home again, continue through
+//           it at HSPD and on past it by HCA, come back at LSPD, and on the
+//           home edge reset to 0 and stop immediately.  RZ=1: return to 0
+//           (already there).
+//   The inputs are levels: a switch already active at the start is found at once.
 //   L+/L-   run toward the limit; stop immediately on it; move back by LCA at
 //           HSPD; that point is zero.
 //   Z+/Z-   run at LSPD until the Z index; stop, position = 0.
@@ -38,6 +40,9 @@ struct ArcusHomingOptions {
     double hca = 0;      // HCA, pulses
     double lca = 1000;   // LCA, pulses (factory 1000)
     bool rz = false;     // RZ: return to zero after H/HL
+    // Reset the encoder counter wherever the position counter is reset (a
+    // drive that keeps PX and EX aligned, as the DMX-CAN simulator does).
+    bool zero_encoder = false;
 };
 
 struct Cia402HomingParams {
@@ -59,7 +64,8 @@ public:
 
     // Starts homing now (motor.time()); direction +1 or -1.
     void start(Method m, int direction);
-    void abort();
+    void abort();  // ABORT: stop now
+    void stop();   // STOP: decelerate to LSPD, then stop
     HomingResult result() const { return result_; }
     bool running() const { return result_ == HomingResult::Running; }
     Method method() const { return method_; }
@@ -80,6 +86,7 @@ private:
     void jog(int direction, double hspd);
     void decel_stop(Nanos t);
     void finish(HomingResult r);
+    void set_zero();
 };
 
 class Cia402Homing {

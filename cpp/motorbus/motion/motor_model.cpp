@@ -11,7 +11,25 @@ bool home_on(const SwitchConfig& c, double p) { return c.present && p >= c.lo &&
 bool minus_on(const SwitchConfig& c, double p) { return c.present && p <= c.lo; }
 bool plus_on(const SwitchConfig& c, double p) { return c.present && p >= c.lo; }
 constexpr int kMaxIndexPerTick = 64;  // bounded work on absurd speeds
+int switch_slot(Switch w) { return w == Switch::Home ? 0 : (w == Switch::MinusLimit ? 1 : 2); }
 }  // namespace
+
+const SwitchConfig& MotorModel::switch_config(Switch w) const {
+    return w == Switch::Home ? cfg_.home : (w == Switch::MinusLimit ? cfg_.minus_limit : cfg_.plus_limit);
+}
+SwitchConfig& MotorModel::switch_config(Switch w) {
+    return w == Switch::Home ? cfg_.home : (w == Switch::MinusLimit ? cfg_.minus_limit : cfg_.plus_limit);
+}
+
+bool MotorModel::switch_level(Switch w, double p) const {
+    const SwitchConfig& c = switch_config(w);
+    const auto& forced = forced_[switch_slot(w)];
+    const bool actuated = forced ? *forced
+                          : w == Switch::Home ? home_on(c, p)
+                          : w == Switch::MinusLimit ? minus_on(c, p)
+                                                    : plus_on(c, p);
+    return actuated != c.inverted;
+}
 
 MotorModel::MotorModel(Clock& clock, MotorConfig cfg) : clock_(clock), cfg_(cfg), profile_(State{0, 0, 0, 0}) {
     if (!(cfg_.steps_per_rev > 0) || !(cfg_.counts_per_rev > 0))
@@ -24,10 +42,62 @@ MotorModel::MotorModel(Clock& clock, MotorConfig cfg) : clock_(clock), cfg_(cfg)
 
 double MotorModel::profile_time(Nanos t) const { return static_cast<double>(t - profile_start_) * 1e-9; }
 
-State MotorModel::command_state(Nanos t) const {
+State MotorModel::units_state(Nanos t) const {
     State s = profile_.at(profile_time(t));
     s.p -= profile_offset_;
     return s;
+}
+
+State MotorModel::command_state(Nanos t) const {
+    State s = units_state(t);
+    s.p = anchor_steps_ + (s.p - anchor_units_) * steps_per_unit_;
+    s.v *= steps_per_unit_;
+    s.a *= steps_per_unit_;
+    s.j *= steps_per_unit_;
+    return s;
+}
+
+void MotorModel::revise(const Profile& profile) {
+    profile_ = profile;
+    running_ = profile_time(now_) < profile.duration();
+}
+
+void MotorModel::set_steps_per_unit(double k) {
+    if (!std::isfinite(k) || k == 0) throw InvalidArgument("MotorModel: steps_per_unit must be finite and non-zero");
+    update();
+    anchor_steps_ = command_state(now_).p;
+    anchor_units_ = units_state(now_).p;
+    steps_per_unit_ = k;
+}
+
+void MotorModel::displace(double steps) {
+    update();
+    physical_ += steps;
+    slip_ -= steps;
+}
+
+void MotorModel::set_switch_inverted(Switch w, bool inverted) {
+    update();
+    const bool before = switch_level(w, physical_);
+    switch_config(w).inverted = inverted;
+    const bool after = switch_level(w, physical_);
+    if (before != after) emit_switch(w, after);
+}
+
+void MotorModel::force_switch(Switch w, std::optional<bool> active) {
+    update();
+    const bool before = switch_level(w, physical_);
+    forced_[switch_slot(w)] = active;
+    const bool after = switch_level(w, physical_);
+    if (before != after) emit_switch(w, after);
+}
+
+void MotorModel::emit_switch(Switch w, bool on) {
+    using K = MotorEvent::Kind;
+    const K k = w == Switch::Home ? (on ? K::HomeOn : K::HomeOff)
+                : w == Switch::MinusLimit ? (on ? K::MinusLimitOn : K::MinusLimitOff)
+                                          : (on ? K::PlusLimitOn : K::PlusLimitOff);
+    emit(k, now_);
 }
 
 bool MotorModel::moving() const { return running_; }
@@ -36,7 +106,7 @@ void MotorModel::command(const Profile& profile, std::optional<Nanos> start) {
     Nanos t = start.value_or(now_);
     if (t < now_) t = now_;
     if (t > now_ && !in_dispatch_) advance_to(t);
-    const double cp = command_state(t).p;
+    const double cp = units_state(t).p;
     profile_ = profile;
     profile_start_ = t;
     profile_offset_ = profile.start_position() - cp;
@@ -62,7 +132,7 @@ void MotorModel::halt(std::optional<Nanos> at) {
     Nanos t = at.value_or(now_);
     if (t < now_) t = now_;
     if (t > now_ && !in_dispatch_) advance_to(t);
-    const double pulse = command_state(t).p + pulse_offset_;
+    const double pulse = units_state(t).p + pulse_offset_;
     Profile hold(State{pulse, 0, 0, 0});
     command(hold, t);
 }
@@ -78,23 +148,24 @@ void MotorModel::remove_listener(int id) {
 }
 
 double MotorModel::commanded_position() const { return command_state(now_).p; }
-double MotorModel::pulse_position() const { return commanded_position() + pulse_offset_; }
+double MotorModel::pulse_position() const { return units_state(now_).p + pulse_offset_; }
 std::int64_t MotorModel::pulse_count() const { return std::llround(pulse_position()); }
 std::int64_t MotorModel::encoder() const {
     return std::llround(steps_to_counts(physical_)) + static_cast<std::int64_t>(encoder_offset_);
 }
 double MotorModel::commanded_velocity() const { return command_state(now_).v; }
+double MotorModel::pulse_velocity() const { return units_state(now_).v; }
 double MotorModel::velocity() const { return stalled_ ? 0.0 : commanded_velocity(); }
 double MotorModel::commanded_acceleration() const { return command_state(now_).a; }
 
-void MotorModel::set_pulse_position(double pulses) { pulse_offset_ = pulses - commanded_position(); }
+void MotorModel::set_pulse_position(double pulses) { pulse_offset_ = pulses - units_state(now_).p; }
 void MotorModel::set_encoder(std::int64_t counts) {
     encoder_offset_ = static_cast<double>(counts - std::llround(steps_to_counts(physical_)));
 }
 
-bool MotorModel::home_active() const { return home_on(cfg_.home, physical_); }
-bool MotorModel::minus_limit_active() const { return minus_on(cfg_.minus_limit, physical_); }
-bool MotorModel::plus_limit_active() const { return plus_on(cfg_.plus_limit, physical_); }
+bool MotorModel::home_active() const { return switch_level(Switch::Home, physical_); }
+bool MotorModel::minus_limit_active() const { return switch_level(Switch::MinusLimit, physical_); }
+bool MotorModel::plus_limit_active() const { return switch_level(Switch::PlusLimit, physical_); }
 bool MotorModel::minus_limit_input() const {
     return cfg_.minus_limit.active_low ? !minus_limit_active() : minus_limit_active();
 }
@@ -129,7 +200,7 @@ void MotorModel::trigger_latch() {
 
 MotorEvent MotorModel::make_event(MotorEvent::Kind k, Nanos t) const {
     const State s = command_state(t);
-    return MotorEvent{k, t, physical_, s.p + pulse_offset_, encoder(),
+    return MotorEvent{k, t, physical_, units_state(t).p + pulse_offset_, encoder(),
                       s.v > 0 ? 1 : (s.v < 0 ? -1 : 0)};
 }
 
@@ -158,6 +229,8 @@ void MotorModel::advance_to(Nanos t) {
     if (in_dispatch_) return;  // a listener's query must not re-enter the integration
     while (now_ < t) {
         Nanos next = std::min<Nanos>(t, now_ + cfg_.tick_ns);
+        // Idle and held by the jam: nothing can change until the next command.
+        if (!running_ && stalled_ && jammed_) next = t;
         // Cruising at constant velocity nothing can change between events, and
         // every event is found exactly (the motion is monotone): take the whole
         // cruise in one step, so a long jog on a simulated clock costs O(events).
@@ -223,8 +296,10 @@ void MotorModel::step_to(Nanos t_end) {
     // Earliest event in (t0, t_end].
     Nanos best_t = std::numeric_limits<Nanos>::max();
     MotorEvent::Kind best_k = MotorEvent::Kind::ProfileDone;
-    auto consider_switch = [&](bool (*pred)(const SwitchConfig&, double), const SwitchConfig& c,
-                               MotorEvent::Kind on, MotorEvent::Kind off) {
+    auto consider_switch = [&](Switch w, MotorEvent::Kind on, MotorEvent::Kind off) {
+        if (forced_[switch_slot(w)]) return;  // held: no edges
+        const SwitchConfig& c = switch_config(w);
+        auto pred = [&](const SwitchConfig&, double p) { return switch_level(w, p); };
         const bool a = pred(c, p_prev), b = pred(c, p_new);
         bool first_edge_seen = false;
         Nanos lo = t0, hi = t_end;
@@ -235,7 +310,7 @@ void MotorModel::step_to(Nanos t_end) {
             // otherwise sample the middle.
             if (!c.present) return;
             const double p_lo = std::min(p_prev, p_new), p_hi = std::max(p_prev, p_new);
-            const bool inside_between = !a && c.lo > p_lo && c.hi < p_hi && pred(c, c.lo);
+            const bool inside_between = w == Switch::Home && c.lo > p_lo && c.hi < p_hi && pred(c, c.lo) != a;
             Nanos probe;
             if (inside_between) {
                 // Bisection to the entering edge: the boundary nearer to p_prev.
@@ -267,9 +342,9 @@ void MotorModel::step_to(Nanos t_end) {
             best_k = target_state ? on : off;
         }
     };
-    consider_switch(home_on, cfg_.home, MotorEvent::Kind::HomeOn, MotorEvent::Kind::HomeOff);
-    consider_switch(minus_on, cfg_.minus_limit, MotorEvent::Kind::MinusLimitOn, MotorEvent::Kind::MinusLimitOff);
-    consider_switch(plus_on, cfg_.plus_limit, MotorEvent::Kind::PlusLimitOn, MotorEvent::Kind::PlusLimitOff);
+    consider_switch(Switch::Home, MotorEvent::Kind::HomeOn, MotorEvent::Kind::HomeOff);
+    consider_switch(Switch::MinusLimit, MotorEvent::Kind::MinusLimitOn, MotorEvent::Kind::MinusLimitOff);
+    consider_switch(Switch::PlusLimit, MotorEvent::Kind::PlusLimitOn, MotorEvent::Kind::PlusLimitOff);
     // Z index rising edges: entering [idx + k*rev, idx + k*rev + width).
     if (p_new != p_prev) {
         const double spr = cfg_.steps_per_rev;
@@ -294,8 +369,11 @@ void MotorModel::step_to(Nanos t_end) {
         }
         (void)kMaxIndexPerTick;
     }
-    if (running_ && profile_end > t0 && profile_end <= t_end && profile_end < best_t) {
-        best_t = profile_end;
+    // An event found exactly at the profile's end comes first; the end is then
+    // at t0 of the next step and must still be reported.
+    const Nanos done_t = std::max(profile_end, t0);
+    if (running_ && done_t <= t_end && done_t < best_t) {
+        best_t = done_t;
         best_k = MotorEvent::Kind::ProfileDone;
     }
     if (best_t == std::numeric_limits<Nanos>::max()) {

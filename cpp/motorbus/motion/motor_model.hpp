@@ -6,7 +6,11 @@
 //    live in this frame, fixed to the machine.
 //  - commanded position (steps, physical frame): where the step generator
 //    says the rotor should be, following the commanded Profile.
-//  - pulse position = commanded + pulse offset (PX, the drive's counter; set_pulse_position
+//  - drive units: the commanded Profile and the pulse counter count in the
+//    drive's units; the rotor turns steps_per_unit steps per unit (1 by
+//    default; a drive that counts encoder counts, or whose direction polarity
+//    is inverted, sets it with set_steps_per_unit).
+//  - pulse position = commanded units + pulse offset (PX, the drive's counter; set_pulse_position
 //    moves the offset, never the rotor).
 //  - encoder counts = round(physical * counts_per_rev / steps_per_rev) + encoder offset.
 // The rotor follows the command exactly unless the load stalls it; a stalled
@@ -38,7 +42,13 @@ struct SwitchConfig {
     bool present = false;
     double lo = 0, hi = 0;  // home window / limit position (use lo for limits)
     bool active_low = true;
+    // The controller's polarity setting disagrees with the wiring: it reads the
+    // switch as active exactly where it is not actuated, and events follow
+    // what the controller reads.
+    bool inverted = false;
 };
+
+enum class Switch { Home, MinusLimit, PlusLimit };
 
 struct MotorConfig {
     double steps_per_rev = 3200;   // DMX-CAN: 16 microsteps x 200
@@ -93,6 +103,10 @@ public:
     void command_from(const Profile& profile, double elapsed, std::optional<Nanos> start = std::nullopt);
     // Stops the step generator at time t (default now) where it is (ABORT).
     void halt(std::optional<Nanos> at = std::nullopt);
+    // An on-the-fly change (new target, new speed, STOP) of the running
+    // profile: `profile` must agree with the current one up to now; it keeps
+    // the current time origin and position frame.
+    void revise(const Profile& profile);
     bool moving() const;                 // a commanded profile is still running
     const Profile& profile() const { return profile_; }
     Nanos profile_start() const { return profile_start_; }
@@ -115,6 +129,7 @@ public:
     double physical_position() const { return physical_; }
     std::int64_t encoder() const;               // EX
     double commanded_velocity() const;          // steps/s
+    double pulse_velocity() const;              // drive units/s (the commanded profile's frame)
     double velocity() const;                    // rotor velocity, steps/s (0 while stalled)
     double commanded_acceleration() const;
     bool stalled() const { return stalled_; }
@@ -122,6 +137,11 @@ public:
 
     void set_pulse_position(double pulses);     // PX=...
     void set_encoder(std::int64_t counts);      // EX=...
+    // Units bridge (see the top): takes effect now, positions stay continuous.
+    void set_steps_per_unit(double steps_per_unit);
+    double steps_per_unit() const { return steps_per_unit_; }
+    // Moves the rotor by `steps` without pulses (a knock, a hand on the shaft).
+    void displace(double steps);
 
     // Switches: logical (true = switch active) and electrical (after polarity).
     bool home_active() const;
@@ -131,6 +151,9 @@ public:
     bool home_input() const { return cfg_.home.active_low ? !home_active() : home_active(); }
     bool minus_limit_input() const;
     bool plus_limit_input() const;
+    // Run-time changes; a change of what the switch reads is an event now.
+    void set_switch_inverted(Switch which, bool inverted);  // polarity setting
+    void force_switch(Switch which, std::optional<bool> active);  // override (nullopt = follow position)
 
     // Load.
     void set_jammed(bool jammed);               // a load that blocks the rotor
@@ -164,6 +187,9 @@ private:
     bool jammed_ = false;
     double pulse_offset_ = 0;  // pulse = commanded + pulse_offset_
     double encoder_offset_ = 0;
+    // Units bridge: physical = anchor_steps_ + (units - anchor_units_) * steps_per_unit_.
+    double steps_per_unit_ = 1, anchor_steps_ = 0, anchor_units_ = 0;
+    std::optional<bool> forced_[3];
     LatchState latch_ = LatchState::Off;
     double latched_pulse_ = 0;
     std::int64_t latched_encoder_ = 0;
@@ -172,9 +198,14 @@ private:
     int next_listener_ = 1;
     bool in_dispatch_ = false;
 
+    State units_state(Nanos t) const;    // drive units, without the pulse offset
     State command_state(Nanos t) const;  // physical frame
+    const SwitchConfig& switch_config(Switch w) const;
+    SwitchConfig& switch_config(Switch w);
+    bool switch_level(Switch w, double physical) const;  // what the controller reads
     void step_to(Nanos t);
     void emit(MotorEvent::Kind k, Nanos t);
+    void emit_switch(Switch w, bool on);
     MotorEvent make_event(MotorEvent::Kind k, Nanos t) const;
 };
 

@@ -395,6 +395,65 @@ TEST(ArcusSim, LimitHoming) {
     EXPECT_FALSE(b.c.status().minus_limit_error());
 }
 
+TEST(ArcusSim, HighLowGoesHcaPastTheSwitchEdge) {
+    // Figure 7.4 E: "The motor is now past the home input by the amount defined by the
+    // home correction amount (HCA)" -- from the edge where it leaves the switch (8000),
+    // although the first deceleration already stopped inside the switch.
+    Bench b;
+    b.open_loop();
+    b.c.set_home_correction(300);
+    b.c.home(HomeMethod::HL, 1);
+    double lowest = 1e9, highest = -1e9;
+    for (int i = 0; i < 3000 && (i < 10 || b.sim.busy()); ++i) {
+        b.run(0.01);
+        highest = std::max(highest, b.sim.physical_position());
+        if (highest > 8000) lowest = std::min(lowest, b.sim.physical_position());  // after the first find
+    }
+    EXPECT_FALSE(b.sim.busy());
+    EXPECT_GT(highest, 8100);               // decelerated inside the switch (8000..8400)
+    EXPECT_NEAR(lowest, 8000 - 300, 2.0);   // HCA past the edge
+    EXPECT_NEAR(b.sim.physical_position(), 8000, 0.5);
+    EXPECT_EQ(b.c.position(), 0);
+}
+
+TEST(ArcusSim, HomingStartedOnTheSwitchFindsItAtOnce) {
+    Bench b;
+    b.open_loop();
+    b.c.move(8100);  // onto the home switch
+    b.run(15);
+    b.c.home(HomeMethod::H, 1);
+    b.run(0.01);
+    EXPECT_FALSE(b.c.moving());  // still at LSPD: zeroed and stopped where it was
+    EXPECT_EQ(b.c.position(), 0);
+    EXPECT_EQ(b.c.encoder(), 0);
+    EXPECT_NEAR(b.sim.physical_position(), 8100, 1e-6);
+}
+
+TEST(ArcusSim, StopAndSspdDuringHoming) {
+    Bench b;
+    b.c.enable(true);
+    b.c.home(HomeMethod::H, 1);
+    b.run(1);
+    EXPECT_EQ(b.c.snl_status(), SnlStatus::Homing);
+    EXPECT_EQ(b.raw("SSPD500"), "?Bad SSPD Command");
+    b.c.stop();
+    b.run(0.1);
+    EXPECT_EQ(b.c.snl_status(), SnlStatus::Stopping);
+    EXPECT_TRUE(b.c.status().decelerating());
+    b.run(0.5);
+    EXPECT_FALSE(b.c.moving());
+    EXPECT_EQ(b.c.snl_status(), SnlStatus::Idle);
+    EXPECT_GT(b.c.position(), 0);  // not homed: the counter was never reset
+    // ABORT stops a homing at once.
+    b.c.home(HomeMethod::H, 1);
+    b.run(0.5);
+    auto p = b.c.position();
+    b.c.abort();
+    b.run(1);
+    EXPECT_EQ(b.c.position(), p);
+    EXPECT_EQ(b.c.snl_status(), SnlStatus::Idle);
+}
+
 // ---- limits ----
 
 TEST(ArcusSim, LimitErrorLatchesUntilClr) {

@@ -272,7 +272,10 @@ TEST(ArcusHoming, ZIndexAndHomeThenZ) {
     EXPECT_EQ(m.pulse_count(), 0);
 
     h.start(ArcusHoming::Method::ZH, +1);
-    EXPECT_EQ(h.snl_status(), 7);
+    EXPECT_EQ(h.snl_status(), 6);  // Homing while it looks for the switch...
+    clk.advance(2000 * kMs);       // (the switch at 5000 is passed after ~1.6 s)
+    m.update();
+    EXPECT_EQ(h.snl_status(), 7);  // ...Z-Homing once it looks for the index
     run_until_done(clk, m, [&] { return h.running(); });
     ASSERT_EQ(h.result(), HomingResult::Done);
     // Home at 5000, decel to LSPD by ~5165, next index: 37 + 2*3200 = 6437.
@@ -393,4 +396,158 @@ TEST(MotorModel, LongJogOnSimClockIsCheapAndExact) {
     EXPECT_NEAR(static_cast<double>(home_t), a.profile().first_crossing(1e6) * 1e9, 2.0);
     // Index once per rev: floor((p - 0) / 3200) + 1 rising edges from 0 (the first at 0 itself is not crossed).
     EXPECT_EQ(index, static_cast<int>(std::floor(m.physical_position() / 3200.0)));
+}
+
+// ---- run-time hooks a drive simulator needs ----------------------------------------
+
+TEST(MotorModel, StepsPerUnitBridgesDriveUnitsAndPolarity) {
+    SimClock clk;
+    MotorModel m(clk);
+    m.set_steps_per_unit(0.8);  // the drive counts encoder counts: 0.8 steps each
+    m.command(move_profile(0, 4000, 4000, 40000));
+    clk.advance(3 * kSec);
+    m.update();
+    EXPECT_EQ(m.pulse_count(), 4000);
+    EXPECT_NEAR(m.physical_position(), 3200, 1e-9);
+    EXPECT_EQ(m.encoder(), 4000);
+    m.set_steps_per_unit(-1.0);  // direction polarity inverted, pulses again
+    m.command(move_profile(4000, 5000));
+    clk.advance(100 * kMs);
+    m.update();
+    EXPECT_GT(m.pulse_velocity(), 0);
+    EXPECT_LT(m.commanded_velocity(), 0);
+    clk.advance(3 * kSec);
+    m.update();
+    EXPECT_EQ(m.pulse_count(), 5000);
+    EXPECT_NEAR(m.physical_position(), 2200, 1e-9);  // continuous across the change
+    EXPECT_THROW(m.set_steps_per_unit(0), motorbus::InvalidArgument);
+}
+
+TEST(MotorModel, ReviseKeepsTheTimeOriginAndDisplaceIsSlip) {
+    SimClock clk;
+    MotorModel m(clk);
+    ArcusMotion a;
+    a.move(0, 2000);
+    m.command(a.profile());
+    clk.advance(500 * kMs);
+    m.update();
+    const double before = m.pulse_position();
+    a.change_target(m.profile_time(m.time()), 800);
+    m.revise(a.profile());
+    EXPECT_DOUBLE_EQ(m.pulse_position(), before);  // no jump at the change
+    clk.advance(10 * kSec);
+    m.update();
+    EXPECT_FALSE(m.moving());
+    EXPECT_EQ(m.pulse_count(), 800);
+    m.displace(40);  // a knock: the rotor moves, the counter does not
+    EXPECT_NEAR(m.physical_position(), 840, 1e-9);
+    EXPECT_EQ(m.pulse_count(), 800);
+    EXPECT_EQ(m.encoder(), 1050);
+    EXPECT_NEAR(m.slip(), -40, 1e-9);
+}
+
+TEST(MotorModel, ForcedAndInvertedSwitchesAreEventsNow) {
+    SimClock clk;
+    MotorModel m(clk, bench_cfg());
+    std::vector<MotorEvent::Kind> seen;
+    m.add_listener([&](const MotorEvent& e) {
+        if (e.kind != MotorEvent::Kind::IndexPulse && e.kind != MotorEvent::Kind::ProfileDone) seen.push_back(e.kind);
+    });
+    m.force_switch(Switch::MinusLimit, true);
+    EXPECT_TRUE(m.minus_limit_active());
+    m.force_switch(Switch::MinusLimit, std::nullopt);
+    EXPECT_FALSE(m.minus_limit_active());
+    m.set_switch_inverted(Switch::Home, true);  // reads active away from the window
+    EXPECT_TRUE(m.home_active());
+    ASSERT_EQ(seen.size(), 3u);
+    EXPECT_EQ(seen[0], MotorEvent::Kind::MinusLimitOn);
+    EXPECT_EQ(seen[1], MotorEvent::Kind::MinusLimitOff);
+    EXPECT_EQ(seen[2], MotorEvent::Kind::HomeOn);
+    // Inverted, the window is where the input goes inactive.
+    seen.clear();
+    m.command(move_profile(0, 6000));
+    clk.advance(4 * kSec);
+    m.update();
+    ASSERT_GE(seen.size(), 2u);
+    EXPECT_EQ(seen[0], MotorEvent::Kind::HomeOff);
+    EXPECT_EQ(seen[1], MotorEvent::Kind::HomeOn);
+    // A forced switch has no edges while held.
+    m.force_switch(Switch::Home, true);
+    seen.clear();
+    m.command(move_profile(6000, 0));
+    clk.advance(4 * kSec);
+    m.update();
+    for (auto k : seen) EXPECT_NE(k, MotorEvent::Kind::HomeOff);
+}
+
+TEST(ArcusHoming, HighLowGoesHcaPastTheSwitchEdge) {
+    // Figure 7.4 E: "The motor is now past the home input by the amount defined by
+    // the home correction amount (HCA)" -- counted from where it leaves the switch,
+    // even when the deceleration stopped inside the switch.
+    SimClock clk;
+    MotorModel m(clk, bench_cfg());
+    ArcusHomingOptions o;
+    o.hca = 300;
+    o.zero_encoder = true;
+    ArcusHoming h(m, homing_params(), o);
+    std::vector<double> stops;
+    m.add_listener([&](const MotorEvent& e) {
+        if (e.kind == MotorEvent::Kind::ProfileDone) stops.push_back(e.physical);
+    });
+    h.start(ArcusHoming::Method::HL, +1);
+    run_until_done(clk, m, [&] { return h.running(); });
+    ASSERT_EQ(h.result(), HomingResult::Done);
+    ASSERT_EQ(stops.size(), 2u);  // the deceleration inside the switch, the HCA move
+    EXPECT_GT(stops[0], 5000);
+    EXPECT_NEAR(stops[1], 5000 - 300, 1e-3);
+    EXPECT_NEAR(m.physical_position(), 5000, 0.01);
+    EXPECT_EQ(m.pulse_count(), 0);
+    EXPECT_EQ(m.encoder(), 0);  // zero_encoder: EX follows PX
+}
+
+TEST(ArcusHoming, StartingOnTheSwitchFindsItAtOnce) {
+    SimClock clk;
+    MotorConfig c = bench_cfg();
+    MotorModel m(clk, c);
+    m.command(move_profile(0, 5100));
+    clk.advance(5 * kSec);
+    m.update();
+    ArcusHoming h(m, homing_params());
+    h.start(ArcusHoming::Method::H, +1);  // already on the home switch
+    run_until_done(clk, m, [&] { return h.running(); });
+    ASSERT_EQ(h.result(), HomingResult::Done);
+    // Zeroed where it started, and stopped there: it was still at LSPD.
+    EXPECT_NEAR(m.physical_position(), 5100, 1e-6);
+    EXPECT_EQ(m.pulse_count(), 0);
+    // On the limit it homes against: backs off by LCA at once.
+    m.force_switch(Switch::MinusLimit, true);
+    h.start(ArcusHoming::Method::L, -1);
+    m.force_switch(Switch::MinusLimit, std::nullopt);
+    const double from = m.physical_position();
+    run_until_done(clk, m, [&] { return h.running(); });
+    ASSERT_EQ(h.result(), HomingResult::Done);
+    EXPECT_NEAR(m.physical_position(), from + 1000, 0.01);
+    EXPECT_EQ(m.pulse_count(), 0);
+}
+
+TEST(MotorModel, MoveEndingExactlyOnTheIndexEdgeStillEnds) {
+    // The index event and the profile's end fall on the same nanosecond.
+    SimClock clk;
+    MotorConfig c;
+    c.index_position = 1600;
+    MotorModel m(clk, c);
+    int done = 0, index = 0;
+    m.add_listener([&](const MotorEvent& e) {
+        done += e.kind == MotorEvent::Kind::ProfileDone;
+        index += e.kind == MotorEvent::Kind::IndexPulse;
+    });
+    ArcusMotion a;  // ends with a jump from LSPD to 0: the edge is reached at the very end
+    a.move(0, 1600);
+    m.command(a.profile());
+    clk.advance(5 * kSec);
+    m.update();
+    EXPECT_FALSE(m.moving());
+    EXPECT_EQ(done, 1);
+    EXPECT_EQ(index, 1);
+    EXPECT_DOUBLE_EQ(m.physical_position(), 1600);
 }

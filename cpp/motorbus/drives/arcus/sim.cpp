@@ -7,15 +7,16 @@
 #include <map>
 #include <sstream>
 
-#include "motorbus/drives/arcus/profile.hpp"
+#include "motorbus/motion/arcus_profile.hpp"
+#include "motorbus/motion/homing.hpp"
+#include "motorbus/motion/motor_model.hpp"
 #include "motorbus/motion/stepnloop.hpp"
 
 namespace motorbus::arcus {
 
 namespace {
 
-constexpr double kStepsPerRev = 3200;
-constexpr double kCountsPerStep = 4000.0 / 3200.0;
+constexpr double kStepsPerCount = 3200.0 / 4000.0;
 constexpr std::int64_t kSyncMax = (1 << 27) - 1;  // SYNP is a 28-bit signed number
 
 // Flash contents (Table 7.10) with the Table 7.11 factory defaults.
@@ -33,7 +34,22 @@ struct Flash {
     }
 };
 
-enum class Job { None, Target, Correct, Jog, Stop, HomeH, HomeHL, HomeZH, HomeZ, HomeL };
+// What the axis is doing, for SLS and for what happens when the motion ends.
+enum class Job { None, Target, Correct, Jog, Stop, Home };
+
+// The world as the motor model sees it.  The switches read active where they
+// are actuated; POL bits 4 and 5 invert that at run time.
+motion::MotorConfig motor_config(const SimOptions& o) {
+    const SimWorld& w = o.world;
+    motion::MotorConfig c;  // 3200 steps and 4000 counts per rev: the DMX-CAN's
+    c.index_position = w.z_position;
+    c.index_width_steps = w.z_width;
+    c.home = motion::SwitchConfig{true, w.home_lo, w.home_hi, false};
+    c.minus_limit = motion::SwitchConfig{w.minus_limit.has_value(), w.minus_limit.value_or(0), 0, false};
+    c.plus_limit = motion::SwitchConfig{w.plus_limit.has_value(), w.plus_limit.value_or(0), 0, false};
+    c.tick_ns = o.tick_ns;
+    return c;
+}
 
 }  // namespace
 
@@ -48,202 +64,140 @@ struct Sim::State {
                  rz = 0, sspdm = 0, inc_mode = 0, eo = 0, user_do = 0, lt = 0, synp = 0,
                  sync_cond = 1;
     bool sync_on = false, sync_hit = false;
-    int latch_state = 0;
     std::int64_t ltp = 0, lte = 0;
 
-    // Motion.
-    detail::Axis axis;
+    // The motor and its world (rotor, encoder, switches, Z, latch, jam).  It
+    // outlives power cycles: the shaft stays where it is.
+    std::unique_ptr<motion::MotorModel> motor;
+    // X, J, T, SSPD, STOP: the profile model; the motor runs its profile
+    // while arcus_profile is true.
+    motion::ArcusMotion arcus{motion::ArcusProfileParams{}};
+    bool arcus_profile = false;
+    // H, HL, L, Z, ZH (declared after the motor: destroyed before it).
+    std::unique_ptr<motion::ArcusHoming> homing;
+    int homing_listener = 0;  // runs after the homing's own listener
+    int home_direction = 1;   // physical direction of the search
+
     Job job = Job::None;
-    int phase = 0;
-    int home_dir = 1;
-    double move_target = 0;
+    bool stopping = false;
     motion::StepNLoop snl{motion::SnlConfig{}};  // the position verification state machine (errors 8..11)
     bool minus_err = false, plus_err = false;
 
-    // The motor and its world.
-    double phys = 0;
-    std::int64_t enc_offset = 0;
     bool blocked = false;
     unsigned inputs = 0;  // DI1..DI6 actuated
-    std::optional<bool> force_home, force_minus, force_plus;
-
-    Nanos t = 0;
     Nanos idle_since = 0;
 };
 
-Sim::Sim(Clock& clock, SimOptions options)
-    : clock_(clock), options_(std::move(options)), s_(std::make_unique<State>()) {
-    if (options_.address < 1 || options_.address > kMaxAddress)
-        throw InvalidArgument("arcus sim address: must be 1..99");
-    if (options_.response_type != 0 && options_.response_type != 1)
-        throw InvalidArgument("arcus sim response_type: must be 0 or 1");
-    if (options_.tick_ns <= 0) throw InvalidArgument("arcus sim tick_ns: must be > 0");
-    s_->phys = options_.world.start_position;
-    power_cycle();
-}
-
-Sim::Sim(std::shared_ptr<Clock> clock, SimOptions options)
-    : Sim((clock ? *clock : throw InvalidArgument("arcus sim: clock is null")), std::move(options)) {
-    clock_owner_ = std::move(clock);
-}
-
-Sim::~Sim() = default;
-
 // ------------------------------------------------------------------------------
 // Everything below runs with mutex_ held.
-// Helpers are free functions on State to keep the class header small.
-namespace {
-
 using State = Sim::State;
 
-bool snl_on(const State& s) { return s.cfg.sl != 0; }
-double steps_per_unit(const State& s) { return snl_on(s) ? 1.0 / kCountsPerStep : 1.0; }
-int dir_sign(const State& s) { return (s.cfg.pol & 2) ? -1 : 1; }
-
-std::int64_t encoder(const State& s) {
-    return std::llround(s.phys * kCountsPerStep) + s.enc_offset;
-}
-std::int64_t pulse(const State& s) { return std::llround(s.axis.position()); }
-std::int64_t delta(const State& s) { return snl_on(s) ? pulse(s) - encoder(s) : 0; }
-
-bool in_interval(double x, double lo, double hi) { return x >= lo && x <= hi; }
-
-bool home_actuated(const State& s, const SimWorld& w, double phys) {
-    if (s.force_home) return *s.force_home;
-    return in_interval(phys, w.home_lo, w.home_hi);
-}
-bool minus_actuated(const State& s, const SimWorld& w, double phys) {
-    if (s.force_minus) return *s.force_minus;
-    return w.minus_limit && phys <= *w.minus_limit;
-}
-bool plus_actuated(const State& s, const SimWorld& w, double phys) {
-    if (s.force_plus) return *s.force_plus;
-    return w.plus_limit && phys >= *w.plus_limit;
-}
-// Polarity bit set = the input's sense is inverted.
-bool home_in(const State& s, const SimWorld& w, double p) {
-    return home_actuated(s, w, p) != bool(s.cfg.pol & 32);
-}
-bool minus_in(const State& s, const SimWorld& w, double p) {
-    return minus_actuated(s, w, p) != bool(s.cfg.pol & 16);
-}
-bool plus_in(const State& s, const SimWorld& w, double p) {
-    return plus_actuated(s, w, p) != bool(s.cfg.pol & 16);
-}
-bool latch_in(const State& s) { return bool(s.inputs & 2u) != bool(s.cfg.pol & 64); }
-bool z_in(const SimWorld& w, double p) {
-    double m = std::fmod(p - w.z_position, kStepsPerRev);
-    if (m < 0) m += kStepsPerRev;
-    return m < w.z_width;
-}
-
-// Fraction of the step [a, b] at which `level` first becomes true (0 if already).
-template <class F>
-std::optional<double> first_true(double a, double b, F level) {
-    if (level(a)) return 0.0;
-    if (!level(b)) return std::nullopt;
-    double lo = 0, hi = 1;
-    for (int i = 0; i < 40; ++i) {
-        double mid = 0.5 * (lo + hi);
-        if (level(a + (b - a) * mid)) hi = mid;
-        else lo = mid;
-    }
-    return hi;
-}
-
-// Z index crossing (the window is narrow enough to be jumped over in one step).
-std::optional<double> z_fraction(const SimWorld& w, double a0, double b0) {
-    if (z_in(w, a0)) return 0.0;
-    if (b0 == a0) return std::nullopt;
-    double a = a0 - w.z_position, b = b0 - w.z_position;
-    if (b > a) {
-        double m = std::ceil(a / kStepsPerRev) * kStepsPerRev;
-        if (m <= b) return (m - a) / (b - a);
-    } else {
-        double m = std::floor(a / kStepsPerRev) * kStepsPerRev + w.z_width;
-        if (m > a) m -= kStepsPerRev;
-        if (m >= b) return (a - m) / (a - b);
-    }
-    return std::nullopt;
-}
-
-}  // namespace
-
-// The sim's behaviour, split out of the class so the header stays small.
+// The drive's firmware around the motor model: the sim's behaviour, split out
+// of the class so the header stays small.
 class SimEngine {
 public:
     SimEngine(State& s, const SimOptions& o) : s(s), o(o) {}
     State& s;
     const SimOptions& o;
 
-    // ---- configuration of a motion from the live parameters ----
-    void configure_axis(double hspd_override = -1) {
-        detail::Axis::Params p;
-        p.hspd = static_cast<double>(hspd_override > 0 ? hspd_override : s.hspd);
-        p.lspd = static_cast<double>(std::min(s.lspd, s.hspd));
-        p.acc_ms = static_cast<double>(s.acc);
-        p.dec_ms = static_cast<double>(s.dec);
-        p.edec = s.edec != 0;
-        p.scurve = s.scv != 0;
-        p.snl_ratio = snl_on(s) ? 1.0 / kCountsPerStep : 1.0;
-        p.sspdm = static_cast<int>(s.sspdm);
-        s.axis.configure(p);
+    motion::MotorModel& m() const { return *s.motor; }
+    bool snl_on() const { return s.cfg.sl != 0; }
+    // Position units: encoder counts with StepNLoop, pulses without; POL bit 1 reverses.
+    double steps_per_unit() const { return (snl_on() ? kStepsPerCount : 1.0) * ((s.cfg.pol & 2) ? -1.0 : 1.0); }
+    int physical_direction(double units_direction) const {
+        const double d = units_direction * steps_per_unit();
+        return d > 0 ? 1 : (d < 0 ? -1 : 0);
     }
+    std::int64_t pulse() const { return m().pulse_count(); }
+    std::int64_t encoder() const { return m().encoder(); }
+    std::int64_t delta() const { return snl_on() ? pulse() - encoder() : 0; }
+    bool latch_in() const { return bool(s.inputs & 2u) != bool(s.cfg.pol & 64); }
 
-    void zero_counters_at(double cmd_at, double phys_at) {
-        s.axis.set_position(s.axis.position() - cmd_at);
-        s.move_target -= cmd_at;
-        s.enc_offset = -std::llround(phys_at * kCountsPerStep);
+    // POL, SL, EO and the jam into the motor model.
+    void apply_wiring() {
+        using motion::Switch;
+        m().set_steps_per_unit(steps_per_unit());
+        m().set_switch_inverted(Switch::Home, (s.cfg.pol & 32) != 0);
+        m().set_switch_inverted(Switch::MinusLimit, (s.cfg.pol & 16) != 0);
+        m().set_switch_inverted(Switch::PlusLimit, (s.cfg.pol & 16) != 0);
+        apply_jam();
     }
-    void zero_here() { zero_counters_at(s.axis.position(), s.phys); }
+    // An unpowered (EO=0) or blocked rotor stays put while the pulses go out.
+    void apply_jam() { m().set_jammed(s.blocked || !s.eo); }
 
-    void set_error_limit(int dir) {
-        (dir > 0 ? s.plus_err : s.minus_err) = true;
-        s.snl.limit_hit();
-        s.job = Job::None;
+    motion::ArcusProfileParams profile_params(double hspd_override = -1) const {
+        motion::ArcusProfileParams ap;
+        ap.snl_ratio = snl_on() ? kStepsPerCount : 1.0;
+        // arcus_effective refuses speeds outside 1..6 000 000 PPS; the sim
+        // validates HSPD/LSPD itself, so only clamp what unit conversion moved.
+        const double min_units = 1.0 / ap.snl_ratio;
+        const double max_units = 6'000'000.0 / ap.snl_ratio;
+        const double hspd = hspd_override > 0 ? hspd_override : static_cast<double>(s.hspd);
+        ap.hspd = std::clamp(hspd, min_units, max_units);
+        ap.lspd = std::clamp(static_cast<double>(std::min(s.lspd, s.hspd)), 1e-6, ap.hspd);
+        ap.acc_ms = std::max(static_cast<double>(s.acc), 1e-3);
+        ap.dec_ms = std::max(static_cast<double>(s.dec), 1e-3);
+        ap.edec = s.edec != 0;
+        ap.scv = s.scv != 0;
+        return ap;
     }
+    void configure_arcus(double hspd_override = -1) {
+        s.arcus.set_params(profile_params(hspd_override));
+        s.arcus.set_sspdm(static_cast<int>(std::clamp<std::int64_t>(s.sspdm, 0, 9)));
+    }
+    void command_arcus() {
+        m().command(s.arcus.profile());
+        s.arcus_profile = true;
+    }
+    double arcus_time() const { return m().profile_time(m().time()); }
 
     int sls() const {
-        if (!snl_on(s)) return 12;
+        if (!snl_on()) return 12;
         if (s.snl.in_error()) return static_cast<int>(s.snl.status());
         switch (s.job) {
             case Job::None: return 0;
-            case Job::Target: return s.axis.stopping() ? 3 : 1;
+            case Job::Target: return s.stopping ? 3 : 1;
             case Job::Correct: return 2;
-            case Job::Jog: return s.axis.stopping() ? 3 : 5;
+            case Job::Jog: return s.stopping ? 3 : 5;
             case Job::Stop: return 3;
-            case Job::HomeH:
-            case Job::HomeHL: return 6;
-            case Job::HomeZH: return s.phase >= 2 ? 7 : 6;
-            case Job::HomeZ: return 7;
-            case Job::HomeL: return 13;
+            case Job::Home: return s.homing ? s.homing->snl_status() : 6;
         }
         return 0;
     }
 
+    // MST bits 0..2.
+    motion::ArcusPhase phase() const {
+        if (!m().moving()) return motion::ArcusPhase::Idle;
+        if (s.arcus_profile) return s.arcus.phase(arcus_time());
+        const double v = m().pulse_velocity(), a = m().commanded_acceleration() * (steps_per_unit() > 0 ? 1 : -1);
+        if (v * a > 0) return motion::ArcusPhase::Accel;
+        if (v * a < 0) return motion::ArcusPhase::Decel;
+        return motion::ArcusPhase::Const;
+    }
+
     std::int64_t mst() const {
         std::int64_t v = 0;
-        if (s.axis.constant()) v |= 1;
-        if (s.axis.accelerating()) v |= 2;
-        if (s.axis.decelerating()) v |= 4;
-        if (home_in(s, o.world, s.phys)) v |= 8;
-        if (minus_in(s, o.world, s.phys)) v |= 16;
-        if (plus_in(s, o.world, s.phys)) v |= 32;
+        const auto ph = phase();
+        if (ph == motion::ArcusPhase::Const) v |= 1;
+        if (ph == motion::ArcusPhase::Accel) v |= 2;
+        if (ph == motion::ArcusPhase::Decel) v |= 4;
+        if (m().home_active()) v |= 8;
+        if (m().minus_limit_active()) v |= 16;
+        if (m().plus_limit_active()) v |= 32;
         if (s.minus_err) v |= 64;
         if (s.plus_err) v |= 128;
-        if (latch_in(s)) v |= 256;
-        if (z_in(o.world, s.phys)) v |= 512;
+        if (latch_in()) v |= 256;
+        if (m().index_active()) v |= 512;
         return v;
     }
 
     bool in_position() const {
-        return snl_on(s) && !s.axis.busy() && !s.snl.in_error() &&
-               std::llabs(delta(s)) <= s.cfg.slt;
+        return snl_on() && !m().moving() && !s.snl.in_error() && std::llabs(delta()) <= s.cfg.slt;
     }
 
     std::int64_t outputs() const {
         std::int64_t v = s.user_do & 7;
-        bool dedicated = snl_on(s) && s.cfg.edo;
+        bool dedicated = snl_on() && s.cfg.edo;
         if (dedicated) {
             v = (v & ~std::int64_t{5}) | (in_position() ? 1 : 0) | (s.snl.in_error() ? 4 : 0);
         }
@@ -253,146 +207,60 @@ public:
 
     std::int64_t current(Nanos now) const {
         if (!s.eo) return 0;
-        bool running = s.axis.busy() || now - s.idle_since < s.cfg.curt * 1'000'000;
+        bool running = m().moving() || now - s.idle_since < s.cfg.curt * 1'000'000;
         return running ? s.cfg.curr : s.cfg.curi;
     }
 
-    // ---- SNL position verification at the end of a target move / when idle ----
     void configure_snl() {
         motion::SnlConfig c;
-        c.enabled = snl_on(s);
+        c.enabled = snl_on();
         c.tolerance = static_cast<std::uint32_t>(s.cfg.slt);
         c.error_range = static_cast<std::uint32_t>(s.cfg.sle);
         c.max_attempts = static_cast<std::uint32_t>(s.cfg.sla);
         c.idle_tolerance = static_cast<std::uint32_t>(s.cfg.slm);
-        c.ratio = 1.0 / kCountsPerStep;
+        c.ratio = kStepsPerCount;
         s.snl.configure(c);
     }
 
     // Table 7.7, motor idle: in position, a correction move, or an error.
     void verify_position(bool idle = false) {
-        if (!snl_on(s)) return;
-        double delta = static_cast<double>(pulse(s) - encoder(s));
-        auto d = idle ? s.snl.idle_check(delta) : s.snl.motion_done(delta);
-        if (d.action != motion::SnlAction::Correct) return;
+        if (!snl_on()) return;
+        const double d = static_cast<double>(pulse() - encoder());
+        auto dec = idle ? s.snl.idle_check(d) : s.snl.motion_done(d);
+        if (dec.action != motion::SnlAction::Correct) return;
         // Re-run the remaining distance at low speed from where the encoder says we are.
-        double target = s.axis.position();
-        s.axis.set_position(target - d.correction);
-        configure_axis(static_cast<double>(std::min(s.lspd, s.hspd)));
+        const double target = m().pulse_position();
+        const double from = target - dec.correction;
+        m().set_pulse_position(from);
+        configure_arcus(static_cast<double>(std::min(s.lspd, s.hspd)));
         s.job = Job::Correct;
-        s.axis.move_to(target);
-        if (!s.axis.busy()) s.job = Job::None;
+        s.stopping = false;
+        if (s.arcus.move(from, target) == motion::ArcusReply::Ok) command_arcus();
+        if (!m().moving()) s.job = Job::None;
     }
 
-    // ---- one integration step ----
-    void tick(double dt, Nanos now) {
-        double cmd_prev = s.axis.position(), phys_prev = s.phys;
-        std::int64_t enc_prev = encoder(s);
-        bool stopped = s.axis.step(dt);
-        double dcmd = s.axis.position() - cmd_prev;
-        if (s.eo && !s.blocked) s.phys += dcmd * steps_per_unit(s) * dir_sign(s);
-        double dphys = s.phys - phys_prev;
-        auto cmd_at = [&](double f) { return cmd_prev + f * dcmd; };
-        auto phys_at = [&](double f) { return phys_prev + f * dphys; };
-        auto stop_at = [&](double f) {
-            s.axis.halt();
-            s.axis.set_position(cmd_at(f));
-            s.phys = phys_at(f);
-        };
-        const SimWorld& w = o.world;
-        int travel = dcmd > 0 ? 1 : (dcmd < 0 ? -1 : 0);
-
-        // Limits in the direction of travel stop the motor at once.
-        if (travel != 0) {
-            auto hit = travel > 0
-                           ? first_true(phys_prev, s.phys, [&](double p) { return plus_in(s, w, p); })
-                           : first_true(phys_prev, s.phys, [&](double p) { return minus_in(s, w, p); });
-            if (hit) {
-                stop_at(*hit);
-                if (s.job == Job::HomeL && s.phase == 0 && travel == s.home_dir) {
-                    // Limit homing: back off by LCA at high speed, that is zero.
-                    s.phase = 1;
-                    configure_axis();
-                    s.axis.move_to(s.axis.position() - travel * static_cast<double>(s.cfg.lca));
-                    if (!s.axis.busy()) finish_limit_homing();
-                } else {
-                    set_error_limit(travel);
-                }
-                after_motion(now);
-                return;
-            }
-        }
-
-        switch (s.job) {
-            case Job::HomeH:
-            case Job::HomeHL:
-                if (s.phase == 0) {
-                    auto f = first_true(phys_prev, s.phys, [&](double p) { return home_in(s, w, p); });
-                    if (f && travel != 0) {
-                        zero_counters_at(cmd_at(*f), phys_at(*f));
-                        s.axis.decel_stop();
-                        s.phase = 1;
-                    }
-                } else if (s.job == Job::HomeHL && s.phase == 2) {
-                    auto f = first_true(phys_prev, s.phys, [&](double p) { return home_in(s, w, p); });
-                    if (f) {
-                        s.phase = 3;  // through the switch at high speed
-                        configure_axis();
-                        s.axis.run(-s.home_dir, true);
-                    }
-                } else if (s.job == Job::HomeHL && s.phase == 3) {
-                    if (!home_in(s, w, s.phys)) {
-                        s.phase = 4;  // then HCA further
-                        configure_axis();
-                        s.axis.move_to(s.axis.position() - s.home_dir * static_cast<double>(s.hca));
-                    }
-                } else if (s.job == Job::HomeHL && s.phase == 5) {
-                    auto f = first_true(phys_prev, s.phys, [&](double p) { return home_in(s, w, p); });
-                    if (f) {
-                        stop_at(*f);
-                        zero_here();
-                        s.job = Job::None;
-                    }
-                }
-                break;
-            case Job::HomeZH:
-                if (s.phase == 0) {
-                    auto f = first_true(phys_prev, s.phys, [&](double p) { return home_in(s, w, p); });
-                    if (f && travel != 0) {
-                        s.axis.decel_stop();
-                        s.phase = 1;
-                    }
-                } else if (s.phase == 2) {
-                    z_stop(phys_prev, cmd_at, phys_at, stop_at);
-                }
-                break;
-            case Job::HomeZ:
-                z_stop(phys_prev, cmd_at, phys_at, stop_at);
-                break;
-            default:
-                break;
-        }
-
-        // Sync output on DO2.
-        if (s.sync_on && !s.sync_hit) check_sync(enc_prev, encoder(s));
-
-        // Delta monitoring while moving.
-        if (snl_on(s) && s.axis.busy() &&
-            s.snl.monitor(static_cast<double>(pulse(s) - encoder(s))).action == motion::SnlAction::StopNow) {
-            s.axis.halt();  // stall error (10)
-            s.job = Job::None;
-        }
-        if (stopped || !s.axis.busy()) after_motion(now);
+    // The motion stopped without a target to verify.
+    void end_job(Nanos t) {
+        s.job = Job::None;
+        s.stopping = false;
+        s.idle_since = t;
+        s.snl.end_without_verification();
     }
 
-    template <class CmdAt, class PhysAt, class StopAt>
-    void z_stop(double phys_prev, CmdAt, PhysAt, StopAt stop_at) {
-        auto f = z_fraction(o.world, phys_prev, s.phys);
-        if (f && s.phys != phys_prev) {
-            stop_at(*f);
-            zero_here();
-            s.job = Job::None;
-        }
+    // A limit in the direction of travel stops the motor at once and latches
+    // the limit error (MST bits 6/7, SLS 11).
+    void limit_stop(int side, Nanos t) {
+        if (s.homing && s.homing->running()) s.homing->abort();
+        m().halt();
+        (side > 0 ? s.plus_err : s.minus_err) = true;
+        s.snl.limit_hit();
+        end_job(t);
+    }
+    // Motion starting into a limit that is already active: the event that
+    // would announce it never comes.
+    void check_limit_at_start(int physical_dir, Nanos t) {
+        if (physical_dir > 0 && m().plus_limit_active()) limit_stop(1, t);
+        else if (physical_dir < 0 && m().minus_limit_active()) limit_stop(-1, t);
     }
 
     void check_sync(std::int64_t a, std::int64_t b) {
@@ -405,93 +273,141 @@ public:
         if (hit) s.sync_hit = true;
     }
 
-    void finish_limit_homing() {
-        zero_here();
-        s.job = Job::None;
-    }
-
-    // Called whenever the axis is idle after a step: moves the job to its next phase.
-    void after_motion(Nanos now) {
-        if (s.axis.busy()) return;
-        s.idle_since = now;
-        const bool verifying = s.job == Job::Target || s.job == Job::Correct;
-        dispatch_stop();
-        if (s.job == Job::None && !verifying) s.snl.end_without_verification();
-    }
-
-    void dispatch_stop() {
-        switch (s.job) {
-            case Job::None:
+    // ---- the motor's events ----
+    void on_event(const motion::MotorEvent& e) {
+        using K = motion::MotorEvent::Kind;
+        switch (e.kind) {
+            case K::PlusLimitOn:
+            case K::MinusLimitOn: {
+                const int side = e.kind == K::PlusLimitOn ? 1 : -1;
+                if (e.direction != side) break;
+                // Limit homing runs onto its limit on purpose: ArcusHoming backs off.
+                if (s.job == Job::Home && s.homing && s.homing->running() &&
+                    s.homing->method() == motion::ArcusHoming::Method::L && side == s.home_direction)
+                    break;
+                limit_stop(side, e.t);
                 break;
-            case Job::Target:
-            case Job::Correct:
-                s.job = Job::None;
-                verify_position();
+            }
+            case K::ProfileDone:
+                motion_done(e.t);
                 break;
-            case Job::Jog:
-            case Job::Stop:
-                s.job = Job::None;
-                break;
-            case Job::HomeH:
-                if (s.phase == 1 && s.rz) {
-                    s.phase = 2;
-                    configure_axis();
-                    s.axis.move_to(0);
-                    if (s.axis.busy()) break;
-                }
-                if (s.phase == 0) break;  // stopped without seeing home (limit handled elsewhere)
-                s.job = Job::None;
-                break;
-            case Job::HomeHL:
-                if (s.phase == 1) {
-                    s.phase = 2;  // back towards the switch at low speed
-                    configure_axis();
-                    s.axis.run(-s.home_dir, false);
-                } else if (s.phase == 4) {
-                    s.phase = 5;  // and forward onto it again at low speed
-                    configure_axis();
-                    s.axis.run(s.home_dir, false);
-                } else {
-                    s.job = Job::None;
-                }
-                break;
-            case Job::HomeZH:
-                if (s.phase == 1) {
-                    s.phase = 2;
-                    configure_axis();
-                    s.axis.run(s.home_dir, false);
-                } else {
-                    s.job = Job::None;
-                }
-                break;
-            case Job::HomeZ:
-                s.job = Job::None;
-                break;
-            case Job::HomeL:
-                if (s.phase == 1) finish_limit_homing();
-                else s.job = Job::None;
+            default:
                 break;
         }
     }
 
-    void advance(Nanos now, std::int64_t tick_ns) {
-        while (s.t < now) {
-            if (!s.axis.busy()) {
-                s.t = now;
+    void motion_done(Nanos t) {
+        s.idle_since = t;
+        switch (s.job) {
+            case Job::Target:
+            case Job::Correct:
+                s.job = Job::None;
+                s.stopping = false;
+                verify_position();
+                break;
+            case Job::Jog:
+            case Job::Stop:
+                end_job(t);
+                break;
+            case Job::Home:  // the homing's own listener decides; after_homing_event ends the job
+            case Job::None:
+                break;
+        }
+    }
+
+    // Runs after ArcusHoming's listener.
+    void after_homing_event(const motion::MotorEvent& e) {
+        if (s.job == Job::Home && s.homing && !s.homing->running()) end_homing(e.t);
+    }
+
+    void end_homing(Nanos t) {
+        if (s.homing->result() == motion::HomingResult::LimitError) {
+            (s.home_direction > 0 ? s.plus_err : s.minus_err) = true;
+            s.snl.limit_hit();
+        }
+        end_job(t);
+    }
+
+    void start_homing(motion::ArcusHoming::Method method, int dir, Nanos now) {
+        if (s.homing) s.homing.reset();
+        if (s.homing_listener) m().remove_listener(s.homing_listener);
+        motion::ArcusHomingOptions ho;
+        ho.hca = static_cast<double>(s.hca);
+        ho.lca = static_cast<double>(s.cfg.lca);
+        ho.rz = s.rz != 0;
+        ho.zero_encoder = true;  // PX and EX both read 0 at home
+        s.homing = std::make_unique<motion::ArcusHoming>(m(), profile_params(), ho);
+        State* sp = &s;
+        const SimOptions* op = &o;
+        s.homing_listener =
+            m().add_listener([sp, op](const motion::MotorEvent& e) { SimEngine(*sp, *op).after_homing_event(e); });
+        s.job = Job::Home;
+        s.stopping = false;
+        s.arcus_profile = false;
+        s.home_direction = physical_direction(dir);
+        s.homing->start(method, dir);
+        if (!s.homing->running()) end_homing(now);
+    }
+
+    // The drive's sampling of the encoder between events: the StepNLoop
+    // delta (stall error 10) and the DO2 sync comparator.
+    void sample(std::int64_t enc_prev) {
+        if (s.sync_on && !s.sync_hit) check_sync(enc_prev, encoder());
+        if (snl_on() && m().moving() &&
+            s.snl.monitor(static_cast<double>(pulse() - encoder())).action == motion::SnlAction::StopNow) {
+            if (s.homing && s.homing->running()) s.homing->abort();
+            m().halt();  // stall error (10)
+            s.job = Job::None;
+            s.stopping = false;
+            s.idle_since = m().time();
+        }
+    }
+
+    // Brings the motor to `now`.  The delta only changes while the rotor is
+    // held (a follower rotor keeps it constant between events), and the sync
+    // comparator only matters while armed: only then is the motion sampled
+    // every tick; otherwise the model runs from event to event.
+    void advance(Nanos now) {
+        while (m().time() < now) {
+            const bool sampled =
+                m().moving() && ((s.sync_on && !s.sync_hit) || (snl_on() && (s.blocked || !s.eo)));
+            if (!sampled) {
+                m().advance_to(now);
                 break;
             }
-            // A long unobserved stretch (a jog left running on real time) is
-            // integrated in at most ~1e6 steps: positions come from the profile
-            // model exactly, and crossings are interpolated inside the step.
-            Nanos step = std::max<Nanos>(tick_ns, (now - s.t) / 1'000'000);
-            Nanos dt = std::min<Nanos>(step, now - s.t);
-            s.t += dt;
-            tick(static_cast<double>(dt) * 1e-9, s.t);
+            // A long unobserved stretch is sampled at most ~1e6 times.
+            const Nanos span = now - m().time();
+            const Nanos step = std::min<Nanos>(span, std::max<Nanos>(o.tick_ns, span / 1'000'000));
+            const std::int64_t enc_prev = encoder();
+            m().advance_to(m().time() + step);
+            sample(enc_prev);
         }
     }
 };
 
 // ------------------------------------------------------------------------------
+
+Sim::Sim(Clock& clock, SimOptions options)
+    : clock_(clock), options_(std::move(options)), s_(std::make_unique<State>()) {
+    if (options_.address < 1 || options_.address > kMaxAddress)
+        throw InvalidArgument("arcus sim address: must be 1..99");
+    if (options_.response_type != 0 && options_.response_type != 1)
+        throw InvalidArgument("arcus sim response_type: must be 0 or 1");
+    if (options_.tick_ns <= 0) throw InvalidArgument("arcus sim tick_ns: must be > 0");
+    s_->motor = std::make_unique<motion::MotorModel>(clock_, motor_config(options_));
+    s_->motor->displace(options_.world.start_position);
+    State* sp = s_.get();
+    const SimOptions* op = &options_;
+    s_->motor->add_listener([sp, op](const motion::MotorEvent& e) { SimEngine(*sp, *op).on_event(e); });
+    power_cycle();
+}
+
+Sim::Sim(std::shared_ptr<Clock> clock, SimOptions options)
+    : Sim((clock ? *clock : throw InvalidArgument("arcus sim: clock is null")), std::move(options)) {
+    clock_owner_ = std::move(clock);
+}
+
+Sim::~Sim() = default;
 
 namespace {
 
@@ -529,17 +445,17 @@ void save_flash(const std::string& path, Flash f) {
 void Sim::power_cycle() {
     std::lock_guard lock(mutex_);
     State& s = *s_;
-    double phys = s.phys;
+    const Nanos now = clock_.now();
+    SimEngine(s, options_).advance(now);
+    if (s.homing) s.homing.reset();
+    if (s.homing_listener) s.motor->remove_listener(s.homing_listener);
+    auto motor = std::move(s.motor);  // the shaft stays where it is
     unsigned inputs = s.inputs;
     bool blocked = s.blocked;
-    auto fh = s.force_home, fm = s.force_minus, fp = s.force_plus;
     s = State{};
-    s.phys = phys;  // the shaft stays where it is
+    s.motor = std::move(motor);
     s.inputs = inputs;
     s.blocked = blocked;
-    s.force_home = fh;
-    s.force_minus = fm;
-    s.force_plus = fp;
     s.flash.dn = options_.address;
     s.flash.rt = options_.response_type;
     s.flash.eoboot = options_.eo_boot ? 1 : 0;
@@ -550,10 +466,15 @@ void Sim::power_cycle() {
     s.active_rt = s.cfg.rt ? 1 : 0;
     s.eo = s.cfg.eoboot ? 1 : 0;
     s.user_do = s.cfg.doboot & 7;
-    s.enc_offset = -std::llround(s.phys * kCountsPerStep);  // counters start at 0
-    s.t = clock_.now();
-    SimEngine(s, options_).configure_snl();
-    s.idle_since = s.t - s.cfg.curt * 1'000'000 - 1;
+    motion::MotorModel& m = *s.motor;
+    m.halt();
+    m.disarm_latch();
+    SimEngine e(s, options_);
+    e.apply_wiring();
+    m.set_pulse_position(0);  // counters start at 0
+    m.set_encoder(0);
+    e.configure_snl();
+    s.idle_since = now - s.cfg.curt * 1'000'000 - 1;
 }
 
 int Sim::address() const {
@@ -566,54 +487,58 @@ std::string Sim::store_path() const { return options_.store_path; }
 #define MOTORBUS_ARCUS_SYNC()            \
     std::lock_guard lock(mutex_);        \
     SimEngine e(*s_, options_);          \
-    e.advance(clock_.now(), options_.tick_ns)
+    e.advance(clock_.now())
 
 void Sim::set_input(int index, bool actuated) {
     if (index < 1 || index > 6) throw InvalidArgument("arcus sim input: index must be 1..6");
     MOTORBUS_ARCUS_SYNC();
-    bool before = latch_in(*s_);
+    bool before = e.latch_in();
     unsigned bit = 1u << (index - 1);
     s_->inputs = actuated ? (s_->inputs | bit) : (s_->inputs & ~bit);
-    if (s_->latch_state == 1 && !before && latch_in(*s_)) {
-        s_->ltp = pulse(*s_);
-        s_->lte = encoder(*s_);
-        s_->latch_state = 2;
+    auto& m = *s_->motor;
+    if (!before && e.latch_in() && m.latch_state() == motion::MotorModel::LatchState::Armed) {
+        m.trigger_latch();
+        s_->ltp = std::llround(m.latched_pulse());
+        s_->lte = m.latched_encoder();
     }
 }
 
 void Sim::force_home(std::optional<bool> actuated) {
     MOTORBUS_ARCUS_SYNC();
-    s_->force_home = actuated;
+    s_->motor->force_switch(motion::Switch::Home, actuated);
 }
 
 void Sim::force_limit(int direction, std::optional<bool> actuated) {
     MOTORBUS_ARCUS_SYNC();
-    (direction > 0 ? s_->force_plus : s_->force_minus) = actuated;
+    s_->motor->force_switch(direction > 0 ? motion::Switch::PlusLimit : motion::Switch::MinusLimit, actuated);
 }
 
 void Sim::set_blocked(bool blocked) {
     MOTORBUS_ARCUS_SYNC();
     s_->blocked = blocked;
+    e.apply_jam();
 }
 
 void Sim::disturb(double steps) {
     MOTORBUS_ARCUS_SYNC();
-    s_->phys += steps;
-    if (!s_->axis.busy() && s_->job == Job::None) e.verify_position(/*idle=*/true);
+    const std::int64_t enc_prev = e.encoder();
+    s_->motor->displace(steps);
+    if (s_->motor->moving()) e.sample(enc_prev);
+    else if (s_->job == Job::None) e.verify_position(/*idle=*/true);
 }
 
 double Sim::physical_position() const {
-    std::lock_guard lock(mutex_);
-    return s_->phys;
+    MOTORBUS_ARCUS_SYNC();
+    return s_->motor->physical_position();
 }
 
 std::int64_t Sim::pulse_position() {
     MOTORBUS_ARCUS_SYNC();
-    return pulse(*s_);
+    return e.pulse();
 }
 std::int64_t Sim::encoder_position() {
     MOTORBUS_ARCUS_SYNC();
-    return encoder(*s_);
+    return e.encoder();
 }
 std::int64_t Sim::motor_status() {
     MOTORBUS_ARCUS_SYNC();
@@ -625,7 +550,7 @@ int Sim::snl_status() {
 }
 bool Sim::busy() {
     MOTORBUS_ARCUS_SYNC();
-    return s_->axis.busy();
+    return s_->motor->moving();
 }
 
 std::string Sim::on_line(std::string_view line) {
@@ -651,7 +576,8 @@ std::string Sim::handle(const Request& req) {
     State& s = *s_;
     SimEngine e(s, options_);
     Nanos now = clock_.now();
-    e.advance(now, options_.tick_ns);
+    e.advance(now);
+    motion::MotorModel& m = *s.motor;
 
     const std::string& cmd = req.command;
     auto unknown = [&] {
@@ -667,32 +593,32 @@ std::string Sim::handle(const Request& req) {
     const std::string ok = "OK";
 
     if (!pc->index_valid) return std::string(error_text(ErrorCode::IndexOutOfRange));
-    bool busy = s.axis.busy();
+    bool busy = m.moving();
     if (info.motion && pc->op != Op::Query && busy) return std::string(error_text(ErrorCode::Moving));
 
     // Value checks for "NAME=value".
     std::optional<std::int64_t> v = pc->value;
     auto in = [&](std::int64_t lo, std::int64_t hi) { return v && *v >= lo && *v <= hi; };
 
-    auto start_move = [&](Job job, int dir) -> std::string {
-        if (s.minus_err || s.plus_err || s.snl.in_error()) return std::string(error_text(ErrorCode::StateError));
-        e.configure_axis();
-        s.job = job;
-        s.phase = 0;
-        s.home_dir = dir;
-        s.snl.begin(job == Job::Jog     ? motion::SnlActivity::Jog
-                    : job == Job::HomeZ ? motion::SnlActivity::ZHome
-                    : job == Job::HomeL ? motion::SnlActivity::LimitHome
-                                        : motion::SnlActivity::Home);
-        switch (job) {
-            case Job::Jog:
-            case Job::HomeH:
-            case Job::HomeHL:
-            case Job::HomeZH:
-            case Job::HomeL: s.axis.run(dir, true); break;
-            case Job::HomeZ: s.axis.run(dir, false); break;
-            default: break;
-        }
+    auto refuse_in_error = [&] { return s.minus_err || s.plus_err || s.snl.in_error(); };
+    auto jog = [&](int dir) -> std::string {
+        if (refuse_in_error()) return std::string(error_text(ErrorCode::StateError));
+        e.configure_arcus();
+        s.job = Job::Jog;
+        s.stopping = false;
+        s.snl.begin(motion::SnlActivity::Jog);
+        s.arcus.jog(m.pulse_position(), dir);
+        e.command_arcus();
+        e.check_limit_at_start(e.physical_direction(dir), now);
+        return ok;
+    };
+    auto home = [&](motion::ArcusHoming::Method method, int dir) -> std::string {
+        if (refuse_in_error()) return std::string(error_text(ErrorCode::StateError));
+        using M = motion::ArcusHoming::Method;
+        s.snl.begin(method == M::Z   ? motion::SnlActivity::ZHome
+                    : method == M::L ? motion::SnlActivity::LimitHome
+                                     : motion::SnlActivity::Home);
+        e.start_homing(method, dir, now);
         return ok;
     };
 
@@ -721,12 +647,12 @@ std::string Sim::handle(const Request& req) {
             return buf;
         }
         if (name == "DOBOOT") return num(s.cfg.doboot);
-        if (name == "DX") return num(delta(s));
+        if (name == "DX") return num(e.delta());
         if (name == "EDEC") return num(s.edec);
         if (name == "EDO") return num(s.cfg.edo);
         if (name == "EO") return num(s.eo);
         if (name == "EOBOOT") return num(s.cfg.eoboot);
-        if (name == "EX") return num(encoder(s));
+        if (name == "EX") return num(e.encoder());
         if (name == "HCA") return num(s.hca);
         if (name == "HSPD") return num(s.hspd);
         if (name == "ID") return "DriveMax-CAN";
@@ -735,13 +661,13 @@ std::string Sim::handle(const Request& req) {
         if (name == "LT") return num(s.lt);
         if (name == "LTE") return num(s.lte);
         if (name == "LTP") return num(s.ltp);
-        if (name == "LTS") return num(s.latch_state);
+        if (name == "LTS") return num(static_cast<int>(m.latch_state()));
         if (name == "MM") return num(s.inc_mode);
         if (name == "MST") return num(e.mst());
         if (name == "NID") return num(s.cfg.nid);
         if (name == "POL") return num(s.cfg.pol);
-        if (name == "PS") return num(std::llround(s.axis.speed()));
-        if (name == "PX") return num(pulse(s));
+        if (name == "PS") return num(std::llround(std::fabs(m.pulse_velocity())));
+        if (name == "PX") return num(e.pulse());
         if (name == "RT") return num(s.cfg.rt);
         if (name == "RZ") return num(s.rz);
         if (name == "SCV") return num(s.scv);
@@ -812,17 +738,18 @@ std::string Sim::handle(const Request& req) {
         if (name == "EO") {
             if (!in(0, 1)) return unknown();
             s.eo = *v;
+            e.apply_jam();
             return ok;
         }
         if (name == "EOBOOT") return set(s.cfg.eoboot, 0, 1);
         if (name == "EX") {
-            s.enc_offset = *v - std::llround(s.phys * kCountsPerStep);
-            if (snl_on(s)) s.axis.set_position(static_cast<double>(*v));
+            m.set_encoder(*v);
+            if (e.snl_on()) m.set_pulse_position(static_cast<double>(*v));
             return ok;
         }
         if (name == "PX") {
-            s.axis.set_position(static_cast<double>(*v));
-            if (snl_on(s)) s.enc_offset = *v - std::llround(s.phys * kCountsPerStep);
+            m.set_pulse_position(static_cast<double>(*v));
+            if (e.snl_on()) m.set_encoder(*v);
             return ok;
         }
         if (name == "HCA") return set(s.hca, 0, INT32_MAX);
@@ -832,11 +759,16 @@ std::string Sim::handle(const Request& req) {
         if (name == "LT") {
             if (!in(0, 1)) return unknown();
             s.lt = *v;
-            s.latch_state = *v ? 1 : 0;
+            if (*v) m.arm_latch();
+            else m.disarm_latch();
             return ok;
         }
         if (name == "NID") return set(s.cfg.nid, 1, 127);
-        if (name == "POL") return set(s.cfg.pol, 0, 511);
+        if (name == "POL") {
+            auto r = set(s.cfg.pol, 0, 511);
+            e.apply_wiring();
+            return r;
+        }
         if (name == "RT") return set(s.cfg.rt, 0, 1);
         if (name == "RZ") return set(s.rz, 0, 1);
         if (name == "SCV") return set(s.scv, 0, 1);
@@ -845,10 +777,11 @@ std::string Sim::handle(const Request& req) {
             if (busy) return std::string(error_text(ErrorCode::Moving));
             if (*v != s.cfg.sl) {
                 // Position units change: counts with SNL, pulses without.
-                std::int64_t ex = encoder(s);
-                s.axis.set_position(*v ? static_cast<double>(ex) : std::round(ex / kCountsPerStep));
+                std::int64_t ex = e.encoder();
+                m.set_pulse_position(*v ? static_cast<double>(ex) : std::round(static_cast<double>(ex) * kStepsPerCount));
             }
             s.cfg.sl = *v;
+            e.apply_wiring();
             e.configure_snl();
             s.snl.clear();
             return ok;
@@ -883,41 +816,49 @@ std::string Sim::handle(const Request& req) {
         if (name == "X") {
             if (!v) return unknown();
             if (s.minus_err || s.plus_err || s.snl.in_error()) return std::string(error_text(ErrorCode::StateError));
-            double from = s.axis.position();
+            double from = m.pulse_position();
             double target = s.inc_mode ? from + static_cast<double>(*v) : static_cast<double>(*v);
             if (std::abs(target - from) > static_cast<double>(kMaxIncrement)) return unknown();
-            e.configure_axis();
+            e.configure_arcus();
+            if (s.arcus.move(from, target) != motion::ArcusReply::Ok) return unknown();
             s.job = Job::Target;
+            s.stopping = false;
             s.snl.begin(motion::SnlActivity::Move);
-            s.move_target = target;
-            s.axis.move_to(target);
-            if (!s.axis.busy()) {
-                s.job = Job::None;
-                e.after_motion(now);
+            e.command_arcus();
+            if (!m.moving()) {
+                e.end_job(now);
+                return ok;
             }
+            e.check_limit_at_start(e.physical_direction(target - from), now);
             return ok;
         }
         if (name == "T") {
             if (!v) return unknown();
-            if (!busy || s.job != Job::Target || s.axis.stopping())
+            if (!busy || s.job != Job::Target || s.stopping || !s.arcus_profile)
                 return std::string(error_text(ErrorCode::MotorNotMoving));
-            auto r = s.axis.retarget(static_cast<double>(*v));
+            // The profile model's frame differs from PX by a constant shift.
+            const double t = e.arcus_time();
+            const double shift = s.arcus.profile().position(t) - m.pulse_position();
+            auto r = s.arcus.change_target(t, static_cast<double>(*v) + shift);
             if (r != motion::ArcusReply::Ok) return motion::arcus_reply_text(r);
-            s.move_target = static_cast<double>(*v);
+            m.revise(s.arcus.profile());
             return ok;
         }
         if (name == "SSPD") {
             if (!v || *v <= 0) return std::string(error_text(ErrorCode::BadSspd));
             if (s.scv) return std::string(error_text(ErrorCode::ScvOn));
             // The window is in PPS; under StepNLoop the value is in counts/s.
-            double pps = static_cast<double>(*v) * (snl_on(s) ? 1.0 / kCountsPerStep : 1.0);
+            double pps = static_cast<double>(*v) * (e.snl_on() ? kStepsPerCount : 1.0);
             auto wdw = window_for_sspdm(s.sspdm);
             if (!wdw || pps < static_cast<double>(wdw->hspd_min) || pps > static_cast<double>(wdw->hspd_max))
                 return std::string(error_text(ErrorCode::SpeedOutOfRange));
-            if (!busy || s.axis.stopping()) return std::string(error_text(ErrorCode::BadSspd));
-            s.axis.set_sspdm(static_cast<int>(s.sspdm));
-            auto r = s.axis.change_speed(static_cast<double>(*v));
+            // A target move or a jog (the homing routines run their own speeds).
+            if (!busy || s.stopping || !s.arcus_profile || (s.job != Job::Target && s.job != Job::Jog))
+                return std::string(error_text(ErrorCode::BadSspd));
+            s.arcus.set_sspdm(static_cast<int>(s.sspdm));
+            auto r = s.arcus.change_speed(e.arcus_time(), static_cast<double>(*v));
             if (r != motion::ArcusReply::Ok) return motion::arcus_reply_text(r);
+            m.revise(s.arcus.profile());
             return ok;
         }
         return unknown();
@@ -925,17 +866,26 @@ std::string Sim::handle(const Request& req) {
 
     // Actions.
     if (name == "ABORT") {
-        s.axis.halt();
+        if (s.homing && s.homing->running()) s.homing->abort();
+        m.halt();
         s.job = Job::None;
+        s.stopping = false;
         if (s.snl.status() != motion::SnlStatus::LimitError) s.snl.clear();
         s.idle_since = now;
         return ok;
     }
     if (name == "STOP") {
         if (busy) {
-            s.axis.decel_stop();
-            if (s.job != Job::Jog && s.job != Job::Target) s.job = Job::Stop;
-            if (s.job == Job::Target) s.job = Job::Stop;
+            if (s.job == Job::Home && s.homing && s.homing->running()) {
+                s.homing->stop();
+                s.job = Job::Stop;
+            } else if (s.arcus_profile) {
+                s.arcus.stop(e.arcus_time());
+                m.revise(s.arcus.profile());
+                if (s.job != Job::Jog) s.job = Job::Stop;
+            }
+            s.stopping = true;
+            if (!m.moving()) e.motion_done(now);
         }
         return ok;
     }
@@ -958,7 +908,7 @@ std::string Sim::handle(const Request& req) {
     if (name == "SYNO") {
         s.sync_on = true;
         s.sync_hit = false;
-        std::int64_t ex = encoder(s);
+        std::int64_t ex = e.encoder();
         if (s.sync_cond != 1 || ex == s.synp) e.check_sync(ex, ex);
         return ok;
     }
@@ -968,18 +918,19 @@ std::string Sim::handle(const Request& req) {
         s.user_do &= ~std::int64_t{2};
         return ok;
     }
-    if (name == "J+") return start_move(Job::Jog, 1);
-    if (name == "J-") return start_move(Job::Jog, -1);
-    if (name == "H+") return start_move(Job::HomeH, 1);
-    if (name == "H-") return start_move(Job::HomeH, -1);
-    if (name == "HL+") return start_move(Job::HomeHL, 1);
-    if (name == "HL-") return start_move(Job::HomeHL, -1);
-    if (name == "ZH+") return start_move(Job::HomeZH, 1);
-    if (name == "ZH-") return start_move(Job::HomeZH, -1);
-    if (name == "Z+") return start_move(Job::HomeZ, 1);
-    if (name == "Z-") return start_move(Job::HomeZ, -1);
-    if (name == "L+") return start_move(Job::HomeL, 1);
-    if (name == "L-") return start_move(Job::HomeL, -1);
+    using M = motion::ArcusHoming::Method;
+    if (name == "J+") return jog(1);
+    if (name == "J-") return jog(-1);
+    if (name == "H+") return home(M::H, 1);
+    if (name == "H-") return home(M::H, -1);
+    if (name == "HL+") return home(M::HL, 1);
+    if (name == "HL-") return home(M::HL, -1);
+    if (name == "ZH+") return home(M::ZH, 1);
+    if (name == "ZH-") return home(M::ZH, -1);
+    if (name == "Z+") return home(M::Z, 1);
+    if (name == "Z-") return home(M::Z, -1);
+    if (name == "L+") return home(M::L, 1);
+    if (name == "L-") return home(M::L, -1);
     return unknown();
 }
 
