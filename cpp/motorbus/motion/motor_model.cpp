@@ -103,14 +103,7 @@ void MotorModel::emit_switch(Switch w, bool on) {
 bool MotorModel::moving() const { return running_; }
 
 void MotorModel::command(const Profile& profile, std::optional<Nanos> start) {
-    Nanos t = start.value_or(now_);
-    if (t < now_) t = now_;
-    if (t > now_ && !in_dispatch_) advance_to(t);
-    const double cp = units_state(t).p;
-    profile_ = profile;
-    profile_start_ = t;
-    profile_offset_ = profile.start_position() - cp;
-    running_ = profile.duration() > 0;
+    command_from(profile, 0.0, start);
 }
 
 void MotorModel::command_from(const Profile& profile, double elapsed, std::optional<Nanos> start) {
@@ -120,7 +113,9 @@ void MotorModel::command_from(const Profile& profile, double elapsed, std::optio
     Nanos t = start.value_or(now_);
     if (t < now_) t = now_;
     if (t > now_ && !in_dispatch_) advance_to(t);
-    const double cp = command_state(t).p;
+    // Continuity in the drive's units: the new profile is shifted so that it
+    // passes through the current pulse position at t.
+    const double cp = units_state(t).p;
     profile_ = profile;
     profile_start_ = t - static_cast<Nanos>(std::llround(elapsed * 1e9));
     const double pt = profile_time(t);

@@ -79,3 +79,25 @@ TEST(MotorModelJoin, LimitSwitchEventsStillExactAfterAJoin) {
     EXPECT_FALSE(m.moving());
     EXPECT_TRUE(m.plus_limit_active());
 }
+
+// With a units ratio (the Arcus sim's 0.8 steps per count under StepNLoop) the
+// join keeps the drive's counter continuous and the rotor moves ratio x units.
+TEST(MotorModelJoin, ContinuityIsInTheDrivesUnitsWhenTheyAreNotSteps) {
+    SimClock clock;
+    MotorModel m(clock, MotorConfig{});
+    m.set_steps_per_unit(0.8);
+    m.set_pulse_position(1000);
+    m.command(ramp_then_cruise());  // 3000 units = 2400 steps: units and steps now differ
+    clock.advance(3'000'000'000);
+    m.update();
+    ASSERT_NEAR(m.pulse_position(), 4000.0, 1e-6);
+    ASSERT_NEAR(m.physical_position(), 2400.0, 1e-6);
+    m.command_from(ramp_then_cruise(), 1.0);  // join the cruise: 2000 units/s for 1 s
+    EXPECT_NEAR(m.pulse_position(), 4000.0, 1e-6);   // no jump in the drive's counter
+    EXPECT_NEAR(m.physical_position(), 2400.0, 1e-6);
+    clock.advance(1'000'000'000);
+    m.update();
+    EXPECT_NEAR(m.pulse_position(), 6000.0, 1e-6);
+    EXPECT_NEAR(m.physical_position(), 4000.0, 1e-6);  // + 2000 units x 0.8 steps per unit
+    EXPECT_FALSE(m.moving());
+}
