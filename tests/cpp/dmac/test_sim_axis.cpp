@@ -6,29 +6,13 @@
 
 #include "motorbus/drives/dmac/sim.hpp"
 #include "motorbus/motion/dmac_profile.hpp"
+#include "sim_rig.hpp"
 
 using namespace motorbus;
 using namespace motorbus::dmac;
+using motorbus::dmac::testing::Rig;
 
 namespace {
-
-struct Rig {
-    std::shared_ptr<SimClock> clock = std::make_shared<SimClock>();
-    std::shared_ptr<DmacSim> sim;
-    explicit Rig(SimOptions o = {}) { sim = std::make_shared<DmacSim>(clock, o); }
-    std::string tx(std::string_view line) { return sim->on_line(line); }
-    void ms(std::int64_t n) { clock->advance(n * 1'000'000); }
-    std::int32_t read(Var v) { return sim->read(v); }
-    std::uint32_t status() { return static_cast<std::uint32_t>(read(Var::Status)); }
-    std::int64_t run_until_idle(std::int64_t limit_ms = 100000) {
-        std::int64_t t = 0;
-        while (bit_set(sim->state().status, status::kMovement) && t < limit_ms) {
-            ms(1);
-            ++t;
-        }
-        return t;
-    }
-};
 
 SimOptions with_switches(double neg, double pos, Model model = Model::Dmac34_1, bool active_low = false) {
     SimOptions o;
