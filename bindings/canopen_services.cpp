@@ -382,6 +382,8 @@ void bind_canopen_services(py::module_& m) {
              }, py::arg("now_ns") = py::none())
         .def("start", [](HbProducerBox& b) { b.obj->start(); })
         .def("stop", [](HbProducerBox& b) { py::gil_scoped_release nogil; b.obj->stop(); })
+        .def_property_readonly("send_failures", [](HbProducerBox& b) { return b.obj->send_failures(); },
+                               "heartbeats the bus refused (closed, full, link down) while started")
         .def_property_readonly("sent", [](HbProducerBox& b) { return b.obj->sent(); });
 
     // ---- EMCY -------------------------------------------------------------------

@@ -3,7 +3,8 @@
 Every test that drives the C++ core's threads (buses, servers, clients,
 simulators) is marked `threaded`, so tools/sanitize.sh runs it again under
 AddressSanitizer + UBSan.  Modules listed here only spawn subprocesses or do
-single-threaded math, which the sanitizer run would not add anything to.
+single-threaded math, which the sanitizer run would not add anything to; a
+single test that does its work in a child process is marked `subprocess`.
 """
 import pytest
 
@@ -15,5 +16,7 @@ NOT_THREADED = {
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
+        if item.get_closest_marker("subprocess"):
+            continue
         if item.module.__name__.rsplit(".", 1)[-1] not in NOT_THREADED:
             item.add_marker(pytest.mark.threaded)

@@ -905,6 +905,11 @@ class HeartbeatProducer:
     def stop(self) -> None:
         ...
     @property
+    def send_failures(self) -> int:
+        """
+        heartbeats the bus refused (closed, full, link down) while started
+        """
+    @property
     def sent(self) -> int:
         ...
 class EmcyConsumer:

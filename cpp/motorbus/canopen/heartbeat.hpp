@@ -126,6 +126,8 @@ public:
     void start();
     void stop();
     std::uint64_t sent() const { return sent_.load(); }
+    // Heartbeats the bus refused (closed, full, link down) while start()ed.
+    std::uint64_t send_failures() const { return timer_.failures(); }
 
 private:
     can::Bus& bus_;

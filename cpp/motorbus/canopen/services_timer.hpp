@@ -7,6 +7,8 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -34,7 +36,16 @@ public:
             while (!stop_) {
                 l.unlock();
                 const Nanos now = clock.now();
-                Nanos next = tick(now);
+                Nanos next = -1;
+                try {
+                    next = tick(now);
+                } catch (const std::exception&) {
+                    // A closed or saturated bus (or a failing user callback)
+                    // must not end the process from a service thread: count
+                    // it and try again at the idle period, as a real node
+                    // keeps producing through a disconnected cable.
+                    failures_.fetch_add(1, std::memory_order_relaxed);
+                }
                 l.lock();
                 if (stop_) break;
                 if (next < 0 || next - now > idle_period) next = now + idle_period;
@@ -67,12 +78,15 @@ public:
         if (thread_.joinable() && thread_.get_id() != std::this_thread::get_id()) thread_.join();
     }
     bool running() const { return thread_.joinable(); }
+    // Ticks that threw (and were retried at the idle period).
+    std::uint64_t failures() const { return failures_.load(std::memory_order_relaxed); }
 
 private:
     std::mutex m_;
     std::condition_variable cv_;
     bool stop_ = false;
     bool poke_ = false;
+    std::atomic<std::uint64_t> failures_{0};
     std::thread thread_;
 };
 

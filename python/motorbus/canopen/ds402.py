@@ -14,11 +14,12 @@ for "OPERATION ENABLED".
 from __future__ import annotations
 
 import enum
+from typing import Optional
 
-from .. import _core
+from .. import _core, _stop_at_exit
 
-__all__ = ["Ds402", "Ds402Host", "Ds402Device", "OpMode", "STATES", "decode_statusword",
-           "Controlword", "next_step"]
+__all__ = ["ABORT_CONNECTION_ACTIONS", "Ds402", "Ds402Host", "Ds402Device", "OpMode", "STATES",
+           "decode_statusword", "Controlword", "next_step"]
 
 STATES = ("NOT READY TO SWITCH ON", "SWITCH ON DISABLED", "READY TO SWITCH ON", "SWITCHED ON",
           "OPERATION ENABLED", "QUICK STOP ACTIVE", "FAULT REACTION ACTIVE", "FAULT", "UNKNOWN")
@@ -50,8 +51,51 @@ class Controlword(enum.IntEnum):
     FAULT_RESET = 0x0080
 
 
+# 0x6007 abort connection option codes (CiA 402): what the drive does by itself
+# when it loses its master (heartbeat missing, bus-off ...).
+ABORT_CONNECTION_ACTIONS = {"fault": 1, "disable_voltage": 2, "quick_stop": 3}
+
+
 class Ds402(_core.Ds402Host):
-    """Host-side CiA 402 state machine of one drive."""
+    """Host-side CiA 402 state machine of one drive.
+
+    ``Ds402(bus_or_sdo, node, timeout=2.0, poll=0.005, on_error="quick_stop",
+    on_exit="quick_stop")``
+
+    Safety, as for every motorbus drive object:
+
+    * as a context manager it stops the motor when an exception leaves the block
+      (``on_error``: "quick_stop" = controlword Quick Stop, the drive decelerates
+      with its 605Ah option; "disable" = Disable Voltage, the power stage is
+      switched off at once; None = leave it);
+    * a drive still open when the interpreter exits is stopped with ``on_exit``;
+    * :meth:`start_watchdog` arms the drive's own heartbeat consumer (0x1016) on
+      a heartbeat this host produces, and sets what the drive does when it stops
+      arriving (0x6007): a crashed host, a pulled cable or a dead adapter stop
+      the motor without any help from the host.
+    """
+
+    def __init__(self, sdo, node: int, timeout: float = 2.0, poll: float = 0.005, *,
+                 on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop") -> None:
+        for name, v in (("on_error", on_error), ("on_exit", on_exit)):
+            if v not in _HALTS:
+                raise _core.InvalidArgument(f"Ds402 {name}: 'quick_stop', 'disable' or None, not {v!r}")
+        if isinstance(sdo, _core.Bus):
+            # One SDO client for the state machine and the watchdog set-up: two
+            # clients on one COB-ID would take each other's responses.
+            self._bus = sdo
+            sdo = _core.SdoClient(sdo, node, timeout=timeout)
+        else:
+            self._bus = None
+        super().__init__(sdo, node, timeout, poll)
+        self._sdo = sdo
+        self._node = node
+        self._on_error = on_error
+        self._on_exit = on_exit
+        self._heartbeat: Optional[_core.HeartbeatProducer] = None
+        self._watchdog_sub: Optional[int] = None
+        self._closed = False
+        _stop_at_exit.track(self)
 
     def set_mode(self, mode: int) -> None:  # accepts OpMode or int
         super().set_mode(int(mode))
@@ -65,6 +109,95 @@ class Ds402(_core.Ds402Host):
 
     def disable(self) -> None:
         self.go_to("SWITCH ON DISABLED")
+
+    # ---- link-loss watchdog: the drive's own heartbeat consumer ----
+    def start_watchdog(self, host_node: int, period: float = 0.1, timeout: Optional[float] = None,
+                       action: str = "quick_stop", bus=None, entry: int = 1) -> None:
+        """Produce a heartbeat as node ``host_node`` every ``period`` seconds and
+        make the drive watch it: 0x1016:``entry`` = host_node / ``timeout``
+        (default 3 periods, at least 10 ms more than the period), 0x6007 =
+        ``action`` ("quick_stop", "disable_voltage" or "fault").  ``bus``: where
+        to produce it (default: the bus this drive was opened on)."""
+        if action not in ABORT_CONNECTION_ACTIONS:
+            raise _core.InvalidArgument(
+                f"start_watchdog action: one of {sorted(ABORT_CONNECTION_ACTIONS)}, not {action!r}")
+        if not 1 <= int(host_node) <= 127 or int(host_node) == self._node:
+            raise _core.InvalidArgument(f"start_watchdog host_node: 1-127 and not the drive's own id, not {host_node}")
+        if not period > 0:
+            raise _core.InvalidArgument(f"start_watchdog period: must be > 0 s, not {period}")
+        timeout_ms = round((timeout if timeout is not None else max(3 * period, period + 0.01)) * 1000)
+        if not period * 1000 < timeout_ms <= 0xFFFF:
+            raise _core.InvalidArgument(
+                f"start_watchdog timeout: {timeout_ms} ms must exceed the period ({period * 1000:g} ms) and fit 16 bits")
+        bus = bus if bus is not None else self._bus
+        if bus is None:
+            raise _core.InvalidArgument("start_watchdog: pass bus= (this drive was opened on an SDO client)")
+        self.stop_watchdog()
+        # Produce first, then arm the consumer: the drive must never watch a silent producer.
+        hb = _core.HeartbeatProducer(bus, int(host_node), period)
+        hb.start()
+        self._heartbeat = hb
+        try:
+            self._sdo.download(0x6007, 0, ABORT_CONNECTION_ACTIONS[action].to_bytes(2, "little", signed=True))
+            self._sdo.download(0x1016, entry, ((int(host_node) << 16) | timeout_ms).to_bytes(4, "little"))
+        except Exception:
+            hb.stop()
+            self._heartbeat = None
+            raise
+        self._watchdog_sub = entry
+
+    def stop_watchdog(self) -> None:
+        """Disarm the drive's consumer entry first, then stop producing (a clean
+        stop must not look like a lost master)."""
+        if self._watchdog_sub is not None:
+            try:
+                self._sdo.download(0x1016, self._watchdog_sub, (0).to_bytes(4, "little"))
+            finally:
+                self._watchdog_sub = None
+        if self._heartbeat is not None:
+            self._heartbeat.stop()
+            self._heartbeat = None
+
+    # ---- lifecycle ----
+    def __enter__(self) -> "Ds402":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        try:
+            if exc_type is not None:
+                self._halt(self._on_error)
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        """Stop the watchdog cleanly and forget this drive for the exit-time stop.
+        The motor is left as it is (use ``with`` or ``on_exit`` to stop it)."""
+        if self._closed:
+            return
+        self._closed = True
+        _stop_at_exit.untrack(self)
+        try:
+            self.stop_watchdog()
+        except Exception:  # noqa: BLE001 - the drive may be unreachable; its watchdog then acts
+            if self._heartbeat is not None:
+                self._heartbeat.stop()
+                self._heartbeat = None
+
+    def _stop_at_exit(self) -> None:
+        self._halt(self._on_exit)
+        # Leave the heartbeat to stop with the process: the drive's watchdog
+        # then applies 0x6007 too, should the stop above not have reached it.
+
+    def _halt(self, how: Optional[str]) -> None:
+        if how is None or self._closed:
+            return
+        try:
+            self.write_controlword(int(Controlword.QUICK_STOP if how == "quick_stop" else Controlword.DISABLE_VOLTAGE))
+        except Exception:  # noqa: BLE001 - best effort while unwinding
+            pass
+
+
+_HALTS = (None, "quick_stop", "disable")
 
 
 Ds402Host = Ds402

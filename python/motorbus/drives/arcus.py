@@ -12,13 +12,10 @@ device; ``motorbus sim serve --pty --drive arcus:01`` uses it.
 """
 from __future__ import annotations
 
-import atexit
 import enum
-import threading
-import weakref
 from typing import Any, Optional, Union
 
-from .. import _core
+from .. import _core, _stop_at_exit
 from .._core import ArcusClientBase, ArcusSim  # noqa: F401  (re-exported)
 
 __all__ = [
@@ -133,19 +130,6 @@ def open_line(port: Union[str, "_core.Port"], baud: int = 9600, timeout: float =
                           max_line=_core.ARCUS_MAX_REPLY, reply_timeout=timeout, turnaround=turnaround)
 
 
-# Clients still open at interpreter exit get their motor stopped.
-_open_clients: "weakref.WeakSet[ArcusClient]" = weakref.WeakSet()
-_open_lock = threading.Lock()
-
-
-def _stop_all_at_exit() -> None:
-    with _open_lock:
-        clients = list(_open_clients)
-    for c in clients:
-        c._safe_halt(c._on_exit)
-
-
-atexit.register(_stop_all_at_exit)
 
 
 class ArcusClient(ArcusClientBase):
@@ -175,8 +159,7 @@ class ArcusClient(ArcusClientBase):
         self._on_error = on_error
         self._on_exit = on_exit
         self._closed = False
-        with _open_lock:
-            _open_clients.add(self)
+        _stop_at_exit.track(self)
 
     # ---- lifecycle ----
     def __enter__(self) -> "ArcusClient":
@@ -193,13 +176,15 @@ class ArcusClient(ArcusClientBase):
         if self._closed:
             return
         self._closed = True
-        with _open_lock:
-            _open_clients.discard(self)
+        _stop_at_exit.untrack(self)
         if self._owns_port:
             try:
                 self.link.port.close()
             except Exception:  # noqa: BLE001 - closing must not mask the real error
                 pass
+
+    def _stop_at_exit(self) -> None:
+        self._safe_halt(self._on_exit)
 
     def _safe_halt(self, how: Optional[str]) -> None:
         if how is None or self._closed:

@@ -20,12 +20,9 @@ say, see docs/drives/dmac.md).
 """
 from __future__ import annotations
 
-import atexit
-import threading
-import weakref
 from typing import Any, Iterable, Optional, Sequence
 
-from .. import _core
+from .. import _core, _stop_at_exit
 
 DmacSim = _core.DmacSim
 DmacStatus = _core.DmacStatus
@@ -66,18 +63,6 @@ __all__ = [
     "variable_info",
 ]
 
-_live: "weakref.WeakSet[DmacClient]" = weakref.WeakSet()
-_live_lock = threading.Lock()
-
-
-def _stop_all_at_exit() -> None:
-    with _live_lock:
-        clients = list(_live)
-    for c in clients:
-        c._emergency_stop()
-
-
-atexit.register(_stop_all_at_exit)
 
 
 class DmacClient(_core.DmacClient):
@@ -100,8 +85,7 @@ class DmacClient(_core.DmacClient):
                  timeout: Optional[float] = None, sleep: Any = None) -> None:
         super().__init__(link, address=address, verify=verify, timeout=timeout, sleep=sleep)
         self._open = True
-        with _live_lock:
-            _live.add(self)
+        _stop_at_exit.track(self)
 
     def __enter__(self) -> "DmacClient":
         return self
@@ -116,8 +100,10 @@ class DmacClient(_core.DmacClient):
     def close(self) -> None:
         """Forget this client for the exit-time STOP (the link stays open)."""
         self._open = False
-        with _live_lock:
-            _live.discard(self)
+        _stop_at_exit.untrack(self)
+
+    def _stop_at_exit(self) -> None:
+        self._emergency_stop()
 
     def _emergency_stop(self) -> None:
         if not getattr(self, "_open", False):

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <thread>
+
+#include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/canopen/emcy.hpp"
 #include "motorbus/canopen/heartbeat.hpp"
 #include "motorbus/errors.hpp"
@@ -169,6 +172,22 @@ TEST(HeartbeatProducer, SendsOnGridWithState) {
     clock.advance(1'000'000'000);
     EXPECT_EQ(p.process(clock.now()), -1);
     EXPECT_EQ(hub.log.size(), 4u);
+}
+
+// The producer's thread outlives its bus: a pulled cable (here: the bus
+// closed under it) is counted, never a crash, and it produces again when it can.
+TEST(HeartbeatProducer, ThreadSurvivesAClosedBusAndCountsTheFailures) {
+    auto dev = can::open_virtual("hb-closed");
+    RealClock clock;
+    HeartbeatProducer p(*dev, clock, 9, 5ms, [] { return NodeState::Operational; });
+    p.start();
+    for (int i = 0; i < 2000 && p.sent() < 2; ++i) std::this_thread::sleep_for(1ms);
+    EXPECT_GE(p.sent(), 2u);
+    dev->close();
+    // The idle period of the service thread is 10 ms: a few retries within 2 s.
+    for (int i = 0; i < 2000 && p.send_failures() < 2; ++i) std::this_thread::sleep_for(1ms);
+    EXPECT_GE(p.send_failures(), 2u);
+    p.stop();
 }
 
 TEST(HeartbeatConsumerThread, DetectsLossOnRealClock) {

@@ -1,0 +1,40 @@
+"""Drive objects still open when the interpreter exits get their motor stopped.
+
+Every drive client (Arcus, DMAC, CiA 402) registers itself with :func:`track`
+when it opens and :func:`untrack` when it closes; at exit each one still
+tracked has its ``_stop_at_exit()`` called (best effort: a link that is
+already gone must not stop the others).  Weak references: a client that was
+garbage-collected is simply gone.
+"""
+from __future__ import annotations
+
+import atexit
+import threading
+import weakref
+from typing import Any
+
+_live: "weakref.WeakSet[Any]" = weakref.WeakSet()
+_lock = threading.Lock()
+
+
+def track(drive: Any) -> None:
+    with _lock:
+        _live.add(drive)
+
+
+def untrack(drive: Any) -> None:
+    with _lock:
+        _live.discard(drive)
+
+
+def stop_all() -> None:
+    with _lock:
+        drives = list(_live)
+    for d in drives:
+        try:
+            d._stop_at_exit()
+        except Exception:  # noqa: BLE001 - one dead link must not spare the other motors
+            pass
+
+
+atexit.register(stop_all)
