@@ -5,7 +5,6 @@ over python-can's virtual bus through motorbus.open_bus(<can.BusABC>).
 """
 from __future__ import annotations
 
-import time
 import uuid
 
 import can
@@ -18,6 +17,7 @@ from hypothesis import strategies as st
 
 import motorbus
 from motorbus.canopen.pdo import PdoMap, PdoReceiver, PdoSender
+from polling import wait_for
 
 # (data type, bits, signed) of the objects 0x2000 + k
 TYPES = [(odm.UNSIGNED8, 8, False), (odm.UNSIGNED16, 16, False), (odm.UNSIGNED32, 32, False),
@@ -162,9 +162,7 @@ def test_sent_by_us_received_by_canopen(buses):
     tx = PdoSender(ours, 0x205, ENTRIES)
     tx.send(VALUES)
     # wait_for_reception() only waits for the *next* frame; poll instead.
-    deadline = time.monotonic() + 2.0
-    while m.timestamp is None and time.monotonic() < deadline:
-        time.sleep(0.002)
+    wait_for(lambda: m.timestamp is not None, 2.0)
     assert m.timestamp is not None
     assert [v.raw for v in m.map] == VALUES
     assert bytes(m.data) == PdoMap(ENTRIES).pack(VALUES)
@@ -178,9 +176,7 @@ def test_sent_by_canopen_received_by_us(buses):
     for var, value in zip(m.map, VALUES):
         var.raw = value
     m.transmit()
-    deadline = time.monotonic() + 2.0
-    while rx.received == 0 and time.monotonic() < deadline:
-        time.sleep(0.002)
+    wait_for(lambda: rx.received > 0, 2.0)
     assert rx.received == 1
     got = rx.values
     # PdoReceiver keeps raw unsigned values; sign-extend the signed entry as PdoMap does.

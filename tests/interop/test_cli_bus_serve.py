@@ -9,6 +9,7 @@ import can
 import pytest
 
 import motorbus
+from polling import recv_id
 
 
 def _serve(*args):
@@ -39,15 +40,6 @@ def _stop(proc):
     return rc
 
 
-def _recv_id(bus, want, timeout=3.0):
-    deadline = time.time() + timeout
-    while time.time() < deadline:
-        m = bus.recv(0.2)
-        if m is not None and m.arbitration_id == want:
-            return m
-    return None
-
-
 @pytest.mark.skipif(not hasattr(motorbus._core, "SlcanServer"), reason="SLCAN backend not built")
 def test_python_can_slcan_clients_share_a_served_bus():
     proc = _serve("virtual:cli-slcan", "--slcan-pty", "--slcan-pty")
@@ -59,10 +51,10 @@ def test_python_can_slcan_clients_share_a_served_bus():
         try:
             time.sleep(0.2)  # both adapters opened
             a.send(can.Message(arbitration_id=0x1ABCDE, is_extended_id=True, data=b"\x01\x02\x03"))
-            m = _recv_id(b, 0x1ABCDE)
+            m = recv_id(b, 0x1ABCDE, timeout=3.0, poll=0.2)
             assert m is not None and bytes(m.data) == b"\x01\x02\x03" and m.is_extended_id
             b.send(can.Message(arbitration_id=0x7FF, is_extended_id=False, data=bytes(range(8))))
-            m = _recv_id(a, 0x7FF)
+            m = recv_id(a, 0x7FF, timeout=3.0, poll=0.2)
             assert m is not None and bytes(m.data) == bytes(range(8))
         finally:
             a.shutdown()
@@ -85,10 +77,10 @@ def test_socketcand_and_slcan_clients_see_each_other():
         try:
             time.sleep(0.2)
             sc.send(can.Message(arbitration_id=0x123, is_extended_id=False, data=b"\xAA"))
-            m = _recv_id(sl, 0x123)
+            m = recv_id(sl, 0x123, timeout=3.0, poll=0.2)
             assert m is not None and bytes(m.data) == b"\xAA"
             sl.send(can.Message(arbitration_id=0x321, is_extended_id=False, data=b"\xBB\xCC"))
-            m = _recv_id(sc, 0x321)
+            m = recv_id(sc, 0x321, timeout=3.0, poll=0.2)
             assert m is not None and bytes(m.data) == b"\xBB\xCC"
         finally:
             sc.shutdown()

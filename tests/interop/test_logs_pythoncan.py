@@ -7,6 +7,7 @@ import pytest
 import motorbus
 from motorbus import Frame
 from motorbus.bus import wall_time
+from polling import wait_for
 
 FRAMES = [Frame(0x123, b"\xde\xad\xbe\xef"), Frame(0x7FF, b""), Frame(0x1FFFFFFF, bytes(range(8)), extended=True),
           Frame(0x001, b"", rtr=True, dlc=4), Frame(0x0, b"\x00", extended=True), Frame(0x55, b"", rtr=True)]
@@ -21,9 +22,7 @@ def test_python_can_reads_our_logs_identically(tmp_path, suffix):
         sub = rx.subscribe(received.append)
         for f in FRAMES:
             tx.send(f)
-        deadline = time.time() + 2
-        while rec.count < len(FRAMES) and time.time() < deadline:
-            time.sleep(0.005)
+        wait_for(lambda: rec.count >= len(FRAMES), 2.0)
         rx.unsubscribe(sub)
         rec.stop()
     # ASC: python-can reports times relative to the trigger block unless asked for absolute ones

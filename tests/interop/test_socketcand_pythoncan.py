@@ -17,17 +17,9 @@ import pytest
 from motorbus import Frame
 from motorbus._core import open_virtual
 from motorbus.socketcand import SocketcandServer, open_socketcand
+from polling import wait_for
 
 _ids = itertools.count()
-
-
-def wait_for(pred, limit=3.0):
-    end = time.monotonic() + limit
-    while time.monotonic() < end:
-        if pred():
-            return True
-        time.sleep(0.001)
-    return pred()
 
 
 @pytest.fixture

@@ -17,6 +17,7 @@ from motorbus import _core
 from motorbus.canopen import LocalNode, ObjectDictionary
 from motorbus.canopen.ds402 import Ds402, Ds402Device
 from motorbus.canopen.services import HeartbeatService
+from polling import wait_for
 
 _hub = itertools.count()
 REPO = Path(__file__).resolve().parents[2]
@@ -96,10 +97,7 @@ def test_watchdog_arms_the_drives_heartbeat_consumer_and_the_drive_stops_when_th
     assert node.od[0x1016, 1].value == (1 << 16) | 60  # node 1, 3 periods
     assert node.abort_option.value == 3                # quick stop
     # The host's heartbeat arrives: the drive watches it and stays enabled.
-    deadline = time.monotonic() + 2.0
-    while not node.heartbeat.health(1)["state"] == "OPERATIONAL" and time.monotonic() < deadline:
-        time.sleep(0.005)
-    assert node.heartbeat.health(1)["state"] == "OPERATIONAL"
+    assert wait_for(lambda: node.heartbeat.health(1)["state"] == "OPERATIONAL", 2.0)
     assert node.dev.state == "OPERATION ENABLED"
     host.close()  # the cable is pulled: no more heartbeats, no SDO either
     assert node.lost.wait(2.0)
@@ -140,7 +138,7 @@ def test_drives_still_open_at_interpreter_exit_are_quick_stopped():
     # motorbus's own exit hook (atexit is last-in, first-out).
     script = textwrap.dedent(f"""
         import atexit, sys
-        sys.path.insert(0, {str(REPO / "tests" / "python")!r})
+        sys.path[:0] = [{str(REPO / "tests" / "python")!r}, {str(REPO / "tests")!r}]
         state = {{}}
         atexit.register(lambda: print("STATE", state["node"].dev.state, hex(state["node"].dev.controlword)))
         from motorbus import _core

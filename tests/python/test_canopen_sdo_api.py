@@ -12,6 +12,7 @@ import motorbus
 from motorbus import Frame
 from motorbus.canopen import (ABORT_CODES, DataType, LocalNode, ObjectDictionary, SdoAbortError, SdoClient,
                               SdoProtocolError, SdoTimeout, abort_text, load_eds, to_eds)
+from polling import recv_id, wait_for
 
 VECTORS = json.loads((pathlib.Path(__file__).parents[1] / "vectors" / "seed_examples.json").read_text())
 _hub = itertools.count()
@@ -55,15 +56,6 @@ def h(s):
     return bytes.fromhex(s)
 
 
-def recv_id(bus, cob_id, timeout=1.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        f = bus.recv(timeout=0.05)
-        if f is not None and f.id == cob_id:
-            return f
-    return None
-
-
 def test_pmc007_exchanges_byte_for_byte(setup):
     host, od, node, sdo, stop, sniff = setup
     for ex in VECTORS["pmc007_canopen"]["sdo"]:
@@ -90,9 +82,7 @@ def test_pmc007_pdo_config_sequence_from_our_client(setup):
     sdo.write_u32(0x1A00, 1, 0x60120010)
     # The sniffer is another endpoint with its own receive thread: it may still
     # be handing over the last request when the write has already completed.
-    deadline = time.monotonic() + 2.0
-    while len(sent) < len(seq) and time.monotonic() < deadline:
-        time.sleep(0.001)
+    wait_for(lambda: len(sent) >= len(seq), 2.0)
     sniff.unsubscribe(sub)
     assert [s.hex(" ").upper() for s in sent] == [r["data"] for r in seq]
     assert od["TPDO1 communication parameter.COB-ID"].value == 0x187
@@ -135,9 +125,7 @@ def test_typed_errors(setup):
     sub = sniff.subscribe(lambda f: frames.append(f), id=0x609)
     with pytest.raises(SdoTimeout) as t:
         lonely.read_u8(0x6001, 0)
-    deadline = time.monotonic() + 2.0  # the request, then the abort, via the sniffer's thread
-    while len(frames) < 2 and time.monotonic() < deadline:
-        time.sleep(0.001)
+    wait_for(lambda: len(frames) >= 2, 2.0)  # the request, then the abort, via the sniffer's thread
     sniff.unsubscribe(sub)
     assert isinstance(t.value, motorbus.TimeoutError) and isinstance(t.value, TimeoutError)
     assert frames[-1].data == h("80 01 60 00 00 00 04 05")  # C1: abort carries the multiplexer
@@ -182,9 +170,7 @@ def test_nmt_stop_silences_sdo(setup):
     seen = []
     node.add_state_listener(lambda a, b: seen.append((a, b)))
     host.send(Frame(0, bytes([0x02, 5])))
-    deadline = time.monotonic() + 1
-    while node.nmt_state != "STOPPED" and time.monotonic() < deadline:
-        time.sleep(0.001)
+    wait_for(lambda: node.nmt_state == "STOPPED", 1.0)
     assert node.nmt_state == "STOPPED"
     sdo.timeout = 0.05
     with pytest.raises(SdoTimeout):

@@ -4,7 +4,6 @@ from __future__ import annotations
 import json
 import pathlib
 import threading
-import time
 
 import pytest
 
@@ -16,6 +15,7 @@ from motorbus.canopen.services import (Ds402, Ds402Device, EmcyConsumer, EmcyPro
                                        read_pdo_config, scan_network)
 from motorbus.canopen import nmt as nmt_mod
 from motorbus.canopen import pdo as pdo_mod
+from polling import recv_id, wait_for
 
 VECTORS = json.loads((pathlib.Path(__file__).parents[1] / "vectors" / "seed_examples.json").read_text())
 _hub = iter(range(1_000_000))
@@ -24,15 +24,6 @@ _hub = iter(range(1_000_000))
 def pair():
     name = f"svc-py-{next(_hub)}"
     return _core.open_virtual(name), _core.open_virtual(name)
-
-
-def recv_id(bus, can_id, timeout=1.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        f = bus.recv(0.05)
-        if f is not None and f.id == can_id:
-            return f
-    return None
 
 
 # ---- PDO codec ---------------------------------------------------------------
@@ -114,9 +105,7 @@ def test_nmt_master_commands_and_states():
     dev.send(nmt_mod.heartbeat_encode(5, "PRE-OPERATIONAL"))
     assert m.wait_for_state(5, "PRE-OPERATIONAL", timeout=1.0)
     dev.send(_core.Frame(0x705, b"\x42"))  # N7
-    deadline = time.monotonic() + 1
-    while m.raw_state(5) != 0x42 and time.monotonic() < deadline:
-        time.sleep(0.001)
+    wait_for(lambda: m.raw_state(5) == 0x42, 1.0)
     assert m.state(5) == "UNKNOWN"
     assert changes[0] == (5, "UNKNOWN", "PRE-OPERATIONAL")
     assert nmt_mod.nmt_decode(_core.Frame(0, b"\x01")) is None  # N1
@@ -171,9 +160,7 @@ def test_sync_producer_jitter_stats():
     host, dev = pair()
     s = SyncProducer(host, 0.002, counter_overflow=5)
     s.start()
-    deadline = time.monotonic() + 2
-    while s.sent < 10 and time.monotonic() < deadline:
-        time.sleep(0.005)
+    wait_for(lambda: s.sent >= 10, 2.0, interval=0.005)
     s.stop()
     j = s.jitter()
     assert j["count"] == s.sent - 1

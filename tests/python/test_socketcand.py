@@ -16,21 +16,13 @@ from motorbus.socketcand import (
     open_socketcand,
     socketcan_unavailable_reason,
 )
+from polling import wait_for
 
 _hub_ids = itertools.count()
 
 
 def hub() -> str:
     return f"py-sockd-{next(_hub_ids)}"
-
-
-def wait_for(pred, limit=3.0):
-    end = time.monotonic() + limit
-    while time.monotonic() < end:
-        if pred():
-            return True
-        time.sleep(0.001)
-    return pred()
 
 
 @pytest.fixture
