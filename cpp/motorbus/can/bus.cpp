@@ -42,20 +42,23 @@ void Bus::send(const Frame& frame, Duration timeout) {
     }
 }
 
-std::optional<Frame> Bus::recv(Duration timeout) {
-    std::unique_lock lock(rx_mutex_);
-    if (!rx_queue_.empty()) {  // the common case under load: no clock read, no wait
-        Frame f = rx_queue_.front();
-        rx_queue_.pop_front();
-        return f;
-    }
+// Waits until the recv() queue has a frame: false after `timeout` (negative =
+// forever); ClosedError once the bus is closed and the queue drained.
+bool Bus::wait_for_rx(std::unique_lock<std::mutex>& lock, Duration timeout) {
+    if (!rx_queue_.empty()) return true;  // the common case under load: no clock read, no wait
     auto ready = [&] { return !rx_queue_.empty() || closed_.load(); };
     if (timeout.count() < 0) {
         rx_cv_.wait(lock, ready);
     } else if (!rx_cv_.wait_for(lock, timeout, ready)) {
-        return std::nullopt;
+        return false;
     }
     if (rx_queue_.empty()) throw ClosedError("bus " + channel_ + " is closed");
+    return true;
+}
+
+std::optional<Frame> Bus::recv(Duration timeout) {
+    std::unique_lock lock(rx_mutex_);
+    if (!wait_for_rx(lock, timeout)) return std::nullopt;
     Frame f = rx_queue_.front();
     rx_queue_.pop_front();
     return f;
@@ -65,18 +68,10 @@ std::vector<Frame> Bus::recv_many(std::size_t max, Duration timeout) {
     std::vector<Frame> out;
     if (max == 0) return out;
     std::unique_lock lock(rx_mutex_);
-    if (rx_queue_.empty()) {
-        auto ready = [&] { return !rx_queue_.empty() || closed_.load(); };
-        if (timeout.count() < 0) {
-            rx_cv_.wait(lock, ready);
-        } else if (!rx_cv_.wait_for(lock, timeout, ready)) {
-            return out;
-        }
-        if (rx_queue_.empty()) throw ClosedError("bus " + channel_ + " is closed");
-    }
-    const std::size_t n = std::min(max, rx_queue_.size());
-    out.assign(rx_queue_.begin(), rx_queue_.begin() + static_cast<std::ptrdiff_t>(n));
-    rx_queue_.erase(rx_queue_.begin(), rx_queue_.begin() + static_cast<std::ptrdiff_t>(n));
+    if (!wait_for_rx(lock, timeout)) return out;
+    const auto n = static_cast<std::ptrdiff_t>(std::min(max, rx_queue_.size()));
+    out.assign(rx_queue_.begin(), rx_queue_.begin() + n);
+    rx_queue_.erase(rx_queue_.begin(), rx_queue_.begin() + n);
     return out;
 }
 

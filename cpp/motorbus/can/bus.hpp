@@ -136,6 +136,7 @@ private:
         return (static_cast<std::uint64_t>(extended) << 32) | id;
     }
     SubscriptionId add_subscriber(std::shared_ptr<Subscriber> s, bool exact);
+    bool wait_for_rx(std::unique_lock<std::mutex>& lock, Duration timeout);
 
     std::string channel_;
     std::atomic<BusState> state_{BusState::Active};
