@@ -21,6 +21,21 @@ std::size_t clamp_copy(std::uint8_t* dst, std::span<const std::uint8_t> src, std
     std::copy_n(src.begin(), n, dst);
     return n;
 }
+// Initiate frames share one layout in both directions; only the command
+// specifier (0x20 download request, 0x40 upload response) differs.
+// Expedited: e=1, s=1, n = 4 - bytes of data in byte 4-7.
+Payload initiate_expedited(std::uint8_t cs, Multiplexer m, std::span<const std::uint8_t> data) {
+    const std::size_t n = std::min<std::size_t>(data.size(), 4);
+    Payload p = with_mux(static_cast<std::uint8_t>(cs | ((4 - n) << 2) | 0x03), m);
+    clamp_copy(&p[4], data, 4);
+    return p;
+}
+// Segmented: e=0, s=1 with the size in bytes 4-7 when it is known.
+Payload initiate_segmented(std::uint8_t cs, Multiplexer m, std::optional<std::uint32_t> size) {
+    Payload p = with_mux(static_cast<std::uint8_t>(size ? cs | 0x01 : cs), m);
+    if (size) put_le32(&p[4], *size);
+    return p;
+}
 }  // namespace
 
 std::optional<Multiplexer> multiplexer_of(std::span<const std::uint8_t> p) {
@@ -29,16 +44,11 @@ std::optional<Multiplexer> multiplexer_of(std::span<const std::uint8_t> p) {
 }
 
 Payload initiate_download_expedited(Multiplexer m, std::span<const std::uint8_t> data) {
-    const std::size_t n = std::min<std::size_t>(data.size(), 4);
-    Payload p = with_mux(static_cast<std::uint8_t>(0x20 | ((4 - n) << 2) | 0x03), m);
-    clamp_copy(&p[4], data, 4);
-    return p;
+    return initiate_expedited(0x20, m, data);
 }
 
 Payload initiate_download_segmented(Multiplexer m, std::optional<std::uint32_t> size) {
-    Payload p = with_mux(size ? 0x21 : 0x20, m);
-    if (size) put_le32(&p[4], *size);
-    return p;
+    return initiate_segmented(0x20, m, size);
 }
 
 Payload initiate_download_response(Multiplexer m) { return with_mux(0x60, m); }
@@ -59,16 +69,11 @@ Payload download_segment_response(bool toggle) {
 Payload initiate_upload(Multiplexer m) { return with_mux(0x40, m); }
 
 Payload initiate_upload_expedited_response(Multiplexer m, std::span<const std::uint8_t> data) {
-    const std::size_t n = std::min<std::size_t>(data.size(), 4);
-    Payload p = with_mux(static_cast<std::uint8_t>(0x40 | ((4 - n) << 2) | 0x03), m);
-    clamp_copy(&p[4], data, 4);
-    return p;
+    return initiate_expedited(0x40, m, data);
 }
 
 Payload initiate_upload_segmented_response(Multiplexer m, std::optional<std::uint32_t> size) {
-    Payload p = with_mux(size ? 0x41 : 0x40, m);
-    if (size) put_le32(&p[4], *size);
-    return p;
+    return initiate_segmented(0x40, m, size);
 }
 
 Payload upload_segment(bool toggle) {
