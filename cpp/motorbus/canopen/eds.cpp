@@ -66,32 +66,6 @@ Ini parse_ini(std::string_view text) {
     return ini;
 }
 
-std::optional<std::int64_t> parse_int_literal(std::string_view s) {
-    s = trim(s);
-    bool neg = false;
-    if (!s.empty() && (s[0] == '-' || s[0] == '+')) {
-        neg = s[0] == '-';
-        s.remove_prefix(1);
-    }
-    if (s.empty()) return std::nullopt;
-    int base = 10;
-    if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
-        base = 16;
-        s.remove_prefix(2);
-    } else if (s.size() > 1 && s[0] == '0') {
-        base = 8;
-        s.remove_prefix(1);
-    }
-    std::uint64_t v = 0;
-    auto r = std::from_chars(s.data(), s.data() + s.size(), v, base);
-    if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return std::nullopt;
-    if (neg) {
-        if (v > (std::uint64_t{1} << 63)) return std::nullopt;
-        return static_cast<std::int64_t>(0 - v);
-    }
-    return static_cast<std::int64_t>(v);  // values >= 2^63 wrap; callers re-read as unsigned
-}
-
 std::optional<std::uint64_t> parse_uint_literal(std::string_view s) {
     s = trim(s);
     int base = 10;
@@ -107,6 +81,24 @@ std::optional<std::uint64_t> parse_uint_literal(std::string_view s) {
     auto r = std::from_chars(s.data(), s.data() + s.size(), v, base);
     if (r.ec != std::errc() || r.ptr != s.data() + s.size()) return std::nullopt;
     return v;
+}
+
+std::optional<std::int64_t> parse_int_literal(std::string_view s) {
+    s = trim(s);
+    bool neg = false;
+    if (!s.empty() && (s[0] == '-' || s[0] == '+')) {
+        neg = s[0] == '-';
+        s.remove_prefix(1);
+    }
+    // The magnitude follows the sign directly: "- 5" is not a number.
+    if (s.empty() || std::isspace(static_cast<unsigned char>(s.front()))) return std::nullopt;
+    const auto v = parse_uint_literal(s);
+    if (!v) return std::nullopt;
+    if (neg) {
+        if (*v > (std::uint64_t{1} << 63)) return std::nullopt;
+        return static_cast<std::int64_t>(0 - *v);
+    }
+    return static_cast<std::int64_t>(*v);  // values >= 2^63 wrap; callers re-read as unsigned
 }
 
 std::string hex(unsigned v, int width) {

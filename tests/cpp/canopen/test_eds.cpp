@@ -235,6 +235,14 @@ TEST(Eds, ExpressionsAndErrors) {
     EXPECT_EQ(eval_eds_integer("$nodeid + 512", 1), 513);
     EXPECT_EQ(eval_eds_integer("-5", 0), -5);
     EXPECT_EQ(eval_eds_integer("017", 0), 15);
+    EXPECT_EQ(eval_eds_integer("-0x10", 0), -16);
+    EXPECT_EQ(eval_eds_integer("-010", 0), -8);
+    EXPECT_EQ(eval_eds_integer("-9223372036854775808", 0), INT64_MIN);
+    EXPECT_FALSE(eval_eds_integer("-9223372036854775809", 0));  // below INT64_MIN
+    EXPECT_FALSE(eval_eds_integer("- 5", 0));                   // sign and digits apart
+    EXPECT_FALSE(eval_eds_integer("--5", 0));
+    EXPECT_FALSE(eval_eds_integer("0x", 0));
+    EXPECT_FALSE(eval_eds_integer("08", 0));                    // not octal
     EXPECT_FALSE(eval_eds_integer("abc", 0));
     EXPECT_FALSE(eval_eds_integer("", 0));
     EXPECT_THROW(parse_eds("[FileInfo]\nFileName=x\n"), InvalidArgument);
