@@ -786,23 +786,10 @@ std::string Sim::handle(const Request& req) {
             s.snl.clear();
             return ok;
         }
-        if (name == "SLA") {
-            auto r = set(s.cfg.sla, 0, INT32_MAX);
-            e.configure_snl();
-            return r;
-        }
-        if (name == "SLE") {
-            auto r = set(s.cfg.sle, 0, INT32_MAX);
-            e.configure_snl();
-            return r;
-        }
-        if (name == "SLM") {
-            auto r = set(s.cfg.slm, 0, INT32_MAX);
-            e.configure_snl();
-            return r;
-        }
-        if (name == "SLT") {
-            auto r = set(s.cfg.slt, 0, INT32_MAX);
+        // StepNLoop parameters: stored, then handed to the StepNLoop machine.
+        if (name == "SLA" || name == "SLE" || name == "SLM" || name == "SLT") {
+            auto& field = name == "SLA" ? s.cfg.sla : name == "SLE" ? s.cfg.sle : name == "SLM" ? s.cfg.slm : s.cfg.slt;
+            auto r = set(field, 0, INT32_MAX);
             e.configure_snl();
             return r;
         }
