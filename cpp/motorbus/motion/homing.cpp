@@ -135,6 +135,23 @@ void ArcusHoming::set_zero() {
     if (opt_.zero_encoder) motor_.set_encoder(0);
 }
 
+// The home switch was found while searching (H, HL): zero the counter there,
+// decelerate to LSPD and stop; stage 1 waits for the end of that ramp.
+void ArcusHoming::zero_and_decelerate(const MotorEvent& e) {
+    set_zero();
+    decel_stop(e.t);
+    stage_ = 1;
+    if (!motor_.moving())
+        on_event(MotorEvent{MotorEvent::Kind::ProfileDone, e.t, e.physical, 0, e.encoder, 0});
+}
+
+// The routine ends where the motor is now: stop at once, that point is zero.
+void ArcusHoming::stop_at_zero() {
+    motor_.halt();
+    set_zero();
+    finish(HomingResult::Done);
+}
+
 void ArcusHoming::finish(HomingResult r) {
     result_ = r;
     stage_ = -1;
@@ -152,10 +169,7 @@ void ArcusHoming::on_event(const MotorEvent& e) {
     switch (method_) {
         case Method::H:
             if (stage_ == 0 && e.kind == K::HomeOn) {
-                set_zero();
-                decel_stop(e.t);
-                stage_ = 1;
-                if (!motor_.moving()) on_event(MotorEvent{K::ProfileDone, e.t, e.physical, 0, e.encoder, 0});
+                zero_and_decelerate(e);
             } else if (stage_ == 1 && e.kind == K::ProfileDone) {
                 if (opt_.rz && std::llround(motor_.pulse_position()) != 0) {
                     run(0, params_.hspd, false);
@@ -171,10 +185,7 @@ void ArcusHoming::on_event(const MotorEvent& e) {
             // Stages: 0 search at HSPD, 1 decelerate, 2 back at LSPD to the switch,
             // 3 through the switch at HSPD, 4 HCA past it, 5 forward at LSPD onto it.
             if (stage_ == 0 && e.kind == K::HomeOn) {
-                set_zero();
-                decel_stop(e.t);
-                stage_ = 1;
-                if (!motor_.moving()) on_event(MotorEvent{K::ProfileDone, e.t, e.physical, 0, e.encoder, 0});
+                zero_and_decelerate(e);
             } else if (stage_ == 1 && e.kind == K::ProfileDone) {
                 if (motor_.home_active()) {
                     // Stopped inside the switch: it is reached already.
@@ -195,16 +206,12 @@ void ArcusHoming::on_event(const MotorEvent& e) {
             } else if (stage_ == 4 && e.kind == K::ProfileDone) {
                 stage_ = 5;
                 if (motor_.home_active()) {
-                    motor_.halt();
-                    set_zero();
-                    finish(HomingResult::Done);
+                    stop_at_zero();
                 } else {
                     jog(dir_, params_.lspd);
                 }
             } else if (stage_ == 5 && e.kind == K::HomeOn) {
-                motor_.halt();
-                set_zero();
-                finish(HomingResult::Done);
+                stop_at_zero();
             }
             break;
         case Method::L:
@@ -223,9 +230,7 @@ void ArcusHoming::on_event(const MotorEvent& e) {
             break;
         case Method::Z:
             if (stage_ == 0 && e.kind == K::IndexPulse) {
-                motor_.halt();
-                set_zero();
-                finish(HomingResult::Done);
+                stop_at_zero();
             }
             break;
         case Method::ZH:
@@ -235,9 +240,7 @@ void ArcusHoming::on_event(const MotorEvent& e) {
                 stage_ = 1;
             } else if (stage_ == 1 && e.kind == K::IndexPulse &&
                        std::fabs(motor_.pulse_velocity()) <= params_.lspd * (1 + 1e-9)) {
-                motor_.halt();
-                set_zero();
-                finish(HomingResult::Done);
+                stop_at_zero();
             }
             break;
     }

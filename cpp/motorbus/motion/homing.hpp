@@ -87,6 +87,8 @@ private:
     void decel_stop(Nanos t);
     void finish(HomingResult r);
     void set_zero();
+    void zero_and_decelerate(const MotorEvent& e);
+    void stop_at_zero();
 };
 
 class Cia402Homing {
