@@ -6,9 +6,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstring>
 #include <functional>
 #include <mutex>
 #include <string>
@@ -26,6 +26,35 @@ using namespace motorbus::can;
 using namespace std::chrono_literals;
 
 namespace {
+
+// The server side of one hand-scripted socketcand session, for tests of how
+// the client copes with a peer that misbehaves: accepts one connection on
+// `listener` (within 2 s), says lines and hears requests raw.
+struct FakePeer {
+    net::Fd c;
+    explicit FakePeer(const net::Fd& listener, int rcvbuf = 0) {
+        pollfd p{listener.get(), POLLIN, 0};
+        ::poll(&p, 1, 2000);
+        c = net::Fd(::accept(listener.get(), nullptr, nullptr));
+        if (rcvbuf > 0) ::setsockopt(c.get(), SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
+    }
+    void say(const std::string& s) { ::send(c.get(), s.data(), s.size(), MSG_NOSIGNAL); }
+    // Reads what has arrived, at most `max` bytes (within 2 s).
+    void hear(std::size_t max = 256) {
+        pollfd q{c.get(), POLLIN, 0};
+        ::poll(&q, 1, 2000);
+        char b[256];
+        [[maybe_unused]] auto r = ::recv(c.get(), b, std::min(max, sizeof b), 0);
+    }
+    // The raw-mode handshake: hi, (open) ok, (rawmode) ok.
+    void handshake(const std::string& hello = "< hi >", std::size_t max_request = 256) {
+        say(hello);
+        hear(max_request);
+        say("< ok >");
+        hear(max_request);
+        say("< ok >");
+    }
+};
 
 bool wait_for(const std::function<bool()>& pred, std::chrono::milliseconds limit = 3000ms) {
     auto end = std::chrono::steady_clock::now() + limit;
@@ -298,21 +327,8 @@ TEST(SocketcandLive, K13_SilentPeerIsDeclaredLinkDown) {
     auto listener = net::tcp_listen("127.0.0.1", 0, port);
     std::atomic<bool> done{false};
     std::thread fake([&] {
-        pollfd p{listener.get(), POLLIN, 0};
-        ::poll(&p, 1, 2000);
-        net::Fd c(::accept(listener.get(), nullptr, nullptr));
-        auto say = [&](const char* s) { ::send(c.get(), s, std::strlen(s), MSG_NOSIGNAL); };
-        auto hear = [&] {
-            pollfd q{c.get(), POLLIN, 0};
-            ::poll(&q, 1, 2000);
-            char b[256];
-            [[maybe_unused]] auto r = ::recv(c.get(), b, sizeof b, 0);
-        };
-        say("< hi >");
-        hear();
-        say("< ok >");
-        hear();
-        say("< ok >");
+        FakePeer peer(listener);
+        peer.handshake();
         while (!done.load()) std::this_thread::sleep_for(2ms);
     });
     SocketcandOptions o = fast_client();
@@ -432,25 +448,12 @@ TEST(SocketcandLive, ClientSendBlocksThenTimesOutWhenServerStopsReading) {
     auto listener = net::tcp_listen("127.0.0.1", 0, port);
     std::atomic<bool> done{false};
     std::thread fake([&] {
-        pollfd p{listener.get(), POLLIN, 0};
-        ::poll(&p, 1, 2000);
-        net::Fd c(::accept(listener.get(), nullptr, nullptr));
-        int small = 4096;
-        ::setsockopt(c.get(), SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
-        auto say = [&](const char* s) { ::send(c.get(), s, std::strlen(s), MSG_NOSIGNAL); };
-        auto hear = [&] {
-            pollfd q{c.get(), POLLIN, 0};
-            ::poll(&q, 1, 2000);
-            char b[64];  // exactly the handshake commands
-            [[maybe_unused]] auto r = ::recv(c.get(), b, 11, 0);
-        };
-        say("< hi >");
-        hear();  // "< open can0 >" is 13 bytes; the rest is read with rawmode
-        say("< ok >");
-        hear();
-        say("< ok >");
+        FakePeer peer(listener, 4096);
+        // Reads at most 11 bytes per request ("< open can0 >" is 13; the rest
+        // is read with rawmode), then never again.
+        peer.handshake("< hi >", 11);
         while (!done.load()) {
-            say("< echo >");  // stays "alive" while never reading
+            peer.say("< echo >");  // stays "alive" while never reading
             std::this_thread::sleep_for(5ms);
         }
     });
@@ -489,22 +492,9 @@ TEST(SocketcandLive, ClientSurvivesGarbageFromTheServer) {
     std::uint16_t port = 0;
     auto listener = net::tcp_listen("127.0.0.1", 0, port);
     std::thread fake([&] {
-        pollfd p{listener.get(), POLLIN, 0};
-        ::poll(&p, 1, 2000);
-        net::Fd c(::accept(listener.get(), nullptr, nullptr));
-        auto say = [&](const std::string& s) { ::send(c.get(), s.data(), s.size(), MSG_NOSIGNAL); };
-        auto hear = [&] {
-            pollfd q{c.get(), POLLIN, 0};
-            ::poll(&q, 1, 2000);
-            char b[256];
-            [[maybe_unused]] auto r = ::recv(c.get(), b, sizeof b, 0);
-        };
-        say("noise< hi >");
-        hear();
-        say("< ok >");
-        hear();
-        say("< ok >");
-        say("junk > < frame XYZ 1.0 AA >< frame 123 1.0 ABC >< frame " + std::string(5000, 'F') +
+        FakePeer peer(listener);
+        peer.handshake("noise< hi >");
+        peer.say("junk > < frame XYZ 1.0 AA >< frame 123 1.0 ABC >< frame " + std::string(5000, 'F') +
             "< frame 123 1.0 112233445566778899 >< frame 1FFFFFFFF 1.0 >< frame 42 2.5 0102 >");
         std::this_thread::sleep_for(300ms);
     });
