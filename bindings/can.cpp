@@ -172,14 +172,14 @@ void bind_can(py::module_& m) {
     m.def("open_virtual",
           [](const std::string& name, double bitrate, std::size_t tx_queue, std::size_t rx_queue_size,
              bool receive_own, double rx_spin) {
-              if (!(rx_spin >= 0)) throw InvalidArgument("virtual bus rx_spin: must be >= 0 seconds");
               VirtualOptions o;
               o.bitrate = bitrate;
               o.tx_queue = tx_queue;
               o.rx_queue_size = rx_queue_size;
               o.receive_own = receive_own;
+              // NaN has no duration: pass it on as negative, which open_virtual refuses.
               o.rx_spin = std::chrono::duration_cast<std::chrono::microseconds>(
-                  std::chrono::duration<double>(rx_spin));
+                  std::chrono::duration<double>(std::isnan(rx_spin) ? -1.0 : rx_spin));
               return open_virtual(name, o);
           },
           py::arg("name"), py::arg("bitrate") = 0.0, py::arg("tx_queue") = 64,

@@ -241,7 +241,7 @@ VirtualBus::VirtualBus(std::shared_ptr<VirtualHub> hub, std::string channel,
     impl_->rng.seed(opts.faults.seed);
     impl_->rx_thread = std::thread([this] {
         std::vector<Frame> batch;
-        const auto spin = impl_->opts.rx_spin;
+        const auto spin = impl_->opts.rx_spin;  // >= 0, checked by open_virtual
         for (;;) {
             // Request/response traffic (an SDO exchange) brings the next frame
             // a few microseconds after the last batch: poll for it briefly
@@ -368,6 +368,7 @@ void VirtualBus::do_send(const Frame& frame, Deadline deadline) {
 std::shared_ptr<VirtualBus> open_virtual(const std::string& name, const VirtualOptions& opts) {
     if (name.empty()) throw InvalidArgument("virtual bus name: must not be empty");
     if (opts.bitrate < 0) throw InvalidArgument("virtual bus bitrate: must be >= 0");
+    if (opts.rx_spin.count() < 0) throw InvalidArgument("virtual bus rx_spin: must be >= 0");
     std::shared_ptr<VirtualHub> hub;
     {
         std::lock_guard lock(g_hubs_mutex);
