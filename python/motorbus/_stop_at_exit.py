@@ -1,4 +1,5 @@
-"""Drive objects still open when the interpreter exits get their motor stopped.
+"""Drive objects stop their motor when an exception leaves ``with`` and when
+the interpreter exits with them still open.
 
 Every drive client (Arcus, DMAC, CiA 402) registers itself with :func:`track`
 when it opens and :func:`untrack` when it closes; at exit each one still
@@ -38,3 +39,20 @@ def stop_all() -> None:
 
 
 atexit.register(stop_all)
+
+
+class StopsMotor:
+    """Mixin for drive objects: ``with`` support that calls ``_stop_on_error()``
+    when an exception leaves the block and ``close()`` in every case.  The
+    class also calls :func:`track` when it opens and :func:`untrack` in
+    ``close()``, and defines ``_stop_at_exit()`` for the exit hook."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        try:
+            if exc_type is not None:
+                self._stop_on_error()
+        finally:
+            self.close()

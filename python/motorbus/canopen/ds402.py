@@ -56,7 +56,7 @@ class Controlword(enum.IntEnum):
 ABORT_CONNECTION_ACTIONS = {"fault": 1, "disable_voltage": 2, "quick_stop": 3}
 
 
-class Ds402(_core.Ds402Host):
+class Ds402(_stop_at_exit.StopsMotor, _core.Ds402Host):
     """Host-side CiA 402 state machine of one drive.
 
     ``Ds402(bus_or_sdo, node, timeout=2.0, poll=0.005, on_error="quick_stop",
@@ -159,15 +159,8 @@ class Ds402(_core.Ds402Host):
             self._heartbeat = None
 
     # ---- lifecycle ----
-    def __enter__(self) -> "Ds402":
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        try:
-            if exc_type is not None:
-                self._halt(self._on_error)
-        finally:
-            self.close()
+    def _stop_on_error(self) -> None:
+        self._halt(self._on_error)
 
     def close(self) -> None:
         """Stop the watchdog cleanly and forget this drive for the exit-time stop.

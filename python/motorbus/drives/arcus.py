@@ -132,7 +132,7 @@ def open_line(port: Union[str, "_core.Port"], baud: int = 9600, timeout: float =
 
 
 
-class ArcusClient(ArcusClientBase):
+class ArcusClient(_stop_at_exit.StopsMotor, ArcusClientBase):
     """Typed client for one DMX-CAN.
 
     ``port`` is a device path (opened at ``baud``), a ``motorbus.Port``, or a
@@ -162,15 +162,8 @@ class ArcusClient(ArcusClientBase):
         _stop_at_exit.track(self)
 
     # ---- lifecycle ----
-    def __enter__(self) -> "ArcusClient":
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        try:
-            if exc_type is not None:
-                self._safe_halt(self._on_error)
-        finally:
-            self.close()
+    def _stop_on_error(self) -> None:
+        self._safe_halt(self._on_error)
 
     def close(self) -> None:
         if self._closed:

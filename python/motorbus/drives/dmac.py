@@ -65,7 +65,7 @@ __all__ = [
 
 
 
-class DmacClient(_core.DmacClient):
+class DmacClient(_stop_at_exit.StopsMotor, _core.DmacClient):
     """Typed DMAC commands for the module at ``address`` on a ``LineLink``.
 
     ``DmacClient(link, address=0, verify=True, timeout=None, sleep=None)``
@@ -87,15 +87,8 @@ class DmacClient(_core.DmacClient):
         self._open = True
         _stop_at_exit.track(self)
 
-    def __enter__(self) -> "DmacClient":
-        return self
-
-    def __exit__(self, exc_type, exc, tb) -> None:
-        try:
-            if exc_type is not None:
-                self._emergency_stop()
-        finally:
-            self.close()
+    def _stop_on_error(self) -> None:
+        self._emergency_stop()
 
     def close(self) -> None:
         """Forget this client for the exit-time STOP (the link stays open)."""
