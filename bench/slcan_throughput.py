@@ -33,32 +33,39 @@ STOP_ID, SYNC_ID, SYNC_REPLY, TX_CMD, TX_FRAME, PING, PONG, LOAD = (
 
 # --------------------------------------------------------------------- agents --
 
+def serve_agent(recv, send, frame, id_and_data) -> None:
+    """The agent's protocol, the same for both libraries: count LOAD frames,
+    answer PING and SYNC, send n frames on TX_CMD, stop on STOP (or after 30 s
+    of silence).  `frame(id, data)` builds a message, `id_and_data(m)` reads one."""
+    count = 0
+    while True:
+        m = recv(30)
+        if m is None:
+            return
+        i, data = id_and_data(m)
+        if i == LOAD:
+            count += 1
+        elif i == PING:
+            send(frame(PONG, data))
+        elif i == SYNC_ID:
+            send(frame(SYNC_REPLY, struct.pack("<I", count)))
+            count = 0
+        elif i == TX_CMD:
+            (n,) = struct.unpack("<I", bytes(data[:4]))
+            out = frame(TX_FRAME, b"\x01\x02\x03\x04\x05\x06\x07\x08")
+            for _ in range(n):
+                send(out)
+        elif i == STOP_ID:
+            return
+
+
 def agent_pycan(path: str) -> None:
     import can
     bus = can.Bus(interface="slcan", channel=path, bitrate=500000, sleep_after_open=0)
-    count = 0
     try:
-        while True:
-            m = bus.recv(timeout=30)
-            if m is None:
-                return
-            i = m.arbitration_id
-            if i == LOAD:
-                count += 1
-            elif i == PING:
-                bus.send(can.Message(arbitration_id=PONG, data=m.data, is_extended_id=False))
-            elif i == SYNC_ID:
-                bus.send(can.Message(arbitration_id=SYNC_REPLY, data=struct.pack("<I", count),
-                                     is_extended_id=False))
-                count = 0
-            elif i == TX_CMD:
-                (n,) = struct.unpack("<I", bytes(m.data[:4]))
-                out = can.Message(arbitration_id=TX_FRAME, data=b"\x01\x02\x03\x04\x05\x06\x07\x08",
-                                  is_extended_id=False)
-                for _ in range(n):
-                    bus.send(out)
-            elif i == STOP_ID:
-                return
+        serve_agent(bus.recv, bus.send,
+                    lambda i, d: can.Message(arbitration_id=i, data=d, is_extended_id=False),
+                    lambda m: (m.arbitration_id, m.data))
     finally:
         bus.shutdown()
 
@@ -68,29 +75,8 @@ def agent_motorbus(path: str) -> None:
     from motorbus.slcan import open_slcan
     # The harness plays a silent wire (no acks), like a python-can peer.
     bus = open_slcan(path, 500000, wait_for_acks=False)
-    Frame = motorbus.Frame
-    count = 0
     try:
-        while True:
-            f = bus.recv(timeout=30)
-            if f is None:
-                return
-            i = f.id
-            if i == LOAD:
-                count += 1
-            elif i == PING:
-                bus.send(Frame(PONG, f.data))
-            elif i == SYNC_ID:
-                bus.send(Frame(SYNC_REPLY, struct.pack("<I", count)))
-                count = 0
-            elif i == TX_CMD:
-                (n,) = struct.unpack("<I", f.data[:4])
-                out = Frame(TX_FRAME, b"\x01\x02\x03\x04\x05\x06\x07\x08")
-                send = bus.send
-                for _ in range(n):
-                    send(out)
-            elif i == STOP_ID:
-                return
+        serve_agent(bus.recv, bus.send, motorbus.Frame, lambda f: (f.id, f.data))
     finally:
         bus.close()
 
