@@ -352,11 +352,14 @@ TEST(SlcanDecode, L12_StatusFlagsMapToBusStatePerLawicelBitLayout) {
 }
 
 TEST(SlcanDecode, NextValidFrameArrivesAfterEveryKindOfBadInput) {
-    const char* bad_inputs[] = {
-        "\x00\x01\x02\xff\r", "tttttttttttttttttttttttttttttttttttttttttttttttttttt",
-        "\r\r\r", "\a\a", "t", "T\r", "t123", "\xfe\r", "F\r", "e\r", "s\r", "V\r",
+    // string_view literals: the first input starts with NUL, which a C string would end at once.
+    using namespace std::string_view_literals;
+    const std::string_view bad_inputs[] = {
+        "\x00\x01\x02\xff\r"sv, "tttttttttttttttttttttttttttttttttttttttttttttttttttt"sv,
+        "\r\r\r"sv, "\a\a"sv, "t"sv, "T\r"sv, "t123"sv, "\xfe\r"sv, "F\r"sv, "e\r"sv, "s\r"sv, "V\r"sv,
     };
-    for (const char* bad : bad_inputs) {
+    for (std::string_view bad : bad_inputs) {
+        ASSERT_FALSE(bad.empty());
         StreamDecoder d;
         feed(d, bad);
         feed(d, "\r");  // whatever the bad input left, one CR ends it
