@@ -289,6 +289,7 @@ void bind_motion(py::module_& m) {
         .def_property_readonly("encoder", &MotorModel::encoder)
         .def_property_readonly("velocity", &MotorModel::velocity)
         .def_property_readonly("commanded_velocity", &MotorModel::commanded_velocity)
+        .def_property_readonly("pulse_velocity", &MotorModel::pulse_velocity)
         .def_property_readonly("stalled", &MotorModel::stalled)
         .def_property_readonly("slip", &MotorModel::slip)
         .def("set_pulse_position", &MotorModel::set_pulse_position)

@@ -1558,6 +1558,9 @@ class MotorModel:
     def pulse_position(self) -> float:
         ...
     @property
+    def pulse_velocity(self) -> float:
+        ...
+    @property
     def slip(self) -> float:
         ...
     @property

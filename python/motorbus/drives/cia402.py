@@ -1,0 +1,646 @@
+"""Any CiA 402 drive on CANopen: a simulated one and the ``Drive`` adapter.
+
+    import motorbus
+    with motorbus.open_drive("cia402", bus="socketcand:127.0.0.1:29536/can0", address=5) as axis:
+        axis.enable()
+        axis.move_to(4000)                  # profile position mode, set-point handshake
+        axis.jog(-1000)                     # profile velocity mode
+        axis.stop()
+        axis.params["0x6081"] = 2000        # profile velocity, by index (or "0x6099:01", or a name)
+
+The adapter runs on the host-side CiA 402 state machine (``motorbus.canopen``'s
+``Ds402``) and uses the drive's own heartbeat consumer (0x1016 + 0x6007) as the
+link-loss watchdog: the host produces a heartbeat, the drive quick-stops when it
+stops arriving (``watchdog=`` option of :func:`open`).
+
+The simulator (:class:`Cia402Sim`, ``make_sim``) is a CiA 402 node as the
+profile describes it, built from the core's pieces: a LocalNode (SDO server,
+NMT slave, boot-up), a HeartbeatService (producer 0x1017, consumer 0x1016), the
+device state machine (Ds402Device), profile position / profile velocity / homing
+on a motor model with home and limit switches.  ``motorbus sim serve --drive
+cia402:5`` serves it over socketcand or SLCAN.
+"""
+from __future__ import annotations
+
+import math
+import threading
+from typing import Any, Optional, Union
+
+from .. import _core
+from ..canopen.ds402 import Controlword, Ds402, Ds402Device, OpMode
+from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params, Units
+from ..registry import DrivePlugin
+
+__all__ = ["Cia402Drive", "Cia402Sim", "PLUGIN", "make_sim", "open", "OBJECTS"]
+
+# Statusword bits the simulator drives itself (the state bits come from Ds402Device).
+_SW_REMOTE = 1 << 9
+_SW_TARGET_REACHED = 1 << 10
+_SW_INTERNAL_LIMIT = 1 << 11
+_SW_BIT12 = 1 << 12   # PV: speed zero; HM: homing attained (bit 12 of PP is the set-point ack)
+_SW_BIT13 = 1 << 13   # HM: homing error
+_SIM_BITS = _SW_REMOTE | _SW_TARGET_REACHED | _SW_INTERNAL_LIMIT | _SW_BIT13
+
+_CW_NEW_SETPOINT = 1 << 4
+_CW_IMMEDIATE = 1 << 5
+_CW_RELATIVE = 1 << 6
+_CW_HALT = 1 << 8
+
+# (index, sub, name, type, access, default, low, high, unit, persists, description): the objects
+# the simulator serves and the adapter's params describe.  One table for both.
+OBJECTS = [
+    (0x1000, 0, "Device type", "U32", "ro", 0x00420192, None, None, "", False, "CiA 402 drive (servo + stepper)"),
+    (0x1001, 0, "Error register", "U8", "ro", 0, None, None, "", False, "CiA 301 error register"),
+    (0x1008, 0, "Manufacturer device name", "VISIBLE_STRING", "ro", "motorbus CiA 402 sim", None, None, "", False,
+     "device name"),
+    (0x603F, 0, "Error code", "U16", "ro", 0, None, None, "", False, "last fault's CiA 402 error code"),
+    (0x6007, 0, "Abort connection option code", "I16", "rw", 1, 0, 3, "", True,
+     "what a lost master does: 1 fault, 2 disable voltage, 3 quick stop"),
+    (0x605A, 0, "Quick stop option code", "I16", "rw", 2, 0, 8, "", True, "quick stop reaction"),
+    (0x6060, 0, "Modes of operation", "I8", "rw", 0, None, None, "", False, "1 PP, 3 PV, 6 HM"),
+    (0x6061, 0, "Modes of operation display", "I8", "ro", 0, None, None, "", False, "the mode in effect"),
+    (0x6064, 0, "Position actual value", "I32", "ro", 0, None, None, "inc", False, "position"),
+    (0x606C, 0, "Velocity actual value", "I32", "ro", 0, None, None, "inc/s", False, "velocity"),
+    (0x607A, 0, "Target position", "I32", "rw", 0, None, None, "inc", False, "PP target"),
+    (0x607C, 0, "Home offset", "I32", "rw", 0, None, None, "inc", True, "position after homing"),
+    (0x6081, 0, "Profile velocity", "U32", "rw", 1000, 1, 10_000_000, "inc/s", True, "PP speed"),
+    (0x6083, 0, "Profile acceleration", "U32", "rw", 10000, 1, 100_000_000, "inc/s²", True, "PP/PV acceleration"),
+    (0x6084, 0, "Profile deceleration", "U32", "rw", 10000, 1, 100_000_000, "inc/s²", True, "PP/PV deceleration"),
+    (0x6085, 0, "Quick stop deceleration", "U32", "rw", 100000, 1, 100_000_000, "inc/s²", True,
+     "deceleration of a quick stop"),
+    (0x6086, 0, "Motion profile type", "I16", "rw", 0, 0, 1, "", True, "0 linear ramp, 1 sin² ramp"),
+    (0x6098, 0, "Homing method", "I8", "rw", 19, None, None, "", True, "7, 11, 17-20, 33-35 (sim default 19: home switch)"),
+    (0x6099, 1, "Speed during search for switch", "U32", "rw", 5000, 1, 10_000_000, "inc/s", True, "homing"),
+    (0x6099, 2, "Speed during search for zero", "U32", "rw", 1000, 1, 10_000_000, "inc/s", True, "homing"),
+    (0x609A, 0, "Homing acceleration", "U32", "rw", 20000, 1, 100_000_000, "inc/s²", True, "homing"),
+    (0x60FD, 0, "Digital inputs", "U32", "ro", 0, None, None, "", False, "bit 0 negative limit, 1 positive, 2 home"),
+    (0x60FF, 0, "Target velocity", "I32", "rw", 0, None, None, "inc/s", False, "PV target"),
+    (0x6502, 0, "Supported drive modes", "U32", "ro", 0b100101, None, None, "", False, "PP, PV, HM"),
+]
+_PERSISTENT = {(row[0], row[1]) for row in OBJECTS if row[9]}
+_SIZES = {"U8": 1, "I8": 1, "U16": 2, "I16": 2, "U32": 4, "I32": 4}
+_SAVE = int.from_bytes(b"save", "little")  # CiA 301 0x1010 signature
+
+
+def _check_node(address: Union[str, int]) -> str:
+    text = str(address).strip()
+    try:
+        node = int(text, 0)
+    except ValueError:
+        raise _core.InvalidArgument(f"cia402 address: a CANopen node-ID 1..127, not {address!r}") from None
+    if not 1 <= node <= 127:
+        raise _core.InvalidArgument(f"cia402 address: node-ID {node} is outside 1..127")
+    return str(node)
+
+
+class Cia402Sim:
+    """A simulated CiA 402 drive (see the module doc).
+
+    Options: ``steps_per_rev`` (motor model, default 3200), ``home=(lo, hi)``
+    (home switch window in increments, default (1000, 1400)), ``minus_limit`` /
+    ``plus_limit`` (switch positions, default -100000 / 100000), ``heartbeat_ms``
+    (0x1017 at boot, default 0 = off, as CiA 301), ``start_position``.
+    Time comes from ``clock`` (a RealClock by default): the motion is evaluated
+    when the host looks (each SDO access), so a SimClock test advances the
+    clock and reads."""
+
+    def __init__(self, node_id: int, clock: Optional[_core.Clock] = None, *, steps_per_rev: float = 3200,
+                 home: tuple = (1000, 1400), minus_limit: Optional[float] = -100000,
+                 plus_limit: Optional[float] = 100000, heartbeat_ms: int = 0, start_position: float = 0) -> None:
+        self.node_id = int(_check_node(node_id))
+        self.clock = clock if clock is not None else _core.RealClock()
+        cfg = _core.MotorConfig()
+        cfg.steps_per_rev = float(steps_per_rev)
+        cfg.counts_per_rev = float(steps_per_rev)
+        cfg.home = _core.SwitchConfig(True, float(home[0]), float(home[1]), False)
+        cfg.minus_limit = _core.SwitchConfig(minus_limit is not None, float(minus_limit or 0), 0.0, False)
+        cfg.plus_limit = _core.SwitchConfig(plus_limit is not None, float(plus_limit or 0), 0.0, False)
+        self.motor = _core.MotorModel(self.clock, cfg)
+        if start_position:
+            self.motor.set_pulse_position(float(start_position))
+            self.motor.set_encoder(int(round(start_position)))
+        self.device = Ds402Device()
+        self._lock = threading.RLock()
+        self._values: dict[tuple[int, int], Any] = {}
+        self._stored: dict[tuple[int, int], Any] = {}
+        self._pp: Optional[Any] = None       # Cia402ProfilePosition of the running PP move
+        self._pp_t0 = 0
+        self._homing: Optional[Any] = None
+        self._activity = "idle"              # idle | pp | pv | homing | stopping
+        self._limit_hit = False
+        self._heartbeat_ms = int(heartbeat_ms)
+        self.od = self._build_od()
+        self.motor.add_listener(self._on_motor_event)
+        self.node: Optional[_core.LocalNode] = None
+        self.heartbeat: Optional[_core.HeartbeatService] = None
+        self.lost_master = threading.Event()
+
+    # ---- serving ----------------------------------------------------------------------
+    def attach(self, bus: _core.Bus) -> "Cia402Sim":
+        """Serve this node on ``bus`` (boot-up is sent at once)."""
+        if self.node is not None:
+            raise _core.InvalidArgument(f"cia402 sim {self.node_id}: already attached")
+        self.node = _core.LocalNode(bus, self.node_id, self.od)
+        self.heartbeat = _core.HeartbeatService(self.node, consumer_entries=4, producer_ms=self._heartbeat_ms)
+        self.heartbeat.set_lost_callback(self._master_lost)
+        return self
+
+    def close(self) -> None:
+        with self._lock:
+            self.motor.halt()
+        if self.node is not None:
+            self.node.close()
+
+    # ---- test hooks ---------------------------------------------------------------------
+    def inject_fault(self, error_code: int = 0x5441) -> None:
+        """The drive detects a fault (default 0x5441: a CiA 402 "interlock" error): the
+        motor stops at once, the state machine goes to FAULT, 0x603F holds the code."""
+        with self._lock:
+            self._stop_now()
+            self.device.fault(int(error_code))
+            self.device.fault_reaction_done()
+            self._values[(0x603F, 0)] = int(error_code)
+            self._values[(0x1001, 0)] = 0x01
+
+    @property
+    def position(self) -> float:
+        with self._lock:
+            self.motor.update()
+            return self.motor.pulse_position
+
+    # ---- the object dictionary ----------------------------------------------------------
+    def _build_od(self) -> _core.ObjectDictionary:
+        od = _core.ObjectDictionary()
+        records = {i for (i, s, *_rest) in OBJECTS if s != 0}
+        for index in sorted(records):
+            name = {0x6099: "Homing speeds"}.get(index, f"0x{index:04X}")
+            od.add_record(index, name)
+        for (index, sub, name, dtype, access, default, low, high, *_rest) in OBJECTS:
+            self._values[(index, sub)] = default
+            kwargs = dict(access=access, default=default)
+            if low is not None:
+                kwargs.update(low=low, high=high)
+            if index in records:
+                var = od.add_member(index, sub, name, dtype, **kwargs)
+            else:
+                var = od.add_variable(index, name, dtype, **kwargs)
+            if dtype in _SIZES:
+                var.set_read_hook(self._reader(index, sub, dtype))
+                if access != "ro":
+                    var.set_write_hook(self._writer(index, sub, dtype))
+        cw = od.add_variable(0x6040, "Controlword", "U16", default=0)
+        cw.set_write_hook(lambda var, data: self._controlword(int.from_bytes(data, "little")))
+        sw = od.add_variable(0x6041, "Statusword", "U16", access="ro", default=0)
+        sw.set_read_hook(lambda var, current: self._statusword().to_bytes(2, "little"))
+        od.add_record(0x1010, "Store parameters", array=True)
+        store = od.add_member(0x1010, 1, "Save all parameters", "U32", default=1)
+        store.set_write_hook(lambda var, data: self._store(int.from_bytes(data, "little")))
+        return od
+
+    def _reader(self, index: int, sub: int, dtype: str):
+        size, signed = _SIZES[dtype], dtype.startswith("I")
+
+        def read(var: Any, current: bytes) -> bytes:
+            return int(self._value(index, sub)).to_bytes(size, "little", signed=signed)
+        return read
+
+    def _writer(self, index: int, sub: int, dtype: str):
+        signed = dtype.startswith("I")
+
+        def write(var: Any, data: bytes) -> Optional[int]:
+            return self._write(index, sub, int.from_bytes(data, "little", signed=signed))
+        return write
+
+    def _value(self, index: int, sub: int) -> int:
+        with self._lock:
+            self._update()
+            if index == 0x6064:
+                return int(round(self.motor.pulse_position))
+            if index == 0x606C:
+                return int(round(self.motor.pulse_velocity))
+            if index == 0x6061:
+                return self.device.mode
+            if index == 0x6060:
+                return self.device.mode
+            if index == 0x60FD:
+                m = self.motor
+                return (m.minus_limit_active << 0) | (m.plus_limit_active << 1) | (m.home_active << 2)
+            return int(self._values[(index, sub)])
+
+    def _write(self, index: int, sub: int, value: int) -> Optional[int]:
+        with self._lock:
+            self._update()
+            if index == 0x6060:
+                code = self.device.set_mode(value)
+                if code:
+                    return code
+                self._pp = None
+            elif index == 0x6007:
+                code = self.device.set_abort_connection_option(value)
+                if code:
+                    return code
+            elif index == 0x605A:
+                code = self.device.set_quick_stop_option(value)
+                if code:
+                    return code
+            elif index == 0x6098 and not _core.Cia402Homing.supported(value):
+                return 0x06090030  # value range of parameter exceeded
+            self._values[(index, sub)] = value
+            if index == 0x60FF and self._activity == "pv":
+                self._apply_velocity()
+        return None
+
+    def _store(self, signature: int) -> Optional[int]:
+        if signature != _SAVE:
+            return 0x08000020  # data cannot be stored (CiA 301: wrong signature)
+        with self._lock:
+            self._stored = {k: v for k, v in self._values.items() if k in _PERSISTENT}
+        return None
+
+    # ---- behaviour ------------------------------------------------------------------------
+    def _params(self) -> Any:
+        v = self._values
+        p = _core.Cia402ProfileParams(
+            profile_velocity=float(v[(0x6081, 0)]), profile_acceleration=float(v[(0x6083, 0)]),
+            profile_deceleration=float(v[(0x6084, 0)]), quick_stop_deceleration=float(v[(0x6085, 0)]),
+            motion_profile_type=int(v[(0x6086, 0)]))
+        return p
+
+    def _now_s(self) -> float:
+        return (self.clock.now() - self._pp_t0) / 1e9
+
+    def _state(self) -> Any:
+        return _core.MotionState(self.motor.pulse_position, self.motor.pulse_velocity, 0.0, 0.0)
+
+    def _controlword(self, value: int) -> Optional[int]:
+        with self._lock:
+            self._update()
+            before_cw = self.device.controlword
+            before = self.device.state
+            self.device.on_controlword(value)
+            after = self.device.state
+            if after != "OPERATION ENABLED":
+                if before == "OPERATION ENABLED" and after == "QUICK STOP ACTIVE":
+                    self._begin_quick_stop()
+                elif after not in ("QUICK STOP ACTIVE",):
+                    self._stop_now()  # power stage off: the motor stops where it is
+                return None
+            mode = self.device.mode
+            rising = bool(value & _CW_NEW_SETPOINT) and not (before_cw & _CW_NEW_SETPOINT)
+            if value & _CW_HALT:
+                if self.motor.moving and self._activity != "stopping":
+                    self._decelerate()
+                return None
+            if mode == OpMode.PROFILE_POSITION and rising:
+                self._new_setpoint(value)
+            elif mode == OpMode.PROFILE_VELOCITY:
+                self._activity = "pv"
+                self._apply_velocity()
+            elif mode == OpMode.HOMING and rising:
+                self._start_homing()
+        return None
+
+    def _new_setpoint(self, cw: int) -> None:
+        target = float(self._values[(0x607A, 0)])
+        if self._pp is None or not self.motor.moving or self._activity != "pp":
+            self._pp = _core.Cia402ProfilePosition(self._params(), self.motor.pulse_position)
+            self._pp_t0 = self.clock.now()
+        self._pp.new_setpoint(self._now_s(), target, relative=bool(cw & _CW_RELATIVE),
+                              change_immediately=bool(cw & _CW_IMMEDIATE))
+        self.motor.command(self._pp.profile, start_ns=self._pp_t0)
+        self._activity = "pp"
+        self._limit_hit = False
+
+    def _apply_velocity(self) -> None:
+        v = float(self._values[(0x60FF, 0)])
+        prof = _core.cia402_velocity_profile(self._state(), v, self._params(), 1e6)
+        self.motor.command(prof)
+        self._limit_hit = False
+
+    def _start_homing(self) -> None:
+        v = self._values
+        params = _core.Cia402HomingParams(method=int(v[(0x6098, 0)]), speed_switch=float(v[(0x6099, 1)]),
+                                          speed_zero=float(v[(0x6099, 2)]), acceleration=float(v[(0x609A, 0)]),
+                                          home_offset=float(v[(0x607C, 0)]))
+        self._homing = _core.Cia402Homing(self.motor, params)
+        self._homing.start()
+        self._activity = "homing"
+
+    def _decelerate(self) -> None:
+        prof = _core.cia402_velocity_profile(self._state(), 0.0, self._params(), 0.0)
+        self.motor.command(prof)
+        self._activity = "stopping"
+
+    def _begin_quick_stop(self) -> None:
+        if self._homing is not None:
+            self._homing.abort()
+            self._homing = None
+        if self.motor.moving:
+            self.motor.command(_core.cia402_quick_stop_profile(self._state(), self._params()))
+        self._activity = "quick_stop"
+
+    def _stop_now(self) -> None:
+        if self._homing is not None:
+            self._homing.abort()
+            self._homing = None
+        self.motor.halt()
+        self._activity = "idle"
+
+    def _on_motor_event(self, event: dict) -> None:
+        # Called from motor.update() (our lock is held).  A limit switch met while
+        # moving toward it stops the motor at once (CiA 402: internal limit active).
+        kind = event["kind"]
+        if self._activity == "homing":
+            return  # the homing methods use the switches themselves
+        if (kind == "minus_limit_on" and event["direction"] < 0) or (kind == "plus_limit_on" and event["direction"] > 0):
+            self.motor.halt()
+            self._limit_hit = True
+            self._activity = "idle"
+
+    def _update(self) -> None:
+        self.motor.update()
+        if self._activity == "quick_stop" and not self.motor.moving:
+            self.device.motion_stopped()
+            self._activity = "idle"
+
+    def _statusword(self) -> int:
+        with self._lock:
+            self._update()
+            mode = self.device.mode
+            bits = _SW_REMOTE
+            if self._limit_hit or self.motor.minus_limit_active or self.motor.plus_limit_active:
+                bits |= _SW_INTERNAL_LIMIT
+            if mode == OpMode.PROFILE_POSITION:
+                if self._pp is None or (not self.motor.moving and self._pp.target_reached(self._now_s())) \
+                        or not self.motor.moving:
+                    bits |= _SW_TARGET_REACHED
+            elif mode == OpMode.PROFILE_VELOCITY:
+                target = float(self._values[(0x60FF, 0)])
+                if abs(self.motor.pulse_velocity - target) < 0.5 or not self.motor.moving:
+                    bits |= _SW_TARGET_REACHED
+            elif mode == OpMode.HOMING:
+                h = self._homing
+                if h is None or h.result != 0:  # HomingResult.Running == 0
+                    bits |= _SW_TARGET_REACHED
+                if h is not None and h.error:
+                    bits |= _SW_BIT13
+            else:
+                if not self.motor.moving:
+                    bits |= _SW_TARGET_REACHED
+            self.device.set_status_bits(_SIM_BITS, bits)
+            sw = self.device.statusword
+            if mode == OpMode.HOMING:
+                attained = self._homing is not None and self._homing.attained
+                # Bit 12 of homing mode is "homing attained", not the set-point acknowledge.
+                sw = (sw & ~_SW_BIT12) | (_SW_BIT12 if attained else 0)
+            return sw
+
+    def _master_lost(self, node: int) -> None:
+        with self._lock:
+            before = self.device.state
+            self.device.loss_of_master()
+            after = self.device.state
+            if after == "QUICK STOP ACTIVE":
+                self._begin_quick_stop()
+            elif after != before:
+                self._stop_now()
+        self.lost_master.set()
+
+
+def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, *,
+             bus: Optional[_core.Bus] = None, **options: Any) -> Cia402Sim:
+    """A simulated CiA 402 drive at node ``address``; attached to ``bus`` when given.
+    Options: see :class:`Cia402Sim`."""
+    known = {"steps_per_rev", "home", "minus_limit", "plus_limit", "heartbeat_ms", "start_position"}
+    unknown = set(options) - known
+    if unknown:
+        raise _core.InvalidArgument(f"cia402 sim options: unknown {sorted(unknown)}; known {sorted(known)}")
+    sim = Cia402Sim(int(_check_node(address)), clock, **options)
+    if bus is not None:
+        sim.attach(bus)
+    return sim
+
+
+# ---- the Drive adapter --------------------------------------------------------------------
+
+class Cia402Params(Params):
+    """Objects by index (``"0x6081"``, ``"0x6099:01"``, ``"6081h"``) or by the names of the
+    objects table (``"Profile velocity"``); read and written by SDO."""
+
+    def _names(self) -> list[str]:
+        return [f"0x{i:04X}" + (f":{s:02X}" if s else "") for (i, s, *_r) in OBJECTS]
+
+    def _key(self, name: str) -> str:
+        name = super()._key(name).strip()
+        for (i, s, n, *_r) in OBJECTS:
+            if name.lower() == n.lower():
+                return f"0x{i:04X}" + (f":{s:02X}" if s else "")
+        text = name[:-1] if name.lower().endswith("h") else name
+        idx, _, sub = text.partition(":")
+        try:
+            index = int(idx, 16)
+            subindex = int(sub, 16) if sub else 0
+        except ValueError:
+            return name
+        return f"0x{index:04X}" + (f":{subindex:02X}" if subindex else "")
+
+    def _info(self, name: str) -> Optional[ParamInfo]:
+        for (i, s, n, dtype, access, default, low, high, unit, persists, desc) in OBJECTS:
+            if name == f"0x{i:04X}" + (f":{s:02X}" if s else ""):
+                kind = "str" if dtype == "VISIBLE_STRING" else "int"
+                if low is None and dtype in _SIZES:
+                    bits = 8 * _SIZES[dtype]
+                    low, high = ((-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if dtype.startswith("I")
+                                 else (0, (1 << bits) - 1))
+                return ParamInfo(name=name, type=kind, minimum=low, maximum=high, unit=unit, default=default,
+                                 persists=persists, writable=access != "ro", description=f"{n}: {desc}")
+        return None
+
+    def _where(self, info: ParamInfo) -> tuple[int, int, str]:
+        idx, _, sub = info.name.partition(":")
+        index, subindex = int(idx, 16), int(sub, 16) if sub else 0
+        dtype = next(d for (i, s, _n, d, *_r) in OBJECTS if (i, s) == (index, subindex))
+        return index, subindex, dtype
+
+    def _read(self, info: ParamInfo) -> Any:
+        index, sub, dtype = self._where(info)
+        data = self._drive._sdo.upload(index, sub)
+        if dtype == "VISIBLE_STRING":
+            return data.decode("latin-1")
+        return int.from_bytes(data, "little", signed=dtype.startswith("I"))
+
+    def _write(self, info: ParamInfo, value: Any) -> None:
+        index, sub, dtype = self._where(info)
+        self._drive._sdo.download(index, sub, int(value).to_bytes(_SIZES[dtype], "little",
+                                                                    signed=dtype.startswith("I")))
+
+
+class Cia402Drive(Drive):
+    """The Drive API over any CiA 402 node (profile position, profile velocity, homing)."""
+
+    kind = "cia402"
+    capabilities = frozenset({Capability.POSITION, Capability.VELOCITY, Capability.HOMING, Capability.STORE,
+                              Capability.WATCHDOG})
+    has_watchdog = True
+
+    def __init__(self, host: Ds402, *, units: Optional[Units] = None, on_error: Optional[str] = "quick_stop",
+                 on_exit: Optional[str] = "quick_stop", close_native=None) -> None:
+        super().__init__(host, units=units, on_error=on_error, on_exit=on_exit, close_native=close_native)
+        self._sdo = host._sdo
+        self._mode: Optional[int] = None
+
+    # ---- helpers ----
+    def _u32(self, index: int, value: float) -> None:
+        self._sdo.download(index, 0, int(round(value)).to_bytes(4, "little", signed=False))
+
+    def _i32(self, index: int, value: float) -> None:
+        self._sdo.download(index, 0, int(round(value)).to_bytes(4, "little", signed=True))
+
+    def _read_i32(self, index: int) -> int:
+        return int.from_bytes(self._sdo.upload(index, 0), "little", signed=True)
+
+    def _use_mode(self, mode: OpMode) -> None:
+        if self._mode != mode:
+            self.native.set_mode(mode)
+            self._mode = mode
+
+    def _operation_enabled(self) -> None:
+        if self.native.state != "OPERATION ENABLED":
+            self.native.go_to("OPERATION ENABLED")
+
+    # ---- Drive ----
+    def _enable(self) -> None:
+        self.native.enable()
+
+    def _disable(self) -> None:
+        self.native.disable()
+
+    def _move_to(self, target: float, velocity: Optional[float]) -> None:
+        self._operation_enabled()
+        self._use_mode(OpMode.PROFILE_POSITION)
+        if velocity is not None:
+            self._u32(0x6081, velocity)  # stays the profile velocity for later moves too
+        self.native.move_to(int(round(target)))
+
+    def _move_by(self, distance: float, velocity: Optional[float]) -> None:
+        self._operation_enabled()
+        self._use_mode(OpMode.PROFILE_POSITION)
+        if velocity is not None:
+            self._u32(0x6081, velocity)
+        self.native.move_to(int(round(distance)), relative=True)
+
+    def _jog(self, velocity: float) -> None:
+        self._operation_enabled()
+        self._use_mode(OpMode.PROFILE_VELOCITY)
+        self.native.set_velocity(int(round(velocity)))
+
+    def _stop(self) -> None:
+        # Halt (controlword bit 8): decelerate with 6084h and stay in Operation Enabled.
+        self.native.write_controlword(int(Controlword.ENABLE_OPERATION) | _CW_HALT)
+
+    def _quick_stop(self) -> None:
+        self.native.write_controlword(int(Controlword.QUICK_STOP))
+
+    def _home(self, method: Any) -> None:
+        self._operation_enabled()
+        self._use_mode(OpMode.HOMING)
+        if method is not None:
+            if not isinstance(method, int) or not _core.Cia402Homing.supported(method):
+                raise _core.InvalidArgument(f"cia402 home: method 7, 11, 17-20 or 33-35, not {method!r}")
+            self._sdo.download(0x6098, 0, int(method).to_bytes(1, "little", signed=True))
+        self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
+        self.native.write_controlword(int(Controlword.ENABLE_OPERATION) | _CW_NEW_SETPOINT)
+
+    def _homing_done(self) -> bool:
+        sw = self.native.statusword
+        if sw & _SW_BIT13:
+            self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
+            raise _core.DriveFault("cia402: homing error (statusword bit 13)")
+        if (sw & 0x4F) == 0x08:
+            raise _core.DriveFault(f"cia402: fault during homing (0x603F = 0x{self._read_u16(0x603F):04X})")
+        if (sw & (_SW_BIT12 | _SW_TARGET_REACHED)) == (_SW_BIT12 | _SW_TARGET_REACHED):
+            self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
+            return True
+        return False
+
+    def _read_u16(self, index: int) -> int:
+        return int.from_bytes(self._sdo.upload(index, 0), "little")
+
+    def _is_idle(self) -> bool:
+        sw = self.native.statusword
+        if (sw & 0x4F) == 0x08:
+            raise _core.DriveFault(f"cia402: fault while moving (0x603F = 0x{self._read_u16(0x603F):04X})")
+        return bool(sw & _SW_TARGET_REACHED) and self._velocity() == 0
+
+    def _clear_faults(self) -> None:
+        self.native.fault_reset()
+
+    def _store(self) -> None:
+        self._sdo.download(0x1010, 1, _SAVE.to_bytes(4, "little"))
+
+    def _position(self) -> float:
+        return float(self._read_i32(0x6064))
+
+    def _velocity(self) -> float:
+        return float(self._read_i32(0x606C))
+
+    def _status(self) -> DriveStatus:
+        sw = self.native.statusword
+        state = _core.ds402_decode_statusword(sw)
+        inputs = int.from_bytes(self._sdo.upload(0x60FD, 0), "little")
+        velocity = self._velocity()
+        mode = self._mode
+        fault = state in ("FAULT", "FAULT REACTION ACTIVE")
+        at_target = bool(sw & _SW_TARGET_REACHED)
+        homed = mode == OpMode.HOMING and bool(sw & _SW_BIT12)
+        self._homed = getattr(self, "_homed", False) or homed
+        text = f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}"
+        if fault:
+            text += f", error 0x{self._read_u16(0x603F):04X}"
+        return DriveStatus(enabled=state == "OPERATION ENABLED", moving=velocity != 0 or not at_target,
+                           homed=self._homed, fault=fault, at_target=at_target,
+                           limit_positive=bool(inputs & 2), limit_negative=bool(inputs & 1), raw=sw, text=text)
+
+    def _make_params(self) -> Params:
+        return Cia402Params(self)
+
+    def _close(self) -> None:
+        self.native.close()
+
+    def start_watchdog(self, host_node: int, period: float = 0.1, **kwargs: Any) -> None:
+        """Arm the drive's own heartbeat consumer on a heartbeat this host produces."""
+        self.native.start_watchdog(host_node, period, **kwargs)
+
+
+def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Units] = None,
+         timeout: float = 1.0, on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop",
+         watchdog: Optional[dict] = None) -> Cia402Drive:  # noqa: A001 - the plugin's verb
+    """``open_drive("cia402", bus=..., address=5)``.  ``watchdog={"host_node": 127, "period": 0.1}``
+    arms the drive's heartbeat consumer at once (see Ds402.start_watchdog)."""
+    from ..bus import open_bus
+
+    owns = isinstance(bus, str)
+    b = open_bus(bus) if owns else bus
+    try:
+        host = Ds402(b, int(address), timeout=timeout, on_error=None, on_exit=None)
+        drive = Cia402Drive(host, units=units, on_error=on_error, on_exit=on_exit,
+                            close_native=b.close if owns else None)
+    except Exception:
+        if owns:
+            b.close()
+        raise
+    if watchdog:
+        drive.start_watchdog(**watchdog)
+    return drive
+
+
+PLUGIN = DrivePlugin(
+    kind="cia402",
+    description="any CiA 402 drive on CANopen (profile position, profile velocity, homing); simulated generically",
+    transport="can",
+    open=open,
+    make_sim=make_sim,
+    check_address=_check_node,
+    default_address="1",
+    sim_options=("steps_per_rev", "home", "minus_limit", "plus_limit", "heartbeat_ms", "start_position"),
+)
