@@ -173,10 +173,15 @@ class PdoChannel:
             if self._rx is None:
                 entries = self._entries()
                 rx = _core.PdoReceiver(self._node.network.bus, self.cob_id, entries)
-                keys = [(e[0], e[1]) for e in entries]
-                rx.set_callback(lambda values, ts: self._dispatch(dict(zip(keys, values))))
-                self._rx, self._keys = rx, keys
+                self._keys = [(e[0], e[1]) for e in entries]
+                # The receiver keeps raw field bits; signed objects are sign-extended here.
+                self._signs = [(1 << (e[2] - 1)) if e[3] else 0 for e in entries]
+                rx.set_callback(lambda values, ts: self._dispatch(self._decode(values)))
+                self._rx = rx
             return self._rx
+
+    def _decode(self, values: Sequence[int]) -> Dict[Tuple[int, int], int]:
+        return {k: (v - 2 * s if s and v >= s else v) for k, v, s in zip(self._keys, values, self._signs)}
 
     def _dispatch(self, values: Dict[Tuple[int, int], int]) -> None:
         for cb in list(self._callbacks):
@@ -191,14 +196,14 @@ class PdoChannel:
     def values(self) -> Dict[Tuple[int, int], int]:
         """The latest values received ({} before the first)."""
         rx = self._receiver()
-        return dict(zip(self._keys, rx.values)) if rx.received else {}
+        return self._decode(rx.values) if rx.received else {}
 
     def wait_for_reception(self, timeout: float = 10.0) -> Dict[Tuple[int, int], int]:
         """Waits for the next TPDO; its values. motorbus.TimeoutError when none comes."""
         rx = self._receiver()
         if not rx.wait_newer(rx.received, timeout):
             raise _core.TimeoutError(f"{self!r}: nothing received within {timeout} s")
-        return dict(zip(self._keys, rx.values))
+        return self._decode(rx.values)
 
     def transmit(self, values: Sequence[int], timeout: float = 1.0) -> None:
         """Sends this RPDO with ``values`` in mapping order."""
