@@ -1,6 +1,13 @@
 // motorbus._core: one bindings file per C++ area; this file only wires them up.
 // Bindings stay thin: argument conversion, GIL release, nothing else.
+//
+// The generic areas are listed here in dependency order (a class is bound
+// before the classes that derive from it).  The vendors come last, each from
+// its own bindings/drives/<vendor>.cpp; CMake generates bind_drives() from the
+// files it finds, so adding a vendor edits nothing here.
 #include <pybind11/pybind11.h>
+
+#include "drive_bindings.inc"
 
 namespace py = pybind11;
 
@@ -13,8 +20,6 @@ void bind_serial(py::module_& m);
 void bind_canopen(py::module_& m);
 void bind_canopen_services(py::module_& m);
 void bind_motion(py::module_& m);
-void bind_arcus(py::module_& m);
-void bind_dmac(py::module_& m);
 
 PYBIND11_MODULE(_core, m) {
     m.doc() = "motorbus C++ core";
@@ -27,6 +32,5 @@ PYBIND11_MODULE(_core, m) {
     bind_canopen(m);
     bind_canopen_services(m);
     bind_motion(m);
-    bind_arcus(m);
-    bind_dmac(m);
+    bind_drives(m);
 }

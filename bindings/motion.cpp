@@ -1,18 +1,15 @@
-// Bindings for cpp/motorbus/motion: planners, profiles, drive profile models,
-// StepNLoop, the motor model and homing.  Thin: conversions only; the Python
+// Bindings for cpp/motorbus/motion: planners, profiles, the CiA 402 profile,
+// StepNLoop, the motor model and the homing engine (vendor profile models bind
+// with their vendor).  Thin: conversions only; the Python
 // conveniences live in python/motorbus/motion.py.
 #include <pybind11/eigen.h>
-#include <pybind11/eval.h>
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "motorbus/motion/arcus_profile.hpp"
+#include "errors.hpp"
 #include "motorbus/motion/cia402_profile.hpp"
-#include "motorbus/motion/pmc007_profile.hpp"
-#include "motorbus/motion/unitek_profile.hpp"
-#include "motorbus/motion/dmac_profile.hpp"
 #include "motorbus/motion/homing.hpp"
 #include "motorbus/motion/motor_model.hpp"
 #include "motorbus/motion/planner.hpp"
@@ -24,7 +21,12 @@ using namespace motorbus;
 using namespace motorbus::motion;
 
 namespace {
-py::handle g_limit_exceeded;
+void fill_limit(py::object& exc, const LimitExceeded& e) {
+    exc.attr("limit") = e.limit;
+    exc.attr("requested") = e.requested;
+    exc.attr("allowed") = e.allowed;
+    exc.attr("excess") = e.excess();
+}
 
 py::tuple state_tuple(const State& s) { return py::make_tuple(s.p, s.v, s.a, s.j); }
 
@@ -37,32 +39,9 @@ py::array_t<double> vec_to_array(const std::vector<double>& v) {
 
 void bind_motion(py::module_& m) {
     // ---- errors ----------------------------------------------------------------
-    py::dict ns;
-    ns["InvalidArgument"] = m.attr("InvalidArgument");
-    py::exec(R"(
-class LimitExceeded(InvalidArgument):
-    "A motion request beyond a limit: .limit names it, .requested/.allowed/.excess quantify it."
-    limit = ""
-    requested = 0.0
-    allowed = 0.0
-    excess = 0.0
-)", ns, ns);
-    py::object le = ns["LimitExceeded"];
-    le.attr("__module__") = "motorbus";
-    m.attr("LimitExceeded") = le;
-    g_limit_exceeded = le.release();
-    py::register_exception_translator([](std::exception_ptr p) {
-        try {
-            if (p) std::rethrow_exception(p);
-        } catch (const LimitExceeded& e) {
-            py::object exc = py::reinterpret_borrow<py::object>(g_limit_exceeded)(e.what());
-            exc.attr("limit") = e.limit;
-            exc.attr("requested") = e.requested;
-            exc.attr("allowed") = e.allowed;
-            exc.attr("excess") = e.excess();
-            PyErr_SetObject(g_limit_exceeded.ptr(), exc.ptr());
-        }
-    });
+    py_errors::add_error_classes(m, {{"LimitExceeded", {"InvalidArgument"},
+        "A motion request beyond a limit: .limit names it, .requested/.allowed/.excess quantify it."}});
+    py_errors::translate<LimitExceeded, fill_limit>(m.attr("LimitExceeded"));
 
     // ---- profiles and planners -------------------------------------------------
     py::class_<State>(m, "MotionState")
@@ -191,97 +170,6 @@ class LimitExceeded(InvalidArgument):
         },
         py::arg("cases"));
 
-    // ---- Arcus -----------------------------------------------------------------
-    py::class_<ArcusSpeedWindow>(m, "ArcusSpeedWindow")
-        .def_readonly("number", &ArcusSpeedWindow::number)
-        .def_readonly("sspdm_first", &ArcusSpeedWindow::sspdm_first)
-        .def_readonly("sspdm_last", &ArcusSpeedWindow::sspdm_last)
-        .def_readonly("hspd_low", &ArcusSpeedWindow::hspd_low)
-        .def_readonly("hspd_high", &ArcusSpeedWindow::hspd_high)
-        .def_readonly("min_lspd", &ArcusSpeedWindow::min_lspd)
-        .def_readonly("min_acc_ms", &ArcusSpeedWindow::min_acc_ms)
-        .def_readonly("delta", &ArcusSpeedWindow::delta);
-    m.def("arcus_speed_windows", [] {
-        const auto& w = arcus_speed_windows();
-        return std::vector<ArcusSpeedWindow>(w.begin(), w.end());
-    });
-    m.def("arcus_window_for_hspd", &arcus_window_for_hspd, py::arg("hspd_pps"), py::return_value_policy::copy);
-    m.def("arcus_window_for_sspdm", &arcus_window_for_sspdm, py::arg("sspdm"), py::return_value_policy::copy);
-    m.def("arcus_max_acc_ms", &arcus_max_acc_ms, py::arg("hspd_pps"), py::arg("lspd_pps"));
-    py::class_<ArcusProfileParams>(m, "ArcusProfileParams")
-        .def(py::init([](double hspd, double lspd, double acc_ms, double dec_ms, bool edec, bool scv, double ratio) {
-                 return ArcusProfileParams{hspd, lspd, acc_ms, dec_ms, edec, scv, ratio};
-             }),
-             py::arg("hspd") = 1000.0, py::arg("lspd") = 100.0, py::arg("acc_ms") = 300.0, py::arg("dec_ms") = 300.0,
-             py::arg("edec") = false, py::arg("scv") = false, py::arg("snl_ratio") = 1.0)
-        .def_readwrite("hspd", &ArcusProfileParams::hspd)
-        .def_readwrite("lspd", &ArcusProfileParams::lspd)
-        .def_readwrite("acc_ms", &ArcusProfileParams::acc_ms)
-        .def_readwrite("dec_ms", &ArcusProfileParams::dec_ms)
-        .def_readwrite("edec", &ArcusProfileParams::edec)
-        .def_readwrite("scv", &ArcusProfileParams::scv)
-        .def_readwrite("snl_ratio", &ArcusProfileParams::snl_ratio);
-    m.def("arcus_effective", [](const ArcusProfileParams& p) {
-        auto e = arcus_effective(p);
-        return py::make_tuple(e.params, e.window ? e.window->number : 0, e.adjustments);
-    }, py::arg("params"), "(effective params, window number, [adjustments]) after Appendix A.");
-    m.def("arcus_check_strict", &arcus_check_strict, py::arg("params"));
-    m.attr("ARCUS_MAX_MOVE_DISTANCE") = kArcusMaxMoveDistance;
-    py::class_<ArcusMotion>(m, "ArcusMotion")
-        .def(py::init<ArcusProfileParams, int>(), py::arg("params") = ArcusProfileParams{}, py::arg("sspdm") = 0)
-        .def("set_params", [](ArcusMotion& a, const ArcusProfileParams& p) { return a.set_params(p).params; })
-        .def("set_sspdm", &ArcusMotion::set_sspdm)
-        .def_property_readonly("effective", [](const ArcusMotion& a) { return a.effective().params; })
-        .def("move", [](ArcusMotion& a, double pos, double target) { return arcus_reply_text(a.move(pos, target)); },
-             py::arg("position"), py::arg("target"), "X: returns '' or the drive's error reply.")
-        .def("jog", [](ArcusMotion& a, double pos, int dir) { return arcus_reply_text(a.jog(pos, dir)); })
-        .def("change_target",
-             [](ArcusMotion& a, double t, double target) { return arcus_reply_text(a.change_target(t, target)); },
-             py::arg("t"), py::arg("target"))
-        .def("change_speed",
-             [](ArcusMotion& a, double t, double v) { return arcus_reply_text(a.change_speed(t, v)); },
-             py::arg("t"), py::arg("hspd"))
-        .def("stop", &ArcusMotion::stop, py::arg("t"))
-        .def("abort", &ArcusMotion::abort, py::arg("t"))
-        .def_property_readonly("profile", &ArcusMotion::profile, py::return_value_policy::copy)
-        .def("moving", &ArcusMotion::moving, py::arg("t"))
-        .def("phase", [](const ArcusMotion& a, double t) {
-            switch (a.phase(t)) {
-                case ArcusPhase::Accel: return "accel";
-                case ArcusPhase::Const: return "const";
-                case ArcusPhase::Decel: return "decel";
-                default: return "idle";
-            }
-        }, py::arg("t"));
-
-    // ---- DMAC ------------------------------------------------------------------
-    py::class_<DmacProfileParams>(m, "DmacProfileParams")
-        .def(py::init([](std::int32_t hs, std::int32_t ls, std::int32_t ati, std::int32_t dti, bool sc) {
-                 DmacProfileParams p{hs, ls, ati, dti, sc};
-                 p.validate();
-                 return p;
-             }),
-             py::arg("high_speed") = 60000, py::arg("low_speed") = 6000, py::arg("accel_time_ms") = 1000,
-             py::arg("decel_time_ms") = 1000, py::arg("s_curve") = false)
-        .def_readwrite("high_speed", &DmacProfileParams::high_speed)
-        .def_readwrite("low_speed", &DmacProfileParams::low_speed)
-        .def_readwrite("accel_time_ms", &DmacProfileParams::accel_time_ms)
-        .def_readwrite("decel_time_ms", &DmacProfileParams::decel_time_ms)
-        .def_readwrite("s_curve", &DmacProfileParams::s_curve);
-    m.def("dmac_ramp_time", &dmac_ramp_time, py::arg("params"), py::arg("v_from"), py::arg("v_to"));
-    m.def("dmac_position_profile", &dmac_position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
-    m.def("dmac_speed_profile", &dmac_speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
-          py::arg("hold") = 0.0);
-    py::class_<DmacMotion>(m, "DmacMotion")
-        .def(py::init<DmacProfileParams, double>(), py::arg("params") = DmacProfileParams{}, py::arg("position") = 0.0)
-        .def("set_params", &DmacMotion::set_params)
-        .def("move_to", &DmacMotion::move_to, py::arg("t"), py::arg("target"))
-        .def("move_on", &DmacMotion::move_on, py::arg("t"), py::arg("offset"))
-        .def("move_speed", &DmacMotion::move_speed, py::arg("t"), py::arg("speed"))
-        .def("stop", &DmacMotion::stop, py::arg("t"))
-        .def_property_readonly("profile", &DmacMotion::profile, py::return_value_policy::copy)
-        .def("moving", &DmacMotion::moving, py::arg("t"));
-
     // ---- StepNLoop -------------------------------------------------------------
     py::class_<SnlConfig>(m, "SnlConfig")
         .def(py::init<>())
@@ -312,29 +200,7 @@ class LimitExceeded(InvalidArgument):
         .def_property_readonly("status_name", [](const StepNLoop& s) { return snl_status_name(s.status()); })
         .def_property_readonly("attempts", &StepNLoop::attempts);
 
-    // ---- PMC007, CiA 402, UNITEK ------------------------------------------------
-    m.def("pmc007_gear_acceleration", &pmc007_gear_acceleration, py::arg("gear"));
-    m.def("pmc007_microsteps", &pmc007_microsteps, py::arg("setting"));
-    m.def("pmc007_convert_position", &pmc007_convert_position, py::arg("position"), py::arg("from_setting"),
-          py::arg("to_setting"));
-    py::class_<Pmc007ProfileParams>(m, "Pmc007ProfileParams")
-        .def(py::init([](double speed, double start_speed, double stop_speed, int ag, int dg, int micro) {
-                 Pmc007ProfileParams p{speed, start_speed, stop_speed, ag, dg, micro};
-                 p.validate();
-                 return p;
-             }),
-             py::arg("speed") = 1000.0, py::arg("start_speed") = 400.0, py::arg("stop_speed") = 0.0,
-             py::arg("accel_gear") = 0, py::arg("decel_gear") = 0, py::arg("microstepping") = 0)
-        .def_readwrite("speed", &Pmc007ProfileParams::speed)
-        .def_readwrite("start_speed", &Pmc007ProfileParams::start_speed)
-        .def_readwrite("stop_speed", &Pmc007ProfileParams::stop_speed)
-        .def_readwrite("accel_gear", &Pmc007ProfileParams::accel_gear)
-        .def_readwrite("decel_gear", &Pmc007ProfileParams::decel_gear)
-        .def_readwrite("microstepping", &Pmc007ProfileParams::microstepping);
-    m.def("pmc007_position_profile", &pmc007_position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
-    m.def("pmc007_speed_profile", &pmc007_speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
-          py::arg("hold") = 0.0);
-
+    // ---- CiA 402 ------------------------------------------------
     py::class_<Cia402ProfileParams>(m, "Cia402ProfileParams")
         .def(py::init([](double v, double a, double d, double qs, int type, double vmax) {
                  Cia402ProfileParams p;
@@ -368,19 +234,6 @@ class LimitExceeded(InvalidArgument):
         .def_property_readonly("profile", &Cia402ProfilePosition::profile, py::return_value_policy::copy)
         .def("target_reached", &Cia402ProfilePosition::target_reached, py::arg("t"))
         .def_property_readonly("setpoint_pending", &Cia402ProfilePosition::setpoint_pending);
-
-    py::class_<UnitekRampParams>(m, "UnitekRampParams")
-        .def(py::init([](double nmax, double acc, double dec) {
-                 UnitekRampParams p{nmax, acc, dec};
-                 p.validate();
-                 return p;
-             }),
-             py::arg("n_max_rpm") = 3000.0, py::arg("acc_ramp_ms") = 1000.0, py::arg("dec_ramp_ms") = 1000.0)
-        .def_readwrite("n_max_rpm", &UnitekRampParams::n_max_rpm)
-        .def_readwrite("acc_ramp_ms", &UnitekRampParams::acc_ramp_ms)
-        .def_readwrite("dec_ramp_ms", &UnitekRampParams::dec_ramp_ms);
-    m.def("unitek_speed_profile", &unitek_speed_profile, py::arg("start"), py::arg("speed_num"), py::arg("params"),
-          py::arg("hold") = 0.0);
 
     // ---- motor model and homing -------------------------------------------------
     py::class_<SwitchConfig>(m, "SwitchConfig")
@@ -450,24 +303,6 @@ class LimitExceeded(InvalidArgument):
         .def_property_readonly("latch_state", [](const MotorModel& mm) { return static_cast<int>(mm.latch_state()); })
         .def_property_readonly("latched_pulse", &MotorModel::latched_pulse)
         .def_property_readonly("latched_encoder", &MotorModel::latched_encoder);
-    py::class_<ArcusHomingOptions>(m, "ArcusHomingOptions")
-        .def(py::init([](double hca, double lca, bool rz) { return ArcusHomingOptions{hca, lca, rz}; }),
-             py::arg("hca") = 0.0, py::arg("lca") = 1000.0, py::arg("rz") = false);
-    py::class_<ArcusHoming>(m, "ArcusHoming")
-        .def(py::init<MotorModel&, ArcusProfileParams, ArcusHomingOptions>(), py::arg("motor"), py::arg("params"),
-             py::arg("options") = ArcusHomingOptions{}, py::keep_alive<1, 2>())
-        .def("start", [](ArcusHoming& h, const std::string& method, int dir) {
-            static const std::pair<const char*, ArcusHoming::Method> map[] = {
-                {"H", ArcusHoming::Method::H}, {"HL", ArcusHoming::Method::HL}, {"L", ArcusHoming::Method::L},
-                {"Z", ArcusHoming::Method::Z}, {"ZH", ArcusHoming::Method::ZH}};
-            for (const auto& [n, mm] : map)
-                if (method == n) return h.start(mm, dir);
-            throw InvalidArgument("ArcusHoming.start: method is H, HL, L, Z or ZH, not '" + method + "'");
-        }, py::arg("method"), py::arg("direction"))
-        .def("abort", &ArcusHoming::abort)
-        .def_property_readonly("running", &ArcusHoming::running)
-        .def_property_readonly("result", [](const ArcusHoming& h) { return static_cast<int>(h.result()); })
-        .def_property_readonly("snl_status", &ArcusHoming::snl_status);
     py::class_<Cia402HomingParams>(m, "Cia402HomingParams")
         .def(py::init([](int method, double s1, double s2, double acc, double off) {
                  return Cia402HomingParams{method, s1, s2, acc, off};

@@ -1,10 +1,10 @@
 // Bindings for cpp/motorbus/serial: ports, the line link, line devices and the
 // pty line server.  Every call that can block releases the GIL; the server
 // thread takes it back only to call a Python LineDevice.
-#include <pybind11/eval.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "errors.hpp"
 #include "common.hpp"
 #include "motorbus/errors.hpp"
 #include "motorbus/serial/echo_device.hpp"
@@ -161,27 +161,17 @@ std::chrono::nanoseconds nonneg_seconds(double s, const char* what) {
 
 }  // namespace
 
+namespace {
+void fill_reply_too_long(py::object& exc, const ReplyTooLong& e) {
+    exc.attr("data") = py::bytes(reinterpret_cast<const char*>(e.bytes.data()), e.bytes.size());
+}
+}  // namespace
+
 void bind_serial(py::module_& m) {
     // ReplyTooLong(ProtocolError): a distinct class so callers can catch it alone.
-    py::dict ns;
-    ns["ProtocolError"] = m.attr("ProtocolError");
-    py::exec(R"(
-class ReplyTooLong(ProtocolError):
-    "A reply exceeded max_line; it was discarded up to its terminator. .data holds its first bytes."
-)", ns, ns);
-    py::object reply_too_long = ns["ReplyTooLong"];
-    reply_too_long.attr("__module__") = "motorbus";
-    m.attr("ReplyTooLong") = reply_too_long;
-    static py::handle rtl = reply_too_long.release();
-    py::register_exception_translator([](std::exception_ptr p) {
-        try {
-            if (p) std::rethrow_exception(p);
-        } catch (const ReplyTooLong& e) {
-            py::object exc = py::reinterpret_borrow<py::object>(rtl)(e.what());
-            exc.attr("data") = py::bytes(reinterpret_cast<const char*>(e.bytes.data()), e.bytes.size());
-            PyErr_SetObject(rtl.ptr(), exc.ptr());
-        }
-    });
+    py_errors::add_error_classes(m, {{"ReplyTooLong", {"ProtocolError"},
+        "A reply exceeded max_line; it was discarded up to its terminator. .data holds its first bytes."}});
+    py_errors::translate<ReplyTooLong, fill_reply_too_long>(m.attr("ReplyTooLong"));
 
     py::class_<Port, std::shared_ptr<Port>>(m, "Port", "A bidirectional byte stream (serial port, pty side).")
         .def(

@@ -32,8 +32,8 @@ from .socketcand import (  # noqa: E402,F401
 )
 from . import canopen  # noqa: E402,F401
 from ._core import SdoAbortError, SdoProtocolError, SdoTimeout  # noqa: E402,F401
-from .drives import arcus, dmac  # noqa: E402,F401
-from .drives.arcus import ArcusClient, ArcusSim  # noqa: E402,F401
-from .drives.dmac import DmacClient, DmacSim  # noqa: E402,F401
+from . import registry  # noqa: E402,F401
+from .drive import Capability, Drive, DriveStatus, ParamInfo, Units, open_drive  # noqa: E402,F401
+from .registry import drive_kinds  # noqa: E402,F401
 
 __version__ = "0.1.0"

@@ -1,6 +1,7 @@
 """Opening buses: ``open_bus(spec, **options)`` and the python-can bridge.
 
-Specs are URL-like strings::
+Specs are URL-like strings, one scheme per registered backend (entry-point group
+``motorbus.bus``, see docs/plugins.md); the ones motorbus brings::
 
     virtual:NAME                    in-process hub (bitrate=, tx_queue=, receive_own=, rx_spin=)
     slcan:PATH[@BITRATE]            Lawicel adapter on a serial line (CANable, USBtin, a pty)
@@ -16,7 +17,7 @@ import threading
 import time
 from typing import Any
 
-from . import _core
+from . import _core, registry
 
 __all__ = ["open_bus", "parse_spec", "frame_to_message", "message_to_frame", "wall_time"]
 
@@ -31,34 +32,16 @@ def wall_time(timestamp_ns: int) -> float:
 
 
 def parse_spec(spec: str) -> tuple[str, dict[str, Any]]:
-    """Split a bus spec into (scheme, arguments). Raises InvalidArgument naming the problem."""
+    """Split a bus spec into (scheme, arguments) through the registered scheme.
+
+    InvalidArgument names the problem (an unknown scheme lists the registered ones)."""
     scheme, sep, rest = spec.partition(":")
     if not sep or not rest:
         raise _core.InvalidArgument(f"bus spec {spec!r}: expected SCHEME:ARGS, e.g. virtual:bench")
-    if scheme == "virtual":
-        return scheme, {"name": rest}
-    if scheme == "slcan":
-        path, at, rate = rest.rpartition("@") if "@" in rest else (rest, "", "")
-        args: dict[str, Any] = {"path": path}
-        if at:
-            try:
-                args["bitrate"] = int(rate)
-            except ValueError:
-                raise _core.InvalidArgument(f"bus spec {spec!r}: bitrate {rate!r} is not an integer") from None
-        return scheme, args
-    if scheme == "socketcand":
-        hostport, slash, channel = rest.partition("/")
-        host, colon, port = hostport.rpartition(":")
-        if not slash or not colon or not channel:
-            raise _core.InvalidArgument(f"bus spec {spec!r}: expected socketcand:HOST:PORT/CHANNEL")
-        try:
-            return scheme, {"host": host, "port": int(port), "channel": channel}
-        except ValueError:
-            raise _core.InvalidArgument(f"bus spec {spec!r}: port {port!r} is not an integer") from None
-    if scheme == "socketcan":
-        return scheme, {"iface": rest}
-    raise _core.InvalidArgument(
-        f"bus spec {spec!r}: unknown scheme {scheme!r} (virtual, slcan, socketcand, socketcan)")
+    try:
+        return scheme, registry.bus_scheme(scheme).parse(rest)
+    except _core.InvalidArgument as e:
+        raise _core.InvalidArgument(f"bus spec {spec!r}: {e}") from None
 
 
 def open_bus(spec: Any, **options: Any) -> _core.Bus:
@@ -66,16 +49,16 @@ def open_bus(spec: Any, **options: Any) -> _core.Bus:
     if not isinstance(spec, str):
         return _bridge(spec, **options)
     scheme, args = parse_spec(spec)
-    opener = {
-        "virtual": "open_virtual",
-        "slcan": "open_slcan",
-        "socketcand": "open_socketcand",
-        "socketcan": "open_socketcan",
-    }[scheme]
-    fn = getattr(_core, opener, None)
-    if fn is None:
-        raise _core.InvalidArgument(f"bus spec {spec!r}: the {scheme} backend is not built in this motorbus")
-    return fn(**args, **options)
+    return registry.bus_scheme(scheme).open(**args, **options)
+
+
+def _parse_virtual(rest: str) -> dict[str, Any]:
+    return {"name": rest}
+
+
+#: ``virtual:NAME``: every bus opened with one NAME in this process is one CAN bus.
+VIRTUAL = registry.BusScheme("virtual", "in-process hub: wire time at a bit rate, arbitration, fault injection",
+                             parse=_parse_virtual, open=_core.open_virtual, example="virtual:bench")
 
 
 # ---------------------------------------------------------------------------

@@ -10,10 +10,11 @@ See docs/slcan.md.
 """
 from __future__ import annotations
 
+from . import _core, registry
 from ._core import SlcanBus, SlcanDecoder, SlcanServer, open_slcan, slcan_encode
 
 __all__ = ["SlcanBus", "SlcanDecoder", "SlcanServer", "open_slcan", "slcan_encode",
-           "STATUS_FLAGS"]
+           "STATUS_FLAGS", "SCHEME"]
 
 #: Bits of the ``F`` status reply (Lawicel CAN232/CANUSB manual, SJA1000 based).
 STATUS_FLAGS = {
@@ -25,3 +26,20 @@ STATUS_FLAGS = {
     "arbitration_lost": 0x40,
     "bus_error": 0x80,
 }
+
+
+def _parse(rest: str) -> dict:
+    """``PATH[@BITRATE]``."""
+    path, at, rate = rest.rpartition("@") if "@" in rest else (rest, "", "")
+    args: dict = {"path": path}
+    if at:
+        try:
+            args["bitrate"] = int(rate)
+        except ValueError:
+            raise _core.InvalidArgument(f"bitrate {rate!r} is not an integer") from None
+    return args
+
+
+#: ``slcan:PATH[@BITRATE]`` for open_bus.
+SCHEME = registry.BusScheme("slcan", "Lawicel adapter on a serial line (CANable, USBtin, a pty)",
+                            parse=_parse, open=open_slcan, example="slcan:/dev/ttyACM0@500000")

@@ -20,7 +20,7 @@ def test_open_bus_virtual_roundtrip_and_counters():
 
 
 def test_bad_specs_name_the_problem():
-    with pytest.raises(motorbus.InvalidArgument, match="unknown scheme"):
+    with pytest.raises(motorbus.InvalidArgument, match=r"unknown bus scheme .nope. \(registered: .*virtual"):
         motorbus.open_bus("nope:x")
     with pytest.raises(motorbus.InvalidArgument, match="SCHEME:ARGS"):
         motorbus.open_bus("virtual")

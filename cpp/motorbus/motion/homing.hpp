@@ -1,22 +1,6 @@
-// Homing routines on the MotorModel.
-//
-// DMX-CAN (000 manual, "Homing", Figures 7.2-7.6):
-//   H+/H-   run at HSPD toward home; on the home edge the position counter is
-//           reset to 0 and the motor decelerates to LSPD and stops (the final
-//           position is not 0).  RZ=1: then return to 0.
-//   HL+/HL- as H, then reverse at LSPD to find home again, continue through
-//           it at HSPD and on past it by HCA, come back at LSPD, and on the
-//           home edge reset to 0 and stop immediately.  RZ=1: return to 0
-//           (already there).
-//   The inputs are levels: a switch already active at the start is found at once.
-//   L+/L-   run toward the limit; stop immediately on it; move back by LCA at
-//           HSPD; that point is zero.
-//   Z+/Z-   run at LSPD until the Z index; stop, position = 0.
-//   ZH+/ZH- run toward home; on home decelerate to LSPD, then search Z at
-//           LSPD; on Z stop, position = 0.
-//   A limit met in the search direction before the home switch ends homing
-//   with a limit error (the DMX-CAN latches a limit error; it does not
-//   reverse).
+// The homing engine: what every drive's homing shares (the result vocabulary, the
+// search ramp) and the CiA 402 methods. Vendor homing lives with its vendor
+// (drives/arcus/homing.hpp).
 //
 // CiA 402 (methods 7, 11, 17, 18, 19, 20, 33, 34, 35), with 6099h:01 speed
 // during search for switch, 6099h:02 speed during search for zero, 609Ah
@@ -29,21 +13,16 @@
 #include <cstdint>
 #include <string>
 
-#include "motorbus/motion/arcus_profile.hpp"
 #include "motorbus/motion/motor_model.hpp"
+#include "motorbus/motion/planner.hpp"
 
 namespace motorbus::motion {
 
 enum class HomingResult { Running, Done, LimitError, Aborted, Failed };
 
-struct ArcusHomingOptions {
-    double hca = 0;      // HCA, pulses
-    double lca = 1000;   // LCA, pulses (factory 1000)
-    bool rz = false;     // RZ: return to zero after H/HL
-    // Reset the encoder counter wherever the position counter is reset (a
-    // drive that keeps PX and EX aligned, as the DMX-CAN simulator does).
-    bool zero_encoder = false;
-};
+// From a commanded state (p, v), ramp to `velocity` at `accel` and hold it until an
+// event ends the search; a stepper with a start speed jumps to it first.
+Profile ramp_and_hold(double p, double v, double velocity, double accel, RampShape shape, double start_speed = 0);
 
 struct Cia402HomingParams {
     int method = 17;               // 6098h
@@ -51,44 +30,6 @@ struct Cia402HomingParams {
     double speed_zero = 100;       // 6099h:02, steps/s
     double acceleration = 10000;   // 609Ah, steps/s^2
     double home_offset = 0;        // 607Ch, steps
-};
-
-class ArcusHoming {
-public:
-    enum class Method { H, HL, L, Z, ZH };
-    using Options = ArcusHomingOptions;
-    ArcusHoming(MotorModel& motor, ArcusProfileParams params, Options opt = {});
-    ~ArcusHoming();
-    ArcusHoming(const ArcusHoming&) = delete;
-    ArcusHoming& operator=(const ArcusHoming&) = delete;
-
-    // Starts homing now (motor.time()); direction +1 or -1.
-    void start(Method m, int direction);
-    void abort();  // ABORT: stop now
-    void stop();   // STOP: decelerate to LSPD, then stop
-    HomingResult result() const { return result_; }
-    bool running() const { return result_ == HomingResult::Running; }
-    Method method() const { return method_; }
-    // The StepNLoop status to show while it runs: Homing, Z-Homing or Limit homing.
-    int snl_status() const;
-
-private:
-    MotorModel& motor_;
-    ArcusProfileParams params_;
-    Options opt_;
-    Method method_ = Method::H;
-    int dir_ = 1;
-    int stage_ = 0;
-    HomingResult result_ = HomingResult::Done;
-    int listener_ = 0;
-    void on_event(const MotorEvent& e);
-    void run(double target_offset, double speed_pps, bool from_current);
-    void jog(int direction, double hspd);
-    void decel_stop(Nanos t);
-    void finish(HomingResult r);
-    void set_zero();
-    void zero_and_decelerate(const MotorEvent& e);
-    void stop_at_zero();
 };
 
 class Cia402Homing {

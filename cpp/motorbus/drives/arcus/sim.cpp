@@ -7,8 +7,8 @@
 #include <map>
 #include <sstream>
 
-#include "motorbus/motion/arcus_profile.hpp"
-#include "motorbus/motion/homing.hpp"
+#include "motorbus/drives/arcus/profile.hpp"
+#include "motorbus/drives/arcus/homing.hpp"
 #include "motorbus/motion/motor_model.hpp"
 #include "motorbus/motion/stepnloop.hpp"
 
@@ -71,10 +71,10 @@ struct Sim::State {
     std::unique_ptr<motion::MotorModel> motor;
     // X, J, T, SSPD, STOP: the profile model; the motor runs its profile
     // while arcus_profile is true.
-    motion::ArcusMotion arcus{motion::ArcusProfileParams{}};
+    ArcusMotion arcus{ArcusProfileParams{}};
     bool arcus_profile = false;
     // H, HL, L, Z, ZH (declared after the motor: destroyed before it).
-    std::unique_ptr<motion::ArcusHoming> homing;
+    std::unique_ptr<ArcusHoming> homing;
     int homing_listener = 0;  // runs after the homing's own listener
     int home_direction = 1;   // physical direction of the search
 
@@ -125,8 +125,8 @@ public:
     // An unpowered (EO=0) or blocked rotor stays put while the pulses go out.
     void apply_jam() { m().set_jammed(s.blocked || !s.eo); }
 
-    motion::ArcusProfileParams profile_params(double hspd_override = -1) const {
-        motion::ArcusProfileParams ap;
+    ArcusProfileParams profile_params(double hspd_override = -1) const {
+        ArcusProfileParams ap;
         ap.snl_ratio = snl_on() ? kStepsPerCount : 1.0;
         // arcus_effective refuses speeds outside 1..6 000 000 PPS; the sim
         // validates HSPD/LSPD itself, so only clamp what unit conversion moved.
@@ -166,21 +166,21 @@ public:
     }
 
     // MST bits 0..2.
-    motion::ArcusPhase phase() const {
-        if (!m().moving()) return motion::ArcusPhase::Idle;
+    ArcusPhase phase() const {
+        if (!m().moving()) return ArcusPhase::Idle;
         if (s.arcus_profile) return s.arcus.phase(arcus_time());
         const double v = m().pulse_velocity(), a = m().commanded_acceleration() * (steps_per_unit() > 0 ? 1 : -1);
-        if (v * a > 0) return motion::ArcusPhase::Accel;
-        if (v * a < 0) return motion::ArcusPhase::Decel;
-        return motion::ArcusPhase::Const;
+        if (v * a > 0) return ArcusPhase::Accel;
+        if (v * a < 0) return ArcusPhase::Decel;
+        return ArcusPhase::Const;
     }
 
     std::int64_t mst() const {
         std::int64_t v = 0;
         const auto ph = phase();
-        if (ph == motion::ArcusPhase::Const) v |= 1;
-        if (ph == motion::ArcusPhase::Accel) v |= 2;
-        if (ph == motion::ArcusPhase::Decel) v |= 4;
+        if (ph == ArcusPhase::Const) v |= 1;
+        if (ph == ArcusPhase::Accel) v |= 2;
+        if (ph == ArcusPhase::Decel) v |= 4;
         if (m().home_active()) v |= 8;
         if (m().minus_limit_active()) v |= 16;
         if (m().plus_limit_active()) v |= 32;
@@ -235,7 +235,7 @@ public:
         configure_arcus(static_cast<double>(std::min(s.lspd, s.hspd)));
         s.job = Job::Correct;
         s.stopping = false;
-        if (s.arcus.move(from, target) == motion::ArcusReply::Ok) command_arcus();
+        if (s.arcus.move(from, target) == ArcusReply::Ok) command_arcus();
         if (!m().moving()) s.job = Job::None;
     }
 
@@ -283,7 +283,7 @@ public:
                 if (e.direction != side) break;
                 // Limit homing runs onto its limit on purpose: ArcusHoming backs off.
                 if (s.job == Job::Home && s.homing && s.homing->running() &&
-                    s.homing->method() == motion::ArcusHoming::Method::L && side == s.home_direction)
+                    s.homing->method() == ArcusHoming::Method::L && side == s.home_direction)
                     break;
                 limit_stop(side, e.t);
                 break;
@@ -328,15 +328,15 @@ public:
         end_job(t);
     }
 
-    void start_homing(motion::ArcusHoming::Method method, int dir, Nanos now) {
+    void start_homing(ArcusHoming::Method method, int dir, Nanos now) {
         if (s.homing) s.homing.reset();
         if (s.homing_listener) m().remove_listener(s.homing_listener);
-        motion::ArcusHomingOptions ho;
+        ArcusHomingOptions ho;
         ho.hca = static_cast<double>(s.hca);
         ho.lca = static_cast<double>(s.cfg.lca);
         ho.rz = s.rz != 0;
         ho.zero_encoder = true;  // PX and EX both read 0 at home
-        s.homing = std::make_unique<motion::ArcusHoming>(m(), profile_params(), ho);
+        s.homing = std::make_unique<ArcusHoming>(m(), profile_params(), ho);
         State* sp = &s;
         const SimOptions* op = &o;
         s.homing_listener =
@@ -612,9 +612,9 @@ std::string Sim::handle(const Request& req) {
         e.check_limit_at_start(e.physical_direction(dir), now);
         return ok;
     };
-    auto home = [&](motion::ArcusHoming::Method method, int dir) -> std::string {
+    auto home = [&](ArcusHoming::Method method, int dir) -> std::string {
         if (refuse_in_error()) return std::string(error_text(ErrorCode::StateError));
-        using M = motion::ArcusHoming::Method;
+        using M = ArcusHoming::Method;
         s.snl.begin(method == M::Z   ? motion::SnlActivity::ZHome
                     : method == M::L ? motion::SnlActivity::LimitHome
                                      : motion::SnlActivity::Home);
@@ -807,7 +807,7 @@ std::string Sim::handle(const Request& req) {
             double target = s.inc_mode ? from + static_cast<double>(*v) : static_cast<double>(*v);
             if (std::abs(target - from) > static_cast<double>(kMaxIncrement)) return unknown();
             e.configure_arcus();
-            if (s.arcus.move(from, target) != motion::ArcusReply::Ok) return unknown();
+            if (s.arcus.move(from, target) != ArcusReply::Ok) return unknown();
             s.job = Job::Target;
             s.stopping = false;
             s.snl.begin(motion::SnlActivity::Move);
@@ -827,7 +827,7 @@ std::string Sim::handle(const Request& req) {
             const double t = e.arcus_time();
             const double shift = s.arcus.profile().position(t) - m.pulse_position();
             auto r = s.arcus.change_target(t, static_cast<double>(*v) + shift);
-            if (r != motion::ArcusReply::Ok) return motion::arcus_reply_text(r);
+            if (r != ArcusReply::Ok) return arcus_reply_text(r);
             m.revise(s.arcus.profile());
             return ok;
         }
@@ -844,7 +844,7 @@ std::string Sim::handle(const Request& req) {
                 return std::string(error_text(ErrorCode::BadSspd));
             s.arcus.set_sspdm(static_cast<int>(s.sspdm));
             auto r = s.arcus.change_speed(e.arcus_time(), static_cast<double>(*v));
-            if (r != motion::ArcusReply::Ok) return motion::arcus_reply_text(r);
+            if (r != ArcusReply::Ok) return arcus_reply_text(r);
             m.revise(s.arcus.profile());
             return ok;
         }
@@ -905,7 +905,7 @@ std::string Sim::handle(const Request& req) {
         s.user_do &= ~std::int64_t{2};
         return ok;
     }
-    using M = motion::ArcusHoming::Method;
+    using M = ArcusHoming::Method;
     if (name == "J+") return jog(1);
     if (name == "J-") return jog(-1);
     if (name == "H+") return home(M::H, 1);

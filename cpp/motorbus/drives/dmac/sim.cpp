@@ -21,8 +21,8 @@ motion::MotorConfig axis_config(const SimOptions& o) {
     motion::MotorConfig c;
     // One step = one encoder count = one DMAC increment: every position the
     // firmware reports is the model's encoder as is.
-    c.steps_per_rev = motion::kDmacIncrementsPerRev;
-    c.counts_per_rev = motion::kDmacIncrementsPerRev;
+    c.steps_per_rev = kDmacIncrementsPerRev;
+    c.counts_per_rev = kDmacIncrementsPerRev;
     c.index_width_steps = 1;
     c.plus_limit = o.positive_end_switch;
     c.minus_limit = o.negative_end_switch;
@@ -127,8 +127,8 @@ std::uint32_t DmacSim::logical_inputs() const {
 
 bool DmacSim::var_available(Var v) const { return dmac34() || !var_info(v).dmac34_only; }
 
-motion::DmacProfileParams DmacSim::params() const {
-    motion::DmacProfileParams p;
+DmacProfileParams DmacSim::params() const {
+    DmacProfileParams p;
     p.high_speed = vars_[static_cast<std::size_t>(Var::HighSpeed)];
     p.low_speed = vars_[static_cast<std::size_t>(Var::LowSpeed)];
     p.accel_time_ms = vars_[static_cast<std::size_t>(Var::AccelTime)];
@@ -150,7 +150,7 @@ double DmacSim::user_position() const {
 std::int32_t DmacSim::position_locked() const { return wrap_i32(axis_->encoder()); }
 
 std::int32_t DmacSim::speed_locked() const {
-    return round_i32(motion::dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->velocity())));
+    return round_i32(dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->velocity())));
 }
 
 bool DmacSim::moving_locked() const { return interpolating_ || motion_->moving(motion_t()); }
@@ -224,7 +224,7 @@ void DmacSim::poll() {
 // ---- motion -----------------------------------------------------------------
 void DmacSim::restart_motion_at(double position) {
     pos_offset_ = 0;
-    motion_ = std::make_unique<motion::DmacMotion>(params(), position);
+    motion_ = std::make_unique<DmacMotion>(params(), position);
     motion_t0_ms_ = now_ms_;
     position_mode_ = false;
 }
@@ -440,7 +440,7 @@ std::uint32_t DmacSim::status_locked() {
     set(status::kMovement, moving);
     if (moving && position_mode_ && !interpolating_) {
         const double err = static_cast<double>(motion_->target() + pos_offset_) - user_position();
-        set(status::kPositionControl, std::fabs(err) <= motion::kDmacApproachIncrements);
+        set(status::kPositionControl, std::fabs(err) <= kDmacApproachIncrements);
     }
     set(status::kBusy, moving);
     set(status::kReference, reference_);

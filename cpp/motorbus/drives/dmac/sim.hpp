@@ -1,5 +1,5 @@
 // A DMAC module as a serial LineDevice: every variable with its stored or
-// volatile behaviour, the DMAC motion profile (motion::DmacMotion), hard and
+// volatile behaviour, the DMAC motion profile (DmacMotion), hard and
 // soft end-stops, the 500-line sequencer (one line per millisecond), the
 // interpolation FIFO and MODULE_RESET [ALL].
 //
@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "motorbus/drives/dmac/codec.hpp"
-#include "motorbus/motion/dmac_profile.hpp"
+#include "motorbus/drives/dmac/profile.hpp"
 #include "motorbus/motion/motor_model.hpp"
 #include "motorbus/runtime/clock.hpp"
 #include "motorbus/serial/line_device.hpp"
@@ -142,7 +142,7 @@ private:
     void check_end_stops();
     void update_end_flags();
     void reset_locked(bool factory);
-    motion::DmacProfileParams params() const;
+    DmacProfileParams params() const;
 
     // sequencer
     void seq_start(int line);
@@ -172,7 +172,7 @@ private:
 
     // motion: the planner (its own time line from motion_t0_ms_) and the axis
     std::unique_ptr<motion::MotorModel> axis_;
-    std::unique_ptr<motion::DmacMotion> motion_;
+    std::unique_ptr<DmacMotion> motion_;
     std::int64_t motion_t0_ms_ = 0;
     bool position_mode_ = false;
     // #POSITION written during a move re-homes without disturbing it: the

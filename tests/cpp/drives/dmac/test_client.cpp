@@ -95,7 +95,7 @@ TEST(DmacClient, MoveToAndWaitIdleOnSimulatedTime) {
     const auto t0 = b.clock->now();
     EXPECT_EQ(c.wait_idle(10s, 1ms), 200000);
     const double took_ms = static_cast<double>(b.clock->now() - t0) / 1e6;
-    motion::DmacMotion ref;
+    DmacMotion ref;
     ref.move_to(0, 200000);
     EXPECT_NEAR(took_ms, ref.profile().duration() * 1000, 2.0);
     c.move_on(-5000);  // the manual's MOVE_ON example: half a turn CCW

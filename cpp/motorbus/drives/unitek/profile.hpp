@@ -11,7 +11,9 @@
 
 #include "motorbus/motion/profile.hpp"
 
-namespace motorbus::motion {
+namespace motorbus::unitek {
+// A vendor profile model is built from the generic motion pieces.
+using namespace motorbus::motion;
 
 inline constexpr std::uint8_t kUnitekRegAccRamp = 0x35;
 inline constexpr std::uint8_t kUnitekRegDecRamp = 0xED;
@@ -31,4 +33,4 @@ double unitek_num_to_counts_per_s(double num, const UnitekRampParams& p);
 // |speed_num| is limited to 32767.
 Profile unitek_speed_profile(const State& start, double speed_num, const UnitekRampParams& p, double hold);
 
-}  // namespace motorbus::motion
+}  // namespace motorbus::unitek

@@ -1,16 +1,17 @@
 // Bindings for cpp/motorbus/drives/dmac: DmacSim (a LineDevice), DmacClient,
 // the global SYNCHRO commands, interpolation streaming and a few codec helpers.
-#include <pybind11/eval.h>
 #include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "errors.hpp"
 #include "motorbus/drives/dmac/client.hpp"
 #include "motorbus/drives/dmac/codec.hpp"
 #include "motorbus/drives/dmac/sim.hpp"
 #include "motorbus/serial/line_device.hpp"
 #include "motorbus/serial/port.hpp"
+#include "motorbus/drives/dmac/profile.hpp"
 
 namespace py = pybind11;
 using namespace motorbus;
@@ -18,8 +19,6 @@ using namespace motorbus::dmac;
 
 namespace {
 
-py::handle g_unknown_command;
-py::handle g_command_rejected;
 
 Var var_arg(const std::string& name) {
     auto v = find_variable(name);
@@ -72,35 +71,56 @@ py::dict state_dict(const SimState& s) {
 
 }  // namespace
 
+namespace {
+// The vendor's profile model (and homing), bound with the vendor.
+void bind_dmac_motion(py::module_& m) {
+    using namespace motorbus::motion;
+    // ---- DMAC ------------------------------------------------------------------
+    py::class_<DmacProfileParams>(m, "DmacProfileParams")
+        .def(py::init([](std::int32_t hs, std::int32_t ls, std::int32_t ati, std::int32_t dti, bool sc) {
+                 DmacProfileParams p{hs, ls, ati, dti, sc};
+                 p.validate();
+                 return p;
+             }),
+             py::arg("high_speed") = 60000, py::arg("low_speed") = 6000, py::arg("accel_time_ms") = 1000,
+             py::arg("decel_time_ms") = 1000, py::arg("s_curve") = false)
+        .def_readwrite("high_speed", &DmacProfileParams::high_speed)
+        .def_readwrite("low_speed", &DmacProfileParams::low_speed)
+        .def_readwrite("accel_time_ms", &DmacProfileParams::accel_time_ms)
+        .def_readwrite("decel_time_ms", &DmacProfileParams::decel_time_ms)
+        .def_readwrite("s_curve", &DmacProfileParams::s_curve);
+    m.def("dmac_ramp_time", &dmac_ramp_time, py::arg("params"), py::arg("v_from"), py::arg("v_to"));
+    m.def("dmac_position_profile", &dmac_position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
+    m.def("dmac_speed_profile", &dmac_speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
+          py::arg("hold") = 0.0);
+    py::class_<DmacMotion>(m, "DmacMotion")
+        .def(py::init<DmacProfileParams, double>(), py::arg("params") = DmacProfileParams{}, py::arg("position") = 0.0)
+        .def("set_params", &DmacMotion::set_params)
+        .def("move_to", &DmacMotion::move_to, py::arg("t"), py::arg("target"))
+        .def("move_on", &DmacMotion::move_on, py::arg("t"), py::arg("offset"))
+        .def("move_speed", &DmacMotion::move_speed, py::arg("t"), py::arg("speed"))
+        .def("stop", &DmacMotion::stop, py::arg("t"))
+        .def_property_readonly("profile", &DmacMotion::profile, py::return_value_policy::copy)
+        .def("moving", &DmacMotion::moving, py::arg("t"));
+
+}
+}  // namespace
+
+namespace {
+void fill_rejected(py::object& exc, const CommandRejected& e) { exc.attr("error") = e.error; }
+}  // namespace
+
 void bind_dmac(py::module_& m) {
+    bind_dmac_motion(m);
     // ---- errors ---------------------------------------------------------------
-    py::dict ns;
-    ns["DriveFault"] = m.attr("DriveFault");
-    py::exec(R"(
-class UnknownCommand(DriveFault):
-    "The DMAC rejected a command as undefined (#ERROR bit 12), or a peer answered '?'."
-class CommandRejected(DriveFault):
-    "The DMAC refused a parameter (#ERROR bit 7 limit, bit 8 computation); .error holds #ERROR."
-    error = 0
-)", ns, ns);
-    for (const char* n : {"UnknownCommand", "CommandRejected"}) {
-        py::object cls = ns[n];
-        cls.attr("__module__") = "motorbus.drives.dmac";
-        m.attr((std::string("Dmac") + n).c_str()) = cls;
-    }
-    g_unknown_command = py::object(ns["UnknownCommand"]).release();
-    g_command_rejected = py::object(ns["CommandRejected"]).release();
-    py::register_exception_translator([](std::exception_ptr p) {
-        try {
-            if (p) std::rethrow_exception(p);
-        } catch (const UnknownCommand& e) {
-            PyErr_SetString(g_unknown_command.ptr(), e.what());
-        } catch (const CommandRejected& e) {
-            py::object exc = py::reinterpret_borrow<py::object>(g_command_rejected)(e.what());
-            exc.attr("error") = e.error;
-            PyErr_SetObject(g_command_rejected.ptr(), exc.ptr());
-        }
+    py_errors::add_error_classes(m, {
+        {"DmacUnknownCommand", {"DriveFault"},
+         "The DMAC rejected a command as undefined (#ERROR bit 12), or a peer answered '?'."},
+        {"DmacCommandRejected", {"DriveFault"},
+         "The DMAC refused a parameter (#ERROR bit 7 limit, bit 8 computation); .error holds #ERROR."},
     });
+    py_errors::translate<UnknownCommand>(m.attr("DmacUnknownCommand"));
+    py_errors::translate<CommandRejected, fill_rejected>(m.attr("DmacCommandRejected"));
 
     // ---- codec helpers ---------------------------------------------------------------
     m.def("dmac_format_value", [](std::int32_t v, const std::string& r) { return format_value(v, radix_arg(r)); },

@@ -1,11 +1,11 @@
-#include "motorbus/motion/pmc007_profile.hpp"
+#include "motorbus/drives/pmc007/profile.hpp"
 
 #include <cmath>
 #include <limits>
 
 #include "motorbus/motion/planner_detail.hpp"
 
-namespace motorbus::motion {
+namespace motorbus::pmc007 {
 
 double pmc007_gear_acceleration(int gear) {
     if (gear < 0) throw LimitExceeded("acceleration gear (6008h/6009h)", gear, 0, "gears are 0..8");
@@ -66,4 +66,4 @@ Profile pmc007_speed_profile(const State& start, double speed, const Pmc007Profi
     return prof;
 }
 
-}  // namespace motorbus::motion
+}  // namespace motorbus::pmc007

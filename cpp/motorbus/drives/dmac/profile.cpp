@@ -1,4 +1,4 @@
-#include "motorbus/motion/dmac_profile.hpp"
+#include "motorbus/drives/dmac/profile.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "motorbus/motion/planner_detail.hpp"
 
-namespace motorbus::motion {
+namespace motorbus::dmac {
 
 namespace {
 constexpr double kSpeedHoldSeconds = 1e7;  // MOVE_SPEED runs until the next command
@@ -177,4 +177,4 @@ void DmacMotion::stop(double t) {
 
 bool DmacMotion::moving(double t) const { return t < motion_end_; }
 
-}  // namespace motorbus::motion
+}  // namespace motorbus::dmac

@@ -1,4 +1,4 @@
-#include "motorbus/motion/arcus_profile.hpp"
+#include "motorbus/drives/arcus/profile.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "motorbus/motion/planner_detail.hpp"
 
-namespace motorbus::motion {
+namespace motorbus::arcus {
 
 namespace {
 // A jog has no end; the profile needs one.  Long enough for any test or sim.
@@ -279,4 +279,4 @@ ArcusPhase ArcusMotion::phase(double t) const {
     return (acc > 0) == (st.v > 0) ? ArcusPhase::Accel : ArcusPhase::Decel;
 }
 
-}  // namespace motorbus::motion
+}  // namespace motorbus::arcus

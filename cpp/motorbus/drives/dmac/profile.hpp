@@ -31,7 +31,9 @@
 #include "motorbus/motion/planner.hpp"
 #include "motorbus/motion/profile.hpp"
 
-namespace motorbus::motion {
+namespace motorbus::dmac {
+// A vendor profile model is built from the generic motion pieces.
+using namespace motorbus::motion;
 
 inline constexpr double kDmacIncrementsPerRev = 10000.0;
 inline constexpr double kDmacApproachIncrements = 1000.0;  // 0.1 turn
@@ -97,4 +99,4 @@ Profile dmac_position_profile(const State& start, double target, const DmacProfi
 Profile dmac_speed_profile(const State& start, double speed_001rpm, const DmacProfileParams& p,
                            double hold);
 
-}  // namespace motorbus::motion
+}  // namespace motorbus::dmac

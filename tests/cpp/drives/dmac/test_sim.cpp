@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "motorbus/drives/dmac/sim.hpp"
-#include "motorbus/motion/dmac_profile.hpp"
+#include "motorbus/drives/dmac/profile.hpp"
 #include "sim_rig.hpp"
 
 using namespace motorbus;
@@ -190,7 +190,7 @@ TEST(DmacSim, MoveToFollowsTheDmacProfileTimes) {
     // in 0.9 s: 49500 inc; the last 1000 inc closed-loop: tau 100 ms, ends in
     // tau (ln 1000 + 1); the rest cruises at 100 inc/ms.
     const double expected_ms = 1000 + (200000 - 100500) / 100.0 + 900 + 100 * (std::log(1000.0) + 1);
-    motion::DmacMotion ref;
+    DmacMotion ref;
     ref.move_to(0, 200000);
     EXPECT_NEAR(ref.profile().duration() * 1000, expected_ms, 1.0);
     r.ms(1000);

@@ -1,14 +1,17 @@
 // Bindings for cpp/motorbus/drives/arcus: codec helpers, the simulator (a
 // LineDevice for PtyLineServer) and the client.  python/motorbus/drives/arcus.py
 // adds the Pythonic layer (enums, context manager, make_sim).
-#include <pybind11/eval.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "errors.hpp"
 #include "motorbus/drives/arcus/client.hpp"
 #include "motorbus/drives/arcus/codec.hpp"
 #include "motorbus/drives/arcus/sim.hpp"
+#include "motorbus/drives/arcus/homing.hpp"
+#include "motorbus/drives/arcus/profile.hpp"
+#include "motorbus/motion/motor_model.hpp"
 
 namespace py = pybind11;
 using namespace motorbus;
@@ -25,63 +28,45 @@ std::string bytes_or_str(const py::handle& h, const char* what) {
     throw InvalidArgument(std::string(what) + ": expected str or bytes");
 }
 
-// Python classes per Table 11.1 reply, all subclasses of ArcusError(DriveFault).
-py::handle g_error_classes[9];
+// One Python class per Table 11.1 reply, all subclasses of ArcusError(DriveFault).
+struct ReplyClass {
+    ErrorCode code;
+    const char* name;
+};
+constexpr ReplyClass kReplyClasses[] = {
+    {ErrorCode::UnknownCommand, "ArcusUnknownCommand"}, {ErrorCode::BadSspd, "ArcusBadSspd"},
+    {ErrorCode::EnableRs485, "ArcusEnableRs485"},       {ErrorCode::IndexOutOfRange, "ArcusIndexOutOfRange"},
+    {ErrorCode::MotorNotMoving, "ArcusMotorNotMoving"}, {ErrorCode::Moving, "ArcusMoving"},
+    {ErrorCode::ScvOn, "ArcusScvOn"},                   {ErrorCode::SpeedOutOfRange, "ArcusSpeedOutOfRange"},
+    {ErrorCode::StateError, "ArcusStateError"}};
+py::handle g_reply_class[std::size(kReplyClasses)];
 py::handle g_arcus_error;
 
-constexpr ErrorCode kCodes[9] = {ErrorCode::UnknownCommand, ErrorCode::BadSspd,        ErrorCode::EnableRs485,
-                                 ErrorCode::IndexOutOfRange, ErrorCode::MotorNotMoving, ErrorCode::Moving,
-                                 ErrorCode::ScvOn,           ErrorCode::SpeedOutOfRange, ErrorCode::StateError};
-
 void register_errors(py::module_& m) {
-    py::dict ns;
-    ns["DriveFault"] = m.attr("DriveFault");
-    py::exec(R"PY(
-class ArcusError(DriveFault):
-    "An Arcus drive refused a command with a Table 11.1 reply. .code, .reply, .command."
-    code = ""
-    reply = ""
-    command = ""
-class ArcusUnknownCommand(ArcusError):
-    "?<command>: the controller did not understand the command."
-class ArcusBadSspd(ArcusError):
-    "?Bad SSPD Command"
-class ArcusEnableRs485(ArcusError):
-    "?Enable RS-485 Mode"
-class ArcusIndexOutOfRange(ArcusError):
-    "?Index out of Range"
-class ArcusMotorNotMoving(ArcusError):
-    "?Motor is not moving (T without a target move)"
-class ArcusMoving(ArcusError):
-    "?Moving (a move or position change while outputting pulses)"
-class ArcusScvOn(ArcusError):
-    "?SCV ON (SSPD with S-curve enabled)"
-class ArcusSpeedOutOfRange(ArcusError):
-    "?Speed out of range (SSPD outside the SSPDM window)"
-class ArcusStateError(ArcusError):
-    "?State Error (a move while a limit or StepNLoop error is latched; CLR clears it)"
-)PY",
-             ns, ns);
-    const char* names[9] = {"ArcusUnknownCommand", "ArcusBadSspd",        "ArcusEnableRs485",
-                            "ArcusIndexOutOfRange", "ArcusMotorNotMoving", "ArcusMoving",
-                            "ArcusScvOn",           "ArcusSpeedOutOfRange", "ArcusStateError"};
-    py::object base = ns["ArcusError"];
-    base.attr("__module__") = "motorbus";
-    m.attr("ArcusError") = base;
-    g_arcus_error = base.release();
-    for (int i = 0; i < 9; ++i) {
-        py::object cls = ns[names[i]];
-        cls.attr("__module__") = "motorbus";
-        m.attr(names[i]) = cls;
-        g_error_classes[i] = cls.release();
-    }
+    py_errors::add_error_classes(m, {
+        {"ArcusError", {"DriveFault"}, "An Arcus drive refused a command with a Table 11.1 reply. .code, .reply, .command."},
+        {"ArcusUnknownCommand", {"ArcusError"}, "?<command>: the controller did not understand the command."},
+        {"ArcusBadSspd", {"ArcusError"}, "?Bad SSPD Command"},
+        {"ArcusEnableRs485", {"ArcusError"}, "?Enable RS-485 Mode"},
+        {"ArcusIndexOutOfRange", {"ArcusError"}, "?Index out of Range"},
+        {"ArcusMotorNotMoving", {"ArcusError"}, "?Motor is not moving (T without a target move)"},
+        {"ArcusMoving", {"ArcusError"}, "?Moving (a move or position change while outputting pulses)"},
+        {"ArcusScvOn", {"ArcusError"}, "?SCV ON (SSPD with S-curve enabled)"},
+        {"ArcusSpeedOutOfRange", {"ArcusError"}, "?Speed out of range (SSPD outside the SSPDM window)"},
+        {"ArcusStateError", {"ArcusError"},
+         "?State Error (a move while a limit or StepNLoop error is latched; CLR clears it)"},
+    });
+    g_arcus_error = py::object(m.attr("ArcusError")).release();
+    for (std::size_t i = 0; i < std::size(kReplyClasses); ++i)
+        g_reply_class[i] = py::object(m.attr(kReplyClasses[i].name)).release();
+    // The class depends on the reply code, so this translator picks it itself.
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
         } catch (const ArcusError& e) {
             py::handle cls = g_arcus_error;
-            for (int i = 0; i < 9; ++i)
-                if (kCodes[i] == e.code) cls = g_error_classes[i];
+            for (std::size_t i = 0; i < std::size(kReplyClasses); ++i)
+                if (kReplyClasses[i].code == e.code) cls = g_reply_class[i];
             py::object exc = py::reinterpret_borrow<py::object>(cls)(e.what());
             exc.attr("code") = std::string(error_name(e.code));
             exc.attr("reply") = e.reply;
@@ -113,7 +98,96 @@ SimOptions sim_options(int address, int response_type, const std::string& store_
 
 }  // namespace
 
+namespace {
+// The vendor's profile model (and homing), bound with the vendor.
+void bind_arcus_motion(py::module_& m) {
+    using namespace motorbus::motion;
+    // ---- Arcus -----------------------------------------------------------------
+    py::class_<ArcusSpeedWindow>(m, "ArcusSpeedWindow")
+        .def_readonly("number", &ArcusSpeedWindow::number)
+        .def_readonly("sspdm_first", &ArcusSpeedWindow::sspdm_first)
+        .def_readonly("sspdm_last", &ArcusSpeedWindow::sspdm_last)
+        .def_readonly("hspd_low", &ArcusSpeedWindow::hspd_low)
+        .def_readonly("hspd_high", &ArcusSpeedWindow::hspd_high)
+        .def_readonly("min_lspd", &ArcusSpeedWindow::min_lspd)
+        .def_readonly("min_acc_ms", &ArcusSpeedWindow::min_acc_ms)
+        .def_readonly("delta", &ArcusSpeedWindow::delta);
+    m.def("arcus_speed_windows", [] {
+        const auto& w = arcus_speed_windows();
+        return std::vector<ArcusSpeedWindow>(w.begin(), w.end());
+    });
+    m.def("arcus_window_for_hspd", &arcus_window_for_hspd, py::arg("hspd_pps"), py::return_value_policy::copy);
+    m.def("arcus_window_for_sspdm", &arcus_window_for_sspdm, py::arg("sspdm"), py::return_value_policy::copy);
+    m.def("arcus_max_acc_ms", &arcus_max_acc_ms, py::arg("hspd_pps"), py::arg("lspd_pps"));
+    py::class_<ArcusProfileParams>(m, "ArcusProfileParams")
+        .def(py::init([](double hspd, double lspd, double acc_ms, double dec_ms, bool edec, bool scv, double ratio) {
+                 return ArcusProfileParams{hspd, lspd, acc_ms, dec_ms, edec, scv, ratio};
+             }),
+             py::arg("hspd") = 1000.0, py::arg("lspd") = 100.0, py::arg("acc_ms") = 300.0, py::arg("dec_ms") = 300.0,
+             py::arg("edec") = false, py::arg("scv") = false, py::arg("snl_ratio") = 1.0)
+        .def_readwrite("hspd", &ArcusProfileParams::hspd)
+        .def_readwrite("lspd", &ArcusProfileParams::lspd)
+        .def_readwrite("acc_ms", &ArcusProfileParams::acc_ms)
+        .def_readwrite("dec_ms", &ArcusProfileParams::dec_ms)
+        .def_readwrite("edec", &ArcusProfileParams::edec)
+        .def_readwrite("scv", &ArcusProfileParams::scv)
+        .def_readwrite("snl_ratio", &ArcusProfileParams::snl_ratio);
+    m.def("arcus_effective", [](const ArcusProfileParams& p) {
+        auto e = arcus_effective(p);
+        return py::make_tuple(e.params, e.window ? e.window->number : 0, e.adjustments);
+    }, py::arg("params"), "(effective params, window number, [adjustments]) after Appendix A.");
+    m.def("arcus_check_strict", &arcus_check_strict, py::arg("params"));
+    m.attr("ARCUS_MAX_MOVE_DISTANCE") = kArcusMaxMoveDistance;
+    py::class_<ArcusMotion>(m, "ArcusMotion")
+        .def(py::init<ArcusProfileParams, int>(), py::arg("params") = ArcusProfileParams{}, py::arg("sspdm") = 0)
+        .def("set_params", [](ArcusMotion& a, const ArcusProfileParams& p) { return a.set_params(p).params; })
+        .def("set_sspdm", &ArcusMotion::set_sspdm)
+        .def_property_readonly("effective", [](const ArcusMotion& a) { return a.effective().params; })
+        .def("move", [](ArcusMotion& a, double pos, double target) { return arcus_reply_text(a.move(pos, target)); },
+             py::arg("position"), py::arg("target"), "X: returns '' or the drive's error reply.")
+        .def("jog", [](ArcusMotion& a, double pos, int dir) { return arcus_reply_text(a.jog(pos, dir)); })
+        .def("change_target",
+             [](ArcusMotion& a, double t, double target) { return arcus_reply_text(a.change_target(t, target)); },
+             py::arg("t"), py::arg("target"))
+        .def("change_speed",
+             [](ArcusMotion& a, double t, double v) { return arcus_reply_text(a.change_speed(t, v)); },
+             py::arg("t"), py::arg("hspd"))
+        .def("stop", &ArcusMotion::stop, py::arg("t"))
+        .def("abort", &ArcusMotion::abort, py::arg("t"))
+        .def_property_readonly("profile", &ArcusMotion::profile, py::return_value_policy::copy)
+        .def("moving", &ArcusMotion::moving, py::arg("t"))
+        .def("phase", [](const ArcusMotion& a, double t) {
+            switch (a.phase(t)) {
+                case ArcusPhase::Accel: return "accel";
+                case ArcusPhase::Const: return "const";
+                case ArcusPhase::Decel: return "decel";
+                default: return "idle";
+            }
+        }, py::arg("t"));
+
+    py::class_<ArcusHomingOptions>(m, "ArcusHomingOptions")
+        .def(py::init([](double hca, double lca, bool rz) { return ArcusHomingOptions{hca, lca, rz}; }),
+             py::arg("hca") = 0.0, py::arg("lca") = 1000.0, py::arg("rz") = false);
+    py::class_<ArcusHoming>(m, "ArcusHoming")
+        .def(py::init<MotorModel&, ArcusProfileParams, ArcusHomingOptions>(), py::arg("motor"), py::arg("params"),
+             py::arg("options") = ArcusHomingOptions{}, py::keep_alive<1, 2>())
+        .def("start", [](ArcusHoming& h, const std::string& method, int dir) {
+            static const std::pair<const char*, ArcusHoming::Method> map[] = {
+                {"H", ArcusHoming::Method::H}, {"HL", ArcusHoming::Method::HL}, {"L", ArcusHoming::Method::L},
+                {"Z", ArcusHoming::Method::Z}, {"ZH", ArcusHoming::Method::ZH}};
+            for (const auto& [n, mm] : map)
+                if (method == n) return h.start(mm, dir);
+            throw InvalidArgument("ArcusHoming.start: method is H, HL, L, Z or ZH, not '" + method + "'");
+        }, py::arg("method"), py::arg("direction"))
+        .def("abort", &ArcusHoming::abort)
+        .def_property_readonly("running", &ArcusHoming::running)
+        .def_property_readonly("result", [](const ArcusHoming& h) { return static_cast<int>(h.result()); })
+        .def_property_readonly("snl_status", &ArcusHoming::snl_status);
+}
+}  // namespace
+
 void bind_arcus(py::module_& m) {
+    bind_arcus_motion(m);
     register_errors(m);
 
     m.attr("ARCUS_MAX_REPLY") = kMaxReply;

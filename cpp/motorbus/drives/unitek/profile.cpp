@@ -1,11 +1,11 @@
-#include "motorbus/motion/unitek_profile.hpp"
+#include "motorbus/drives/unitek/profile.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "motorbus/motion/planner_detail.hpp"
 
-namespace motorbus::motion {
+namespace motorbus::unitek {
 
 void UnitekRampParams::validate() const {
     if (!(n_max_rpm > 0) || !std::isfinite(n_max_rpm)) throw LimitExceeded("N max", n_max_rpm, 0, "must be positive");
@@ -42,4 +42,4 @@ Profile unitek_speed_profile(const State& start, double speed_num, const UnitekR
     return prof;
 }
 
-}  // namespace motorbus::motion
+}  // namespace motorbus::unitek

@@ -18,7 +18,9 @@
 #include "motorbus/motion/planner.hpp"
 #include "motorbus/motion/profile.hpp"
 
-namespace motorbus::motion {
+namespace motorbus::arcus {
+// A vendor profile model is built from the generic motion pieces.
+using namespace motorbus::motion;
 
 // One row of Table A.0.  HSPD in (hspd_low, hspd_high] belongs to the window
 // (the first row also includes HSPD = 1).  The manual prints the bounds in
@@ -145,4 +147,4 @@ private:
 Profile arcus_stepper_profile(const State& start, double target, double hspd, double lspd,
                               double accel, double decel, RampShape shape);
 
-}  // namespace motorbus::motion
+}  // namespace motorbus::arcus

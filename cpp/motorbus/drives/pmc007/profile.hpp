@@ -14,7 +14,9 @@
 #include "motorbus/motion/planner.hpp"
 #include "motorbus/motion/profile.hpp"
 
-namespace motorbus::motion {
+namespace motorbus::pmc007 {
+// A vendor profile model is built from the generic motion pieces.
+using namespace motorbus::motion;
 
 inline constexpr std::array<double, 9> kPmc007GearAcceleration = {0,     77440, 48410, 27170, 21510,
                                                                   14080, 10460, 6915,  5210};
@@ -43,4 +45,4 @@ Profile pmc007_position_profile(const State& start, double target, const Pmc007P
 // Speed mode: ramp to `speed` (signed pps) from the start speed, hold `hold` s.
 Profile pmc007_speed_profile(const State& start, double speed, const Pmc007ProfileParams& p, double hold);
 
-}  // namespace motorbus::motion
+}  // namespace motorbus::pmc007

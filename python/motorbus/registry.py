@@ -1,0 +1,153 @@
+"""The registry of drive kinds and bus schemes, filled from entry points.
+
+Two entry-point groups, read once and lazily (as python-can reads ``can.interface``):
+
+* ``motorbus.drive``: ``<kind> = "package.module:PLUGIN"``, a :class:`DrivePlugin`;
+* ``motorbus.bus``: ``<scheme> = "package.module:SCHEME"``, a :class:`BusScheme`.
+
+motorbus declares its own vendors and schemes in its ``pyproject.toml`` exactly
+as another package declares its own (docs/plugins.md), so nothing in motorbus
+names a vendor outside the vendor's own module.
+"""
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
+from importlib import metadata
+from typing import Any, Callable, Optional
+
+from . import _core
+
+__all__ = ["DRIVE_GROUP", "BUS_GROUP", "DrivePlugin", "BusScheme", "drive_plugin", "drive_plugins",
+           "drive_kinds", "bus_scheme", "bus_schemes", "parse_drive_spec"]
+
+DRIVE_GROUP = "motorbus.drive"
+BUS_GROUP = "motorbus.bus"
+
+
+@dataclass(frozen=True)
+class DrivePlugin:
+    """What a vendor module exports as ``PLUGIN``.
+
+    * ``transport``: ``"serial"`` (a line, shared by drives of one kind: RS-485
+      multi-drop) or ``"can"`` (a node on a CAN bus).
+    * ``open(*, line, bus, address, units, **options) -> Drive``: the Drive adapter.
+    * ``make_sim(address, clock=None, **options)``: a simulated drive.  Serial:
+      a LineDevice for a PtyLineServer.  CAN: an object with ``attach(bus)`` and
+      ``close()`` (``make_sim(..., bus=bus)`` attaches at once).
+    * ``line_settings``: serial only, the framing (request/reply terminators,
+      max line) a line server and a LineLink need.
+    * ``check_address(text) -> str``: the canonical form of an address, or
+      InvalidArgument naming the problem.
+    """
+
+    kind: str
+    description: str
+    transport: str
+    open: Callable[..., Any]
+    make_sim: Callable[..., Any]
+    check_address: Callable[[str], str]
+    default_address: str
+    line_settings: Optional[dict] = None
+    default_baud: int = 0
+    sim_options: tuple = ()
+    #: Options make_sim takes per served drive from ``sim serve --store-dir``: a
+    #: function (store_dir, address) -> dict of options.
+    store_options: Optional[Callable[[str, str], dict]] = None
+
+    def __post_init__(self) -> None:
+        if self.transport not in ("serial", "can"):
+            raise _core.InvalidArgument(f"drive plugin {self.kind!r}: transport 'serial' or 'can', "
+                                        f"not {self.transport!r}")
+
+
+@dataclass(frozen=True)
+class BusScheme:
+    """What a bus backend module exports for ``open_bus("<scheme>:...")``.
+
+    ``parse(rest) -> dict`` turns the text after ``<scheme>:`` into keyword
+    arguments of ``open(**kwargs, **options) -> Bus``."""
+
+    scheme: str
+    description: str
+    parse: Callable[[str], dict]
+    open: Callable[..., Any]
+    example: str = ""
+
+
+_lock = threading.Lock()
+_cache: dict[str, dict[str, Any]] = {}
+
+
+def _load(group: str) -> dict[str, Any]:
+    with _lock:
+        if group in _cache:
+            return _cache[group]
+        found: dict[str, Any] = {}
+        for ep in metadata.entry_points(group=group):
+            found.setdefault(ep.name, ep)  # first declaration wins, as importlib orders them
+        _cache[group] = found
+        return found
+
+
+def _resolve(group: str, name: str, what: str) -> Any:
+    entries = _load(group)
+    ep = entries.get(name)
+    if ep is None:
+        known = ", ".join(sorted(entries)) or "none registered: is motorbus installed (pip install -e .)?"
+        raise _core.InvalidArgument(f"unknown {what} {name!r} (registered: {known})")
+    if not isinstance(ep, metadata.EntryPoint):
+        return ep
+    obj = ep.load()
+    with _lock:
+        _cache[group][name] = obj
+    return obj
+
+
+def register(group: str, name: str, obj: Any) -> None:
+    """Adds a plugin at run time (tests, notebooks); entry points are the normal way."""
+    if group not in (DRIVE_GROUP, BUS_GROUP):
+        raise _core.InvalidArgument(f"registry group: {DRIVE_GROUP!r} or {BUS_GROUP!r}, not {group!r}")
+    _load(group)
+    with _lock:
+        _cache[group][name] = obj
+
+
+def drive_plugin(kind: str) -> DrivePlugin:
+    plugin = _resolve(DRIVE_GROUP, kind, "drive kind")
+    if not isinstance(plugin, DrivePlugin):
+        raise _core.InvalidArgument(f"drive kind {kind!r}: its entry point is not a motorbus.registry.DrivePlugin")
+    return plugin
+
+
+def drive_plugins() -> dict[str, DrivePlugin]:
+    """Every registered drive kind, loaded (imports each vendor module)."""
+    return {kind: drive_plugin(kind) for kind in sorted(_load(DRIVE_GROUP))}
+
+
+def drive_kinds() -> dict[str, str]:
+    """``{kind: one-line description}`` of every registered drive kind."""
+    return {kind: plugin.description for kind, plugin in drive_plugins().items()}
+
+
+def bus_scheme(scheme: str) -> BusScheme:
+    obj = _resolve(BUS_GROUP, scheme, "bus scheme")
+    if not isinstance(obj, BusScheme):
+        raise _core.InvalidArgument(f"bus scheme {scheme!r}: its entry point is not a motorbus.registry.BusScheme")
+    return obj
+
+
+def bus_schemes() -> dict[str, BusScheme]:
+    return {name: bus_scheme(name) for name in sorted(_load(BUS_GROUP))}
+
+
+def parse_drive_spec(spec: str) -> tuple[DrivePlugin, list[str]]:
+    """``"arcus:01,02"`` -> (the arcus plugin, ["01", "02"]); InvalidArgument naming the problem."""
+    kind, sep, addrs = spec.partition(":")
+    if not sep or not addrs:
+        raise _core.InvalidArgument(f"drive spec {spec!r}: expected KIND:ADDR[,ADDR...], e.g. arcus:01")
+    plugin = drive_plugin(kind)
+    addresses = [plugin.check_address(a.strip()) for a in addrs.split(",")]
+    if len(set(addresses)) != len(addresses):
+        raise _core.InvalidArgument(f"drive spec {spec!r}: addresses must be distinct")
+    return plugin, addresses
