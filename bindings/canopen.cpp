@@ -1,11 +1,12 @@
 // Bindings for cpp/motorbus/canopen: object dictionary, EDS, SDO client,
-// LocalNode, and the SDO errors (SdoAbortError, SdoTimeout, SdoProtocolError).
-#include <pybind11/eval.h>
+// LocalNode, and the SDO errors (SdoAbortError, SdoTimeout, SdoProtocolError)
+// through the error table of errors.hpp.
 #include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "errors.hpp"
 #include "motorbus/can/bus.hpp"
 #include "motorbus/canopen/abort_codes.hpp"
 #include "motorbus/canopen/eds.hpp"
@@ -21,7 +22,24 @@ using motorbus::py_helpers::seconds_to_ns;
 
 namespace {
 
-py::handle g_abort, g_timeout, g_protocol;
+py::handle g_abort;  // SdoAbortError: hooks may raise it to answer with its code
+
+void fill_abort(py::object& exc, const SdoAbortError& e) {
+    exc.attr("code") = e.code;
+    exc.attr("text") = e.text();
+    exc.attr("index") = e.index;
+    exc.attr("subindex") = e.subindex;
+}
+void fill_timeout(py::object& exc, const SdoTimeout& e) {
+    exc.attr("index") = e.index;
+    exc.attr("subindex") = e.subindex;
+}
+void fill_protocol(py::object& exc, const SdoProtocolError& e) {
+    exc.attr("data") = py::bytes(reinterpret_cast<const char*>(e.bytes.data()), e.bytes.size());
+    exc.attr("code") = e.code;
+    exc.attr("index") = e.index;
+    exc.attr("subindex") = e.subindex;
+}
 
 py::bytes to_bytes(const Bytes& b) { return py::bytes(reinterpret_cast<const char*>(b.data()), b.size()); }
 
@@ -170,60 +188,26 @@ TransferMode mode_of(bool block, bool segmented) {
 }  // namespace
 
 void bind_canopen(py::module_& m) {
-    // ---- errors -------------------------------------------------------------
-    py::dict ns;
-    ns["MotorbusError"] = m.attr("MotorbusError");
-    ns["TimeoutError_"] = m.attr("TimeoutError");
-    ns["ProtocolError"] = m.attr("ProtocolError");
-    py::exec(R"(
-class SdoAbortError(MotorbusError):
-    "An SDO transfer was aborted: .code (CiA 301 abort code), .text, .index, .subindex."
-    code = 0
-    text = ""
-    index = 0
-    subindex = 0
-class SdoTimeout(TimeoutError_):
-    "No SDO response in time; the client sent abort 0x05040000 with the index and sub-index."
-    index = 0
-    subindex = 0
-class SdoProtocolError(ProtocolError):
-    "The server broke the SDO protocol; .data is its frame, .code the abort code we sent."
-    code = 0
-    index = 0
-    subindex = 0
-)", ns, ns);
+    // ---- errors (the table of errors.hpp) ---------------------------------------
+    py_errors::add_error_classes(m, {
+        {"SdoAbortError", {"MotorbusError"},
+         "An SDO transfer was aborted: .code (CiA 301 abort code), .text, .index, .subindex."},
+        {"SdoTimeout", {"TimeoutError"},
+         "No SDO response in time; the client sent abort 0x05040000 with the index and sub-index."},
+        {"SdoProtocolError", {"ProtocolError"},
+         "The server broke the SDO protocol; .data is its frame, .code the abort code we sent."},
+    }, "motorbus.canopen");
+    // Class-level defaults, so the attributes exist on instances made from Python too.
+    for (const char* n : {"SdoAbortError", "SdoProtocolError"}) m.attr(n).attr("code") = 0;
+    m.attr("SdoAbortError").attr("text") = "";
     for (const char* n : {"SdoAbortError", "SdoTimeout", "SdoProtocolError"}) {
-        py::object cls = ns[n];
-        cls.attr("__module__") = "motorbus.canopen";
-        m.attr(n) = cls;
+        m.attr(n).attr("index") = 0;
+        m.attr(n).attr("subindex") = 0;
     }
-    g_abort = py::object(ns["SdoAbortError"]).release();
-    g_timeout = py::object(ns["SdoTimeout"]).release();
-    g_protocol = py::object(ns["SdoProtocolError"]).release();
-    py::register_exception_translator([](std::exception_ptr p) {
-        try {
-            if (p) std::rethrow_exception(p);
-        } catch (const SdoAbortError& e) {
-            py::object exc = py::reinterpret_borrow<py::object>(g_abort)(e.what());
-            exc.attr("code") = e.code;
-            exc.attr("text") = e.text();
-            exc.attr("index") = e.index;
-            exc.attr("subindex") = e.subindex;
-            PyErr_SetObject(g_abort.ptr(), exc.ptr());
-        } catch (const SdoTimeout& e) {
-            py::object exc = py::reinterpret_borrow<py::object>(g_timeout)(e.what());
-            exc.attr("index") = e.index;
-            exc.attr("subindex") = e.subindex;
-            PyErr_SetObject(g_timeout.ptr(), exc.ptr());
-        } catch (const SdoProtocolError& e) {
-            py::object exc = py::reinterpret_borrow<py::object>(g_protocol)(e.what());
-            exc.attr("data") = py::bytes(reinterpret_cast<const char*>(e.bytes.data()), e.bytes.size());
-            exc.attr("code") = e.code;
-            exc.attr("index") = e.index;
-            exc.attr("subindex") = e.subindex;
-            PyErr_SetObject(g_protocol.ptr(), exc.ptr());
-        }
-    });
+    g_abort = m.attr("SdoAbortError");  // owned by the module for the interpreter's life
+    py_errors::translate<SdoAbortError, fill_abort>(m.attr("SdoAbortError"));
+    py_errors::translate<SdoTimeout, fill_timeout>(m.attr("SdoTimeout"));
+    py_errors::translate<SdoProtocolError, fill_protocol>(m.attr("SdoProtocolError"));
 
     m.def("abort_text", [](std::uint32_t c) -> py::object {
         const char* t = abort_text(c);
