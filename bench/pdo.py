@@ -14,7 +14,8 @@ from canopen import objectdictionary as odm
 from canopen.pdo.base import PdoMap as CoPdoMap
 
 from motorbus import _core
-from motorbus.canopen.pdo import PdoMap, SyncProducer
+from motorbus.canopen.pdo import PdoMap
+from motorbus.canopen.sync import SyncProducer
 
 ENTRIES = [(0x6041, 0, 16), (0x6064, 0, 32, True), (0x6061, 0, 8, True)]
 FRAME = bytes.fromhex("37061027000001")
@@ -75,9 +76,9 @@ def main() -> None:
         s.stop()
         j = s.jitter()
         label = (" SCHED_FIFO" if s.realtime_granted else " (SCHED_FIFO refused)") if rt else ""
-        print(f"SYNC producer{label} {a.period_us} us for {a.sync_seconds} s: {j['count']} periods, error "
-              f"min {j['min_ns'] / 1e3:.1f} us mean {j['mean_ns'] / 1e3:.2f} us max {j['max_ns'] / 1e3:.1f} us "
-              f"p99 |error| {j['p99_abs_ns'] / 1e3:.1f} us")
+        print(f"SYNC producer{label} {a.period_us} us for {a.sync_seconds} s: {j.count} periods, error "
+              f"min {j.min_ns / 1e3:.1f} us mean {j.mean_ns / 1e3:.2f} us max {j.max_ns / 1e3:.1f} us "
+              f"p99 |error| {j.p99_abs_ns / 1e3:.1f} us")
 
 
 if __name__ == "__main__":

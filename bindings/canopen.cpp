@@ -1,11 +1,12 @@
 // Bindings for cpp/motorbus/canopen: object dictionary, EDS, SDO client,
-// LocalNode, and the SDO errors (SdoAbortError, SdoTimeout, SdoProtocolError).
-#include <pybind11/eval.h>
+// LocalNode, and the SDO errors (SdoAbortError, SdoTimeout, SdoProtocolError)
+// through the error table of errors.hpp.
 #include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "errors.hpp"
 #include "motorbus/can/bus.hpp"
 #include "motorbus/canopen/abort_codes.hpp"
 #include "motorbus/canopen/eds.hpp"
@@ -21,7 +22,24 @@ using motorbus::py_helpers::seconds_to_ns;
 
 namespace {
 
-py::handle g_abort, g_timeout, g_protocol;
+py::handle g_abort;  // SdoAbortError: hooks may raise it to answer with its code
+
+void fill_abort(py::object& exc, const SdoAbortError& e) {
+    exc.attr("code") = e.code;
+    exc.attr("text") = e.text();
+    exc.attr("index") = e.index;
+    exc.attr("subindex") = e.subindex;
+}
+void fill_timeout(py::object& exc, const SdoTimeout& e) {
+    exc.attr("index") = e.index;
+    exc.attr("subindex") = e.subindex;
+}
+void fill_protocol(py::object& exc, const SdoProtocolError& e) {
+    exc.attr("data") = py::bytes(reinterpret_cast<const char*>(e.bytes.data()), e.bytes.size());
+    exc.attr("code") = e.code;
+    exc.attr("index") = e.index;
+    exc.attr("subindex") = e.subindex;
+}
 
 py::bytes to_bytes(const Bytes& b) { return py::bytes(reinterpret_cast<const char*>(b.data()), b.size()); }
 
@@ -43,20 +61,7 @@ DataType type_from_py(const py::object& o) {
         return static_cast<DataType>(c);
     }
     std::string n = o.cast<std::string>();
-    std::string u;
-    for (char c : n) u.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
-    static const std::pair<const char*, DataType> aliases[] = {
-        {"BOOL", DataType::Boolean},       {"I8", DataType::Integer8},     {"I16", DataType::Integer16},
-        {"I32", DataType::Integer32},      {"I64", DataType::Integer64},   {"U8", DataType::Unsigned8},
-        {"U16", DataType::Unsigned16},     {"U32", DataType::Unsigned32},  {"U64", DataType::Unsigned64},
-        {"F32", DataType::Real32},         {"F64", DataType::Real64},      {"STR", DataType::VisibleString},
-        {"BYTES", DataType::OctetString},
-    };
-    for (auto& [a, t] : aliases)
-        if (u == a) return t;
-    for (unsigned c = 1; c <= 0x1B; ++c)
-        if (is_known_type(static_cast<std::uint16_t>(c)) && u == type_name(static_cast<DataType>(c)))
-            return static_cast<DataType>(c);
+    if (auto dt = data_type_from_name(n)) return *dt;
     throw InvalidArgument("data type: '" + n + "' unknown (e.g. 'u32', 'UNSIGNED32', DataType.UNSIGNED32)");
 }
 
@@ -77,9 +82,8 @@ py::object scalar_to_py(const Scalar& s) {
     return std::visit([](auto v) -> py::object { return py::cast(v); }, s);
 }
 
-// A Python value for a variable's raw bytes, by its type.
-py::object value_to_py(const Variable& v, const Bytes& raw) {
-    const DataType t = v.type();
+// A Python value for raw bytes of type `t`.
+py::object value_to_py(DataType t, const Bytes& raw) {
     if (t == DataType::Boolean && raw.size() == 1) return py::bool_(raw[0] != 0);
     if (is_numeric(t)) {
         if (auto s = decode_scalar(t, raw)) return scalar_to_py(*s);
@@ -92,16 +96,18 @@ py::object value_to_py(const Variable& v, const Bytes& raw) {
     return to_bytes(raw);
 }
 
-Bytes value_from_py(const Variable& v, const py::object& o) {
-    const DataType t = v.type();
+// The bytes of `o` as type `t`; `what` names the value in the error.
+Bytes value_from_py(DataType t, const py::object& o, const std::string& what) {
     if (is_numeric(t) && !py::isinstance<py::bytes>(o) && !py::isinstance<py::bytearray>(o)) {
         auto s = scalar_from_py(o);
         auto b = s ? encode_scalar(t, *s) : std::nullopt;
-        if (!b) throw InvalidArgument(v.name() + ": " + py::str(o).cast<std::string>() + " does not fit " + type_name(t));
+        if (!b) throw InvalidArgument(what + ": " + py::str(o).cast<std::string>() + " does not fit " + type_name(t));
         return *b;
     }
     return from_buffer(o);
 }
+py::object value_to_py(const Variable& v, const Bytes& raw) { return value_to_py(v.type(), raw); }
+Bytes value_from_py(const Variable& v, const py::object& o) { return value_from_py(v.type(), o, v.name()); }
 
 VariableSpec spec_from_py(std::uint16_t index, std::uint8_t sub, std::string name, const py::object& type,
                           const std::string& access, bool pdo, const py::object& low, const py::object& high,
@@ -154,44 +160,12 @@ std::shared_ptr<py::function> hold(py::function f) {
     });
 }
 
-py::dict counters_dict(const SdoClientCounters& c) {
-    py::dict d;
-    d["transfers"] = c.transfers;
-    d["aborts_received"] = c.aborts_received;
-    d["aborts_sent"] = c.aborts_sent;
-    d["timeouts"] = c.timeouts;
-    d["ignored_frames"] = c.ignored_frames;
-    d["retransmit_requests"] = c.retransmit_requests;
-    d["fallbacks"] = c.fallbacks;
-    return d;
-}
-
-py::dict node_counters_dict(const LocalNodeCounters& c) {
-    py::dict d;
-    d["sdo_requests"] = c.sdo.requests;
-    d["sdo_responses"] = c.sdo.responses;
-    d["sdo_aborts_sent"] = c.sdo.aborts_sent;
-    d["sdo_aborts_received"] = c.sdo.aborts_received;
-    d["sdo_ignored"] = c.sdo.ignored;
-    d["sdo_timeouts"] = c.sdo.timeouts;
-    d["sdo_dropped"] = c.sdo.dropped;
-    d["sdo_transfers_completed"] = c.sdo.transfers_completed;
-    d["nmt_commands"] = c.nmt_commands;
-    d["nmt_ignored"] = c.nmt_ignored;
-    d["sdo_while_stopped"] = c.sdo_while_stopped;
-    return d;
-}
-
-NmtState nmt_from_py(const std::string& s) {
-    std::string u;
-    for (char c : s)
-        if (c != '-' && c != '_' && c != ' ') u.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
-    if (u == "OPERATIONAL") return NmtState::Operational;
-    if (u == "STOPPED") return NmtState::Stopped;
-    if (u == "PREOPERATIONAL") return NmtState::PreOperational;
-    if (u == "INITIALISING" || u == "INITIALIZING") return NmtState::Initialising;
+NmtState nmt_state_of(const std::string& s) {
+    if (auto st = nmt_state_from_name(s)) return *st;
     throw InvalidArgument("NMT state: '" + s + "' unknown (OPERATIONAL, STOPPED, PRE-OPERATIONAL)");
 }
+
+std::string u64s(std::uint64_t v) { return std::to_string(v); }
 
 // A LocalNode joins its worker on destruction, and the worker may be waiting
 // for the GIL inside a Python hook: never destroy it while holding the GIL.
@@ -214,60 +188,26 @@ TransferMode mode_of(bool block, bool segmented) {
 }  // namespace
 
 void bind_canopen(py::module_& m) {
-    // ---- errors -------------------------------------------------------------
-    py::dict ns;
-    ns["MotorbusError"] = m.attr("MotorbusError");
-    ns["TimeoutError_"] = m.attr("TimeoutError");
-    ns["ProtocolError"] = m.attr("ProtocolError");
-    py::exec(R"(
-class SdoAbortError(MotorbusError):
-    "An SDO transfer was aborted: .code (CiA 301 abort code), .text, .index, .subindex."
-    code = 0
-    text = ""
-    index = 0
-    subindex = 0
-class SdoTimeout(TimeoutError_):
-    "No SDO response in time; the client sent abort 0x05040000 with the index and sub-index."
-    index = 0
-    subindex = 0
-class SdoProtocolError(ProtocolError):
-    "The server broke the SDO protocol; .data is its frame, .code the abort code we sent."
-    code = 0
-    index = 0
-    subindex = 0
-)", ns, ns);
+    // ---- errors (the table of errors.hpp) ---------------------------------------
+    py_errors::add_error_classes(m, {
+        {"SdoAbortError", {"MotorbusError"},
+         "An SDO transfer was aborted: .code (CiA 301 abort code), .text, .index, .subindex."},
+        {"SdoTimeout", {"TimeoutError"},
+         "No SDO response in time; the client sent abort 0x05040000 with the index and sub-index."},
+        {"SdoProtocolError", {"ProtocolError"},
+         "The server broke the SDO protocol; .data is its frame, .code the abort code we sent."},
+    }, "motorbus.canopen");
+    // Class-level defaults, so the attributes exist on instances made from Python too.
+    for (const char* n : {"SdoAbortError", "SdoProtocolError"}) m.attr(n).attr("code") = 0;
+    m.attr("SdoAbortError").attr("text") = "";
     for (const char* n : {"SdoAbortError", "SdoTimeout", "SdoProtocolError"}) {
-        py::object cls = ns[n];
-        cls.attr("__module__") = "motorbus.canopen";
-        m.attr(n) = cls;
+        m.attr(n).attr("index") = 0;
+        m.attr(n).attr("subindex") = 0;
     }
-    g_abort = py::object(ns["SdoAbortError"]).release();
-    g_timeout = py::object(ns["SdoTimeout"]).release();
-    g_protocol = py::object(ns["SdoProtocolError"]).release();
-    py::register_exception_translator([](std::exception_ptr p) {
-        try {
-            if (p) std::rethrow_exception(p);
-        } catch (const SdoAbortError& e) {
-            py::object exc = py::reinterpret_borrow<py::object>(g_abort)(e.what());
-            exc.attr("code") = e.code;
-            exc.attr("text") = e.text();
-            exc.attr("index") = e.index;
-            exc.attr("subindex") = e.subindex;
-            PyErr_SetObject(g_abort.ptr(), exc.ptr());
-        } catch (const SdoTimeout& e) {
-            py::object exc = py::reinterpret_borrow<py::object>(g_timeout)(e.what());
-            exc.attr("index") = e.index;
-            exc.attr("subindex") = e.subindex;
-            PyErr_SetObject(g_timeout.ptr(), exc.ptr());
-        } catch (const SdoProtocolError& e) {
-            py::object exc = py::reinterpret_borrow<py::object>(g_protocol)(e.what());
-            exc.attr("data") = py::bytes(reinterpret_cast<const char*>(e.bytes.data()), e.bytes.size());
-            exc.attr("code") = e.code;
-            exc.attr("index") = e.index;
-            exc.attr("subindex") = e.subindex;
-            PyErr_SetObject(g_protocol.ptr(), exc.ptr());
-        }
-    });
+    g_abort = m.attr("SdoAbortError");  // owned by the module for the interpreter's life
+    py_errors::translate<SdoAbortError, fill_abort>(m.attr("SdoAbortError"));
+    py_errors::translate<SdoTimeout, fill_timeout>(m.attr("SdoTimeout"));
+    py_errors::translate<SdoProtocolError, fill_protocol>(m.attr("SdoProtocolError"));
 
     m.def("abort_text", [](std::uint32_t c) -> py::object {
         const char* t = abort_text(c);
@@ -406,6 +346,11 @@ class SdoProtocolError(ProtocolError):
                 for (auto& [s, var] : o->subs) v.push_back(s);
             return v;
         })
+        .def("object_code", [](const ObjectDictionary& od, std::uint16_t i) -> py::object {
+            auto o = od.object(i);
+            if (!o) return py::none();
+            return py::str(o->code == ObjectCode::Var || o->code == ObjectCode::Domain ? "VAR" : o->code == ObjectCode::Array ? "ARRAY" : "RECORD");
+        }, py::arg("index"), "'VAR', 'RECORD' or 'ARRAY'; None when the index is not in the dictionary.")
         .def("object_name", [](const ObjectDictionary& od, std::uint16_t i) -> py::object {
             auto o = od.object(i);
             return o ? py::object(py::str(o->name)) : py::none();
@@ -448,6 +393,58 @@ class SdoProtocolError(ProtocolError):
                  save_eds(od, path, o);
              },
              py::arg("path"), py::arg("dcf") = false);
+
+    m.def("decode_value", [](DataType t, const py::bytes& data) {
+              std::string s = data;
+              return value_to_py(t, Bytes(s.begin(), s.end()));
+          }, py::arg("data_type"), py::arg("data"),
+          "The Python value of little-endian bytes of a CiA 301 type (int, float, bool, str or bytes).");
+    m.def("encode_value", [](DataType t, const py::object& value) {
+              return to_bytes(value_from_py(t, value, std::string("value of type ") + type_name(t)));
+          }, py::arg("data_type"), py::arg("value"),
+          "The little-endian bytes of `value` as a CiA 301 type; InvalidArgument when it does not fit.");
+
+    // ---- counters: C++ structs, read-only -------------------------------------------
+    py::class_<SdoClientCounters>(m, "SdoClientCounters", "Counters of one SDO client, across its transfers.")
+        .def_readonly("transfers", &SdoClientCounters::transfers)
+        .def_readonly("aborts_received", &SdoClientCounters::aborts_received, "the server aborted")
+        .def_readonly("aborts_sent", &SdoClientCounters::aborts_sent, "we aborted (timeout, protocol error)")
+        .def_readonly("timeouts", &SdoClientCounters::timeouts)
+        .def_readonly("ignored_frames", &SdoClientCounters::ignored_frames, "responses while idle, duplicates")
+        .def_readonly("retransmit_requests", &SdoClientCounters::retransmit_requests,
+                      "block: sub-blocks acknowledged short (lost frames)")
+        .def_readonly("fallbacks", &SdoClientCounters::fallbacks, "block refused, retried segmented")
+        .def("__repr__", [](const SdoClientCounters& c) {
+            return "SdoClientCounters(transfers=" + u64s(c.transfers) + ", aborts_received=" + u64s(c.aborts_received) +
+                   ", aborts_sent=" + u64s(c.aborts_sent) + ", timeouts=" + u64s(c.timeouts) + ", ignored_frames=" +
+                   u64s(c.ignored_frames) + ", retransmit_requests=" + u64s(c.retransmit_requests) +
+                   ", fallbacks=" + u64s(c.fallbacks) + ")";
+        });
+    py::class_<SdoServerCounters>(m, "SdoServerCounters", "Counters of a LocalNode's SDO server.")
+        .def_readonly("requests", &SdoServerCounters::requests)
+        .def_readonly("responses", &SdoServerCounters::responses, "including aborts")
+        .def_readonly("aborts_sent", &SdoServerCounters::aborts_sent)
+        .def_readonly("aborts_received", &SdoServerCounters::aborts_received)
+        .def_readonly("ignored", &SdoServerCounters::ignored, "DLC 0, stray block segments, duplicates")
+        .def_readonly("timeouts", &SdoServerCounters::timeouts)
+        .def_readonly("dropped", &SdoServerCounters::dropped, "requests dropped while the mailbox was full (S18)")
+        .def_readonly("transfers_completed", &SdoServerCounters::transfers_completed)
+        .def("__repr__", [](const SdoServerCounters& c) {
+            return "SdoServerCounters(requests=" + u64s(c.requests) + ", responses=" + u64s(c.responses) +
+                   ", aborts_sent=" + u64s(c.aborts_sent) + ", aborts_received=" + u64s(c.aborts_received) +
+                   ", ignored=" + u64s(c.ignored) + ", timeouts=" + u64s(c.timeouts) + ", dropped=" +
+                   u64s(c.dropped) + ", transfers_completed=" + u64s(c.transfers_completed) + ")";
+        });
+    py::class_<LocalNodeCounters>(m, "LocalNodeCounters", "Counters of a LocalNode: its SDO server and NMT.")
+        .def_readonly("sdo", &LocalNodeCounters::sdo)
+        .def_readonly("nmt_commands", &LocalNodeCounters::nmt_commands, "applied")
+        .def_readonly("nmt_ignored", &LocalNodeCounters::nmt_ignored, "wrong DLC, other node, unknown command")
+        .def_readonly("sdo_while_stopped", &LocalNodeCounters::sdo_while_stopped)
+        .def("__repr__", [](const LocalNodeCounters& c) {
+            return "LocalNodeCounters(nmt_commands=" + u64s(c.nmt_commands) + ", nmt_ignored=" + u64s(c.nmt_ignored) +
+                   ", sdo_while_stopped=" + u64s(c.sdo_while_stopped) + ", sdo=" +
+                   py::repr(py::cast(c.sdo)).cast<std::string>() + ")";
+        });
 
     // ---- SDO client --------------------------------------------------------------
     py::class_<SdoClient>(m, "SdoClient", "SDO client for one node (requests 0x600+n, responses 0x580+n).")
@@ -523,7 +520,7 @@ class SdoProtocolError(ProtocolError):
         .def_property_readonly("node_id", &SdoClient::node_id)
         .def_property_readonly("request_id", &SdoClient::request_id)
         .def_property_readonly("response_id", &SdoClient::response_id)
-        .def_property_readonly("counters", [](const SdoClient& c) { return counters_dict(c.counters()); });
+        .def_property_readonly("counters", &SdoClient::counters);
 
     // ---- LocalNode ---------------------------------------------------------------
     py::class_<LocalNode, LocalNodeHolder>(m, "LocalNode",
@@ -543,7 +540,7 @@ class SdoProtocolError(ProtocolError):
         .def_property_readonly("od", &LocalNode::od_ptr)
         .def_property("nmt_state", [](const LocalNode& n) { return to_string(n.nmt_state()); },
                       [](LocalNode& n, const std::string& s) {
-                          auto st = nmt_from_py(s);
+                          auto st = nmt_state_of(s);
                           py::gil_scoped_release nogil;
                           n.set_nmt_state(st);
                       })
@@ -561,7 +558,7 @@ class SdoProtocolError(ProtocolError):
              py::arg("callback"), "callback(previous: str, now: str) on every NMT transition")
         .def("remove_state_listener", &LocalNode::remove_state_listener, py::arg("handle"))
         .def("send_boot_up", &LocalNode::send_boot_up, py::call_guard<py::gil_scoped_release>())
-        .def_property_readonly("counters", [](const LocalNode& n) { return node_counters_dict(n.counters()); })
+        .def_property_readonly("counters", &LocalNode::counters)
         .def("close", &LocalNode::close, py::call_guard<py::gil_scoped_release>())
         .def("__enter__", [](py::object self) { return self; })
         .def("__exit__", [](LocalNode& n, py::args) {

@@ -1,16 +1,18 @@
 // Bindings for the CANopen services: NMT, heartbeat, EMCY, SYNC, TIME, PDO,
 // CiA 402 and the network scanner.  Thin: conversion, GIL release, lifetimes.
 //
-// Objects that subscribe to a bus keep the bus (and clock) alive and are
-// destroyed with the GIL released, because unsubscribing waits for a callback
-// that may itself be waiting for the GIL.
+// Services are bound as themselves (shared_ptr holders made by make_service):
+// the holder's deleter owns the bus, clock or SDO client the service refers
+// to, and destroys the service with the GIL released, because unsubscribing
+// or joining a timer thread waits for a callback that may itself be waiting
+// for the GIL.  Counters and statuses are the C++ structs, read-only.
 #include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include "common.hpp"
 #include "motorbus/can/bus.hpp"
-#include "motorbus/canopen/ds402.hpp"
+#include "motorbus/canopen/cia402.hpp"
 #include "motorbus/canopen/emcy.hpp"
 #include "motorbus/canopen/heartbeat.hpp"
 #include "motorbus/canopen/heartbeat_service.hpp"
@@ -20,7 +22,7 @@
 #include "motorbus/canopen/pdo_service.hpp"
 #include "motorbus/canopen/sdo_client.hpp"
 #include "motorbus/canopen/scanner.hpp"
-#include "motorbus/canopen/services_sdo_adapter.hpp"
+#include "motorbus/canopen/sdo_client_access.hpp"
 #include "motorbus/canopen/sync.hpp"
 #include "motorbus/canopen/time.hpp"
 #include "motorbus/errors.hpp"
@@ -36,9 +38,11 @@ namespace {
 using BusPtr = std::shared_ptr<can::Bus>;
 using ClockPtr = std::shared_ptr<Clock>;
 
-template <class T, class... A>
-std::shared_ptr<T> make_nogil(A&&... args) {
-    return std::shared_ptr<T>(new T(std::forward<A>(args)...), [](T* p) {
+// `keep` (bus, clock, SDO client...) outlives the service: it is released
+// with the deleter, after the service is deleted.
+template <class T, class Keep, class... A>
+std::shared_ptr<T> make_service(Keep keep, A&&... args) {
+    return std::shared_ptr<T>(new T(std::forward<A>(args)...), [keep = std::move(keep)](T* p) {
         if (PyGILState_Check()) {
             py::gil_scoped_release nogil;
             delete p;
@@ -64,45 +68,8 @@ std::vector<std::uint8_t> from_bytes(const py::bytes& b) {
     return {s.begin(), s.end()};
 }
 
-// Every wrapper keeps what the C++ object refers to alive.
-struct NmtMasterBox {
-    BusPtr bus;
-    std::shared_ptr<NmtMaster> obj;
-};
-struct HbConsumerBox {
-    BusPtr bus;
-    ClockPtr clock;
-    std::shared_ptr<HeartbeatConsumer> obj;
-};
-struct HbProducerBox {
-    BusPtr bus;
-    ClockPtr clock;
-    std::shared_ptr<HeartbeatProducer> obj;
-};
-struct EmcyConsumerBox {
-    BusPtr bus;
-    std::shared_ptr<EmcyConsumer> obj;
-};
-struct EmcyProducerBox {
-    BusPtr bus;
-    ClockPtr clock;
-    std::shared_ptr<EmcyProducer> obj;
-};
-struct SyncProducerBox {
-    BusPtr bus;
-    std::shared_ptr<SyncProducer> obj;
-};
-struct PdoReceiverBox {
-    BusPtr bus;
-    std::shared_ptr<PdoReceiver> obj;
-};
-struct PdoSenderBox {
-    BusPtr bus;
-    std::shared_ptr<PdoSender> obj;
-};
-
 // SdoAccess over a Python object with upload(index, sub) -> bytes and
-// download(index, sub, data): lets any SDO client (canopen-sdo's binding, a
+// download(index, sub, data): lets any SDO client (our SdoClient binding, a
 // python `canopen` SdoClient wrapper, a fake) serve the services.
 class PySdoAccess : public SdoAccess {
 public:
@@ -134,7 +101,7 @@ struct SdoBox {
 SdoBox make_sdo(const py::object& o, int node) {
     SdoBox b;
     if (py::isinstance<SdoClient>(o)) {
-        // canopen-sdo's client: called directly in C++, no GIL round trip.
+        // Our own client: called directly in C++, no GIL round trip.
         b.client = o;
         b.access = std::make_shared<ClientSdoAccess>(o.cast<SdoClient&>(), static_cast<std::uint8_t>(node));
     } else if (py::isinstance<can::Bus>(o)) {
@@ -147,12 +114,6 @@ SdoBox make_sdo(const py::object& o, int node) {
     }
     return b;
 }
-
-struct Ds402HostBox {
-    SdoBox sdo;
-    std::shared_ptr<Ds402Host> obj;
-    std::shared_ptr<PdoReceiverBox> sw_pdo;
-};
 
 std::vector<PdoMapEntry> entries_from(const py::iterable& it) {
     std::vector<PdoMapEntry> v;
@@ -178,43 +139,23 @@ py::list entries_to(const std::vector<PdoMapEntry>& v) {
     return l;
 }
 
-py::dict emcy_dict(const EmcyMessage& m) {
-    py::dict d;
-    d["node"] = m.node_id;
-    d["code"] = m.code;
-    d["register"] = m.error_register;
-    d["data"] = to_bytes(m.manufacturer);
-    d["short"] = m.short_frame;
-    d["timestamp_ns"] = m.timestamp_ns;
-    d["text"] = emcy_code_text(m.code);
-    return d;
+std::string hex(unsigned v, int width) {
+    char b[16];
+    std::snprintf(b, sizeof b, "0x%0*X", width, v);
+    return b;
 }
 
-py::dict health_dict(const NodeHealth& h) {
-    py::dict d;
-    d["node"] = h.node_id;
-    d["state"] = to_string(h.state);
-    d["raw_state"] = h.raw_state;
-    d["alive"] = h.alive;
-    d["lost"] = h.lost;
-    d["last_seen_ns"] = h.last_seen;
-    d["heartbeats"] = h.heartbeats;
-    d["boot_ups"] = h.boot_ups;
-    d["timeouts"] = h.timeouts;
-    return d;
+std::string opt_hex(const std::optional<std::uint32_t>& v) { return v ? hex(*v, 8) : "None"; }
+
+// The C++ codecs parse the names; these only turn "not a name" into the error.
+NodeState node_state_of(const std::string& s) {
+    if (auto st = node_state_from_name(s)) return *st;
+    throw InvalidArgument("NMT state: expected INITIALISING, STOPPED, OPERATIONAL, PRE-OPERATIONAL; got '" + s + "'");
 }
 
-NodeState node_state_from_name(const std::string& s) {
-    for (auto st : {NodeState::Initialising, NodeState::Stopped, NodeState::Operational,
-                    NodeState::PreOperational, NodeState::Unknown})
-        if (s == to_string(st)) return st;
-    throw InvalidArgument("NMT state: expected INITIALISING, STOPPED, OPERATIONAL, PRE-OPERATIONAL; got " + s);
-}
-
-Ds402State ds402_from_name(const std::string& s) {
-    for (int i = 0; i <= static_cast<int>(Ds402State::Unknown); ++i)
-        if (s == to_string(static_cast<Ds402State>(i))) return static_cast<Ds402State>(i);
-    throw InvalidArgument("CiA 402 state name not known: " + s);
+Cia402State cia402_state_of(const std::string& s) {
+    if (auto st = cia402_state_from_name(s)) return *st;
+    throw InvalidArgument("CiA 402 state name not known: '" + s + "'");
 }
 
 void check_node(int n, bool allow_zero) {
@@ -225,6 +166,114 @@ void check_node(int n, bool allow_zero) {
 }  // namespace
 
 void bind_canopen_services(py::module_& m) {
+    // ---- records: C++ structs, read-only --------------------------------------------
+    py::class_<EmcyMessage>(m, "EmcyError", "One EMCY message as received (CiA 301).")
+        .def_readonly("node", &EmcyMessage::node_id)
+        .def_readonly("code", &EmcyMessage::code, "emergency error code (EEC)")
+        .def_readonly("register", &EmcyMessage::error_register, "error register (0x1001) as sent")
+        .def_property_readonly("data", [](const EmcyMessage& e) { return to_bytes(e.manufacturer); },
+                               "manufacturer-specific bytes (5)")
+        .def_readonly("short", &EmcyMessage::short_frame, "the frame had fewer than 8 bytes (missing ones read as 0)")
+        .def_readonly("timestamp_ns", &EmcyMessage::timestamp_ns)
+        .def_property_readonly("text", [](const EmcyMessage& e) { return emcy_code_text(e.code); })
+        .def_property_readonly("is_reset", &EmcyMessage::is_reset, "EEC 0x0000: the node's errors are cleared")
+        .def("__repr__", [](const EmcyMessage& e) {
+            return "EmcyError(node=" + std::to_string(e.node_id) + ", code=" + hex(e.code, 4) + ", register=" +
+                   hex(e.error_register, 2) + ", text='" + emcy_code_text(e.code) + "'" +
+                   (e.short_frame ? ", short=True)" : ")");
+        });
+
+    py::class_<NodeHealth>(m, "NodeHealth", "What a heartbeat consumer knows about one node.")
+        .def_readonly("node", &NodeHealth::node_id)
+        .def_property_readonly("state", [](const NodeHealth& h) { return std::string(to_string(h.state)); })
+        .def_readonly("raw_state", &NodeHealth::raw_state)
+        .def_readonly("alive", &NodeHealth::alive, "heard within the consumer time")
+        .def_readonly("lost", &NodeHealth::lost, "timed out and not heard since")
+        .def_readonly("last_seen_ns", &NodeHealth::last_seen)
+        .def_readonly("heartbeats", &NodeHealth::heartbeats)
+        .def_readonly("boot_ups", &NodeHealth::boot_ups)
+        .def_readonly("timeouts", &NodeHealth::timeouts)
+        .def("__repr__", [](const NodeHealth& h) {
+            return "NodeHealth(node=" + std::to_string(h.node_id) + ", state='" + to_string(h.state) +
+                   "', alive=" + (h.alive ? "True" : "False") + ", lost=" + (h.lost ? "True" : "False") +
+                   ", heartbeats=" + std::to_string(h.heartbeats) + ", boot_ups=" + std::to_string(h.boot_ups) +
+                   ", timeouts=" + std::to_string(h.timeouts) + ")";
+        });
+
+    py::class_<JitterStats>(m, "JitterStats", "SYNC period error (actual - nominal) over the last periods.")
+        .def_readonly("count", &JitterStats::count, "periods measured")
+        .def_readonly("min_ns", &JitterStats::min_ns)
+        .def_readonly("mean_ns", &JitterStats::mean_ns)
+        .def_readonly("max_ns", &JitterStats::max_ns)
+        .def_readonly("p99_abs_ns", &JitterStats::p99_abs_ns, "99th percentile of the error's magnitude")
+        .def_readonly("max_abs_ns", &JitterStats::max_abs_ns)
+        .def("__repr__", [](const JitterStats& j) {
+            char b[160];
+            std::snprintf(b, sizeof b, "JitterStats(count=%llu, min_ns=%.0f, mean_ns=%.0f, max_ns=%.0f, p99_abs_ns=%.0f)",
+                          static_cast<unsigned long long>(j.count), j.min_ns, j.mean_ns, j.max_ns, j.p99_abs_ns);
+            return std::string(b);
+        });
+
+    py::class_<PdoEngine::Counters>(m, "PdoCounters", "Counters of a served node's PDO engine.")
+        .def_readonly("tpdo_sent", &PdoEngine::Counters::tpdo_sent)
+        .def_readonly("rpdo_applied", &PdoEngine::Counters::rpdo_applied)
+        .def_readonly("rpdo_ignored", &PdoEngine::Counters::rpdo_ignored)
+        .def_readonly("rpdo_length_errors", &PdoEngine::Counters::rpdo_length_errors)
+        .def_readonly("sync_received", &PdoEngine::Counters::sync_received)
+        .def_readonly("sync_errors", &PdoEngine::Counters::sync_errors)
+        .def_readonly("rtr_ignored", &PdoEngine::Counters::rtr_ignored)
+        .def_readonly("collisions", &PdoEngine::Counters::collisions)
+        .def("__repr__", [](const PdoEngine::Counters& c) {
+            return "PdoCounters(tpdo_sent=" + std::to_string(c.tpdo_sent) + ", rpdo_applied=" +
+                   std::to_string(c.rpdo_applied) + ", rpdo_ignored=" + std::to_string(c.rpdo_ignored) +
+                   ", rpdo_length_errors=" + std::to_string(c.rpdo_length_errors) + ", sync_received=" +
+                   std::to_string(c.sync_received) + ")";
+        });
+
+    py::class_<PdoConfig>(m, "PdoConfig", "A PDO's communication parameters and mapping as read from a device.")
+        .def_readonly("tpdo", &PdoConfig::tpdo)
+        .def_readonly("number", &PdoConfig::number)
+        .def_readonly("cob_id", &PdoConfig::cob_id)
+        .def_readonly("enabled", &PdoConfig::enabled)
+        .def_readonly("transmission_type", &PdoConfig::transmission_type)
+        .def_readonly("inhibit_100us", &PdoConfig::inhibit_100us)
+        .def_readonly("event_timer_ms", &PdoConfig::event_timer_ms)
+        .def_readonly("sync_start", &PdoConfig::sync_start)
+        .def_property_readonly("mapping", [](const PdoConfig& c) {
+            return c.mapping ? entries_to(*c.mapping) : py::list();
+        }, "[(index, subindex, bits), ...]")
+        .def("__repr__", [](const PdoConfig& c) {
+            std::string map;
+            if (c.mapping)
+                for (auto& e : *c.mapping)
+                    map += (map.empty() ? "" : ", ") + hex(e.index, 4) + ":" + std::to_string(e.sub) + "/" +
+                           std::to_string(e.bits);
+            return std::string("PdoConfig(") + (c.tpdo ? "tpdo=" : "rpdo=") + std::to_string(c.number) +
+                   ", cob_id=" + opt_hex(c.cob_id) + ", enabled=" + (c.enabled ? "True" : "False") +
+                   ", mapping=[" + map + "])";
+        });
+
+    py::class_<ScanResult>(m, "NodeInfo", "A node found by scan_network().")
+        .def_readonly("node", &ScanResult::node_id)
+        .def_readonly("sdo_answered", &ScanResult::sdo_answered, "any SDO reply (value or abort)")
+        .def_readonly("heard_heartbeat", &ScanResult::heard_heartbeat)
+        .def_readonly("heard_boot_up", &ScanResult::heard_boot_up)
+        .def_property_readonly("state", [](const ScanResult& r) { return std::string(to_string(r.state)); })
+        .def_readonly("device_type", &ScanResult::device_type, "0x1000")
+        .def_readonly("device_type_abort", &ScanResult::device_type_abort, "abort code when 0x1000 was refused")
+        .def_readonly("vendor_id", &ScanResult::vendor_id)
+        .def_readonly("product_code", &ScanResult::product_code)
+        .def_readonly("revision", &ScanResult::revision)
+        .def_readonly("serial_number", &ScanResult::serial_number)
+        .def_property_readonly("profile", [](const ScanResult& r) -> std::optional<std::uint16_t> {
+            if (!r.device_type) return std::nullopt;
+            return r.profile();
+        }, "device profile number (402 for drives) from 0x1000's low 16 bits")
+        .def("__repr__", [](const ScanResult& r) {
+            return "NodeInfo(node=" + std::to_string(r.node_id) + ", state='" + to_string(r.state) +
+                   "', device_type=" + opt_hex(r.device_type) + ", vendor_id=" + opt_hex(r.vendor_id) + ")";
+        });
+
     // ---- pure codecs --------------------------------------------------------
     m.def("nmt_encode", [](int cs, int node) {
               if (!is_known_nmt_command(static_cast<std::uint8_t>(cs)) || cs < 0 || cs > 255)
@@ -239,7 +288,7 @@ void bind_canopen_services(py::module_& m) {
           }, py::arg("frame"), "(command, node) or None for anything that is not a valid NMT frame.");
     m.def("heartbeat_encode", [](int node, const std::string& state) {
               check_node(node, false);
-              return encode_heartbeat(static_cast<std::uint8_t>(node), node_state_from_name(state));
+              return encode_heartbeat(static_cast<std::uint8_t>(node), node_state_of(state));
           }, py::arg("node"), py::arg("state"));
     m.def("heartbeat_decode", [](const can::Frame& f) -> py::object {
               auto d = decode_heartbeat(f);
@@ -257,7 +306,7 @@ void bind_canopen_services(py::module_& m) {
     m.def("emcy_decode", [](const can::Frame& f) -> py::object {
               auto d = decode_emcy(f);
               if (!d) return py::none();
-              return emcy_dict(*d);
+              return py::cast(*d);
           }, py::arg("frame"));
     m.def("emcy_code_text", &emcy_code_text, py::arg("code"));
     m.def("sync_encode", [](std::optional<int> counter, std::uint32_t cob_id) {
@@ -275,88 +324,102 @@ void bind_canopen_services(py::module_& m) {
           }, py::arg("frame"), "Unix time in ms, or None.");
 
     // ---- NMT master -----------------------------------------------------------
-    py::class_<NmtMasterBox, std::shared_ptr<NmtMasterBox>>(m, "NmtMaster",
+    py::class_<NmtMaster, std::shared_ptr<NmtMaster>>(m, "NmtMaster",
         "Sends NMT commands and tracks node states from heartbeats and boot-ups.")
         .def(py::init([](BusPtr bus, std::optional<int> own) {
                  if (own) check_node(*own, false);
-                 auto b = std::make_shared<NmtMasterBox>();
-                 b->bus = bus;
-                 b->obj = make_nogil<NmtMaster>(*bus, own ? std::optional<std::uint8_t>(static_cast<std::uint8_t>(*own))
-                                                          : std::nullopt);
-                 return b;
+                 return make_service<NmtMaster>(bus, *bus, own ? std::optional<std::uint8_t>(static_cast<std::uint8_t>(*own))
+                                                               : std::nullopt);
              }), py::arg("bus"), py::arg("own_node_id") = py::none())
-        .def("send", [](NmtMasterBox& b, int cs, int node) {
+        .def("send", [](NmtMaster& b, int cs, int node) {
                  if (cs < 0 || cs > 255 || !is_known_nmt_command(static_cast<std::uint8_t>(cs)))
                      throw InvalidArgument("NMT command specifier must be 0x01, 0x02, 0x80, 0x81 or 0x82");
                  check_node(node, true);
                  py::gil_scoped_release nogil;
-                 b.obj->send(static_cast<NmtCommand>(cs), static_cast<std::uint8_t>(node));
+                 b.send(static_cast<NmtCommand>(cs), static_cast<std::uint8_t>(node));
              }, py::arg("command"), py::arg("node"))
-        .def("state", [](NmtMasterBox& b, int node) { check_node(node, false); return to_string(b.obj->state(static_cast<std::uint8_t>(node))); }, py::arg("node"))
-        .def("raw_state", [](NmtMasterBox& b, int node) { check_node(node, false); return b.obj->raw_state(static_cast<std::uint8_t>(node)); }, py::arg("node"))
-        .def("wait_for_state", [](NmtMasterBox& b, int node, const std::string& st, const py::object& t) {
+        .def("state", [](NmtMaster& b, int node) { check_node(node, false); return to_string(b.state(static_cast<std::uint8_t>(node))); }, py::arg("node"))
+        .def("raw_state", [](NmtMaster& b, int node) { check_node(node, false); return b.raw_state(static_cast<std::uint8_t>(node)); }, py::arg("node"))
+        .def("wait_for_state", [](NmtMaster& b, int node, const std::string& st, const py::object& t) {
                  check_node(node, false);
-                 auto want = node_state_from_name(st);
+                 auto want = node_state_of(st);
                  auto to = timeout_of(t);
                  py::gil_scoped_release nogil;
-                 return b.obj->wait_for_state(static_cast<std::uint8_t>(node), want, to);
+                 return b.wait_for_state(static_cast<std::uint8_t>(node), want, to);
              }, py::arg("node"), py::arg("state"), py::arg("timeout") = 1.0)
-        .def("wait_for_boot", [](NmtMasterBox& b, int node, const py::object& t) {
+        .def("set_state", [](NmtMaster& b, int node, const std::string& state) {
+                 check_node(node, true);
+                 auto c = nmt_command_for_state(state);
+                 if (!c)
+                     throw InvalidArgument("NMT state to command: '" + state +
+                                           "' (OPERATIONAL, PRE-OPERATIONAL, STOPPED, RESET, RESET COMMUNICATION)");
+                 py::gil_scoped_release nogil;
+                 b.send(*c, static_cast<std::uint8_t>(node));
+             }, py::arg("node"), py::arg("state"),
+             "Sends the NMT command that puts `node` (0 = all) in `state`; RESET / RESET COMMUNICATION reset it.")
+        .def("wait_for_heartbeat", [](NmtMaster& b, int node, const py::object& t) -> std::optional<std::string> {
+                 check_node(node, false);
+                 auto to = timeout_of(t);
+                 std::optional<NodeState> s;
+                 {
+                     py::gil_scoped_release nogil;
+                     s = b.wait_for_heartbeat(static_cast<std::uint8_t>(node), to);
+                 }
+                 if (!s) return std::nullopt;
+                 return std::string(to_string(*s));
+             }, py::arg("node"), py::arg("timeout") = 1.0,
+             "State reported by the next heartbeat or boot-up of `node`; None on timeout.")
+        .def("wait_for_boot", [](NmtMaster& b, int node, const py::object& t) {
                  check_node(node, false);
                  auto to = timeout_of(t);
                  py::gil_scoped_release nogil;
-                 return b.obj->wait_for_boot(static_cast<std::uint8_t>(node), to);
+                 return b.wait_for_boot(static_cast<std::uint8_t>(node), to);
              }, py::arg("node"), py::arg("timeout") = 1.0)
-        .def("set_callback", [](NmtMasterBox& b, py::object cb) {
-                 if (cb.is_none()) { b.obj->on_state_change = nullptr; return; }
+        .def("set_callback", [](NmtMaster& b, py::object cb) {
+                 if (cb.is_none()) { b.on_state_change = nullptr; return; }
                  PyCallable call(cb.cast<py::function>());
-                 b.obj->on_state_change = [call](std::uint8_t n, NodeState a, NodeState c) {
+                 b.on_state_change = [call](std::uint8_t n, NodeState a, NodeState c) {
                      call(n, std::string(to_string(a)), std::string(to_string(c)));
                  };
              }, py::arg("callback"), "callback(node, old_state, new_state) on the bus thread.")
-        .def_property_readonly("foreign_commands_ignored", [](NmtMasterBox& b) { return b.obj->foreign_commands_ignored(); });
+        .def_property_readonly("foreign_commands_ignored", [](NmtMaster& b) { return b.foreign_commands_ignored(); });
 
     // ---- heartbeat --------------------------------------------------------------
-    py::class_<HbConsumerBox, std::shared_ptr<HbConsumerBox>>(m, "HeartbeatConsumer",
+    py::class_<HeartbeatConsumer, std::shared_ptr<HeartbeatConsumer>>(m, "HeartbeatConsumer",
         "Per-node heartbeat supervision: started / lost / back / reset / state events.")
         .def(py::init([](BusPtr bus, ClockPtr clock) {
-                 auto b = std::make_shared<HbConsumerBox>();
-                 b->bus = bus;
-                 b->clock = clock_or_real(clock);
-                 b->obj = make_nogil<HeartbeatConsumer>(*bus, *b->clock);
-                 return b;
+                 clock = clock_or_real(clock);
+                 return make_service<HeartbeatConsumer>(std::pair(bus, clock), *bus, *clock);
              }), py::arg("bus"), py::arg("clock") = nullptr)
-        .def("monitor", [](HbConsumerBox& b, int node, double timeout) {
+        .def("monitor", [](HeartbeatConsumer& b, int node, double timeout) {
                  check_node(node, false);
                  if (!(timeout > 0)) throw InvalidArgument("heartbeat timeout must be > 0 s");
-                 b.obj->monitor(static_cast<std::uint8_t>(node), std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9)));
+                 b.monitor(static_cast<std::uint8_t>(node), std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9)));
              }, py::arg("node"), py::arg("timeout"))
-        .def("forget", [](HbConsumerBox& b, int node) { check_node(node, false); b.obj->forget(static_cast<std::uint8_t>(node)); })
-        .def("health", [](HbConsumerBox& b, int node) { check_node(node, false); return health_dict(b.obj->health(static_cast<std::uint8_t>(node))); })
-        .def("process", [](HbConsumerBox& b, std::optional<Nanos> now) {
+        .def("forget", [](HeartbeatConsumer& b, int node) { check_node(node, false); b.forget(static_cast<std::uint8_t>(node)); })
+        .def("health", [](HeartbeatConsumer& b, int node) { check_node(node, false); return b.health(static_cast<std::uint8_t>(node)); })
+        .def("process", [](HeartbeatConsumer& b, std::optional<Nanos> now) {
                  py::gil_scoped_release nogil;
-                 return b.obj->process(now ? *now : b.clock->now());
+                 return b.process(now ? *now : b.clock().now());
              }, py::arg("now_ns") = py::none())
-        .def("start", [](HbConsumerBox& b) { b.obj->start(); })
-        .def("stop", [](HbConsumerBox& b) { py::gil_scoped_release nogil; b.obj->stop(); })
-        .def("set_callback", [](HbConsumerBox& b, py::object cb) {
-                 if (cb.is_none()) { b.obj->on_event = nullptr; return; }
+        .def("start", [](HeartbeatConsumer& b) { b.start(); })
+        .def("stop", [](HeartbeatConsumer& b) { py::gil_scoped_release nogil; b.stop(); })
+        .def("set_callback", [](HeartbeatConsumer& b, py::object cb) {
+                 if (cb.is_none()) { b.on_event = nullptr; return; }
                  PyCallable call(cb.cast<py::function>());
-                 b.obj->on_event = [call](std::uint8_t n, HeartbeatEvent e, NodeState s) {
+                 b.on_event = [call](std::uint8_t n, HeartbeatEvent e, NodeState s) {
                      call(n, std::string(to_string(e)), std::string(to_string(s)));
                  };
              }, py::arg("callback"), "callback(node, event, state); events: started, lost, back, reset, state-changed, unknown-state.")
-        .def_property_readonly("ignored_frames", [](HbConsumerBox& b) { return b.obj->ignored_frames(); });
+        .def_property_readonly("ignored_frames", [](HeartbeatConsumer& b) { return b.ignored_frames(); });
 
-    py::class_<HbProducerBox, std::shared_ptr<HbProducerBox>>(m, "HeartbeatProducer")
+    py::class_<HeartbeatProducer, std::shared_ptr<HeartbeatProducer>>(m, "HeartbeatProducer")
         .def(py::init([](BusPtr bus, int node, double period, py::object state, ClockPtr clock) {
                  check_node(node, false);
-                 auto b = std::make_shared<HbProducerBox>();
-                 b->bus = bus;
-                 b->clock = clock_or_real(clock);
+                 clock = clock_or_real(clock);
                  std::function<NodeState()> fn;
                  if (py::isinstance<py::str>(state)) {
-                     auto st = node_state_from_name(state.cast<std::string>());
+                     auto st = node_state_of(state.cast<std::string>());
                      fn = [st] { return st; };
                  } else {
                      // Released from a thread without the GIL: take it for the decref.
@@ -367,122 +430,102 @@ void bind_canopen_services(py::module_& m) {
                      });
                      fn = [holder] {
                          py::gil_scoped_acquire gil;
-                         return node_state_from_name((*holder)().cast<std::string>());
+                         return node_state_of((*holder)().cast<std::string>());
                      };
                  }
-                 b->obj = make_nogil<HeartbeatProducer>(*bus, *b->clock, static_cast<std::uint8_t>(node),
+                 return make_service<HeartbeatProducer>(std::pair(bus, clock), *bus, *clock, static_cast<std::uint8_t>(node),
                                                         std::chrono::nanoseconds(static_cast<std::int64_t>(period * 1e9)), fn);
-                 return b;
+                 
              }), py::arg("bus"), py::arg("node"), py::arg("period"), py::arg("state") = "OPERATIONAL",
              py::arg("clock") = nullptr)
-        .def("send_boot_up", [](HbProducerBox& b) { py::gil_scoped_release nogil; b.obj->send_boot_up(); })
-        .def("process", [](HbProducerBox& b, std::optional<Nanos> now) {
+        .def("send_boot_up", [](HeartbeatProducer& b) { py::gil_scoped_release nogil; b.send_boot_up(); })
+        .def("process", [](HeartbeatProducer& b, std::optional<Nanos> now) {
                  py::gil_scoped_release nogil;
-                 return b.obj->process(now ? *now : b.clock->now());
+                 return b.process(now ? *now : b.clock().now());
              }, py::arg("now_ns") = py::none())
-        .def("start", [](HbProducerBox& b) { b.obj->start(); })
-        .def("stop", [](HbProducerBox& b) { py::gil_scoped_release nogil; b.obj->stop(); })
-        .def_property_readonly("send_failures", [](HbProducerBox& b) { return b.obj->send_failures(); },
+        .def("start", [](HeartbeatProducer& b) { b.start(); })
+        .def("stop", [](HeartbeatProducer& b) { py::gil_scoped_release nogil; b.stop(); })
+        .def_property_readonly("send_failures", [](HeartbeatProducer& b) { return b.send_failures(); },
                                "heartbeats the bus refused (closed, full, link down) while started")
-        .def_property_readonly("sent", [](HbProducerBox& b) { return b.obj->sent(); });
+        .def_property_readonly("sent", [](HeartbeatProducer& b) { return b.sent(); });
 
     // ---- EMCY -------------------------------------------------------------------
-    py::class_<EmcyConsumerBox, std::shared_ptr<EmcyConsumerBox>>(m, "EmcyConsumer",
+    py::class_<EmcyConsumer, std::shared_ptr<EmcyConsumer>>(m, "EmcyConsumer",
         "Collects EMCY messages: bounded history and active codes per node.")
         .def(py::init([](BusPtr bus, std::size_t history) {
-                 auto b = std::make_shared<EmcyConsumerBox>();
-                 b->bus = bus;
-                 b->obj = make_nogil<EmcyConsumer>(*bus, history);
-                 return b;
+                 return make_service<EmcyConsumer>(bus, *bus, history);
              }), py::arg("bus"), py::arg("history") = 32)
-        .def("history", [](EmcyConsumerBox& b, int node) {
+        .def("history", [](EmcyConsumer& b, int node) {
                  check_node(node, false);
                  py::list l;
-                 for (auto& e : b.obj->history(static_cast<std::uint8_t>(node))) l.append(emcy_dict(e));
+                 for (auto& e : b.history(static_cast<std::uint8_t>(node))) l.append(py::cast(e));
                  return l;
              }, py::arg("node"))
-        .def("active", [](EmcyConsumerBox& b, int node) { check_node(node, false); return b.obj->active(static_cast<std::uint8_t>(node)); }, py::arg("node"))
-        .def("clear", [](EmcyConsumerBox& b, int node) { check_node(node, false); b.obj->clear(static_cast<std::uint8_t>(node)); }, py::arg("node"))
-        .def("wait", [](EmcyConsumerBox& b, int node, const py::object& t) -> py::object {
+        .def("active", [](EmcyConsumer& b, int node) { check_node(node, false); return b.active(static_cast<std::uint8_t>(node)); }, py::arg("node"))
+        .def("clear", [](EmcyConsumer& b, int node) { check_node(node, false); b.clear(static_cast<std::uint8_t>(node)); }, py::arg("node"))
+        .def("wait", [](EmcyConsumer& b, int node, const py::object& t) -> py::object {
                  check_node(node, true);
                  auto to = timeout_of(t);
                  std::optional<EmcyMessage> r;
                  {
                      py::gil_scoped_release nogil;
-                     r = b.obj->wait(static_cast<std::uint8_t>(node), to);
+                     r = b.wait(static_cast<std::uint8_t>(node), to);
                  }
                  if (!r) return py::none();
-                 return emcy_dict(*r);
+                 return py::cast(*r);
              }, py::arg("node") = 0, py::arg("timeout") = 1.0)
-        .def("set_callback", [](EmcyConsumerBox& b, py::object cb) {
-                 if (cb.is_none()) { b.obj->on_emcy = nullptr; return; }
+        .def("set_callback", [](EmcyConsumer& b, py::object cb) {
+                 if (cb.is_none()) { b.on_emcy = nullptr; return; }
                  PyCallable call(cb.cast<py::function>());
-                 b.obj->on_emcy = [call](const EmcyMessage& e) {
-                     py::gil_scoped_acquire gil;
-                     call(emcy_dict(e));
-                 };
+                 b.on_emcy = [call](const EmcyMessage& e) { call(e); };
              }, py::arg("callback"))
-        .def_property_readonly("received", [](EmcyConsumerBox& b) { return b.obj->received(); })
-        .def_property_readonly("ignored_frames", [](EmcyConsumerBox& b) { return b.obj->ignored_frames(); });
+        .def_property_readonly("received", [](EmcyConsumer& b) { return b.received(); })
+        .def_property_readonly("ignored_frames", [](EmcyConsumer& b) { return b.ignored_frames(); });
 
-    py::class_<EmcyProducerBox, std::shared_ptr<EmcyProducerBox>>(m, "EmcyProducer")
+    py::class_<EmcyProducer, std::shared_ptr<EmcyProducer>>(m, "EmcyProducer")
         .def(py::init([](BusPtr bus, int node, std::uint16_t inhibit, std::size_t queue, ClockPtr clock) {
                  check_node(node, false);
-                 auto b = std::make_shared<EmcyProducerBox>();
-                 b->bus = bus;
-                 b->clock = clock_or_real(clock);
-                 b->obj = make_nogil<EmcyProducer>(*bus, *b->clock, static_cast<std::uint8_t>(node), inhibit, queue);
-                 return b;
+                 clock = clock_or_real(clock);
+                 return make_service<EmcyProducer>(std::pair(bus, clock), *bus, *clock, static_cast<std::uint8_t>(node),
+                                                   inhibit, queue);
              }), py::arg("bus"), py::arg("node"), py::arg("inhibit_100us") = 0, py::arg("queue_limit") = 16,
              py::arg("clock") = nullptr)
-        .def("report", [](EmcyProducerBox& b, std::uint16_t code, std::uint8_t reg, const py::bytes& data) {
+        .def("report", [](EmcyProducer& b, std::uint16_t code, std::uint8_t reg, const py::bytes& data) {
                  auto d = from_bytes(data);
                  if (d.size() > 5) throw InvalidArgument("EMCY manufacturer data: at most 5 bytes");
                  std::array<std::uint8_t, 5> msef{};
                  std::copy(d.begin(), d.end(), msef.begin());
                  py::gil_scoped_release nogil;
-                 return b.obj->report(code, reg, msef);
+                 return b.report(code, reg, msef);
              }, py::arg("code"), py::arg("register") = 0, py::arg("data") = py::bytes())
-        .def("process", [](EmcyProducerBox& b, std::optional<Nanos> now) {
+        .def("process", [](EmcyProducer& b, std::optional<Nanos> now) {
                  py::gil_scoped_release nogil;
-                 return b.obj->process(now ? *now : b.clock->now());
+                 return b.process(now ? *now : b.clock().now());
              }, py::arg("now_ns") = py::none())
-        .def("start", [](EmcyProducerBox& b) { b.obj->start(); })
-        .def("stop", [](EmcyProducerBox& b) { py::gil_scoped_release nogil; b.obj->stop(); })
-        .def_property_readonly("pending", [](EmcyProducerBox& b) { return b.obj->pending(); })
-        .def_property_readonly("sent", [](EmcyProducerBox& b) { return b.obj->sent(); })
-        .def_property_readonly("dropped", [](EmcyProducerBox& b) { return b.obj->dropped(); });
+        .def("start", [](EmcyProducer& b) { b.start(); })
+        .def("stop", [](EmcyProducer& b) { py::gil_scoped_release nogil; b.stop(); })
+        .def_property_readonly("pending", [](EmcyProducer& b) { return b.pending(); })
+        .def_property_readonly("sent", [](EmcyProducer& b) { return b.sent(); })
+        .def_property_readonly("dropped", [](EmcyProducer& b) { return b.dropped(); });
 
     // ---- SYNC -------------------------------------------------------------------
-    py::class_<SyncProducerBox, std::shared_ptr<SyncProducerBox>>(m, "SyncProducer",
+    py::class_<SyncProducer, std::shared_ptr<SyncProducer>>(m, "SyncProducer",
         "SYNC on a C++ thread; jitter() reports the period error statistics.")
         .def(py::init([](BusPtr bus, double period, int overflow, std::uint32_t cob_id) {
                  if (!(period > 0)) throw InvalidArgument("SYNC period must be > 0 s");
                  if (overflow < 0 || overflow > 240) throw InvalidArgument("SYNC counter overflow must be 0 or 2-240");
-                 auto b = std::make_shared<SyncProducerBox>();
-                 b->bus = bus;
-                 b->obj = make_nogil<SyncProducer>(*bus, std::chrono::nanoseconds(static_cast<std::int64_t>(period * 1e9)),
+                 return make_service<SyncProducer>(bus, *bus, std::chrono::nanoseconds(static_cast<std::int64_t>(period * 1e9)),
                                                    static_cast<std::uint8_t>(overflow), cob_id);
-                 return b;
+                 
              }), py::arg("bus"), py::arg("period"), py::arg("counter_overflow") = 0, py::arg("cob_id") = kSyncCobId)
-        .def("start", [](SyncProducerBox& b, bool realtime) { b.obj->start(realtime); }, py::arg("realtime") = false,
+        .def("start", [](SyncProducer& b, bool realtime) { b.start(realtime); }, py::arg("realtime") = false,
              "realtime=True asks for SCHED_FIFO; see realtime_granted.")
-        .def("stop", [](SyncProducerBox& b) { py::gil_scoped_release nogil; b.obj->stop(); })
-        .def_property_readonly("running", [](SyncProducerBox& b) { return b.obj->running(); })
-        .def_property_readonly("realtime_granted", [](SyncProducerBox& b) { return b.obj->realtime_granted(); })
-        .def_property_readonly("sent", [](SyncProducerBox& b) { return b.obj->sent(); })
-        .def("jitter", [](SyncProducerBox& b) {
-                 auto j = b.obj->jitter();
-                 py::dict d;
-                 d["count"] = j.count;
-                 d["min_ns"] = j.min_ns;
-                 d["mean_ns"] = j.mean_ns;
-                 d["max_ns"] = j.max_ns;
-                 d["p99_abs_ns"] = j.p99_abs_ns;
-                 d["max_abs_ns"] = j.max_abs_ns;
-                 return d;
-             })
-        .def("reset_stats", [](SyncProducerBox& b) { b.obj->reset_stats(); });
+        .def("stop", [](SyncProducer& b) { py::gil_scoped_release nogil; b.stop(); })
+        .def_property_readonly("running", [](SyncProducer& b) { return b.running(); })
+        .def_property_readonly("realtime_granted", [](SyncProducer& b) { return b.realtime_granted(); })
+        .def_property_readonly("sent", [](SyncProducer& b) { return b.sent(); })
+        .def("jitter", [](SyncProducer& b) { return b.jitter(); })
+        .def("reset_stats", [](SyncProducer& b) { b.reset_stats(); });
 
     // ---- PDO ----------------------------------------------------------------------
     py::class_<PdoLayout>(m, "PdoLayout", "A compiled PDO mapping: bit-exact pack/unpack (CiA 301, little-endian).")
@@ -524,43 +567,37 @@ void bind_canopen_services(py::module_& m) {
                  return out;
              }, py::arg("data"), "Signed entries (4th tuple item True) are sign-extended.");
 
-    py::class_<PdoReceiverBox, std::shared_ptr<PdoReceiverBox>>(m, "PdoReceiver",
+    py::class_<PdoReceiver, std::shared_ptr<PdoReceiver>>(m, "PdoReceiver",
         "Receives a device's TPDO on the bus and keeps the latest values.")
         .def(py::init([](BusPtr bus, std::uint32_t cob_id, const py::iterable& entries) {
-                 auto b = std::make_shared<PdoReceiverBox>();
-                 b->bus = bus;
-                 b->obj = make_nogil<PdoReceiver>(*bus, cob_id, entries_from(entries));
-                 return b;
+                 return make_service<PdoReceiver>(bus, *bus, cob_id, entries_from(entries));
              }), py::arg("bus"), py::arg("cob_id"), py::arg("entries"))
-        .def_property_readonly("values", [](PdoReceiverBox& b) { return b.obj->values(); })
-        .def("value", [](PdoReceiverBox& b, std::uint16_t i, std::uint8_t s) { return b.obj->value(i, s); },
+        .def_property_readonly("values", [](PdoReceiver& b) { return b.values(); })
+        .def("value", [](PdoReceiver& b, std::uint16_t i, std::uint8_t s) { return b.value(i, s); },
              py::arg("index"), py::arg("subindex") = 0)
-        .def_property_readonly("received", [](PdoReceiverBox& b) { return b.obj->received(); })
-        .def_property_readonly("short_frames", [](PdoReceiverBox& b) { return b.obj->short_frames(); })
-        .def("wait_newer", [](PdoReceiverBox& b, std::uint64_t after, const py::object& t) {
+        .def_property_readonly("received", [](PdoReceiver& b) { return b.received(); })
+        .def_property_readonly("short_frames", [](PdoReceiver& b) { return b.short_frames(); })
+        .def("wait_newer", [](PdoReceiver& b, std::uint64_t after, const py::object& t) {
                  auto to = timeout_of(t);
                  py::gil_scoped_release nogil;
-                 return b.obj->wait_newer(after, to);
+                 return b.wait_newer(after, to);
              }, py::arg("after"), py::arg("timeout") = 1.0)
-        .def("request", [](PdoReceiverBox& b) { py::gil_scoped_release nogil; b.obj->request(); })
-        .def("set_callback", [](PdoReceiverBox& b, py::object cb) {
-                 if (cb.is_none()) { b.obj->on_receive = nullptr; return; }
+        .def("request", [](PdoReceiver& b) { py::gil_scoped_release nogil; b.request(); })
+        .def("set_callback", [](PdoReceiver& b, py::object cb) {
+                 if (cb.is_none()) { b.on_receive = nullptr; return; }
                  PyCallable call(cb.cast<py::function>());
-                 b.obj->on_receive = [call](const std::vector<std::uint64_t>& v, Nanos ts) { call(v, ts); };
+                 b.on_receive = [call](const std::vector<std::uint64_t>& v, Nanos ts) { call(v, ts); };
              }, py::arg("callback"), "callback(values, timestamp_ns) on the bus thread.");
 
-    py::class_<PdoSenderBox, std::shared_ptr<PdoSenderBox>>(m, "PdoSender")
+    py::class_<PdoSender, std::shared_ptr<PdoSender>>(m, "PdoSender")
         .def(py::init([](BusPtr bus, std::uint32_t cob_id, const py::iterable& entries) {
-                 auto b = std::make_shared<PdoSenderBox>();
-                 b->bus = bus;
-                 b->obj = std::make_shared<PdoSender>(*bus, cob_id, entries_from(entries));
-                 return b;
+                 return make_service<PdoSender>(bus, *bus, cob_id, entries_from(entries));
              }), py::arg("bus"), py::arg("cob_id"), py::arg("entries"))
-        .def("send", [](PdoSenderBox& b, const std::vector<std::int64_t>& values, const py::object& t) {
+        .def("send", [](PdoSender& b, const std::vector<std::int64_t>& values, const py::object& t) {
                  std::vector<std::uint64_t> v(values.begin(), values.end());
                  auto to = timeout_of(t);
                  py::gil_scoped_release nogil;
-                 b.obj->send(v, to);
+                 b.send(v, to);
              }, py::arg("values"), py::arg("timeout") = 1.0);
 
     m.def("pdo_write_config",
@@ -608,111 +645,99 @@ void bind_canopen_services(py::module_& m) {
                   py::gil_scoped_release nogil;
                   c = read_pdo(*box.access, static_cast<std::uint8_t>(node), tpdo, number);
               }
-              py::dict d;
-              d["tpdo"] = c.tpdo;
-              d["number"] = c.number;
-              d["cob_id"] = c.cob_id;
-              d["enabled"] = c.enabled;
-              d["transmission_type"] = c.transmission_type;
-              d["inhibit_100us"] = c.inhibit_100us;
-              d["event_timer_ms"] = c.event_timer_ms;
-              d["sync_start"] = c.sync_start;
-              d["mapping"] = entries_to(*c.mapping);
-              return d;
+              return c;
           }, py::arg("sdo"), py::arg("node"), py::arg("tpdo"), py::arg("number"));
 
     // ---- CiA 402 ------------------------------------------------------------------
-    m.def("ds402_decode_statusword", [](std::uint16_t sw) { return std::string(to_string(decode_statusword(sw))); },
+    m.def("cia402_decode_statusword", [](std::uint16_t sw) { return std::string(to_string(decode_statusword(sw))); },
           py::arg("statusword"), "State name; 'UNKNOWN' for patterns outside the table.");
-    m.def("ds402_next_step", [](const std::string& from, const std::string& to) -> py::object {
-              auto s = next_step(ds402_from_name(from), ds402_from_name(to));
+    m.def("cia402_next_step", [](const std::string& from, const std::string& to) -> py::object {
+              auto s = next_step(cia402_state_of(from), cia402_state_of(to));
               if (!s) return py::none();
               return py::make_tuple(s->controlword, s->transition);
           }, py::arg("from_state"), py::arg("to_state"));
 
-    py::class_<Ds402HostBox, std::shared_ptr<Ds402HostBox>>(m, "Ds402Host",
+    py::class_<Cia402Host, std::shared_ptr<Cia402Host>>(m, "Cia402Host",
         "CiA 402 power state machine and PP/PV/HM handshakes, driven from the host.")
         .def(py::init([](const py::object& sdo, int node, double timeout, double poll) {
                  check_node(node, false);
-                 auto b = std::make_shared<Ds402HostBox>();
-                 b->sdo = make_sdo(sdo, node);
-                 Ds402HostOptions o;
+                 auto box = make_sdo(sdo, node);
+                 SdoAccess& access = *box.access;  // owned by box, which the host keeps
+                 Cia402HostOptions o;
                  o.timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9));
                  o.sdo_poll = std::chrono::nanoseconds(static_cast<std::int64_t>(poll * 1e9));
-                 b->obj = make_nogil<Ds402Host>(*b->sdo.access, static_cast<std::uint8_t>(node), o);
-                 return b;
+                 return make_service<Cia402Host>(std::move(box), access, static_cast<std::uint8_t>(node), o);
              }), py::arg("sdo"), py::arg("node"), py::arg("timeout") = 2.0, py::arg("poll") = 0.005)
-        .def("use_statusword_pdo", [](Ds402HostBox& b, std::shared_ptr<PdoReceiverBox> rx) {
-                 b.obj->use_statusword_pdo(rx ? rx->obj.get() : nullptr);
-                 b.sw_pdo = rx;
-             }, py::arg("receiver"))
-        .def_property_readonly("statusword", [](Ds402HostBox& b) { py::gil_scoped_release nogil; return b.obj->read_statusword(); })
-        .def_property_readonly("state", [](Ds402HostBox& b) {
-                 Ds402State s;
+        .def("use_statusword_pdo", [](Cia402Host& b, PdoReceiver* rx) { b.use_statusword_pdo(rx); },
+             py::arg("receiver"), py::keep_alive<1, 2>(),
+             "Wait on this TPDO receiver's statusword (0x6041 must be mapped); None = poll over SDO.")
+        .def_property_readonly("statusword", [](Cia402Host& b) { py::gil_scoped_release nogil; return b.read_statusword(); })
+        .def_property_readonly("state", [](Cia402Host& b) {
+                 Cia402State s;
                  {
                      py::gil_scoped_release nogil;
-                     s = b.obj->state();
+                     s = b.state();
                  }
                  return std::string(to_string(s));
              })
-        .def("write_controlword", [](Ds402HostBox& b, std::uint16_t c) { py::gil_scoped_release nogil; b.obj->write_controlword(c); })
-        .def("go_to", [](Ds402HostBox& b, const std::string& s) {
-                 auto t = ds402_from_name(s);
+        .def("write_controlword", [](Cia402Host& b, std::uint16_t c) { py::gil_scoped_release nogil; b.write_controlword(c); })
+        .def("go_to", [](Cia402Host& b, const std::string& s) {
+                 auto t = cia402_state_of(s);
                  py::gil_scoped_release nogil;
-                 b.obj->go_to(t);
+                 b.go_to(t);
              }, py::arg("state"))
-        .def("fault_reset", [](Ds402HostBox& b) { py::gil_scoped_release nogil; b.obj->fault_reset(); })
-        .def("quick_stop", [](Ds402HostBox& b) { py::gil_scoped_release nogil; b.obj->quick_stop(); })
-        .def("wait_statusword", [](Ds402HostBox& b, std::uint16_t mask, std::uint16_t value, const py::object& t) {
+        .def("fault_reset", [](Cia402Host& b) { py::gil_scoped_release nogil; b.fault_reset(); })
+        .def("quick_stop", [](Cia402Host& b) { py::gil_scoped_release nogil; b.quick_stop(); })
+        .def("wait_statusword", [](Cia402Host& b, std::uint16_t mask, std::uint16_t value, const py::object& t) {
                  std::optional<std::chrono::nanoseconds> to;
                  if (!t.is_none()) to = timeout_of(t);
                  py::gil_scoped_release nogil;
-                 return b.obj->wait_statusword(mask, value, to);
+                 return b.wait_statusword(mask, value, to);
              }, py::arg("mask"), py::arg("value"), py::arg("timeout") = py::none())
-        .def("set_mode", [](Ds402HostBox& b, int mode) {
+        .def("set_mode", [](Cia402Host& b, int mode) {
                  py::gil_scoped_release nogil;
-                 b.obj->set_mode(static_cast<OpMode>(mode));
+                 b.set_mode(static_cast<OpMode>(mode));
              }, py::arg("mode"))
-        .def_property_readonly("mode", [](Ds402HostBox& b) { py::gil_scoped_release nogil; return static_cast<int>(b.obj->mode()); })
-        .def("move_to", [](Ds402HostBox& b, std::int32_t target, bool relative, bool immediate) {
+        .def_property_readonly("mode", [](Cia402Host& b) { py::gil_scoped_release nogil; return static_cast<int>(b.mode()); })
+        .def("move_to", [](Cia402Host& b, std::int32_t target, bool relative, bool immediate) {
                  py::gil_scoped_release nogil;
-                 b.obj->move_to(target, relative, immediate);
+                 b.move_to(target, relative, immediate);
              }, py::arg("target"), py::arg("relative") = false, py::arg("immediate") = true)
-        .def("wait_target_reached", [](Ds402HostBox& b, const py::object& t) {
+        .def("wait_target_reached", [](Cia402Host& b, const py::object& t) {
                  std::optional<std::chrono::nanoseconds> to;
                  if (!t.is_none()) to = timeout_of(t);
                  py::gil_scoped_release nogil;
-                 b.obj->wait_target_reached(to);
+                 b.wait_target_reached(to);
              }, py::arg("timeout") = py::none())
-        .def("set_velocity", [](Ds402HostBox& b, std::int32_t v) { py::gil_scoped_release nogil; b.obj->set_velocity(v); })
-        .def("home", [](Ds402HostBox& b, std::optional<int> method, const py::object& t) {
+        .def("set_velocity", [](Cia402Host& b, std::int32_t v) { py::gil_scoped_release nogil; b.set_velocity(v); })
+        .def("home", [](Cia402Host& b, std::optional<int> method, const py::object& t) {
                  std::optional<std::chrono::nanoseconds> to;
                  if (!t.is_none()) to = timeout_of(t);
                  std::optional<std::int8_t> mth;
                  if (method) mth = static_cast<std::int8_t>(*method);
                  py::gil_scoped_release nogil;
-                 b.obj->home(mth, to);
+                 b.home(mth, to);
              }, py::arg("method") = py::none(), py::arg("timeout") = py::none());
 
-    py::class_<Ds402Device, std::shared_ptr<Ds402Device>>(m, "Ds402Device",
+    py::class_<Cia402Device, std::shared_ptr<Cia402Device>>(m, "Cia402Device",
         "Device-side CiA 402 state machine for simulators.")
-        .def(py::init([] { return std::make_shared<Ds402Device>(); }))
-        .def_property_readonly("state", [](const Ds402Device& d) { return std::string(to_string(d.state())); })
-        .def_property_readonly("statusword", &Ds402Device::statusword)
-        .def_property_readonly("controlword", &Ds402Device::controlword)
-        .def("on_controlword", &Ds402Device::on_controlword, py::arg("controlword"))
-        .def("set_mode", &Ds402Device::set_mode, py::arg("mode"), "0 or the SDO abort code (0x06090030).")
-        .def_property_readonly("mode", &Ds402Device::mode)
-        .def("set_supported_modes", &Ds402Device::set_supported_modes)
-        .def("set_abort_connection_option", &Ds402Device::set_abort_connection_option)
-        .def("set_quick_stop_option", &Ds402Device::set_quick_stop_option)
-        .def("fault", &Ds402Device::fault, py::arg("error_code"))
-        .def("fault_reaction_done", &Ds402Device::fault_reaction_done)
-        .def("loss_of_master", &Ds402Device::loss_of_master)
-        .def("motion_stopped", &Ds402Device::motion_stopped)
-        .def("set_status_bits", &Ds402Device::set_status_bits, py::arg("mask"), py::arg("value"))
-        .def_property_readonly("last_error_code", &Ds402Device::last_error_code)
-        .def_property_readonly("drive_enabled", &Ds402Device::drive_enabled);
+        .def(py::init([] { return std::make_shared<Cia402Device>(); }))
+        .def_property_readonly("state", [](const Cia402Device& d) { return std::string(to_string(d.state())); })
+        .def_property_readonly("statusword", &Cia402Device::statusword)
+        .def_property_readonly("controlword", &Cia402Device::controlword)
+        .def("on_controlword", &Cia402Device::on_controlword, py::arg("controlword"))
+        .def("set_mode", &Cia402Device::set_mode, py::arg("mode"), "0 or the SDO abort code (0x06090030).")
+        .def_property_readonly("mode", &Cia402Device::mode)
+        .def("set_supported_modes", &Cia402Device::set_supported_modes)
+        .def("set_abort_connection_option", &Cia402Device::set_abort_connection_option)
+        .def("set_quick_stop_option", &Cia402Device::set_quick_stop_option)
+        .def("fault", &Cia402Device::fault, py::arg("error_code"))
+        .def("fault_reaction_done", &Cia402Device::fault_reaction_done)
+        .def("loss_of_master", &Cia402Device::loss_of_master)
+        .def("motion_stopped", &Cia402Device::motion_stopped)
+        .def("set_status_bits", &Cia402Device::set_status_bits, py::arg("mask"), py::arg("value"))
+        .def_property_readonly("last_error_code", &Cia402Device::last_error_code)
+        .def_property_readonly("drive_enabled", &Cia402Device::drive_enabled);
 
     // ---- PDO engine on a LocalNode -----------------------------------------------------
     py::class_<PdoService, std::shared_ptr<PdoService>>(m, "PdoService",
@@ -743,19 +768,7 @@ void bind_canopen_services(py::module_& m) {
                  PyCallable call(cb.cast<py::function>());
                  s.engine().on_rpdo_timeout = [call](unsigned n) { call(n); };
              }, py::arg("callback"), "callback(rpdo_number) when an RPDO's event timer expires (P11).")
-        .def_property_readonly("counters", [](PdoService& s) {
-                 auto c = s.engine().counters();
-                 py::dict d;
-                 d["tpdo_sent"] = c.tpdo_sent;
-                 d["rpdo_applied"] = c.rpdo_applied;
-                 d["rpdo_ignored"] = c.rpdo_ignored;
-                 d["rpdo_length_errors"] = c.rpdo_length_errors;
-                 d["sync_received"] = c.sync_received;
-                 d["sync_errors"] = c.sync_errors;
-                 d["rtr_ignored"] = c.rtr_ignored;
-                 d["collisions"] = c.collisions;
-                 return d;
-             });
+        .def_property_readonly("counters", [](PdoService& s) { return s.engine().counters(); });
 
     py::class_<HeartbeatService, std::shared_ptr<HeartbeatService>>(m, "HeartbeatService",
         "Heartbeat producer (0x1017) and consumer (0x1016) of a LocalNode; EMCY 0x8130 and 0x1029 on loss.")
@@ -767,13 +780,13 @@ void bind_canopen_services(py::module_& m) {
                  return HeartbeatService::attach(node, o);
              }), py::arg("node"), py::arg("consumer_entries") = 4, py::arg("producer_ms") = 0,
              py::keep_alive<1, 2>())
-        .def("health", [](HeartbeatService& s, int node) { check_node(node, false); return health_dict(s.health(static_cast<std::uint8_t>(node))); })
+        .def("health", [](HeartbeatService& s, int node) { check_node(node, false); return s.health(static_cast<std::uint8_t>(node)); })
         .def_property_readonly("heartbeats_sent", &HeartbeatService::heartbeats_sent)
         .def("set_lost_callback", [](HeartbeatService& s, py::object cb) {
                  if (cb.is_none()) { s.on_lost = nullptr; return; }
                  PyCallable call(cb.cast<py::function>());
                  s.on_lost = [call](std::uint8_t n) { call(n); };
-             }, py::arg("callback"), "callback(node) when a consumed heartbeat is lost (e.g. Ds402Device.loss_of_master).");
+             }, py::arg("callback"), "callback(node) when a consumed heartbeat is lost (e.g. Cia402Device.loss_of_master).");
 
     // ---- scanner ------------------------------------------------------------------
     m.def("scan_network", [](BusPtr bus, int first, int last, double sdo_timeout, double listen, bool probe_sdo,
@@ -791,23 +804,7 @@ void bind_canopen_services(py::module_& m) {
                   py::gil_scoped_release nogil;
                   res = scan_network(*bus, o);
               }
-              py::list out;
-              for (auto& r : res) {
-                  py::dict d;
-                  d["node"] = r.node_id;
-                  d["sdo_answered"] = r.sdo_answered;
-                  d["heard_heartbeat"] = r.heard_heartbeat;
-                  d["heard_boot_up"] = r.heard_boot_up;
-                  d["state"] = to_string(r.state);
-                  d["device_type"] = r.device_type;
-                  d["device_type_abort"] = r.device_type_abort;
-                  d["vendor_id"] = r.vendor_id;
-                  d["product_code"] = r.product_code;
-                  d["revision"] = r.revision;
-                  d["serial_number"] = r.serial_number;
-                  out.append(d);
-              }
-              return out;
+              return res;
           }, py::arg("bus"), py::arg("first") = 1, py::arg("last") = 127, py::arg("sdo_timeout") = 0.2,
           py::arg("listen") = 0.0, py::arg("probe_sdo") = true, py::arg("identity") = true);
 }

@@ -30,7 +30,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'Cia402Homing', 'Cia402HomingParams', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacCommandRejected', 'DmacErrorWord', 'DmacMotion', 'DmacProfileParams', 'DmacSim', 'DmacStatus', 'DmacUnknownCommand', 'DriveFault', 'Ds402Device', 'Ds402Host', 'EchoLineDevice', 'EmcyConsumer', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'LimitExceeded', 'Limits', 'LineDevice', 'LineLink', 'LinkDown', 'LocalNode', 'LogEntry', 'MotionState', 'MotorConfig', 'MotorModel', 'MotorbusError', 'NmtMaster', 'ObjectDictionary', 'PdoLayout', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoProtocolError', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanServer', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandServer', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'ds402_decode_statusword', 'ds402_next_step', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacCommandRejected', 'DmacErrorWord', 'DmacMotion', 'DmacProfileParams', 'DmacSim', 'DmacStatus', 'DmacUnknownCommand', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineDevice', 'LineLink', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'MotionState', 'MotorConfig', 'MotorModel', 'MotorbusError', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanServer', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandServer', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -719,6 +719,10 @@ class ObjectDictionary:
         ...
     def indices(self) -> list[int]:
         ...
+    def object_code(self, index: typing.SupportsInt | typing.SupportsIndex) -> typing.Any:
+        """
+        'VAR', 'RECORD' or 'ARRAY'; None when the index is not in the dictionary.
+        """
     def object_name(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> typing.Any:
         ...
     def save_eds(self, path: str, dcf: bool = False) -> None:
@@ -738,6 +742,101 @@ class ObjectDictionary:
         ...
     @node_id.setter
     def node_id(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+class SdoClientCounters:
+    """
+    Counters of one SDO client, across its transfers.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def aborts_received(self) -> int:
+        """
+        the server aborted
+        """
+    @property
+    def aborts_sent(self) -> int:
+        """
+        we aborted (timeout, protocol error)
+        """
+    @property
+    def fallbacks(self) -> int:
+        """
+        block refused, retried segmented
+        """
+    @property
+    def ignored_frames(self) -> int:
+        """
+        responses while idle, duplicates
+        """
+    @property
+    def retransmit_requests(self) -> int:
+        """
+        block: sub-blocks acknowledged short (lost frames)
+        """
+    @property
+    def timeouts(self) -> int:
+        ...
+    @property
+    def transfers(self) -> int:
+        ...
+class SdoServerCounters:
+    """
+    Counters of a LocalNode's SDO server.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def aborts_received(self) -> int:
+        ...
+    @property
+    def aborts_sent(self) -> int:
+        ...
+    @property
+    def dropped(self) -> int:
+        """
+        requests dropped while the mailbox was full (S18)
+        """
+    @property
+    def ignored(self) -> int:
+        """
+        DLC 0, stray block segments, duplicates
+        """
+    @property
+    def requests(self) -> int:
+        ...
+    @property
+    def responses(self) -> int:
+        """
+        including aborts
+        """
+    @property
+    def timeouts(self) -> int:
+        ...
+    @property
+    def transfers_completed(self) -> int:
+        ...
+class LocalNodeCounters:
+    """
+    Counters of a LocalNode: its SDO server and NMT.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def nmt_commands(self) -> int:
+        """
+        applied
+        """
+    @property
+    def nmt_ignored(self) -> int:
+        """
+        wrong DLC, other node, unknown command
+        """
+    @property
+    def sdo(self) -> SdoServerCounters:
+        ...
+    @property
+    def sdo_while_stopped(self) -> int:
         ...
 class SdoClient:
     """
@@ -798,7 +897,7 @@ class SdoClient:
     def write_u8(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     @property
-    def counters(self) -> dict:
+    def counters(self) -> SdoClientCounters:
         ...
     @property
     def node_id(self) -> int:
@@ -837,13 +936,233 @@ class LocalNode:
     def send_boot_up(self) -> None:
         ...
     @property
-    def counters(self) -> dict:
+    def counters(self) -> LocalNodeCounters:
         ...
     @property
     def node_id(self) -> int:
         ...
     @property
     def od(self) -> ObjectDictionary:
+        ...
+class EmcyError:
+    """
+    One EMCY message as received (CiA 301).
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def code(self) -> int:
+        """
+        emergency error code (EEC)
+        """
+    @property
+    def data(self) -> bytes:
+        """
+        manufacturer-specific bytes (5)
+        """
+    @property
+    def is_reset(self) -> bool:
+        """
+        EEC 0x0000: the node's errors are cleared
+        """
+    @property
+    def node(self) -> int:
+        ...
+    @property
+    def register(self) -> int:
+        """
+        error register (0x1001) as sent
+        """
+    @property
+    def short(self) -> bool:
+        """
+        the frame had fewer than 8 bytes (missing ones read as 0)
+        """
+    @property
+    def text(self) -> str:
+        ...
+    @property
+    def timestamp_ns(self) -> int:
+        ...
+class NodeHealth:
+    """
+    What a heartbeat consumer knows about one node.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def alive(self) -> bool:
+        """
+        heard within the consumer time
+        """
+    @property
+    def boot_ups(self) -> int:
+        ...
+    @property
+    def heartbeats(self) -> int:
+        ...
+    @property
+    def last_seen_ns(self) -> int:
+        ...
+    @property
+    def lost(self) -> bool:
+        """
+        timed out and not heard since
+        """
+    @property
+    def node(self) -> int:
+        ...
+    @property
+    def raw_state(self) -> int:
+        ...
+    @property
+    def state(self) -> str:
+        ...
+    @property
+    def timeouts(self) -> int:
+        ...
+class JitterStats:
+    """
+    SYNC period error (actual - nominal) over the last periods.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def count(self) -> int:
+        """
+        periods measured
+        """
+    @property
+    def max_abs_ns(self) -> float:
+        ...
+    @property
+    def max_ns(self) -> float:
+        ...
+    @property
+    def mean_ns(self) -> float:
+        ...
+    @property
+    def min_ns(self) -> float:
+        ...
+    @property
+    def p99_abs_ns(self) -> float:
+        """
+        99th percentile of the error's magnitude
+        """
+class PdoCounters:
+    """
+    Counters of a served node's PDO engine.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def collisions(self) -> int:
+        ...
+    @property
+    def rpdo_applied(self) -> int:
+        ...
+    @property
+    def rpdo_ignored(self) -> int:
+        ...
+    @property
+    def rpdo_length_errors(self) -> int:
+        ...
+    @property
+    def rtr_ignored(self) -> int:
+        ...
+    @property
+    def sync_errors(self) -> int:
+        ...
+    @property
+    def sync_received(self) -> int:
+        ...
+    @property
+    def tpdo_sent(self) -> int:
+        ...
+class PdoConfig:
+    """
+    A PDO's communication parameters and mapping as read from a device.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def cob_id(self) -> int | None:
+        ...
+    @property
+    def enabled(self) -> bool:
+        ...
+    @property
+    def event_timer_ms(self) -> int | None:
+        ...
+    @property
+    def inhibit_100us(self) -> int | None:
+        ...
+    @property
+    def mapping(self) -> list:
+        """
+        [(index, subindex, bits), ...]
+        """
+    @property
+    def number(self) -> int:
+        ...
+    @property
+    def sync_start(self) -> int | None:
+        ...
+    @property
+    def tpdo(self) -> bool:
+        ...
+    @property
+    def transmission_type(self) -> int | None:
+        ...
+class NodeInfo:
+    """
+    A node found by scan_network().
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def device_type(self) -> int | None:
+        """
+        0x1000
+        """
+    @property
+    def device_type_abort(self) -> int | None:
+        """
+        abort code when 0x1000 was refused
+        """
+    @property
+    def heard_boot_up(self) -> bool:
+        ...
+    @property
+    def heard_heartbeat(self) -> bool:
+        ...
+    @property
+    def node(self) -> int:
+        ...
+    @property
+    def product_code(self) -> int | None:
+        ...
+    @property
+    def profile(self) -> int | None:
+        """
+        device profile number (402 for drives) from 0x1000's low 16 bits
+        """
+    @property
+    def revision(self) -> int | None:
+        ...
+    @property
+    def sdo_answered(self) -> bool:
+        """
+        any SDO reply (value or abort)
+        """
+    @property
+    def serial_number(self) -> int | None:
+        ...
+    @property
+    def state(self) -> str:
+        ...
+    @property
+    def vendor_id(self) -> int | None:
         ...
 class NmtMaster:
     """
@@ -859,10 +1178,18 @@ class NmtMaster:
         """
         callback(node, old_state, new_state) on the bus thread.
         """
+    def set_state(self, node: typing.SupportsInt | typing.SupportsIndex, state: str) -> None:
+        """
+        Sends the NMT command that puts `node` (0 = all) in `state`; RESET / RESET COMMUNICATION reset it.
+        """
     def state(self, node: typing.SupportsInt | typing.SupportsIndex) -> str:
         ...
     def wait_for_boot(self, node: typing.SupportsInt | typing.SupportsIndex, timeout: typing.Any = 1.0) -> bool:
         ...
+    def wait_for_heartbeat(self, node: typing.SupportsInt | typing.SupportsIndex, timeout: typing.Any = 1.0) -> str | None:
+        """
+        State reported by the next heartbeat or boot-up of `node`; None on timeout.
+        """
     def wait_for_state(self, node: typing.SupportsInt | typing.SupportsIndex, state: str, timeout: typing.Any = 1.0) -> bool:
         ...
     @property
@@ -876,7 +1203,7 @@ class HeartbeatConsumer:
         ...
     def forget(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
-    def health(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> dict:
+    def health(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> NodeHealth:
         ...
     def monitor(self, node: typing.SupportsInt | typing.SupportsIndex, timeout: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
@@ -960,7 +1287,7 @@ class SyncProducer:
     """
     def __init__(self, bus: Bus, period: typing.SupportsFloat | typing.SupportsIndex, counter_overflow: typing.SupportsInt | typing.SupportsIndex = 0, cob_id: typing.SupportsInt | typing.SupportsIndex = 128) -> None:
         ...
-    def jitter(self) -> dict:
+    def jitter(self) -> JitterStats:
         ...
     def reset_stats(self) -> None:
         ...
@@ -1036,7 +1363,7 @@ class PdoSender:
         ...
     def send(self, values: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], timeout: typing.Any = 1.0) -> None:
         ...
-class Ds402Host:
+class Cia402Host:
     """
     CiA 402 power state machine and PP/PV/HM handshakes, driven from the host.
     """
@@ -1057,7 +1384,9 @@ class Ds402Host:
     def set_velocity(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     def use_statusword_pdo(self, receiver: PdoReceiver) -> None:
-        ...
+        """
+        Wait on this TPDO receiver's statusword (0x6041 must be mapped); None = poll over SDO.
+        """
     def wait_statusword(self, mask: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex, timeout: typing.Any = None) -> int:
         ...
     def wait_target_reached(self, timeout: typing.Any = None) -> None:
@@ -1073,7 +1402,7 @@ class Ds402Host:
     @property
     def statusword(self) -> int:
         ...
-class Ds402Device:
+class Cia402Device:
     """
     Device-side CiA 402 state machine for simulators.
     """
@@ -1138,7 +1467,7 @@ class PdoService:
     def trigger_tpdo(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     @property
-    def counters(self) -> dict:
+    def counters(self) -> PdoCounters:
         ...
 class HeartbeatService:
     """
@@ -1146,11 +1475,11 @@ class HeartbeatService:
     """
     def __init__(self, node: LocalNode, consumer_entries: typing.SupportsInt | typing.SupportsIndex = 4, producer_ms: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
-    def health(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> dict:
+    def health(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> NodeHealth:
         ...
     def set_lost_callback(self, callback: typing.Any) -> None:
         """
-        callback(node) when a consumed heartbeat is lost (e.g. Ds402Device.loss_of_master).
+        callback(node) when a consumed heartbeat is lost (e.g. Cia402Device.loss_of_master).
         """
     @property
     def heartbeats_sent(self) -> int:
@@ -2387,12 +2716,22 @@ def arcus_window_for_hspd(hspd_pps: typing.SupportsFloat | typing.SupportsIndex)
     ...
 def arcus_window_for_sspdm(sspdm: typing.SupportsInt | typing.SupportsIndex) -> ArcusSpeedWindow:
     ...
+def cia402_decode_statusword(statusword: typing.SupportsInt | typing.SupportsIndex) -> str:
+    """
+    State name; 'UNKNOWN' for patterns outside the table.
+    """
+def cia402_next_step(from_state: str, to_state: str) -> typing.Any:
+    ...
 def cia402_position_profile(start: MotionState, target: typing.SupportsFloat | typing.SupportsIndex, params: Cia402ProfileParams) -> Profile:
     ...
 def cia402_quick_stop_profile(start: MotionState, params: Cia402ProfileParams) -> Profile:
     ...
 def cia402_velocity_profile(start: MotionState, target_velocity: typing.SupportsFloat | typing.SupportsIndex, params: Cia402ProfileParams, hold: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> Profile:
     ...
+def decode_value(data_type: DataType, data: bytes) -> typing.Any:
+    """
+    The Python value of little-endian bytes of a CiA 301 type (int, float, bool, str or bytes).
+    """
 def dmac_error_names(error: typing.SupportsInt | typing.SupportsIndex) -> list[str]:
     ...
 def dmac_format_value(value: typing.SupportsInt | typing.SupportsIndex, radix: str = 'dec') -> str:
@@ -2421,18 +2760,16 @@ def dmac_synchro(link: LineLink, what: str) -> None:
     """
 def dmac_variable(name: str) -> dict:
     ...
-def ds402_decode_statusword(statusword: typing.SupportsInt | typing.SupportsIndex) -> str:
-    """
-    State name; 'UNKNOWN' for patterns outside the table.
-    """
-def ds402_next_step(from_state: str, to_state: str) -> typing.Any:
-    ...
 def emcy_code_text(code: typing.SupportsInt | typing.SupportsIndex) -> str:
     ...
 def emcy_decode(frame: Frame) -> typing.Any:
     ...
 def emcy_encode(node: typing.SupportsInt | typing.SupportsIndex, code: typing.SupportsInt | typing.SupportsIndex, register: typing.SupportsInt | typing.SupportsIndex = 0, data: bytes = b'') -> Frame:
     ...
+def encode_value(data_type: DataType, value: typing.Any) -> bytes:
+    """
+    The little-endian bytes of `value` as a CiA 301 type; InvalidArgument when it does not fit.
+    """
 def heartbeat_decode(frame: Frame) -> typing.Any:
     """
     (node, state name, raw byte) or None (DLC != 1, bad id).
@@ -2473,7 +2810,7 @@ def open_virtual(name: str, bitrate: typing.SupportsFloat | typing.SupportsIndex
     """
 def parse_candump_line(line: str) -> LogEntry | None:
     ...
-def pdo_read_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex) -> dict:
+def pdo_read_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex) -> PdoConfig:
     ...
 def pdo_write_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex, cob_id: typing.SupportsInt | typing.SupportsIndex | None = None, enabled: bool = True, transmission_type: typing.SupportsInt | typing.SupportsIndex | None = None, inhibit_100us: typing.SupportsInt | typing.SupportsIndex | None = None, event_timer_ms: typing.SupportsInt | typing.SupportsIndex | None = None, sync_start: typing.SupportsInt | typing.SupportsIndex | None = None, mapping: collections.abc.Iterable | None = None, procedure: str = 'cia301') -> None:
     ...
@@ -2513,7 +2850,7 @@ def read_log(path: str) -> tuple[list[LogEntry], int]:
     """
     Reads a candump (.log) or ASC (.asc) file: (entries, bad_line_count).
     """
-def scan_network(bus: Bus, first: typing.SupportsInt | typing.SupportsIndex = 1, last: typing.SupportsInt | typing.SupportsIndex = 127, sdo_timeout: typing.SupportsFloat | typing.SupportsIndex = 0.2, listen: typing.SupportsFloat | typing.SupportsIndex = 0.0, probe_sdo: bool = True, identity: bool = True) -> list:
+def scan_network(bus: Bus, first: typing.SupportsInt | typing.SupportsIndex = 1, last: typing.SupportsInt | typing.SupportsIndex = 127, sdo_timeout: typing.SupportsFloat | typing.SupportsIndex = 0.2, listen: typing.SupportsFloat | typing.SupportsIndex = 0.0, probe_sdo: bool = True, identity: bool = True) -> list[NodeInfo]:
     ...
 def slcan_encode(frame: Frame, timestamp_ms: typing.Any = None) -> bytes:
     """

@@ -150,7 +150,7 @@ def test_our_client_block_falls_back_against_canopen(theirs_served):
     data = payload(1024)
     sdo.download(0x2003, 0, data, block=True)  # canopen's server answers 0x05040001 (B16)
     assert local.sdo.upload(0x2003, 0) == data
-    assert sdo.counters["fallbacks"] == 1
+    assert sdo.counters.fallbacks == 1
     # For block upload canopen's server switches protocol (answers a plain upload), which we follow.
     assert sdo.upload(0x2003, 0, block=True) == data
-    assert sdo.counters["fallbacks"] == 1
+    assert sdo.counters.fallbacks == 1

@@ -162,7 +162,7 @@ def test_many_threads_share_a_client(setup):
     for t in ts:
         t.join()
     assert errors == []
-    assert sdo.counters["transfers"] == 240
+    assert sdo.counters.transfers == 240
 
 
 def test_nmt_stop_silences_sdo(setup):

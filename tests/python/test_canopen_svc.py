@@ -9,10 +9,11 @@ import pytest
 
 from motorbus import _core
 import motorbus
-from motorbus.canopen.services import (Ds402, Ds402Device, EmcyConsumer, EmcyProducer,
+from motorbus.canopen import (Cia402, Cia402Device, EmcyConsumer, EmcyProducer,
                                        HeartbeatConsumer, NmtMaster, OpMode, PdoMap, PdoReceiver,
                                        SyncProducer, configure_pdo, decode_statusword,
                                        read_pdo_config, scan_network)
+from motorbus.canopen import heartbeat as hb_mod
 from motorbus.canopen import nmt as nmt_mod
 from motorbus.canopen import pdo as pdo_mod
 from polling import recv_id, wait_for
@@ -75,8 +76,8 @@ def test_pmc007_pdo_configuration_byte_for_byte():
     m = PdoMap([(0x6012, 0, 16)])
     assert m.pack([3]) == bytes.fromhex(seq["resulting_pdo"]["data"])
     back = read_pdo_config(RecordingSdo({**sdo.values, (0x1800, 0): 5}), 5, tpdo=1)
-    assert back["cob_id"] == 0x187 and back["enabled"]
-    assert back["mapping"] == [(0x6012, 0, 16)]
+    assert back.cob_id == 0x187 and back.enabled
+    assert back.mapping == [(0x6012, 0, 16)]
 
 
 def test_cia301_procedure_order():
@@ -102,7 +103,7 @@ def test_nmt_master_commands_and_states():
     assert f.data == b"\x01\x05"
     m.reset_node()
     assert recv_id(dev, 0x000).data == b"\x81\x00"
-    dev.send(nmt_mod.heartbeat_encode(5, "PRE-OPERATIONAL"))
+    dev.send(hb_mod.heartbeat_encode(5, "PRE-OPERATIONAL"))
     assert m.wait_for_state(5, "PRE-OPERATIONAL", timeout=1.0)
     dev.send(_core.Frame(0x705, b"\x42"))  # N7
     wait_for(lambda: m.raw_state(5) == 0x42, 1.0)
@@ -124,12 +125,12 @@ def test_heartbeat_consumer_lost_on_sim_clock():
 
     hb.on_event = on_event
     hb.monitor(7, timeout=0.1)
-    dev.send(nmt_mod.heartbeat_encode(7, "OPERATIONAL"))
+    dev.send(hb_mod.heartbeat_encode(7, "OPERATIONAL"))
     assert got.wait(1.0)
     clock.advance(100_000_000)
     hb.process()
     assert events == [(7, "started", "OPERATIONAL"), (7, "lost", "OPERATIONAL")]
-    assert hb.health(7)["lost"] and hb.health(7)["timeouts"] == 1
+    assert hb.health(7).lost and hb.health(7).timeouts == 1
 
 
 def test_emcy_consumer_and_producer_inhibit():
@@ -163,8 +164,8 @@ def test_sync_producer_jitter_stats():
     wait_for(lambda: s.sent >= 10, 2.0, interval=0.005)
     s.stop()
     j = s.jitter()
-    assert j["count"] == s.sent - 1
-    assert j["min_ns"] <= j["mean_ns"] <= j["max_ns"]
+    assert j.count == s.sent - 1
+    assert j.min_ns <= j.mean_ns <= j.max_ns
     first = recv_id(dev, 0x80)
     assert first.data == b"\x01"
 
@@ -190,7 +191,7 @@ class DeviceSdo:
     """SDO stand-in served by the C++ device-side state machine."""
 
     def __init__(self):
-        self.dev = Ds402Device()
+        self.dev = Cia402Device()
         self.objects = {}
         self.controlwords = []
 
@@ -216,7 +217,7 @@ class DeviceSdo:
         return self.objects.get(index, 0).to_bytes(4, "little")
 
 
-def test_ds402_decode_every_state_and_unknown():
+def test_cia402_decode_every_state_and_unknown():
     assert decode_statusword(0x0040) == "SWITCH ON DISABLED"
     assert decode_statusword(0x0237) == "OPERATION ENABLED"
     assert decode_statusword(0x0007) == "QUICK STOP ACTIVE"
@@ -224,9 +225,9 @@ def test_ds402_decode_every_state_and_unknown():
     assert decode_statusword(0x0067) == "UNKNOWN"  # D3
 
 
-def test_ds402_host_enable_move_and_faults():
+def test_cia402_host_enable_move_and_faults():
     sdo = DeviceSdo()
-    d = Ds402(sdo, 5, timeout=0.5, poll=0.001)
+    d = Cia402(sdo, 5, timeout=0.5, poll=0.001)
     d.set_mode(OpMode.PROFILE_POSITION)
     assert d.op_mode == OpMode.PROFILE_POSITION
     d.enable()
@@ -247,8 +248,8 @@ def test_ds402_host_enable_move_and_faults():
     assert d.state == "OPERATION ENABLED"
 
 
-def test_ds402_device_loss_of_master_and_quick_stop():
-    dev = Ds402Device()
+def test_cia402_device_loss_of_master_and_quick_stop():
+    dev = Cia402Device()
     dev.set_abort_connection_option(3)
     dev.on_controlword(0x06)
     dev.on_controlword(0x0F)
@@ -280,10 +281,10 @@ def test_scan_network_finds_a_responder():
     assert (n.vendor_id, n.product_code, n.revision, n.serial_number) == (0x12E, 7, 1, 99)
 
 
-# ---- end to end with canopen-sdo's LocalNode and SdoClient ------------------------------
+# ---- end to end with our LocalNode and SdoClient ------------------------------------------
 
 def test_pmc007_end_to_end_on_local_node():
-    from motorbus.canopen.services import PdoService
+    from motorbus.canopen import PdoService
     from motorbus.canopen import LocalNode, ObjectDictionary, SdoClient
 
     seq = VECTORS["pmc007_canopen"]["pdo_config_sequence"]
@@ -307,19 +308,19 @@ def test_pmc007_end_to_end_on_local_node():
     NmtMaster(host).start(5)
     f = recv_id(sniff, 0x187, timeout=2.0)
     assert f is not None and f.data == bytes.fromhex(seq["resulting_pdo"]["data"])
-    assert pdo.counters["tpdo_sent"] >= 1
+    assert pdo.counters.tpdo_sent >= 1
     node.close()
 
 
 def test_heartbeat_service_on_local_node_applies_loss_of_master():
-    from motorbus.canopen.services import HeartbeatService
+    from motorbus.canopen import HeartbeatService
     from motorbus.canopen import LocalNode, ObjectDictionary, SdoClient
 
     name = f"svc-py-{next(_hub)}"
     dev, host = _core.open_virtual(name), _core.open_virtual(name)
     node = LocalNode(dev, 5, ObjectDictionary())
     hb = HeartbeatService(node, consumer_entries=2)
-    drive = Ds402Device()
+    drive = Cia402Device()
     drive.set_abort_connection_option(2)
     drive.on_controlword(0x06)
     drive.on_controlword(0x0F)
@@ -330,10 +331,10 @@ def test_heartbeat_service_on_local_node_applies_loss_of_master():
     with pytest.raises(Exception) as exc:
         sdo.download(0x1016, 2, (0x00010050).to_bytes(4, "little"))  # N12 duplicate
     assert getattr(exc.value, "code", None) == 0x06040043
-    host.send(nmt_mod.heartbeat_encode(1, "OPERATIONAL"))
+    host.send(hb_mod.heartbeat_encode(1, "OPERATIONAL"))
     assert lost.wait(2.0)
     assert drive.state == "SWITCH ON DISABLED"   # 0x6007 = 2 (D5)
-    assert hb.health(1)["lost"]
+    assert hb.health(1).lost
     node.close()
 
 
@@ -341,7 +342,7 @@ def test_heartbeat_producer_with_python_state_function():
     host, dev = pair()
     clock = _core.SimClock(0)
     states = iter(["PRE-OPERATIONAL", "OPERATIONAL"])
-    p = nmt_mod.HeartbeatProducer(dev, 9, 0.1, lambda: next(states), clock=clock)
+    p = hb_mod.HeartbeatProducer(dev, 9, 0.1, lambda: next(states), clock=clock)
     p.send_boot_up()
     p.process()
     clock.advance(100_000_000)

@@ -24,3 +24,22 @@ def test_notebook_cells_run_in_order(capsys):
     out = capsys.readouterr().out
     assert "encoder 4000" in out
     assert "frame spacing at 250 kbit/s (us): [540.0, 540.0, 540.0]" in out
+
+
+def run_example(name):
+    out = subprocess.run([sys.executable, str(ROOT / "examples" / name)], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    return out.stdout
+
+
+def test_example_02_sdo_python():
+    out = run_example("02_sdo.py")
+    assert "name: example drive" in out
+    assert "vendor: 0x12e" in out
+    assert "offset: -300 served: -300" in out
+    assert "refused: 0x06090031" in out
+
+
+def test_example_05_cia402_python():
+    out = run_example("05_cia402.py")
+    assert out.splitlines() == ["state: OPERATION ENABLED", "position: 10000", "state: SWITCH ON DISABLED"]

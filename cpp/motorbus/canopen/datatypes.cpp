@@ -1,5 +1,8 @@
 #include "motorbus/canopen/datatypes.hpp"
 
+#include <cctype>
+#include <utility>
+
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -217,6 +220,24 @@ std::string scalar_to_string(const Scalar& v) {
             }
         },
         v);
+}
+
+std::optional<DataType> data_type_from_name(std::string_view name) {
+    std::string u;
+    for (char c : name) u.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+    static const std::pair<const char*, DataType> aliases[] = {
+        {"BOOL", DataType::Boolean},       {"I8", DataType::Integer8},     {"I16", DataType::Integer16},
+        {"I32", DataType::Integer32},      {"I64", DataType::Integer64},   {"U8", DataType::Unsigned8},
+        {"U16", DataType::Unsigned16},     {"U32", DataType::Unsigned32},  {"U64", DataType::Unsigned64},
+        {"F32", DataType::Real32},         {"F64", DataType::Real64},      {"STR", DataType::VisibleString},
+        {"BYTES", DataType::OctetString},
+    };
+    for (auto& [a, t] : aliases)
+        if (u == a) return t;
+    for (unsigned c = 1; c <= 0x1B; ++c)
+        if (is_known_type(static_cast<std::uint16_t>(c)) && u == type_name(static_cast<DataType>(c)))
+            return static_cast<DataType>(c);
+    return std::nullopt;
 }
 
 }  // namespace motorbus::canopen

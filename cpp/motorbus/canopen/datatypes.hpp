@@ -55,6 +55,9 @@ bool is_real(DataType t);      // Real32, Real64
 bool is_variable_length(DataType t);
 bool is_numeric(DataType t);   // signed, unsigned or real
 const char* type_name(DataType t);  // "UNSIGNED32", "VISIBLE_STRING", ...
+// A type from its CiA name ("UNSIGNED32") or the short forms the Python API
+// documents ("u32", "i8", "f64", "str", "bytes", "bool"); case-insensitive.
+std::optional<DataType> data_type_from_name(std::string_view name);
 
 // A number as the dictionary understands it: signed types decode to int64,
 // unsigned (and Boolean) to uint64, reals to double.

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
-#include "motorbus/canopen/services_timer.hpp"
+#include "motorbus/canopen/timer_thread.hpp"
 #include "motorbus/runtime/clock.hpp"
 
 namespace motorbus::canopen {
@@ -97,6 +97,7 @@ public:
     // Sends one queued message when the inhibit time allows; returns the next
     // due time (-1 when the queue is empty).
     Nanos process(Nanos now);
+    Clock& clock() const { return clock_; }  // the one process(now) is meant to run on
     void start();
     void stop();
 

@@ -14,7 +14,7 @@
 
 #include "motorbus/can/bus.hpp"
 #include "motorbus/canopen/nmt.hpp"
-#include "motorbus/canopen/services_timer.hpp"
+#include "motorbus/canopen/timer_thread.hpp"
 #include "motorbus/runtime/clock.hpp"
 
 namespace motorbus::canopen {
@@ -84,6 +84,7 @@ public:
     // Checks deadlines at clock time `now`; fires Lost for overdue nodes.
     // Returns the earliest pending deadline (or -1).
     Nanos process(Nanos now);
+    Clock& clock() const { return clock_; }  // the one process(now) is meant to run on
     // Runs process() on a thread until stop()/destruction.
     void start();
     void stop();
@@ -123,6 +124,7 @@ public:
     void set_period(std::chrono::nanoseconds period);
     // Sends when due at `now`; returns the next due time (-1 when disabled).
     Nanos process(Nanos now);
+    Clock& clock() const { return clock_; }  // the one process(now) is meant to run on
     void start();
     void stop();
     std::uint64_t sent() const { return sent_.load(); }

@@ -1,6 +1,7 @@
 #include "motorbus/canopen/local_node.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 
 #include "motorbus/errors.hpp"
@@ -15,6 +16,25 @@ const char* to_string(NmtState s) {
         case NmtState::PreOperational: return "PRE-OPERATIONAL";
     }
     return "UNKNOWN";
+}
+
+namespace {
+// Upper case without the separators people use interchangeably.
+std::string squash(std::string_view s) {
+    std::string u;
+    for (char c : s)
+        if (c != '-' && c != '_' && c != ' ') u.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+    return u;
+}
+}  // namespace
+
+std::optional<NmtState> nmt_state_from_name(std::string_view name) {
+    const std::string u = squash(name);
+    if (u == "OPERATIONAL") return NmtState::Operational;
+    if (u == "STOPPED") return NmtState::Stopped;
+    if (u == "PREOPERATIONAL") return NmtState::PreOperational;
+    if (u == "INITIALISING" || u == "INITIALIZING") return NmtState::Initialising;
+    return std::nullopt;
 }
 
 LocalNode::LocalNode(can::Bus& bus, std::uint8_t node_id, std::shared_ptr<ObjectDictionary> od,

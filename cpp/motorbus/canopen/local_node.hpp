@@ -23,6 +23,8 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -40,6 +42,10 @@ enum class NmtState : std::uint8_t {
     PreOperational = 0x7F,
 };
 const char* to_string(NmtState s);
+// The state for a name as to_string() spells it; case, '-', '_' and ' ' are
+// ignored ("pre_operational" works) and INITIALIZING is accepted.  nullopt for
+// anything else.
+std::optional<NmtState> nmt_state_from_name(std::string_view name);
 
 // NMT command specifiers (byte 0 of a COB-ID 0x000 frame).
 enum class NmtCommand : std::uint8_t {

@@ -1,5 +1,7 @@
 #include "motorbus/canopen/nmt.hpp"
 
+#include <cctype>
+
 #include "motorbus/canopen/heartbeat.hpp"
 #include "motorbus/errors.hpp"
 
@@ -18,6 +20,33 @@ const char* to_string(NmtCommand c) {
 
 bool is_known_nmt_command(std::uint8_t cs) {
     return cs == 0x01 || cs == 0x02 || cs == 0x80 || cs == 0x81 || cs == 0x82;
+}
+
+std::optional<NmtCommand> nmt_command_for_state(std::string_view name) {
+    // RESET COMMUNICATION would squash into a state-like word; compare with
+    // the separators removed, as nmt_state_from_name does.
+    std::string u;
+    for (char c : name)
+        if (c != '-' && c != '_' && c != ' ') u.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+    if (u == "RESET" || u == "RESETNODE") return NmtCommand::ResetNode;
+    if (u == "RESETCOMMUNICATION") return NmtCommand::ResetCommunication;
+    auto s = nmt_state_from_name(name);
+    if (!s) return std::nullopt;
+    switch (*s) {
+        case NmtState::Operational: return NmtCommand::Start;
+        case NmtState::Stopped: return NmtCommand::Stop;
+        case NmtState::PreOperational: return NmtCommand::EnterPreOperational;
+        case NmtState::Initialising: return std::nullopt;  // reached by a reset, not commanded
+    }
+    return std::nullopt;
+}
+
+std::optional<NodeState> node_state_from_name(std::string_view name) {
+    if (auto s = nmt_state_from_name(name)) return to_node_state(*s);
+    std::string u;
+    for (char c : name) u.push_back(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+    if (u == "UNKNOWN") return NodeState::Unknown;
+    return std::nullopt;
 }
 
 const char* to_string(NodeState s) {
@@ -121,16 +150,20 @@ void NmtMaster::on_heartbeat(const can::Frame& f) {
     auto hb = decode_heartbeat(f);
     if (!hb) return;
     NodeState old, now;
+    bool changed;
     {
         std::lock_guard l(mutex_);
         std::int16_t prev = raw_[hb->node_id];
         old = prev < 0 ? NodeState::Unknown : node_state_from_byte(static_cast<std::uint8_t>(prev));
         raw_[hb->node_id] = hb->raw_state;
         if (hb->is_boot_up()) ++boots_[hb->node_id];
+        ++heard_[hb->node_id];
         now = hb->state;
-        if (prev == hb->raw_state && !hb->is_boot_up()) return;
+        changed = prev != hb->raw_state || hb->is_boot_up();
     }
+    // Every heartbeat wakes wait_for_heartbeat(); the callback is for changes.
     cv_.notify_all();
+    if (!changed) return;
     if (on_state_change) on_state_change(hb->node_id, old, now);
 }
 
@@ -160,6 +193,14 @@ bool NmtMaster::wait_for_boot(std::uint8_t node, std::chrono::nanoseconds timeou
     std::unique_lock l(mutex_);
     const auto start = boots_[node];
     return cv_.wait_for(l, timeout, [&] { return boots_[node] != start; });
+}
+
+std::optional<NodeState> NmtMaster::wait_for_heartbeat(std::uint8_t node, std::chrono::nanoseconds timeout) {
+    if (node == 0 || node > kMaxNodeId) throw InvalidArgument("node id must be 1-127");
+    std::unique_lock l(mutex_);
+    const auto start = heard_[node];
+    if (!cv_.wait_for(l, timeout, [&] { return heard_[node] != start; })) return std::nullopt;
+    return node_state_from_byte(static_cast<std::uint8_t>(raw_[node]));
 }
 
 }  // namespace motorbus::canopen

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "motorbus/can/bus.hpp"
 #include "motorbus/can/frame.hpp"
@@ -24,6 +25,10 @@ constexpr std::uint8_t kMaxNodeId = 127;
 
 const char* to_string(NmtCommand c);
 bool is_known_nmt_command(std::uint8_t cs);
+// The command that puts a node in the named state, in the vocabulary of the
+// `canopen` package's `nmt.state = ...`: OPERATIONAL, PRE-OPERATIONAL, STOPPED,
+// RESET (node), RESET COMMUNICATION.  Case, '-', '_' and ' ' are ignored.
+std::optional<NmtCommand> nmt_command_for_state(std::string_view name);
 
 // The state a remote node reported in its heartbeat.  Like NmtState but with
 // Unknown: a byte outside the valid set (0x42...) or nothing heard yet is never
@@ -39,6 +44,9 @@ const char* to_string(NodeState s);
 // Maps the raw heartbeat byte; the toggle bit (node guarding) is not part of it.
 NodeState node_state_from_byte(std::uint8_t b);
 inline NodeState to_node_state(NmtState s) { return static_cast<NodeState>(s); }
+// INITIALISING, STOPPED, OPERATIONAL, PRE-OPERATIONAL or UNKNOWN, spelled as
+// nmt_state_from_name() accepts them; nullopt for anything else.
+std::optional<NodeState> node_state_from_name(std::string_view name);
 
 struct NmtMessage {
     NmtCommand command;
@@ -104,6 +112,9 @@ public:
     bool wait_for_state(std::uint8_t node, NodeState want, std::chrono::nanoseconds timeout);
     // Blocks until `node` sends its boot-up message; false on timeout.
     bool wait_for_boot(std::uint8_t node, std::chrono::nanoseconds timeout);
+    // Blocks until the next heartbeat or boot-up of `node` (one sent after
+    // this call started); returns the state it reported, nullopt on timeout.
+    std::optional<NodeState> wait_for_heartbeat(std::uint8_t node, std::chrono::nanoseconds timeout);
 
     // Called on the bus thread when a node's reported state changes, and for
     // every boot-up message (old state may equal new state then).
@@ -119,6 +130,7 @@ private:
     std::condition_variable cv_;
     std::array<std::int16_t, 128> raw_{};  // -1 = never heard
     std::array<std::uint32_t, 128> boots_{};
+    std::array<std::uint64_t, 128> heard_{};  // heartbeats + boot-ups per node
     std::atomic<std::uint64_t> foreign_ignored_{0};
     can::SubscriptionId hb_sub_ = 0, nmt_sub_ = 0;
 };

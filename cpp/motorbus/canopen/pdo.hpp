@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
-#include "motorbus/canopen/services_sdo.hpp"
+#include "motorbus/canopen/sdo_access.hpp"
 
 namespace motorbus::canopen {
 

@@ -1,34 +1,36 @@
-"""CANopen: object dictionary, EDS, SDO client and server (LocalNode), NMT, heartbeat, EMCY,
-SYNC, PDO, CiA 402 and a network scanner.
+"""CANopen: a node-centric Network (as the `canopen` package has it) over the
+services underneath -- object dictionary, EDS, SDO client and server
+(LocalNode), NMT, heartbeat, EMCY, SYNC, TIME, PDO, CiA 402 and a scanner.
 
     import motorbus
-    from motorbus.canopen import SdoClient, ObjectDictionary, LocalNode
+    from motorbus.canopen import Network
 
-    bus = motorbus.open_bus("virtual:lab")
-    sdo = SdoClient(bus, 5, timeout=0.5)
+    with Network("virtual:lab") as network:
+        node = network.add_node(5, "drive.eds")
+        print(node.sdo["Statusword"].raw)
+
+The services stand on their own too:
+
+    from motorbus.canopen import SdoClient
+    sdo = SdoClient(motorbus.open_bus("virtual:lab"), 5, timeout=0.5)
     status = sdo.read_u8(0x6001, 0)
 """
 from __future__ import annotations
 
-from .eds import load_eds, save_eds, to_eds  # noqa: F401
-from .node import LocalNode  # noqa: F401
-from .od import DataType, ObjectDictionary, Variable  # noqa: F401
-from .sdo import (  # noqa: F401
-    ABORT_CODES,
-    SdoAbortError,
-    SdoClient,
-    SdoProtocolError,
-    SdoTimeout,
-    abort_text,
-)
+from .cia402 import *  # noqa: F401,F403
+from .eds import *  # noqa: F401,F403
+from .emcy import *  # noqa: F401,F403
+from .heartbeat import *  # noqa: F401,F403
+from .network import *  # noqa: F401,F403
+from .nmt import *  # noqa: F401,F403
+from .node import *  # noqa: F401,F403
+from .od import *  # noqa: F401,F403
+from .pdo import *  # noqa: F401,F403
+from .scanner import *  # noqa: F401,F403
+from .sdo import *  # noqa: F401,F403
+from .sync import *  # noqa: F401,F403
+from .time import *  # noqa: F401,F403
+from . import cia402, eds, emcy, heartbeat, network, nmt, node, od, pdo, scanner, sdo, sync, time  # noqa: F401,E402
 
-__all__ = [
-    "ABORT_CODES", "DataType", "LocalNode", "ObjectDictionary", "SdoAbortError", "SdoClient",
-    "SdoProtocolError", "SdoTimeout", "Variable", "abort_text", "load_eds", "save_eds", "to_eds",
-]
-
-# NMT, SYNC, EMCY, heartbeat, TIME, PDO, CiA 402 and the scanner
-from .services import *  # noqa: E402,F401,F403
-from .services import __all__ as _services_all  # noqa: E402
-
-__all__ += _services_all
+__all__ = (cia402.__all__ + eds.__all__ + emcy.__all__ + heartbeat.__all__ + network.__all__ + nmt.__all__
+           + node.__all__ + od.__all__ + pdo.__all__ + scanner.__all__ + sdo.__all__ + sync.__all__ + time.__all__)

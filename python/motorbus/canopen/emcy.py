@@ -8,39 +8,18 @@
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Callable, List, Optional
 
 from .. import _core
 
 __all__ = ["EmcyError", "EmcyConsumer", "EmcyProducer", "emcy_encode", "emcy_decode", "emcy_code_text"]
 
+#: One received message: node, code, register, data, short, timestamp_ns, text, is_reset.
+EmcyError = _core.EmcyError
+EmcyProducer = _core.EmcyProducer
 emcy_encode = _core.emcy_encode
+emcy_decode = _core.emcy_decode
 emcy_code_text = _core.emcy_code_text
-
-
-@dataclass(frozen=True)
-class EmcyError:
-    node: int
-    code: int
-    register: int
-    data: bytes
-    short: bool          # the frame had fewer than 8 bytes (missing ones read as 0)
-    timestamp_ns: int
-    text: str
-
-    @classmethod
-    def _from(cls, d: dict) -> "EmcyError":
-        return cls(d["node"], d["code"], d["register"], d["data"], d["short"], d["timestamp_ns"], d["text"])
-
-    @property
-    def is_reset(self) -> bool:
-        return self.code == 0
-
-
-def emcy_decode(frame: _core.Frame) -> Optional[EmcyError]:
-    d = _core.emcy_decode(frame)
-    return None if d is None else EmcyError._from(d)
 
 
 class EmcyConsumer:
@@ -49,7 +28,7 @@ class EmcyConsumer:
         self._cb = None
 
     def history(self, node: int) -> List[EmcyError]:
-        return [EmcyError._from(d) for d in self._c.history(node)]
+        return self._c.history(node)
 
     def active(self, node: int) -> List[int]:
         return list(self._c.active(node))
@@ -58,8 +37,7 @@ class EmcyConsumer:
         self._c.clear(node)
 
     def wait(self, node: int = 0, timeout: float = 1.0) -> Optional[EmcyError]:
-        d = self._c.wait(node, timeout)
-        return None if d is None else EmcyError._from(d)
+        return self._c.wait(node, timeout)
 
     @property
     def on_emcy(self):
@@ -68,7 +46,7 @@ class EmcyConsumer:
     @on_emcy.setter
     def on_emcy(self, cb: Optional[Callable[[EmcyError], None]]) -> None:
         self._cb = cb
-        self._c.set_callback(None if cb is None else (lambda d: cb(EmcyError._from(d))))
+        self._c.set_callback(cb)
 
     @property
     def received(self) -> int:
@@ -79,4 +57,37 @@ class EmcyConsumer:
         return self._c.ignored_frames
 
 
-EmcyProducer = _core.EmcyProducer
+class NodeEmcy:
+    """``node.emcy``: the network's EMCY consumer, for one node (names as in the
+    `canopen` package: ``active``, ``log``, ``wait``, ``add_callback``, ``reset``)."""
+
+    def __init__(self, consumer: "_core.EmcyConsumer", node_id: int) -> None:
+        self._c = consumer
+        self.node_id = node_id
+        self._callbacks: list = []
+
+    @property
+    def active(self) -> List[int]:
+        """Error codes raised and not yet cleared by EEC 0x0000."""
+        return list(self._c.active(self.node_id))
+
+    @property
+    def log(self) -> List[EmcyError]:
+        """Messages received, oldest first (bounded by the network's history)."""
+        return self._c.history(self.node_id)
+
+    def wait(self, timeout: float = 10.0) -> Optional[EmcyError]:
+        """The next message not handed out yet (oldest first), or None on timeout."""
+        return self._c.wait(self.node_id, timeout)
+
+    def add_callback(self, callback: Callable[[EmcyError], None]) -> None:
+        """callback(EmcyError) on the bus thread."""
+        self._callbacks.append(callback)
+
+    def reset(self) -> None:
+        """Forget this node's history and active codes."""
+        self._c.clear(self.node_id)
+
+    def _dispatch(self, e: EmcyError) -> None:
+        for cb in list(self._callbacks):
+            cb(e)

@@ -1,14 +1,12 @@
-"""NMT master, heartbeat consumer/producer (CiA 301).
+"""NMT (CiA 301): the master that commands nodes and tracks their states.
 
-    from motorbus.canopen import NmtMaster, HeartbeatConsumer
+    from motorbus.canopen import NmtMaster
     nmt = NmtMaster(bus)
     nmt.start(5)                        # or nmt.start() for every node
     nmt.wait_for_state(5, "OPERATIONAL", timeout=1.0)
+    nmt.set_state(5, "PRE-OPERATIONAL") # the command by the state it leads to
 
-    hb = HeartbeatConsumer(bus)
-    hb.on_event = lambda node, event, state: print(node, event, state)
-    hb.monitor(5, timeout=0.3)          # "lost" after 300 ms of silence
-    hb.start()                          # timers on a C++ thread
+Heartbeat supervision is in motorbus.canopen.heartbeat.
 
 States are the strings INITIALISING, STOPPED, OPERATIONAL, PRE-OPERATIONAL and
 UNKNOWN (nothing heard, or a byte outside that set: never treated as running).
@@ -20,15 +18,12 @@ from typing import Callable, Optional
 
 from .. import _core
 
-__all__ = ["NmtCommand", "NmtMaster", "HeartbeatConsumer", "HeartbeatProducer", "HeartbeatService",
-           "NMT_STATES", "nmt_encode", "nmt_decode", "heartbeat_encode", "heartbeat_decode"]
+__all__ = ["NmtCommand", "NmtMaster", "NMT_STATES", "nmt_encode", "nmt_decode"]
 
 NMT_STATES = ("INITIALISING", "STOPPED", "OPERATIONAL", "PRE-OPERATIONAL", "UNKNOWN")
 
 nmt_encode = _core.nmt_encode
 nmt_decode = _core.nmt_decode
-heartbeat_encode = _core.heartbeat_encode
-heartbeat_decode = _core.heartbeat_decode
 
 
 class NmtCommand(enum.IntEnum):
@@ -66,6 +61,11 @@ class NmtMaster:
     def reset_communication(self, node: int = 0) -> None:
         self.send(NmtCommand.RESET_COMMUNICATION, node)
 
+    def set_state(self, node: int, state: str) -> None:
+        """The command that leads to ``state``: OPERATIONAL, PRE-OPERATIONAL,
+        STOPPED, RESET (node) or RESET COMMUNICATION; node 0 = every node."""
+        self._m.set_state(node, state)
+
     def state(self, node: int) -> str:
         return self._m.state(node)
 
@@ -77,6 +77,10 @@ class NmtMaster:
 
     def wait_for_boot(self, node: int, timeout: float = 1.0) -> bool:
         return self._m.wait_for_boot(node, timeout)
+
+    def wait_for_heartbeat(self, node: int, timeout: float = 1.0) -> Optional[str]:
+        """State reported by the next heartbeat or boot-up of ``node``; None on timeout."""
+        return self._m.wait_for_heartbeat(node, timeout)
 
     @property
     def on_state_change(self) -> Optional[Callable[[int, str, str], None]]:
@@ -93,49 +97,37 @@ class NmtMaster:
         return self._m.foreign_commands_ignored
 
 
-class HeartbeatConsumer:
-    """Per-node heartbeat timeouts; events: started, lost, back, reset,
-    state-changed, unknown-state."""
+class NodeNmt:
+    """``node.nmt``: NMT of one remote node, as the `canopen` package spells it.
 
-    def __init__(self, bus: _core.Bus, clock: Optional[_core.Clock] = None) -> None:
-        self._c = _core.HeartbeatConsumer(bus, clock)
-        self._cb = None
+    ``state`` reads the last state the node reported (heartbeat or boot-up;
+    UNKNOWN until one is heard) and, assigned, sends the command leading to it
+    (OPERATIONAL, PRE-OPERATIONAL, STOPPED, RESET, RESET COMMUNICATION)."""
 
-    def monitor(self, node: int, timeout: float) -> None:
-        self._c.monitor(node, timeout)
-
-    def forget(self, node: int) -> None:
-        self._c.forget(node)
-
-    def health(self, node: int) -> dict:
-        return self._c.health(node)
-
-    def process(self, now_ns: Optional[int] = None) -> int:
-        """Check deadlines now (for simulated clocks); returns the next deadline or -1."""
-        return self._c.process(now_ns)
-
-    def start(self) -> None:
-        self._c.start()
-
-    def stop(self) -> None:
-        self._c.stop()
+    def __init__(self, master: NmtMaster, node_id: int) -> None:
+        self._m = master
+        self.node_id = node_id
 
     @property
-    def on_event(self):
-        return self._cb
+    def state(self) -> str:
+        return self._m.state(self.node_id)
 
-    @on_event.setter
-    def on_event(self, cb: Optional[Callable[[int, str, str], None]]) -> None:
-        self._cb = cb
-        self._c.set_callback(cb)
+    @state.setter
+    def state(self, new_state: str) -> None:
+        self._m.set_state(self.node_id, new_state)
 
-    @property
-    def ignored_frames(self) -> int:
-        return self._c.ignored_frames
+    def send_command(self, command: int) -> None:
+        self._m.send(command, self.node_id)
 
+    def wait_for_bootup(self, timeout: float = 10.0) -> None:
+        """Waits for the node's next boot-up message; motorbus.TimeoutError if none comes."""
+        if not self._m.wait_for_boot(self.node_id, timeout):
+            raise _core.TimeoutError(f"node {self.node_id}: no boot-up within {timeout} s")
 
-HeartbeatProducer = _core.HeartbeatProducer
-
-#: HeartbeatService(local_node, consumer_entries=4, producer_ms=0): 0x1017/0x1016 of a served
-#: node; set_lost_callback(cb) for the loss-of-master reaction.
-HeartbeatService = _core.HeartbeatService
+    def wait_for_heartbeat(self, timeout: float = 10.0) -> str:
+        """Waits for the node's next heartbeat; returns the state it reports.
+        motorbus.TimeoutError if none comes."""
+        state = self._m.wait_for_heartbeat(self.node_id, timeout)
+        if state is None:
+            raise _core.TimeoutError(f"node {self.node_id}: no heartbeat within {timeout} s")
+        return state

@@ -1,4 +1,5 @@
-"""PDO mapping, bit-exact pack/unpack, configuration over SDO, SYNC.
+"""PDO mapping, bit-exact pack/unpack, configuration over SDO, and ``node.tpdo`` /
+``node.rpdo`` of a remote node (SYNC and TIME are in sync.py and time.py).
 
     from motorbus.canopen import PdoMap, configure_pdo
     m = PdoMap([(0x6041, 0, 16), (0x6064, 0, 32, True)])   # (index, sub, bits[, signed])
@@ -13,12 +14,13 @@ object with ``upload(index, sub) -> bytes`` and ``download(index, sub, data)``.
 """
 from __future__ import annotations
 
-from typing import Iterable, List, Optional, Sequence, Tuple, Union
+import threading
+from typing import Callable, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 from .. import _core
 
-__all__ = ["PdoMap", "pack", "unpack", "configure_pdo", "read_pdo_config", "PdoReceiver", "PdoService",
-           "PdoSender", "SyncProducer", "sync_encode", "time_encode", "time_decode"]
+__all__ = ["PdoMap", "pack", "unpack", "configure_pdo", "read_pdo_config", "PdoConfig", "PdoCounters",
+           "PdoReceiver", "PdoService", "PdoSender", "PdoChannel", "PdoChannels"]
 
 Entry = Union[Tuple[int, int, int], Tuple[int, int, int, bool]]
 
@@ -27,10 +29,8 @@ PdoReceiver = _core.PdoReceiver
 #: strict=False accepts parameter changes while a PDO is valid (as the PMC007 does).
 PdoService = _core.PdoService
 PdoSender = _core.PdoSender
-SyncProducer = _core.SyncProducer
-sync_encode = _core.sync_encode
-time_encode = _core.time_encode
-time_decode = _core.time_decode
+PdoConfig = _core.PdoConfig
+PdoCounters = _core.PdoCounters
 
 
 class PdoMap:
@@ -98,7 +98,150 @@ def configure_pdo(sdo, node: int, *, tpdo: Optional[int] = None, rpdo: Optional[
                            procedure)
 
 
-def read_pdo_config(sdo, node: int, *, tpdo: Optional[int] = None, rpdo: Optional[int] = None) -> dict:
+def read_pdo_config(sdo, node: int, *, tpdo: Optional[int] = None, rpdo: Optional[int] = None) -> PdoConfig:
     if (tpdo is None) == (rpdo is None):
         raise _core.InvalidArgument("read_pdo_config: give exactly one of tpdo= or rpdo=")
     return _core.pdo_read_config(sdo, node, tpdo is not None, tpdo if tpdo is not None else rpdo)
+
+
+# Signed CiA 301 types (INTEGER8..64, INTEGER24..56): their PDO fields are sign-extended.
+_SIGNED_TYPES = frozenset({0x02, 0x03, 0x04, 0x10, 0x12, 0x13, 0x14, 0x15})
+
+
+class PdoChannel:
+    """One PDO of a remote node (``node.tpdo[1]``, ``node.rpdo[1]``).
+
+    ``read()`` reads its configuration from the device, ``configure(...)``
+    writes it (as :func:`configure_pdo`); a TPDO delivers its values to
+    ``add_callback`` callbacks and :meth:`wait_for_reception`, keyed by
+    ``(index, subindex)``; an RPDO is sent with :meth:`transmit`."""
+
+    def __init__(self, node, tpdo: bool, number: int) -> None:
+        self._node = node
+        self.tpdo = tpdo
+        self.number = number
+        self.config: Optional[PdoConfig] = None
+        self._rx: Optional[_core.PdoReceiver] = None
+        self._tx: Optional[_core.PdoSender] = None
+        self._callbacks: List[Callable[[Dict[Tuple[int, int], int]], None]] = []
+        self._lock = threading.Lock()
+
+    def __repr__(self) -> str:
+        return f"<PdoChannel node {self._node.id} {'TPDO' if self.tpdo else 'RPDO'}{self.number}>"
+
+    def _kw(self) -> dict:
+        return {"tpdo": self.number} if self.tpdo else {"rpdo": self.number}
+
+    def read(self) -> PdoConfig:
+        self.config = read_pdo_config(self._node.sdo.client, self._node.id, **self._kw())
+        return self.config
+
+    def configure(self, **kwargs) -> PdoConfig:
+        """``cob_id=, enabled=, transmission_type=, inhibit_100us=, event_timer_ms=,
+        sync_start=, mapping=, procedure=`` as :func:`configure_pdo`; returns the
+        configuration read back from the device."""
+        configure_pdo(self._node.sdo.client, self._node.id, **self._kw(), **kwargs)
+        with self._lock:  # a new mapping or COB-ID: receivers are rebuilt on demand
+            self._rx = self._tx = None
+        return self.read()
+
+    @property
+    def cob_id(self) -> int:
+        return self._config().cob_id & 0x1FFFFFFF
+
+    @property
+    def mapping(self) -> List[Tuple[int, int, int]]:
+        return self._config().mapping
+
+    def _config(self) -> PdoConfig:
+        return self.config if self.config is not None else self.read()
+
+    def _entries(self) -> list:
+        od = self._node.object_dictionary
+        out = []
+        for index, sub, bits in self.mapping:
+            signed = od is not None and (index, sub) in od and int(od[index, sub].data_type) in _SIGNED_TYPES
+            out.append((index, sub, bits, signed))
+        if not out:
+            raise _core.InvalidArgument(f"{self!r}: nothing is mapped (configure(mapping=...) first)")
+        return out
+
+    def _receiver(self) -> _core.PdoReceiver:
+        if not self.tpdo:
+            raise _core.InvalidArgument(f"{self!r}: an RPDO is sent by the host, not received (use transmit)")
+        with self._lock:
+            if self._rx is None:
+                entries = self._entries()
+                rx = _core.PdoReceiver(self._node.network.bus, self.cob_id, entries)
+                self._keys = [(e[0], e[1]) for e in entries]
+                # The receiver keeps raw field bits; signed objects are sign-extended here.
+                self._signs = [(1 << (e[2] - 1)) if e[3] else 0 for e in entries]
+                rx.set_callback(lambda values, ts: self._dispatch(self._decode(values)))
+                self._rx = rx
+            return self._rx
+
+    def _decode(self, values: Sequence[int]) -> Dict[Tuple[int, int], int]:
+        return {k: (v - 2 * s if s and v >= s else v) for k, v, s in zip(self._keys, values, self._signs)}
+
+    def _dispatch(self, values: Dict[Tuple[int, int], int]) -> None:
+        for cb in list(self._callbacks):
+            cb(values)
+
+    def add_callback(self, callback: Callable[[Dict[Tuple[int, int], int]], None]) -> None:
+        """callback({(index, subindex): value}) on the bus thread for every TPDO received."""
+        self._callbacks.append(callback)
+        self._receiver()
+
+    @property
+    def values(self) -> Dict[Tuple[int, int], int]:
+        """The latest values received ({} before the first)."""
+        rx = self._receiver()
+        return self._decode(rx.values) if rx.received else {}
+
+    def wait_for_reception(self, timeout: float = 10.0) -> Dict[Tuple[int, int], int]:
+        """Waits for the next TPDO; its values. motorbus.TimeoutError when none comes."""
+        rx = self._receiver()
+        if not rx.wait_newer(rx.received, timeout):
+            raise _core.TimeoutError(f"{self!r}: nothing received within {timeout} s")
+        return self._decode(rx.values)
+
+    def transmit(self, values: Sequence[int], timeout: float = 1.0) -> None:
+        """Sends this RPDO with ``values`` in mapping order."""
+        if self.tpdo:
+            raise _core.InvalidArgument(f"{self!r}: a TPDO is sent by the device (use add_callback)")
+        with self._lock:
+            if self._tx is None:
+                self._tx = _core.PdoSender(self._node.network.bus, self.cob_id, self._entries())
+            tx = self._tx
+        tx.send([int(v) for v in values], timeout)
+
+    def _close(self) -> None:
+        with self._lock:
+            if self._rx is not None:
+                self._rx.set_callback(None)
+            self._rx = self._tx = None
+
+
+class PdoChannels:
+    """``node.tpdo`` / ``node.rpdo``: PDO 1-512 of a remote node, made on first use."""
+
+    def __init__(self, node, tpdo: bool) -> None:
+        self._node = node
+        self._tpdo = tpdo
+        self._channels: Dict[int, PdoChannel] = {}
+
+    def __getitem__(self, number: int) -> PdoChannel:
+        if not 1 <= int(number) <= 512:
+            raise _core.InvalidArgument(f"{'TPDO' if self._tpdo else 'RPDO'} number {number} is outside 1-512")
+        ch = self._channels.get(int(number))
+        if ch is None:
+            ch = self._channels[int(number)] = PdoChannel(self._node, self._tpdo, int(number))
+        return ch
+
+    def read(self, numbers: Iterable[int] = (1, 2, 3, 4)) -> List[PdoConfig]:
+        """Reads the configuration of these PDOs (default: the predefined four)."""
+        return [self[n].read() for n in numbers]
+
+    def _close(self) -> None:
+        for ch in self._channels.values():
+            ch._close()

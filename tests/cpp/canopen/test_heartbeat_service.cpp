@@ -7,7 +7,7 @@
 #include "motorbus/canopen/abort_codes.hpp"
 #include "motorbus/canopen/heartbeat_service.hpp"
 #include "motorbus/canopen/nmt.hpp"
-#include "motorbus/canopen/services_sdo_adapter.hpp"
+#include "motorbus/canopen/sdo_client_access.hpp"
 
 using namespace motorbus;
 using namespace motorbus::canopen;

@@ -548,13 +548,13 @@ TEST(PdoHost, ReceiverAndSenderOverBus) {
     EXPECT_THROW(tx.send(std::span<const std::uint64_t>(v, 1)), InvalidArgument);
 }
 
-#include "motorbus/canopen/ds402.hpp"
+#include "motorbus/canopen/cia402.hpp"
 
 TEST_F(EngineFixture, P11_D5_RpdoTimeoutAppliesLossOfMasterReaction) {
     make();
     map_rpdo1();
     ASSERT_EQ(w16(0x1400, 5, 50), 0u);
-    Ds402Device drive;
+    Cia402Device drive;
     ASSERT_EQ(drive.set_abort_connection_option(2), 0u);  // 0x6007 = 2: disable voltage
     drive.on_controlword(0x06);
     drive.on_controlword(0x0F);
@@ -563,9 +563,9 @@ TEST_F(EngineFixture, P11_D5_RpdoTimeoutAppliesLossOfMasterReaction) {
     eng->on_frame(frame(0x205, {0x0F, 0x00, 0x00, 0x00, 0x00, 0x00}));
     clock.advance(49'000'000);
     eng->process(clock.now());
-    EXPECT_EQ(drive.state(), Ds402State::OperationEnabled);
+    EXPECT_EQ(drive.state(), Cia402State::OperationEnabled);
     clock.advance(1'000'000);
     eng->process(clock.now());
-    EXPECT_EQ(drive.state(), Ds402State::SwitchOnDisabled);
+    EXPECT_EQ(drive.state(), Cia402State::SwitchOnDisabled);
     EXPECT_EQ(emcy.back(), std::make_pair(std::uint16_t(0x8250), true));
 }

@@ -10,7 +10,7 @@
 #include "motorbus/canopen/nmt.hpp"
 #include "motorbus/canopen/pdo.hpp"
 #include "motorbus/canopen/pdo_service.hpp"
-#include "motorbus/canopen/services_sdo_adapter.hpp"
+#include "motorbus/canopen/sdo_client_access.hpp"
 #include "motorbus/canopen/abort_codes.hpp"
 
 using namespace motorbus;

@@ -15,8 +15,8 @@ import pytest
 import motorbus
 from motorbus import _core
 from motorbus.canopen import LocalNode, ObjectDictionary
-from motorbus.canopen.ds402 import Ds402, Ds402Device
-from motorbus.canopen.services import HeartbeatService
+from motorbus.canopen.cia402 import Cia402, Cia402Device
+from motorbus.canopen.heartbeat import HeartbeatService
 from polling import wait_for
 
 _hub = itertools.count()
@@ -24,11 +24,11 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 class Cia402Node:
-    """Ds402Device behind an object dictionary: 0x6040/0x6041/0x6060/0x6061/0x6007,
+    """Cia402Device behind an object dictionary: 0x6040/0x6041/0x6060/0x6061/0x6007,
     with a heartbeat consumer (0x1016) whose loss applies 0x6007 (CiA 402 D5)."""
 
     def __init__(self, bus, node_id=5):
-        self.dev = Ds402Device()
+        self.dev = Cia402Device()
         self.lost = threading.Event()
         od = ObjectDictionary()
         cw = od.add_variable(0x6040, "Controlword", "U16")
@@ -57,7 +57,7 @@ class Cia402Node:
 
 @pytest.fixture()
 def bench():
-    name = f"ds402-safety-{next(_hub)}"
+    name = f"cia402-safety-{next(_hub)}"
     dev_bus, host_bus = _core.open_virtual(name), _core.open_virtual(name)
     node = Cia402Node(dev_bus)
     yield node, host_bus
@@ -69,7 +69,7 @@ def bench():
 def test_exception_leaving_with_quick_stops_the_drive(bench):
     node, host = bench
     with pytest.raises(RuntimeError, match="script failed"):
-        with Ds402(host, 5, timeout=1.0, poll=0.001) as drive:
+        with Cia402(host, 5, timeout=1.0, poll=0.001) as drive:
             drive.enable()
             assert node.dev.state == "OPERATION ENABLED"
             raise RuntimeError("script failed")
@@ -79,11 +79,11 @@ def test_exception_leaving_with_quick_stops_the_drive(bench):
 
 def test_disable_voltage_on_error_and_a_clean_exit_leaves_the_motor_alone(bench):
     node, host = bench
-    with Ds402(host, 5, timeout=1.0, poll=0.001) as drive:
+    with Cia402(host, 5, timeout=1.0, poll=0.001) as drive:
         drive.enable()
     assert node.dev.state == "OPERATION ENABLED"  # no exception: nothing to stop
     with pytest.raises(KeyError):
-        with Ds402(host, 5, timeout=1.0, poll=0.001, on_error="disable"):
+        with Cia402(host, 5, timeout=1.0, poll=0.001, on_error="disable"):
             raise KeyError("x")
     assert node.dev.controlword == 0x0000
     assert node.dev.state == "SWITCH ON DISABLED"
@@ -91,13 +91,13 @@ def test_disable_voltage_on_error_and_a_clean_exit_leaves_the_motor_alone(bench)
 
 def test_watchdog_arms_the_drives_heartbeat_consumer_and_the_drive_stops_when_the_host_goes(bench):
     node, host = bench
-    drive = Ds402(host, 5, timeout=1.0, poll=0.001)
+    drive = Cia402(host, 5, timeout=1.0, poll=0.001)
     drive.enable()
     drive.start_watchdog(host_node=1, period=0.02)
     assert node.od[0x1016, 1].value == (1 << 16) | 60  # node 1, 3 periods
     assert node.abort_option.value == 3                # quick stop
     # The host's heartbeat arrives: the drive watches it and stays enabled.
-    assert wait_for(lambda: node.heartbeat.health(1)["state"] == "OPERATIONAL", 2.0)
+    assert wait_for(lambda: node.heartbeat.health(1).state == "OPERATIONAL", 2.0)
     assert node.dev.state == "OPERATION ENABLED"
     host.close()  # the cable is pulled: no more heartbeats, no SDO either
     assert node.lost.wait(2.0)
@@ -107,7 +107,7 @@ def test_watchdog_arms_the_drives_heartbeat_consumer_and_the_drive_stops_when_th
 
 def test_clean_close_disarms_the_watchdog_before_the_heartbeat_stops(bench):
     node, host = bench
-    drive = Ds402(host, 5, timeout=1.0, poll=0.001)
+    drive = Cia402(host, 5, timeout=1.0, poll=0.001)
     drive.enable()
     drive.start_watchdog(host_node=1, period=0.02, timeout=0.06, action="fault")
     assert node.abort_option.value == 1
@@ -120,7 +120,7 @@ def test_clean_close_disarms_the_watchdog_before_the_heartbeat_stops(bench):
 
 def test_watchdog_arguments_are_checked(bench):
     node, host = bench
-    drive = Ds402(host, 5, timeout=1.0, poll=0.001)
+    drive = Cia402(host, 5, timeout=1.0, poll=0.001)
     with pytest.raises(motorbus.InvalidArgument, match="action"):
         drive.start_watchdog(host_node=1, action="explode")
     with pytest.raises(motorbus.InvalidArgument, match="host_node"):
@@ -128,7 +128,7 @@ def test_watchdog_arguments_are_checked(bench):
     with pytest.raises(motorbus.InvalidArgument, match="timeout"):
         drive.start_watchdog(host_node=1, period=0.1, timeout=0.05)
     with pytest.raises(motorbus.InvalidArgument, match="on_error"):
-        Ds402(host, 5, on_error="brake")
+        Cia402(host, 5, on_error="brake")
     drive.close()
 
 
@@ -142,11 +142,11 @@ def test_drives_still_open_at_interpreter_exit_are_quick_stopped():
         state = {{}}
         atexit.register(lambda: print("STATE", state["node"].dev.state, hex(state["node"].dev.controlword)))
         from motorbus import _core
-        from motorbus.canopen.ds402 import Ds402
-        from test_canopen_ds402_safety import Cia402Node
+        from motorbus.canopen.cia402 import Cia402
+        from test_canopen_cia402_safety import Cia402Node
         dev, host = _core.open_virtual("exit"), _core.open_virtual("exit")
         state["node"] = Cia402Node(dev)
-        drive = Ds402(host, 5, timeout=1.0, poll=0.001)
+        drive = Cia402(host, 5, timeout=1.0, poll=0.001)
         drive.enable()
         print("ENABLED", state["node"].dev.state)
     """)

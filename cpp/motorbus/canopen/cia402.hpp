@@ -1,6 +1,6 @@
 // CiA 402 (drives and motion control): the power state machine as the host
-// drives it (Ds402Host: statusword decoding, controlword transitions, PP/PV/HM
-// set-point handshakes) and as a device runs it (Ds402Device, for simulators).
+// drives it (Cia402Host: statusword decoding, controlword transitions, PP/PV/HM
+// set-point handshakes) and as a device runs it (Cia402Device, for simulators).
 #pragma once
 #include <chrono>
 #include <cstdint>
@@ -9,13 +9,14 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 
 #include "motorbus/canopen/pdo.hpp"
-#include "motorbus/canopen/services_sdo.hpp"
+#include "motorbus/canopen/sdo_access.hpp"
 
 namespace motorbus::canopen {
 
-enum class Ds402State {
+enum class Cia402State {
     NotReadyToSwitchOn,
     SwitchOnDisabled,
     ReadyToSwitchOn,
@@ -26,10 +27,12 @@ enum class Ds402State {
     Fault,
     Unknown,  // a statusword pattern outside the table (D3): never "enabled"
 };
-const char* to_string(Ds402State s);
-Ds402State decode_statusword(std::uint16_t sw);
+const char* to_string(Cia402State s);
+// The state whose to_string() is `name` (exact spelling); nullopt otherwise.
+std::optional<Cia402State> cia402_state_from_name(std::string_view name);
+Cia402State decode_statusword(std::uint16_t sw);
 // The state bits (0-3, 5, 6) of a statusword reporting `s`.
-std::uint16_t statusword_bits(Ds402State s);
+std::uint16_t statusword_bits(Cia402State s);
 
 // Objects.
 constexpr std::uint16_t kControlword = 0x6040;
@@ -88,22 +91,22 @@ const char* to_string(OpMode m);
 // The controlword that drives `from` one step towards `to` along the CiA 402
 // graph, and the transition number it causes; nullopt when no step is needed
 // or none exists (Unknown, or a target that cannot be commanded).
-struct Ds402Step {
+struct Cia402Step {
     std::uint16_t controlword;
     int transition;
 };
-std::optional<Ds402Step> next_step(Ds402State from, Ds402State to);
+std::optional<Cia402Step> next_step(Cia402State from, Cia402State to);
 
 // ---- host -----------------------------------------------------------------
 
-struct Ds402HostOptions {
+struct Cia402HostOptions {
     std::chrono::nanoseconds timeout{std::chrono::seconds(2)};   // per state change
     std::chrono::nanoseconds sdo_poll{std::chrono::milliseconds(5)};  // when no PDO carries 0x6041
 };
 
-class Ds402Host {
+class Cia402Host {
 public:
-    Ds402Host(SdoAccess& sdo, std::uint8_t node, Ds402HostOptions options = {});
+    Cia402Host(SdoAccess& sdo, std::uint8_t node, Cia402HostOptions options = {});
 
     // Statusword from this TPDO receiver when it maps 0x6041 (waits become
     // event-driven); nullptr = read over SDO.
@@ -112,7 +115,7 @@ public:
     void use_controlword_writer(std::function<void(std::uint16_t)> fn);
 
     std::uint16_t read_statusword();
-    Ds402State state() { return decode_statusword(read_statusword()); }
+    Cia402State state() { return decode_statusword(read_statusword()); }
     void write_controlword(std::uint16_t cw);
     std::uint16_t last_controlword() const { return last_cw_; }
 
@@ -130,11 +133,11 @@ public:
     // ReadyToSwitchOn or SwitchOnDisabled), waiting for each state; throws
     // TimeoutError naming the state it got stuck in, DriveFault when the
     // drive faults on the way, ProtocolError on an UNKNOWN statusword.
-    void go_to(Ds402State target);
+    void go_to(Cia402State target);
     // Waits until the statusword satisfies mask/value; returns it.
     std::uint16_t wait_statusword(std::uint16_t mask, std::uint16_t value,
                                   std::optional<std::chrono::nanoseconds> timeout = std::nullopt);
-    Ds402State wait_state(Ds402State s, std::optional<std::chrono::nanoseconds> timeout = std::nullopt);
+    Cia402State wait_state(Cia402State s, std::optional<std::chrono::nanoseconds> timeout = std::nullopt);
 
     // Modes: writes 0x6060 and waits for 0x6061 to follow.
     void set_mode(OpMode m);
@@ -152,10 +155,10 @@ public:
               std::optional<std::chrono::nanoseconds> timeout = std::nullopt);
 
 private:
-    void wait_leave(Ds402State cur, int transition);
+    void wait_leave(Cia402State cur, int transition);
     SdoAccess& sdo_;
     std::uint8_t node_;
-    Ds402HostOptions opt_;
+    Cia402HostOptions opt_;
     PdoReceiver* sw_pdo_ = nullptr;
     std::function<void(std::uint16_t)> cw_writer_;
     std::uint16_t last_cw_ = 0;
@@ -163,11 +166,11 @@ private:
 
 // ---- device (simulators) -----------------------------------------------------
 
-class Ds402Device {
+class Cia402Device {
 public:
-    Ds402Device();
+    Cia402Device();
 
-    Ds402State state() const;
+    Cia402State state() const;
     std::uint16_t statusword() const;
     std::uint16_t controlword() const;
     // Applies a controlword; returns the transition taken (-1 = none: e.g.
@@ -199,7 +202,7 @@ public:
     void set_status_bits(std::uint16_t mask, std::uint16_t value);
 
     // Called without the lock held.
-    std::function<void(Ds402State old_state, Ds402State new_state, int transition)> on_state_change;
+    std::function<void(Cia402State old_state, Cia402State new_state, int transition)> on_state_change;
     // PP/HM: new set-point rising edge (bit 4) in Operation Enabled.  Return
     // true to acknowledge (bit 12 set until bit 4 falls).
     std::function<bool(std::uint16_t controlword)> on_new_setpoint;
@@ -210,13 +213,13 @@ public:
 
 private:
     struct Change {
-        Ds402State from, to;
+        Cia402State from, to;
         int transition;
     };
-    int go(Ds402State to, int transition, std::optional<Change>& ch);
+    int go(Cia402State to, int transition, std::optional<Change>& ch);
     void notify(const std::optional<Change>& ch);
     mutable std::mutex m_;
-    Ds402State state_ = Ds402State::SwitchOnDisabled;
+    Cia402State state_ = Cia402State::SwitchOnDisabled;
     std::uint16_t cw_ = 0;
     std::uint16_t extra_ = 0;  // bits 8-15 and 7 set by the simulator
     bool ack_ = false;

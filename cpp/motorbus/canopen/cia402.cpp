@@ -1,4 +1,4 @@
-#include "motorbus/canopen/ds402.hpp"
+#include "motorbus/canopen/cia402.hpp"
 
 #include <thread>
 
@@ -6,17 +6,17 @@
 
 namespace motorbus::canopen {
 
-const char* to_string(Ds402State s) {
+const char* to_string(Cia402State s) {
     switch (s) {
-        case Ds402State::NotReadyToSwitchOn: return "NOT READY TO SWITCH ON";
-        case Ds402State::SwitchOnDisabled: return "SWITCH ON DISABLED";
-        case Ds402State::ReadyToSwitchOn: return "READY TO SWITCH ON";
-        case Ds402State::SwitchedOn: return "SWITCHED ON";
-        case Ds402State::OperationEnabled: return "OPERATION ENABLED";
-        case Ds402State::QuickStopActive: return "QUICK STOP ACTIVE";
-        case Ds402State::FaultReactionActive: return "FAULT REACTION ACTIVE";
-        case Ds402State::Fault: return "FAULT";
-        case Ds402State::Unknown: return "UNKNOWN";
+        case Cia402State::NotReadyToSwitchOn: return "NOT READY TO SWITCH ON";
+        case Cia402State::SwitchOnDisabled: return "SWITCH ON DISABLED";
+        case Cia402State::ReadyToSwitchOn: return "READY TO SWITCH ON";
+        case Cia402State::SwitchedOn: return "SWITCHED ON";
+        case Cia402State::OperationEnabled: return "OPERATION ENABLED";
+        case Cia402State::QuickStopActive: return "QUICK STOP ACTIVE";
+        case Cia402State::FaultReactionActive: return "FAULT REACTION ACTIVE";
+        case Cia402State::Fault: return "FAULT";
+        case Cia402State::Unknown: return "UNKNOWN";
     }
     return "UNKNOWN";
 }
@@ -37,65 +37,71 @@ const char* to_string(OpMode m) {
     return "manufacturer";
 }
 
-Ds402State decode_statusword(std::uint16_t s) {
+std::optional<Cia402State> cia402_state_from_name(std::string_view name) {
+    for (int i = 0; i <= static_cast<int>(Cia402State::Unknown); ++i)
+        if (name == to_string(static_cast<Cia402State>(i))) return static_cast<Cia402State>(i);
+    return std::nullopt;
+}
+
+Cia402State decode_statusword(std::uint16_t s) {
     switch (s & 0x4F) {
-        case 0x00: return Ds402State::NotReadyToSwitchOn;
-        case 0x40: return Ds402State::SwitchOnDisabled;
-        case 0x0F: return Ds402State::FaultReactionActive;
-        case 0x08: return Ds402State::Fault;
+        case 0x00: return Cia402State::NotReadyToSwitchOn;
+        case 0x40: return Cia402State::SwitchOnDisabled;
+        case 0x0F: return Cia402State::FaultReactionActive;
+        case 0x08: return Cia402State::Fault;
         default: break;
     }
     switch (s & 0x6F) {
-        case 0x21: return Ds402State::ReadyToSwitchOn;
-        case 0x23: return Ds402State::SwitchedOn;
-        case 0x27: return Ds402State::OperationEnabled;
-        case 0x07: return Ds402State::QuickStopActive;
-        default: return Ds402State::Unknown;  // D3
+        case 0x21: return Cia402State::ReadyToSwitchOn;
+        case 0x23: return Cia402State::SwitchedOn;
+        case 0x27: return Cia402State::OperationEnabled;
+        case 0x07: return Cia402State::QuickStopActive;
+        default: return Cia402State::Unknown;  // D3
     }
 }
 
-std::uint16_t statusword_bits(Ds402State s) {
+std::uint16_t statusword_bits(Cia402State s) {
     switch (s) {
-        case Ds402State::NotReadyToSwitchOn: return 0x0000;
-        case Ds402State::SwitchOnDisabled: return 0x0040;
-        case Ds402State::ReadyToSwitchOn: return 0x0021;
-        case Ds402State::SwitchedOn: return 0x0023;
-        case Ds402State::OperationEnabled: return 0x0027;
-        case Ds402State::QuickStopActive: return 0x0007;
-        case Ds402State::FaultReactionActive: return 0x000F;
-        case Ds402State::Fault: return 0x0008;
-        case Ds402State::Unknown: break;
+        case Cia402State::NotReadyToSwitchOn: return 0x0000;
+        case Cia402State::SwitchOnDisabled: return 0x0040;
+        case Cia402State::ReadyToSwitchOn: return 0x0021;
+        case Cia402State::SwitchedOn: return 0x0023;
+        case Cia402State::OperationEnabled: return 0x0027;
+        case Cia402State::QuickStopActive: return 0x0007;
+        case Cia402State::FaultReactionActive: return 0x000F;
+        case Cia402State::Fault: return 0x0008;
+        case Cia402State::Unknown: break;
     }
     throw InvalidArgument("UNKNOWN has no statusword");
 }
 
-std::optional<Ds402Step> next_step(Ds402State from, Ds402State to) {
-    using S = Ds402State;
+std::optional<Cia402Step> next_step(Cia402State from, Cia402State to) {
+    using S = Cia402State;
     if (from == to || from == S::Unknown || from == S::NotReadyToSwitchOn ||
         from == S::FaultReactionActive)
         return std::nullopt;  // nothing to do, or the drive moves on by itself
-    if (from == S::Fault) return Ds402Step{cw::kFaultReset, 15};
-    if (from == S::QuickStopActive) return Ds402Step{cw::kDisableVoltage, 12};
+    if (from == S::Fault) return Cia402Step{cw::kFaultReset, 15};
+    if (from == S::QuickStopActive) return Cia402Step{cw::kDisableVoltage, 12};
     switch (to) {
         case S::OperationEnabled:
-            if (from == S::SwitchOnDisabled) return Ds402Step{cw::kShutdown, 2};
-            if (from == S::ReadyToSwitchOn) return Ds402Step{cw::kSwitchOn, 3};
-            if (from == S::SwitchedOn) return Ds402Step{cw::kEnableOperation, 4};
+            if (from == S::SwitchOnDisabled) return Cia402Step{cw::kShutdown, 2};
+            if (from == S::ReadyToSwitchOn) return Cia402Step{cw::kSwitchOn, 3};
+            if (from == S::SwitchedOn) return Cia402Step{cw::kEnableOperation, 4};
             break;
         case S::SwitchedOn:
-            if (from == S::SwitchOnDisabled) return Ds402Step{cw::kShutdown, 2};
-            if (from == S::ReadyToSwitchOn) return Ds402Step{cw::kSwitchOn, 3};
-            if (from == S::OperationEnabled) return Ds402Step{cw::kDisableOperation, 5};
+            if (from == S::SwitchOnDisabled) return Cia402Step{cw::kShutdown, 2};
+            if (from == S::ReadyToSwitchOn) return Cia402Step{cw::kSwitchOn, 3};
+            if (from == S::OperationEnabled) return Cia402Step{cw::kDisableOperation, 5};
             break;
         case S::ReadyToSwitchOn:
-            if (from == S::SwitchOnDisabled) return Ds402Step{cw::kShutdown, 2};
-            if (from == S::SwitchedOn) return Ds402Step{cw::kShutdown, 6};
-            if (from == S::OperationEnabled) return Ds402Step{cw::kShutdown, 8};
+            if (from == S::SwitchOnDisabled) return Cia402Step{cw::kShutdown, 2};
+            if (from == S::SwitchedOn) return Cia402Step{cw::kShutdown, 6};
+            if (from == S::OperationEnabled) return Cia402Step{cw::kShutdown, 8};
             break;
         case S::SwitchOnDisabled:
-            if (from == S::ReadyToSwitchOn) return Ds402Step{cw::kDisableVoltage, 7};
-            if (from == S::SwitchedOn) return Ds402Step{cw::kDisableVoltage, 10};
-            if (from == S::OperationEnabled) return Ds402Step{cw::kDisableVoltage, 9};
+            if (from == S::ReadyToSwitchOn) return Cia402Step{cw::kDisableVoltage, 7};
+            if (from == S::SwitchedOn) return Cia402Step{cw::kDisableVoltage, 10};
+            if (from == S::OperationEnabled) return Cia402Step{cw::kDisableVoltage, 9};
             break;
         default: break;
     }
@@ -104,12 +110,12 @@ std::optional<Ds402Step> next_step(Ds402State from, Ds402State to) {
 
 // ---- host -----------------------------------------------------------------
 
-Ds402Host::Ds402Host(SdoAccess& sdo, std::uint8_t node, Ds402HostOptions options)
+Cia402Host::Cia402Host(SdoAccess& sdo, std::uint8_t node, Cia402HostOptions options)
     : sdo_(sdo), node_(node), opt_(options) {
     if (node == 0 || node > 127) throw InvalidArgument("CiA 402 host: node id must be 1-127");
 }
 
-void Ds402Host::use_statusword_pdo(PdoReceiver* rx) {
+void Cia402Host::use_statusword_pdo(PdoReceiver* rx) {
     if (rx) {
         bool mapped = false;
         for (std::size_t i = 0; i < rx->layout().size(); ++i)
@@ -119,15 +125,15 @@ void Ds402Host::use_statusword_pdo(PdoReceiver* rx) {
     sw_pdo_ = rx;
 }
 
-void Ds402Host::use_controlword_writer(std::function<void(std::uint16_t)> fn) { cw_writer_ = std::move(fn); }
+void Cia402Host::use_controlword_writer(std::function<void(std::uint16_t)> fn) { cw_writer_ = std::move(fn); }
 
-std::uint16_t Ds402Host::read_statusword() {
+std::uint16_t Cia402Host::read_statusword() {
     if (sw_pdo_)
         if (auto v = sw_pdo_->value(kStatusword, 0)) return static_cast<std::uint16_t>(*v);
     return static_cast<std::uint16_t>(sdo_.read_uint(node_, kStatusword, 0));
 }
 
-void Ds402Host::write_controlword(std::uint16_t c) {
+void Cia402Host::write_controlword(std::uint16_t c) {
     if (cw_writer_)
         cw_writer_(c);
     else
@@ -135,12 +141,12 @@ void Ds402Host::write_controlword(std::uint16_t c) {
     last_cw_ = c;
 }
 
-void Ds402Host::fault_reset() {
+void Cia402Host::fault_reset() {
     if (last_cw_ & cw::kFaultReset) write_controlword(static_cast<std::uint16_t>(last_cw_ & ~cw::kFaultReset));
     write_controlword(cw::kFaultReset);
 }
 
-std::uint16_t Ds402Host::wait_statusword(std::uint16_t mask, std::uint16_t value,
+std::uint16_t Cia402Host::wait_statusword(std::uint16_t mask, std::uint16_t value,
                                          std::optional<std::chrono::nanoseconds> timeout) {
     const auto deadline = std::chrono::steady_clock::now() + timeout.value_or(opt_.timeout);
     while (true) {
@@ -162,17 +168,17 @@ std::uint16_t Ds402Host::wait_statusword(std::uint16_t mask, std::uint16_t value
     }
 }
 
-Ds402State Ds402Host::wait_state(Ds402State target, std::optional<std::chrono::nanoseconds> timeout) {
+Cia402State Cia402Host::wait_state(Cia402State target, std::optional<std::chrono::nanoseconds> timeout) {
     const std::uint16_t mask =
-        (target == Ds402State::NotReadyToSwitchOn || target == Ds402State::SwitchOnDisabled ||
-         target == Ds402State::Fault || target == Ds402State::FaultReactionActive)
+        (target == Cia402State::NotReadyToSwitchOn || target == Cia402State::SwitchOnDisabled ||
+         target == Cia402State::Fault || target == Cia402State::FaultReactionActive)
             ? 0x4F
             : 0x6F;
     wait_statusword(mask, statusword_bits(target), timeout);
     return target;
 }
 
-void Ds402Host::wait_leave(Ds402State cur, int transition) {
+void Cia402Host::wait_leave(Cia402State cur, int transition) {
     const auto deadline = std::chrono::steady_clock::now() + opt_.timeout;
     while (true) {
         const std::uint64_t seen = sw_pdo_ ? sw_pdo_->received() : 0;
@@ -189,22 +195,22 @@ void Ds402Host::wait_leave(Ds402State cur, int transition) {
     }
 }
 
-void Ds402Host::go_to(Ds402State target) {
-    if (target != Ds402State::OperationEnabled && target != Ds402State::SwitchedOn &&
-        target != Ds402State::ReadyToSwitchOn && target != Ds402State::SwitchOnDisabled)
+void Cia402Host::go_to(Cia402State target) {
+    if (target != Cia402State::OperationEnabled && target != Cia402State::SwitchedOn &&
+        target != Cia402State::ReadyToSwitchOn && target != Cia402State::SwitchOnDisabled)
         throw InvalidArgument(std::string("CiA 402: cannot command state ") + to_string(target));
     bool reset_done = false;
     for (int guard = 0; guard < 12; ++guard) {
         const std::uint16_t s = read_statusword();
-        const Ds402State cur = decode_statusword(s);
+        const Cia402State cur = decode_statusword(s);
         if (cur == target) return;
-        if (cur == Ds402State::Unknown)
+        if (cur == Cia402State::Unknown)
             throw ProtocolError("CiA 402: statusword pattern not in the state table (UNKNOWN)",
                                 {std::uint8_t(s), std::uint8_t(s >> 8)});
-        if (cur == Ds402State::Fault && reset_done)
+        if (cur == Cia402State::Fault && reset_done)
             throw DriveFault("CiA 402 node " + std::to_string(node_) + " is in FAULT");
-        if (cur == Ds402State::NotReadyToSwitchOn || cur == Ds402State::FaultReactionActive) {
-            wait_leave(cur, cur == Ds402State::NotReadyToSwitchOn ? 1 : 14);  // automatic
+        if (cur == Cia402State::NotReadyToSwitchOn || cur == Cia402State::FaultReactionActive) {
+            wait_leave(cur, cur == Cia402State::NotReadyToSwitchOn ? 1 : 14);  // automatic
             continue;
         }
         auto step = next_step(cur, target);
@@ -218,7 +224,7 @@ void Ds402Host::go_to(Ds402State target) {
         try {
             wait_leave(cur, step->transition);
         } catch (const TimeoutError&) {
-            if (cur == Ds402State::Fault)
+            if (cur == Cia402State::Fault)
                 throw DriveFault("CiA 402 node " + std::to_string(node_) + ": fault reset did not clear the fault");
             throw;
         }
@@ -226,7 +232,7 @@ void Ds402Host::go_to(Ds402State target) {
     throw TimeoutError("CiA 402: state machine did not settle");
 }
 
-void Ds402Host::set_mode(OpMode m) {
+void Cia402Host::set_mode(OpMode m) {
     sdo_.write_u8(node_, kModesOfOperation, 0, static_cast<std::uint8_t>(m));
     const auto deadline = std::chrono::steady_clock::now() + opt_.timeout;
     while (mode() != m) {
@@ -236,11 +242,11 @@ void Ds402Host::set_mode(OpMode m) {
     }
 }
 
-OpMode Ds402Host::mode() {
+OpMode Cia402Host::mode() {
     return static_cast<OpMode>(static_cast<std::int8_t>(sdo_.read_uint(node_, kModesOfOperationDisplay, 0)));
 }
 
-void Ds402Host::move_to(std::int32_t target, bool relative, bool immediate) {
+void Cia402Host::move_to(std::int32_t target, bool relative, bool immediate) {
     sdo_.write_u32(node_, kTargetPosition, 0, static_cast<std::uint32_t>(target));
     std::uint16_t base = cw::kEnableOperation;
     if (immediate) base |= cw::kChangeImmediately;
@@ -249,11 +255,11 @@ void Ds402Host::move_to(std::int32_t target, bool relative, bool immediate) {
     wait_statusword(sw::kSetPointAck, 0);
     write_controlword(static_cast<std::uint16_t>(base | cw::kNewSetPoint));
     const std::uint16_t s = wait_statusword(sw::kSetPointAck, sw::kSetPointAck);
-    if (decode_statusword(s) == Ds402State::Fault) throw DriveFault("CiA 402: fault during set-point handshake");
+    if (decode_statusword(s) == Cia402State::Fault) throw DriveFault("CiA 402: fault during set-point handshake");
     write_controlword(base);
 }
 
-void Ds402Host::wait_target_reached(std::optional<std::chrono::nanoseconds> timeout) {
+void Cia402Host::wait_target_reached(std::optional<std::chrono::nanoseconds> timeout) {
     const auto deadline = std::chrono::steady_clock::now() + timeout.value_or(opt_.timeout);
     while (true) {
         auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - std::chrono::steady_clock::now());
@@ -261,7 +267,7 @@ void Ds402Host::wait_target_reached(std::optional<std::chrono::nanoseconds> time
         // Either target reached or a fault ends the wait; check both on each change.
         const std::uint16_t s = read_statusword();
         const auto st = decode_statusword(s);
-        if (st == Ds402State::Fault || st == Ds402State::FaultReactionActive)
+        if (st == Cia402State::Fault || st == Cia402State::FaultReactionActive)
             throw DriveFault("CiA 402 node " + std::to_string(node_) + " faulted while moving");
         if (s & sw::kTargetReached) return;
         if (left.count() == 0) throw TimeoutError("CiA 402: target not reached in time");
@@ -272,12 +278,12 @@ void Ds402Host::wait_target_reached(std::optional<std::chrono::nanoseconds> time
     }
 }
 
-void Ds402Host::set_velocity(std::int32_t velocity) {
+void Cia402Host::set_velocity(std::int32_t velocity) {
     sdo_.write_u32(node_, kTargetVelocity, 0, static_cast<std::uint32_t>(velocity));
     write_controlword(static_cast<std::uint16_t>(cw::kEnableOperation | (last_cw_ & ~cw::kHalt & 0xFF70)));
 }
 
-void Ds402Host::home(std::optional<std::int8_t> method, std::optional<std::chrono::nanoseconds> timeout) {
+void Cia402Host::home(std::optional<std::int8_t> method, std::optional<std::chrono::nanoseconds> timeout) {
     if (method) sdo_.write_u8(node_, kHomingMethod, 0, static_cast<std::uint8_t>(*method));
     write_controlword(cw::kEnableOperation);
     write_controlword(static_cast<std::uint16_t>(cw::kEnableOperation | cw::kNewSetPoint));
@@ -290,7 +296,7 @@ void Ds402Host::home(std::optional<std::int8_t> method, std::optional<std::chron
         }
         if ((s & (sw::kSetPointAck | sw::kTargetReached)) == (sw::kSetPointAck | sw::kTargetReached)) break;
         const auto st = decode_statusword(s);
-        if (st == Ds402State::Fault || st == Ds402State::FaultReactionActive)
+        if (st == Cia402State::Fault || st == Cia402State::FaultReactionActive)
             throw DriveFault("CiA 402: fault during homing");
         auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - std::chrono::steady_clock::now());
         if (left.count() <= 0) throw TimeoutError("CiA 402: homing did not complete in time");
@@ -304,24 +310,24 @@ void Ds402Host::home(std::optional<std::int8_t> method, std::optional<std::chron
 
 // ---- device ---------------------------------------------------------------
 
-Ds402Device::Ds402Device() = default;
+Cia402Device::Cia402Device() = default;
 
-Ds402State Ds402Device::state() const {
+Cia402State Cia402Device::state() const {
     std::lock_guard l(m_);
     return state_;
 }
 
-std::uint16_t Ds402Device::controlword() const {
+std::uint16_t Cia402Device::controlword() const {
     std::lock_guard l(m_);
     return cw_;
 }
 
-std::uint16_t Ds402Device::statusword() const {
+std::uint16_t Cia402Device::statusword() const {
     std::lock_guard l(m_);
     std::uint16_t s = statusword_bits(state_);
-    if (state_ == Ds402State::ReadyToSwitchOn || state_ == Ds402State::SwitchedOn ||
-        state_ == Ds402State::OperationEnabled || state_ == Ds402State::QuickStopActive ||
-        state_ == Ds402State::FaultReactionActive)
+    if (state_ == Cia402State::ReadyToSwitchOn || state_ == Cia402State::SwitchedOn ||
+        state_ == Cia402State::OperationEnabled || state_ == Cia402State::QuickStopActive ||
+        state_ == Cia402State::FaultReactionActive)
         s |= sw::kVoltageEnabled;
     s |= sw::kRemote;
     s |= extra_ & 0xFF80;
@@ -332,7 +338,7 @@ std::uint16_t Ds402Device::statusword() const {
     return s;
 }
 
-int Ds402Device::go(Ds402State to, int transition, std::optional<Change>& ch) {
+int Cia402Device::go(Cia402State to, int transition, std::optional<Change>& ch) {
     if (!ch) ch = Change{state_, to, transition};
     ch->to = to;
     ch->transition = transition;
@@ -340,11 +346,11 @@ int Ds402Device::go(Ds402State to, int transition, std::optional<Change>& ch) {
     return transition;
 }
 
-void Ds402Device::notify(const std::optional<Change>& ch) {
+void Cia402Device::notify(const std::optional<Change>& ch) {
     if (ch && on_state_change) on_state_change(ch->from, ch->to, ch->transition);
 }
 
-int Ds402Device::on_controlword(std::uint16_t c) {
+int Cia402Device::on_controlword(std::uint16_t c) {
     std::optional<Change> ch;
     int t = -1;
     bool setpoint_edge = false, quick_stop = false;
@@ -353,7 +359,7 @@ int Ds402Device::on_controlword(std::uint16_t c) {
         std::lock_guard l(m_);
         const std::uint16_t prev = cw_;
         cw_ = c;
-        using S = Ds402State;
+        using S = Cia402State;
         if (c & cw::kFaultReset) {
             // Only the rising edge counts, and only in FAULT (transition 15).
             if (!(prev & cw::kFaultReset) && state_ == S::Fault) {
@@ -419,7 +425,7 @@ int Ds402Device::on_controlword(std::uint16_t c) {
     return t;
 }
 
-std::uint32_t Ds402Device::set_mode(std::int8_t m) {
+std::uint32_t Cia402Device::set_mode(std::int8_t m) {
     std::lock_guard l(m_);
     if (!supported_.count(m)) return 0x06090030;  // D4
     mode_ = m;
@@ -427,67 +433,67 @@ std::uint32_t Ds402Device::set_mode(std::int8_t m) {
     return 0;
 }
 
-std::int8_t Ds402Device::mode() const {
+std::int8_t Cia402Device::mode() const {
     std::lock_guard l(m_);
     return mode_;
 }
 
-void Ds402Device::set_supported_modes(std::set<std::int8_t> modes) {
+void Cia402Device::set_supported_modes(std::set<std::int8_t> modes) {
     std::lock_guard l(m_);
     supported_ = std::move(modes);
 }
 
-std::uint32_t Ds402Device::set_abort_connection_option(std::int16_t v) {
+std::uint32_t Cia402Device::set_abort_connection_option(std::int16_t v) {
     if (v > 3) return 0x06090030;
     std::lock_guard l(m_);
     abort_option_ = v;
     return 0;
 }
 
-std::uint32_t Ds402Device::set_quick_stop_option(std::int16_t v) {
+std::uint32_t Cia402Device::set_quick_stop_option(std::int16_t v) {
     if (v > 8) return 0x06090030;
     std::lock_guard l(m_);
     quick_stop_option_ = v;
     return 0;
 }
 
-std::int16_t Ds402Device::quick_stop_option() const {
+std::int16_t Cia402Device::quick_stop_option() const {
     std::lock_guard l(m_);
     return quick_stop_option_;
 }
 
-std::int16_t Ds402Device::abort_connection_option() const {
+std::int16_t Cia402Device::abort_connection_option() const {
     std::lock_guard l(m_);
     return abort_option_;
 }
 
-void Ds402Device::fault(std::uint16_t code) {
+void Cia402Device::fault(std::uint16_t code) {
     std::optional<Change> ch;
     {
         std::lock_guard l(m_);
-        if (state_ == Ds402State::Fault || state_ == Ds402State::FaultReactionActive) return;
+        if (state_ == Cia402State::Fault || state_ == Cia402State::FaultReactionActive) return;
         error_code_ = code;
         ack_ = false;
-        go(Ds402State::FaultReactionActive, 13, ch);
-        if (fault_option_ == 0) go(Ds402State::Fault, 14, ch);
+        go(Cia402State::FaultReactionActive, 13, ch);
+        if (fault_option_ == 0) go(Cia402State::Fault, 14, ch);
     }
     notify(ch);
 }
 
-void Ds402Device::fault_reaction_done() {
+void Cia402Device::fault_reaction_done() {
     std::optional<Change> ch;
     {
         std::lock_guard l(m_);
-        if (state_ == Ds402State::FaultReactionActive) go(Ds402State::Fault, 14, ch);
+        if (state_ == Cia402State::FaultReactionActive) go(Cia402State::Fault, 14, ch);
     }
     notify(ch);
 }
 
-int Ds402Device::loss_of_master() {
+int Cia402Device::loss_of_master() {
     std::int16_t opt;
     {
         std::lock_guard l(m_);
-        if (state_ != Ds402State::OperationEnabled) return -1;
+        if (state_ != Cia402State::OperationEnabled) return -1;
         opt = abort_option_;
     }
     switch (opt) {
@@ -498,33 +504,33 @@ int Ds402Device::loss_of_master() {
     }
 }
 
-void Ds402Device::motion_stopped() {
+void Cia402Device::motion_stopped() {
     std::optional<Change> ch;
     {
         std::lock_guard l(m_);
-        if (state_ == Ds402State::QuickStopActive && quick_stop_option_ >= 1 && quick_stop_option_ <= 4)
-            go(Ds402State::SwitchOnDisabled, 12, ch);
-        else if (state_ == Ds402State::FaultReactionActive)
-            go(Ds402State::Fault, 14, ch);
+        if (state_ == Cia402State::QuickStopActive && quick_stop_option_ >= 1 && quick_stop_option_ <= 4)
+            go(Cia402State::SwitchOnDisabled, 12, ch);
+        else if (state_ == Cia402State::FaultReactionActive)
+            go(Cia402State::Fault, 14, ch);
     }
     notify(ch);
 }
 
-std::uint16_t Ds402Device::last_error_code() const {
+std::uint16_t Cia402Device::last_error_code() const {
     std::lock_guard l(m_);
     return error_code_;
 }
 
-void Ds402Device::set_status_bits(std::uint16_t mask, std::uint16_t value) {
+void Cia402Device::set_status_bits(std::uint16_t mask, std::uint16_t value) {
     std::lock_guard l(m_);
     mask &= 0xFF80;  // the state bits belong to the state machine
     extra_ = static_cast<std::uint16_t>((extra_ & ~mask) | (value & mask));
 }
 
-bool Ds402Device::drive_enabled() const {
+bool Cia402Device::drive_enabled() const {
     std::lock_guard l(m_);
-    return state_ == Ds402State::OperationEnabled || state_ == Ds402State::QuickStopActive ||
-           state_ == Ds402State::FaultReactionActive;
+    return state_ == Cia402State::OperationEnabled || state_ == Cia402State::QuickStopActive ||
+           state_ == Cia402State::FaultReactionActive;
 }
 
 }  // namespace motorbus::canopen

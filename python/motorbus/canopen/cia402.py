@@ -1,7 +1,7 @@
-"""CiA 402 on the host (Ds402) and on a simulated device (Ds402Device).
+"""CiA 402 on the host (Cia402) and on a simulated device (Cia402Device).
 
-    from motorbus.canopen import Ds402, OpMode
-    drive = Ds402(bus, node=5)                  # or an SDO client object
+    from motorbus.canopen import Cia402, OpMode
+    drive = Cia402(bus, node=5)                  # or an SDO client object
     drive.use_statusword_pdo(rx)                # optional: wait on TPDOs, not SDO polls
     drive.set_mode(OpMode.PROFILE_POSITION)
     drive.go_to("OPERATION ENABLED")            # walks 2, 3, 4 (fault reset first if needed)
@@ -18,14 +18,14 @@ from typing import Optional
 
 from .. import _core, _stop_at_exit
 
-__all__ = ["ABORT_CONNECTION_ACTIONS", "Ds402", "Ds402Host", "Ds402Device", "OpMode", "STATES",
+__all__ = ["ABORT_CONNECTION_ACTIONS", "Cia402", "Cia402Device", "OpMode", "STATES",
            "decode_statusword", "Controlword", "next_step"]
 
 STATES = ("NOT READY TO SWITCH ON", "SWITCH ON DISABLED", "READY TO SWITCH ON", "SWITCHED ON",
           "OPERATION ENABLED", "QUICK STOP ACTIVE", "FAULT REACTION ACTIVE", "FAULT", "UNKNOWN")
 
-decode_statusword = _core.ds402_decode_statusword
-next_step = _core.ds402_next_step
+decode_statusword = _core.cia402_decode_statusword
+next_step = _core.cia402_next_step
 
 
 class OpMode(enum.IntEnum):
@@ -56,11 +56,13 @@ class Controlword(enum.IntEnum):
 ABORT_CONNECTION_ACTIONS = {"fault": 1, "disable_voltage": 2, "quick_stop": 3}
 
 
-class Ds402(_stop_at_exit.StopsMotor, _core.Ds402Host):
+class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
     """Host-side CiA 402 state machine of one drive.
 
-    ``Ds402(bus_or_sdo, node, timeout=2.0, poll=0.005, on_error="quick_stop",
-    on_exit="quick_stop")``
+    ``Cia402(bus_or_sdo, node, timeout=2.0, poll=0.005, on_error="quick_stop",
+    on_exit="quick_stop", bus=None)`` -- ``bus``: where :meth:`start_watchdog`
+    produces its heartbeat when the first argument is an SDO client
+    (``node.cia402`` of a Network passes the network's bus).
 
     Safety, as for every motorbus drive object:
 
@@ -76,17 +78,18 @@ class Ds402(_stop_at_exit.StopsMotor, _core.Ds402Host):
     """
 
     def __init__(self, sdo, node: int, timeout: float = 2.0, poll: float = 0.005, *,
-                 on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop") -> None:
+                 on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop",
+                 bus: Optional[_core.Bus] = None) -> None:
         for name, v in (("on_error", on_error), ("on_exit", on_exit)):
             if v not in _HALTS:
-                raise _core.InvalidArgument(f"Ds402 {name}: 'quick_stop', 'disable' or None, not {v!r}")
+                raise _core.InvalidArgument(f"Cia402 {name}: 'quick_stop', 'disable' or None, not {v!r}")
         if isinstance(sdo, _core.Bus):
             # One SDO client for the state machine and the watchdog set-up: two
             # clients on one COB-ID would take each other's responses.
             self._bus = sdo
             sdo = _core.SdoClient(sdo, node, timeout=timeout)
         else:
-            self._bus = None
+            self._bus = bus
         super().__init__(sdo, node, timeout, poll)
         self._sdo = sdo
         self._node = node
@@ -193,5 +196,5 @@ class Ds402(_stop_at_exit.StopsMotor, _core.Ds402Host):
 _HALTS = (None, "quick_stop", "disable")
 
 
-Ds402Host = Ds402
-Ds402Device = _core.Ds402Device
+#: The device-side state machine for simulators (C++ Cia402Device).
+Cia402Device = _core.Cia402Device

@@ -1,6 +1,7 @@
-// The narrow SDO interface the services need (PDO configuration, CiA 402 host,
-// scanner).  canopen-sdo's SdoClient is adapted to it in
-// services_sdo_adapter.hpp, so these services compile and test without it.
+// SdoAccess: the narrow SDO interface the services need (PDO configuration,
+// CiA 402 host, scanner).  Our SdoClient implements it in sdo_client_access.hpp;
+// tests and Python clients implement it directly, so the services compile and
+// test without a bus.
 #pragma once
 #include <cstdint>
 #include <span>

@@ -2,16 +2,16 @@
 
 #include <map>
 
-#include "motorbus/canopen/ds402.hpp"
+#include "motorbus/canopen/cia402.hpp"
 #include "motorbus/errors.hpp"
 #include "test_nmt_support.hpp"
 
 using namespace motorbus;
 using namespace motorbus::canopen;
-using S = Ds402State;
+using S = Cia402State;
 using namespace std::chrono_literals;
 
-TEST(Ds402Statusword, DecodesEveryStateAndMasksOtherBits) {
+TEST(Cia402Statusword, DecodesEveryStateAndMasksOtherBits) {
     EXPECT_EQ(decode_statusword(0x0000), S::NotReadyToSwitchOn);
     EXPECT_EQ(decode_statusword(0x0040), S::SwitchOnDisabled);
     EXPECT_EQ(decode_statusword(0x0021), S::ReadyToSwitchOn);
@@ -30,7 +30,7 @@ TEST(Ds402Statusword, DecodesEveryStateAndMasksOtherBits) {
         EXPECT_EQ(decode_statusword(statusword_bits(s)), s);
 }
 
-TEST(Ds402Statusword, D3_PatternsOutsideTheTableAreUnknown) {
+TEST(Cia402Statusword, D3_PatternsOutsideTheTableAreUnknown) {
     int unknown = 0;
     for (unsigned sw = 0; sw < 0x80; ++sw) {
         const auto s = decode_statusword(static_cast<std::uint16_t>(sw));
@@ -47,8 +47,8 @@ TEST(Ds402Statusword, D3_PatternsOutsideTheTableAreUnknown) {
     EXPECT_EQ(decode_statusword(0x0003), S::Unknown);
 }
 
-TEST(Ds402Device, Transitions2To16) {
-    Ds402Device d;
+TEST(Cia402Device, Transitions2To16) {
+    Cia402Device d;
     std::vector<int> ts;
     d.on_state_change = [&](S, S, int t) { ts.push_back(t); };
     EXPECT_EQ(d.state(), S::SwitchOnDisabled);
@@ -89,8 +89,8 @@ TEST(Ds402Device, Transitions2To16) {
     EXPECT_EQ(ts, (std::vector<int>{2, 3, 4, 5, 6, 7, 2, 4, 8, 4, 9, 2, 3, 10, 2, 4, 11, 12, 13, 14, 15, 2, 4, 11, 16}));
 }
 
-TEST(Ds402Device, D1_EnableOperationFromSwitchOnDisabledDoesNothing) {
-    Ds402Device d;
+TEST(Cia402Device, D1_EnableOperationFromSwitchOnDisabledDoesNothing) {
+    Cia402Device d;
     EXPECT_EQ(d.on_controlword(0x000F), -1);
     EXPECT_EQ(d.state(), S::SwitchOnDisabled);
     EXPECT_EQ(d.on_controlword(0x0007), -1);
@@ -99,8 +99,8 @@ TEST(Ds402Device, D1_EnableOperationFromSwitchOnDisabledDoesNothing) {
     EXPECT_EQ(d.on_controlword(0x000F), 4);
 }
 
-TEST(Ds402Device, FaultResetOnlyOnRisingEdge) {
-    Ds402Device d;
+TEST(Cia402Device, FaultResetOnlyOnRisingEdge) {
+    Cia402Device d;
     d.on_controlword(0x80);  // bit 7 already high before the fault
     d.fault(0x5000);
     d.fault_reaction_done();
@@ -111,8 +111,8 @@ TEST(Ds402Device, FaultResetOnlyOnRisingEdge) {
     EXPECT_EQ(d.last_error_code(), 0);
 }
 
-TEST(Ds402Device, D4_UnsupportedModeAborts) {
-    Ds402Device d;
+TEST(Cia402Device, D4_UnsupportedModeAborts) {
+    Cia402Device d;
     EXPECT_EQ(d.set_mode(1), 0u);
     EXPECT_EQ(d.mode(), 1);
     EXPECT_EQ(d.set_mode(8), 0x06090030u);
@@ -123,7 +123,7 @@ TEST(Ds402Device, D4_UnsupportedModeAborts) {
     EXPECT_EQ(d.set_mode(8), 0u);
 }
 
-TEST(Ds402Device, D5_LossOfMasterApplies6007) {
+TEST(Cia402Device, D5_LossOfMasterApplies6007) {
     struct Case {
         std::int16_t option;
         S after;
@@ -132,22 +132,22 @@ TEST(Ds402Device, D5_LossOfMasterApplies6007) {
     for (auto c : {Case{0, S::OperationEnabled, -1}, Case{1, S::FaultReactionActive, 13},
                    Case{2, S::SwitchOnDisabled, 9}, Case{3, S::QuickStopActive, 11},
                    Case{-1, S::FaultReactionActive, 13}}) {
-        Ds402Device d;
+        Cia402Device d;
         ASSERT_EQ(d.set_abort_connection_option(c.option), 0u);
         d.on_controlword(0x06);
         d.on_controlword(0x0F);
         EXPECT_EQ(d.loss_of_master(), c.transition) << c.option;
         EXPECT_EQ(d.state(), c.after) << c.option;
     }
-    Ds402Device idle;
+    Cia402Device idle;
     EXPECT_EQ(idle.loss_of_master(), -1);  // only while Operation Enabled
     EXPECT_EQ(idle.state(), S::SwitchOnDisabled);
     EXPECT_EQ(idle.set_abort_connection_option(4), 0x06090030u);
 }
 
-TEST(Ds402Device, D6_QuickStopPer605A) {
+TEST(Cia402Device, D6_QuickStopPer605A) {
     for (std::int16_t opt : {1, 2, 5, 6}) {
-        Ds402Device d;
+        Cia402Device d;
         ASSERT_EQ(d.set_quick_stop_option(opt), 0u);
         std::int16_t ramp = -99;
         d.on_quick_stop = [&](std::int16_t o) { ramp = o; };
@@ -160,11 +160,11 @@ TEST(Ds402Device, D6_QuickStopPer605A) {
         d.motion_stopped();
         EXPECT_EQ(d.state(), opt <= 4 ? S::SwitchOnDisabled : S::QuickStopActive) << opt;
     }
-    Ds402Device d;
+    Cia402Device d;
     EXPECT_EQ(d.set_quick_stop_option(9), 0x06090030u);
 }
 
-TEST(Ds402Steps, NextStepTable) {
+TEST(Cia402Steps, NextStepTable) {
     EXPECT_EQ(next_step(S::SwitchOnDisabled, S::OperationEnabled)->controlword, 0x06);
     EXPECT_EQ(next_step(S::ReadyToSwitchOn, S::OperationEnabled)->transition, 3);
     EXPECT_EQ(next_step(S::SwitchedOn, S::OperationEnabled)->controlword, 0x0F);
@@ -180,7 +180,7 @@ TEST(Ds402Steps, NextStepTable) {
 namespace {
 
 struct DeviceSdo : SdoAccess {
-    Ds402Device dev;
+    Cia402Device dev;
     std::map<std::uint16_t, std::uint64_t> objects;
     std::vector<std::uint16_t> controlwords;
     bool auto_motion = true;
@@ -223,9 +223,9 @@ struct DeviceSdo : SdoAccess {
 
 }  // namespace
 
-TEST(Ds402Host, WalksToOperationEnabledAndBack) {
+TEST(Cia402Host, WalksToOperationEnabledAndBack) {
     DeviceSdo sdo;
-    Ds402Host h(sdo, 5, {200ms, 1ms});
+    Cia402Host h(sdo, 5, {200ms, 1ms});
     h.go_to(S::OperationEnabled);
     EXPECT_EQ(sdo.dev.state(), S::OperationEnabled);
     EXPECT_EQ(sdo.controlwords, (std::vector<std::uint16_t>{0x06, 0x07, 0x0F}));
@@ -234,9 +234,9 @@ TEST(Ds402Host, WalksToOperationEnabledAndBack) {
     EXPECT_EQ(h.state(), S::SwitchOnDisabled);
 }
 
-TEST(Ds402Host, FaultResetRisingEdgeThenEnable) {
+TEST(Cia402Host, FaultResetRisingEdgeThenEnable) {
     DeviceSdo sdo;
-    Ds402Host h(sdo, 5, {200ms, 1ms});
+    Cia402Host h(sdo, 5, {200ms, 1ms});
     h.write_controlword(0x80);  // bit 7 left high by someone
     sdo.dev.fault(0x7300);
     sdo.dev.fault_reaction_done();
@@ -247,9 +247,9 @@ TEST(Ds402Host, FaultResetRisingEdgeThenEnable) {
     EXPECT_EQ(sdo.controlwords[2], 0x80);
 }
 
-TEST(Ds402Host, PersistentFaultRaisesDriveFault) {
+TEST(Cia402Host, PersistentFaultRaisesDriveFault) {
     DeviceSdo sdo;
-    Ds402Host h(sdo, 5, {50ms, 1ms});
+    Cia402Host h(sdo, 5, {50ms, 1ms});
     sdo.dev.fault(0x7300);
     sdo.dev.fault_reaction_done();
     sdo.dev.on_state_change = [&](S, S to, int) {
@@ -258,19 +258,19 @@ TEST(Ds402Host, PersistentFaultRaisesDriveFault) {
     EXPECT_THROW(h.go_to(S::OperationEnabled), DriveFault);
 }
 
-TEST(Ds402Host, D3_UnknownStatuswordIsNeverTreatedAsEnabled) {
+TEST(Cia402Host, D3_UnknownStatuswordIsNeverTreatedAsEnabled) {
     struct Odd : SdoAccess {
         void download(std::uint8_t, std::uint16_t, std::uint8_t, std::span<const std::uint8_t>) override {}
         std::vector<std::uint8_t> upload(std::uint8_t, std::uint16_t, std::uint8_t) override { return {0x67, 0x00}; }
     } odd;
-    Ds402Host h(odd, 5, {20ms, 1ms});
+    Cia402Host h(odd, 5, {20ms, 1ms});
     EXPECT_EQ(h.state(), S::Unknown);
     EXPECT_THROW(h.go_to(S::OperationEnabled), ProtocolError);
 }
 
-TEST(Ds402Host, ProfilePositionHandshake) {
+TEST(Cia402Host, ProfilePositionHandshake) {
     DeviceSdo sdo;
-    Ds402Host h(sdo, 5, {200ms, 1ms});
+    Cia402Host h(sdo, 5, {200ms, 1ms});
     h.set_mode(OpMode::ProfilePosition);
     EXPECT_EQ(h.mode(), OpMode::ProfilePosition);
     h.go_to(S::OperationEnabled);
@@ -291,15 +291,15 @@ TEST(Ds402Host, ProfilePositionHandshake) {
     EXPECT_THROW(h.wait_target_reached(10ms), DriveFault);
 }
 
-TEST(Ds402Host, D4_UnsupportedModeSurfaces) {
+TEST(Cia402Host, D4_UnsupportedModeSurfaces) {
     DeviceSdo sdo;
-    Ds402Host h(sdo, 5, {20ms, 1ms});
+    Cia402Host h(sdo, 5, {20ms, 1ms});
     EXPECT_THROW(h.set_mode(OpMode::CyclicSyncTorque), ProtocolError);
 }
 
-TEST(Ds402Host, HomingAndVelocity) {
+TEST(Cia402Host, HomingAndVelocity) {
     DeviceSdo sdo;
-    Ds402Host h(sdo, 5, {200ms, 1ms});
+    Cia402Host h(sdo, 5, {200ms, 1ms});
     h.set_mode(OpMode::Homing);
     h.go_to(S::OperationEnabled);
     h.home(std::int8_t{35}, 100ms);
@@ -311,13 +311,13 @@ TEST(Ds402Host, HomingAndVelocity) {
     EXPECT_EQ(sdo.controlwords.back() & cw::kHalt, 0);
 }
 
-TEST(Ds402Host, WaitsOnStatuswordPdo) {
+TEST(Cia402Host, WaitsOnStatuswordPdo) {
     svc_test::Hub hub;
     auto host = hub.open("host");
     auto dev = hub.open("dev");
     DeviceSdo sdo;
     PdoReceiver rx(*host, 0x185, {{0x6041, 0, 16}});
-    Ds402Host h(sdo, 5, {200ms, 1ms});
+    Cia402Host h(sdo, 5, {200ms, 1ms});
     EXPECT_THROW(
         [&] {
             PdoReceiver other(*host, 0x285, {{0x6064, 0, 32}});

@@ -1,12 +1,14 @@
-// SdoAccess over canopen-sdo's SdoClient: one client per node id, created on
-// first use.  Errors are the client's own (SdoAbortError, SdoTimeout, ...).
+// SdoAccess implemented with our SdoClient (sdo_client.hpp): BusSdoAccess keeps
+// one client per node id, created on first use; ClientSdoAccess wraps a client
+// the caller already has (one node).  Errors are the client's own (SdoAbortError,
+// SdoTimeout, ...).
 #pragma once
 #include <array>
 #include <memory>
 #include <mutex>
 
 #include "motorbus/canopen/sdo_client.hpp"
-#include "motorbus/canopen/services_sdo.hpp"
+#include "motorbus/canopen/sdo_access.hpp"
 #include "motorbus/errors.hpp"
 
 namespace motorbus::canopen {

@@ -1,0 +1,14 @@
+"""TIME (CiA 301 TIME_OF_DAY): milliseconds after midnight, days since 1984-01-01.
+
+    from motorbus.canopen import time_encode, time_decode
+    frame = time_encode(unix_ms)        # the 6-byte TIME frame on 0x100
+    time_decode(frame)                  # unix ms, or None for anything else
+"""
+from __future__ import annotations
+
+from .. import _core
+
+__all__ = ["time_encode", "time_decode"]
+
+time_encode = _core.time_encode
+time_decode = _core.time_decode
