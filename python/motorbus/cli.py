@@ -3,7 +3,9 @@
     motorbus bus serve SPEC [--socketcand HOST:PORT] [--slcan-pty] [--channel NAME]
     motorbus bus dump SPEC [--count N] [--log FILE]
     motorbus bus play FILE SPEC [--speed X]
-    motorbus sim serve --pty --drive KIND:ADDR[,ADDR...] [--drive ...] [--baud N]
+    motorbus sim serve [--pty] [--bus virtual:NAME] [--bitrate N] [--socketcand HOST:PORT]...
+                       [--slcan-pty]... --drive KIND:ADDR[,ADDR...]... [--baud N] [--store-dir DIR]
+    motorbus drives
     motorbus demo
 """
 from __future__ import annotations
@@ -12,7 +14,7 @@ import argparse
 import signal
 import sys
 import threading
-from typing import Any, Callable, Optional, Sequence
+from typing import Any, Optional, Sequence
 
 from . import _core
 from .bus import open_bus
@@ -38,48 +40,16 @@ def _say(line: str) -> None:
     print(line, flush=True)
 
 
-def _need(name: str) -> Callable[..., Any]:
-    fn = getattr(_core, name, None)
-    if fn is None:
-        raise SystemExit(f"motorbus: this build has no {name}")
-    return fn
-
-
 # ---------------------------------------------------------------------------
 def cmd_bus_serve(args: argparse.Namespace) -> int:
-    """Serves one bus to other processes until SIGINT/SIGTERM.
+    """Serves one bus to other processes until SIGINT/SIGTERM (see motorbus.bus_server)."""
+    from .bus_server import BusServers
 
-    Each server gets its own endpoint on a virtual bus, so a frame from an SLCAN
-    client reaches socketcand clients and the reverse, as on a real bus.
-    """
-    if not args.socketcand and not args.slcan_pty:
-        args.socketcand = ["127.0.0.1:0"]
-    shared = None if args.spec.startswith("virtual:") else open_bus(args.spec)
-    endpoint = (lambda: open_bus(args.spec)) if shared is None else (lambda: shared)
-    servers: list[Any] = []
-    buses: list[Any] = []
-    try:
-        for hp in args.socketcand or []:
-            host, _, port = hp.rpartition(":")
-            bus = endpoint()
-            buses.append(bus)
-            srv = _need("SocketcandServer")(bus, host=host or "127.0.0.1", port=int(port))
-            servers.append(srv)
-            _say(f"socketcand {srv.host}:{srv.port} {args.channel}")
-        for _ in range(args.slcan_pty):
-            bus = endpoint()
-            buses.append(bus)
-            srv = _need("SlcanServer")(bus)
-            servers.append(srv)
-            _say(f"slcan {srv.pty_path}")
+    socketcand = args.socketcand or ([] if args.slcan_pty else ["127.0.0.1:0"])
+    with BusServers(args.spec, socketcand=socketcand, slcan_ptys=args.slcan_pty, channel=args.channel) as servers:
+        for line in servers.announce():
+            _say(line)
         _wait_for_signal()
-    finally:
-        for s in servers:
-            s.close()
-        for b in buses:
-            b.close()
-        if shared is not None:
-            shared.close()
     return 0
 
 
@@ -113,18 +83,24 @@ def cmd_bus_play(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------------------
 def cmd_sim_serve(args: argparse.Namespace) -> int:
-    from . import sim
+    """Serial kinds on ptys, CAN kinds as nodes on one served bus (see motorbus.sim)."""
+    from .sim import SimBench
 
-    if not args.pty:
-        raise SystemExit("motorbus sim serve: only --pty is supported (serial lines on pseudo-terminals)")
-    lines = sim.serve_lines(args.drive, baud=args.baud, store_dir=args.store_dir)
-    try:
-        for line in lines:
-            _say(f"{line.label} {line.pty_path}")
+    with SimBench(args.drive, bus=args.bus, bitrate=args.bitrate, socketcand=args.socketcand or (),
+                  slcan_ptys=args.slcan_pty, channel=args.channel, baud=args.baud,
+                  store_dir=args.store_dir) as bench:
+        for line in bench.announce():
+            _say(line)
         _wait_for_signal()
-    finally:
-        for line in lines:
-            line.close()
+    return 0
+
+
+def cmd_drives(args: argparse.Namespace) -> int:
+    """Lists the registered drive kinds."""
+    from .registry import drive_plugins
+
+    for kind, plugin in drive_plugins().items():
+        _say(f"{kind:10s} {plugin.transport:6s} {plugin.description}")
     return 0
 
 
@@ -160,14 +136,25 @@ def build_parser() -> argparse.ArgumentParser:
     pl.set_defaults(func=cmd_bus_play)
 
     sim = sub.add_parser("sim", help="simulated drives").add_subparsers(dest="sim_cmd", required=True)
-    ss = sim.add_parser("serve", help="serve simulated serial drives on ptys")
-    ss.add_argument("--pty", action="store_true", help="serve each serial line on a new pseudo-terminal")
+    ss = sim.add_parser("serve", help="serve simulated drives: serial kinds on ptys, CAN kinds on a served bus")
     ss.add_argument("--drive", action="append", required=True, metavar="KIND:ADDR[,ADDR...]",
-                    help="a line with one or more drives of one kind, e.g. arcus:01 or arcus:01,02 (RS-485 "
-                         "multi-drop); repeat for more lines")
-    ss.add_argument("--baud", type=int, default=0, help="pace replies at this baud rate (0 = unthrottled)")
-    ss.add_argument("--store-dir", default=None, help="where drives persist STORE'd settings")
+                    help="drives of one registered kind (`motorbus drives` lists them): a serial line with one "
+                         "or more drives (arcus:01,02 = RS-485 multi-drop), or CAN nodes (cia402:5,6); repeatable")
+    ss.add_argument("--pty", action="store_true", help="serve serial lines on pseudo-terminals (the default)")
+    ss.add_argument("--baud", type=int, default=0, help="pace serial replies at this baud rate (0 = unthrottled)")
+    ss.add_argument("--store-dir", default=None, help="where drives persist their stored settings")
+    ss.add_argument("--bus", default=None, metavar="SPEC",
+                    help="the CAN bus the CAN drives sit on (default: a new virtual bus)")
+    ss.add_argument("--bitrate", type=int, default=None, help="wire time of the virtual CAN bus (bit/s)")
+    ss.add_argument("--socketcand", action="append", metavar="HOST:PORT",
+                    help="serve the CAN bus over socketcand (port 0 picks a free port); repeatable; "
+                         "default 127.0.0.1:0 when CAN drives are served")
+    ss.add_argument("--slcan-pty", action="count", default=0, help="serve the CAN bus as an SLCAN adapter on a pty")
+    ss.add_argument("--channel", default="can0", help="channel name announced to socketcand clients")
     ss.set_defaults(func=cmd_sim_serve)
+
+    dl = sub.add_parser("drives", help="list the registered drive kinds")
+    dl.set_defaults(func=cmd_drives)
 
     dm = sub.add_parser("demo", help="run the simulated bench demo")
     dm.add_argument("--quick", action="store_true", help="shorter run (used by the tests)")

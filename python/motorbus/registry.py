@@ -98,7 +98,11 @@ def _resolve(group: str, name: str, what: str) -> Any:
         raise _core.InvalidArgument(f"unknown {what} {name!r} (registered: {known})")
     if not isinstance(ep, metadata.EntryPoint):
         return ep
-    obj = ep.load()
+    try:
+        obj = ep.load()
+    except Exception as e:  # a broken plugin must say which one and why
+        raise _core.InvalidArgument(f"{what} {name!r}: its entry point {ep.value} does not load: "
+                                    f"{type(e).__name__}: {e}") from e
     with _lock:
         _cache[group][name] = obj
     return obj

@@ -1,52 +1,38 @@
-"""Serving simulated drives to other processes.
+"""Serving simulated drives, in-process or to other processes.
 
-A *line* is one serial line (a pty) carrying one or more drives of one kind,
-as an RS-485 multi-drop bus does: every drive sees every request and only the
-addressed one answers.  Line specs::
+A drive spec is ``KIND:ADDR[,ADDR...]`` for any registered kind
+(``motorbus.drive_kinds()``):
 
-    arcus:01          one Arcus DMX-CAN at address 01
-    arcus:01,02,03    three DMX-CANs sharing one RS-485 line
-    dmac:00           one Midi DMAC at address 00
+* a **serial** kind gets one serial line (a pty) per spec, carrying all its
+  addresses as an RS-485 multi-drop bus does (every drive sees every request,
+  only the addressed one answers): ``arcus:01,02``;
+* a **CAN** kind puts one node per address on the served CAN bus: ``cia402:5,6``.
 
-``motorbus sim serve --pty --drive arcus:01 --drive dmac:00`` prints one line
-per serial line, ``<spec> <pty path>``, then serves until SIGINT/SIGTERM.
+``motorbus sim serve --drive arcus:01 --drive cia402:5`` prints one line per
+serial line (``<spec> <pty path>``) and one per CAN server (``socketcand
+HOST:PORT CHANNEL`` / ``slcan PTY``), then serves until SIGINT/SIGTERM.
+
+In-process, :func:`serve_line` and :class:`SimBench` give the same simulators;
+``make_sim(kind, address, ...)`` gives one drive's simulator without serving it.
 """
 from __future__ import annotations
 
-import importlib
-import os
 from dataclasses import dataclass, field
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
 
-from . import _core
+from . import _core, registry
+from .bus_server import BusServers
 
-# kind -> module providing make_sim(address, clock=None, **options) -> LineDevice
-DRIVE_KINDS = {
-    "arcus": "motorbus.drives.arcus",
-    "dmac": "motorbus.drives.dmac",
-}
+__all__ = ["ServedLine", "SimBench", "make_sim", "serve_line", "serve_lines"]
 
 
-def parse_line_spec(spec: str) -> tuple[str, list[str]]:
-    """'arcus:01,02' -> ('arcus', ['01', '02']); InvalidArgument naming the problem."""
-    kind, sep, addrs = spec.partition(":")
-    if not sep or not addrs:
-        raise _core.InvalidArgument(f"drive spec {spec!r}: expected KIND:ADDR[,ADDR...], e.g. arcus:01")
-    if kind not in DRIVE_KINDS:
-        raise _core.InvalidArgument(f"drive spec {spec!r}: unknown kind {kind!r} ({', '.join(DRIVE_KINDS)})")
-    addresses = [a.strip() for a in addrs.split(",")]
-    if any(not a for a in addresses) or len(set(addresses)) != len(addresses):
-        raise _core.InvalidArgument(f"drive spec {spec!r}: addresses must be non-empty and distinct")
-    return kind, addresses
-
-
-def make_drive(kind: str, address: str, clock: Any = None, store_dir: Optional[str] = None,
-               **options: Any) -> Any:
-    """Builds one simulated drive (a LineDevice)."""
-    mod = importlib.import_module(DRIVE_KINDS[kind])
-    if store_dir is not None and kind == "arcus":
-        options["store_path"] = os.path.join(store_dir, f"{kind}-{address}.store")
-    return mod.make_sim(address, clock=clock, **options)
+def make_sim(kind: str, address: str, clock: Any = None, store_dir: Optional[str] = None, **options: Any) -> Any:
+    """One simulated drive of a registered kind (not served)."""
+    plugin = registry.drive_plugin(kind)
+    address = plugin.check_address(str(address))
+    if store_dir is not None and plugin.store_options is not None:
+        options = {**plugin.store_options(store_dir, address), **options}
+    return plugin.make_sim(address, clock=clock, **options)
 
 
 @dataclass
@@ -55,7 +41,7 @@ class ServedLine:
 
     label: str
     server: Any
-    drives: list[Any] = field(default_factory=list)
+    drives: list = field(default_factory=list)
 
     @property
     def pty_path(self) -> str:
@@ -73,14 +59,16 @@ class ServedLine:
 
 def serve_line(spec: str, baud: int = 0, clock: Any = None, store_dir: Optional[str] = None,
                **options: Any) -> ServedLine:
-    """Starts one line (see the module doc for the spec) on a new pty."""
-    kind, addresses = parse_line_spec(spec)
-    drives = [make_drive(kind, a, clock=clock, store_dir=store_dir, **options) for a in addresses]
+    """Starts one serial line (``KIND:ADDR[,ADDR...]`` of a serial kind) on a new pty."""
+    plugin, addresses = registry.parse_drive_spec(spec)
+    if plugin.transport != "serial":
+        raise _core.InvalidArgument(f"drive spec {spec!r}: {plugin.kind} is a {plugin.transport} drive, not serial")
+    drives = [make_sim(plugin.kind, a, clock=clock, store_dir=store_dir, **options) for a in addresses]
     server = _core.PtyLineServer(devices=drives, baud=baud)
     return ServedLine(label=spec, server=server, drives=drives)
 
 
-def serve_lines(specs: list[str], baud: int = 0, clock: Any = None,
+def serve_lines(specs: Sequence[str], baud: int = 0, clock: Any = None,
                 store_dir: Optional[str] = None) -> list[ServedLine]:
     lines: list[ServedLine] = []
     try:
@@ -91,3 +79,68 @@ def serve_lines(specs: list[str], baud: int = 0, clock: Any = None,
             line.close()
         raise
     return lines
+
+
+class SimBench:
+    """Simulated drives of any kinds, served as a bench would be wired.
+
+    ``SimBench(["arcus:01,02", "cia402:5"], bus="virtual:sim", socketcand=["127.0.0.1:0"])``:
+    serial kinds on their ptys (``lines``), CAN kinds as nodes on ``bus``,
+    exposed through the socketcand / SLCAN servers (``can``; with CAN drives and
+    no server asked for, one socketcand server on 127.0.0.1 with a free port).
+    ``sims[(kind, address)]`` reaches each simulator (to inject faults in tests)."""
+
+    def __init__(self, specs: Sequence[str], *, bus: Optional[str] = None, bitrate: Optional[int] = None,
+                 socketcand: Sequence[str] = (), slcan_ptys: int = 0, channel: str = "can0", baud: int = 0,
+                 clock: Any = None, store_dir: Optional[str] = None) -> None:
+        self.lines: list[ServedLine] = []
+        self.can: Optional[BusServers] = None
+        self.sims: dict[tuple[str, str], Any] = {}
+        self._can_sims: list[Any] = []
+        parsed = [(spec, *registry.parse_drive_spec(spec)) for spec in specs]
+        try:
+            for spec, plugin, addresses in parsed:
+                if plugin.transport == "serial":
+                    line = serve_line(spec, baud=baud, clock=clock, store_dir=store_dir)
+                    self.lines.append(line)
+                    self.sims.update({(plugin.kind, a): d for a, d in zip(addresses, line.drives)})
+            can_specs = [(plugin, addresses) for _, plugin, addresses in parsed if plugin.transport == "can"]
+            if can_specs or socketcand or slcan_ptys:
+                if not socketcand and not slcan_ptys:
+                    socketcand = ["127.0.0.1:0"]
+                options = {"bitrate": bitrate} if bitrate else {}
+                self.can = BusServers(bus or f"virtual:motorbus-sim-{id(self):x}", socketcand=socketcand,
+                                      slcan_ptys=slcan_ptys, channel=channel, **options)
+                for plugin, addresses in can_specs:
+                    for a in addresses:
+                        sim = make_sim(plugin.kind, a, clock=clock, store_dir=store_dir)
+                        sim.attach(self.can.endpoint())
+                        self._can_sims.append(sim)
+                        self.sims[(plugin.kind, a)] = sim
+        except Exception:
+            self.close()
+            raise
+
+    def announce(self) -> list[str]:
+        """``<spec> <pty>`` per serial line, then one line per CAN server."""
+        out = [f"{line.label} {line.pty_path}" for line in self.lines]
+        if self.can is not None:
+            out += self.can.announce()
+        return out
+
+    def close(self) -> None:
+        for sim in self._can_sims:
+            sim.close()
+        self._can_sims = []
+        if self.can is not None:
+            self.can.close()
+            self.can = None
+        for line in self.lines:
+            line.close()
+        self.lines = []
+
+    def __enter__(self) -> "SimBench":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()

@@ -9,31 +9,30 @@
         axis.params["0x6081"] = 2000        # profile velocity, by index (or "0x6099:01", or a name)
 
 The adapter runs on the host-side CiA 402 state machine (``motorbus.canopen``'s
-``Ds402``) and uses the drive's own heartbeat consumer (0x1016 + 0x6007) as the
+``Cia402``) and uses the drive's own heartbeat consumer (0x1016 + 0x6007) as the
 link-loss watchdog: the host produces a heartbeat, the drive quick-stops when it
 stops arriving (``watchdog=`` option of :func:`open`).
 
 The simulator (:class:`Cia402Sim`, ``make_sim``) is a CiA 402 node as the
 profile describes it, built from the core's pieces: a LocalNode (SDO server,
 NMT slave, boot-up), a HeartbeatService (producer 0x1017, consumer 0x1016), the
-device state machine (Ds402Device), profile position / profile velocity / homing
+device state machine (Cia402Device), profile position / profile velocity / homing
 on a motor model with home and limit switches.  ``motorbus sim serve --drive
 cia402:5`` serves it over socketcand or SLCAN.
 """
 from __future__ import annotations
 
-import math
 import threading
 from typing import Any, Optional, Union
 
 from .. import _core
-from ..canopen.ds402 import Controlword, Ds402, Ds402Device, OpMode
+from ..canopen.cia402 import Cia402, Cia402Device, Controlword, OpMode
 from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params, Units
 from ..registry import DrivePlugin
 
 __all__ = ["Cia402Drive", "Cia402Sim", "PLUGIN", "make_sim", "open", "OBJECTS"]
 
-# Statusword bits the simulator drives itself (the state bits come from Ds402Device).
+# Statusword bits the simulator drives itself (the state bits come from Cia402Device).
 _SW_REMOTE = 1 << 9
 _SW_TARGET_REACHED = 1 << 10
 _SW_INTERNAL_LIMIT = 1 << 11
@@ -119,7 +118,7 @@ class Cia402Sim:
         if start_position:
             self.motor.set_pulse_position(float(start_position))
             self.motor.set_encoder(int(round(start_position)))
-        self.device = Ds402Device()
+        self.device = Cia402Device()
         self._lock = threading.RLock()
         self._values: dict[tuple[int, int], Any] = {}
         self._stored: dict[tuple[int, int], Any] = {}
@@ -483,7 +482,7 @@ class Cia402Drive(Drive):
                               Capability.WATCHDOG})
     has_watchdog = True
 
-    def __init__(self, host: Ds402, *, units: Optional[Units] = None, on_error: Optional[str] = "quick_stop",
+    def __init__(self, host: Cia402, *, units: Optional[Units] = None, on_error: Optional[str] = "quick_stop",
                  on_exit: Optional[str] = "quick_stop", close_native=None) -> None:
         super().__init__(host, units=units, on_error=on_error, on_exit=on_exit, close_native=close_native)
         self._sdo = host._sdo
@@ -586,7 +585,7 @@ class Cia402Drive(Drive):
 
     def _status(self) -> DriveStatus:
         sw = self.native.statusword
-        state = _core.ds402_decode_statusword(sw)
+        state = _core.cia402_decode_statusword(sw)
         inputs = int.from_bytes(self._sdo.upload(0x60FD, 0), "little")
         velocity = self._velocity()
         mode = self._mode
@@ -616,13 +615,13 @@ def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Uni
          timeout: float = 1.0, on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop",
          watchdog: Optional[dict] = None) -> Cia402Drive:  # noqa: A001 - the plugin's verb
     """``open_drive("cia402", bus=..., address=5)``.  ``watchdog={"host_node": 127, "period": 0.1}``
-    arms the drive's heartbeat consumer at once (see Ds402.start_watchdog)."""
+    arms the drive's heartbeat consumer at once (see Cia402.start_watchdog)."""
     from ..bus import open_bus
 
     owns = isinstance(bus, str)
     b = open_bus(bus) if owns else bus
     try:
-        host = Ds402(b, int(address), timeout=timeout, on_error=None, on_exit=None)
+        host = Cia402(b, int(address), timeout=timeout, on_error=None, on_exit=None)
         drive = Cia402Drive(host, units=units, on_error=on_error, on_exit=on_exit,
                             close_native=b.close if owns else None)
     except Exception:
