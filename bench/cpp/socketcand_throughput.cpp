@@ -1,6 +1,6 @@
 // socketcand over loopback: frames/s both ways and one-way latency for our C++
 // client, and frames/s for python-can's socketcand interface against the same
-// SocketcandServer in the same run (spawned as bench/socketcand_pycan_peer.py).
+// SocketcandServer in the same run (spawned as bench/helpers/socketcand_pycan_peer.py).
 //
 //   ./build/h/bench_socketcand_throughput [frames=200000] [pycan_frames=frames] [reps=3] [counting|virtual]
 //
@@ -28,6 +28,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "bench_python.hpp"
 
 #include "motorbus/can/socketcand_bus.hpp"
 #include "motorbus/can/socketcand_server.hpp"
@@ -71,14 +73,16 @@ struct Peer {
     bool start(const std::string& script, std::uint16_t port, const char* mode, int n) {
         int in[2], out[2];
         if (::pipe(in) || ::pipe(out)) return false;
+        // Built before fork(): the child only calls dup2 and exec.
+        const std::string py = motorbus_bench::python();
+        const std::string p = std::to_string(port), c = std::to_string(n);
         pid = ::fork();
         if (pid == 0) {
             ::dup2(in[0], 0);
             ::dup2(out[1], 1);
             ::close(in[1]);
             ::close(out[0]);
-            std::string p = std::to_string(port), c = std::to_string(n);
-            ::execlp("python3", "python3", script.c_str(), p.c_str(), mode, c.c_str(), nullptr);
+            ::execlp(py.c_str(), py.c_str(), script.c_str(), p.c_str(), mode, c.c_str(), nullptr);
             std::_Exit(127);
         }
         ::close(in[0]);
@@ -107,14 +111,11 @@ struct Peer {
     }
 };
 
-std::string peer_script(const char* argv0) {
-    // bench/cpp/../socketcand_pycan_peer.py relative to the source tree, found from the binary
-    // path (build/h/bench_...) or the working directory.
-    for (std::string cand : {std::string("bench/socketcand_pycan_peer.py"),
-                             std::string(argv0).substr(0, std::string(argv0).rfind('/') + 1) +
-                                 "../../bench/socketcand_pycan_peer.py"})
-        if (::access(cand.c_str(), R_OK) == 0) return cand;
-    return {};
+std::string peer_script() {
+    // A helper, not a benchmark: it lives in bench/helpers/ so tools/bench.sh
+    // does not run it on its own.
+    const std::string path = motorbus_bench::repo_file("bench/helpers/socketcand_pycan_peer.py");
+    return ::access(path.c_str(), R_OK) == 0 ? path : std::string();
 }
 
 // Counts frames arriving at "the rest of the bus" and lets the main thread
@@ -312,8 +313,8 @@ int main(int argc, char** argv) {
     const int pc_frames = argc > 2 ? std::atoi(argv[2]) : frames;
     const int reps = argc > 3 ? std::max(1, std::atoi(argv[3])) : 3;
     const std::string only = argc > 4 ? argv[4] : "";
-    const std::string script = peer_script(argv[0]);
-    if (script.empty()) std::printf("python-can peer script not found (run from the repository root)\n");
+    const std::string script = peer_script();
+    if (script.empty()) std::printf("python-can peer script not found (bench/helpers/socketcand_pycan_peer.py in the checkout)\n");
     std::printf("socketcand over 127.0.0.1: motorbus SocketcandServer; %d frames (C++), %d (python-can),"
                 " 8-byte payloads, best of %d\n", frames, pc_frames, reps);
 
