@@ -186,6 +186,7 @@ void feed_clients(Medium& m, const SocketcandServer& server, int n, const Frame&
 
 struct Result {
     double tx, rx, up_med, up_p99, down_med, down_p99, pc_tx, pc_rx;
+    double c2c_med, c2c_p99;  // client -> server -> client -> server -> client round trip
 };
 
 // Throughputs are the best of `reps` runs, for both clients alike: on a shared
@@ -260,6 +261,40 @@ Result run(Medium& m, int frames, int pc_frames, int reps, const std::string& sc
         res.up_p99 = pu.p99_us;
         res.down_med = pd.median_us;
         res.down_p99 = pd.p99_us;
+
+        // Client-to-client round trip through the server, the shape of an SDO
+        // request/reply between two processes on a served bus: a second,
+        // later-connected client answers 0x601 with 0x581 from its own thread.
+        auto responder = open_socketcand("127.0.0.1", server.port(), "vcan0", co);
+        std::this_thread::sleep_for(10ms);  // past the rawmode settle time
+        std::atomic<bool> stop{false};
+        std::thread answer([&] {
+            while (!stop.load()) {
+                auto req = responder->recv(100ms);
+                if (req && req->id == 0x601) responder->send(Frame::make(0x581, req->payload()));
+            }
+        });
+        while (client->recv(0ms)) {
+        }
+        std::vector<double> rt;
+        for (int i = 0; i < 2050; ++i) {
+            std::vector<std::uint8_t> d{0x40, static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8)};
+            auto t = monotonic_ns();
+            client->send(Frame::make(0x601, d));
+            std::optional<Frame> rep;
+            do rep = client->recv(1s);
+            while (rep && rep->id != 0x581);  // the medium's own frames are not the reply
+            const auto dt = monotonic_ns() - t;
+            if (!rep || rep->payload().size() != d.size() ||
+                !std::equal(d.begin(), d.end(), rep->payload().begin()))
+                fail("client-to-client round trip " + std::to_string(i) + ": no or wrong reply");
+            if (i >= 50) rt.push_back(static_cast<double>(dt));
+        }
+        stop.store(true);
+        answer.join();
+        auto pr = percentiles(rt);
+        res.c2c_med = pr.median_us;
+        res.c2c_p99 = pr.p99_us;
     }
     if (client_drops_any(server)) fail("the server dropped frames for the C++ client");
     if (auto o = m.served->counters().overruns) fail("the medium overran " + std::to_string(o) + " frames");
@@ -304,6 +339,12 @@ void print(const char* name, const Result& r) {
     std::printf("  latency (C++ client, one frame in flight): client->bus median %.1f us p99 %.1f us;"
                 " bus->client median %.1f us p99 %.1f us\n",
                 r.up_med, r.up_p99, r.down_med, r.down_p99);
+    // The target compares a client-to-client round trip with a client<->bus
+    // round trip (client->bus + bus->client): each leg crosses the server twice.
+    const double c2b_rt = r.up_med + r.down_med;
+    std::printf("  client-to-client round trip (two C++ clients, responder on its own thread): median %.1f us"
+                " p99 %.1f us = %.2fx the client<->bus round trip %.1f us (target <= ~2x)\n",
+                r.c2c_med, r.c2c_p99, c2b_rt > 0 ? r.c2c_med / c2b_rt : 0.0, c2b_rt);
 }
 
 }  // namespace
