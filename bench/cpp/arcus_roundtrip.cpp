@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "bench_python.hpp"
+
 #include "motorbus/drives/arcus/client.hpp"
 #include "motorbus/drives/arcus/sim.hpp"
 #include "motorbus/serial/line_server.hpp"
@@ -67,7 +69,7 @@ Stats pyserial_loop(const std::string& path, int n) {
         "    t=time.perf_counter(); rt(); us.append((time.perf_counter()-t)*1e6)\n"
         "us.sort()\n"
         "print(sum(us)/len(us), us[len(us)//2], us[min(len(us)-1,len(us)*99//100)])\n";
-    std::string cmd = "python3 -c \"$MB_SCRIPT\" " + path + " " + std::to_string(n);
+    std::string cmd = motorbus_bench::python() + " -c \"$MB_SCRIPT\" " + path + " " + std::to_string(n);
     setenv("MB_SCRIPT", script.c_str(), 1);
     FILE* f = popen(cmd.c_str(), "r");
     if (!f) return {0, 0, 0};

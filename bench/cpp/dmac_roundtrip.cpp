@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "bench_python.hpp"
+
 #include "motorbus/drives/dmac/client.hpp"
 #include "motorbus/drives/dmac/sim.hpp"
 #include "motorbus/serial/line_server.hpp"
@@ -63,7 +65,7 @@ bool run_pyserial(const std::string& path, int n, Stat& out) {
         "    assert r==b'00#POS=+0\\r\\n', r\n"
         "    if i>=50: t.append(time.perf_counter()-a)\n"
         "t.sort(); print(statistics.median(t)*1e6, t[int(len(t)*0.99)-1]*1e6)\n";
-    std::string cmd = "python3 -c \"$DMAC_BENCH_SCRIPT\"";
+    std::string cmd = motorbus_bench::python() + " -c \"$DMAC_BENCH_SCRIPT\"";
     setenv("DMAC_BENCH_SCRIPT", script.c_str(), 1);
     FILE* p = popen(cmd.c_str(), "r");
     if (!p) return false;

@@ -11,6 +11,8 @@
 #include <thread>
 #include <vector>
 
+#include "bench_python.hpp"
+
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/canopen/pdo.hpp"
 #include "motorbus/canopen/sync.hpp"
@@ -68,7 +70,7 @@ double canopen_decode_ns() {
         "  m.on_message(0x185,d,0.0); return [v.raw for v in m.map]\n"
         "n_=20000; t=min(timeit.repeat(f,number=n_,repeat=5))\n"
         "print(t/n_*1e9)\n";
-    std::string cmd = "python3 -c \"" ;
+    std::string cmd = motorbus_bench::python() + " -c \"";
     for (const char* p = script; *p; ++p) {
         if (*p == '"' || *p == '\\' || *p == '$' || *p == '`') cmd += '\\';
         cmd += *p;

@@ -18,6 +18,8 @@
 #include <thread>
 #include <vector>
 
+#include "bench_python.hpp"
+
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/canopen/local_node.hpp"
 #include "motorbus/canopen/sdo_client.hpp"
@@ -133,9 +135,8 @@ double expedited_rate_many(double seconds, const SdoClientOptions& copts) {
 
 std::map<std::string, double> reference(double seconds) {
     std::map<std::string, double> r;
-    const auto repo = std::filesystem::path(__FILE__).parent_path().parent_path().parent_path();
-    const std::string cmd = "PYTHONPATH=" + (repo / "python").string() + " python3 " +
-                            (repo / "bench" / "sdo.py").string() + " --reference --seconds " +
+    const std::string cmd = "PYTHONPATH=" + motorbus_bench::repo_file("python") + " " + motorbus_bench::python() +
+                            " " + motorbus_bench::repo_file("bench/sdo.py") + " --reference --seconds " +
                             std::to_string(seconds);
     FILE* p = popen(cmd.c_str(), "r");
     if (!p) return r;

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "bench_python.hpp"
+
 #include "motorbus/serial/echo_device.hpp"
 #include "motorbus/serial/line_server.hpp"
 #include "motorbus/serial/port.hpp"
@@ -65,7 +67,7 @@ std::optional<Stats> bench_pyserial(const std::string& path, int n) {
         " assert r==b'1PX\\r\\n', r\n lat.append((time.perf_counter()-a)*1e6)\n"
         "tot=time.perf_counter()-t0\nlat.sort()\n"
         "print(n/tot, lat[len(lat)//2], lat[min(len(lat)-1, len(lat)*99//100)])\n";
-    std::string cmd = "python3 -c \"$MB_SCRIPT\"";
+    std::string cmd = motorbus_bench::python() + " -c \"$MB_SCRIPT\"";
     setenv("MB_SCRIPT", script.c_str(), 1);
     FILE* f = popen(cmd.c_str(), "r");
     if (!f) return std::nullopt;

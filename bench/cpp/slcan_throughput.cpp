@@ -21,6 +21,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "bench_python.hpp"
+
 #include "motorbus/can/slcan_bus.hpp"
 #include "motorbus/can/slcan_codec.hpp"
 #include "motorbus/errors.hpp"
@@ -182,11 +184,7 @@ void cpp_agent(const std::string& path, std::atomic<bool>& done) {
     }
 }
 
-std::string script_path() {
-    std::string here = __FILE__;  // .../bench/cpp/slcan_throughput.cpp
-    auto pos = here.rfind("/cpp/");
-    return here.substr(0, pos) + "/slcan_throughput.py";
-}
+std::string script_path() { return motorbus_bench::repo_file("bench/slcan_throughput.py"); }
 
 Result run_cpp(std::size_t n, std::size_t k) {
     serial::PtyPair pty;
@@ -207,10 +205,12 @@ Result run_cpp(std::size_t n, std::size_t k) {
 
 Result run_pycan(std::size_t n, std::size_t k) {
     serial::PtyPair pty;
+    // Resolved before fork(): the child only calls exec.
+    const std::string script = script_path();
+    const std::string py = motorbus_bench::python();
     pid_t pid = ::fork();
     if (pid == 0) {
-        std::string script = script_path();
-        ::execlp("python3", "python3", script.c_str(), "--agent", "pycan", "--path",
+        ::execlp(py.c_str(), py.c_str(), script.c_str(), "--agent", "pycan", "--path",
                  pty.slave_path().c_str(), static_cast<char*>(nullptr));
         std::_Exit(127);
     }

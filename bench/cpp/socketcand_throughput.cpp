@@ -1,6 +1,6 @@
 // socketcand over loopback: frames/s both ways and one-way latency for our C++
 // client, and frames/s for python-can's socketcand interface against the same
-// SocketcandServer in the same run (spawned as bench/socketcand_pycan_peer.py).
+// SocketcandServer in the same run (spawned as bench/helpers/socketcand_pycan_peer.py).
 //
 //   ./build/h/bench_socketcand_throughput [frames=200000] [pycan_frames=frames] [reps=3] [counting|virtual]
 //
@@ -28,6 +28,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "bench_python.hpp"
 
 #include "motorbus/can/socketcand_bus.hpp"
 #include "motorbus/can/socketcand_server.hpp"
@@ -71,14 +73,16 @@ struct Peer {
     bool start(const std::string& script, std::uint16_t port, const char* mode, int n) {
         int in[2], out[2];
         if (::pipe(in) || ::pipe(out)) return false;
+        // Built before fork(): the child only calls dup2 and exec.
+        const std::string py = motorbus_bench::python();
+        const std::string p = std::to_string(port), c = std::to_string(n);
         pid = ::fork();
         if (pid == 0) {
             ::dup2(in[0], 0);
             ::dup2(out[1], 1);
             ::close(in[1]);
             ::close(out[0]);
-            std::string p = std::to_string(port), c = std::to_string(n);
-            ::execlp("python3", "python3", script.c_str(), p.c_str(), mode, c.c_str(), nullptr);
+            ::execlp(py.c_str(), py.c_str(), script.c_str(), p.c_str(), mode, c.c_str(), nullptr);
             std::_Exit(127);
         }
         ::close(in[0]);
@@ -107,14 +111,11 @@ struct Peer {
     }
 };
 
-std::string peer_script(const char* argv0) {
-    // bench/cpp/../socketcand_pycan_peer.py relative to the source tree, found from the binary
-    // path (build/h/bench_...) or the working directory.
-    for (std::string cand : {std::string("bench/socketcand_pycan_peer.py"),
-                             std::string(argv0).substr(0, std::string(argv0).rfind('/') + 1) +
-                                 "../../bench/socketcand_pycan_peer.py"})
-        if (::access(cand.c_str(), R_OK) == 0) return cand;
-    return {};
+std::string peer_script() {
+    // A helper, not a benchmark: it lives in bench/helpers/ so tools/bench.sh
+    // does not run it on its own.
+    const std::string path = motorbus_bench::repo_file("bench/helpers/socketcand_pycan_peer.py");
+    return ::access(path.c_str(), R_OK) == 0 ? path : std::string();
 }
 
 // Counts frames arriving at "the rest of the bus" and lets the main thread
@@ -185,6 +186,7 @@ void feed_clients(Medium& m, const SocketcandServer& server, int n, const Frame&
 
 struct Result {
     double tx, rx, up_med, up_p99, down_med, down_p99, pc_tx, pc_rx;
+    double c2c_med, c2c_p99;  // client -> server -> client -> server -> client round trip
 };
 
 // Throughputs are the best of `reps` runs, for both clients alike: on a shared
@@ -259,6 +261,40 @@ Result run(Medium& m, int frames, int pc_frames, int reps, const std::string& sc
         res.up_p99 = pu.p99_us;
         res.down_med = pd.median_us;
         res.down_p99 = pd.p99_us;
+
+        // Client-to-client round trip through the server, the shape of an SDO
+        // request/reply between two processes on a served bus: a second,
+        // later-connected client answers 0x601 with 0x581 from its own thread.
+        auto responder = open_socketcand("127.0.0.1", server.port(), "vcan0", co);
+        std::this_thread::sleep_for(10ms);  // past the rawmode settle time
+        std::atomic<bool> stop{false};
+        std::thread answer([&] {
+            while (!stop.load()) {
+                auto req = responder->recv(100ms);
+                if (req && req->id == 0x601) responder->send(Frame::make(0x581, req->payload()));
+            }
+        });
+        while (client->recv(0ms)) {
+        }
+        std::vector<double> rt;
+        for (int i = 0; i < 2050; ++i) {
+            std::vector<std::uint8_t> d{0x40, static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8)};
+            auto t = monotonic_ns();
+            client->send(Frame::make(0x601, d));
+            std::optional<Frame> rep;
+            do rep = client->recv(1s);
+            while (rep && rep->id != 0x581);  // the medium's own frames are not the reply
+            const auto dt = monotonic_ns() - t;
+            if (!rep || rep->payload().size() != d.size() ||
+                !std::equal(d.begin(), d.end(), rep->payload().begin()))
+                fail("client-to-client round trip " + std::to_string(i) + ": no or wrong reply");
+            if (i >= 50) rt.push_back(static_cast<double>(dt));
+        }
+        stop.store(true);
+        answer.join();
+        auto pr = percentiles(rt);
+        res.c2c_med = pr.median_us;
+        res.c2c_p99 = pr.p99_us;
     }
     if (client_drops_any(server)) fail("the server dropped frames for the C++ client");
     if (auto o = m.served->counters().overruns) fail("the medium overran " + std::to_string(o) + " frames");
@@ -303,6 +339,12 @@ void print(const char* name, const Result& r) {
     std::printf("  latency (C++ client, one frame in flight): client->bus median %.1f us p99 %.1f us;"
                 " bus->client median %.1f us p99 %.1f us\n",
                 r.up_med, r.up_p99, r.down_med, r.down_p99);
+    // The target compares a client-to-client round trip with a client<->bus
+    // round trip (client->bus + bus->client): each leg crosses the server twice.
+    const double c2b_rt = r.up_med + r.down_med;
+    std::printf("  client-to-client round trip (two C++ clients, responder on its own thread): median %.1f us"
+                " p99 %.1f us = %.2fx the client<->bus round trip %.1f us (target <= ~2x)\n",
+                r.c2c_med, r.c2c_p99, c2b_rt > 0 ? r.c2c_med / c2b_rt : 0.0, c2b_rt);
 }
 
 }  // namespace
@@ -312,8 +354,8 @@ int main(int argc, char** argv) {
     const int pc_frames = argc > 2 ? std::atoi(argv[2]) : frames;
     const int reps = argc > 3 ? std::max(1, std::atoi(argv[3])) : 3;
     const std::string only = argc > 4 ? argv[4] : "";
-    const std::string script = peer_script(argv[0]);
-    if (script.empty()) std::printf("python-can peer script not found (run from the repository root)\n");
+    const std::string script = peer_script();
+    if (script.empty()) std::printf("python-can peer script not found (bench/helpers/socketcand_pycan_peer.py in the checkout)\n");
     std::printf("socketcand over 127.0.0.1: motorbus SocketcandServer; %d frames (C++), %d (python-can),"
                 " 8-byte payloads, best of %d\n", frames, pc_frames, reps);
 

@@ -18,6 +18,7 @@ import tty
 
 import can
 import pytest
+from can.interfaces.slcan import slcanBus
 
 import motorbus
 from motorbus import _core
@@ -164,3 +165,73 @@ def test_pythoncan_host_against_our_slcanbus():
             ours.close()
     finally:
         modem.close()
+
+
+# ---- CR LF hosts (docs/slcan.md "Line endings") ------------------------------
+# A host that ends commands with CR LF used to lose every second frame: the LF
+# led the next command, which our adapter answered with BEL and dropped.
+
+class _CrLfSlcanBus(slcanBus):
+    """python-can's own slcan bus, ending every command (C, S6, O and each frame) with CR LF."""
+
+    LINE_TERMINATOR = b"\r\n"
+
+
+@pytest.mark.threaded
+def test_pythoncan_host_with_crlf_line_endings_loses_no_frame(hub):
+    inner, peer = hub
+    with SlcanServer(inner) as server:
+        bus = _CrLfSlcanBus(channel=server.pty_path, bitrate=500000, sleep_after_open=0)
+        try:
+            # python-can does not wait for answers: the O after "C\r\nS6\r\n" lands soon
+            deadline = time.monotonic() + 3
+            while not server.is_open and time.monotonic() < deadline:
+                time.sleep(0.01)
+            assert server.is_open
+            for f in FRAMES:
+                bus.send(_to_msg(f))
+            got = []
+            for _ in FRAMES:
+                fr = peer.recv(timeout=3.0)
+                assert fr is not None, f"bus received only {len(got)} of {len(FRAMES)}"
+                got.append(_frame_tuple(fr))
+            assert got == FRAMES
+            for f in FRAMES:
+                peer.send(_to_frame(f))
+            assert _pycan_recv_all(bus, len(FRAMES)) == FRAMES
+            assert server.stats["transmitted"] == len(FRAMES)
+            # The only BELs are the three python-can's open sequence earns with CR
+            # too (C, S6, "" for no data bitrate, O, O): C while closed, the empty
+            # line and the second O.  Before the fix every frame after the first
+            # drew one as well.
+            assert server.stats["invalid_commands"] == 3
+        finally:
+            bus.shutdown()
+
+
+@pytest.mark.threaded
+def test_pyserial_host_writing_crlf_and_nul_padded_lines(hub):
+    """Raw bytes from pyserial: CR LF, LF alone and NUL pads; every frame arrives, every reply is z."""
+    import serial  # pyserial
+
+    inner, peer = hub
+    n = 200
+    with SlcanServer(inner) as server:
+        port = serial.Serial(server.pty_path, 115200, timeout=3.0)
+        try:
+            port.write(b"S6\r\nO\r\n")
+            assert port.read(2) == b"\r\r"
+            ends = (b"\r\n", b"\n", b"\r\n\x00\x00", b"\x00\r\n")
+            lines = b"".join(b"t%03X2%02X%02X" % (0x100 + i, i, 0xFF - i) + ends[i % 4] for i in range(n))
+            port.write(lines)
+            # i % 4 == 3 puts a NUL inside the line: that one is refused, never mangled.
+            expected = b"".join(b"\a" if i % 4 == 3 else b"z\r" for i in range(n))
+            assert port.read(len(expected)) == expected
+            got = []
+            while (fr := peer.recv(timeout=0.5)) is not None:
+                got.append((fr.id, fr.data))
+            assert got == [(0x100 + i, bytes((i, 0xFF - i))) for i in range(n) if i % 4 != 3]
+            assert server.stats["transmitted"] == n - n // 4
+            assert server.stats["invalid_commands"] == n // 4
+        finally:
+            port.close()

@@ -151,3 +151,29 @@ def test_our_client_against_our_server_every_id_width_and_dlc(served):
         for ext, can_id, n in CASES:
             got = ours.recv(2)
             assert (got.id, got.extended, got.data) == (can_id, ext, payload(n))
+
+
+def test_pythoncan_clients_answer_each_other_without_the_poll_stall(served):
+    """Two python-can clients of our server in request/reply: the later-connected one's
+    frame to the earlier one used to wait out the server's 50 ms poll() timeout.
+    20 round trips must take far less than 20 x 50 ms (loose bound; latency is
+    measured in bench/socketcand_roundtrip.py)."""
+    server, _node = served
+    early, late = pc_bus(server), pc_bus(server)
+    try:
+        assert wait_for(lambda: server.stats["clients_active"] == 2)
+        time.sleep(0.005)
+        rounds = 20
+        start = time.perf_counter()
+        for i in range(rounds):
+            late.send(can.Message(arbitration_id=0x601, is_extended_id=False, data=bytes((0x40, i))))
+            m = recv_data(early)
+            assert (m.arbitration_id, bytes(m.data)) == (0x601, bytes((0x40, i)))
+            early.send(can.Message(arbitration_id=0x581, is_extended_id=False, data=bytes((0x60, i))))
+            m = recv_data(late)
+            assert (m.arbitration_id, bytes(m.data)) == (0x581, bytes((0x60, i)))
+        took = time.perf_counter() - start
+        assert took < 0.5, f"{rounds} round trips took {took * 1e3:.0f} ms"
+    finally:
+        early.shutdown()
+        late.shutdown()

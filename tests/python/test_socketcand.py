@@ -165,3 +165,41 @@ def test_socketcan_on_this_kernel():
 def test_socketcan_bad_interface_name_is_invalid_argument():
     with pytest.raises((motorbus.InvalidArgument, motorbus.LinkDown)):
         open_socketcan("x" * 20)
+
+
+def test_client_to_client_round_trips_through_bus_serve_do_not_stall():
+    """Two clients of `motorbus bus serve --socketcand` (a separate process) answer each
+    other: the frame to the earlier-connected client used to wait for the server's 50 ms
+    poll() timeout, so 20 request/reply round trips took ~1 s.  The bound is loose on
+    purpose (loaded machines); bench/socketcand_roundtrip.py measures the latency."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "motorbus", "bus", "serve", f"virtual:{hub()}",
+                             "--socketcand", "127.0.0.1:0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        kind, hostport, channel = proc.stdout.readline().split()
+        assert kind == "socketcand"
+        host, port = hostport.rsplit(":", 1)
+        with open_socketcand(host, int(port), channel) as early, \
+                open_socketcand(host, int(port), channel) as late:
+            time.sleep(0.01)  # past the server's rawmode settle time
+            rounds = 20
+            start = time.perf_counter()
+            for i in range(rounds):
+                late.send(Frame(0x601, bytes((0x40, i))))
+                got = early.recv(2)
+                assert got is not None and (got.id, got.data) == (0x601, bytes((0x40, i)))
+                early.send(Frame(0x581, bytes((0x60, i))))
+                got = late.recv(2)
+                assert got is not None and (got.id, got.data) == (0x581, bytes((0x60, i)))
+            took = time.perf_counter() - start
+            assert took < 0.5, f"{rounds} round trips took {took * 1e3:.0f} ms"
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        finally:
+            if proc.poll() is None:
+                proc.kill()

@@ -262,10 +262,11 @@ void StreamDecoder::count(const Event& e) {
 }
 
 bool StreamDecoder::discard_partial() {
-    const bool had = overflow_ || len_ > 0;
-    if (len_ > 0 && !overflow_) ++counters_.dropped_partial;
+    const bool had = in_line();
+    if ((len_ > 0 || broken_) && !overflow_) ++counters_.dropped_partial;
     len_ = 0;
     overflow_ = false;
+    broken_ = false;
     return had;
 }
 

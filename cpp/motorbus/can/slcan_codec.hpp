@@ -10,6 +10,14 @@
 //
 // Every decoder keeps at most kMtu bytes of a line; anything longer puts it in
 // an error state until the next CR or BEL (the kernel's slcan_unesc rule).
+//
+// LF and NUL are separators, never line content: hosts end commands with CR LF
+// (terminal programs, scripts), some firmwares pad with NUL,
+// and both would otherwise prefix the next line and turn it into garbage.
+//   * LF or NUL between lines is skipped;
+//   * LF after line bytes ends the line like CR (LF-only peers work too);
+//   * NUL after line bytes breaks that line: it is dropped as malformed at
+//     its terminator (a NUL inside a frame is corruption, never a pad).
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -123,7 +131,14 @@ public:
     template <class OnEvent>
     void feed(std::span<const std::uint8_t> bytes, OnEvent&& on_event) {
         for (std::uint8_t b : bytes) {
-            if (b == '\r' || b == '\a') {
+            if (b == '\n' || b == '\0') {
+                if (!in_line()) continue;  // separator between lines (CR LF, pads)
+                if (b == '\n') {
+                    finish_line(false, on_event);  // LF-only peer
+                } else {
+                    broken_ = true;  // NUL inside a line: drop it at its end
+                }
+            } else if (b == '\r' || b == '\a') {
                 finish_line(b == '\a', on_event);
             } else if (overflow_) {
                 // discarding until the terminator (L1)
@@ -147,11 +162,23 @@ public:
     const DecoderCounters& counters() const { return counters_; }
 
 private:
+    bool in_line() const { return len_ > 0 || overflow_ || broken_; }
     template <class OnEvent>
     void finish_line(bool bel, OnEvent& on_event) {
         if (overflow_) {
             overflow_ = false;
+            broken_ = false;
             len_ = 0;
+            if (bel) emit_bel(on_event);
+            return;
+        }
+        if (broken_) {
+            broken_ = false;
+            len_ = 0;
+            Event e;
+            e.kind = EventKind::Malformed;
+            count(e);
+            on_event(static_cast<const Event&>(e));
             if (bel) emit_bel(on_event);
             return;
         }
@@ -188,6 +215,7 @@ private:
     char buf_[kMtu];
     std::size_t len_ = 0;
     bool overflow_ = false;
+    bool broken_ = false;  // a NUL arrived inside the current line
     DecoderCounters counters_;
 };
 
@@ -221,20 +249,34 @@ Command parse_command(std::string_view line);
 
 class CommandDecoder {
 public:
-    // Calls on_command(const Command&) per CR-terminated line.  BEL bytes from
-    // a host are noise: they end the partial line, which is dropped.
+    // Calls on_command(const Command&) per CR- (or LF-) terminated line.  BEL
+    // bytes from a host are noise: they end the partial line, which is
+    // dropped.  LF and NUL between commands are skipped (CR LF hosts, pads),
+    // so they never cost a command; a NUL inside a line makes it Invalid.
     template <class OnCommand>
     void feed(std::span<const std::uint8_t> bytes, OnCommand&& on_command) {
         for (std::uint8_t b : bytes) {
-            if (b == '\r' || b == '\a') {
+            if (b == '\n' || b == '\0') {
+                if (len_ == 0 && !overflow_ && !broken_) continue;  // separator
+                if (b == '\0') {
+                    broken_ = true;
+                    continue;
+                }
+                // LF after command bytes: an LF-only host's terminator.
+            }
+            if (b == '\r' || b == '\a' || b == '\n') {
                 const bool was_over = overflow_;
+                const bool was_broken = broken_;
                 overflow_ = false;
+                broken_ = false;
                 std::string_view line(buf_, len_);
                 len_ = 0;
                 if (b == '\a') continue;
                 Command c;
                 if (was_over) {
                     ++over_errors_;
+                    c.kind = CommandKind::Invalid;
+                } else if (was_broken) {
                     c.kind = CommandKind::Invalid;
                 } else {
                     c = parse_command(line);
@@ -255,6 +297,7 @@ private:
     char buf_[kMtu];
     std::size_t len_ = 0;
     bool overflow_ = false;
+    bool broken_ = false;  // a NUL arrived inside the current line
     std::uint64_t over_errors_ = 0;
 };
 

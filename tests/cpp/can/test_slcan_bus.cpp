@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstring>
 #include <deque>
 #include <functional>
 #include <mutex>
@@ -538,4 +539,74 @@ TEST(SlcanBus, BurstsAreBatchedInOrderAndIsolatedFramesStillGoStraightOut) {
     auto got = peer->recv(2s);
     ASSERT_TRUE(got);
     EXPECT_EQ(got->id, 0x7ABu);
+}
+
+// ---- line endings on real ptys: LF and NUL are separators (docs/slcan.md) ----
+
+TEST(SlcanServer, CrLfHostWithNulPadsLosesNoFrameAndGetsNoBel) {
+    // A CR LF host used to lose every second frame: the LF led the next
+    // command, which the adapter answered with BEL and never transmitted.
+    auto hub = "slcan-test-" + std::to_string(::getpid()) + "-crlf";
+    auto inner = open_virtual(hub);
+    auto peer = open_virtual(hub);
+    SlcanServer server(inner);
+    auto tty = serial::open_port(server.pty_path(), 0);
+    constexpr int kFrames = 100;
+    std::string out = "C\r\nS6\r\nO\r\n";
+    for (int i = 0; i < kFrames; ++i) {
+        char line[32];
+        // CR LF, LF alone and NUL pads mixed, as different hosts send them.
+        const char* end = i % 3 == 0 ? "\r\n" : i % 3 == 1 ? "\n" : "\r\n\0\0";
+        std::snprintf(line, sizeof line, "t%03X2%02X%02X", 0x100 + i, i, 0xFF - i);
+        out += line;
+        out.append(end, i % 3 == 2 ? 4 : std::strlen(end));
+    }
+    tty->write(bytes_of(out));
+    std::string replies;
+    std::array<std::uint8_t, 512> buf;
+    const std::size_t want = 3 + kFrames;  // C (BEL: closed), S6, O, then z per frame
+    auto end = std::chrono::steady_clock::now() + 5s;
+    while (std::chrono::steady_clock::now() < end &&
+           static_cast<std::size_t>(std::count_if(replies.begin(), replies.end(),
+                                                  [](char c) { return c == '\r' || c == '\a'; })) < want) {
+        std::size_t n = tty->read(buf, 50ms);
+        replies.append(reinterpret_cast<char*>(buf.data()), n);
+    }
+    std::string expected = "\a\r\r";
+    for (int i = 0; i < kFrames; ++i) expected += "z\r";
+    EXPECT_EQ(replies, expected);
+    for (int i = 0; i < kFrames; ++i) {
+        auto got = peer->recv(2s);
+        ASSERT_TRUE(got.has_value()) << "frame " << i << " lost";
+        EXPECT_EQ(got->id, static_cast<std::uint32_t>(0x100 + i));
+        ASSERT_EQ(got->len, 2);
+        EXPECT_EQ(got->data[0], i);
+        EXPECT_EQ(got->data[1], 0xFF - i);
+    }
+    auto s = server.stats();
+    EXPECT_EQ(s.transmitted, static_cast<std::uint64_t>(kFrames));
+    EXPECT_EQ(s.invalid_commands, 1u);  // only the C while closed
+}
+
+TEST(SlcanBus, AdapterEndingLinesWithCrLfAndNulPadsIsDecodedWithoutErrors) {
+    serial::PtyPair pty;
+    // An adapter that ends every reply and frame with CR LF.
+    ScriptedAdapter adapter(pty.port(), [](const std::string& l) { return lawicel(l) + "\n"; });
+    SlcanBus bus(pty.open_slave(), fast_opts());
+    for (int i = 0; i < 20; ++i) bus.send(Frame::make(0x200 + i, std::vector<std::uint8_t>{static_cast<std::uint8_t>(i)}));
+    bus.flush_tx(2s);  // every z\r\n acknowledged one frame
+    using namespace std::string_literals;
+    adapter.inject("t1232CAFE\r\n\0\0t456110\r\n\0T1FFFFFFF0\n"s);
+    for (std::uint32_t id : {0x123u, 0x456u, 0x1FFFFFFFu}) {
+        auto got = bus.recv(2s);
+        ASSERT_TRUE(got.has_value()) << std::hex << id;
+        EXPECT_EQ(got->id, id);
+    }
+    auto c = bus.counters();
+    EXPECT_EQ(c.parse_errors, 0u);
+    EXPECT_EQ(c.ignored, 0u);
+    EXPECT_EQ(c.bus_errors, 0u);
+    EXPECT_EQ(c.tx_dropped, 0u);
+    EXPECT_EQ(bus.stats().acks, 20u);
+    EXPECT_EQ(bus.stats().nacks, 0u);
 }

@@ -459,3 +459,134 @@ TEST(SlcanAdapter, AnswersLikeACanusb) {
     EXPECT_EQ(run("t1230").bytes, "\a");  // listen-only never transmits
     EXPECT_FALSE(run("t1230").transmit.has_value());
 }
+
+// ------------------------------------------------ line endings: LF and NUL --
+// LF and NUL are separators, never frame bytes (docs/slcan.md "Line endings").
+
+TEST(SlcanDecode, CrLfLinesDecodeWithoutErrorsInAnyChunking) {
+    const std::string_view stream = "t1232AABB\r\nz\r\n\r\nT1FFFFFFF1EE\r\nF04\r\n";
+    for (bool bytewise : {false, true}) {
+        StreamDecoder d;
+        auto v = bytewise ? feed_bytewise(d, stream) : feed(d, stream);
+        ASSERT_EQ(v.size(), 5u) << bytewise;
+        EXPECT_EQ(v[0].kind, EventKind::Frame);
+        EXPECT_EQ(v[0].frame.id, 0x123u);
+        EXPECT_EQ(v[0].frame.len, 2);
+        EXPECT_EQ(v[0].frame.data[0], 0xAA);
+        EXPECT_EQ(v[0].frame.data[1], 0xBB);
+        EXPECT_EQ(v[1].kind, EventKind::TxAck);
+        EXPECT_EQ(v[2].kind, EventKind::Ok);  // the lone CR, its LF adds nothing
+        EXPECT_EQ(v[3].kind, EventKind::Frame);
+        EXPECT_EQ(v[3].frame.id, 0x1FFFFFFFu);
+        EXPECT_EQ(v[3].frame.data[0], 0xEE);
+        EXPECT_EQ(v[4].kind, EventKind::Status);
+        EXPECT_EQ(v[4].status, 0x04);
+        EXPECT_EQ(d.counters().frames, 2u);
+        EXPECT_EQ(d.counters().rx_errors, 0u);
+        EXPECT_EQ(d.counters().ignored, 0u);
+        EXPECT_EQ(d.pending(), 0u);
+    }
+}
+
+TEST(SlcanDecode, LfAloneEndsALineAndStrayLfsAreSkipped) {
+    StreamDecoder d;
+    auto v = feed(d, "\n\nt1231AB\nz\n\n\nt4560\n");
+    ASSERT_EQ(v.size(), 3u);
+    EXPECT_EQ(v[0].kind, EventKind::Frame);
+    EXPECT_EQ(v[0].frame.id, 0x123u);
+    EXPECT_EQ(v[0].frame.data[0], 0xAB);
+    EXPECT_EQ(v[1].kind, EventKind::TxAck);
+    EXPECT_EQ(v[2].kind, EventKind::Frame);
+    EXPECT_EQ(v[2].frame.id, 0x456u);
+    EXPECT_EQ(v[2].frame.len, 0);
+    EXPECT_EQ(d.counters().rx_errors, 0u);
+}
+
+TEST(SlcanDecode, NulPadsBetweenLinesAreSkippedAndANulInsideALineBreaksIt) {
+    using namespace std::string_view_literals;
+    StreamDecoder d;
+    auto v = feed(d, "\0\0\0t1231AB\r\0\0\0\0z\r\0"sv);
+    ASSERT_EQ(v.size(), 2u);
+    EXPECT_EQ(v[0].kind, EventKind::Frame);
+    EXPECT_EQ(v[0].frame.data[0], 0xAB);
+    EXPECT_EQ(v[1].kind, EventKind::TxAck);
+    EXPECT_EQ(d.counters().rx_errors, 0u);
+    EXPECT_EQ(d.pending(), 0u);
+    // A NUL inside a line is corruption: the whole line is one malformed
+    // event (never "t1231A" + "B", never a frame with a hole in it).
+    v = feed(d, "t12\x00" "31AB\r"sv);
+    ASSERT_EQ(v.size(), 1u);
+    EXPECT_EQ(v[0].kind, EventKind::Malformed);
+    EXPECT_EQ(d.counters().rx_errors, 1u);
+    expect_next_valid_frame(d);
+    // ... also when the line then ends with LF, and a partial broken line is
+    // dropped like any other partial line.
+    v = feed(d, "t1231A\x00\n"sv);
+    ASSERT_EQ(v.size(), 1u);
+    EXPECT_EQ(v[0].kind, EventKind::Malformed);
+    feed(d, "t12\x00"sv);
+    EXPECT_TRUE(d.discard_partial());
+    expect_next_valid_frame(d);
+}
+
+namespace {
+std::vector<Command> feed_commands(CommandDecoder& d, std::string_view s, bool bytewise = false) {
+    std::vector<Command> out;
+    auto on = [&](const Command& c) { out.push_back(c); };
+    if (bytewise) {
+        for (char c : s) d.feed(std::span(reinterpret_cast<const std::uint8_t*>(&c), 1), on);
+    } else {
+        d.feed(std::span(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()), on);
+    }
+    return out;
+}
+}  // namespace
+
+TEST(SlcanCommand, CrLfHostLosesNoCommandAndGetsNoBel) {
+    // Before LF was a separator, every command after the first arrived as
+    // "\nt..." and was answered with BEL: every second frame of a CR LF host.
+    for (bool bytewise : {false, true}) {
+        CommandDecoder d;
+        AdapterSession s;
+        std::string replies;
+        std::vector<Frame> sent;
+        for (const Command& c : feed_commands(d, "C\r\nS6\r\nO\r\nt1232AABB\r\nt4560\r\nT1FFFFFFF1EE\r\nr7FF8\r\n", bytewise)) {
+            auto r = s.handle(c);
+            replies += r.bytes;
+            if (r.transmit) sent.push_back(*r.transmit);
+        }
+        EXPECT_EQ(replies, "\a\r\rz\rz\rZ\rz\r") << bytewise;  // C while closed is the only BEL
+        ASSERT_EQ(sent.size(), 4u);
+        EXPECT_EQ(sent[0].id, 0x123u);
+        EXPECT_EQ(sent[0].data[1], 0xBB);
+        EXPECT_EQ(sent[1].id, 0x456u);
+        EXPECT_EQ(sent[2].id, 0x1FFFFFFFu);
+        EXPECT_TRUE(sent[3].rtr);
+        EXPECT_EQ(sent[3].len, 8);
+    }
+}
+
+TEST(SlcanCommand, LfOnlyHostAndNulPadsAreAccepted) {
+    using namespace std::string_view_literals;
+    CommandDecoder d;
+    auto v = feed_commands(d, "O\nt1231AB\n\n\0\0t4560\r\0\n\0"sv);
+    ASSERT_EQ(v.size(), 3u);
+    EXPECT_EQ(v[0].kind, CommandKind::Open);
+    EXPECT_EQ(v[1].kind, CommandKind::Transmit);
+    EXPECT_EQ(v[1].frame.data[0], 0xAB);
+    EXPECT_EQ(v[2].kind, CommandKind::Transmit);
+    EXPECT_EQ(v[2].frame.id, 0x456u);
+    // A NUL inside a command makes that one command invalid (answered BEL),
+    // never a shorter or a joined command; the next one is intact.
+    v = feed_commands(d, "t123\x00" "1AB\rt7FF0\r"sv);
+    ASSERT_EQ(v.size(), 2u);
+    EXPECT_EQ(v[0].kind, CommandKind::Invalid);
+    EXPECT_EQ(v[1].kind, CommandKind::Transmit);
+    EXPECT_EQ(v[1].frame.id, 0x7FFu);
+    // An over-long line ended by LF is one overflow, as with CR.
+    v = feed_commands(d, std::string(100, 't') + "\nO\r");
+    ASSERT_EQ(v.size(), 2u);
+    EXPECT_EQ(v[0].kind, CommandKind::Invalid);
+    EXPECT_EQ(v[1].kind, CommandKind::Open);
+    EXPECT_EQ(d.over_errors(), 1u);
+}

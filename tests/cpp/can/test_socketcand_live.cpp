@@ -239,6 +239,40 @@ TEST(SocketcandLive, ClientsSeeEachOthersFramesButNotTheirOwn) {
     EXPECT_FALSE(own.has_value());
 }
 
+TEST(SocketcandLive, ClientToClientRoundTripsDoNotWaitForThePollTimeout) {
+    // A frame from a later-connected client to an earlier one used to sit in
+    // the earlier client's queue until the I/O thread's 50 ms poll() timed out
+    // (its output was filled before the later client's input was read), so a
+    // request/reply between two clients cost ~50 ms.  20 round trips must
+    // take well under 20 x 50 ms; the bound is loose on purpose (loaded CI),
+    // the latency itself is measured in bench/socketcand_roundtrip.py.
+    auto served = open_virtual(unique_hub());
+    SocketcandServer server(served);
+    auto early = open_socketcand("127.0.0.1", server.port(), "can0", fast_client());
+    auto late = open_socketcand("127.0.0.1", server.port(), "can0", fast_client());
+    ASSERT_TRUE(wait_for([&] { return server.stats().clients_active == 2; }));
+    std::this_thread::sleep_for(5ms);  // past the rawmode settle time
+    constexpr int kRounds = 20;
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < kRounds; ++i) {
+        const std::vector<std::uint8_t> req{0x40, static_cast<std::uint8_t>(i)};
+        late->send(Frame::make(0x601, req));  // later client -> earlier client
+        auto got = early->recv(2s);
+        ASSERT_TRUE(got.has_value()) << i;
+        EXPECT_EQ(got->id, 0x601u);
+        EXPECT_EQ(payload(*got), req);
+        const std::vector<std::uint8_t> rep{0x60, static_cast<std::uint8_t>(i)};
+        early->send(Frame::make(0x581, rep));  // and back
+        got = late->recv(2s);
+        ASSERT_TRUE(got.has_value()) << i;
+        EXPECT_EQ(got->id, 0x581u);
+        EXPECT_EQ(payload(*got), rep);
+    }
+    const auto took = std::chrono::steady_clock::now() - start;
+    EXPECT_LT(took, 500ms) << kRounds << " round trips took "
+                           << std::chrono::duration_cast<std::chrono::milliseconds>(took).count() << " ms";
+}
+
 TEST(SocketcandLive, HandshakeFailuresAreTyped) {
     auto served = open_virtual(unique_hub());
     SocketcandServerOptions so;

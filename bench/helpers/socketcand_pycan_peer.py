@@ -1,8 +1,8 @@
 """python-can's socketcand interface as a benchmark peer, driven by
 bench_socketcand_throughput (C++) over stdin/stdout:
 
-    python3 bench/socketcand_pycan_peer.py PORT tx N   -> sends N frames as fast as it can
-    python3 bench/socketcand_pycan_peer.py PORT rx N   -> receives N frames, prints the time
+    python bench/helpers/socketcand_pycan_peer.py PORT tx N   -> sends N frames as fast as it can
+    python bench/helpers/socketcand_pycan_peer.py PORT rx N   -> receives N frames, prints the time
 
 It prints READY once connected, then waits for a line on stdin before starting,
 so process start-up and the handshake stay out of the measurement.
