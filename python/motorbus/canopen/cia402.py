@@ -100,6 +100,12 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
         self._closed = False
         _stop_at_exit.track(self)
 
+    @property
+    def sdo(self):
+        """The SDO client this drive object talks through (one per node: a second
+        client on the same COB-IDs would take this one's responses)."""
+        return self._sdo
+
     def set_mode(self, mode: int) -> None:  # accepts OpMode or int
         super().set_mode(int(mode))
 

@@ -485,7 +485,7 @@ class Cia402Drive(Drive):
     def __init__(self, host: Cia402, *, units: Optional[Units] = None, on_error: Optional[str] = "quick_stop",
                  on_exit: Optional[str] = "quick_stop", close_native=None) -> None:
         super().__init__(host, units=units, on_error=on_error, on_exit=on_exit, close_native=close_native)
-        self._sdo = host._sdo
+        self._sdo = host.sdo
         self._mode: Optional[int] = None
 
     # ---- helpers ----
@@ -514,24 +514,34 @@ class Cia402Drive(Drive):
     def _disable(self) -> None:
         self.native.disable()
 
-    def _move_to(self, target: float, velocity: Optional[float]) -> None:
-        self._operation_enabled()
+    def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
         self._use_mode(OpMode.PROFILE_POSITION)
         if velocity is not None:
             self._u32(0x6081, velocity)  # stays the profile velocity for later moves too
-        self.native.move_to(int(round(target)))
+        try:
+            self.native.move_to(int(round(target)), relative=relative)
+        except _core.TimeoutError:
+            # A drive that is not in Operation Enabled never acknowledges a set-point:
+            # say that rather than "timeout" (checked only on failure: it costs an SDO read).
+            self._refused("move")
+            raise
+
+    def _refused(self, what: str) -> None:
+        state = self.native.state
+        if state != "OPERATION ENABLED":
+            raise _core.DriveFault(f"cia402: {what} refused in state {state} (enable() first"
+                                   f"{', clear_faults()' if state == 'FAULT' else ''})")
+
+    def _move_to(self, target: float, velocity: Optional[float]) -> None:
+        self._set_point(target, False, velocity)
 
     def _move_by(self, distance: float, velocity: Optional[float]) -> None:
-        self._operation_enabled()
-        self._use_mode(OpMode.PROFILE_POSITION)
-        if velocity is not None:
-            self._u32(0x6081, velocity)
-        self.native.move_to(int(round(distance)), relative=True)
+        self._set_point(distance, True, velocity)
 
     def _jog(self, velocity: float) -> None:
-        self._operation_enabled()
         self._use_mode(OpMode.PROFILE_VELOCITY)
         self.native.set_velocity(int(round(velocity)))
+        self._refused("jog")  # PV has no handshake: look whether the drive can run
 
     def _stop(self) -> None:
         # Halt (controlword bit 8): decelerate with 6084h and stay in Operation Enabled.
