@@ -139,7 +139,8 @@ def build_parser() -> argparse.ArgumentParser:
     ss = sim.add_parser("serve", help="serve simulated drives: serial kinds on ptys, CAN kinds on a served bus")
     ss.add_argument("--drive", action="append", required=True, metavar="KIND:ADDR[,ADDR...]",
                     help="drives of one registered kind (`motorbus drives` lists them): a serial line with one "
-                         "or more drives (arcus:01,02 = RS-485 multi-drop), or CAN nodes (cia402:5,6); repeatable")
+                         "or more drives of a serial kind (KIND:01,02 = RS-485 multi-drop), or CAN nodes (cia402:5,6); "
+                         "repeatable")
     ss.add_argument("--pty", action="store_true", help="serve serial lines on pseudo-terminals (the default)")
     ss.add_argument("--baud", type=int, default=0, help="pace serial replies at this baud rate (0 = unthrottled)")
     ss.add_argument("--store-dir", default=None, help="where drives persist their stored settings")

@@ -1,7 +1,7 @@
 """One API over every drive: :class:`Drive`, what python-can's ``BusABC`` is to buses.
 
     import motorbus
-    with motorbus.open_drive("arcus", line="/dev/ttyUSB0", address="01",
+    with motorbus.open_drive("<kind>", line="/dev/ttyUSB0", address="01",
                              units=motorbus.Units("mm", 0.0025)) as x:
         x.enable()
         x.move_to(25.0)                 # mm, waits until the move is done
@@ -452,8 +452,8 @@ def open_drive(kind: str, *, line: Any = None, bus: Any = None, address: Union[s
       an open ``LineLink`` shared with other drives on one RS-485 line;
     * CAN kinds: ``bus`` = an ``open_bus`` spec (opened, and closed with the
       drive) or an open Bus;
-    * ``address``: the vendor's own (``"01"`` for an Arcus, ``"00"`` for a DMAC,
-      the node-ID for CANopen);
+    * ``address``: the vendor's own (two digits on an ASCII line, the node-ID
+      for CANopen: see docs/drives/<vendor>.md);
     * ``options``: the vendor's (``on_error``, ``on_exit``, timeouts...).
     """
     plugin = registry.drive_plugin(kind)

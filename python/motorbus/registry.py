@@ -146,10 +146,10 @@ def bus_schemes() -> dict[str, BusScheme]:
 
 
 def parse_drive_spec(spec: str) -> tuple[DrivePlugin, list[str]]:
-    """``"arcus:01,02"`` -> (the arcus plugin, ["01", "02"]); InvalidArgument naming the problem."""
+    """``"<kind>:01,02"`` -> (that kind's plugin, ["01", "02"]); InvalidArgument naming the problem."""
     kind, sep, addrs = spec.partition(":")
     if not sep or not addrs:
-        raise _core.InvalidArgument(f"drive spec {spec!r}: expected KIND:ADDR[,ADDR...], e.g. arcus:01")
+        raise _core.InvalidArgument(f"drive spec {spec!r}: expected KIND:ADDR[,ADDR...], e.g. cia402:5")
     plugin = drive_plugin(kind)
     addresses = [plugin.check_address(a.strip()) for a in addrs.split(",")]
     if len(set(addresses)) != len(addresses):

@@ -5,10 +5,10 @@ A drive spec is ``KIND:ADDR[,ADDR...]`` for any registered kind
 
 * a **serial** kind gets one serial line (a pty) per spec, carrying all its
   addresses as an RS-485 multi-drop bus does (every drive sees every request,
-  only the addressed one answers): ``arcus:01,02``;
+  only the addressed one answers): ``<kind>:01,02``;
 * a **CAN** kind puts one node per address on the served CAN bus: ``cia402:5,6``.
 
-``motorbus sim serve --drive arcus:01 --drive cia402:5`` prints one line per
+``motorbus sim serve --drive <kind>:01 --drive cia402:5`` prints one line per
 serial line (``<spec> <pty path>``) and one per CAN server (``socketcand
 HOST:PORT CHANNEL`` / ``slcan PTY``), then serves until SIGINT/SIGTERM.
 
@@ -84,7 +84,7 @@ def serve_lines(specs: Sequence[str], baud: int = 0, clock: Any = None,
 class SimBench:
     """Simulated drives of any kinds, served as a bench would be wired.
 
-    ``SimBench(["arcus:01,02", "cia402:5"], bus="virtual:sim", socketcand=["127.0.0.1:0"])``:
+    ``SimBench(["<serial kind>:01,02", "cia402:5"], bus="virtual:sim", socketcand=["127.0.0.1:0"])``:
     serial kinds on their ptys (``lines``), CAN kinds as nodes on ``bus``,
     exposed through the socketcand / SLCAN servers (``can``; with CAN drives and
     no server asked for, one socketcand server on 127.0.0.1 with a free port).
