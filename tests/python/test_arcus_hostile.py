@@ -153,6 +153,7 @@ def test_a13_power_cycle_then_boot_state(rig):
 
 def test_a14_motion_not_retried_query_retried(rig):
     dev, c, sim = rig
+    c.enable()  # a disabled motor does no motion (manual §6)
     seen = []
 
     def swallow(r):
