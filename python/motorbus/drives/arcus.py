@@ -1,11 +1,12 @@
 """Arcus DMX-CAN drives over their ASCII line (RS-232 or RS-485 multi-drop).
 
     from motorbus.drives.arcus import ArcusClient
-    with ArcusClient("/dev/ttyUSB0", address=1, baud=9600) as drive:
+    with ArcusClient("/dev/ttyUSB0", address="01", baud=9600) as drive:
         drive.enable()
+        drive.high_speed = 2000     # HSPD (a read/write property)
         drive.move(4000)            # X4000: counts with StepNLoop on, pulses without
         drive.wait_idle(timeout=10)
-        print(drive.position(), drive.status())
+        print(drive.position, drive.status)
 
 A simulator for tests and demos (``make_sim``) answers on a pty exactly like the
 device; ``motorbus sim serve --pty --drive arcus:01`` uses it.
@@ -13,6 +14,7 @@ device; ``motorbus sim serve --pty --drive arcus:01`` uses it.
 from __future__ import annotations
 
 import enum
+import os
 from typing import Any, Optional, Union
 
 from .. import _core, _stop_at_exit
@@ -31,6 +33,7 @@ __all__ = [
     "REPLY_TERMINATOR",
     "make_sim",
     "open_line",
+    "STOP_WAYS",
     "build_request",
     "parse_reply",
 ]
@@ -118,97 +121,132 @@ class SyncCondition(enum.IntEnum):
     GREATER = 3
 
 
-def open_line(port: Union[str, "_core.Port"], baud: int = 9600, timeout: float = 0.2,
+def open_line(port: Union[str, "os.PathLike[str]", "_core.Port"], *, baud: int = 9600, timeout: float = 0.2,
               turnaround: float = 0.0) -> "_core.LineLink":
     """A LineLink framed for DMX-CAN (CR after requests, NUL after replies).
 
-    Share it between several ArcusClient objects to talk to up to 99 devices on
-    one RS-485 line."""
-    if isinstance(port, str):
-        port = _core.open_port(port, baud)
+    ``port``: a device path (opened at ``baud``) or an open ``motorbus.serial.Port``.
+    ``timeout``: seconds to wait for a reply; ``turnaround``: seconds of quiet
+    before each request (slow RS-485 transceivers).  Share the link between
+    several ArcusClient objects to talk to up to 99 devices on one RS-485 line."""
+    if isinstance(port, (str, os.PathLike)):
+        port = _core.open_port(os.fspath(port), baud)
+    elif not isinstance(port, _core.Port):
+        raise _core.InvalidArgument(f"arcus open_line: a path or a motorbus Port, not {type(port).__name__}")
     return _core.LineLink(port, request_terminator=REQUEST_TERMINATOR, reply_terminators=[REPLY_TERMINATOR],
                           max_line=_core.ARCUS_MAX_REPLY, reply_timeout=timeout, turnaround=turnaround)
 
 
+#: on_error / on_exit words, the same as motorbus.Drive's.
+STOP_WAYS = ("stop", "quick_stop", "disable", None)
 
 
 class ArcusClient(_stop_at_exit.StopsMotor, ArcusClientBase):
     """Typed client for one DMX-CAN.
 
-    ``port`` is a device path (opened at ``baud``), a ``motorbus.Port``, or a
-    ``motorbus.LineLink`` from :func:`open_line` shared with other clients on
-    the same RS-485 line.
+    ``line``: a device path (opened with :func:`open_line` at ``baud`` and
+    closed by :meth:`close`), an open ``motorbus.serial.Port``, or a
+    ``LineLink`` from :func:`open_line` shared with other clients on the same
+    RS-485 line (neither is closed by :meth:`close`).  ``address``: ``"01"``..
+    ``"99"``, ``"DMC05"`` or an int.  ``timeout``: reply timeout in s (None: the
+    link's, 0.2 s for a line opened here).
+
+    Readings are properties (``position``, ``encoder``, ``speed``, ``status``
+    -> :class:`MotorStatus`, ``snl_status`` -> :class:`SnlStatus`, ...);
+    settings are read/write properties (``client.high_speed = 10000``);
+    commands are methods.
 
     As a context manager it stops the motor when an exception leaves the block
-    (``on_error``: "abort" = ABORT, immediate; "stop" = STOP, decelerated; None)
-    and, for clients still open when the interpreter exits, with ``on_exit``
-    (default "stop").
+    (``on_error``) and, for clients still open when the interpreter exits, with
+    ``on_exit``: "stop" (STOP, decelerated), "quick_stop" (ABORT, at once),
+    "disable" (EO=0, power off) or None.  A failed stop falls back to the next
+    harder one.
     """
 
-    def __init__(self, port: Any, address: Union[int, str] = 1, *, baud: int = 9600, timeout: float = 0.2,
-                 query_retries: int = 1, on_error: Optional[str] = "abort", on_exit: Optional[str] = "stop"):
+    def __init__(self, line: Any, address: Union[int, str] = "01", *, baud: int = 9600,
+                 timeout: Optional[float] = None, on_error: Optional[str] = "stop",
+                 on_exit: Optional[str] = "stop", query_retries: int = 1):
         for name, v in (("on_error", on_error), ("on_exit", on_exit)):
-            if v not in (None, "stop", "abort"):
-                raise _core.InvalidArgument(f"{name}: 'stop', 'abort' or None, not {v!r}")
-        if isinstance(port, _core.LineLink):
-            link, self._owns_port = port, False
+            if v not in STOP_WAYS:
+                raise _core.InvalidArgument(f"{name}: one of 'stop', 'quick_stop', 'disable' or None, not {v!r}")
+        number = _address(address)
+        self._owned_port = None
+        if isinstance(line, _core.LineLink):
+            link = line
+        elif isinstance(line, _core.Port):
+            link = open_line(line, timeout=0.2 if timeout is None else timeout)
         else:
-            link, self._owns_port = open_line(port, baud=baud, timeout=timeout), True
-        super().__init__(link, int(address), None, query_retries)
+            link = open_line(line, baud=baud, timeout=0.2 if timeout is None else timeout)
+            self._owned_port = link.port
+        super().__init__(link, number, timeout, query_retries)
         self.link = link
-        self._on_error = on_error
-        self._on_exit = on_exit
+        self.on_error = on_error
+        self.on_exit = on_exit
         self._closed = False
         _stop_at_exit.track(self)
 
     # ---- lifecycle ----
     def _stop_on_error(self) -> None:
-        self._safe_halt(self._on_error)
+        self._halt(self.on_error)
 
     def close(self) -> None:
         if self._closed:
             return
         self._closed = True
         _stop_at_exit.untrack(self)
-        if self._owns_port:
+        if self._owned_port is not None:
             try:
-                self.link.port.close()
+                self._owned_port.close()
             except Exception:  # noqa: BLE001 - closing must not mask the real error
                 pass
 
-    def _stop_at_exit(self) -> None:
-        self._safe_halt(self._on_exit)
+    @property
+    def closed(self) -> bool:
+        return self._closed
 
-    def _safe_halt(self, how: Optional[str]) -> None:
+    def _stop_at_exit(self) -> None:
+        self._halt(self.on_exit)
+
+    def _halt(self, how: Optional[str]) -> None:
+        """Best effort while unwinding: a failed stop falls back to the next harder one."""
         if how is None or self._closed:
             return
-        try:
-            self.abort() if how == "abort" else self.stop()
-        except Exception:  # noqa: BLE001 - best effort while unwinding
-            if how == "stop":
-                try:
-                    self.abort()
-                except Exception:  # noqa: BLE001
-                    pass
+        ladder = {"stop": (self.stop, self.abort, self.disable),
+                  "quick_stop": (self.abort, self.disable),
+                  "disable": (self.disable,)}[how]
+        for step in ladder:
+            try:
+                step()
+                return
+            except Exception:  # noqa: BLE001 - the link may be gone; try the next way
+                continue
 
     # ---- typed views of the status registers ----
+    @property
     def status(self) -> MotorStatus:
-        return MotorStatus(self.status_raw())
+        """MST as :class:`MotorStatus` flags."""
+        return MotorStatus(self._status_raw)
 
+    @property
     def snl_status(self) -> SnlStatus:
-        return SnlStatus(self.snl_status_raw())
+        """SLS as :class:`SnlStatus`."""
+        return SnlStatus(self._snl_status_raw)
 
+    @property
     def latch_status(self) -> LatchStatus:
-        return LatchStatus(self.latch_status_raw())
+        return LatchStatus(self._latch_status_raw)
 
+    @property
     def sync_status(self) -> SyncStatus:
-        return SyncStatus(self.sync_status_raw())
+        return SyncStatus(self._sync_status_raw)
 
+    @property
     def sync_condition(self) -> SyncCondition:
-        return SyncCondition(self.sync_condition_raw())
+        return SyncCondition(self._sync_condition_raw)
 
-    def set_sync_condition(self, condition: Union[SyncCondition, int]) -> None:
-        self.set_sync_condition_raw(int(condition))
+    @sync_condition.setter
+    def sync_condition(self, condition: Union[SyncCondition, int]) -> None:
+        self._sync_condition_raw = int(condition)
 
     def broadcast_command(self, command: str) -> None:
         """``@00<command>``: every device on this line acts; none replies."""
