@@ -24,3 +24,23 @@ def test_notebook_cells_run_in_order(capsys):
     out = capsys.readouterr().out
     assert "encoder 4000" in out
     assert "frame spacing at 250 kbit/s (us): [540.0, 540.0, 540.0]" in out
+
+
+def test_example_03_arcus_python():
+    out = subprocess.run([sys.executable, str(ROOT / "examples" / "03_arcus.py")], capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert "position 12.50 mm, EX=1250" in out.stdout
+    assert "homed True, SLS IDLE" in out.stdout
+    assert "SLT=10 SLR=0.800 ID=DriveMax-CAN" in out.stdout
+
+
+def test_example_03_arcus_cpp():
+    exe = ROOT / "build" / "dev" / "example_03_arcus"
+    if not exe.exists():
+        import pytest
+        pytest.skip("C++ examples not built (MOTORBUS_EXAMPLES=OFF)")
+    out = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert "EX=1250 PX=1250 SLS=0" in out.stdout
+    assert "SLR=0.800 ID=DriveMax-CAN" in out.stdout
