@@ -1,6 +1,6 @@
 """Command-to-reply round trip to the Arcus simulator on a pty, from Python.
 
-Compares motorbus' ArcusClient.position() with a plain pyserial loop (the
+Compares motorbus' ArcusClient.position with a plain pyserial loop (the
 reference) on the same PtyLineServer, unthrottled and paced at 115200 baud.
 
     PYTHONPATH=python python3 bench/arcus_roundtrip.py [iterations]
@@ -23,13 +23,13 @@ def summarize(us):
 
 
 def bench_motorbus(path, n):
-    with ArcusClient(path, 1, baud=0, timeout=1.0, query_retries=0, on_exit=None) as c:
+    with ArcusClient(path, "01", baud=0, timeout=1.0, query_retries=0, on_exit=None) as c:
         for _ in range(50):
-            c.position()
+            c.position
         us = []
         for _ in range(n):
             t = time.perf_counter()
-            c.position()
+            c.position
             us.append((time.perf_counter() - t) * 1e6)
     return summarize(us)
 

@@ -274,6 +274,9 @@ void bind_arcus(py::module_& m) {
 
     using C = Client;
     auto rel = py::call_guard<py::gil_scoped_release>();
+    // Property accessors release the GIL like the methods (each is a line transaction).
+    auto get = [rel](auto f) { return py::cpp_function(f, rel); };
+    auto put = [rel](auto f) { return py::cpp_function(f, py::is_setter(), rel); };
     py::class_<C, std::shared_ptr<C>> c(m, "ArcusClientBase",
                                         "Typed client for one DMX-CAN address on a LineLink (see ArcusClient).");
     c.def(py::init([](std::shared_ptr<serial::LineLink> link, int address, const py::object& timeout,
@@ -305,39 +308,36 @@ void bind_arcus(py::module_& m) {
         .def_static(
             "broadcast", [](serial::LineLink& link, const std::string& cmd) { C::broadcast(link, cmd); },
             py::arg("link"), py::arg("command"), rel)
-        .def("id", &C::id, rel)
-        .def("version", &C::version, rel)
-        .def("device_name", &C::device_name, rel)
-        .def("set_device_name", &C::set_device_name, py::arg("address"), rel)
-        .def("response_type", &C::response_type, rel)
-        .def("set_response_type", &C::set_response_type, py::arg("rt"), rel)
+        // Readings: read-only properties; simple settings: read/write
+        // properties; commands and anything with arguments: methods.  The
+        // enum-valued readings are bound as _*_raw and wrapped into Python
+        // enums by motorbus.drives.arcus.ArcusClient.
+        .def_property_readonly("id", get(&C::id))
+        .def_property_readonly("version", get(&C::version))
+        .def_property_readonly("device_name", get(&C::device_name))
+        .def("set_device_name", &C::set_device_name, py::arg("address"), rel,
+             "DN=DMCnn (takes effect after store() and a power cycle).")
+        .def_property("response_type", get(&C::response_type), put(&C::set_response_type))
         .def("store", &C::store, rel)
-        .def("position", &C::position, rel)
+        .def_property_readonly("position", get(&C::position))
         .def("set_position", &C::set_position, py::arg("position"), rel)
-        .def("encoder", &C::encoder, rel)
+        .def_property_readonly("encoder", get(&C::encoder))
         .def("set_encoder", &C::set_encoder, py::arg("counts"), rel)
-        .def("delta", &C::delta, rel)
-        .def("speed", &C::speed, rel)
-        .def("status_raw", [](C& cl) { return cl.status().raw; }, rel)
-        .def("snl_status_raw", [](C& cl) { return static_cast<int>(cl.snl_status()); }, rel)
-        .def("moving", &C::moving, rel)
-        .def("high_speed", &C::high_speed, rel)
-        .def("set_high_speed", &C::set_high_speed, py::arg("pps"), rel)
-        .def("low_speed", &C::low_speed, rel)
-        .def("set_low_speed", &C::set_low_speed, py::arg("pps"), rel)
-        .def("acceleration", &C::acceleration, rel)
-        .def("set_acceleration", &C::set_acceleration, py::arg("ms"), rel)
-        .def("deceleration", &C::deceleration, rel)
-        .def("set_deceleration", &C::set_deceleration, py::arg("ms"), rel)
-        .def("unique_deceleration", &C::unique_deceleration, rel)
-        .def("set_unique_deceleration", &C::set_unique_deceleration, py::arg("on"), rel)
-        .def("s_curve", &C::s_curve, rel)
-        .def("set_s_curve", &C::set_s_curve, py::arg("on"), rel)
-        .def("speed_window", &C::speed_window, rel)
-        .def("set_speed_window", &C::set_speed_window, py::arg("sspdm"), rel)
+        .def_property_readonly("delta", get(&C::delta))
+        .def_property_readonly("speed", get(&C::speed))
+        .def_property_readonly("_status_raw", get([](C& cl) { return cl.status().raw; }))
+        .def_property_readonly("_snl_status_raw", get([](C& cl) { return static_cast<int>(cl.snl_status()); }))
+        .def_property_readonly("moving", get(&C::moving))
+        .def_property("high_speed", get(&C::high_speed), put(&C::set_high_speed))
+        .def_property("low_speed", get(&C::low_speed), put(&C::set_low_speed))
+        .def_property("acceleration", get(&C::acceleration), put(&C::set_acceleration))
+        .def_property("deceleration", get(&C::deceleration), put(&C::set_deceleration))
+        .def_property("unique_deceleration", get(&C::unique_deceleration), put(&C::set_unique_deceleration))
+        .def_property("s_curve", get(&C::s_curve), put(&C::set_s_curve))
+        .def_property("speed_window", get(&C::speed_window), put(&C::set_speed_window))
         .def("absolute_mode", &C::absolute_mode, rel)
         .def("incremental_mode", &C::incremental_mode, rel)
-        .def("incremental", &C::incremental, rel)
+        .def_property_readonly("incremental", get(&C::incremental))
         .def("move", &C::move, py::arg("target"), rel)
         .def("change_target", &C::change_target, py::arg("target"), rel)
         .def("change_speed", &C::change_speed, py::arg("pps"), rel)
@@ -361,12 +361,9 @@ void bind_arcus(py::module_& m) {
                 cl.home(hm, direction);
             },
             py::arg("method"), py::arg("direction"))
-        .def("home_correction", &C::home_correction, rel)
-        .def("set_home_correction", &C::set_home_correction, py::arg("steps"), rel)
-        .def("return_to_zero", &C::return_to_zero, rel)
-        .def("set_return_to_zero", &C::set_return_to_zero, py::arg("on"), rel)
-        .def("limit_correction", &C::limit_correction, rel)
-        .def("set_limit_correction", &C::set_limit_correction, py::arg("steps"), rel)
+        .def_property("home_correction", get(&C::home_correction), put(&C::set_home_correction))
+        .def_property("return_to_zero", get(&C::return_to_zero), put(&C::set_return_to_zero))
+        .def_property("limit_correction", get(&C::limit_correction), put(&C::set_limit_correction))
         .def(
             "wait_idle",
             [](C& cl, const py::object& timeout, double poll) {
@@ -375,63 +372,48 @@ void bind_arcus(py::module_& m) {
                 cl.wait_idle(t, std::chrono::nanoseconds(static_cast<std::int64_t>(poll * 1e9)));
             },
             py::arg("timeout"), py::arg("poll") = 0.005)
-        .def("enabled", &C::enabled, rel)
+        .def_property("enabled", get(&C::enabled), put(&C::enable))
         .def("enable", &C::enable, py::arg("on") = true, rel)
-        .def("enabled_at_boot", &C::enabled_at_boot, rel)
-        .def("set_enabled_at_boot", &C::set_enabled_at_boot, py::arg("on"), rel)
-        .def("current", &C::current, rel)
-        .def("run_current", &C::run_current, rel)
-        .def("set_run_current", &C::set_run_current, py::arg("ma"), rel)
-        .def("idle_current", &C::idle_current, rel)
-        .def("set_idle_current", &C::set_idle_current, py::arg("ma"), rel)
-        .def("idle_time", &C::idle_time, rel)
-        .def("set_idle_time", &C::set_idle_time, py::arg("ms"), rel)
-        .def("digital_inputs", &C::digital_inputs, rel)
+        .def("disable", [](C& cl) { cl.enable(false); }, rel)
+        .def_property("enabled_at_boot", get(&C::enabled_at_boot), put(&C::set_enabled_at_boot))
+        .def_property_readonly("current", get(&C::current))
+        .def_property("run_current", get(&C::run_current), put(&C::set_run_current))
+        .def_property("idle_current", get(&C::idle_current), put(&C::set_idle_current))
+        .def_property("idle_time", get(&C::idle_time), put(&C::set_idle_time))
+        .def_property_readonly("digital_inputs", get(&C::digital_inputs))
         .def("digital_input", &C::digital_input, py::arg("n"), rel)
-        .def("digital_outputs", &C::digital_outputs, rel)
-        .def("set_digital_outputs", &C::set_digital_outputs, py::arg("value"), rel)
+        .def_property("digital_outputs", get(&C::digital_outputs), put(&C::set_digital_outputs))
         .def("digital_output", &C::digital_output, py::arg("n"), rel)
         .def("set_digital_output", &C::set_digital_output, py::arg("n"), py::arg("on"), rel)
-        .def("outputs_at_boot", &C::outputs_at_boot, rel)
-        .def("set_outputs_at_boot", &C::set_outputs_at_boot, py::arg("value"), rel)
-        .def("alarm_outputs", &C::alarm_outputs, rel)
-        .def("set_alarm_outputs", &C::set_alarm_outputs, py::arg("on"), rel)
-        .def("polarity", &C::polarity, rel)
-        .def("set_polarity", &C::set_polarity, py::arg("bits"), rel)
+        .def_property("outputs_at_boot", get(&C::outputs_at_boot), put(&C::set_outputs_at_boot))
+        .def_property("alarm_outputs", get(&C::alarm_outputs), put(&C::set_alarm_outputs))
+        .def_property("polarity", get(&C::polarity), put(&C::set_polarity))
         .def("enable_latch", &C::enable_latch, py::arg("on") = true, rel)
-        .def("latch_status_raw", [](C& cl) { return static_cast<int>(cl.latch_status()); }, rel)
-        .def("latched_position", &C::latched_position, rel)
-        .def("latched_encoder", &C::latched_encoder, rel)
+        .def_property_readonly("_latch_status_raw", get([](C& cl) { return static_cast<int>(cl.latch_status()); }))
+        .def_property_readonly("latched_position", get(&C::latched_position))
+        .def_property_readonly("latched_encoder", get(&C::latched_encoder))
         .def("sync_on", &C::sync_on, rel)
         .def("sync_off", &C::sync_off, rel)
-        .def("sync_position", &C::sync_position, rel)
-        .def("set_sync_position", &C::set_sync_position, py::arg("position"), rel)
-        .def("sync_condition_raw", [](C& cl) { return static_cast<int>(cl.sync_condition()); }, rel)
-        .def(
-            "set_sync_condition_raw",
-            [](C& cl, int v) {
-                if (v < 1 || v > 3) throw InvalidArgument("SYNC: 1 (equal), 2 (less), 3 (greater)");
-                py::gil_scoped_release nogil;
-                cl.set_sync_condition(static_cast<SyncCondition>(v));
-            },
-            py::arg("condition"))
-        .def("sync_status_raw", [](C& cl) { return static_cast<int>(cl.sync_status()); }, rel)
-        .def("snl_enabled", &C::snl_enabled, rel)
-        .def("set_snl_enabled", &C::set_snl_enabled, py::arg("on"), rel)
-        .def("snl_tolerance", &C::snl_tolerance, rel)
-        .def("set_snl_tolerance", &C::set_snl_tolerance, py::arg("counts"), rel)
-        .def("snl_error_range", &C::snl_error_range, rel)
-        .def("set_snl_error_range", &C::set_snl_error_range, py::arg("counts"), rel)
-        .def("snl_max_attempts", &C::snl_max_attempts, rel)
-        .def("set_snl_max_attempts", &C::set_snl_max_attempts, py::arg("n"), rel)
-        .def("snl_idle_tolerance", &C::snl_idle_tolerance, rel)
-        .def("set_snl_idle_tolerance", &C::set_snl_idle_tolerance, py::arg("counts"), rel)
-        .def("comm_mode", &C::comm_mode, rel)
-        .def("set_comm_mode", &C::set_comm_mode, py::arg("mode"), rel)
-        .def("baud_code", &C::baud_code, rel)
-        .def("set_baud_code", &C::set_baud_code, py::arg("code"), rel)
-        .def("can_bit_rate_code", &C::can_bit_rate_code, rel)
-        .def("set_can_bit_rate_code", &C::set_can_bit_rate_code, py::arg("code"), rel)
-        .def("node_id", &C::node_id, rel)
-        .def("set_node_id", &C::set_node_id, py::arg("node_id"), rel);
+        .def_property("sync_position", get(&C::sync_position), put(&C::set_sync_position))
+        .def_property(
+            "_sync_condition_raw", get([](C& cl) { return static_cast<int>(cl.sync_condition()); }),
+            py::cpp_function(
+                [](C& cl, int v) {
+                    if (v < 1 || v > 3)
+                        throw InvalidArgument("SYNC: 1 (equal), 2 (less), 3 (greater), not " + std::to_string(v));
+                    py::gil_scoped_release nogil;
+                    cl.set_sync_condition(static_cast<SyncCondition>(v));
+                },
+                py::is_setter()))
+        .def_property_readonly("_sync_status_raw", get([](C& cl) { return static_cast<int>(cl.sync_status()); }))
+        .def_property("snl_enabled", get(&C::snl_enabled), put(&C::set_snl_enabled))
+        .def_property("snl_tolerance", get(&C::snl_tolerance), put(&C::set_snl_tolerance))
+        .def_property("snl_error_range", get(&C::snl_error_range), put(&C::set_snl_error_range))
+        .def_property("snl_max_attempts", get(&C::snl_max_attempts), put(&C::set_snl_max_attempts))
+        .def_property("snl_idle_tolerance", get(&C::snl_idle_tolerance), put(&C::set_snl_idle_tolerance))
+        .def_property("snl_ratio", get(&C::snl_ratio), put(&C::set_snl_ratio))
+        .def_property("comm_mode", get(&C::comm_mode), put(&C::set_comm_mode))
+        .def_property("baud_code", get(&C::baud_code), put(&C::set_baud_code))
+        .def_property("can_bit_rate_code", get(&C::can_bit_rate_code), put(&C::set_can_bit_rate_code))
+        .def_property("node_id", get(&C::node_id), put(&C::set_node_id));
 }

@@ -63,13 +63,13 @@ def serial_bench(quick: bool) -> None:
         print(f"  {arcus_spec} on {arcus_pty} (RS-485 multi-drop), {dmac_spec} on {dmac_pty}")
 
         line = open_line(arcus_pty, baud=115200, timeout=0.5)
-        with ArcusClient(line, 1) as x, ArcusClient(line, 2) as y:
+        with ArcusClient(line, "01") as x, ArcusClient(line, "02") as y:
             target = 2000 if quick else 8000
             for d in (x, y):
                 d.enable()
-                d.set_high_speed(10000)
-                d.set_acceleration(100)
-                d.set_deceleration(100)
+                d.high_speed = 10000
+                d.acceleration = 100
+                d.deceleration = 100
             model = motion.ArcusMotion(motion.ArcusProfileParams(hspd=10000, lspd=100, acc_ms=100, dec_ms=100,
                                                                  snl_ratio=0.8))
             model.move(0, target)
@@ -80,8 +80,8 @@ def serial_bench(quick: bool) -> None:
             x.wait_idle(timeout=10)
             y.wait_idle(timeout=10)
             took = time.monotonic() - t0
-            print(f"  @01 X{target} -> EX={x.encoder()} PX={x.position()} in {took:.3f} s (wall, incl. polling)")
-            print(f"  @02 X{-target // 2} -> EX={y.encoder()} status={y.status()!r} SLS={y.snl_status()!r}")
+            print(f"  @01 X{target} -> EX={x.encoder} PX={x.position} in {took:.3f} s (wall, incl. polling)")
+            print(f"  @02 X{-target // 2} -> EX={y.encoder} status={y.status!r} SLS={y.snl_status!r}")
 
         link = open_link(dmac_pty, baud=38400)
         with DmacClient(link, address=0) as m:

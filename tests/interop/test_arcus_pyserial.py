@@ -47,6 +47,8 @@ def line():
 def _prepare(sim, port, exchange):
     """Puts the device in the state the example needs ("while": moving / idle)."""
     if exchange.get("while") == "moving":
+        port.write(b"@01EO=1\r")  # powered: a disabled motor does no motion (manual §6)
+        assert read_reply(port) == b"OK\0"
         port.write(b"@01J+\r")
         assert read_reply(port) == b"OK\0"
     if exchange["send"] == "@01EX\r":
@@ -191,3 +193,110 @@ def test_appendix_a_windows(w):
     assert lo_ms == w["min_acc_ms"]
     # max ACC = ((HSPD - LSPD) / delta) x 1000 ms (truncated to 10 ms, as the manual's example).
     assert hi_ms == max(lo_ms, (hspd - w["min_lspd"]) * 100 // w["delta"] * 10)
+
+
+
+# ---- defects found by the audit against the manual (each failed before its fix) ----
+
+def _say(port, cmd: str) -> bytes:
+    port.write(f"@01{cmd}\r".encode())
+    return read_reply(port)[:-1]
+
+
+def _ok(port, *cmds: str) -> None:
+    for cmd in cmds:
+        assert _say(port, cmd) == b"OK", cmd
+
+
+def test_pol_bits_7_and_8_invert_in_position_and_alarm_outputs(line):
+    """Tables 7.2 and 7.11: bit 7 In Position Output, bit 8 Alarm Output (SL=1, EDO=1)."""
+    sim, clock, port = line
+    _ok(port, "EO=1", "X1000")
+    clock.advance(3_000_000_000)
+    assert (_say(port, "DO1"), _say(port, "DO3")) == (b"1", b"0")   # in position, no alarm
+    _ok(port, "POL=128")
+    assert (_say(port, "DO1"), _say(port, "DO3")) == (b"0", b"0")
+    _ok(port, "POL=256")
+    assert (_say(port, "DO1"), _say(port, "DO3")) == (b"1", b"1")
+    _ok(port, "POL=384")
+    sim.disturb(1000)  # 1250 counts > SLE while idle: correction range error, the alarm
+    assert _say(port, "SLS") == b"8"
+    assert (_say(port, "DO1"), _say(port, "DO3")) == (b"1", b"0")
+
+
+def test_slr_reads_and_sets_the_stepnloop_ratio(tmp_path):
+    """Table 7.10 lists SLR (stored); syntax as docs/drives/arcus.md: x.xxx pulses per count."""
+    clock = core.SimClock()
+    sim = make_sim("01", clock=clock, store_path=str(tmp_path / "flash.txt"))
+    with core.PtyLineServer([sim], 0, None) as server, serial.Serial(server.slave_path, 9600, timeout=0.05) as port:
+        assert _say(port, "SLR") == b"0.800"
+        _ok(port, "SLR=1.25")
+        assert _say(port, "SLR") == b"1.250"
+        assert _say(port, "SLR=0") == b"?SLR=0"
+        assert _say(port, "SLR=1000") == b"?SLR=1000"
+        assert _say(port, "SLR=x") == b"?SLR=x"
+        _ok(port, "STORE", "SLR=2")
+        sim.power_cycle()
+        assert _say(port, "SLR") == b"1.250"
+
+
+def test_abort_clears_the_stepnloop_limit_error(line):
+    """Table 11.0, ABORT: "used for clearing the StepNLoop error status"; MST bits need CLR."""
+    sim, clock, port = line
+    sim.force_limit(1, True)
+    _ok(port, "EO=1", "J+")
+    clock.advance(10_000_000)
+    assert _say(port, "SLS") == b"11"
+    assert _say(port, "MST") == b"160"
+    _ok(port, "ABORT")
+    assert _say(port, "SLS") == b"0"
+    assert _say(port, "MST") == b"160"
+    assert _say(port, "X0") == b"?State Error"
+    _ok(port, "CLR")
+    assert _say(port, "MST") == b"32"
+
+
+def test_sync_equal_output_is_a_pulse_while_positions_are_equal(line):
+    """Chapter 7, Sync Output, condition 1: on only while encoder == SYNP; SYNS stays 2."""
+    sim, clock, port = line
+    _ok(port, "EO=1", "SYNP=500", "SYNC=1", "SYNO", "X500")
+    clock.advance(3_000_000_000)
+    assert _say(port, "EX") == b"500"
+    assert (_say(port, "SYNS"), _say(port, "DO2")) == (b"2", b"1")
+    _ok(port, "X1000")
+    clock.advance(3_000_000_000)
+    assert _say(port, "EX") == b"1000"
+    assert (_say(port, "SYNS"), _say(port, "DO2")) == (b"2", b"0")
+
+
+def test_disabled_motor_does_no_motion(line):
+    """§6: "When motor is disabled, no motion is done" (EO=0 at boot, StepNLoop on)."""
+    sim, clock, port = line
+    assert _say(port, "EO") == b"0"
+    _ok(port, "X3000")
+    clock.advance(5_000_000_000)
+    assert (_say(port, "PX"), _say(port, "EX"), _say(port, "MST"), _say(port, "SLS")) == (b"0", b"0", b"0", b"0")
+    _ok(port, "EO=1", "J+")
+    clock.advance(500_000_000)
+    assert int(_say(port, "MST")) & 7
+    _ok(port, "EO=0")
+    assert int(_say(port, "MST")) & 7 == 0
+    px = _say(port, "PX")
+    clock.advance(1_000_000_000)
+    assert _say(port, "PX") == px
+
+
+def test_slm_correction_uses_idle_current(line):
+    """Table 7.5, SLM: the additional correction runs on idle current (CUR = CURI)."""
+    sim, clock, port = line
+    _ok(port, "EO=1", "X2000")
+    clock.advance(5_000_000_000)
+    assert _say(port, "CUR") == b"1000"
+    sim.disturb(40)                 # 50 counts: a correction at run current
+    assert (_say(port, "SLS"), _say(port, "CUR")) == (b"2", b"1600")
+    clock.advance(100_000_000)
+    sim.disturb(8)                  # leaves 10 counts > SLM after the first correction
+    clock.advance(450_000_000)
+    assert (_say(port, "SLS"), _say(port, "CUR")) == (b"2", b"1000")
+    clock.advance(2_000_000_000)
+    assert (_say(port, "SLS"), _say(port, "EX")) == (b"0", b"2000")

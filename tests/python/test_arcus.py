@@ -43,31 +43,31 @@ def rig():
 
 def test_factory_defaults(rig):
     d = rig.client()
-    assert (d.idle_current(), d.run_current(), d.idle_time()) == (1000, 1600, 500)
-    assert d.device_name() == "DMC01"
-    assert d.snl_enabled() and d.snl_tolerance() == 20 and d.snl_error_range() == 1000
-    assert d.snl_max_attempts() == 10 and d.snl_idle_tolerance() == 5
-    assert d.outputs_at_boot() == 7 and d.alarm_outputs() and not d.enabled_at_boot()
-    assert (d.limit_correction(), d.node_id(), d.polarity(), d.response_type()) == (1000, 1, 0, 0)
-    assert (d.baud_code(), d.can_bit_rate_code(), d.comm_mode()) == (1, 5, 0)
-    assert d.status() == MotorStatus(0)
-    assert d.snl_status() is SnlStatus.IDLE
+    assert (d.idle_current, d.run_current, d.idle_time) == (1000, 1600, 500)
+    assert d.device_name == "DMC01"
+    assert d.snl_enabled and d.snl_tolerance == 20 and d.snl_error_range == 1000
+    assert d.snl_max_attempts == 10 and d.snl_idle_tolerance == 5
+    assert d.outputs_at_boot == 7 and d.alarm_outputs and not d.enabled_at_boot
+    assert (d.limit_correction, d.node_id, d.polarity, d.response_type) == (1000, 1, 0, 0)
+    assert (d.baud_code, d.can_bit_rate_code, d.comm_mode) == (1, 5, 0)
+    assert d.status == MotorStatus(0)
+    assert d.snl_status is SnlStatus.IDLE
 
 
 def test_trapezoid_move_positions_and_times(rig):
     d = rig.client()
-    d.set_snl_enabled(False)
+    d.snl_enabled = False
     d.enable()
-    d.set_acceleration(100)
+    d.acceleration = 100
     d.move(1000)
     rig.run(0.05)
-    assert d.status() == MotorStatus.ACCELERATING
+    assert d.status == MotorStatus.ACCELERATING
     rig.run(0.45)
-    assert d.status() == MotorStatus.CONSTANT_SPEED
-    assert abs(d.position() - 455) <= 2
+    assert d.status == MotorStatus.CONSTANT_SPEED
+    assert abs(d.position - 455) <= 2
     rig.run(0.6)
-    assert not d.status().moving
-    assert (d.position(), d.encoder()) == (1000, 1250)
+    assert not d.status.moving
+    assert (d.position, d.encoder) == (1000, 1250)
 
 
 def test_stepnloop_move_in_counts(rig):
@@ -75,15 +75,15 @@ def test_stepnloop_move_in_counts(rig):
     d.enable()
     d.move(4000)
     rig.run(0.1)
-    assert d.snl_status() is SnlStatus.MOVING
+    assert d.snl_status is SnlStatus.MOVING
     rig.run(6)
-    assert (d.encoder(), d.position(), d.delta()) == (4000, 4000, 0)
+    assert (d.encoder, d.position, d.delta) == (4000, 4000, 0)
     assert rig.sims[0].physical_position == pytest.approx(3200)
 
 
 def test_moving_and_state_errors_are_typed(rig):
     d = rig.client()
-    d.set_snl_enabled(False)
+    d.snl_enabled = False
     d.enable()
     d.jog(1)
     with pytest.raises(motorbus._core.ArcusMoving) as e:
@@ -96,11 +96,11 @@ def test_moving_and_state_errors_are_typed(rig):
     rig.sims[0].force_limit(-1, True)
     d.jog(-1)
     rig.run(0.01)
-    assert d.status() & MotorStatus.MINUS_LIMIT_ERROR
+    assert d.status & MotorStatus.MINUS_LIMIT_ERROR
     with pytest.raises(motorbus._core.ArcusStateError):
         d.jog(-1)
     d.clear()
-    assert d.status() == MotorStatus.MINUS_LIMIT
+    assert d.status == MotorStatus.MINUS_LIMIT
     with pytest.raises(motorbus._core.ArcusIndexOutOfRange):
         d.command("DI7")
     with pytest.raises(motorbus._core.ArcusUnknownCommand):
@@ -109,39 +109,39 @@ def test_moving_and_state_errors_are_typed(rig):
 
 def test_on_the_fly_target_and_speed(rig):
     d = rig.client()
-    d.set_snl_enabled(False)
+    d.snl_enabled = False
     d.enable()
     d.move(10000)
     rig.run(1)
     d.change_target(2500)
     rig.run(10)
-    assert d.position() == 2500
+    assert d.position == 2500
     d.jog(1)
     rig.run(1)
     d.change_speed(3000)
     rig.run(1)
-    assert d.speed() == 3000
+    assert d.speed == 3000
     with pytest.raises(motorbus._core.ArcusSpeedOutOfRange):
         d.change_speed(50000)
     d.stop()
     rig.run(1)
-    assert not d.moving()
+    assert not d.moving
 
 
 def test_homing_routines(rig):
     d = rig.client()
-    d.set_snl_enabled(False)
+    d.snl_enabled = False
     d.enable()
-    d.set_home_correction(200)
+    d.home_correction = 200
     d.home("HL", 1)
     rig.run(30)
-    assert (d.position(), d.encoder()) == (0, 0)
+    assert (d.position, d.encoder) == (0, 0)
     assert rig.sims[0].physical_position == pytest.approx(8000, abs=0.5)
     d.move(1000)  # off the index (8000 = 1600 + 2 x 3200 is one)
     rig.run(3)
     d.home("Z", 1)
     rig.run(40)
-    assert d.position() == 0
+    assert d.position == 0
     assert rig.sims[0].physical_position == pytest.approx(11200, abs=0.01)
     with pytest.raises(motorbus.InvalidArgument):
         d.home("Q", 1)
@@ -150,39 +150,39 @@ def test_homing_routines(rig):
 def test_latch_sync_and_io(rig):
     d = rig.client()
     sim = rig.sims[0]
-    d.set_snl_enabled(False)
+    d.snl_enabled = False
     d.enable()
     d.enable_latch()
-    assert d.latch_status() is LatchStatus.WAITING
-    d.set_sync_position(600)
-    d.set_sync_condition(SyncCondition.GREATER)
+    assert d.latch_status is LatchStatus.WAITING
+    d.sync_position = 600
+    d.sync_condition = SyncCondition.GREATER
     d.sync_on()
-    assert d.sync_status() is SyncStatus.WAITING
+    assert d.sync_status is SyncStatus.WAITING
     d.move(1000)
     rig.run(0.6)
     px = sim.pulse_position
     sim.set_input(2, True)
     rig.run(2)
-    assert d.latch_status() is LatchStatus.TRIGGERED
-    assert d.latched_position() == px
-    assert d.sync_status() is SyncStatus.OCCURRED and d.digital_output(2)
-    assert d.sync_condition() is SyncCondition.GREATER
-    assert d.digital_inputs() == 0b10 and d.digital_input(2)
+    assert d.latch_status is LatchStatus.TRIGGERED
+    assert d.latched_position == px
+    assert d.sync_status is SyncStatus.OCCURRED and d.digital_output(2)
+    assert d.sync_condition is SyncCondition.GREATER
+    assert d.digital_inputs == 0b10 and d.digital_input(2)
 
 
 def test_currents_after_curt(rig):
     d = rig.client()
-    d.set_snl_enabled(False)
+    d.snl_enabled = False
     d.enable()
     rig.run(1)
-    assert d.current() == 1000
+    assert d.current == 1000
     d.jog(1)
-    assert d.current() == 1600
+    assert d.current == 1600
     d.abort()
     rig.run(0.4)
-    assert d.current() == 1600
+    assert d.current == 1600
     rig.run(0.2)
-    assert d.current() == 1000
+    assert d.current == 1000
 
 
 def test_store_persists_and_power_cycle_applies(tmp_path):
@@ -193,13 +193,13 @@ def test_store_persists_and_power_cycle_applies(tmp_path):
     try:
         d = r.client()
         d.set_device_name(7)
-        d.set_response_type(1)
-        d.set_idle_current(500)
+        d.response_type = 1
+        d.idle_current = 500
         d.store()
         sim.power_cycle()
         assert sim.address == 7
         d7 = r.client(7)
-        assert d7.idle_current() == 500  # RT=1 replies "#07500" are accepted
+        assert d7.idle_current == 500  # RT=1 replies "#07500" are accepted
         assert "DN=7" in store.read_text()
     finally:
         r.close()
@@ -213,35 +213,60 @@ def test_rs485_line_with_several_devices():
         clients = {a: r.client(a) for a in (1, 2, 42, 99)}
         for a, c in clients.items():
             c.set_position(a * 10)
-        assert [c.position() for c in clients.values()] == [10, 20, 420, 990]
+        assert [c.position for c in clients.values()] == [10, 20, 420, 990]
         clients[1].broadcast_command("J-")
         r.run(0.5)
-        assert all(c.moving() for c in clients.values())
+        assert all(c.moving for c in clients.values())
         clients[42].abort()
-        assert not clients[42].moving() and clients[99].moving()
+        assert not clients[42].moving and clients[99].moving
         clients[1].broadcast_command("ABORT")
-        assert not any(c.moving() for c in clients.values())
+        assert not any(c.moving for c in clients.values())
         with pytest.raises(motorbus.TimeoutError):
-            ArcusClient(r.link, 5, query_retries=0).position()
+            ArcusClient(r.link, 5, query_retries=0).position
     finally:
         r.close()
 
 
 def test_context_manager_aborts_on_exception(rig):
     d = rig.client()
-    d.set_snl_enabled(False)
+    d.snl_enabled = False
     d.enable()
     with pytest.raises(RuntimeError):
-        with rig.client() as c:
+        with rig.client(on_error="quick_stop") as c:
             c.jog(1)
             rig.run(0.5)
-            assert c.moving()
+            assert c.moving
             raise RuntimeError("boom")
-    assert not d.moving()  # ABORT was sent on the way out
+    assert not d.moving  # ABORT was sent on the way out
     with rig.client() as c:  # a clean exit leaves the motor alone
         c.jog(1)
-    assert d.moving()
+    assert d.moving
     d.abort()
+
+
+def test_on_error_words_stop_and_disable(rig):
+    d = rig.client()
+    d.snl_enabled = False
+    d.enable()
+    with pytest.raises(RuntimeError):
+        with rig.client() as c:  # default on_error="stop": STOP, decelerating
+            c.jog(1)
+            rig.run(0.5)
+            raise RuntimeError("boom")
+    assert d.moving and d.status & MotorStatus.DECELERATING
+    rig.run(1)
+    assert not d.moving
+    with pytest.raises(RuntimeError):
+        with rig.client(on_error="disable") as c:  # EO=0: the pulses stop, the power is off
+            c.jog(1)
+            rig.run(0.5)
+            raise RuntimeError("boom")
+    assert not d.moving and not d.enabled
+    for bad in ("abort", "halt", 1):
+        with pytest.raises(motorbus.InvalidArgument):
+            rig.client(on_error=bad)
+        with pytest.raises(motorbus.InvalidArgument):
+            rig.client(on_exit=bad)
 
 
 def test_motor_stopped_at_process_exit(tmp_path):
@@ -260,7 +285,7 @@ def test_motor_stopped_at_process_exit(tmp_path):
         server = core.PtyLineServer([sim], 0, None)
         c = ArcusClient(server.slave_path, 1, baud=0)
         c.jog(1)
-        assert c.moving()
+        assert c.moving
         """
     )
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60,
@@ -285,15 +310,15 @@ def test_real_time_sim_and_wait_idle():
     sim = make_sim("01", snl=False, eo_boot=True)
     with core.PtyLineServer([sim], 0, None) as server:
         with ArcusClient(server.slave_path, 1, baud=0) as d:
-            d.set_high_speed(100000)
-            d.set_low_speed(1000)
-            d.set_acceleration(10)
+            d.high_speed = 100000
+            d.low_speed = 1000
+            d.acceleration = 10
             d.move(2000)  # about 30 ms
             d.wait_idle(timeout=5)
-            assert d.position() == 2000
-            assert d.encoder() == 2500
+            assert d.position == 2000
+            assert d.encoder == 2500
             with pytest.raises(motorbus.TimeoutError):
                 d.jog(1)
                 d.wait_idle(timeout=0.05)
             d.abort()
-            assert not d.moving()
+            assert not d.moving

@@ -43,27 +43,27 @@ def test_a1_no_terminator_times_out_then_resyncs(rig):
     dev, c, _ = rig
     dev.mangle = lambda r: r[:-1]
     with pytest.raises(motorbus.TimeoutError):
-        c.position()
+        c.position
     dev.mangle = None
     c.set_position(321)
-    assert c.position() == 321
+    assert c.position == 321
 
 
 def test_a2_bytes_after_nul_are_flushed(rig):
     dev, c, _ = rig
     dev.mangle = lambda r: r + b"555\0"
     c.set_position(9)
-    assert c.position() == 9
-    assert c.position() == 9
+    assert c.position == 9
+    assert c.position == 9
 
 
 def test_a3_overlong_reply(rig):
     dev, c, _ = rig
     dev.mangle = lambda r: b"7" * 400 + b"\0"
     with pytest.raises(motorbus.ProtocolError):
-        c.position()
+        c.position
     dev.mangle = None
-    assert c.position() == 0
+    assert c.position == 0
 
 
 def test_a5_unknown_command_is_typed_and_not_retried(rig):
@@ -79,9 +79,9 @@ def test_a6_reply_for_another_address(rig):
     dev, c, _ = rig
     dev.mangle = lambda r: b"#02" + r
     with pytest.raises(motorbus.ProtocolError):
-        c.position()
+        c.position
     dev.mangle = lambda r: b"#01" + r
-    assert c.position() == 0
+    assert c.position == 0
 
 
 @pytest.mark.parametrize("bad", [b"-", b"+99999999999", b"1e3", b"10 00", b"+5", b"OK", b"0x10"])
@@ -89,9 +89,9 @@ def test_a7_numeric_garbage(rig, bad):
     dev, c, _ = rig
     dev.mangle = lambda r: bad + b"\0"
     with pytest.raises(motorbus.ProtocolError):
-        c.position()
+        c.position
     dev.mangle = None
-    assert c.position() == 0
+    assert c.position == 0
 
 
 def test_a8_late_reply_is_discarded(rig):
@@ -104,10 +104,10 @@ def test_a8_late_reply_is_discarded(rig):
 
     dev.mangle = slow_once
     with pytest.raises(motorbus.TimeoutError):
-        c.set_high_speed(2500)  # a set: not retried
+        c.high_speed = 2500  # a set: not retried
     time.sleep(0.3)  # the late "OK" is now waiting in the input buffer
-    assert c.position() == 0  # flushed before the request, not taken as the answer to PX
-    assert c.high_speed() == 2500
+    assert c.position == 0  # flushed before the request, not taken as the answer to PX
+    assert c.high_speed == 2500
 
 
 def test_a8_late_reply_glued_to_the_next_one_is_rejected(rig):
@@ -117,42 +117,43 @@ def test_a8_late_reply_glued_to_the_next_one_is_rejected(rig):
     held = []
     dev.mangle = lambda r: held.append(r) or b""
     with pytest.raises(motorbus.TimeoutError):
-        c.position()
+        c.position
     dev.mangle = lambda r: held.pop(0) + r if held else r
     with pytest.raises(motorbus.ProtocolError):
-        c.set_high_speed(2500)
+        c.high_speed = 2500
     dev.mangle = None
-    assert c.high_speed() == 2500
+    assert c.high_speed == 2500
 
 
 def test_a10_noise_is_skipped_and_counted(rig):
     dev, c, _ = rig
     dev.mangle = lambda r: b"\xff\xfe\0\x80\0" + r
-    assert c.position() == 0
+    assert c.position == 0
     assert c.counters["noise_lines"] == 2
     dev.mangle = None
-    assert c.high_speed() == 1000
+    assert c.high_speed == 1000
 
 
 def test_a11_only_nul_terminates(rig):
     dev, c, _ = rig
     dev.mangle = lambda r: r[:-1] + b"\r\n"
     with pytest.raises(motorbus.TimeoutError):
-        c.position()
+        c.position
     dev.mangle = None
-    assert c.position() == 0
+    assert c.position == 0
 
 
 def test_a13_power_cycle_then_boot_state(rig):
     dev, c, sim = rig
-    c.set_high_speed(4000)
+    c.high_speed = 4000
     sim.power_cycle()
-    assert c.high_speed() == 1000
-    assert not c.enabled()
+    assert c.high_speed == 1000
+    assert not c.enabled
 
 
 def test_a14_motion_not_retried_query_retried(rig):
     dev, c, sim = rig
+    c.enable()  # a disabled motor does no motion (manual §6)
     seen = []
 
     def swallow(r):
@@ -164,10 +165,10 @@ def test_a14_motion_not_retried_query_retried(rig):
         c.jog(1)
     assert len(seen) == 1
     with pytest.raises(motorbus.TimeoutError):
-        c.position()
+        c.position
     assert len(seen) == 3  # one retry for the query
     dev.mangle = None
-    assert c.moving()  # the jog did start: query, do not resend
+    assert c.moving  # the jog did start: query, do not resend
     c.abort()
 
 

@@ -43,3 +43,21 @@ def test_example_02_sdo_python():
 def test_example_05_cia402_python():
     out = run_example("05_cia402.py")
     assert out.splitlines() == ["state: OPERATION ENABLED", "position: 10000", "state: SWITCH ON DISABLED"]
+
+
+def test_example_03_arcus_python():
+    out = run_example("03_arcus.py")
+    assert "position 12.50 mm, EX=1250" in out
+    assert "homed True, SLS IDLE" in out
+    assert "SLT=10 SLR=0.800 ID=DriveMax-CAN" in out
+
+
+def test_example_03_arcus_cpp():
+    exe = ROOT / "build" / "dev" / "example_03_arcus"
+    if not exe.exists():
+        import pytest
+        pytest.skip("C++ examples not built (MOTORBUS_EXAMPLES=OFF)")
+    out = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert "EX=1250 PX=1250 SLS=0" in out.stdout
+    assert "SLR=0.800 ID=DriveMax-CAN" in out.stdout

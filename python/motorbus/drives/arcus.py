@@ -1,11 +1,12 @@
 """Arcus DMX-CAN drives over their ASCII line (RS-232 or RS-485 multi-drop).
 
     from motorbus.drives.arcus import ArcusClient
-    with ArcusClient("/dev/ttyUSB0", address=1, baud=9600) as drive:
+    with ArcusClient("/dev/ttyUSB0", address="01", baud=9600) as drive:
         drive.enable()
+        drive.high_speed = 2000     # HSPD (a read/write property)
         drive.move(4000)            # X4000: counts with StepNLoop on, pulses without
         drive.wait_idle(timeout=10)
-        print(drive.position(), drive.status())
+        print(drive.position, drive.status)
 
 A simulator for tests and demos (``make_sim``) answers on a pty exactly like the
 device; ``motorbus sim serve --pty --drive arcus:01`` uses it.
@@ -13,6 +14,7 @@ device; ``motorbus sim serve --pty --drive arcus:01`` uses it.
 from __future__ import annotations
 
 import enum
+import os
 from typing import Any, Optional, Union
 
 from .. import _core, _stop_at_exit
@@ -30,7 +32,16 @@ __all__ = [
     "REQUEST_TERMINATOR",
     "REPLY_TERMINATOR",
     "make_sim",
+    "ArcusDrive",
+    "ArcusParams",
+    "ArcusHomingError",
+    "ArcusMotorDisabled",
+    "HOME_METHODS",
+    "DEFAULT_HOME_METHOD",
+    "PLUGIN",
+    "check_address",
     "open_line",
+    "STOP_WAYS",
     "build_request",
     "parse_reply",
 ]
@@ -118,97 +129,132 @@ class SyncCondition(enum.IntEnum):
     GREATER = 3
 
 
-def open_line(port: Union[str, "_core.Port"], baud: int = 9600, timeout: float = 0.2,
+def open_line(port: Union[str, "os.PathLike[str]", "_core.Port"], *, baud: int = 9600, timeout: float = 0.2,
               turnaround: float = 0.0) -> "_core.LineLink":
     """A LineLink framed for DMX-CAN (CR after requests, NUL after replies).
 
-    Share it between several ArcusClient objects to talk to up to 99 devices on
-    one RS-485 line."""
-    if isinstance(port, str):
-        port = _core.open_port(port, baud)
+    ``port``: a device path (opened at ``baud``) or an open ``motorbus.serial.Port``.
+    ``timeout``: seconds to wait for a reply; ``turnaround``: seconds of quiet
+    before each request (slow RS-485 transceivers).  Share the link between
+    several ArcusClient objects to talk to up to 99 devices on one RS-485 line."""
+    if isinstance(port, (str, os.PathLike)):
+        port = _core.open_port(os.fspath(port), baud)
+    elif not isinstance(port, _core.Port):
+        raise _core.InvalidArgument(f"arcus open_line: a path or a motorbus Port, not {type(port).__name__}")
     return _core.LineLink(port, request_terminator=REQUEST_TERMINATOR, reply_terminators=[REPLY_TERMINATOR],
                           max_line=_core.ARCUS_MAX_REPLY, reply_timeout=timeout, turnaround=turnaround)
 
 
+#: on_error / on_exit words, the same as motorbus.Drive's.
+STOP_WAYS = ("stop", "quick_stop", "disable", None)
 
 
 class ArcusClient(_stop_at_exit.StopsMotor, ArcusClientBase):
     """Typed client for one DMX-CAN.
 
-    ``port`` is a device path (opened at ``baud``), a ``motorbus.Port``, or a
-    ``motorbus.LineLink`` from :func:`open_line` shared with other clients on
-    the same RS-485 line.
+    ``line``: a device path (opened with :func:`open_line` at ``baud`` and
+    closed by :meth:`close`), an open ``motorbus.serial.Port``, or a
+    ``LineLink`` from :func:`open_line` shared with other clients on the same
+    RS-485 line (neither is closed by :meth:`close`).  ``address``: ``"01"``..
+    ``"99"``, ``"DMC05"`` or an int.  ``timeout``: reply timeout in s (None: the
+    link's, 0.2 s for a line opened here).
+
+    Readings are properties (``position``, ``encoder``, ``speed``, ``status``
+    -> :class:`MotorStatus`, ``snl_status`` -> :class:`SnlStatus`, ...);
+    settings are read/write properties (``client.high_speed = 10000``);
+    commands are methods.
 
     As a context manager it stops the motor when an exception leaves the block
-    (``on_error``: "abort" = ABORT, immediate; "stop" = STOP, decelerated; None)
-    and, for clients still open when the interpreter exits, with ``on_exit``
-    (default "stop").
+    (``on_error``) and, for clients still open when the interpreter exits, with
+    ``on_exit``: "stop" (STOP, decelerated), "quick_stop" (ABORT, at once),
+    "disable" (EO=0, power off) or None.  A failed stop falls back to the next
+    harder one.
     """
 
-    def __init__(self, port: Any, address: Union[int, str] = 1, *, baud: int = 9600, timeout: float = 0.2,
-                 query_retries: int = 1, on_error: Optional[str] = "abort", on_exit: Optional[str] = "stop"):
+    def __init__(self, line: Any, address: Union[int, str] = "01", *, baud: int = 9600,
+                 timeout: Optional[float] = None, on_error: Optional[str] = "stop",
+                 on_exit: Optional[str] = "stop", query_retries: int = 1):
         for name, v in (("on_error", on_error), ("on_exit", on_exit)):
-            if v not in (None, "stop", "abort"):
-                raise _core.InvalidArgument(f"{name}: 'stop', 'abort' or None, not {v!r}")
-        if isinstance(port, _core.LineLink):
-            link, self._owns_port = port, False
+            if v not in STOP_WAYS:
+                raise _core.InvalidArgument(f"{name}: one of 'stop', 'quick_stop', 'disable' or None, not {v!r}")
+        number = _address(address)
+        self._owned_port = None
+        if isinstance(line, _core.LineLink):
+            link = line
+        elif isinstance(line, _core.Port):
+            link = open_line(line, timeout=0.2 if timeout is None else timeout)
         else:
-            link, self._owns_port = open_line(port, baud=baud, timeout=timeout), True
-        super().__init__(link, int(address), None, query_retries)
+            link = open_line(line, baud=baud, timeout=0.2 if timeout is None else timeout)
+            self._owned_port = link.port
+        super().__init__(link, number, timeout, query_retries)
         self.link = link
-        self._on_error = on_error
-        self._on_exit = on_exit
+        self.on_error = on_error
+        self.on_exit = on_exit
         self._closed = False
         _stop_at_exit.track(self)
 
     # ---- lifecycle ----
     def _stop_on_error(self) -> None:
-        self._safe_halt(self._on_error)
+        self._halt(self.on_error)
 
     def close(self) -> None:
         if self._closed:
             return
         self._closed = True
         _stop_at_exit.untrack(self)
-        if self._owns_port:
+        if self._owned_port is not None:
             try:
-                self.link.port.close()
+                self._owned_port.close()
             except Exception:  # noqa: BLE001 - closing must not mask the real error
                 pass
 
-    def _stop_at_exit(self) -> None:
-        self._safe_halt(self._on_exit)
+    @property
+    def closed(self) -> bool:
+        return self._closed
 
-    def _safe_halt(self, how: Optional[str]) -> None:
+    def _stop_at_exit(self) -> None:
+        self._halt(self.on_exit)
+
+    def _halt(self, how: Optional[str]) -> None:
+        """Best effort while unwinding: a failed stop falls back to the next harder one."""
         if how is None or self._closed:
             return
-        try:
-            self.abort() if how == "abort" else self.stop()
-        except Exception:  # noqa: BLE001 - best effort while unwinding
-            if how == "stop":
-                try:
-                    self.abort()
-                except Exception:  # noqa: BLE001
-                    pass
+        ladder = {"stop": (self.stop, self.abort, self.disable),
+                  "quick_stop": (self.abort, self.disable),
+                  "disable": (self.disable,)}[how]
+        for step in ladder:
+            try:
+                step()
+                return
+            except Exception:  # noqa: BLE001 - the link may be gone; try the next way
+                continue
 
     # ---- typed views of the status registers ----
+    @property
     def status(self) -> MotorStatus:
-        return MotorStatus(self.status_raw())
+        """MST as :class:`MotorStatus` flags."""
+        return MotorStatus(self._status_raw)
 
+    @property
     def snl_status(self) -> SnlStatus:
-        return SnlStatus(self.snl_status_raw())
+        """SLS as :class:`SnlStatus`."""
+        return SnlStatus(self._snl_status_raw)
 
+    @property
     def latch_status(self) -> LatchStatus:
-        return LatchStatus(self.latch_status_raw())
+        return LatchStatus(self._latch_status_raw)
 
+    @property
     def sync_status(self) -> SyncStatus:
-        return SyncStatus(self.sync_status_raw())
+        return SyncStatus(self._sync_status_raw)
 
+    @property
     def sync_condition(self) -> SyncCondition:
-        return SyncCondition(self.sync_condition_raw())
+        return SyncCondition(self._sync_condition_raw)
 
-    def set_sync_condition(self, condition: Union[SyncCondition, int]) -> None:
-        self.set_sync_condition_raw(int(condition))
+    @sync_condition.setter
+    def sync_condition(self, condition: Union[SyncCondition, int]) -> None:
+        self._sync_condition_raw = int(condition)
 
     def broadcast_command(self, command: str) -> None:
         """``@00<command>``: every device on this line acts; none replies."""
@@ -243,8 +289,286 @@ def make_sim(address: Union[str, int] = "01", clock: Optional["_core.Clock"] = N
     LINE_SETTINGS (requests end with CR, replies with NUL).
     """
     known = {"response_type", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
-             "start_position", "tick"}
+             "start_position", "tick"}  # = _SIM_OPTIONS
     unknown = set(options) - known
     if unknown:
         raise _core.InvalidArgument(f"arcus sim options: unknown {sorted(unknown)}; known {sorted(known)}")
     return ArcusSim(clock, address=_address(address), store_path=store_path or "", **options)
+
+
+# ---- the motorbus.Drive adapter ------------------------------------------------------------------
+
+from .. import drive as _drive  # noqa: E402  (after the client: the adapter is built on it)
+from ..registry import DrivePlugin  # noqa: E402
+
+#: home() methods: the manual's homing commands (Figures 7.2-7.6).
+HOME_METHODS = ("H+", "H-", "HL+", "HL-", "L+", "L-", "Z+", "Z-", "ZH+", "ZH-")
+#: home(None): H+ (home input only, Figure 7.2): the shortest routine; the
+#: counter is zeroed at the switch edge and the motor stops past it by its
+#: deceleration distance.  HL+/ZH+ end exactly at zero but search at LSPD.
+DEFAULT_HOME_METHOD = "H+"
+
+
+class ArcusHomingError(_core.DriveFault):
+    """home() ended in a limit error or a StepNLoop error instead of at the switch."""
+
+    __module__ = "motorbus.drives.arcus"
+
+
+class ArcusMotorDisabled(_core.DriveFault):
+    """A motion was asked of a disabled motor (EO=0): the DMX-CAN would answer OK and not move (§6)."""
+
+    __module__ = "motorbus.drives.arcus"
+
+
+_I, _F, _B, _S = "int", "float", "bool", "str"
+_INT32 = 2**31 - 1
+# name: (type, min, max, unit, factory default, stored by STORE, writable, description)
+_PARAMS: dict[str, tuple] = {
+    "HSPD": (_I, 1, 6_000_000, "pulses/s (counts/s with SL=1)", 1000, False, True, "high speed"),
+    "LSPD": (_I, 1, 6_000_000, "pulses/s (counts/s with SL=1)", 100, False, True, "low (start) speed"),
+    "ACC": (_I, 1, _INT32, "ms", 300, False, True, "acceleration time (adjusted into Appendix A's window)"),
+    "DEC": (_I, 1, _INT32, "ms", 300, False, True, "deceleration time, used when EDEC=1"),
+    "EDEC": (_B, 0, 1, "", False, False, True, "use DEC for deceleration (else ACC)"),
+    "SCV": (_B, 0, 1, "", False, False, True, "S-curve acceleration"),
+    "SSPDM": (_I, 0, 9, "", 0, False, True, "on-the-fly speed window (Appendix A)"),
+    "HCA": (_I, 0, _INT32, "pulses", 100, False, True, "home correction amount (HL homing)"),
+    "RZ": (_B, 0, 1, "", False, False, True, "return to zero after H/HL homing"),
+    "LCA": (_I, 0, _INT32, "pulses", 1000, True, True, "limit correction amount (L homing)"),
+    "CURR": (_I, 100, 2500, "mA", 1600, True, True, "run current"),
+    "CURI": (_I, 0, 2500, "mA", 1000, True, True, "idle current (0, or 100..2500; 0 = unpowered when idle)"),
+    "CURT": (_I, 0, _INT32, "ms", 500, True, True, "idle time before idle current"),
+    "CUR": (_I, 0, 2500, "mA", None, False, False, "actual current"),
+    "EOBOOT": (_B, 0, 1, "", False, True, True, "motor power at boot"),
+    "DOBOOT": (_I, 0, 7, "", 7, True, True, "digital outputs at boot"),
+    "EDO": (_B, 0, 1, "", True, True, True, "DO1 in-position / DO3 alarm outputs under StepNLoop"),
+    "POL": (_I, 0, 511, "bits", 0, True, True, "polarity: 1 dir, 4 limit, 5 home, 6 latch, 7 in-pos, 8 alarm"),
+    "SL": (_B, 0, 1, "", True, True, True, "StepNLoop closed loop (positions and speeds in encoder counts)"),
+    "SLT": (_I, 0, _INT32, "counts", 20, True, True, "StepNLoop tolerance (in position)"),
+    "SLE": (_I, 0, _INT32, "counts", 1000, True, True, "StepNLoop error range"),
+    "SLA": (_I, 0, _INT32, "", 10, True, True, "StepNLoop maximum correction attempts"),
+    "SLM": (_I, 0, _INT32, "counts", 5, True, True, "StepNLoop idle tolerance"),
+    "SLR": (_F, 0.001, 999.999, "pulses/count", 0.8, True, True, "StepNLoop ratio"),
+    "DN": (_I, 1, 99, "", 1, True, True, "device name DMCnn (after STORE and a power cycle)"),
+    "RT": (_I, 0, 1, "", 0, True, True, "response type (after STORE and a power cycle)"),
+    "DB": (_I, 1, 5, "", 1, True, True, "serial baud code 1=9600 .. 5=115200"),
+    "CM": (_I, 0, 2, "", 0, True, True, "communication mode 0 RS-232, 1 RS-485, 2 CANopen"),
+    "BR": (_I, 1, 9, "", 5, True, True, "CANopen bit rate code"),
+    "NID": (_I, 1, 127, "", 1, True, True, "CANopen node id"),
+    "SYNP": (_I, -(2**27), 2**27 - 1, "counts", 0, False, True, "sync output position"),
+    "SYNC": (_I, 1, 3, "", 1, False, True, "sync condition 1 =, 2 <, 3 >"),
+    "ID": (_S, None, None, "", "DriveMax-CAN", False, False, "product id"),
+    "VER": (_S, None, None, "", None, False, False, "firmware version"),
+}
+
+
+class ArcusParams(_drive.Params):
+    """``drive.params``: the DMX-CAN's own command names (Tables 7.10, 7.11 and the profile)."""
+
+    def _names(self) -> list[str]:
+        return list(_PARAMS)
+
+    def _key(self, name: str) -> str:
+        return super()._key(name).strip().upper()
+
+    def _info(self, name: str) -> Optional[_drive.ParamInfo]:
+        row = _PARAMS.get(name)
+        if row is None:
+            return None
+        typ, lo, hi, unit, default, persists, writable, desc = row
+        return _drive.ParamInfo(name, typ, lo, hi, unit, default, persists, writable, desc)
+
+    def _read(self, info: _drive.ParamInfo) -> Any:
+        c: ArcusClient = self._drive.native
+        if info.name == "SLR":
+            return c.snl_ratio
+        if info.name == "DN":
+            return int(c.device_name[-2:])
+        if info.type == "str":
+            return c.command(info.name, True)
+        value = c.query(info.name)
+        return bool(value) if info.type == "bool" else value
+
+    def _write(self, info: _drive.ParamInfo, value: Any) -> None:
+        c: ArcusClient = self._drive.native
+        if info.type == "int" and isinstance(value, float) and not value.is_integer():
+            raise _core.InvalidArgument(f"arcus: {info.name} takes an integer, not {value!r}")
+        if info.type == "bool" and value not in (0, 1):
+            raise _core.InvalidArgument(f"arcus: {info.name} takes True/False (1/0), not {value!r}")
+        if info.name == "SLR":
+            c.snl_ratio = float(value)
+        elif info.name == "DN":
+            c.set_device_name(int(value))
+        else:
+            c.set(info.name, int(value))
+        if info.name in ("SL", "SLT"):
+            self._drive._read_loop_settings()
+
+
+class ArcusDrive(_drive.Drive):
+    """A DMX-CAN behind :class:`motorbus.Drive`.
+
+    Native units are the drive's own: with StepNLoop on (SL=1, the factory
+    setting) positions, targets and velocities are encoder counts and
+    counts/s (4000 per rev) and ``position`` is EX; with SL=0 they are pulses
+    and pulses/s (3200 per rev) and ``position`` is PX.  ``velocity=`` of a
+    move sets HSPD, which stays set afterwards.  No watchdog: on link loss the
+    motor keeps doing what it was last told and the next call raises LinkDown.
+    """
+
+    kind = "arcus"
+    capabilities = frozenset({_drive.Capability.POSITION, _drive.Capability.VELOCITY, _drive.Capability.HOMING,
+                              _drive.Capability.ENCODER, _drive.Capability.STORE})
+    has_watchdog = False
+
+    def __init__(self, native: ArcusClient, **kw: Any) -> None:
+        super().__init__(native, **kw)
+        self._homed = False
+        self._homing = False
+        self._target: Optional[float] = None
+        self._direction = 1
+        self._read_loop_settings()
+
+    def _read_loop_settings(self) -> None:
+        self._snl = self.native.snl_enabled
+        self._tolerance = self.native.snl_tolerance if self._snl else 0
+
+    def _require_enabled(self) -> None:
+        if not self.native.enabled:
+            raise ArcusMotorDisabled(f"arcus {self.native.address:02d}: the motor is disabled (EO=0); "
+                                     "call enable() first")
+
+    # ---- motion ----
+    def _enable(self) -> None:
+        self.native.enable(True)
+
+    def _disable(self) -> None:
+        self.native.enable(False)
+
+    def _move_to(self, target: float, velocity: Optional[float]) -> None:
+        self._require_enabled()
+        goal = int(round(target))
+        if velocity is not None:
+            self.native.high_speed = max(1, int(round(velocity)))
+        self.native.absolute_mode()
+        here = self._position()
+        self._direction = 1 if goal >= here else -1
+        self._target = goal
+        self.native.move(goal)
+
+    def _jog(self, velocity: float) -> None:
+        self._require_enabled()
+        self.native.high_speed = max(1, int(round(abs(velocity))))
+        self._direction = 1 if velocity > 0 else -1
+        self._target = None
+        self.native.jog(self._direction)
+
+    def _stop(self) -> None:
+        self.native.stop()
+
+    def _quick_stop(self) -> None:
+        self.native.abort()
+
+    def _home(self, method: Any) -> None:
+        method = DEFAULT_HOME_METHOD if method is None else method
+        if not isinstance(method, str) or method.strip().upper() not in HOME_METHODS:
+            raise _core.InvalidArgument(f"arcus home method: one of {', '.join(HOME_METHODS)} (None = "
+                                        f"{DEFAULT_HOME_METHOD}), not {method!r}")
+        method = method.strip().upper()
+        self._require_enabled()
+        self._homed = False
+        self._homing = True
+        self._target = None
+        self._direction = 1 if method.endswith("+") else -1
+        self.native.action(method)
+
+    def _homing_done(self) -> bool:
+        st = self.native.status
+        if st.moving:
+            return False
+        self._homing = False
+        snl = self.native.snl_status if self._snl else SnlStatus.DISABLED
+        if st.limit_error or snl.is_error:
+            raise ArcusHomingError(f"arcus {self.native.address:02d}: homing failed: MST {st!r}, SLS {snl.name}")
+        self._homed = True
+        return True
+
+    def _clear_faults(self) -> None:
+        self.native.clear()  # CLR: limit errors and the StepNLoop error status
+
+    def _store(self) -> None:
+        self.native.store()
+
+    # ---- readings ----
+    def _position(self) -> float:
+        return float(self.native.encoder if self._snl else self.native.position)
+
+    def _velocity(self) -> float:
+        return float(self.native.speed * self._direction) if self.native.moving else 0.0
+
+    def _is_idle(self) -> bool:
+        return not self.native.status.moving
+
+    def _status(self) -> _drive.DriveStatus:
+        c = self.native
+        st = c.status
+        snl = c.snl_status
+        enabled = c.enabled
+        moving = st.moving
+        fault = st.limit_error or snl.is_error
+        pos = self._position()
+        at_target = (not moving and not fault and self._target is not None
+                     and abs(pos - self._target) <= self._tolerance)
+        flags = "|".join(f.name for f in MotorStatus if f in st) or "idle"
+        text = (f"arcus {c.address:02d}: {'enabled' if enabled else 'disabled'}, MST {flags}, SLS {snl.name}, "
+                f"{'EX' if self._snl else 'PX'}={int(pos)}")
+        return _drive.DriveStatus(enabled=enabled, moving=moving, homed=self._homed, fault=fault,
+                                  at_target=at_target, limit_positive=bool(st & MotorStatus.PLUS_LIMIT),
+                                  limit_negative=bool(st & MotorStatus.MINUS_LIMIT), raw=(st, snl), text=text)
+
+    def _make_params(self) -> _drive.Params:
+        return ArcusParams(self)
+
+    def _close(self) -> None:
+        self.native.close()
+
+
+def check_address(text: str) -> str:
+    """'1', '01', 'DMC01' -> '01'; InvalidArgument naming the problem."""
+    return f"{_address(text):02d}"
+
+
+def open_drive(*, line: Any, bus: Any = None, address: str = "01", units: Optional[_drive.Units] = None,
+               baud: int = 9600, timeout: Optional[float] = None, on_error: Optional[str] = "stop",
+               on_exit: Optional[str] = "stop", query_retries: int = 1) -> ArcusDrive:
+    """The plugin's ``open``: ``line`` is a path (opened here, closed with the drive) or a shared LineLink."""
+    if bus is not None:
+        raise _core.InvalidArgument("arcus: a serial drive takes line=, not bus=")
+    if line is None:
+        raise _core.InvalidArgument("arcus: line= (a port path or a LineLink) is required")
+    # The Drive applies on_error/on_exit; the client itself stays quiet.
+    native = ArcusClient(line, address, baud=baud, timeout=timeout, on_error=None, on_exit=None,
+                         query_retries=query_retries)
+    try:
+        return ArcusDrive(native, units=units, on_error=on_error, on_exit=on_exit)
+    except BaseException:
+        native.close()
+        raise
+
+
+_SIM_OPTIONS = ("response_type", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
+                "start_position", "tick")
+
+PLUGIN = DrivePlugin(
+    kind="arcus",
+    description="Arcus DMX-CAN integrated stepper, ASCII over RS-232/RS-485 (StepNLoop closed loop)",
+    transport="serial",
+    open=open_drive,
+    make_sim=make_sim,
+    check_address=check_address,
+    default_address="01",
+    line_settings=LINE_SETTINGS,
+    default_baud=9600,
+    sim_options=_SIM_OPTIONS + ("store_path",),
+    store_options=lambda store_dir, address: {"store_path": os.path.join(store_dir, f"arcus-{address}.store")},
+)

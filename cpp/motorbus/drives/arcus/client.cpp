@@ -1,5 +1,6 @@
 #include "motorbus/drives/arcus/client.hpp"
 
+#include <cmath>
 #include <thread>
 
 namespace motorbus::arcus {
@@ -344,6 +345,22 @@ std::int64_t Client::snl_max_attempts() { return query("SLA"); }
 void Client::set_snl_max_attempts(std::int64_t n) { set("SLA", n); }
 std::int64_t Client::snl_idle_tolerance() { return query("SLM"); }
 void Client::set_snl_idle_tolerance(std::int64_t c) { set("SLM", c); }
+double Client::snl_ratio() {
+    auto body = transact("SLR", true);
+    auto milli = parse_milli(body);
+    if (!milli) {
+        ++counters_.protocol_errors;
+        throw ProtocolError("arcus: SLR -> '" + body + "' is not a ratio like 0.800");
+    }
+    return static_cast<double>(*milli) / 1000.0;
+}
+void Client::set_snl_ratio(double r) {
+    const double milli = std::round(r * 1000.0);
+    if (!std::isfinite(r) || milli < static_cast<double>(kSlrMinMilli) || milli > static_cast<double>(kSlrMaxMilli))
+        throw InvalidArgument("arcus SLR: a ratio of 0.001..999.999 pulses per count, not " + std::to_string(r));
+    const std::string cmd = "SLR=" + format_milli(static_cast<std::int64_t>(milli));
+    expect_ok(cmd, transact(cmd, false));
+}
 
 // ---- communication ---------------------------------------------------------------------------------------
 

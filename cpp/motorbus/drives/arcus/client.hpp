@@ -170,6 +170,8 @@ public:
     void set_snl_max_attempts(std::int64_t n);
     std::int64_t snl_idle_tolerance();           // SLM
     void set_snl_idle_tolerance(std::int64_t counts);
+    double snl_ratio();                          // SLR, pulses per encoder count ("0.800")
+    void set_snl_ratio(double pulses_per_count); // 0.001..999.999, rounded to 1/1000
 
     // ---- communication settings (take effect after STORE and a power cycle) ----------------
     int comm_mode();                             // CM

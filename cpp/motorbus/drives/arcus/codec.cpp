@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <charconv>
+#include <cstdio>
 
 namespace motorbus::arcus {
 
@@ -66,6 +67,7 @@ constexpr CommandInfo kTable[] = {
     {"SLA", Q | S, false, true, 0, "StepNLoop max attempts"},
     {"SLE", Q | S, false, true, 0, "StepNLoop error range"},
     {"SLM", Q | S, false, true, 0, "StepNLoop idle tolerance"},
+    {"SLR", Q | S, false, true, 0, "StepNLoop ratio, pulses per count (x.xxx)"},
     {"SLS", Q, false, false, 0, "StepNLoop status"},
     {"SLT", Q | S, false, true, 0, "StepNLoop tolerance"},
     {"SSPD", R, false, false, 0, "on-the-fly speed change"},
@@ -98,6 +100,35 @@ bool printable(char c) { return c >= 0x20 && c < 0x7f; }
 }  // namespace
 
 std::span<const CommandInfo> command_table() { return kTable; }
+
+std::optional<std::int64_t> parse_milli(std::string_view text) {
+    // Digits, optionally '.' and 1..3 more digits: "0.8", "1", "0.250".
+    auto dot = text.find('.');
+    std::string_view whole = text.substr(0, dot);
+    std::string_view frac = dot == std::string_view::npos ? std::string_view{} : text.substr(dot + 1);
+    if (whole.empty() || whole.size() > 6) return std::nullopt;
+    if (dot != std::string_view::npos && (frac.empty() || frac.size() > 3)) return std::nullopt;
+    std::int64_t v = 0;
+    for (char c : whole) {
+        if (c < '0' || c > '9') return std::nullopt;
+        v = v * 10 + (c - '0');
+    }
+    std::int64_t f = 0;
+    for (std::size_t i = 0; i < 3; ++i) {
+        char c = i < frac.size() ? frac[i] : '0';
+        if (c < '0' || c > '9') return std::nullopt;
+        f = f * 10 + (c - '0');
+    }
+    return v * 1000 + f;
+}
+
+std::string format_milli(std::int64_t milli) {
+    const bool neg = milli < 0;
+    const unsigned long long m = neg ? 0ULL - static_cast<unsigned long long>(milli) : static_cast<unsigned long long>(milli);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%llu.%03llu", neg ? "-" : "", m / 1000, m % 1000);
+    return buf;
+}
 
 const CommandInfo* find_command(std::string_view name) {
     auto it = std::lower_bound(std::begin(kTable), std::end(kTable), name,

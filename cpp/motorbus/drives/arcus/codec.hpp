@@ -123,6 +123,13 @@ std::string format_reply(int address, std::string_view body, int response_type);
 // Strict decimal integer: optional '-' (a '+' is tolerated), 1..10 digits, no
 // spaces, inside int32.  nullopt otherwise.
 std::optional<std::int64_t> parse_int(std::string_view text);
+// SLR's fixed-point form (docs/drives/arcus.md): "0.800" <-> 800 thousandths.
+// parse_milli takes 1..6 digits, optionally '.' and 1..3 decimals, no sign;
+// nullopt otherwise.  format_milli always writes three decimals.
+std::optional<std::int64_t> parse_milli(std::string_view text);
+std::string format_milli(std::int64_t milli);
+// StepNLoop ratio limits (thousandths): 0.001..999.999 pulses per count.
+inline constexpr std::int64_t kSlrMinMilli = 1, kSlrMaxMilli = 999'999;
 // Throws ProtocolError when `body` is not a strict int32.
 std::int64_t reply_int(std::string_view body);
 

@@ -16,21 +16,22 @@ namespace motorbus::arcus {
 
 namespace {
 
-constexpr double kStepsPerCount = 3200.0 / 4000.0;
+// The DMX-CAN's own StepNLoop ratio: 3200 steps per 4000 counts (SLR 0.800).
+constexpr std::int64_t kFactorySlrMilli = 800;
 constexpr std::int64_t kSyncMax = (1 << 27) - 1;  // SYNP is a 28-bit signed number
 
 // Flash contents (Table 7.10) with the Table 7.11 factory defaults.
 struct Flash {
     std::int64_t br = 5, cm = 0, curi = 1000, curr = 1600, curt = 500, db = 1, dn = 1,
                  doboot = 7, edo = 1, eoboot = 0, lca = 1000, pol = 0, rt = 0, sl = 1,
-                 sla = 10, sle = 1000, slm = 5, slt = 20, nid = 1;
+                 sla = 10, sle = 1000, slm = 5, slt = 20, nid = 1, slr = kFactorySlrMilli;
 
     std::map<std::string, std::int64_t*> fields() {
         return {{"BR", &br},     {"CM", &cm},         {"CURI", &curi}, {"CURR", &curr},
                 {"CURT", &curt}, {"DB", &db},         {"DN", &dn},     {"DOBOOT", &doboot},
                 {"EDO", &edo},   {"EOBOOT", &eoboot}, {"LCA", &lca},   {"POL", &pol},
                 {"RT", &rt},     {"SL", &sl},         {"SLA", &sla},   {"SLE", &sle},
-                {"SLM", &slm},   {"SLT", &slt},       {"NID", &nid}};
+                {"SLM", &slm},   {"SLR", &slr},       {"SLT", &slt},   {"NID", &nid}};
     }
 };
 
@@ -84,6 +85,9 @@ struct Sim::State {
     bool minus_err = false, plus_err = false;
 
     bool blocked = false;
+    // The running (or last) motion is an SLM correction: Table 7.5 runs it on
+    // idle current.
+    bool idle_current_motion = false;
     unsigned inputs = 0;  // DI1..DI6 actuated
     Nanos idle_since = 0;
 };
@@ -102,8 +106,11 @@ public:
 
     motion::MotorModel& m() const { return *s.motor; }
     bool snl_on() const { return s.cfg.sl != 0; }
-    // Position units: encoder counts with StepNLoop, pulses without; POL bit 1 reverses.
-    double steps_per_unit() const { return (snl_on() ? kStepsPerCount : 1.0) * ((s.cfg.pol & 2) ? -1.0 : 1.0); }
+    // SLR: pulses per encoder count, the ratio StepNLoop converts with.
+    double slr() const { return static_cast<double>(s.cfg.slr) / 1000.0; }
+    // Position units: encoder counts with StepNLoop (SLR pulses each), pulses
+    // without; POL bit 1 reverses.
+    double steps_per_unit() const { return (snl_on() ? slr() : 1.0) * ((s.cfg.pol & 2) ? -1.0 : 1.0); }
     int physical_direction(double units_direction) const {
         const double d = units_direction * steps_per_unit();
         return d > 0 ? 1 : (d < 0 ? -1 : 0);
@@ -127,7 +134,7 @@ public:
 
     ArcusProfileParams profile_params(double hspd_override = -1) const {
         ArcusProfileParams ap;
-        ap.snl_ratio = snl_on() ? kStepsPerCount : 1.0;
+        ap.snl_ratio = snl_on() ? slr() : 1.0;
         // arcus_effective refuses speeds outside 1..6 000 000 PPS; the sim
         // validates HSPD/LSPD itself, so only clamp what unit conversion moved.
         const double min_units = 1.0 / ap.snl_ratio;
@@ -199,16 +206,24 @@ public:
         std::int64_t v = s.user_do & 7;
         bool dedicated = snl_on() && s.cfg.edo;
         if (dedicated) {
-            v = (v & ~std::int64_t{5}) | (in_position() ? 1 : 0) | (s.snl.in_error() ? 4 : 0);
+            // POL bit 7 inverts the in-position output, bit 8 the alarm (Table 7.2).
+            const bool in_pos = in_position() != ((s.cfg.pol & 128) != 0);
+            const bool alarm = s.snl.in_error() != ((s.cfg.pol & 256) != 0);
+            v = (v & ~std::int64_t{5}) | (in_pos ? 1 : 0) | (alarm ? 4 : 0);
         }
-        if (s.sync_on) v = (v & ~std::int64_t{2}) | (s.sync_hit ? 2 : 0);
+        if (s.sync_on) {
+            // EQUAL is a pulse "only when the encoder position and sync position
+            // are equal"; LESS/GREATER stay on once the condition occurred.
+            const bool on = s.sync_cond == 1 ? encoder() == s.synp : s.sync_hit;
+            v = (v & ~std::int64_t{2}) | (on ? 2 : 0);
+        }
         return v;
     }
 
     std::int64_t current(Nanos now) const {
         if (!s.eo) return 0;
         bool running = m().moving() || now - s.idle_since < s.cfg.curt * 1'000'000;
-        return running ? s.cfg.curr : s.cfg.curi;
+        return running && !s.idle_current_motion ? s.cfg.curr : s.cfg.curi;
     }
 
     void configure_snl() {
@@ -218,7 +233,7 @@ public:
         c.error_range = static_cast<std::uint32_t>(s.cfg.sle);
         c.max_attempts = static_cast<std::uint32_t>(s.cfg.sla);
         c.idle_tolerance = static_cast<std::uint32_t>(s.cfg.slm);
-        c.ratio = kStepsPerCount;
+        c.ratio = slr();
         s.snl.configure(c);
     }
 
@@ -233,6 +248,7 @@ public:
         const double from = target - dec.correction;
         m().set_pulse_position(from);
         configure_arcus(static_cast<double>(std::min(s.lspd, s.hspd)));
+        s.idle_current_motion = dec.idle_current;
         s.job = Job::Correct;
         s.stopping = false;
         if (s.arcus.move(from, target) == ArcusReply::Ok) command_arcus();
@@ -601,8 +617,13 @@ std::string Sim::handle(const Request& req) {
     auto in = [&](std::int64_t lo, std::int64_t hi) { return v && *v >= lo && *v <= hi; };
 
     auto refuse_in_error = [&] { return s.minus_err || s.plus_err || s.snl.in_error(); };
+    // §6: "When motor is disabled, no motion is done": the command is taken
+    // (OK, no error of Table 11.1 fits) and no pulse goes out.
+    auto disabled = [&] { return s.eo == 0; };
     auto jog = [&](int dir) -> std::string {
         if (refuse_in_error()) return std::string(error_text(ErrorCode::StateError));
+        if (disabled()) return ok;
+        s.idle_current_motion = false;
         e.configure_arcus();
         s.job = Job::Jog;
         s.stopping = false;
@@ -614,6 +635,8 @@ std::string Sim::handle(const Request& req) {
     };
     auto home = [&](ArcusHoming::Method method, int dir) -> std::string {
         if (refuse_in_error()) return std::string(error_text(ErrorCode::StateError));
+        if (disabled()) return ok;
+        s.idle_current_motion = false;
         using M = ArcusHoming::Method;
         s.snl.begin(method == M::Z   ? motion::SnlActivity::ZHome
                     : method == M::L ? motion::SnlActivity::LimitHome
@@ -675,6 +698,7 @@ std::string Sim::handle(const Request& req) {
         if (name == "SLA") return num(s.cfg.sla);
         if (name == "SLE") return num(s.cfg.sle);
         if (name == "SLM") return num(s.cfg.slm);
+        if (name == "SLR") return format_milli(s.cfg.slr);
         if (name == "SLS") return num(e.sls());
         if (name == "SLT") return num(s.cfg.slt);
         if (name == "SSPDM") return num(s.sspdm);
@@ -693,6 +717,16 @@ std::string Sim::handle(const Request& req) {
             auto a = t.size() == 2 ? parse_int(t) : std::nullopt;
             if (!a || *a < 1 || *a > 99) return unknown();
             s.cfg.dn = *a;
+            return ok;
+        }
+        if (name == "SLR") {
+            // Fixed point, three decimals (docs/drives/arcus.md): "SLR=0.8".
+            auto milli = parse_milli(pc->text_value);
+            if (!milli || *milli < kSlrMinMilli || *milli > kSlrMaxMilli) return unknown();
+            if (busy) return std::string(error_text(ErrorCode::Moving));
+            s.cfg.slr = *milli;
+            e.apply_wiring();
+            e.configure_snl();
             return ok;
         }
         if (!v) return unknown();
@@ -738,6 +772,12 @@ std::string Sim::handle(const Request& req) {
         if (name == "EO") {
             if (!in(0, 1)) return unknown();
             s.eo = *v;
+            if (!s.eo && m.moving()) {
+                // Power off: the pulses stop at once, as ABORT (no motion is done).
+                if (s.homing && s.homing->running()) s.homing->abort();
+                m.halt();
+                e.end_job(now);
+            }
             e.apply_jam();
             return ok;
         }
@@ -778,7 +818,7 @@ std::string Sim::handle(const Request& req) {
             if (*v != s.cfg.sl) {
                 // Position units change: counts with SNL, pulses without.
                 std::int64_t ex = e.encoder();
-                m.set_pulse_position(*v ? static_cast<double>(ex) : std::round(static_cast<double>(ex) * kStepsPerCount));
+                m.set_pulse_position(*v ? static_cast<double>(ex) : std::round(static_cast<double>(ex) * e.slr()));
             }
             s.cfg.sl = *v;
             e.apply_wiring();
@@ -802,12 +842,14 @@ std::string Sim::handle(const Request& req) {
     if (pc->op == Op::Argument) {
         if (name == "X") {
             if (!v) return unknown();
-            if (s.minus_err || s.plus_err || s.snl.in_error()) return std::string(error_text(ErrorCode::StateError));
+            if (refuse_in_error()) return std::string(error_text(ErrorCode::StateError));
             double from = m.pulse_position();
             double target = s.inc_mode ? from + static_cast<double>(*v) : static_cast<double>(*v);
             if (std::abs(target - from) > static_cast<double>(kMaxIncrement)) return unknown();
             e.configure_arcus();
             if (s.arcus.move(from, target) != ArcusReply::Ok) return unknown();
+            if (disabled()) return ok;
+            s.idle_current_motion = false;
             s.job = Job::Target;
             s.stopping = false;
             s.snl.begin(motion::SnlActivity::Move);
@@ -835,7 +877,7 @@ std::string Sim::handle(const Request& req) {
             if (!v || *v <= 0) return std::string(error_text(ErrorCode::BadSspd));
             if (s.scv) return std::string(error_text(ErrorCode::ScvOn));
             // The window is in PPS; under StepNLoop the value is in counts/s.
-            double pps = static_cast<double>(*v) * (e.snl_on() ? kStepsPerCount : 1.0);
+            double pps = static_cast<double>(*v) * (e.snl_on() ? e.slr() : 1.0);
             auto wdw = window_for_sspdm(s.sspdm);
             if (!wdw || pps < static_cast<double>(wdw->hspd_min) || pps > static_cast<double>(wdw->hspd_max))
                 return std::string(error_text(ErrorCode::SpeedOutOfRange));
@@ -857,7 +899,9 @@ std::string Sim::handle(const Request& req) {
         m.halt();
         s.job = Job::None;
         s.stopping = false;
-        if (s.snl.status() != motion::SnlStatus::LimitError) s.snl.clear();
+        // Table 11.0: ABORT clears the StepNLoop error status, the limit error
+        // (SLS 11) included; MST's limit error bits stay until CLR (Table 7.3).
+        s.snl.clear();
         s.idle_since = now;
         return ok;
     }

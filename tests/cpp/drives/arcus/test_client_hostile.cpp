@@ -145,6 +145,7 @@ TEST(ArcusHostile, A13PowerCycleOutputIsDroppedAndStateIsBootState) {
 
 TEST(ArcusHostile, A14MotionCommandsAreNotRetriedQueriesAre) {
     Bench b;
+    b.c.enable(true);  // a disabled motor does no motion (§6)
     b.port->silent = true;
     EXPECT_THROW(b.c.move(1000), motorbus::TimeoutError);
     EXPECT_EQ(count(b.port->written, "@01X1000\r"), 1u);

@@ -23,6 +23,7 @@ TEST(ArcusSim, SeedExamplesRt0) {
     EXPECT_EQ(sim.on_line("@01EX"), nul("0"));
     EXPECT_EQ(sim.on_line("@01EX=1000"), nul("OK"));
     EXPECT_EQ(sim.on_line("@01EX"), nul("1000"));
+    EXPECT_EQ(sim.on_line("@01EO=1"), nul("OK"));  // powered: a disabled motor does no motion (§6)
     EXPECT_EQ(sim.on_line("@01J+"), nul("OK"));
     EXPECT_EQ(sim.on_line("@01X1000"), nul("?Moving"));
     EXPECT_EQ(sim.on_line("@01ABORT"), nul("OK"));
@@ -300,14 +301,6 @@ TEST(ArcusSim, StepNLoopStallAndAttemptErrors) {
     EXPECT_EQ(b.c.snl_status(), SnlStatus::Idle);
 }
 
-TEST(ArcusSim, UnpoweredMotorStallsUnderStepNLoop) {
-    Bench b;  // EO=0 at boot (EOBOOT=0)
-    b.c.move(3000);
-    b.run(5);
-    EXPECT_EQ(b.c.snl_status(), SnlStatus::StallError);
-    EXPECT_EQ(b.c.encoder(), 0);
-}
-
 // ---- homing ----
 
 TEST(ArcusSim, HomeInputOnly) {
@@ -529,7 +522,11 @@ TEST(ArcusSim, SyncOutputOnDo2) {
     b.c.move(1000);  // encoder passes 500 on the way to 1250
     b.run(3);
     EXPECT_EQ(b.c.sync_status(), SyncStatus::Occurred);
-    EXPECT_TRUE(b.c.digital_output(2));
+    EXPECT_FALSE(b.c.digital_output(2));  // EQUAL: a pulse while equal only (ArcusAudit)
+    b.c.set_sync_condition(SyncCondition::Greater);
+    b.c.sync_off();
+    b.c.sync_on();
+    EXPECT_TRUE(b.c.digital_output(2));   // GREATER stays on
     b.c.sync_off();
     EXPECT_EQ(b.c.sync_status(), SyncStatus::Off);
     EXPECT_FALSE(b.c.digital_output(2));
