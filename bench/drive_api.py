@@ -39,8 +39,16 @@ def _cia402_setup(d: Any) -> None:
     d.move_by(0, wait=True)  # leaves the drive in profile position mode, as the native call expects
 
 
+def _arcus_setup(d: Any) -> None:
+    d.params["HSPD"] = 50000
+    d.params["ACC"] = 1
+    d.enable()
+    d.move_by(0, wait=True)  # INC mode, as the native relative move below expects
+
+
 # kind -> (address, native position read, native relative move of n steps, setup)
 NATIVE: dict[str, tuple[str, Callable[[Any], Any], Callable[[Any, int], Any], Callable[[Any], None]]] = {
+    "arcus": ("01", lambda d: d.native.encoder, lambda d, n: d.native.move(n), _arcus_setup),
     "cia402": ("5", _cia402_native_position, lambda d, n: d.native.move_to(n, relative=True), _cia402_setup),
 }
 

@@ -34,12 +34,13 @@ class Kind:
     kind: str
     address: str
     scale: float                      # user units (mm) per native unit
-    fault: Callable[[Any], None]      # provokes a fault on the simulator
+    fault: Callable[[Any, Any], None]  # (sim, drive): provokes a fault
     param: str                        # a writable parameter and a valid value for it
     value: Any
     jog: float                        # user units / s
     home: Any = None                  # home() method (None = the drive's default)
     setup: Callable[[Any], None] = lambda drive: None   # fast profile for the test
+    unfault: Callable[[Any], None] = lambda sim: None   # removes the fault's cause (not its latch)
     open_options: dict = field(default_factory=dict)
 
 
@@ -49,8 +50,21 @@ def _cia402_setup(drive: Any) -> None:
     drive.params["0x6084"] = 400000
 
 
+def _arcus_setup(drive: Any) -> None:
+    drive.params["HSPD"] = 20000     # pps (counts/s with StepNLoop)
+    drive.params["LSPD"] = 2000      # HL homing searches at LSPD
+    drive.params["ACC"] = 20         # ms
+
+
+def _arcus_fault(sim: Any, drive: Any) -> None:
+    sim.force_limit(-1, True)        # the -limit switch closes...
+    drive.jog(-10.0)                 # ...and a jog into it latches a limit error
+
+
 KINDS = {
-    "cia402": Kind("cia402", "5", 0.01, fault=lambda sim: sim.inject_fault(0x5441),
+    "arcus": Kind("arcus", "01", 0.01, fault=_arcus_fault, unfault=lambda sim: sim.force_limit(-1, None),
+                  param="HSPD", value=15000, jog=50.0, home="HL+", setup=_arcus_setup),
+    "cia402": Kind("cia402", "5", 0.01, fault=lambda sim, drive: sim.inject_fault(0x5441),
                    param="0x6081", value=25000, jog=50.0, home=19, setup=_cia402_setup),
 }
 
@@ -171,10 +185,15 @@ def test_fault_then_clear_faults(rig, kind):
     drive, sim = rig.drive, rig.sim
     kind.setup(drive)
     drive.enable()
-    kind.fault(sim)
-    st = drive.status
-    assert st.fault and not st.enabled
-    assert st.text
+    kind.fault(sim, drive)
+    deadline = time.monotonic() + 5
+    while not drive.status.fault:
+        assert time.monotonic() < deadline, "the drive never reported the fault"
+        time.sleep(0.01)
+    assert drive.status.text
+    with pytest.raises(motorbus.DriveFault):   # a faulted drive refuses motion, typed
+        drive.move_to(2.0, timeout=5)
+    kind.unfault(sim)
     drive.clear_faults()
     assert not drive.status.fault
     drive.enable()

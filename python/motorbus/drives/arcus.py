@@ -427,6 +427,12 @@ class ArcusDrive(_drive.Drive):
         self._homing = False
         self._target: Optional[float] = None
         self._direction = 1
+        # What this Drive last told the drive, so a move costs one request like the
+        # native client's (EO and ABS/INC are read once here and after enable/disable;
+        # a script that changes them through drive.native should reopen the Drive).
+        self._enabled = self.native.enabled
+        self._incremental: Optional[bool] = None
+        self._relative_move = False
         self._read_loop_settings()
 
     def _read_loop_settings(self) -> None:
@@ -434,33 +440,49 @@ class ArcusDrive(_drive.Drive):
         self._tolerance = self.native.snl_tolerance if self._snl else 0
 
     def _require_enabled(self) -> None:
-        if not self.native.enabled:
+        if not self._enabled:
             raise ArcusMotorDisabled(f"arcus {self.native.address:02d}: the motor is disabled (EO=0); "
                                      "call enable() first")
 
     # ---- motion ----
     def _enable(self) -> None:
         self.native.enable(True)
+        self._enabled = True
 
     def _disable(self) -> None:
+        self._enabled = False
         self.native.enable(False)
+
+    def _use_mode(self, incremental: bool) -> None:
+        if self._incremental is not incremental:
+            self.native.incremental_mode() if incremental else self.native.absolute_mode()
+            self._incremental = incremental
 
     def _move_to(self, target: float, velocity: Optional[float]) -> None:
         self._require_enabled()
         goal = int(round(target))
         if velocity is not None:
             self.native.high_speed = max(1, int(round(velocity)))
-        self.native.absolute_mode()
-        here = self._position()
-        self._direction = 1 if goal >= here else -1
-        self._target = goal
+        self._use_mode(False)
+        self._target, self._direction = goal, 0   # direction: worked out when velocity is read
+        self._relative_move = False
         self.native.move(goal)
+
+    def _move_by(self, distance: float, velocity: Optional[float]) -> None:
+        self._require_enabled()
+        step = int(round(distance))
+        if velocity is not None:
+            self.native.high_speed = max(1, int(round(velocity)))
+        self._use_mode(True)
+        self._target, self._direction = None, 1 if step >= 0 else -1
+        self._relative_move = True                # at target once it stops without a fault
+        self.native.move(step)                    # X in INC mode: relative
 
     def _jog(self, velocity: float) -> None:
         self._require_enabled()
         self.native.high_speed = max(1, int(round(abs(velocity))))
         self._direction = 1 if velocity > 0 else -1
-        self._target = None
+        self._target, self._relative_move = None, False
         self.native.jog(self._direction)
 
     def _stop(self) -> None:
@@ -478,7 +500,7 @@ class ArcusDrive(_drive.Drive):
         self._require_enabled()
         self._homed = False
         self._homing = True
-        self._target = None
+        self._target, self._relative_move = None, False
         self._direction = 1 if method.endswith("+") else -1
         self.native.action(method)
 
@@ -504,7 +526,11 @@ class ArcusDrive(_drive.Drive):
         return float(self.native.encoder if self._snl else self.native.position)
 
     def _velocity(self) -> float:
-        return float(self.native.speed * self._direction) if self.native.moving else 0.0
+        if not self.native.moving:
+            return 0.0
+        if self._direction == 0 and self._target is not None:
+            self._direction = 1 if self._target >= self._position() else -1
+        return float(self.native.speed * (self._direction or 1))
 
     def _is_idle(self) -> bool:
         return not self.native.status.moving
@@ -517,8 +543,8 @@ class ArcusDrive(_drive.Drive):
         moving = st.moving
         fault = st.limit_error or snl.is_error
         pos = self._position()
-        at_target = (not moving and not fault and self._target is not None
-                     and abs(pos - self._target) <= self._tolerance)
+        at_target = not moving and not fault and (
+            self._relative_move or (self._target is not None and abs(pos - self._target) <= self._tolerance))
         flags = "|".join(f.name for f in MotorStatus if f in st) or "idle"
         text = (f"arcus {c.address:02d}: {'enabled' if enabled else 'disabled'}, MST {flags}, SLS {snl.name}, "
                 f"{'EX' if self._snl else 'PX'}={int(pos)}")
