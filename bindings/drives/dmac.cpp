@@ -233,8 +233,20 @@ void bind_dmac(py::module_& m) {
         .def("sequence_line", &DmacSim::sequence_line, py::arg("n"))
         .def("set_input", &DmacSim::set_input, py::arg("n"), py::arg("active"), py::call_guard<py::gil_scoped_release>())
         .def("set_analog", &DmacSim::set_analog, py::arg("channel"), py::arg("mv"))
-        .def("set_supply_voltage", &DmacSim::set_supply_voltage, py::arg("mv"))
-        .def("inject_error", &DmacSim::inject_error, py::arg("bit"))
+        .def("set_supply_voltage", &DmacSim::set_supply_voltage, py::arg("mv"), py::call_guard<py::gil_scoped_release>(),
+             "Supply voltage in mV; outside the model's range latches undervoltage/overvoltage and stops the motor.")
+        .def("set_temperature", [](DmacSim& s, const std::string& which, std::int32_t tenths) {
+                 DmacSim::Sensor w;
+                 if (which == "cpu") w = DmacSim::Sensor::Cpu;
+                 else if (which == "driver") w = DmacSim::Sensor::Driver;
+                 else if (which == "motor") w = DmacSim::Sensor::Motor;
+                 else throw InvalidArgument("sensor: '" + which + "' is not 'cpu', 'driver' or 'motor'");
+                 py::gil_scoped_release nogil;
+                 s.set_temperature(w, tenths);
+             }, py::arg("sensor"), py::arg("tenths_c"),
+             "Temperature in 0.1 degC; CPU > 120 degC or driver/motor > 85 degC latches a thermal fault.")
+        .def("inject_error", &DmacSim::inject_error, py::arg("bit"), py::call_guard<py::gil_scoped_release>(),
+             "Sets an #ERROR bit; fault bits 2..5 also stop the motor as the real fault does.")
         .def("physical_outputs", &DmacSim::physical_outputs, py::call_guard<py::gil_scoped_release>())
         .def("power_cycle", &DmacSim::power_cycle, py::call_guard<py::gil_scoped_release>())
         .def_property_readonly("lines_handled", &DmacSim::lines_handled)

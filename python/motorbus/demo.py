@@ -85,6 +85,7 @@ def serial_bench(quick: bool) -> None:
 
         link = open_link(dmac_pty, baud=38400)
         with DmacClient(link, address=0) as m:
+            m.brake(False)  # a DMAC34 starts with its brake applied (factory BRAKE ON)
             m.set_profile(high_speed=60000, accel_ms=100, decel_ms=100)
             goal = 5000 if quick else 20000
             m.move_to(goal)

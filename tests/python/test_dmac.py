@@ -30,6 +30,8 @@ def bus():
         link = open_link(server.slave_path, timeout=0.5)
         sleep = lambda s: clock.advance(int(s * 1e9))  # noqa: E731
         clients = [DmacClient(link, address=a, sleep=sleep) for a in range(3)]
+        for c in clients:
+            c.brake(False)  # DMAC34: factory BRAKE ON (annex 7.1)
         yield clock, sims, link, clients
         for c in clients:
             c.close()
@@ -55,6 +57,7 @@ def test_make_sim_factory_and_line_settings():
 def test_sim_profile_times_on_sim_clock():
     clock = SimClock()
     sim = make_sim("00", clock=clock)
+    sim.on_line(b"00BRAKE OFF")
     sim.on_line(b"00MOVE_SPEED 30000")  # ATI 1000 ms, HSP 60000: 0.5 s to 30000
     clock.advance(250 * MS)
     assert abs(sim.state()["speed"] - 15000) <= 100
@@ -69,7 +72,7 @@ def test_sim_end_stop_switches_stop_the_axis_on_the_switch():
     # and stops the move exactly there (1/10000 rev = one model step).
     clock = SimClock()
     sim = make_sim("00", clock=clock, positive_end_switch=2500, negative_end_switch=-2500)
-    sim.on_line(b"00HARD_ENDS ALL, MOVE_SPEED 6000")
+    sim.on_line(b"00BRAKE OFF, HARD_ENDS ALL, MOVE_SPEED 6000")
     clock.advance(2000 * MS)
     assert sim.on_line(b"00READ #POSITION") == b"00#POS=+2500\r\n"
     status = sim.state()["status"]
@@ -214,6 +217,7 @@ def test_exit_time_stop_from_another_process():
     """A script that starts a move and exits without stopping: atexit sends STOP."""
     clock = SimClock()
     sim = make_sim("05", clock=clock)
+    sim.on_line(b"05BRAKE OFF")
     with PtyLineServer([sim]) as server:
         script = textwrap.dedent(f"""
             from motorbus.drives.dmac import DmacClient, open_link
@@ -277,12 +281,13 @@ def test_a8_a10_a13_stray_lines_are_skipped_and_counted():
 
 def test_a14_motion_timeout_is_not_retried():
     sim = make_sim("00")
+    sim.on_line(b"00BRAKE OFF")
     dev = Tamper(sim, lambda line, r: b"" if b"MOVE_TO" in line else r)
     with PtyLineServer([dev]) as server:
         c = DmacClient(open_link(server.slave_path, timeout=0.1), address=0)
         with pytest.raises(motorbus.TimeoutError):
             c.move_to(1000)
-        assert sim.lines_handled == 1
+        assert sim.lines_handled == 2  # BRAKE OFF, then the MOVE_TO
         assert c.status().moving  # query the state instead of resending
         c.close()
 
