@@ -37,6 +37,7 @@ motion::MotorConfig axis_config(const SimOptions& o) {
     c.index_width_steps = 1;
     c.plus_limit = o.positive_end_switch;
     c.minus_limit = o.negative_end_switch;
+    c.home = o.reference_switch;
     c.tick_ns = kNsPerMs;  // the firmware's own tick; edges inside it are refined anyway
     return c;
 }
@@ -133,6 +134,7 @@ std::uint32_t DmacSim::logical_inputs() const {
         electrical |= dmac34() ? bit_mask(9) : bit_mask(1);
     if (options_.negative_end_switch.present && axis_->minus_limit_input())
         electrical |= dmac34() ? bit_mask(10) : bit_mask(2);
+    if (options_.reference_switch.present && axis_->home_input()) electrical |= bit_mask(5);
     return (electrical ^ (invert_in_ ? input_mask() : 0u)) & input_mask();
 }
 
@@ -337,6 +339,10 @@ void DmacSim::advance_axis(Nanos t) {
 
 void DmacSim::on_axis_event(const motion::MotorEvent& e) {
     using K = motion::MotorEvent::Kind;
+    if (e.kind == K::HomeOn || e.kind == K::HomeOff) {
+        in5_changed_locked(wrap_i32(e.encoder));
+        return;
+    }
     if (e.kind != K::PlusLimitOn && e.kind != K::PlusLimitOff && e.kind != K::MinusLimitOn &&
         e.kind != K::MinusLimitOff)
         return;
@@ -1054,19 +1060,23 @@ void DmacSim::set_input(int n, bool active) {
     if (n < 1 || n > 10) throw InvalidArgument("DmacSim input: " + std::to_string(n) + " is outside 1..10");
     std::lock_guard lock(mutex_);
     catch_up_locked();
-    const bool was = (logical_inputs() & bit_mask(5)) != 0;
     if (active) physical_inputs_ |= bit_mask(n);
     else physical_inputs_ &= ~bit_mask(n);
-    const bool is = (logical_inputs() & bit_mask(5)) != 0;
-    if (!was && is) {
-        // IN5 rising edge: capture, and re-home in reference mode when turning CW.
-        vars_[static_cast<std::size_t>(Var::Capture)] = position_locked();
-        if (reference_ && axis_->velocity() > 0) {
-            write_var_locked(Var::Position, 0, 0);
-            reference_ = false;
-        }
-    }
+    in5_changed_locked(position_locked());
     check_end_stops();
+}
+
+void DmacSim::in5_changed_locked(std::int32_t position) {
+    const bool is = (logical_inputs() & bit_mask(5)) != 0;
+    const bool rising = is && !in5_last_;
+    in5_last_ = is;
+    if (!rising) return;
+    // IN5 rising edge: capture, and re-home in reference mode when turning CW (4.18).
+    vars_[static_cast<std::size_t>(Var::Capture)] = position;
+    if (reference_ && axis_->velocity() > 0) {
+        write_var_locked(Var::Position, 0, 0);
+        reference_ = false;
+    }
 }
 
 void DmacSim::set_analog(int channel, std::int32_t mv) {

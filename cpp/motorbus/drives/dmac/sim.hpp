@@ -62,6 +62,8 @@ struct SimOptions {
     // Absent by default; set_input() drives those inputs either way.
     motion::SwitchConfig positive_end_switch{false, 0, 0, false};
     motion::SwitchConfig negative_end_switch{false, 0, 0, false};
+    // A reference switch on IN5 (REFERENCE, CAPTURE): active on [lo, hi).
+    motion::SwitchConfig reference_switch{false, 0, 0, false};
 };
 
 // Snapshot of what a test usually asserts on.
@@ -187,6 +189,8 @@ private:
     bool power_ = false, brake_ = false, reference_ = false, synchro_ = false;
     bool abnormal_stop_ = false;
     bool coasting_ = false;  // power off / short-circuited, rotor running down
+    bool in5_last_ = false;  // IN5 as last seen, for its rising edge
+    void in5_changed_locked(std::int32_t position);
     bool hard_pos_hit_ = false, hard_neg_hit_ = false, soft_pos_hit_ = false, soft_neg_hit_ = false;
 
     // motion: the planner (its own time line from motion_t0_ms_) and the axis
