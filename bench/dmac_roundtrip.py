@@ -15,7 +15,7 @@ import time
 
 import serial
 
-from motorbus.drives.dmac import DmacClient, make_sim, open_link
+from motorbus.drives.dmac import DmacClient, make_sim, open_line
 from motorbus.serial import PtyLineServer
 
 
@@ -25,8 +25,8 @@ def stats(samples):
 
 
 def run_motorbus(path, n):
-    link = open_link(path, baud=115200, timeout=1.0)
-    c = DmacClient(link, address=0)
+    link = open_line(path, baud=115200, timeout=1.0)
+    c = DmacClient(link, address=0, baud=115200)
     for _ in range(50):
         c.read("#POSITION")
     out = []

@@ -54,6 +54,14 @@ std::function<void(Duration)> sleep_arg(const py::object& f) {
     return [cb](Duration d) { cb(static_cast<double>(d.count()) / 1e9); };
 }
 
+template <class T>
+std::function<void(DmacClient&, T)> dmac_setter(void (DmacClient::*f)(T)) {
+    return [f](DmacClient& c, T v) {
+        py::gil_scoped_release nogil;
+        (c.*f)(v);
+    };
+}
+
 py::dict state_dict(const SimState& s) {
     py::dict d;
     d["now_ms"] = s.now_ms;
@@ -154,37 +162,6 @@ void bind_dmac(py::module_& m) {
         return d;
     }, py::arg("name"));
 
-    // ---- status words ------------------------------------------------------------
-    py::class_<Status>(m, "DmacStatus", "#STATUS, bits numbered 1..32 from the LSB.")
-        .def(py::init([](std::uint32_t raw) { return Status{raw}; }), py::arg("raw"))
-        .def_readonly("raw", &Status::raw)
-        .def("bit", &Status::bit, py::arg("n"))
-        .def_property_readonly("busy", &Status::busy)
-        .def_property_readonly("moving", &Status::moving)
-        .def_property_readonly("power_on", &Status::power_on)
-        .def_property_readonly("error", &Status::error)
-        .def_property_readonly("sequencer_running", &Status::sequencer_running)
-        .def_property_readonly("sequencer_edit", &Status::sequencer_edit)
-        .def_property_readonly("position_control", &Status::position_control)
-        .def_property_readonly("abnormal_stop", &Status::abnormal_stop)
-        .def_property_readonly("end_stop", &Status::end_stop)
-        .def_property_readonly("names", &Status::names)
-        .def("__int__", [](const Status& s) { return s.raw; })
-        .def("__repr__", [](const Status& s) {
-            std::string r = "DmacStatus(";
-            for (const auto& n : s.names()) r += n + " ";
-            if (r.back() == ' ') r.pop_back();
-            return r + ")";
-        });
-    py::class_<ErrorWord>(m, "DmacErrorWord", "#ERROR, bits numbered 1..32 from the LSB.")
-        .def(py::init([](std::uint32_t raw) { return ErrorWord{raw}; }), py::arg("raw"))
-        .def_readonly("raw", &ErrorWord::raw)
-        .def("bit", &ErrorWord::bit, py::arg("n"))
-        .def_property_readonly("any", &ErrorWord::any)
-        .def_property_readonly("names", &ErrorWord::names)
-        .def("__bool__", &ErrorWord::any)
-        .def("__int__", [](const ErrorWord& e) { return e.raw; });
-
     // ---- simulator -----------------------------------------------------------------
     py::class_<DmacSim, serial::LineDevice, std::shared_ptr<DmacSim>>(
         m, "DmacSim",
@@ -193,7 +170,8 @@ void bind_dmac(py::module_& m) {
         .def(py::init([](std::shared_ptr<Clock> clock, int address, const std::string& model,
                          const py::bytes& request_terminator, const py::bytes& reply_terminator,
                          std::int32_t supply_voltage, std::int32_t baudrate, std::optional<double> positive_end_switch,
-                         std::optional<double> negative_end_switch, bool end_switch_active_low) {
+                         std::optional<double> negative_end_switch, bool end_switch_active_low,
+                         std::optional<double> reference_switch) {
                  SimOptions o;
                  o.address = address;
                  auto mdl = parse_model(model);
@@ -209,13 +187,15 @@ void bind_dmac(py::module_& m) {
                      o.positive_end_switch = motion::SwitchConfig{true, *positive_end_switch, 0, end_switch_active_low};
                  if (negative_end_switch)
                      o.negative_end_switch = motion::SwitchConfig{true, *negative_end_switch, 0, end_switch_active_low};
+                 if (reference_switch)
+                     o.reference_switch = motion::SwitchConfig{true, *reference_switch, 1e15, false};
                  return std::make_shared<DmacSim>(std::move(clock), o);
              }),
              py::arg("clock") = nullptr, py::arg("address") = 0, py::arg("model") = "DMAC34-1",
              py::arg("request_terminator") = py::bytes("\r"), py::arg("reply_terminator") = py::bytes("\r\n"),
              py::arg("supply_voltage") = 32000, py::arg("baudrate") = 38400,
              py::arg("positive_end_switch") = py::none(), py::arg("negative_end_switch") = py::none(),
-             py::arg("end_switch_active_low") = false)
+             py::arg("end_switch_active_low") = false, py::arg("reference_switch") = py::none())
         .def("poll", &DmacSim::poll, py::call_guard<py::gil_scoped_release>(), "Catch up with the clock.")
         .def("state", [](DmacSim& s) {
             SimState st;
@@ -233,8 +213,20 @@ void bind_dmac(py::module_& m) {
         .def("sequence_line", &DmacSim::sequence_line, py::arg("n"))
         .def("set_input", &DmacSim::set_input, py::arg("n"), py::arg("active"), py::call_guard<py::gil_scoped_release>())
         .def("set_analog", &DmacSim::set_analog, py::arg("channel"), py::arg("mv"))
-        .def("set_supply_voltage", &DmacSim::set_supply_voltage, py::arg("mv"))
-        .def("inject_error", &DmacSim::inject_error, py::arg("bit"))
+        .def("set_supply_voltage", &DmacSim::set_supply_voltage, py::arg("mv"), py::call_guard<py::gil_scoped_release>(),
+             "Supply voltage in mV; outside the model's range latches undervoltage/overvoltage and stops the motor.")
+        .def("set_temperature", [](DmacSim& s, const std::string& which, std::int32_t tenths) {
+                 DmacSim::Sensor w;
+                 if (which == "cpu") w = DmacSim::Sensor::Cpu;
+                 else if (which == "driver") w = DmacSim::Sensor::Driver;
+                 else if (which == "motor") w = DmacSim::Sensor::Motor;
+                 else throw InvalidArgument("sensor: '" + which + "' is not 'cpu', 'driver' or 'motor'");
+                 py::gil_scoped_release nogil;
+                 s.set_temperature(w, tenths);
+             }, py::arg("sensor"), py::arg("tenths_c"),
+             "Temperature in 0.1 degC; CPU > 120 degC or driver/motor > 85 degC latches a thermal fault.")
+        .def("inject_error", &DmacSim::inject_error, py::arg("bit"), py::call_guard<py::gil_scoped_release>(),
+             "Sets an #ERROR bit; fault bits 2..5 also stop the motor as the real fault does.")
         .def("physical_outputs", &DmacSim::physical_outputs, py::call_guard<py::gil_scoped_release>())
         .def("power_cycle", &DmacSim::power_cycle, py::call_guard<py::gil_scoped_release>())
         .def_property_readonly("lines_handled", &DmacSim::lines_handled)
@@ -243,19 +235,28 @@ void bind_dmac(py::module_& m) {
     // ---- client --------------------------------------------------------------------
     using C = DmacClient;
     auto rel = py::call_guard<py::gil_scoped_release>();
+    // Readings and simple settings are properties (the native facade convention).
+    auto ro = [](auto f) {
+        return [f](C& c) {
+            py::gil_scoped_release nogil;
+            return (c.*f)();
+        };
+    };
+    auto wo = [](auto f) { return dmac_setter(f); };
     py::class_<C, std::shared_ptr<C>>(m, "DmacClient",
                                       "Typed DMAC commands over a LineLink (one client per module address).")
-        .def(py::init([](std::shared_ptr<serial::LineLink> link, int address, bool verify, const py::object& timeout,
-                         const py::object& sleep) {
+        .def(py::init([](std::shared_ptr<serial::LineLink> link, int address, int baud, bool verify,
+                         const py::object& timeout, const py::object& sleep) {
                  ClientOptions o;
                  o.address = address;
+                 o.baud = baud;
                  o.verify = verify;
                  if (!timeout.is_none()) o.timeout = motorbus::py_helpers::seconds_to_ns(timeout);
                  o.sleep = sleep_arg(sleep);
                  return std::make_shared<C>(std::move(link), o);
              }),
-             py::arg("link"), py::arg("address") = 0, py::arg("verify") = true, py::arg("timeout") = py::none(),
-             py::arg("sleep") = py::none())
+             py::arg("link"), py::arg("address") = 0, py::kw_only(), py::arg("baud") = 38400, py::arg("verify") = true,
+             py::arg("timeout") = py::none(), py::arg("sleep") = py::none())
         .def_property_readonly("address", &C::address)
         .def_property_readonly("counters", [](const C& c) {
             auto k = c.counters();
@@ -296,38 +297,61 @@ void bind_dmac(py::module_& m) {
             },
             "#POSITION (1/10000 rev); assigning re-homes the axis.")
         .def("set_position", &C::set_position, py::arg("position"), rel)
-        .def("speed", &C::speed, rel)
-        .def("profile_speed", &C::profile_speed, rel)
-        .def("status", &C::status, rel)
-        .def("error", &C::error, rel)
+        .def_property_readonly("speed", ro(&C::speed), "#SPEED, measured (0.01 rpm, signed).")
+        .def_property_readonly("profile_speed", ro(&C::profile_speed), "#PROFILE_SPEED, computed (0.01 rpm).")
+        .def_property_readonly("status", [](C& c) {
+            std::uint32_t raw;
+            {
+                py::gil_scoped_release nogil;
+                raw = c.status().raw;
+            }
+            return py::module_::import("motorbus.drives.dmac").attr("DmacStatus")(raw);
+        }, "#STATUS as a DmacStatus (enum.IntFlag).")
+        .def_property_readonly("error", [](C& c) {
+            std::uint32_t raw;
+            {
+                py::gil_scoped_release nogil;
+                raw = c.error().raw;
+            }
+            return py::module_::import("motorbus.drives.dmac").attr("DmacErrorWord")(raw);
+        }, "#ERROR as a DmacErrorWord (enum.IntFlag); clear_error() acknowledges it.")
         .def("clear_error", &C::clear_error, rel)
-        .def("inputs", &C::inputs, rel)
-        .def("outputs", &C::outputs, rel)
-        .def("set_outputs", &C::set_outputs, py::arg("value"), rel)
+        .def_property_readonly("is_dmac34", ro(&C::is_dmac34), "The module is a DMAC34 (from REQUEST_VERSION, cached).")
+        .def_property_readonly("inputs", ro(&C::inputs), "#INPUT (bit 0 = IN1).")
+        .def_property("outputs", ro(&C::outputs), wo(&C::set_outputs), "#OUTPUT (bit 0 = OUT1).")
         .def("set_output", &C::set_output, py::arg("n"), py::arg("on"), rel)
-        .def("supply_voltage", &C::supply_voltage, rel)
-        .def("cpu_temperature", &C::cpu_temperature, rel)
-        .def("capture", &C::capture, rel)
-        .def("interpol_count", &C::interpol_count, rel)
-        .def("line", &C::line, rel)
+        .def_property_readonly("supply_voltage", ro(&C::supply_voltage), "#SUPPLY_VOLTAGE (mV).")
+        .def_property_readonly("cpu_temperature", ro(&C::cpu_temperature), "#CPU_TEMPERATURE (0.1 degC).")
+        .def_property_readonly("capture", ro(&C::capture), "#CAPTURE: #POSITION at the last IN5 rising edge.")
+        .def_property_readonly("interpol_count", ro(&C::interpol_count), "#INTERPOL_COUNT (segments queued).")
+        .def_property_readonly("line", ro(&C::line), "#LINE: sequencer line running (0 = stopped).")
         .def("set_profile", &C::set_profile, py::arg("high_speed") = py::none(), py::arg("low_speed") = py::none(),
              py::arg("accel_ms") = py::none(), py::arg("decel_ms") = py::none(), rel,
              "#HIGH_SPEED / #LOW_SPEED (0.01 rpm), #ACCEL_TIME / #DECEL_TIME (ms) in one frame.")
-        .def("torque_ratio", &C::torque_ratio, rel)
-        .def("set_torque_ratio", &C::set_torque_ratio, py::arg("percent"), rel)
+        .def_property("high_speed", [](C& c) { py::gil_scoped_release g; return c.read(Var::HighSpeed); },
+                      [](C& c, std::int32_t v) { py::gil_scoped_release g; c.write(Var::HighSpeed, v); },
+                      "#HIGH_SPEED (0.01 rpm).")
+        .def_property("low_speed", [](C& c) { py::gil_scoped_release g; return c.read(Var::LowSpeed); },
+                      [](C& c, std::int32_t v) { py::gil_scoped_release g; c.write(Var::LowSpeed, v); },
+                      "#LOW_SPEED (0.01 rpm).")
+        .def_property("accel_time", [](C& c) { py::gil_scoped_release g; return c.read(Var::AccelTime); },
+                      [](C& c, std::int32_t v) { py::gil_scoped_release g; c.write(Var::AccelTime, v); },
+                      "#ACCEL_TIME (ms).")
+        .def_property("decel_time", [](C& c) { py::gil_scoped_release g; return c.read(Var::DecelTime); },
+                      [](C& c, std::int32_t v) { py::gil_scoped_release g; c.write(Var::DecelTime, v); },
+                      "#DECEL_TIME (ms).")
+        .def_property("torque_ratio", ro(&C::torque_ratio), wo(&C::set_torque_ratio), "#TORQUE_RATIO (%).")
         .def("soft_limits", &C::soft_limits, rel, "(#NEGATIVE_END, #POSITIVE_END)")
         .def("set_soft_limits", &C::set_soft_limits, py::arg("negative"), py::arg("positive"), rel)
-        .def("output_config", &C::output_config, rel)
-        .def("set_output_config", &C::set_output_config, py::arg("bits"), rel)
-        .def("line_delay", &C::line_delay, rel)
-        .def("set_line_delay", &C::set_line_delay, py::arg("us"), rel)
-        .def("on_reset", &C::on_reset, rel)
+        .def_property("output_config", ro(&C::output_config), wo(&C::set_output_config), "#OUTPUT_CONFIG.")
+        .def_property("line_delay", ro(&C::line_delay), wo(&C::set_line_delay), "#LINE_DELAY (us).")
+        .def_property("on_reset", ro(&C::on_reset), wo(&C::set_on_reset), "#ON_RESET (sequencer line, 0 = none).")
         .def("set_interpolation", &C::set_interpolation, py::arg("time_ms"), py::arg("fifo_size"),
              py::arg("mode") = 0, rel)
         .def("analog_input", &C::analog_input, py::arg("channel"), rel)
         .def("set_analog_output", &C::set_analog_output, py::arg("channel"), py::arg("mv"), rel)
-        .def("driver_temperature", &C::driver_temperature, rel)
-        .def("motor_temperature", &C::motor_temperature, rel)
+        .def_property_readonly("driver_temperature", ro(&C::driver_temperature), "#DRIVER_TEMPERATURE (DMAC34, 0.1 degC).")
+        .def_property_readonly("motor_temperature", ro(&C::motor_temperature), "#MOTOR_TEMPERATURE (DMAC34, 0.1 degC).")
         .def("user_var", &C::user_var, py::arg("n"), rel)
         .def("set_user_var", &C::set_user_var, py::arg("n"), py::arg("value"), rel)
         .def("memorized_var", &C::memorized_var, py::arg("n"), rel)
@@ -403,7 +427,6 @@ void bind_dmac(py::module_& m) {
         .def("start_sequence", &C::start_sequence, py::arg("line") = 1, rel)
         .def("stop_sequence", &C::stop_sequence, rel)
         .def("step", &C::step, py::arg("line") = py::none(), rel)
-        .def("set_on_reset", &C::set_on_reset, py::arg("line"), rel)
         .def("move_interpol", &C::move_interpol, py::arg("offset"), rel,
              "Queues one segment; returns the FIFO level, or None when the FIFO was full (XON_ERROR).");
 

@@ -30,7 +30,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacCommandRejected', 'DmacErrorWord', 'DmacMotion', 'DmacProfileParams', 'DmacSim', 'DmacStatus', 'DmacUnknownCommand', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineDevice', 'LineLink', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'MotionState', 'MotorConfig', 'MotorModel', 'MotorbusError', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanServer', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandServer', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacSim', 'DmacUnknownCommand', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineDevice', 'LineLink', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'MotionState', 'MotorConfig', 'MotorModel', 'MotorbusError', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanServer', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandServer', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -2405,80 +2405,16 @@ class DmacMotion:
     @property
     def profile(self) -> Profile:
         ...
-class DmacStatus:
-    """
-    #STATUS, bits numbered 1..32 from the LSB.
-    """
-    def __init__(self, raw: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    def __int__(self) -> int:
-        ...
-    def __repr__(self) -> str:
-        ...
-    def bit(self, n: typing.SupportsInt | typing.SupportsIndex) -> bool:
-        ...
-    @property
-    def abnormal_stop(self) -> bool:
-        ...
-    @property
-    def busy(self) -> bool:
-        ...
-    @property
-    def end_stop(self) -> bool:
-        ...
-    @property
-    def error(self) -> bool:
-        ...
-    @property
-    def moving(self) -> bool:
-        ...
-    @property
-    def names(self) -> list[str]:
-        ...
-    @property
-    def position_control(self) -> bool:
-        ...
-    @property
-    def power_on(self) -> bool:
-        ...
-    @property
-    def raw(self) -> int:
-        ...
-    @property
-    def sequencer_edit(self) -> bool:
-        ...
-    @property
-    def sequencer_running(self) -> bool:
-        ...
-class DmacErrorWord:
-    """
-    #ERROR, bits numbered 1..32 from the LSB.
-    """
-    def __bool__(self) -> bool:
-        ...
-    def __init__(self, raw: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    def __int__(self) -> int:
-        ...
-    def bit(self, n: typing.SupportsInt | typing.SupportsIndex) -> bool:
-        ...
-    @property
-    def any(self) -> bool:
-        ...
-    @property
-    def names(self) -> list[str]:
-        ...
-    @property
-    def raw(self) -> int:
-        ...
 class DmacSim(LineDevice):
     """
     A simulated DMAC module (a LineDevice: serve it with PtyLineServer). Device time runs on `clock` (a SimClock in tests); nothing runs in the background.
     """
-    def __init__(self, clock: Clock = None, address: typing.SupportsInt | typing.SupportsIndex = 0, model: str = 'DMAC34-1', request_terminator: bytes = b'\r', reply_terminator: bytes = b'\r\n', supply_voltage: typing.SupportsInt | typing.SupportsIndex = 32000, baudrate: typing.SupportsInt | typing.SupportsIndex = 38400, positive_end_switch: typing.SupportsFloat | typing.SupportsIndex | None = None, negative_end_switch: typing.SupportsFloat | typing.SupportsIndex | None = None, end_switch_active_low: bool = False) -> None:
+    def __init__(self, clock: Clock = None, address: typing.SupportsInt | typing.SupportsIndex = 0, model: str = 'DMAC34-1', request_terminator: bytes = b'\r', reply_terminator: bytes = b'\r\n', supply_voltage: typing.SupportsInt | typing.SupportsIndex = 32000, baudrate: typing.SupportsInt | typing.SupportsIndex = 38400, positive_end_switch: typing.SupportsFloat | typing.SupportsIndex | None = None, negative_end_switch: typing.SupportsFloat | typing.SupportsIndex | None = None, end_switch_active_low: bool = False, reference_switch: typing.SupportsFloat | typing.SupportsIndex | None = None) -> None:
         ...
     def inject_error(self, bit: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
+        """
+        Sets an #ERROR bit; fault bits 2..5 also stop the motor as the real fault does.
+        """
     def physical_outputs(self) -> int:
         ...
     def poll(self) -> None:
@@ -2496,7 +2432,13 @@ class DmacSim(LineDevice):
     def set_input(self, n: typing.SupportsInt | typing.SupportsIndex, active: bool) -> None:
         ...
     def set_supply_voltage(self, mv: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
+        """
+        Supply voltage in mV; outside the model's range latches undervoltage/overvoltage and stops the motor.
+        """
+    def set_temperature(self, sensor: str, tenths_c: typing.SupportsInt | typing.SupportsIndex) -> None:
+        """
+        Temperature in 0.1 degC; CPU > 120 degC or driver/motor > 85 degC latches a thermal fault.
+        """
     def state(self) -> dict:
         ...
     @property
@@ -2518,43 +2460,25 @@ class DmacClient:
     """
     Typed DMAC commands over a LineLink (one client per module address).
     """
-    def __init__(self, link: LineLink, address: typing.SupportsInt | typing.SupportsIndex = 0, verify: bool = True, timeout: typing.Any = None, sleep: typing.Any = None) -> None:
+    def __init__(self, link: LineLink, address: typing.SupportsInt | typing.SupportsIndex = 0, *, baud: typing.SupportsInt | typing.SupportsIndex = 38400, verify: bool = True, timeout: typing.Any = None, sleep: typing.Any = None) -> None:
         ...
     def analog_input(self, channel: typing.SupportsInt | typing.SupportsIndex) -> int:
         ...
     def brake(self, on: bool) -> None:
         ...
-    def capture(self) -> int:
-        ...
     def clear_error(self) -> None:
         ...
     def command(self, command: str) -> None:
-        ...
-    def cpu_temperature(self) -> int:
-        ...
-    def driver_temperature(self) -> int:
-        ...
-    def error(self) -> DmacErrorWord:
         ...
     def halt(self, what: str = 'all') -> None:
         ...
     def hard_ends(self, which: str) -> None:
         ...
-    def inputs(self) -> int:
-        ...
-    def interpol_count(self) -> int:
-        ...
     def inverse_polarity(self, which: str) -> None:
-        ...
-    def line(self) -> int:
-        ...
-    def line_delay(self) -> int:
         ...
     def memorized_var(self, n: typing.SupportsInt | typing.SupportsIndex) -> int:
         ...
     def module_reset(self, factory: bool = False) -> None:
-        ...
-    def motor_temperature(self) -> int:
         ...
     def move_interpol(self, offset: typing.SupportsInt | typing.SupportsIndex) -> int | None:
         """
@@ -2566,17 +2490,9 @@ class DmacClient:
         ...
     def move_to(self, position: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
-    def on_reset(self) -> int:
-        ...
     def optimized_current(self, on: bool) -> None:
         ...
-    def output_config(self) -> int:
-        ...
-    def outputs(self) -> int:
-        ...
     def power(self, mode: str) -> None:
-        ...
-    def profile_speed(self) -> int:
         ...
     def raw(self, frame: str, expect_reply: bool = True) -> bytes:
         ...
@@ -2602,17 +2518,9 @@ class DmacClient:
         ...
     def set_interpolation(self, time_ms: typing.SupportsInt | typing.SupportsIndex, fifo_size: typing.SupportsInt | typing.SupportsIndex, mode: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
-    def set_line_delay(self, us: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
     def set_memorized_var(self, n: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
-    def set_on_reset(self, line: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
     def set_output(self, n: typing.SupportsInt | typing.SupportsIndex, on: bool) -> None:
-        ...
-    def set_output_config(self, bits: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    def set_outputs(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     def set_position(self, position: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
@@ -2624,8 +2532,6 @@ class DmacClient:
         ...
     def set_timer(self, n: typing.SupportsInt | typing.SupportsIndex, ms: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
-    def set_torque_ratio(self, percent: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
     def set_user_var(self, n: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     def soft_ends(self, on: bool) -> None:
@@ -2634,11 +2540,7 @@ class DmacClient:
         """
         (#NEGATIVE_END, #POSITIVE_END)
         """
-    def speed(self) -> int:
-        ...
     def start_sequence(self, line: typing.SupportsInt | typing.SupportsIndex = 1) -> None:
-        ...
-    def status(self) -> DmacStatus:
         ...
     def step(self, line: typing.SupportsInt | typing.SupportsIndex | None = None) -> None:
         ...
@@ -2646,11 +2548,7 @@ class DmacClient:
         ...
     def stop_sequence(self) -> None:
         ...
-    def supply_voltage(self) -> int:
-        ...
     def timer(self, n: typing.SupportsInt | typing.SupportsIndex) -> int:
-        ...
-    def torque_ratio(self) -> int:
         ...
     def upload_sequence(self, lines: collections.abc.Sequence[str], first: typing.SupportsInt | typing.SupportsIndex = 1, verify_readback: bool = True) -> None:
         ...
@@ -2665,10 +2563,119 @@ class DmacClient:
     def write_bit(self, variable: str, bit: typing.SupportsInt | typing.SupportsIndex, value: bool) -> None:
         ...
     @property
+    def accel_time(self) -> int:
+        """
+        #ACCEL_TIME (ms).
+        """
+    @accel_time.setter
+    def accel_time(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
     def address(self) -> int:
         ...
     @property
+    def capture(self) -> int:
+        """
+        #CAPTURE: #POSITION at the last IN5 rising edge.
+        """
+    @property
     def counters(self) -> dict:
+        ...
+    @property
+    def cpu_temperature(self) -> int:
+        """
+        #CPU_TEMPERATURE (0.1 degC).
+        """
+    @property
+    def decel_time(self) -> int:
+        """
+        #DECEL_TIME (ms).
+        """
+    @decel_time.setter
+    def decel_time(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def driver_temperature(self) -> int:
+        """
+        #DRIVER_TEMPERATURE (DMAC34, 0.1 degC).
+        """
+    @property
+    def error(self) -> typing.Any:
+        """
+        #ERROR as a DmacErrorWord (enum.IntFlag); clear_error() acknowledges it.
+        """
+    @property
+    def high_speed(self) -> int:
+        """
+        #HIGH_SPEED (0.01 rpm).
+        """
+    @high_speed.setter
+    def high_speed(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def inputs(self) -> int:
+        """
+        #INPUT (bit 0 = IN1).
+        """
+    @property
+    def interpol_count(self) -> int:
+        """
+        #INTERPOL_COUNT (segments queued).
+        """
+    @property
+    def is_dmac34(self) -> bool:
+        """
+        The module is a DMAC34 (from REQUEST_VERSION, cached).
+        """
+    @property
+    def line(self) -> int:
+        """
+        #LINE: sequencer line running (0 = stopped).
+        """
+    @property
+    def line_delay(self) -> int:
+        """
+        #LINE_DELAY (us).
+        """
+    @line_delay.setter
+    def line_delay(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def low_speed(self) -> int:
+        """
+        #LOW_SPEED (0.01 rpm).
+        """
+    @low_speed.setter
+    def low_speed(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def motor_temperature(self) -> int:
+        """
+        #MOTOR_TEMPERATURE (DMAC34, 0.1 degC).
+        """
+    @property
+    def on_reset(self) -> int:
+        """
+        #ON_RESET (sequencer line, 0 = none).
+        """
+    @on_reset.setter
+    def on_reset(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def output_config(self) -> int:
+        """
+        #OUTPUT_CONFIG.
+        """
+    @output_config.setter
+    def output_config(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def outputs(self) -> int:
+        """
+        #OUTPUT (bit 0 = OUT1).
+        """
+    @outputs.setter
+    def outputs(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     @property
     def position(self) -> int:
@@ -2677,6 +2684,34 @@ class DmacClient:
         """
     @position.setter
     def position(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def profile_speed(self) -> int:
+        """
+        #PROFILE_SPEED, computed (0.01 rpm).
+        """
+    @property
+    def speed(self) -> int:
+        """
+        #SPEED, measured (0.01 rpm, signed).
+        """
+    @property
+    def status(self) -> typing.Any:
+        """
+        #STATUS as a DmacStatus (enum.IntFlag).
+        """
+    @property
+    def supply_voltage(self) -> int:
+        """
+        #SUPPLY_VOLTAGE (mV).
+        """
+    @property
+    def torque_ratio(self) -> int:
+        """
+        #TORQUE_RATIO (%).
+        """
+    @torque_ratio.setter
+    def torque_ratio(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
 class Pmc007ProfileParams:
     def __init__(self, speed: typing.SupportsFloat | typing.SupportsIndex = 1000.0, start_speed: typing.SupportsFloat | typing.SupportsIndex = 400.0, stop_speed: typing.SupportsFloat | typing.SupportsIndex = 0.0, accel_gear: typing.SupportsInt | typing.SupportsIndex = 0, decel_gear: typing.SupportsInt | typing.SupportsIndex = 0, microstepping: typing.SupportsInt | typing.SupportsIndex = 0) -> None:

@@ -54,7 +54,7 @@ def _stop(proc: subprocess.Popen) -> None:
 def serial_bench(quick: bool) -> None:
     from . import motion
     from .drives.arcus import ArcusClient, open_line
-    from .drives.dmac import DmacClient, open_link
+    from .drives.dmac import DmacClient
 
     _title("serial drives: `motorbus sim serve --pty --drive arcus:01,02 --drive dmac:00`")
     proc = _spawn("sim", "serve", "--pty", "--drive", "arcus:01,02", "--drive", "dmac:00")
@@ -83,13 +83,13 @@ def serial_bench(quick: bool) -> None:
             print(f"  @01 X{target} -> EX={x.encoder} PX={x.position} in {took:.3f} s (wall, incl. polling)")
             print(f"  @02 X{-target // 2} -> EX={y.encoder} status={y.status!r} SLS={y.snl_status!r}")
 
-        link = open_link(dmac_pty, baud=38400)
-        with DmacClient(link, address=0) as m:
+        with DmacClient(dmac_pty, "00", baud=38400) as m:  # opens (and closes) the line itself
+            m.brake(False)  # a DMAC34 starts with its brake applied (factory BRAKE ON)
             m.set_profile(high_speed=60000, accel_ms=100, decel_ms=100)
             goal = 5000 if quick else 20000
             m.move_to(goal)
             pos = m.wait_idle(timeout=10)
-            print(f"  DMAC 00 MOVE_TO {goal} -> #POSITION={pos}, status {m.status()}")
+            print(f"  DMAC 00 MOVE_TO {goal} -> #POSITION={pos}, status {m.status}")
             print(f"  DMAC 00 version: {m.request_version()}")
     finally:
         _stop(proc)

@@ -14,7 +14,7 @@ import pytest
 import motorbus
 from motorbus._core import SimClock
 from motorbus.drives import dmac
-from motorbus.drives.dmac import (CommandRejected, DmacClient, UnknownCommand, make_sim, open_link,
+from motorbus.drives.dmac import (CommandRejected, DmacClient, DmacStatus, UnknownCommand, make_sim, open_line,
                                   stream_interpolation, synchro)
 from motorbus.serial import LineDevice, PtyLineServer
 
@@ -27,9 +27,11 @@ def bus():
     clock = SimClock()
     sims = [make_sim(f"{a:02d}", clock=clock) for a in range(3)]
     with PtyLineServer(sims) as server:
-        link = open_link(server.slave_path, timeout=0.5)
+        link = open_line(server.slave_path, timeout=0.5)
         sleep = lambda s: clock.advance(int(s * 1e9))  # noqa: E731
         clients = [DmacClient(link, address=a, sleep=sleep) for a in range(3)]
+        for c in clients:
+            c.brake(False)  # DMAC34: factory BRAKE ON (annex 7.1)
         yield clock, sims, link, clients
         for c in clients:
             c.close()
@@ -55,6 +57,7 @@ def test_make_sim_factory_and_line_settings():
 def test_sim_profile_times_on_sim_clock():
     clock = SimClock()
     sim = make_sim("00", clock=clock)
+    sim.on_line(b"00BRAKE OFF")
     sim.on_line(b"00MOVE_SPEED 30000")  # ATI 1000 ms, HSP 60000: 0.5 s to 30000
     clock.advance(250 * MS)
     assert abs(sim.state()["speed"] - 15000) <= 100
@@ -69,7 +72,7 @@ def test_sim_end_stop_switches_stop_the_axis_on_the_switch():
     # and stops the move exactly there (1/10000 rev = one model step).
     clock = SimClock()
     sim = make_sim("00", clock=clock, positive_end_switch=2500, negative_end_switch=-2500)
-    sim.on_line(b"00HARD_ENDS ALL, MOVE_SPEED 6000")
+    sim.on_line(b"00BRAKE OFF, HARD_ENDS ALL, MOVE_SPEED 6000")
     clock.advance(2000 * MS)
     assert sim.on_line(b"00READ #POSITION") == b"00#POS=+2500\r\n"
     status = sim.state()["status"]
@@ -88,8 +91,9 @@ def test_client_typed_moves_status_and_errors(bus):
     c1.set_profile(high_speed=30000, accel_ms=200, decel_ms=200)
     t0 = clock.now()
     c1.move_to(50000)
-    st = c1.status()
-    assert st.busy and st.moving and st.power_on
+    st = c1.status
+    assert isinstance(st, DmacStatus)
+    assert DmacStatus.BUSY | DmacStatus.MOVEMENT | DmacStatus.POWER_ON in st
     assert c1.wait_idle(timeout=30.0, poll=0.001) == 50000
     assert 1.5 < (clock.now() - t0) / 1e9 < 3.0
     assert c1.position == 50000
@@ -98,9 +102,9 @@ def test_client_typed_moves_status_and_errors(bus):
     assert c0.position == 0
     c2.move_speed(-20000)
     clock.advance(2000 * MS)
-    assert c2.speed() == -20000
+    assert c2.speed == -20000
     c2.halt()
-    assert c2.speed() == 0
+    assert c2.speed == 0
     with pytest.raises(UnknownCommand):
         c0.command("FROB 1")
     with pytest.raises(CommandRejected) as e:
@@ -108,10 +112,10 @@ def test_client_typed_moves_status_and_errors(bus):
     assert e.value.error == 1 << 6  # bit 7 (1-based)
     assert isinstance(e.value, motorbus.DriveFault)
     sims[0].inject_error(5)
-    err = c0.error()
-    assert err.bit(5) and err.names == ["overvoltage"]
+    err = c0.error
+    assert err.bit(5) and err.names == ["overvoltage"] and err == dmac.DmacErrorWord.OVERVOLTAGE
     c0.clear_error()
-    assert not c0.error()
+    assert not c0.error
     assert dmac.status_names(0x13000800) == ["s_curve", "power_on", "movement", "busy"]
     v = c0.request_version()
     assert (v["code"], v["product"], v["version"], v["release"]) == ("H142", "DMAC34-1", 1, 7)
@@ -124,7 +128,7 @@ def test_client_variables_and_bits(bus):
     assert c0.read("V5") == -40
     c0.write_bit("#OUTPUT", 2, True)
     assert c0.read_bit("#OUTPUT", 2) is True
-    assert c0.outputs() == 2
+    assert c0.outputs == 2
     c0.set_memorized_var(3, 11)
     c0.set_user_var(3, 12)
     c0.module_reset()
@@ -133,14 +137,16 @@ def test_client_variables_and_bits(bus):
     clock.advance(100 * MS)
     assert c0.timer(2) == 200
     sims[0].set_input(3, True)
-    assert c0.inputs() == 4
+    assert c0.inputs == 4
     c0.set_soft_limits(-80000, 100000)
     assert c0.soft_limits() == (-80000, 100000)
     c0.set_interpolation(time_ms=50, fifo_size=16)
     assert (c0.read("#ITI"), c0.read("#IFI"), c0.read("#IMO")) == (50, 16, 0)
     sims[0].set_analog(2, 1500)
     assert c0.analog_input(2) == 1500
-    assert (c0.motor_temperature(), c0.cpu_temperature()) == (650, 520)
+    assert (c0.motor_temperature, c0.cpu_temperature) == (650, 520)
+    c0.torque_ratio = 70
+    assert c0.torque_ratio == 70 and c0.high_speed == 60000
     with pytest.raises(motorbus.InvalidArgument):
         c0.write("#STATUS", 1)
     with pytest.raises(motorbus.InvalidArgument):
@@ -152,17 +158,17 @@ def test_sequencer_upload_read_back_run(bus):
     c0.upload_sequence(["MOVE_ON 10000", "WAIT 2000", "JUMP 1"])
     assert c0.read_sequence(1, 3) == ["MON +10000", "WAI +2000", "JUM +1"]
     c0.start_sequence(1)
-    assert c0.status().sequencer_running
+    assert DmacStatus.SEQUENCER_RUN in c0.status
     clock.advance(2001 * MS)
     assert c0.position == 10000
     clock.advance(2002 * MS)
     assert c0.position == 20000
     c0.stop()
-    assert not c0.status().sequencer_running
+    assert not DmacStatus.SEQUENCER_RUN in c0.status
     # OPEN_SEQ erases the whole program: one upload holds the main part and the subroutine.
     c0.upload_sequence(["#V1:=#V1 + 1", "CALL 14", "JUMP 0", "NOP", "#V2:=#V1 * 100", "RETURN"], first=10)
     assert c0.read_sequence_line(1) == ""
-    c0.set_on_reset(10)
+    c0.on_reset = 10
     c0.module_reset()
     clock.advance(10 * MS)
     assert (c0.user_var(1), c0.user_var(2)) == (1, 100)
@@ -191,7 +197,7 @@ def test_synchro_on_top(bus):
     assert c0.position == 0
     synchro(link, "TOP")
     synchro(link, "OFF")
-    c0.status()  # globals have no reply: a query tells us the line got that far
+    c0.status  # globals have no reply: a query tells us the line got that far
     clock.advance(3000 * MS)
     assert (c0.position, c1.position) == (1000, -1000)
 
@@ -214,10 +220,11 @@ def test_exit_time_stop_from_another_process():
     """A script that starts a move and exits without stopping: atexit sends STOP."""
     clock = SimClock()
     sim = make_sim("05", clock=clock)
+    sim.on_line(b"05BRAKE OFF")
     with PtyLineServer([sim]) as server:
         script = textwrap.dedent(f"""
-            from motorbus.drives.dmac import DmacClient, open_link
-            ax = DmacClient(open_link({server.slave_path!r}), address=5)
+            from motorbus.drives.dmac import DmacClient, open_line
+            ax = DmacClient(open_line({server.slave_path!r}), address=5)
             ax.move_speed(30000)
         """)
         env = dict(os.environ, PYTHONPATH=str(pathlib.Path(motorbus.__file__).parents[1]))
@@ -255,7 +262,7 @@ def test_hostile_replies_raise_typed_and_next_call_works(row, reply, exc):
     state = {"on": True}
     dev = Tamper(sim, lambda line, r: reply(r) if state["on"] and b"READ #POS" in line else r)
     with PtyLineServer([dev]) as server:
-        c = DmacClient(open_link(server.slave_path, timeout=0.2), address=0)
+        c = DmacClient(open_line(server.slave_path, timeout=0.2), address=0)
         with pytest.raises(exc):
             c.position
         state["on"] = False
@@ -268,7 +275,7 @@ def test_a8_a10_a13_stray_lines_are_skipped_and_counted():
     banner = b'00EV v1.7 H142 "MIDI-INGENIERIE_DMAC34-1_H142-10145_25/01/05_12/04/06" PHASE:6A BOOT:v1.1\r\n'
     dev = Tamper(sim, lambda line, r: (b"\xff\x00\xff\r\n" + banner + r) if b"READ #POS" in line else r)
     with PtyLineServer([dev]) as server:
-        c = DmacClient(open_link(server.slave_path, timeout=0.2), address=0)
+        c = DmacClient(open_line(server.slave_path, timeout=0.2), address=0)
         assert c.position == 0
         k = c.counters
         assert k["stray_lines"] == 2 and k["device_resets"] == 1
@@ -277,13 +284,14 @@ def test_a8_a10_a13_stray_lines_are_skipped_and_counted():
 
 def test_a14_motion_timeout_is_not_retried():
     sim = make_sim("00")
+    sim.on_line(b"00BRAKE OFF")
     dev = Tamper(sim, lambda line, r: b"" if b"MOVE_TO" in line else r)
     with PtyLineServer([dev]) as server:
-        c = DmacClient(open_link(server.slave_path, timeout=0.1), address=0)
+        c = DmacClient(open_line(server.slave_path, timeout=0.1), address=0)
         with pytest.raises(motorbus.TimeoutError):
             c.move_to(1000)
-        assert sim.lines_handled == 1
-        assert c.status().moving  # query the state instead of resending
+        assert sim.lines_handled == 2  # BRAKE OFF, then the MOVE_TO
+        assert DmacStatus.MOVEMENT in c.status  # query the state instead of resending
         c.close()
 
 

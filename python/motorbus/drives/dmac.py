@@ -1,18 +1,19 @@
-"""Midi Ingénierie DMAC17/23/34 over its ASCII protocol: client, simulator, helpers.
+"""Midi Ingénierie DMAC17/23/34 over its ASCII protocol: client, simulator, Drive adapter.
 
 Example — a simulated module on a pty, driven through the typed client::
 
     from motorbus._core import SimClock
     from motorbus.serial import PtyLineServer
-    from motorbus.drives.dmac import DmacClient, make_sim, open_link
+    from motorbus.drives.dmac import DmacClient, DmacStatus, make_sim
 
     clock = SimClock()
     with PtyLineServer([make_sim("00", clock=clock)]) as server:
-        link = open_link(server.slave_path)
-        with DmacClient(link, address=0) as axis:   # STOP on error and at exit
+        with DmacClient(server.slave_path, "00") as axis:   # STOP on error and at exit
+            axis.brake(False)                       # DMAC34: factory BRAKE ON
             axis.move_to(200000)                    # 20 turns, 1/10000 rev units
             clock.advance(5_000_000_000)            # 5 s of device time
             assert axis.position == 200000
+            assert DmacStatus.POWER_ON in axis.status
 
 Units are the module's: positions in 1/10000 rev, speeds in 0.01 rpm, times in ms.
 Requests end with CR, replies with CR LF (``LINE_SETTINGS``; the manual does not
@@ -20,13 +21,15 @@ say, see docs/drives/dmac.md).
 """
 from __future__ import annotations
 
+import enum
+import math
 from typing import Any, Iterable, Optional, Sequence
 
 from .. import _core, _stop_at_exit
+from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params
+from ..registry import DrivePlugin
 
 DmacSim = _core.DmacSim
-DmacStatus = _core.DmacStatus
-DmacErrorWord = _core.DmacErrorWord
 UnknownCommand = _core.DmacUnknownCommand
 CommandRejected = _core.DmacCommandRejected
 format_value = _core.dmac_format_value
@@ -41,21 +44,111 @@ LINE_SETTINGS = {"request_terminator": b"\r", "reply_terminators": [b"\r\n"], "m
 XON_ERROR = b"\x17"
 #: Baud rates SET_BAUDRATE accepts; 38400 is the factory default.
 BAUDRATES = (9600, 19200, 38400, 115200)
+DEFAULT_BAUD = 38400
+DEFAULT_ADDRESS = "00"
+
+
+def _bit(n: int) -> int:
+    """The manual numbers bits 1..32, bit 1 the LSB: bit n is 1 << (n - 1)."""
+    return 1 << (n - 1)
+
+
+class DmacStatus(enum.IntFlag):
+    """#STATUS (manual 5.25), bits named as the manual's table names them.
+
+    The manual numbers bits 1..32 with bit 1 the LSB: ``BUSY`` (bit 29) is
+    ``1 << 28``.  Where the manual's text contradicts its table (5.7 and 5.19
+    call the polarity bits 13 and 12) the table wins: 12 S-curve, 13 inputs, 14
+    outputs."""
+
+    OPTIMIZED_CURRENT = _bit(4)
+    HARD_POSITIVE_END_ENABLED = _bit(5)
+    HARD_NEGATIVE_END_ENABLED = _bit(6)
+    SOFT_ENDS_ENABLED = _bit(7)
+    HARD_ENDS_INVERTED = _bit(8)
+    S_CURVE = _bit(12)
+    INPUTS_INVERTED = _bit(13)
+    OUTPUTS_INVERTED = _bit(14)
+    SEQUENCER_RUN = _bit(15)
+    SEQUENCER_EDIT = _bit(16)
+    HARD_POSITIVE_END = _bit(17)
+    HARD_NEGATIVE_END = _bit(18)
+    SOFT_POSITIVE_END = _bit(19)
+    SOFT_NEGATIVE_END = _bit(20)
+    BRAKE = _bit(21)
+    SYNCHRO = _bit(23)
+    POWER_ON = _bit(25)
+    MOVEMENT = _bit(26)
+    POSITION_CONTROL = _bit(27)
+    BUSY = _bit(29)
+    REFERENCE = _bit(30)
+    ERROR = _bit(31)
+    ABNORMAL_STOP = _bit(32)
+
+    def bit(self, n: int) -> bool:
+        """Bit ``n`` as the manual numbers it (1..32)."""
+        if not 1 <= n <= 32:
+            raise _core.InvalidArgument(f"#STATUS bit: {n} is outside 1..32")
+        return bool(int(self) & _bit(n))
+
+    @property
+    def names(self) -> list:
+        return status_names(int(self))
+
+
+class DmacErrorWord(enum.IntFlag):
+    """#ERROR (manual 5.5), bits named as the manual names them (bit n = 1 << (n - 1)).
+
+    Bits 2..5 are hardware faults that stop the motor (``FAULTS``); 7, 8 and 12
+    are a refused command.  ``#ERROR:=0`` (``clear_error()``) acknowledges."""
+
+    THERMAL = _bit(2)
+    SHORT_CIRCUIT = _bit(3)
+    UNDERVOLTAGE = _bit(4)
+    OVERVOLTAGE = _bit(5)
+    LIMIT = _bit(7)
+    COMPUTATION = _bit(8)
+    SYNTAX = _bit(12)
+
+    def bit(self, n: int) -> bool:
+        if not 1 <= n <= 32:
+            raise _core.InvalidArgument(f"#ERROR bit: {n} is outside 1..32")
+        return bool(int(self) & _bit(n))
+
+    @property
+    def names(self) -> list:
+        return error_names(int(self))
+
+
+#: The #ERROR bits that are hardware faults (the FAULT output, OUT2).
+FAULTS = DmacErrorWord.THERMAL | DmacErrorWord.SHORT_CIRCUIT | DmacErrorWord.UNDERVOLTAGE | DmacErrorWord.OVERVOLTAGE
+
+
+class HomingFailed(_core.DriveFault):
+    """A DMAC reference run stopped before IN5 re-homed the axis (an end-stop, a fault, a STOP)."""
+
 
 __all__ = [
     "BAUDRATES",
     "CommandRejected",
+    "DEFAULT_ADDRESS",
+    "DEFAULT_BAUD",
     "DmacClient",
+    "DmacDrive",
     "DmacErrorWord",
     "DmacSim",
     "DmacStatus",
+    "FAULTS",
+    "HomingFailed",
     "LINE_SETTINGS",
+    "PLUGIN",
     "UnknownCommand",
     "XON_ERROR",
+    "check_address",
     "error_names",
     "format_value",
     "make_sim",
-    "open_link",
+    "open_line",
     "parse_read_reply",
     "status_names",
     "stream_interpolation",
@@ -63,48 +156,90 @@ __all__ = [
     "variable_info",
 ]
 
+_STOP_WAYS = ("stop", "quick_stop", "disable", None)
+
+
+def open_line(port: Any, *, baud: int = DEFAULT_BAUD, timeout: float = 0.5, turnaround: float = 0.0) -> Any:
+    """A ``LineLink`` framed for the DMAC (CR / CR LF) on a path or an open ``Port``.
+
+    ``timeout``: seconds a reply may take (the client adds the module's
+    #LINE_DELAY and the wire time); ``turnaround``: pause before each request."""
+    from ..serial import LineLink, open_port
+
+    if baud not in BAUDRATES:
+        raise _core.InvalidArgument(f"DMAC baud: {baud!r} is not one of {BAUDRATES}")
+    if isinstance(port, str):
+        port = open_port(port, baud)
+    return LineLink(port, request_terminator=LINE_SETTINGS["request_terminator"],
+                    reply_terminators=LINE_SETTINGS["reply_terminators"],
+                    max_line=LINE_SETTINGS["max_line"], reply_timeout=timeout, turnaround=turnaround)
 
 
 class DmacClient(_stop_at_exit.StopsMotor, _core.DmacClient):
-    """Typed DMAC commands for the module at ``address`` on a ``LineLink``.
+    """Typed DMAC commands for the module at ``address`` on a line.
 
-    ``DmacClient(link, address=0, verify=True, timeout=None, sleep=None)``
+    ``DmacClient(line, address=0, *, baud=38400, timeout=None, verify=True,
+    sleep=None, on_error="stop", on_exit="stop")``
 
+    * ``line``: a port path (opened with :func:`open_line`, closed by
+      ``close()``), an open ``Port``, or a ``LineLink`` shared with the other
+      modules of an RS-485 line (left open by ``close()``).
+    * ``address``: "00".."63" or an int.
     * ``verify``: each command frame ends with ``READ #ERROR`` so a rejected
       command raises at once (``UnknownCommand`` for bit 12, ``CommandRejected``
-      for bits 7/8).
-    * ``timeout``: seconds per transaction (None = the link's reply timeout).
-    * ``sleep``: how the client waits when polling or backing off (seconds);
-      pass ``lambda s: clock.advance(int(s * 1e9))`` to run on a SimClock.
-
-    As a context manager it sends STOP when an exception leaves the block; every
-    client that is still open at interpreter exit is stopped too.
+      for bits 7/8, and for a move while a fault is latched).
+    * ``timeout``: seconds per reply (None = the link's); ``sleep``: how the
+      client waits when polling (``lambda s: clock.advance(int(s * 1e9))`` on a SimClock).
+    * ``on_error`` / ``on_exit``: ``"stop"`` (STOP: decelerate with
+      #DECEL_TIME), ``"quick_stop"`` (HALT: no ramp, maximum braking torque —
+      the fastest stop a DMAC has), ``"disable"`` (POWER OFF) or None; applied
+      when an exception leaves ``with`` and at interpreter exit.
     """
 
-    def __init__(self, link: Any, address: int = 0, verify: bool = True,
-                 timeout: Optional[float] = None, sleep: Any = None) -> None:
-        super().__init__(link, address=address, verify=verify, timeout=timeout, sleep=sleep)
+    def __init__(self, line: Any, address: Any = 0, *, baud: int = DEFAULT_BAUD, timeout: Optional[float] = None,
+                 verify: bool = True, sleep: Any = None, on_error: Optional[str] = "stop",
+                 on_exit: Optional[str] = "stop") -> None:
+        for name, how in (("on_error", on_error), ("on_exit", on_exit)):
+            if how not in _STOP_WAYS:
+                raise _core.InvalidArgument(f"{name}: one of 'stop', 'quick_stop', 'disable' or None, not {how!r}")
+        self._port = None
+        if isinstance(line, str):
+            from ..serial import open_port
+            self._port = open_port(line, baud)
+            line = open_line(self._port, baud=baud, timeout=0.5 if timeout is None else timeout)
+        elif isinstance(line, _core.Port):
+            line = open_line(line, baud=baud, timeout=0.5 if timeout is None else timeout)
+        elif not isinstance(line, _core.LineLink):
+            raise _core.InvalidArgument(f"DmacClient line: a path, a Port or a LineLink, not {type(line).__name__}")
+        super().__init__(line, address=_parse_address(address), baud=baud, verify=verify, timeout=timeout,
+                         sleep=sleep)
+        self.on_error = on_error
+        self.on_exit = on_exit
         self._open = True
         _stop_at_exit.track(self)
 
     def _stop_on_error(self) -> None:
-        self._emergency_stop()
+        self._apply(self.on_error)
 
     def close(self) -> None:
-        """Forget this client for the exit-time STOP (the link stays open)."""
+        """Forget this client for the exit hook; closes the port if it opened it."""
         self._open = False
         _stop_at_exit.untrack(self)
+        if self._port is not None:
+            port, self._port = self._port, None
+            port.close()
 
     def _stop_at_exit(self) -> None:
-        self._emergency_stop()
+        self._apply(self.on_exit)
 
-    def _emergency_stop(self) -> None:
-        if not getattr(self, "_open", False):
+    def _apply(self, how: Optional[str]) -> None:
+        if how is None or not getattr(self, "_open", False):
             return
+        cmd = {"stop": "STOP", "quick_stop": "HALT", "disable": "POWER OFF"}[how]
         try:
-            # STOP plus a READ, so we know the module took it before we go on;
-            # no error checking that could itself raise.
-            self.raw(f"{self.address:02d}STOP, READ #STATUS", expect_reply=True)
+            # The command plus a READ, so we know the module took it; no error
+            # checking that could itself raise while unwinding.
+            self.raw(f"{self.address:02d}{cmd}, READ #STATUS", expect_reply=True)
         except Exception:  # the link may already be gone; nothing more to do
             pass
 
@@ -112,18 +247,9 @@ class DmacClient(_stop_at_exit.StopsMotor, _core.DmacClient):
         return f"DmacClient(address={self.address:02d})"
 
 
-def open_link(port: Any, baud: int = 38400, timeout: float = 0.5) -> Any:
-    """A ``LineLink`` with the DMAC line settings on a path or an open Port."""
-    from ..serial import LineLink, open_port
-
-    if isinstance(port, str):
-        port = open_port(port, baud)
-    return LineLink(port, request_terminator=LINE_SETTINGS["request_terminator"],
-                    reply_terminators=LINE_SETTINGS["reply_terminators"],
-                    max_line=LINE_SETTINGS["max_line"], reply_timeout=timeout)
-
-
 def _parse_address(address: Any) -> int:
+    if isinstance(address, bool):
+        raise _core.InvalidArgument(f"DMAC address: {address!r} is not a number 00..63")
     try:
         a = int(address)
     except (TypeError, ValueError):
@@ -141,11 +267,12 @@ def make_sim(address: Any = "00", clock: Any = None, **options: Any) -> DmacSim:
     ``baudrate``, ``request_terminator`` / ``reply_terminator`` (bytes),
     ``positive_end_switch`` / ``negative_end_switch`` (position in 1/10000 rev
     where a mechanical end-stop switch on IN1/IN2 or IN9/IN10 closes) and
-    ``end_switch_active_low``.
+    ``end_switch_active_low``, ``reference_switch`` (position where a switch
+    on IN5 turns on and stays on beyond: REFERENCE homing and #CAPTURE).
     ``clock`` is a motorbus Clock (SimClock for tests); None = real time.
     """
     allowed = {"model", "supply_voltage", "baudrate", "request_terminator", "reply_terminator",
-               "positive_end_switch", "negative_end_switch", "end_switch_active_low"}
+               "positive_end_switch", "negative_end_switch", "end_switch_active_low", "reference_switch"}
     unknown = set(options) - allowed
     if unknown:
         raise _core.InvalidArgument(f"make_sim: unknown option(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
@@ -175,3 +302,247 @@ def stream_interpolation(axes: Sequence[DmacClient], segments: Iterable[Sequence
     """
     return _core.dmac_stream_interpolation(list(axes), [list(map(int, s)) for s in segments],
                                            interpol_time_ms, fifo_size, sleep, backoff)
+
+
+SIM_OPTIONS = ("model", "supply_voltage", "baudrate", "request_terminator", "reply_terminator",
+               "positive_end_switch", "negative_end_switch", "end_switch_active_low", "reference_switch")
+
+
+def check_address(text: str) -> str:
+    """The canonical two-digit address ("00".."63"), or InvalidArgument naming the problem."""
+    if not isinstance(text, str) or not text.strip().isdigit():
+        raise _core.InvalidArgument(f"DMAC address: {text!r} is not a number 00..63")
+    return f"{_parse_address(text.strip()):02d}"
+
+
+# ---- the Drive adapter ------------------------------------------------------------------------
+#: 0.01 rpm per increment/s (1 rev = 10000 increments): the unit of #HIGH_SPEED and MOVE_SPEED.
+_SPEED_PER_INC_S = 6000.0 / 10000.0
+
+_UNITS = {"#ACCEL_TIME": "ms", "#DECEL_TIME": "ms", "#HIGH_SPEED": "0.01 rpm", "#LOW_SPEED": "0.01 rpm",
+          "#LINE_DELAY": "us", "#TORQUE_RATIO": "%", "#POSITION": "1/10000 rev", "#NEGATIVE_END": "1/10000 rev",
+          "#POSITIVE_END": "1/10000 rev", "#SPEED": "0.01 rpm", "#PROFILE_SPEED": "0.01 rpm",
+          "#SUPPLY_VOLTAGE": "mV", "#CPU_TEMPERATURE": "0.1 degC", "#DRIVER_TEMPERATURE": "0.1 degC",
+          "#MOTOR_TEMPERATURE": "0.1 degC", "#INTERPOL_TIME": "ms", "#INPUT_ANALOG": "mV", "#INPUT_A1": "mV",
+          "#INPUT_A2": "mV", "#OUTPUT_A1": "mV", "#OUTPUT_A2": "mV", "#CAPTURE": "1/10000 rev"}
+_DESCRIPTIONS = {
+    "#ACCEL_TIME": "time from standstill to #HIGH_SPEED", "#DECEL_TIME": "time from #HIGH_SPEED to standstill",
+    "#HIGH_SPEED": "cruise speed of a position move, limit of MOVE_SPEED", "#LOW_SPEED": "approach speed of the closed position loop",
+    "#LINE_DELAY": "RS-485 turnaround before each reply", "#TORQUE_RATIO": "share of the torque available",
+    "#POSITION": "position (assigning re-homes)", "#NEGATIVE_END": "soft negative end-stop",
+    "#POSITIVE_END": "soft positive end-stop", "#OUTPUT_CONFIG": "OUT1=BUSY (bit 1), OUT2=FAULT (bit 2)",
+    "#ON_RESET": "sequencer line run at reset (0 = none)", "#ERROR": "error register (write 0 to acknowledge)",
+    "#STATUS": "status word", "#INTERPOL_TIME": "duration of one interpolation segment",
+    "#INTERPOL_FIFOSIZE": "interpolation FIFO size (segments)", "#INTERPOL_MODE": "0 SimpleSYNC, -1 UltraSYNC",
+}
+# The variables drive.params lists (the #V/#M/#TIMER families are reachable by name too).
+_PARAM_NAMES = ("#ACCEL_TIME", "#DECEL_TIME", "#HIGH_SPEED", "#LOW_SPEED", "#TORQUE_RATIO", "#LINE_DELAY",
+                "#POSITIVE_END", "#NEGATIVE_END", "#OUTPUT_CONFIG", "#ON_RESET", "#INTERPOL_TIME",
+                "#INTERPOL_FIFOSIZE", "#INTERPOL_MODE", "#POSITION", "#OUTPUT", "#ERROR", "#STATUS", "#SPEED",
+                "#PROFILE_SPEED", "#INPUT", "#SUPPLY_VOLTAGE", "#CPU_TEMPERATURE", "#CAPTURE", "#LINE",
+                "#INTERPOL_COUNT")
+
+
+class DmacParams(Params):
+    """``drive.params`` over the DMAC variables: ``params["#HIGH_SPEED"]`` or
+    ``params["HIGH_SPEED"]`` (the ``#`` is optional; mnemonics such as ``HSP`` too)."""
+
+    def _key(self, name: str) -> str:
+        name = super()._key(name).strip().upper()
+        return name if name.startswith("#") else "#" + name
+
+    def _names(self) -> list:
+        return list(_PARAM_NAMES)
+
+    def _info(self, name: str) -> Optional[ParamInfo]:
+        try:
+            v = variable_info(name)
+        except _core.InvalidArgument:
+            return None
+        canonical = v["name"]
+        writable = not v["read_only"] and canonical not in ("#STATUS",)
+        return ParamInfo(name=canonical, type="int", minimum=v["min"], maximum=v["max"],
+                         unit=_UNITS.get(canonical, ""), default=v["factory"], persists=bool(v["stored"]),
+                         writable=writable, description=_DESCRIPTIONS.get(canonical, ""))
+
+    def _read(self, info: ParamInfo) -> Any:
+        return self._drive.native.read(info.name)
+
+    def _write(self, info: ParamInfo, value: Any) -> None:
+        if isinstance(value, bool) or int(value) != value:
+            raise _core.InvalidArgument(f"dmac: {info.name} takes an integer, not {value!r}")
+        self._drive.native.write(info.name, int(value))
+
+
+class DmacDrive(Drive):
+    """A DMAC module as a :class:`motorbus.Drive` (native unit: the increment, 1/10000 rev).
+
+    * ``enable()``: BRAKE OFF (DMAC34) and POWER ON; ``disable()``: POWER OFF.
+    * ``stop()``: STOP (#DECEL_TIME ramp); ``quick_stop()``: HALT (no ramp).
+    * ``move_to(..., velocity=v)``: writes #HIGH_SPEED for the move; it stays set.
+    * ``home(method)``: ``"reference"`` (default): REFERENCE ON and MOVE_SPEED
+      at #LOW_SPEED clockwise until IN5 rises (the module re-homes there), then
+      back to 0; ``"here"``: #POSITION:=0 where the axis stands.
+    * ``clear_faults()``: #ERROR:=0; ``store()``: nothing to send — the DMAC
+      writes its stored variables to non-volatile memory as they are written.
+    * No watchdog: on link loss the module keeps doing what it was last told.
+    """
+
+    kind = "dmac"
+    capabilities = frozenset({Capability.POSITION, Capability.VELOCITY, Capability.HOMING,
+                              Capability.INTERPOLATION, Capability.ENCODER, Capability.STORE})
+    has_watchdog = False
+    HOME_METHODS = ("reference", "here")
+
+    def __init__(self, native: DmacClient, **kwargs: Any) -> None:
+        super().__init__(native, **kwargs)
+        self._homed = False
+        self._homing: Optional[str] = None
+
+    def _make_params(self) -> Params:
+        return DmacParams(self)
+
+    def _enable(self) -> None:
+        if self.native.is_dmac34:
+            self.native.brake(False)
+        self.native.power("ON")
+
+    def _disable(self) -> None:
+        self.native.power("OFF")
+
+    def _set_speed(self, velocity: Optional[float]) -> None:
+        if velocity is None:
+            return
+        speed = int(round(velocity * _SPEED_PER_INC_S))
+        if not 1 <= speed <= 400000:
+            raise _core.InvalidArgument(f"dmac: velocity {velocity:g} increments/s is outside "
+                                        f"1..400000 (0.01 rpm, #HIGH_SPEED)")
+        self.native.high_speed = speed
+
+    def _move_to(self, target: float, velocity: Optional[float]) -> None:
+        self._set_speed(velocity)
+        self.native.move_to(self._increments(target))
+
+    def _move_by(self, distance: float, velocity: Optional[float]) -> None:
+        self._set_speed(velocity)
+        self.native.move_on(self._increments(distance))
+
+    def _jog(self, velocity: float) -> None:
+        speed = int(round(velocity * _SPEED_PER_INC_S))
+        if abs(speed) > 400000:
+            raise _core.InvalidArgument(f"dmac: jog velocity {velocity:g} increments/s exceeds 400000 (0.01 rpm)")
+        if speed == 0:
+            self.native.stop()
+            return
+        self.native.move_speed(speed)  # the module limits |speed| to #HIGH_SPEED
+
+    def _stop(self) -> None:
+        self._homing = None
+        self.native.stop()
+
+    def _quick_stop(self) -> None:
+        self._homing = None
+        self.native.halt()
+
+    def _home(self, method: Any) -> None:
+        method = "reference" if method is None else method
+        if method not in self.HOME_METHODS:
+            raise _core.InvalidArgument(f"dmac: home method {method!r} is not one of {self.HOME_METHODS}")
+        self._homed = False
+        if method == "here":
+            self.native.position = 0
+            self._homed = True
+            self._homing = None
+            return
+        self.native.reference(True)
+        self.native.move_speed(max(1, self.native.low_speed))
+        self._homing = "search"
+
+    def _homing_done(self) -> bool:
+        if self._homing is None:
+            return True
+        st = self.native.status
+        if self._homing == "search":
+            if DmacStatus.REFERENCE not in st:          # IN5 rose: the module re-homed
+                self.native.move_to(0)                 # back onto the reference point
+                self._homing = "return"
+                return False
+            if DmacStatus.MOVEMENT not in st or DmacStatus.ABNORMAL_STOP in st:
+                self._homing = None
+                self.native.reference(False)
+                raise HomingFailed(f"dmac {self.native.address:02d}: the reference run stopped before IN5 "
+                                   f"rose (#STATUS {st.names})")
+            return False
+        if DmacStatus.MOVEMENT in st:
+            return False
+        self._homing = None
+        self._homed = True
+        return True
+
+    def _clear_faults(self) -> None:
+        self.native.clear_error()
+
+    def _store(self) -> None:
+        # Stored variables go to non-volatile memory when written (manual 5.x,
+        # "This parameter is stored in non-volatile memory"); HARD_ENDS and
+        # OPTIMIZED_CURRENT at shut-down.  There is no save command to send.
+        pass
+
+    def _position(self) -> float:
+        return float(self.native.position)
+
+    def _velocity(self) -> float:
+        return self.native.speed / _SPEED_PER_INC_S
+
+    def _is_idle(self) -> bool:
+        # At rest, not merely at the target speed (BUSY ends there in velocity mode).
+        return DmacStatus.MOVEMENT not in self.native.status
+
+    def _status(self) -> DriveStatus:
+        st = self.native.status
+        err = DmacErrorWord(int(self.native.error)) if DmacStatus.ERROR in st else DmacErrorWord(0)
+        fault = bool(err & FAULTS)
+        moving = DmacStatus.MOVEMENT in st
+        words = [n for n in ("power on" if DmacStatus.POWER_ON in st else "power off",
+                             "moving" if moving else "at rest",
+                             "busy" if DmacStatus.BUSY in st else "",
+                             "brake" if DmacStatus.BRAKE in st else "",
+                             "fault: " + ", ".join(err.names) if err else "") if n]
+        return DriveStatus(enabled=DmacStatus.POWER_ON in st, moving=moving, homed=self._homed, fault=fault,
+                           at_target=DmacStatus.BUSY not in st and not moving,
+                           limit_positive=bool(st & (DmacStatus.HARD_POSITIVE_END | DmacStatus.SOFT_POSITIVE_END)),
+                           limit_negative=bool(st & (DmacStatus.HARD_NEGATIVE_END | DmacStatus.SOFT_NEGATIVE_END)),
+                           raw=(st, err), text=f"DMAC {self.native.address:02d}: " + ", ".join(words))
+
+    @staticmethod
+    def _increments(x: float) -> int:
+        n = int(round(x))
+        if not -2**31 <= n < 2**31:
+            raise _core.InvalidArgument(f"dmac: position {x:g} increments is outside int32")
+        return n
+
+
+def _open(*, line: Any, bus: Any = None, address: str = DEFAULT_ADDRESS, units: Any = None,
+          baud: int = DEFAULT_BAUD, timeout: Optional[float] = None, on_error: Optional[str] = "stop",
+          on_exit: Optional[str] = "stop", sleep: Any = None) -> DmacDrive:
+    if bus is not None:
+        raise _core.InvalidArgument("dmac: a serial drive takes line=, not bus=")
+    # The adapter owns the safety words: the client does nothing at exit itself.
+    client = DmacClient(line, check_address(str(address)), baud=baud, timeout=timeout, sleep=sleep,
+                        on_error=None, on_exit=None)
+    return DmacDrive(client, units=units, on_error=on_error, on_exit=on_exit, close_native=client.close)
+
+
+PLUGIN = DrivePlugin(
+    kind="dmac",
+    description="Midi Ingénierie DMAC17/23/34 brushless modules, ASCII protocol over RS-232/RS-485",
+    transport="serial",
+    open=_open,
+    make_sim=make_sim,
+    check_address=check_address,
+    default_address=DEFAULT_ADDRESS,
+    line_settings=LINE_SETTINGS,
+    default_baud=DEFAULT_BAUD,
+    sim_options=SIM_OPTIONS,
+    store_options=None,
+)

@@ -7,6 +7,7 @@ namespace motorbus::dmac {
 namespace {
 
 constexpr int kMaxStrayLines = 8;  // lines skipped while looking for the awaited reply
+constexpr Duration kMaxLineDelay = std::chrono::microseconds(3000);  // #LINE_DELAY range 100..3000 us
 
 std::vector<std::uint8_t> bytes_of(std::string_view s) { return {s.begin(), s.end()}; }
 
@@ -34,6 +35,9 @@ DmacClient::DmacClient(std::shared_ptr<serial::LineLink> link, ClientOptions opt
     if (options_.address < 0 || options_.address > kMaxAddress)
         throw InvalidArgument("DmacClient address: " + std::to_string(options_.address) +
                               " is outside 0..63 (global commands go through synchro()/raw())");
+    if (options_.baud != 9600 && options_.baud != 19200 && options_.baud != 38400 && options_.baud != 115200)
+        throw InvalidArgument("DmacClient baud: " + std::to_string(options_.baud) +
+                              " is not 9600, 19200, 38400 or 115200");
 }
 
 int DmacClient::check_family(int n, int count, const char* name) {
@@ -46,6 +50,14 @@ int DmacClient::check_family(int n, int count, const char* name) {
 void DmacClient::sleep(Duration d) {
     if (options_.sleep) options_.sleep(d);
     else std::this_thread::sleep_for(d);
+}
+
+Duration DmacClient::reply_wait() const {
+    const Duration base = options_.timeout.value_or(link_->options().reply_timeout);
+    // 10 bits a character; a request and its reply of up to 256 characters each.
+    const Duration wire = std::chrono::nanoseconds(2LL * static_cast<long long>(kMaxFrame) * 10 *
+                                                   1'000'000'000LL / std::max(options_.baud, 1));
+    return base + kMaxLineDelay + wire;
 }
 
 std::string DmacClient::frame(std::string_view command) const {
@@ -63,14 +75,14 @@ std::string DmacClient::await(const std::string& request,
         link_->send(request);
         return "";
     }
-    std::string reply = link_->transact(request, options_.timeout);
+    std::string reply = link_->transact(request, reply_wait());
     const std::string first = reply;
     for (int i = 0; i < kMaxStrayLines; ++i) {
         if (match(reply)) return reply;
         if (!reply.empty() && reply[0] == '?') throw UnknownCommand("DMAC answered '" + reply + "' to '" + request + "'");
         ++counters_.stray_lines;
         if (reply.find("EV v") != std::string::npos) ++counters_.device_resets;
-        auto next = link_->read_line(options_.timeout.value_or(link_->options().reply_timeout));
+        auto next = link_->read_line(reply_wait());
         if (!next) break;
         reply = *next;
     }
@@ -107,8 +119,17 @@ void DmacClient::command(std::string_view cmd) {
     const auto err = static_cast<std::uint32_t>(r.value);
     const std::uint32_t command_bits =
         bit_mask(error::kSyntax) | bit_mask(error::kLimit) | bit_mask(error::kComputation);
-    if (!(err & command_bits)) return;
     const std::uint32_t hardware = err & ~command_bits;
+    const std::uint32_t faults = bit_mask(error::kThermal) | bit_mask(error::kShortCircuit) |
+                                 bit_mask(error::kUndervoltage) | bit_mask(error::kOvervoltage);
+    // With a fault latched the power stage stays off: a move or POWER ON is
+    // not carried out (manual 2.1), so say so instead of waiting for nothing.
+    if ((err & faults) && (cmd.find("MOVE_") != std::string_view::npos || cmd.find("POWER ON") != std::string_view::npos))
+        throw CommandRejected("DMAC " + std::to_string(options_.address) + " did not run '" + std::string(cmd) +
+                                  "': a fault is latched (#ERROR " + describe_error(err) +
+                                  "); acknowledge it with clear_error()",
+                              err);
+    if (!(err & command_bits)) return;
     // Acknowledge a command error so the next command starts clean, unless a
     // hardware fault is latched too: that one is the user's to acknowledge.
     if (!hardware) read_reply(frame("#ERROR:=0, READ #ERROR"), Var::Error, 0);
@@ -197,12 +218,21 @@ void DmacClient::set_interpolation(std::int32_t time_ms, std::int32_t fifo_size,
             encode_write(kGlobal, Var::InterpolMode, mode));
 }
 
+bool DmacClient::is_dmac34() {
+    // Software codes H142/J142/K142 are the DMAC34 firmwares (4.19).
+    if (!dmac34_) {
+        const VersionInfo v = request_version();
+        dmac34_ = v.code.size() == 4 && v.code.substr(1) == "142";
+    }
+    return *dmac34_;
+}
+
 std::int32_t DmacClient::analog_input(int channel) {
-    // A module answers nothing for a variable it lacks, so pick by name:
-    // #INPUT_ANALOG (DMAC17/23) for channel 1, #INPUT_A2 (DMAC34) for channel 2.
-    if (channel == 1) return read(Var::InputAnalog);
-    if (channel == 2) return read(Var::InputA2);
-    throw InvalidArgument("analog input: channel " + std::to_string(channel) + " is not 1 or 2");
+    if (channel != 1 && channel != 2)
+        throw InvalidArgument("analog input: channel " + std::to_string(channel) + " is not 1 or 2");
+    const bool d34 = is_dmac34();
+    if (channel == 2 && !d34) throw InvalidArgument("analog input: channel 2 exists on a DMAC34 only");
+    return read(channel == 2 ? Var::InputA2 : d34 ? Var::InputA1 : Var::InputAnalog);
 }
 
 void DmacClient::set_analog_output(int channel, std::int32_t mv) {

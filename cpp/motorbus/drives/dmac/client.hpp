@@ -67,7 +67,12 @@ struct ErrorWord {
 struct ClientOptions {
     int address = 0;
     bool verify = true;                               // append READ #ERROR to commands
-    std::optional<Duration> timeout{};                // per transaction; default: the link's
+    // Per transaction: how long the module may take to answer; default: the
+    // link's reply timeout.  The client adds the turnaround the DMAC itself
+    // inserts (#LINE_DELAY, up to 3 ms, 5.13) and the time a full 256-character
+    // request and reply take on the wire at `baud`.
+    std::optional<Duration> timeout{};
+    int baud = 38400;                                 // the line's speed, for that allowance
     // How the client waits (polling, FIFO back-pressure).  Default: real sleep.
     // Tests on a SimClock pass a function that advances the clock instead.
     std::function<void(Duration)> sleep{};
@@ -136,9 +141,11 @@ public:
     std::int32_t on_reset() { return read(Var::OnReset); }
     // #INTERPOL_TIME (ms), #INTERPOL_FIFOSIZE (segments), #INTERPOL_MODE (0 SimpleSYNC, -1 UltraSYNC).
     void set_interpolation(std::int32_t time_ms, std::int32_t fifo_size, std::int32_t mode = 0);
-    // Analog input in mV: channel 1 = #INPUT_ANALOG, channel 2 = #INPUT_A2 (DMAC34).
-    // On a DMAC34 read("#INPUT_A1") names the first input the way the manual does.
+    // Analog input in mV: channel 1 = #INPUT_ANALOG on a DMAC17/23, #INPUT_A1
+    // on a DMAC34; channel 2 = #INPUT_A2 (DMAC34 only).  The model is learnt
+    // once from REQUEST_VERSION (a module answers nothing for a variable it lacks).
     std::int32_t analog_input(int channel);
+    bool is_dmac34();
     // DMAC34 analog outputs (#OUTPUT_A1/#OUTPUT_A2), 0..10000 mV.
     void set_analog_output(int channel, std::int32_t mv);
     std::int32_t driver_temperature() { return read(Var::DriverTemperature); }
@@ -196,6 +203,8 @@ private:
                       bool send_only);
     ReadReply read_reply(const std::string& request, Var v, int bit);
     void sleep(Duration d);
+    Duration reply_wait() const;
+    std::optional<bool> dmac34_;
 
     std::shared_ptr<serial::LineLink> link_;
     ClientOptions options_;

@@ -141,6 +141,7 @@ void DmacMotion::splice(double t, const Profile& tail) {
     head.finish(tail_end.p, tail_end.v);
     profile_ = head;
     motion_end_ = t + tail_len;
+    target_reached_ = motion_end_;
 }
 
 void DmacMotion::move_to(double t, std::int64_t target) {
@@ -162,8 +163,9 @@ void DmacMotion::move_speed(double t, std::int32_t speed_001rpm) {
     Profile tail = dmac_speed_profile(st, speed_001rpm, params_, kSpeedHoldSeconds);
     splice(t, tail);
     const double vt = tail.final_state().v;
+    target_reached_ = t + (tail.duration() - kSpeedHoldSeconds);
     if (vt != 0) motion_end_ = std::numeric_limits<double>::infinity();
-    else motion_end_ = t + (tail.duration() - kSpeedHoldSeconds);
+    else motion_end_ = target_reached_;
     speed_mode_ = true;
 }
 

@@ -80,6 +80,9 @@ public:
     const Profile& profile() const { return profile_; }
     State at(double t) const { return profile_.at(t); }
     bool moving(double t) const;
+    // BUSY (manual 3.5.4): until the target is reached, the target velocity in
+    // velocity mode (the end of the ramp) or the target position otherwise.
+    bool busy(double t) const { return t < target_reached_; }
     bool speed_mode() const { return speed_mode_; }
     std::int64_t target() const { return target_; }
 
@@ -89,6 +92,7 @@ private:
     bool speed_mode_ = false;
     std::int64_t target_ = 0;
     double motion_end_ = 0;  // time the motor comes to rest (infinity while a speed holds)
+    double target_reached_ = 0;  // time the target velocity / position is reached
     void splice(double t, const Profile& tail);
 };
 

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <chrono>
 #include <limits>
+#include <thread>
 
 namespace motorbus::dmac {
 
@@ -14,6 +16,15 @@ struct DmacSim::Pending {
 namespace {
 
 constexpr std::int64_t kNsPerMs = 1'000'000;
+// Run-down of a rotor whose power stage is off, as an exponential decay of
+// speed (the manual gives no figures; these are the simulator's): POWER SC
+// short-circuits the coils, whose braking torque stops it within tens of ms;
+// POWER OFF leaves only friction, so it coasts ten times longer.
+constexpr double kShortCircuitTau = 0.02;  // s
+constexpr double kFreewheelTau = 0.2;      // s
+// Hardware faults latched in #ERROR (manual 5.5); OUT2 FAULT reflects them.
+constexpr std::uint32_t kFaultBits = bit_mask(error::kThermal) | bit_mask(error::kShortCircuit) |
+                                     bit_mask(error::kUndervoltage) | bit_mask(error::kOvervoltage);
 // A soft end-stop reached by an exact crossing sits on it to within rounding.
 constexpr double kEndTolerance = 1e-6;
 
@@ -26,6 +37,7 @@ motion::MotorConfig axis_config(const SimOptions& o) {
     c.index_width_steps = 1;
     c.plus_limit = o.positive_end_switch;
     c.minus_limit = o.negative_end_switch;
+    c.home = o.reference_switch;
     c.tick_ns = kNsPerMs;  // the firmware's own tick; edges inside it are refined anyway
     return c;
 }
@@ -122,10 +134,15 @@ std::uint32_t DmacSim::logical_inputs() const {
         electrical |= dmac34() ? bit_mask(9) : bit_mask(1);
     if (options_.negative_end_switch.present && axis_->minus_limit_input())
         electrical |= dmac34() ? bit_mask(10) : bit_mask(2);
+    if (options_.reference_switch.present && axis_->home_input()) electrical |= bit_mask(5);
     return (electrical ^ (invert_in_ ? input_mask() : 0u)) & input_mask();
 }
 
-bool DmacSim::var_available(Var v) const { return dmac34() || !var_info(v).dmac34_only; }
+bool DmacSim::var_available(Var v) const {
+    // #INPUT_ANALOG is the DMAC17/23 name; a DMAC34 has #INPUT_A1/#INPUT_A2 (5.8, 7.2).
+    if (v == Var::InputAnalog) return !dmac34();
+    return dmac34() || !var_info(v).dmac34_only;
+}
 
 DmacProfileParams DmacSim::params() const {
     DmacProfileParams p;
@@ -153,7 +170,36 @@ std::int32_t DmacSim::speed_locked() const {
     return round_i32(dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->velocity())));
 }
 
-bool DmacSim::moving_locked() const { return interpolating_ || motion_->moving(motion_t()); }
+bool DmacSim::moving_locked() const {
+    return interpolating_ || (coasting_ && axis_->moving()) || motion_->moving(motion_t());
+}
+
+// BUSY: active until the target is reached (3.5.4) -- the target velocity in
+// velocity mode, the target position otherwise.  A rotor running down with
+// the power stage off has no target.
+bool DmacSim::busy_locked() const { return interpolating_ || (!coasting_ && motion_->busy(motion_t())); }
+
+void DmacSim::coast(double tau) {
+    const double v = axis_->velocity();  // increments/s
+    interpolating_ = false;
+    fifo_.clear();
+    seg_elapsed_ms_ = 0;
+    pending_.reset();
+    // Exponential run-down until below half an increment per second.
+    if (std::fabs(v) > 0.5) {
+        const double duration = tau * std::log(std::fabs(v) / 0.5);
+        motion::Profile p(motion::State{0, v, 0, 0});
+        p.append_exp_approach(duration, v * tau, tau).finish(v * tau * (1 - std::exp(-duration / tau)), 0);
+        axis_->halt();
+        axis_->command(p, tick_time());
+        restart_motion_at(user_position());
+        coasting_ = true;
+    } else {
+        axis_->halt();
+        restart_motion_at(user_position());
+        coasting_ = false;
+    }
+}
 
 void DmacSim::catch_up_locked() {
     const std::int64_t target = (clock_->now() - epoch_ns_) / kNsPerMs;
@@ -178,6 +224,10 @@ void DmacSim::tick_locked() {
         if (t > 0) --t;
     }
     advance_axis(tick_time());
+    if (coasting_ && !axis_->moving()) {
+        coasting_ = false;
+        restart_motion_at(user_position());
+    }
     if (interpolating_ && !fifo_.empty() && ++seg_elapsed_ms_ >= fifo_.front().duration_ms) {
         // The segment's profile has just ended on its exact end position.
         fifo_.pop_front();
@@ -230,6 +280,7 @@ void DmacSim::restart_motion_at(double position) {
 }
 
 void DmacSim::halt_motion() {
+    coasting_ = false;
     interpolating_ = false;
     fifo_.clear();
     seg_elapsed_ms_ = 0;
@@ -288,6 +339,10 @@ void DmacSim::advance_axis(Nanos t) {
 
 void DmacSim::on_axis_event(const motion::MotorEvent& e) {
     using K = motion::MotorEvent::Kind;
+    if (e.kind == K::HomeOn || e.kind == K::HomeOff) {
+        in5_changed_locked(wrap_i32(e.encoder));
+        return;
+    }
     if (e.kind != K::PlusLimitOn && e.kind != K::PlusLimitOff && e.kind != K::MinusLimitOn &&
         e.kind != K::MinusLimitOff)
         return;
@@ -303,6 +358,14 @@ bool DmacSim::start_move(Cmd kind, std::int32_t value) {
     if (brake_) {
         flag(error::kLimit);
         return false;
+    }
+    // A latched hardware fault keeps the power stage off until #ERROR:=0 or a reset (2.1).
+    if (error_ & kFaultBits) return false;
+    if (coasting_) {
+        // The power stage takes the rotor over where it is.
+        coasting_ = false;
+        axis_->halt();
+        restart_motion_at(user_position());
     }
     const double p = user_position();
     int dir = 0;
@@ -387,7 +450,10 @@ void DmacSim::reset_locked(bool factory) {
     }
     vars_[static_cast<std::size_t>(Var::Capture)] = 0;
     error_ = 0;
-    power_ = brake_ = reference_ = synchro_ = abnormal_stop_ = false;
+    power_ = reference_ = synchro_ = abnormal_stop_ = false;
+    // BRAKE's factory value is ON (annex 7.1): the fail-safe brake is applied
+    // after a reset until BRAKE OFF (the brake output exists on a DMAC34 only).
+    brake_ = dmac34();
     pending_.reset();
     interpolating_ = false;
     fifo_.clear();
@@ -397,11 +463,16 @@ void DmacSim::reset_locked(bool factory) {
     line_ = 0;
     call_stack_.clear();
     wait_ = WaitKind::None;
+    // "Motor is powered off and then stopped (short-circuited) until complete
+    // stop" (4.8): a moving rotor runs down as under POWER SC.
+    coast(kShortCircuitTau);
     // Position is stored (kept across a reset) unless factory settings are restored.
-    axis_->halt();
-    if (factory) axis_->set_encoder(0);
-    restart_motion_at(user_position());
+    if (factory) {
+        axis_->set_encoder(0);
+        if (!coasting_) restart_motion_at(user_position());
+    }
     first_reset_ = false;
+    check_supply_locked();
     const std::int32_t on_reset = vars_[static_cast<std::size_t>(Var::OnReset)];
     if (on_reset >= 1 && on_reset <= kSeqLines) seq_start(on_reset);
 }
@@ -442,7 +513,7 @@ std::uint32_t DmacSim::status_locked() {
         const double err = static_cast<double>(motion_->target() + pos_offset_) - user_position();
         set(status::kPositionControl, std::fabs(err) <= kDmacApproachIncrements);
     }
-    set(status::kBusy, moving);
+    set(status::kBusy, busy_locked());
     set(status::kReference, reference_);
     set(status::kError, error_ != 0);
     set(status::kAbnormalStop, abnormal_stop_);
@@ -498,6 +569,8 @@ int DmacSim::write_var_locked(Var v, int bit, std::int32_t value) {
         }
         case Var::Error:
             error_ = 0;
+            // A supply or temperature still out of range latches again at once.
+            check_supply_locked();
             return 0;
         case Var::Line:
             if (value == 0) seq_stop();
@@ -765,9 +838,12 @@ std::string DmacSim::execute_locked(const Command& c, bool from_sequencer, bool 
             soft_ends_ = c.keyword == Keyword::On;
             return "";
         case Cmd::Power:
-            if (c.keyword == Keyword::On) power_ = true;
-            else {
-                halt_motion();
+            if (c.keyword == Keyword::On) {
+                if (!(error_ & kFaultBits)) power_ = true;
+            } else {
+                // OFF: no current, no torque -- the rotor freewheels; SC: the
+                // short-circuited coils brake it (low-speed resisting torque, 4.15).
+                coast(c.keyword == Keyword::Sc ? kShortCircuitTau : kFreewheelTau);
                 power_ = false;
             }
             return "";
@@ -909,20 +985,33 @@ std::string DmacSim::handle_locked(std::string_view line) {
 }
 
 std::string DmacSim::on_line(std::string_view line) {
-    std::lock_guard lock(mutex_);
-    try {
-        catch_up_locked();
-        return handle_locked(line);
-    } catch (...) {
-        // Hostile input must never take the device down: flag and stay silent.
-        flag(error::kSyntax);
-        return "";
+    std::string reply;
+    std::int32_t delay_us = 0;
+    {
+        std::lock_guard lock(mutex_);
+        try {
+            catch_up_locked();
+            reply = handle_locked(line);
+        } catch (...) {
+            // Hostile input must never take the device down: flag and stay silent.
+            flag(error::kSyntax);
+            reply.clear();
+        }
+        delay_us = vars_[static_cast<std::size_t>(Var::LineDelay)];
     }
+    // #LINE_DELAY (5.13): the module waits that long after the end of the
+    // command before it answers.  A wire-level delay, so real time whatever
+    // the device clock is; taken outside the lock.
+    if (!reply.empty() && delay_us > 0) std::this_thread::sleep_for(std::chrono::microseconds(delay_us));
+    return reply;
 }
 
 std::string DmacSim::on_overlong() {
     std::lock_guard lock(mutex_);
+    catch_up_locked();
     ++lines_rejected_;
+    // Beyond kOverlongWindow the address is lost with the line: every module flags it.
+    flag(error::kSyntax);
     return "";
 }
 
@@ -971,36 +1060,81 @@ void DmacSim::set_input(int n, bool active) {
     if (n < 1 || n > 10) throw InvalidArgument("DmacSim input: " + std::to_string(n) + " is outside 1..10");
     std::lock_guard lock(mutex_);
     catch_up_locked();
-    const bool was = (logical_inputs() & bit_mask(5)) != 0;
     if (active) physical_inputs_ |= bit_mask(n);
     else physical_inputs_ &= ~bit_mask(n);
-    const bool is = (logical_inputs() & bit_mask(5)) != 0;
-    if (!was && is) {
-        // IN5 rising edge: capture, and re-home in reference mode when turning CW.
-        vars_[static_cast<std::size_t>(Var::Capture)] = position_locked();
-        if (reference_ && axis_->velocity() > 0) {
-            write_var_locked(Var::Position, 0, 0);
-            reference_ = false;
-        }
-    }
+    in5_changed_locked(position_locked());
     check_end_stops();
 }
 
+void DmacSim::in5_changed_locked(std::int32_t position) {
+    const bool is = (logical_inputs() & bit_mask(5)) != 0;
+    const bool rising = is && !in5_last_;
+    in5_last_ = is;
+    if (!rising) return;
+    // IN5 rising edge: capture, and re-home in reference mode when turning CW (4.18).
+    vars_[static_cast<std::size_t>(Var::Capture)] = position;
+    if (reference_ && axis_->velocity() > 0) {
+        write_var_locked(Var::Position, 0, 0);
+        reference_ = false;
+    }
+}
+
 void DmacSim::set_analog(int channel, std::int32_t mv) {
-    if (channel < 1 || channel > 2) throw InvalidArgument("DmacSim analog channel: 1 or 2");
+    // One analog input on a DMAC17/23, two on a DMAC34 (1.2.1, 3.5.3).
+    if (channel < 1 || channel > (dmac34() ? 2 : 1))
+        throw InvalidArgument("DmacSim analog channel: " + std::to_string(channel) + " (a " +
+                              std::string(model_name(options_.model)) + " has " + (dmac34() ? "1 and 2)" : "1 only)"));
     std::lock_guard lock(mutex_);
     analog_[channel] = mv;
 }
 
 void DmacSim::set_supply_voltage(std::int32_t mv) {
     std::lock_guard lock(mutex_);
+    catch_up_locked();
     options_.supply_voltage_mv = mv;
+    check_supply_locked();
+}
+
+void DmacSim::set_temperature(Sensor which, std::int32_t tenths_c) {
+    std::lock_guard lock(mutex_);
+    catch_up_locked();
+    switch (which) {
+        case Sensor::Cpu: options_.cpu_temperature = tenths_c; break;
+        case Sensor::Driver: options_.driver_temperature = tenths_c; break;
+        case Sensor::Motor: options_.motor_temperature = tenths_c; break;
+    }
+    check_supply_locked();
 }
 
 void DmacSim::inject_error(int bit) {
     if (bit < 1 || bit > 32) throw InvalidArgument("DmacSim error bit: 1..32");
     std::lock_guard lock(mutex_);
+    catch_up_locked();
+    if (kFaultBits & bit_mask(bit)) fault_locked(bit);
+    else flag(bit);
+}
+
+void DmacSim::fault_locked(int bit) {
+    const bool already = (error_ & bit_mask(bit)) != 0;
     flag(bit);
+    if (already) return;
+    if (moving_locked() && !coasting_) abnormal_stop_ = true;
+    // Undervoltage: "motion is stopped" and the module locks out; the other
+    // disjunctions cut the motor power, so the rotor runs down freely.
+    if (bit == error::kUndervoltage) halt_motion();
+    else coast(kFreewheelTau);
+    power_ = false;
+}
+
+void DmacSim::check_supply_locked() {
+    const std::int32_t mv = options_.supply_voltage_mv;
+    const std::int32_t under = dmac34() ? 20000 : 12000;
+    const std::int32_t over = dmac34() ? 170000 : 49000;
+    if (mv < under) fault_locked(error::kUndervoltage);
+    if (mv > over) fault_locked(error::kOvervoltage);
+    const bool hot = options_.cpu_temperature > 1200 ||
+                     (dmac34() && (options_.driver_temperature > 850 || options_.motor_temperature > 850));
+    if (hot) fault_locked(error::kThermal);
 }
 
 std::uint32_t DmacSim::physical_outputs() {
@@ -1009,12 +1143,8 @@ std::uint32_t DmacSim::physical_outputs() {
     const std::uint32_t mask = dmac34() ? 0xFFu : 0x0Fu;
     auto logical = static_cast<std::uint32_t>(vars_[static_cast<std::size_t>(Var::Output)]);
     const std::int32_t cfg = vars_[static_cast<std::size_t>(Var::OutputConfig)];
-    if (cfg & 1) logical = (logical & ~1u) | (moving_locked() ? 1u : 0u);
-    if (cfg & 2) {
-        const std::uint32_t faults = bit_mask(error::kThermal) | bit_mask(error::kShortCircuit) |
-                                     bit_mask(error::kUndervoltage) | bit_mask(error::kOvervoltage);
-        logical = (logical & ~2u) | ((error_ & faults) ? 2u : 0u);
-    }
+    if (cfg & 1) logical = (logical & ~1u) | (busy_locked() ? 1u : 0u);
+    if (cfg & 2) logical = (logical & ~2u) | ((error_ & kFaultBits) ? 2u : 0u);
     return (logical ^ (invert_out_ ? mask : 0u)) & mask;
 }
 

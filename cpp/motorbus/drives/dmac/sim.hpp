@@ -42,7 +42,7 @@ struct SimOptions {
     Model model = Model::Dmac34_1;
     std::string request_terminator = "\r";
     std::string reply_terminator = "\r\n";
-    std::int32_t supply_voltage_mv = 32000;
+    std::int32_t supply_voltage_mv = 32000;  // DMAC34 runs on 20..160 V, DMAC17/23 on 12..45 V
     std::int32_t cpu_temperature = 520;     // 0.1 degC
     std::int32_t driver_temperature = 450;  // DMAC34
     std::int32_t motor_temperature = 650;   // DMAC34
@@ -62,6 +62,8 @@ struct SimOptions {
     // Absent by default; set_input() drives those inputs either way.
     motion::SwitchConfig positive_end_switch{false, 0, 0, false};
     motion::SwitchConfig negative_end_switch{false, 0, 0, false};
+    // A reference switch on IN5 (REFERENCE, CAPTURE): active on [lo, hi).
+    motion::SwitchConfig reference_switch{false, 0, 0, false};
 };
 
 // Snapshot of what a test usually asserts on.
@@ -86,8 +88,13 @@ public:
     // ---- LineDevice -------------------------------------------------------
     std::string on_line(std::string_view line) override;
     std::string request_terminator() const override { return options_.request_terminator; }
-    std::size_t max_request() const override { return kMaxFrame; }
-    // An over-long frame sets the syntax error bit and is not answered.
+    // A frame longer than 256 characters sets the syntax error bit of the
+    // module it addresses and is not answered (its commands are not run).
+    // The line server hands lines up to kOverlongWindow characters to on_line,
+    // which reads the address and rejects them; a longer one reaches
+    // on_overlong without its address, so every module on the line flags it.
+    static constexpr std::size_t kOverlongWindow = 4096;
+    std::size_t max_request() const override { return kOverlongWindow; }
     std::string on_overlong() override;
 
     // ---- inspection and physical world (tests, demos) --------------------
@@ -101,8 +108,17 @@ public:
     // Physical input n (1-based) active or not (before INVERSE_POLARITY).
     void set_input(int n, bool active);
     void set_analog(int channel, std::int32_t mv);
+    // Supply voltage (mV): below 12 V (DMAC17/23) or 20 V (DMAC34) the module
+    // stops and latches undervoltage (#ERROR bit 4); above 49 V / 170 V it cuts
+    // motor power and latches overvoltage (bit 5) -- manual 2.1.
     void set_supply_voltage(std::int32_t mv);
-    void inject_error(int bit);       // e.g. error::kOvervoltage
+    // Temperatures (0.1 degC): CPU above 120 degC, driver or motor (DMAC34)
+    // above 85 degC is a thermal disjunction (bit 2, manual 3.5.4).
+    enum class Sensor : std::uint8_t { Cpu, Driver, Motor };
+    void set_temperature(Sensor which, std::int32_t tenths_c);
+    // Sets an #ERROR bit; the fault bits (2 thermal, 3 short-circuit,
+    // 4 undervoltage, 5 overvoltage) also stop the motor as the real fault does.
+    void inject_error(int bit);
     std::uint32_t physical_outputs(); // after polarity and OUT1/OUT2 alternate functions
     void power_cycle();               // same as MODULE_RESET
     std::uint64_t lines_handled();
@@ -129,6 +145,10 @@ private:
     std::int32_t position_locked() const;
     std::int32_t speed_locked() const;
     bool moving_locked() const;
+    bool busy_locked() const;
+    void coast(double tau_s);                  // power stage off: the rotor runs down
+    void fault_locked(int error_bit);          // latch a hardware fault and react
+    void check_supply_locked();                // re-latch faults whose cause persists
     bool dmac34() const;
     std::uint32_t input_mask() const;
     std::uint32_t logical_inputs() const;
@@ -168,6 +188,9 @@ private:
     // volatile state
     bool power_ = false, brake_ = false, reference_ = false, synchro_ = false;
     bool abnormal_stop_ = false;
+    bool coasting_ = false;  // power off / short-circuited, rotor running down
+    bool in5_last_ = false;  // IN5 as last seen, for its rising edge
+    void in5_changed_locked(std::int32_t position);
     bool hard_pos_hit_ = false, hard_neg_hit_ = false, soft_pos_hit_ = false, soft_neg_hit_ = false;
 
     // motion: the planner (its own time line from motion_t0_ms_) and the axis

@@ -15,12 +15,22 @@ namespace motorbus::dmac::testing {
 struct Rig {
     std::shared_ptr<SimClock> clock = std::make_shared<SimClock>();
     std::shared_ptr<DmacSim> sim;
-    explicit Rig(SimOptions o) { sim = std::make_shared<DmacSim>(clock, o); }
-    explicit Rig(int address = 0, Model model = Model::Dmac34_1) {
+    // A DMAC34 starts with its brake applied (factory BRAKE ON, annex 7.1):
+    // the rig releases it, as a user does before moving; released = false keeps it.
+    explicit Rig(SimOptions o, bool released = true) {
+        sim = std::make_shared<DmacSim>(clock, o);
+        if (released) release_brake();
+    }
+    explicit Rig(int address = 0, Model model = Model::Dmac34_1, bool released = true) {
         SimOptions o;
         o.address = address;
         o.model = model;
         sim = std::make_shared<DmacSim>(clock, o);
+        if (released) release_brake();
+    }
+    void release_brake() {
+        const auto m = sim->options().model;
+        if (m == Model::Dmac34_1 || m == Model::Dmac34_2) sim->on_line(address_prefix(sim->address()) + "BRAKE OFF");
     }
     std::string tx(std::string_view line) { return sim->on_line(line); }
     void ms(std::int64_t n) { clock->advance(n * 1'000'000); }

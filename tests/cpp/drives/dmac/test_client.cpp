@@ -27,6 +27,7 @@ struct Bench {
         link = std::make_shared<serial::LineLink>(port, opts);
         for (int a : addresses) {
             auto s = std::make_shared<DmacSim>(clock, SimOptions{.address = a});
+            s->on_line(address_prefix(a) + "BRAKE OFF");  // factory BRAKE ON (annex 7.1)
             sims.push_back(s);
             port->attach(s);
             ClientOptions co;
@@ -106,7 +107,7 @@ TEST(DmacClient, MoveToAndWaitIdleOnSimulatedTime) {
 
 TEST(DmacClient, WaitIdleTimesOutInSimulatedTime) {
     Bench b;
-    b.c().move_speed(1000);
+    b.c().move_to(100000);  // 10 turns: busy for seconds (a MOVE_SPEED is idle once at speed)
     EXPECT_THROW(b.c().wait_idle(50ms, 10ms), TimeoutError);
     b.c().stop();
     EXPECT_NO_THROW(b.c().wait_idle(5s, 10ms));
@@ -274,6 +275,7 @@ TEST(DmacClient, OverARealPtyWithTheLineServer) {
     auto port = serial::open_port(server.slave_path(), 115200);
     auto link = std::make_shared<serial::LineLink>(port, default_line_options());
     DmacClient c0(link, {.address = 0}), c1(link, {.address = 1});
+    c1.brake(false);
     c1.move_to(1234);
     clock->advance(5'000'000'000);
     EXPECT_EQ(c1.position(), 1234);

@@ -312,6 +312,8 @@ TEST(DmacSim, HardEndStopsFollowInputsAndPolarity) {
 TEST(DmacSim, SynchroOnArmsMovesUntilSynchroTop) {
     auto clock = std::make_shared<SimClock>();
     DmacSim a(clock, SimOptions{.address = 0}), b(clock, SimOptions{.address = 3});
+    a.on_line("00BRAKE OFF");  // factory BRAKE ON (annex 7.1)
+    b.on_line("03BRAKE OFF");
     for (auto* s : {&a, &b}) s->on_line("SYNCHRO ON");
     a.on_line("00MOVE_SPEED 4000");
     b.on_line("03MOVE_SPEED -12500");
@@ -366,7 +368,8 @@ TEST(DmacSim, OutputsWithAlternateFunctionsAndPolarity) {
     r.tx("00MOVE_SPEED 100");
     EXPECT_EQ(r.sim->physical_outputs(), 5u);  // OUT1 = BUSY
     r.sim->inject_error(error::kUndervoltage);
-    EXPECT_EQ(r.sim->physical_outputs(), 7u);  // OUT2 = FAULT
+    // OUT2 = FAULT; the undervoltage also stopped the motor (manual 2.1), so OUT1 is off.
+    EXPECT_EQ(r.sim->physical_outputs(), 6u);
     r.tx("00#OUTPUT_CONFIG:=0");
     EXPECT_EQ(r.sim->physical_outputs(), 4u);
     r.tx("00INVERSE_POLARITY OUT");
