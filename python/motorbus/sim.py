@@ -88,11 +88,13 @@ class SimBench:
     serial kinds on their ptys (``lines``), CAN kinds as nodes on ``bus``,
     exposed through the socketcand / SLCAN servers (``can``; with CAN drives and
     no server asked for, one socketcand server on 127.0.0.1 with a free port).
-    ``sims[(kind, address)]`` reaches each simulator (to inject faults in tests)."""
+    ``sims[(kind, address)]`` reaches each simulator (to inject faults in tests);
+    ``sim_options={kind: {...}}`` passes options to that kind's ``make_sim``."""
 
     def __init__(self, specs: Sequence[str], *, bus: Optional[str] = None, bitrate: Optional[int] = None,
                  socketcand: Sequence[str] = (), slcan_ptys: int = 0, channel: str = "can0", baud: int = 0,
-                 clock: Any = None, store_dir: Optional[str] = None) -> None:
+                 clock: Any = None, store_dir: Optional[str] = None,
+                 sim_options: Optional[dict] = None) -> None:
         self.lines: list[ServedLine] = []
         self.can: Optional[BusServers] = None
         self.sims: dict[tuple[str, str], Any] = {}
@@ -101,7 +103,8 @@ class SimBench:
         try:
             for spec, plugin, addresses in parsed:
                 if plugin.transport == "serial":
-                    line = serve_line(spec, baud=baud, clock=clock, store_dir=store_dir)
+                    line = serve_line(spec, baud=baud, clock=clock, store_dir=store_dir,
+                                      **(sim_options or {}).get(plugin.kind, {}))
                     self.lines.append(line)
                     self.sims.update({(plugin.kind, a): d for a, d in zip(addresses, line.drives)})
             can_specs = [(plugin, addresses) for _, plugin, addresses in parsed if plugin.transport == "can"]
@@ -113,7 +116,8 @@ class SimBench:
                                       slcan_ptys=slcan_ptys, channel=channel, **options)
                 for plugin, addresses in can_specs:
                     for a in addresses:
-                        sim = make_sim(plugin.kind, a, clock=clock, store_dir=store_dir)
+                        sim = make_sim(plugin.kind, a, clock=clock, store_dir=store_dir,
+                                       **(sim_options or {}).get(plugin.kind, {}))
                         sim.attach(self.can.endpoint())
                         self._can_sims.append(sim)
                         self.sims[(plugin.kind, a)] = sim

@@ -42,6 +42,7 @@ class Kind:
     setup: Callable[[Any], None] = lambda drive: None   # fast profile for the test
     unfault: Callable[[Any], None] = lambda sim: None   # removes the fault's cause (not its latch)
     open_options: dict = field(default_factory=dict)
+    sim_options: dict = field(default_factory=dict)
 
 
 def _cia402_setup(drive: Any) -> None:
@@ -61,7 +62,14 @@ def _arcus_fault(sim: Any, drive: Any) -> None:
     drive.jog(-10.0)                 # ...and a jog into it latches a limit error
 
 
+def _dmac_setup(drive: Any) -> None:
+    drive.params["#LOW_SPEED"] = 60000   # 0.01 rpm: the reference search speed
+
+
 KINDS = {
+    "dmac": Kind("dmac", "00", 0.01, fault=lambda sim, drive: sim.set_supply_voltage(11000),  # undervoltage
+                 unfault=lambda sim: sim.set_supply_voltage(32000), param="#HIGH_SPEED", value=50000, jog=50.0,
+                 home="reference", setup=_dmac_setup, sim_options={"reference_switch": 3000}),
     "arcus": Kind("arcus", "01", 0.01, fault=_arcus_fault, unfault=lambda sim: sim.force_limit(-1, None),
                   param="HSPD", value=15000, jog=50.0, home="HL+", setup=_arcus_setup),
     "cia402": Kind("cia402", "5", 0.01, fault=lambda sim, drive: sim.inject_fault(0x5441),
@@ -97,7 +105,7 @@ def rig(request, kind):
         return open_one
 
     if plugin.transport == "serial":
-        with SimBench([spec]) as bench:
+        with SimBench([spec], sim_options={kind.kind: kind.sim_options}) as bench:
             reopen = opener(line=bench.lines[0].pty_path)
             yield Rig(reopen(), bench.sims[(kind.kind, plugin.check_address(kind.address))], reopen)
             for d in opened:
@@ -105,7 +113,7 @@ def rig(request, kind):
         return
     name = f"virtual:drive-api-{next(_names)}"
     if request.param == "transport":
-        with SimBench([spec], bus=name) as bench:
+        with SimBench([spec], bus=name, sim_options={kind.kind: kind.sim_options}) as bench:
             srv = bench.can.servers[0]
             reopen = opener(bus=f"socketcand:{srv.host}:{srv.port}/can0")
             yield Rig(reopen(), bench.sims[(kind.kind, kind.address)], reopen)
@@ -113,7 +121,7 @@ def rig(request, kind):
                 d.close()
     else:
         with motorbus.open_bus(name) as sim_bus:
-            sim = plugin.make_sim(kind.address, bus=sim_bus)
+            sim = plugin.make_sim(kind.address, bus=sim_bus, **kind.sim_options)
             reopen = opener(bus=name)
             yield Rig(reopen(), sim, reopen)
             for d in opened:
