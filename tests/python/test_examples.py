@@ -61,3 +61,26 @@ def test_example_03_arcus_cpp():
     assert out.returncode == 0, out.stderr
     assert "EX=1250 PX=1250 SLS=0" in out.stdout
     assert "SLR=0.800 ID=DriveMax-CAN" in out.stdout
+
+
+def test_example_04_dmac_interpolation_python():
+    out = run_example("04_dmac_interpolation.py")
+    assert "segments 40," in out and "underruns 0" in out
+    assert "x -10000 y 10000" in out   # a quarter circle ends exactly where it should
+
+
+def test_example_04_dmac_interpolation_cpp():
+    exe = ROOT / "build" / "dev" / "example_04_dmac_interpolation"
+    if not exe.exists():
+        import pytest
+        pytest.skip("C++ examples not built (MOTORBUS_EXAMPLES=OFF)")
+    out = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert "x -10000 y 10000" in out.stdout
+
+
+def test_example_06_drive_api_python():
+    out = run_example("06_drive_api.py")
+    assert "kinds: arcus, cia402, dmac" in out
+    for kind in ("arcus", "dmac", "cia402"):
+        assert f"{kind}: at 3.50 mm, enabled=True moving=False fault=False" in out, out
