@@ -130,47 +130,21 @@ void bind_motion(py::module_& m) {
           py::arg("shape") = RampShape::Trapezoid);
     m.def("plan_synchronized_jerk_limited", &plan_synchronized_jerk_limited, py::arg("start"), py::arg("target"),
           py::arg("limits"));
-    m.def(
-        "synchronized_jerk_limited_durations",
-        [](py::array_t<double, py::array::c_style | py::array::forcecast> cases) {
-            // Rows: 3 axes x (p0, target, vmax, amax, jmax) = 15 columns; the common duration.
-            if (cases.ndim() != 2 || cases.shape(1) != 15) throw InvalidArgument("cases must be N x 15");
-            auto c = cases.unchecked<2>();
-            py::array_t<double> out(cases.shape(0));
-            double* o = out.mutable_data();
-            for (py::ssize_t i = 0; i < cases.shape(0); ++i) {
-                std::vector<double> s(3), t(3);
-                std::vector<Limits> l(3);
-                for (int k = 0; k < 3; ++k) {
-                    s[k] = c(i, 5 * k);
-                    t[k] = c(i, 5 * k + 1);
-                    l[k] = Limits{c(i, 5 * k + 2), c(i, 5 * k + 3), 0, c(i, 5 * k + 4)};
-                }
-                o[i] = plan_synchronized_jerk_limited(s, t, l)[0].duration();
-            }
-            return out;
-        },
-        py::arg("cases"));
+    m.def("synchronized_jerk_limited_durations",
+          [](py::array_t<double, py::array::c_style | py::array::forcecast> cases) {
+              if (cases.ndim() != 2 || cases.shape(1) != 15) throw InvalidArgument("cases must be N x 15");
+              return vec_to_array(synchronized_jerk_limited_durations(std::span(cases.data(), cases.size())));
+          },
+          py::arg("cases"), "Rows: 3 axes x (p0, target, vmax, amax, jmax); the common duration of each row.");
     m.def("plan_straight_line", &plan_straight_line, py::arg("start"), py::arg("target"), py::arg("limits"),
           py::arg("shape") = RampShape::Trapezoid);
     m.def("split_interpolation", &split_interpolation, py::arg("axes"), py::arg("period_ms"));
-    m.def(
-        "jerk_limited_durations",
-        [](py::array_t<double, py::array::c_style | py::array::forcecast> cases) {
-            // Batch duration query (rows: p0, v0, a0, target, vmax, amax, jmax) for
-            // interop tests and benchmarks without per-call Python overhead.
-            if (cases.ndim() != 2 || cases.shape(1) != 7) throw InvalidArgument("cases must be N x 7");
-            const auto n = cases.shape(0);
-            py::array_t<double> out(n);
-            auto c = cases.unchecked<2>();
-            double* o = out.mutable_data();
-            for (py::ssize_t i = 0; i < n; ++i) {
-                Limits lim{c(i, 4), c(i, 5), 0, c(i, 6)};
-                o[i] = plan_jerk_limited(State{c(i, 0), c(i, 1), c(i, 2), 0}, c(i, 3), lim).duration();
-            }
-            return out;
-        },
-        py::arg("cases"));
+    m.def("jerk_limited_durations",
+          [](py::array_t<double, py::array::c_style | py::array::forcecast> cases) {
+              if (cases.ndim() != 2 || cases.shape(1) != 7) throw InvalidArgument("cases must be N x 7");
+              return vec_to_array(jerk_limited_durations(std::span(cases.data(), cases.size())));
+          },
+          py::arg("cases"), "Rows: p0, v0, a0, target, vmax, amax, jmax; the duration of each row's plan.");
 
     // ---- StepNLoop -------------------------------------------------------------
     py::class_<SnlConfig>(m, "SnlConfig")

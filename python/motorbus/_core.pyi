@@ -3546,7 +3546,9 @@ def heartbeat_decode(frame: Frame) -> typing.Any:
 def heartbeat_encode(node: typing.SupportsInt | typing.SupportsIndex, state: str) -> Frame:
     ...
 def jerk_limited_durations(cases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
-    ...
+    """
+    Rows: p0, v0, a0, target, vmax, amax, jmax; the duration of each row's plan.
+    """
 def monotonic_ns() -> int:
     """
     The monotonic clock frame timestamps use (ns).
@@ -3640,7 +3642,9 @@ def split_interpolation(axes: collections.abc.Sequence[Profile], period_ms: typi
 def sync_encode(counter: typing.SupportsInt | typing.SupportsIndex | None = None, cob_id: typing.SupportsInt | typing.SupportsIndex = 128) -> Frame:
     ...
 def synchronized_jerk_limited_durations(cases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
-    ...
+    """
+    Rows: 3 axes x (p0, target, vmax, amax, jmax); the common duration of each row.
+    """
 def time_decode(frame: Frame) -> typing.Any:
     """
     Unix time in ms, or None.
