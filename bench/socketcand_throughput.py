@@ -25,9 +25,9 @@ logging.getLogger("can").setLevel(logging.ERROR)  # python-can warns on every pa
 
 def wait_rx(node, want: int, limit: float = 60.0) -> None:
     end = time.perf_counter() + limit
-    while node.counters["rx_frames"] < want and time.perf_counter() < end:
+    while node.counters.rx_frames < want and time.perf_counter() < end:
         time.sleep(0.0002)
-    got = node.counters["rx_frames"]
+    got = node.counters.rx_frames
     if got != want:
         raise SystemExit(f"FAILED: the bus counted {got} frames, {want} expected")
 
@@ -53,7 +53,7 @@ def measure(label: str, bus, msg, node, n: int, pings: int, reps: int) -> dict:
     f = Frame(0x123, bytes(range(8)))
     tx = rx = 0.0
     for _ in range(reps):
-        base = node.counters["rx_frames"]
+        base = node.counters.rx_frames
         t0 = time.perf_counter()
         for _ in range(n):
             bus.send(msg)

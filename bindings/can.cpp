@@ -16,6 +16,7 @@ namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::can;
 using motorbus::py_helpers::PyCallable;
+using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
 
 namespace {
@@ -52,19 +53,6 @@ Frame frame_from_py(std::uint32_t id, const py::object& data, bool extended, boo
                        extended, rtr, rtr_dlc);
 }
 
-py::dict counters_dict(const BusCounters& c) {
-    py::dict d;
-    d["rx_frames"] = c.rx_frames;
-    d["tx_frames"] = c.tx_frames;
-    d["rx_dropped"] = c.rx_dropped;
-    d["tx_dropped"] = c.tx_dropped;
-    d["overruns"] = c.overruns;
-    d["parse_errors"] = c.parse_errors;
-    d["bus_errors"] = c.bus_errors;
-    d["ignored"] = c.ignored;
-    return d;
-}
-
 }  // namespace
 
 void bind_can(py::module_& m) {
@@ -92,6 +80,16 @@ void bind_can(py::module_& m) {
         });
     m.def("wire_bits_worst_case", &wire_bits_worst_case, py::arg("frame"),
           "Bits a classic frame occupies on the wire with worst-case stuffing, incl. intermission.");
+
+    Record<BusCounters>(m, "BusCounters", "A bus's counters (Bus.counters), read-only.")
+        .field("rx_frames", &BusCounters::rx_frames, "frames received from the medium")
+        .field("tx_frames", &BusCounters::tx_frames, "frames handed to the medium")
+        .field("rx_dropped", &BusCounters::rx_dropped, "received frames dropped because the recv() queue was full")
+        .field("tx_dropped", &BusCounters::tx_dropped, "frames the medium lost (fault injection, adapter NACK)")
+        .field("overruns", &BusCounters::overruns, "adapter/medium reported overrun or line too long")
+        .field("parse_errors", &BusCounters::parse_errors, "malformed input from the medium, discarded")
+        .field("bus_errors", &BusCounters::bus_errors, "error frames / BEL / error states reported")
+        .field("ignored", &BusCounters::ignored, "well-formed input not used (status lines etc.)");
 
     py::class_<Bus, std::shared_ptr<Bus>>(m, "Bus", "A CAN bus endpoint (open one with open_bus).")
         .def("send",
@@ -139,7 +137,7 @@ void bind_can(py::module_& m) {
         .def("unsubscribe", &Bus::unsubscribe, py::arg("handle"),
              py::call_guard<py::gil_scoped_release>())
         .def_property_readonly("state", [](const Bus& b) { return to_string(b.state()); })
-        .def_property_readonly("counters", [](const Bus& b) { return counters_dict(b.counters()); })
+        .def_property_readonly("counters", &Bus::counters, "BusCounters (a snapshot)")
         .def_property_readonly("channel", &Bus::channel)
         .def_property_readonly("closed", &Bus::closed)
         .def("close", &Bus::close, py::call_guard<py::gil_scoped_release>())
@@ -218,11 +216,15 @@ void bind_can(py::module_& m) {
         .def_readonly("channel", &LogEntry::channel)
         .def_readonly("rx", &LogEntry::rx)
         .def("__repr__", [](const LogEntry& e) { return "LogEntry(" + format_candump_line(e) + ")"; });
+    py::enum_<LogFormat>(m, "LogFormat", "Log file formats: candump (.log) and Vector ASC (.asc).")
+        .value("CANDUMP", LogFormat::Candump)
+        .value("ASC", LogFormat::Asc);
+    // None = from the file name; a LogFormat; or its name ('candump'/'log', 'asc').
     auto fmt = [](const py::object& f) -> std::optional<LogFormat> {
         if (f.is_none()) return std::nullopt;
+        if (py::isinstance<LogFormat>(f)) return f.cast<LogFormat>();
         auto s = f.cast<std::string>();
-        if (s == "candump" || s == "log") return LogFormat::Candump;
-        if (s == "asc") return LogFormat::Asc;
+        if (auto v = log_format_from_name(s)) return v;
         throw InvalidArgument("log format: '" + s + "' (expected 'candump' or 'asc')");
     };
     py::class_<Recorder>(m, "Recorder", "Writes every frame a bus receives to a candump or ASC log.")

@@ -7,6 +7,7 @@
 // or joining a timer thread waits for a callback that may itself be waiting
 // for the GIL.  Counters and statuses are the C++ structs, read-only.
 #include <pybind11/functional.h>
+#include <pybind11/native_enum.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -275,6 +276,23 @@ void bind_canopen_services(py::module_& m) {
         });
 
     // ---- pure codecs --------------------------------------------------------
+    // An enum.IntEnum (not py::enum_): it replaces the IntEnum motorbus.canopen.nmt
+    // defined before, whose members are ints (== 0x01, usable as a byte).
+    py::native_enum<NmtCommand>(m, "NmtCommand", "enum.IntEnum", "NMT command specifiers (CiA 301).")
+        .value("START", NmtCommand::Start)
+        .value("STOP", NmtCommand::Stop)
+        .value("ENTER_PRE_OPERATIONAL", NmtCommand::EnterPreOperational)
+        .value("RESET_NODE", NmtCommand::ResetNode)
+        .value("RESET_COMMUNICATION", NmtCommand::ResetCommunication)
+        .finalize();
+    py::enum_<PdoProcedure>(m, "PdoProcedure", "How pdo_write_config writes a PDO.")
+        .value("CIA301", PdoProcedure::Cia301, "disable, parameters, clear sub0, entries, set sub0, enable")
+        .value("DIRECT", PdoProcedure::Direct, "COB-ID, parameters, sub0 = n, entries (no disable/enable)");
+
+    m.def("nmt_encode", [](NmtCommand cs, int node) {
+              check_node(node, true);
+              return encode_nmt(cs, static_cast<std::uint8_t>(node));
+          }, py::arg("command"), py::arg("node"));
     m.def("nmt_encode", [](int cs, int node) {
               if (!is_known_nmt_command(static_cast<std::uint8_t>(cs)) || cs < 0 || cs > 255)
                   throw InvalidArgument("NMT command specifier must be 0x01, 0x02, 0x80, 0x81 or 0x82");
@@ -284,7 +302,7 @@ void bind_canopen_services(py::module_& m) {
     m.def("nmt_decode", [](const can::Frame& f) -> py::object {
               auto d = decode_nmt(f);
               if (!d) return py::none();
-              return py::make_tuple(static_cast<int>(d->command), d->node_id);
+              return py::make_tuple(d->command, d->node_id);
           }, py::arg("frame"), "(command, node) or None for anything that is not a valid NMT frame.");
     m.def("heartbeat_encode", [](int node, const std::string& state) {
               check_node(node, false);
@@ -324,13 +342,18 @@ void bind_canopen_services(py::module_& m) {
           }, py::arg("frame"), "Unix time in ms, or None.");
 
     // ---- NMT master -----------------------------------------------------------
-    py::class_<NmtMaster, std::shared_ptr<NmtMaster>>(m, "NmtMaster",
-        "Sends NMT commands and tracks node states from heartbeats and boot-ups.")
+    // Wrapped by motorbus.canopen.nmt.NmtMaster, which carries the docstrings.
+    py::class_<NmtMaster, std::shared_ptr<NmtMaster>>(m, "NmtMaster")
         .def(py::init([](BusPtr bus, std::optional<int> own) {
                  if (own) check_node(*own, false);
                  return make_service<NmtMaster>(bus, *bus, own ? std::optional<std::uint8_t>(static_cast<std::uint8_t>(*own))
                                                                : std::nullopt);
              }), py::arg("bus"), py::arg("own_node_id") = py::none())
+        .def("send", [](NmtMaster& b, NmtCommand cs, int node) {
+                 check_node(node, true);
+                 py::gil_scoped_release nogil;
+                 b.send(cs, static_cast<std::uint8_t>(node));
+             }, py::arg("command"), py::arg("node"))
         .def("send", [](NmtMaster& b, int cs, int node) {
                  if (cs < 0 || cs > 255 || !is_known_nmt_command(static_cast<std::uint8_t>(cs)))
                      throw InvalidArgument("NMT command specifier must be 0x01, 0x02, 0x80, 0x81 or 0x82");
@@ -355,8 +378,7 @@ void bind_canopen_services(py::module_& m) {
                                            "' (OPERATIONAL, PRE-OPERATIONAL, STOPPED, RESET, RESET COMMUNICATION)");
                  py::gil_scoped_release nogil;
                  b.send(*c, static_cast<std::uint8_t>(node));
-             }, py::arg("node"), py::arg("state"),
-             "Sends the NMT command that puts `node` (0 = all) in `state`; RESET / RESET COMMUNICATION reset it.")
+             }, py::arg("node"), py::arg("state"))
         .def("wait_for_heartbeat", [](NmtMaster& b, int node, const py::object& t) -> std::optional<std::string> {
                  check_node(node, false);
                  auto to = timeout_of(t);
@@ -367,8 +389,7 @@ void bind_canopen_services(py::module_& m) {
                  }
                  if (!s) return std::nullopt;
                  return std::string(to_string(*s));
-             }, py::arg("node"), py::arg("timeout") = 1.0,
-             "State reported by the next heartbeat or boot-up of `node`; None on timeout.")
+             }, py::arg("node"), py::arg("timeout") = 1.0)
         .def("wait_for_boot", [](NmtMaster& b, int node, const py::object& t) {
                  check_node(node, false);
                  auto to = timeout_of(t);
@@ -381,7 +402,7 @@ void bind_canopen_services(py::module_& m) {
                  b.on_state_change = [call](std::uint8_t n, NodeState a, NodeState c) {
                      call(n, std::string(to_string(a)), std::string(to_string(c)));
                  };
-             }, py::arg("callback"), "callback(node, old_state, new_state) on the bus thread.")
+             }, py::arg("callback"))
         .def_property_readonly("foreign_commands_ignored", [](NmtMaster& b) { return b.foreign_commands_ignored(); });
 
     // ---- heartbeat --------------------------------------------------------------
@@ -603,7 +624,7 @@ void bind_canopen_services(py::module_& m) {
     m.def("pdo_write_config",
           [](const py::object& sdo, int node, bool tpdo, unsigned number, std::optional<std::uint32_t> cob_id,
              bool enabled, std::optional<int> ttype, std::optional<int> inhibit, std::optional<int> timer,
-             std::optional<int> sync_start, std::optional<py::iterable> mapping, const std::string& procedure) {
+             std::optional<int> sync_start, std::optional<py::iterable> mapping, const py::object& procedure) {
               check_node(node, false);
               auto box = make_sdo(sdo, node);
               PdoConfig c;
@@ -627,16 +648,20 @@ void bind_canopen_services(py::module_& m) {
               c.sync_start = u8(sync_start, "sync start");
               if (mapping) c.mapping = entries_from(*mapping);
               PdoProcedure p;
-              if (procedure == "cia301") p = PdoProcedure::Cia301;
-              else if (procedure == "direct") p = PdoProcedure::Direct;
-              else throw InvalidArgument("procedure must be 'cia301' or 'direct'");
+              if (py::isinstance<PdoProcedure>(procedure)) {
+                  p = procedure.cast<PdoProcedure>();
+              } else if (auto named = pdo_procedure_from_name(procedure.cast<std::string>())) {
+                  p = *named;
+              } else {
+                  throw InvalidArgument("procedure must be 'cia301' or 'direct'");
+              }
               py::gil_scoped_release nogil;
               write_pdo(*box.access, static_cast<std::uint8_t>(node), c, p);
           },
           py::arg("sdo"), py::arg("node"), py::arg("tpdo"), py::arg("number"), py::arg("cob_id") = py::none(),
           py::arg("enabled") = true, py::arg("transmission_type") = py::none(), py::arg("inhibit_100us") = py::none(),
           py::arg("event_timer_ms") = py::none(), py::arg("sync_start") = py::none(), py::arg("mapping") = py::none(),
-          py::arg("procedure") = "cia301");
+          py::arg("procedure") = "cia301", "procedure: a PdoProcedure or its name ('cia301', 'direct').");
     m.def("pdo_read_config", [](const py::object& sdo, int node, bool tpdo, unsigned number) {
               check_node(node, false);
               auto box = make_sdo(sdo, node);

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace motorbus::py_helpers {
 namespace py = pybind11;
@@ -54,5 +56,45 @@ private:
     std::shared_ptr<py::function> f_;
 };
 
+// A C++ counters/status struct bound as a read-only Python class whose
+// __repr__ lists every field:
+//     Record<BusCounters>(m, "BusCounters", "doc").field("rx_frames", &BusCounters::rx_frames)...;
+// (fields are def_readonly; `prop` adds a computed read-only attribute).
+template <class T>
+class Record {
+public:
+    Record(py::handle scope, const char* name, const char* doc)
+        : cls_(scope, name, doc), names_(std::make_shared<std::vector<const char*>>()) {
+        auto names = names_;
+        std::string cls_name = name;
+        cls_.def("__repr__", [names, cls_name](py::handle self) {
+            std::string out = cls_name + "(";
+            for (std::size_t i = 0; i < names->size(); ++i) {
+                if (i) out += ", ";
+                out += (*names)[i];
+                out += "=";
+                out += py::repr(self.attr((*names)[i])).template cast<std::string>();
+            }
+            return out + ")";
+        });
+    }
+    template <class D>
+    Record& field(const char* name, const D T::*pm, const char* doc = "") {
+        cls_.def_readonly(name, pm, doc);
+        names_->push_back(name);
+        return *this;
+    }
+    template <class F>
+    Record& prop(const char* name, F&& getter, const char* doc = "") {
+        cls_.def_property_readonly(name, std::forward<F>(getter), doc);
+        names_->push_back(name);
+        return *this;
+    }
+    py::class_<T>& cls() { return cls_; }
+
+private:
+    py::class_<T> cls_;
+    std::shared_ptr<std::vector<const char*>> names_;
+};
 
 }  // namespace motorbus::py_helpers

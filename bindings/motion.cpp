@@ -8,6 +8,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "common.hpp"
 #include "errors.hpp"
 #include "motorbus/motion/cia402_profile.hpp"
 #include "motorbus/motion/homing.hpp"
@@ -19,6 +20,7 @@
 namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::motion;
+using motorbus::py_helpers::Record;
 
 namespace {
 void fill_limit(py::object& exc, const LimitExceeded& e) {
@@ -128,47 +130,21 @@ void bind_motion(py::module_& m) {
           py::arg("shape") = RampShape::Trapezoid);
     m.def("plan_synchronized_jerk_limited", &plan_synchronized_jerk_limited, py::arg("start"), py::arg("target"),
           py::arg("limits"));
-    m.def(
-        "synchronized_jerk_limited_durations",
-        [](py::array_t<double, py::array::c_style | py::array::forcecast> cases) {
-            // Rows: 3 axes x (p0, target, vmax, amax, jmax) = 15 columns; the common duration.
-            if (cases.ndim() != 2 || cases.shape(1) != 15) throw InvalidArgument("cases must be N x 15");
-            auto c = cases.unchecked<2>();
-            py::array_t<double> out(cases.shape(0));
-            double* o = out.mutable_data();
-            for (py::ssize_t i = 0; i < cases.shape(0); ++i) {
-                std::vector<double> s(3), t(3);
-                std::vector<Limits> l(3);
-                for (int k = 0; k < 3; ++k) {
-                    s[k] = c(i, 5 * k);
-                    t[k] = c(i, 5 * k + 1);
-                    l[k] = Limits{c(i, 5 * k + 2), c(i, 5 * k + 3), 0, c(i, 5 * k + 4)};
-                }
-                o[i] = plan_synchronized_jerk_limited(s, t, l)[0].duration();
-            }
-            return out;
-        },
-        py::arg("cases"));
+    m.def("synchronized_jerk_limited_durations",
+          [](py::array_t<double, py::array::c_style | py::array::forcecast> cases) {
+              if (cases.ndim() != 2 || cases.shape(1) != 15) throw InvalidArgument("cases must be N x 15");
+              return vec_to_array(synchronized_jerk_limited_durations(std::span(cases.data(), cases.size())));
+          },
+          py::arg("cases"), "Rows: 3 axes x (p0, target, vmax, amax, jmax); the common duration of each row.");
     m.def("plan_straight_line", &plan_straight_line, py::arg("start"), py::arg("target"), py::arg("limits"),
           py::arg("shape") = RampShape::Trapezoid);
     m.def("split_interpolation", &split_interpolation, py::arg("axes"), py::arg("period_ms"));
-    m.def(
-        "jerk_limited_durations",
-        [](py::array_t<double, py::array::c_style | py::array::forcecast> cases) {
-            // Batch duration query (rows: p0, v0, a0, target, vmax, amax, jmax) for
-            // interop tests and benchmarks without per-call Python overhead.
-            if (cases.ndim() != 2 || cases.shape(1) != 7) throw InvalidArgument("cases must be N x 7");
-            const auto n = cases.shape(0);
-            py::array_t<double> out(n);
-            auto c = cases.unchecked<2>();
-            double* o = out.mutable_data();
-            for (py::ssize_t i = 0; i < n; ++i) {
-                Limits lim{c(i, 4), c(i, 5), 0, c(i, 6)};
-                o[i] = plan_jerk_limited(State{c(i, 0), c(i, 1), c(i, 2), 0}, c(i, 3), lim).duration();
-            }
-            return out;
-        },
-        py::arg("cases"));
+    m.def("jerk_limited_durations",
+          [](py::array_t<double, py::array::c_style | py::array::forcecast> cases) {
+              if (cases.ndim() != 2 || cases.shape(1) != 7) throw InvalidArgument("cases must be N x 7");
+              return vec_to_array(jerk_limited_durations(std::span(cases.data(), cases.size())));
+          },
+          py::arg("cases"), "Rows: p0, v0, a0, target, vmax, amax, jmax; the duration of each row's plan.");
 
     // ---- StepNLoop -------------------------------------------------------------
     py::class_<SnlConfig>(m, "SnlConfig")
@@ -179,18 +155,23 @@ void bind_motion(py::module_& m) {
         .def_readwrite("max_attempts", &SnlConfig::max_attempts)
         .def_readwrite("idle_tolerance", &SnlConfig::idle_tolerance)
         .def_readwrite("ratio", &SnlConfig::ratio);
+    py::enum_<SnlActivity>(m, "SnlActivity", "What kind of motion StepNLoop.begin() starts.")
+        .value("MOVE", SnlActivity::Move)
+        .value("JOG", SnlActivity::Jog)
+        .value("HOME", SnlActivity::Home)
+        .value("ZHOME", SnlActivity::ZHome)
+        .value("LIMIT_HOME", SnlActivity::LimitHome)
+        .value("STOP", SnlActivity::Stop)
+        .value("ABORT", SnlActivity::Abort);
     py::class_<StepNLoop>(m, "StepNLoop")
         .def(py::init<SnlConfig>(), py::arg("config") = SnlConfig{})
         .def("configure", &StepNLoop::configure)
+        .def("begin", &StepNLoop::begin, py::arg("activity"))
         .def("begin", [](StepNLoop& s, const std::string& what) {
-            static const std::pair<const char*, SnlActivity> map[] = {
-                {"move", SnlActivity::Move}, {"jog", SnlActivity::Jog}, {"home", SnlActivity::Home},
-                {"zhome", SnlActivity::ZHome}, {"limit_home", SnlActivity::LimitHome},
-                {"stop", SnlActivity::Stop}, {"abort", SnlActivity::Abort}};
-            for (const auto& [n, a] : map)
-                if (what == n) return s.begin(a);
-            throw InvalidArgument("StepNLoop.begin: unknown activity '" + what + "'");
-        }, py::arg("activity"))
+            auto a = snl_activity_from_name(what);
+            if (!a) throw InvalidArgument("StepNLoop.begin: unknown activity '" + what + "'");
+            return s.begin(*a);
+        }, py::arg("activity"), "The activity by name: 'move', 'jog', 'home', 'zhome', 'limit_home', 'stop', 'abort'.")
         .def("monitor", [](StepNLoop& s, double d) { auto r = s.monitor(d); return py::make_tuple(static_cast<int>(r.action), r.correction, r.idle_current); })
         .def("motion_done", [](StepNLoop& s, double d) { auto r = s.motion_done(d); return py::make_tuple(static_cast<int>(r.action), r.correction, r.idle_current); })
         .def("idle_check", [](StepNLoop& s, double d) { auto r = s.idle_check(d); return py::make_tuple(static_cast<int>(r.action), r.correction, r.idle_current); })
@@ -255,6 +236,27 @@ void bind_motion(py::module_& m) {
         .def_readwrite("pull_out_speed", &MotorConfig::pull_out_speed)
         .def_readwrite("max_acceleration", &MotorConfig::max_acceleration)
         .def_readwrite("tick_ns", &MotorConfig::tick_ns);
+    using Kind = MotorEvent::Kind;
+    py::enum_<Kind>(m, "MotorEventKind", "What a MotorEvent reports.")
+        .value("HOME_ON", Kind::HomeOn)
+        .value("HOME_OFF", Kind::HomeOff)
+        .value("MINUS_LIMIT_ON", Kind::MinusLimitOn)
+        .value("MINUS_LIMIT_OFF", Kind::MinusLimitOff)
+        .value("PLUS_LIMIT_ON", Kind::PlusLimitOn)
+        .value("PLUS_LIMIT_OFF", Kind::PlusLimitOff)
+        .value("INDEX", Kind::IndexPulse)
+        .value("STALLED", Kind::Stalled)
+        .value("RECOVERED", Kind::Recovered)
+        .value("LATCHED", Kind::Latched)
+        .value("PROFILE_DONE", Kind::ProfileDone);
+    Record<MotorEvent>(m, "MotorEvent", "One MotorModel event (MotorModel.add_listener), read-only.")
+        .field("kind", &MotorEvent::kind)
+        .field("t_ns", &MotorEvent::t, "exact time of the event (ns)")
+        .field("physical", &MotorEvent::physical, "rotor position at t (steps)")
+        .field("pulse", &MotorEvent::pulse, "pulse position at t")
+        .field("encoder", &MotorEvent::encoder)
+        .field("direction", &MotorEvent::direction, "sign of the commanded velocity at t (0 at rest)")
+        ;
     py::class_<MotorModel>(m, "MotorModel")
         .def(py::init([](std::shared_ptr<Clock> clock, MotorConfig cfg) {
                  if (!clock) throw InvalidArgument("MotorModel needs a clock");
@@ -266,21 +268,10 @@ void bind_motion(py::module_& m) {
         .def("halt", [](MotorModel& mm) { mm.halt(); })
         .def("update", &MotorModel::update)
         .def("advance_to", &MotorModel::advance_to, py::arg("t_ns"))
-        .def("add_listener", [](MotorModel& mm, std::function<void(py::dict)> cb) {
-            return mm.add_listener([cb](const MotorEvent& e) {
-                static const char* names[] = {"home_on", "home_off", "minus_limit_on", "minus_limit_off",
-                                              "plus_limit_on", "plus_limit_off", "index", "stalled",
-                                              "recovered", "latched", "profile_done"};
-                py::dict d;
-                d["kind"] = names[static_cast<int>(e.kind)];
-                d["t_ns"] = e.t;
-                d["physical"] = e.physical;
-                d["pulse"] = e.pulse;
-                d["encoder"] = e.encoder;
-                d["direction"] = e.direction;
-                cb(d);
-            });
-        }, py::arg("callback"), "callback(dict) for every event, called from update().")
+        .def("add_listener", [](MotorModel& mm, std::function<void(MotorEvent)> cb) {
+            // By value: Python gets its own copy, which it may keep.
+            return mm.add_listener([cb = std::move(cb)](const MotorEvent& e) { cb(e); });
+        }, py::arg("callback"), "callback(MotorEvent) for every event, called from update().")
         .def("remove_listener", &MotorModel::remove_listener)
         .def_property_readonly("moving", &MotorModel::moving)
         .def_property_readonly("pulse_position", &MotorModel::pulse_position)

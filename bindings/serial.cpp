@@ -15,6 +15,7 @@
 namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::serial;
+using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
 
 namespace {
@@ -128,32 +129,6 @@ private:
     std::vector<py::object> keep_;
 };
 
-py::dict link_counters(const LineCounters& c) {
-    py::dict d;
-    d["bytes_in"] = c.bytes_in;
-    d["bytes_out"] = c.bytes_out;
-    d["requests"] = c.requests;
-    d["replies"] = c.replies;
-    d["timeouts"] = c.timeouts;
-    d["stale_bytes"] = c.stale_bytes;
-    d["overlong_lines"] = c.overlong_lines;
-    d["echo_bytes"] = c.echo_bytes;
-    d["echo_mismatches"] = c.echo_mismatches;
-    return d;
-}
-
-py::dict server_counters(const LineServerCounters& c) {
-    py::dict d;
-    d["bytes_in"] = c.bytes_in;
-    d["bytes_out"] = c.bytes_out;
-    d["lines"] = c.lines;
-    d["overlong_lines"] = c.overlong_lines;
-    d["replies"] = c.replies;
-    d["device_errors"] = c.device_errors;
-    d["dropped_replies"] = c.dropped_replies;
-    return d;
-}
-
 std::chrono::nanoseconds nonneg_seconds(double s, const char* what) {
     if (!(s >= 0) || s > 1e6) throw InvalidArgument(std::string(what) + ": must be in [0, 1e6] seconds");
     return std::chrono::nanoseconds(static_cast<std::int64_t>(s * 1e9));
@@ -173,7 +148,34 @@ void bind_serial(py::module_& m) {
         "A reply exceeded max_line; it was discarded up to its terminator. .data holds its first bytes."}});
     py_errors::translate<ReplyTooLong, fill_reply_too_long>(m.attr("ReplyTooLong"));
 
-    py::class_<Port, std::shared_ptr<Port>>(m, "Port", "A bidirectional byte stream (serial port, pty side).")
+    Record<LineCounters>(m, "LineCounters", "LineLink counters, read-only.")
+        .field("bytes_in", &LineCounters::bytes_in, "read from the port (echo and stale bytes included)")
+        .field("bytes_out", &LineCounters::bytes_out, "written, terminators included")
+        .field("requests", &LineCounters::requests, "transact() + send() calls that wrote")
+        .field("replies", &LineCounters::replies, "lines returned by transact()/read_line()")
+        .field("timeouts", &LineCounters::timeouts, "transact() calls that got no complete reply")
+        .field("stale_bytes", &LineCounters::stale_bytes, "discarded by the flush before a request")
+        .field("overlong_lines", &LineCounters::overlong_lines, "replies longer than max_line (ReplyTooLong)")
+        .field("echo_bytes", &LineCounters::echo_bytes, "own bytes skipped by echo suppression")
+        .field("echo_mismatches", &LineCounters::echo_mismatches, "expected echo did not arrive as sent");
+
+    Record<LineServerCounters>(m, "LineServerCounters", "PtyLineServer counters, read-only.")
+        .field("bytes_in", &LineServerCounters::bytes_in)
+        .field("bytes_out", &LineServerCounters::bytes_out)
+        .field("lines", &LineServerCounters::lines, "complete request lines handed to the devices")
+        .field("overlong_lines", &LineServerCounters::overlong_lines, "request lines longer than every device accepts")
+        .field("replies", &LineServerCounters::replies, "non-empty replies written")
+        .field("device_errors", &LineServerCounters::device_errors, "a device broke its no-throw promise (reply dropped)")
+        .field("dropped_replies", &LineServerCounters::dropped_replies, "the client stopped reading; reply not written");
+
+    py::class_<Port, std::shared_ptr<Port>>(m, "Port", R"doc(A bidirectional byte stream (a serial device or one side of a pty).
+
+    write(data)                 blocks until all bytes are written; LinkDown if the peer is gone
+    read(size=4096, timeout=None) -> bytes   b'' on timeout; timeout None = wait forever
+    flush_input()               drops unread input
+    drain()                     waits until written bytes left the UART (no-op on a pty)
+    close()                     wakes blocked readers/writers, which raise ClosedError
+)doc")
         .def(
             "write",
             [](Port& p, const py::object& data) {
@@ -209,7 +211,12 @@ void bind_serial(py::module_& m) {
         });
 
     py::class_<TtyPort, Port, std::shared_ptr<TtyPort>>(m, "TtyPort",
-                                                        "A termios serial device in raw 8N1 mode.")
+                                                        R"doc(A termios serial device in raw 8N1 mode: TtyPort(path, baud=0).
+
+    baud=0 keeps the current speed.  Standard rates use the B* constants; any
+    other rate (e.g. 250000) goes through termios2/BOTHER and raises
+    InvalidArgument if the driver refuses it.  `.baud` reads/sets the speed.
+)doc")
         .def(py::init<const std::string&, unsigned>(), py::arg("path"), py::arg("baud") = 0,
              py::call_guard<py::gil_scoped_release>())
         .def_property("baud", &TtyPort::baud, &TtyPort::set_baud)
@@ -221,7 +228,14 @@ void bind_serial(py::module_& m) {
         .def_property_readonly("is_open", &TtyPort::is_open);
 
     py::class_<PtyPair, std::shared_ptr<PtyPair>>(m, "PtyPair",
-                                                  "A raw pseudo-terminal: .port is ours, .slave_path is for a peer.")
+                                                  R"doc(A raw pseudo-terminal pair for tests.
+
+    .port        our side (a Port)
+    .slave_path  e.g. '/dev/pts/7', for a peer: serial.Serial(path), can.Bus('slcan', channel=path)
+    open_slave(baud=0) -> TtyPort   a second motorbus port on the slave
+    release_slave()  drop the pair's own hold on the slave: once every peer has
+                     closed it, reads on .port raise LinkDown (an unplugged adapter)
+)doc")
         .def(py::init<>())
         .def_property_readonly("slave_path", &PtyPair::slave_path)
         .def_property_readonly("port", &PtyPair::master)
@@ -237,7 +251,25 @@ void bind_serial(py::module_& m) {
     m.def("open_port", &open_port, py::arg("path"), py::arg("baud") = 0,
           py::call_guard<py::gil_scoped_release>(), "Opens a serial device at `baud` (0 = keep the current speed).");
 
-    py::class_<LineLink, std::shared_ptr<LineLink>>(m, "LineLink", "Request/reply line framing on a Port.")
+    py::class_<LineLink, std::shared_ptr<LineLink>>(m, "LineLink", R"doc(Request/reply line framing on a Port.
+
+    LineLink(port, request_terminator="\r", reply_terminators=["\r\n"], max_line=256,
+             reply_timeout=0.5, flush_before_request=True, echo_suppression=False,
+             turnaround=0.0)
+
+    transact(request, timeout=None) -> bytes
+        Drops stale input (flush_before_request), writes request + terminator,
+        waits `turnaround` s (RS-485 direction switch), skips the exact echo of
+        our own bytes (echo_suppression), then reads until ANY reply terminator,
+        reassembling replies split across reads.  Returns the reply without its
+        terminator.  timeout None = reply_timeout.  TimeoutError discards the
+        partial reply; ReplyTooLong when the reply exceeds max_line (the rest is
+        discarded up to the terminator).  Concurrent calls are serialized.
+    send(request)              write without waiting (broadcasts)
+    read_line(timeout=None) -> bytes | None   one line (unsolicited); None on timeout
+    counters -> LineCounters   .bytes_in .bytes_out .requests .replies .timeouts
+                               .stale_bytes .overlong_lines .echo_bytes .echo_mismatches
+)doc")
         .def(py::init([](std::shared_ptr<Port> port, const py::object& request_terminator,
                          const py::object& reply_terminators, std::size_t max_line, const py::object& reply_timeout,
                          bool flush_before_request, bool echo_suppression, double turnaround) {
@@ -298,7 +330,7 @@ void bind_serial(py::module_& m) {
             },
             py::arg("timeout") = py::none(),
             "One line (e.g. unsolicited) or None on timeout; a partial line stays buffered.")
-        .def_property_readonly("counters", [](const LineLink& l) { return link_counters(l.counters()); })
+        .def_property_readonly("counters", &LineLink::counters, "LineCounters (a snapshot)")
         .def_property_readonly("port", [](LineLink& l) { return &l.port(); }, py::return_value_policy::reference_internal)
         .def_property_readonly("max_line", [](const LineLink& l) { return l.options().max_line; })
         .def_property_readonly("request_terminator",
@@ -311,8 +343,18 @@ void bind_serial(py::module_& m) {
 
     py::class_<LineDevice, PyLineDevice, std::shared_ptr<LineDevice>>(
         m, "LineDevice",
-        "A simulated serial device. Subclass and override on_line(line: bytes) -> bytes|str|None "
-        "(reply with its terminator; empty/None = silent).")
+        R"doc(A simulated serial device; subclass it (call super().__init__()).
+
+    on_line(line: bytes) -> bytes | str | None
+        One request without its terminator; return the exact reply bytes,
+        terminator included.  None/b'' = stay silent (not addressed).
+        Exceptions are reported as unraisable and the device stays silent.
+    request_terminator() -> bytes | str     default "\r"
+    max_request() -> int                    default 256
+    on_overlong() -> bytes | str | None     reply to an over-long request (default silent)
+
+    Called from the server thread with the GIL held.
+)doc")
         .def(py::init<>())
         .def(
             "on_line",
@@ -341,7 +383,18 @@ void bind_serial(py::module_& m) {
              py::arg("prefix") = "", py::arg("reply_terminator") = "\r\n", py::arg("request_terminator") = "\r");
 
     py::class_<PyLineServer>(m, "PtyLineServer",
-                             "Serves LineDevices on a pty (multi-drop); clients open .slave_path.")
+                             R"doc(Serves LineDevices on a pty, like drives on one RS-485 line.
+
+    PtyLineServer(devices=[], baud=0, port=None)
+
+    Every complete request line goes to EVERY device (each decides whether it
+    is addressed); replies are written in device order.  Request lines longer
+    than a device's max_request() get its on_overlong() reply, and the line
+    resyncs at the next terminator.  baud > 0 paces both directions at 10 bit
+    times per byte, so a pty behaves like a real line for benchmarks.  port=
+    serves on an existing Port instead of a new pty (slave_path is then "").
+    Use as a context manager or call close(); counters is a LineServerCounters.
+)doc")
         .def(py::init<const std::vector<py::object>&, unsigned, std::shared_ptr<Port>>(),
              py::arg("devices") = std::vector<py::object>{}, py::arg("baud") = 0, py::arg("port") = nullptr)
         .def("attach", &PyLineServer::attach, py::arg("device"))
@@ -349,7 +402,8 @@ void bind_serial(py::module_& m) {
         .def_property_readonly("slave_path", [](PyLineServer& s) { return s.get().slave_path(); })
         .def_property_readonly("baud", [](PyLineServer& s) { return s.get().baud(); })
         .def_property_readonly("running", [](PyLineServer& s) { return s.get().running(); })
-        .def_property_readonly("counters", [](PyLineServer& s) { return server_counters(s.get().counters()); })
+        .def_property_readonly("counters", [](PyLineServer& s) { return s.get().counters(); },
+                               "LineServerCounters (a snapshot)")
         .def("__enter__", [](py::object self) { return self; })
         .def("__exit__", [](PyLineServer& s, py::args) { s.close(); });
 }

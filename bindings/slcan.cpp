@@ -12,6 +12,7 @@
 namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::can;
+using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
 
 namespace {
@@ -21,63 +22,80 @@ Duration secs(double s) {
     return std::chrono::nanoseconds(static_cast<std::int64_t>(s * 1e9));
 }
 
-py::dict stats_dict(const SlcanStats& s) {
-    py::dict d;
-    d["acks"] = s.acks;
-    d["nacks"] = s.nacks;
-    d["ack_timeouts"] = s.ack_timeouts;
-    d["echoes_suppressed"] = s.echoes_suppressed;
-    d["link_downs"] = s.link_downs;
-    d["reconnects"] = s.reconnects;
-    d["partial_lines_dropped"] = s.partial_lines_dropped;
-    d["status_replies"] = s.status_replies;
-    d["last_status"] = s.last_status;
-    d["link_up"] = s.link_up;
-    d["version"] = s.version;
-    d["serial_number"] = s.serial_number;
-    return d;
-}
-
-py::dict server_stats_dict(const SlcanServerStats& s) {
-    py::dict d;
-    d["commands"] = s.commands;
-    d["invalid_commands"] = s.invalid_commands;
-    d["transmitted"] = s.transmitted;
-    d["transmit_failed"] = s.transmit_failed;
-    d["forwarded"] = s.forwarded;
-    d["forward_dropped"] = s.forward_dropped;
-    d["open"] = s.open;
-    return d;
-}
-
-py::dict event_dict(const slcan::Event& e) {
-    py::dict d;
-    d["kind"] = slcan::to_string(e.kind);
-    switch (e.kind) {
-        case slcan::EventKind::Frame:
-            d["frame"] = e.frame;
-            d["timestamp_ms"] = e.timestamp_ms ? py::object(py::int_(*e.timestamp_ms)) : py::none();
-            break;
-        case slcan::EventKind::TxAck: d["extended"] = e.extended; break;
-        case slcan::EventKind::Status:
-            d["status"] = e.status;
-            d["state"] = to_string(e.state);
-            break;
-        case slcan::EventKind::ErrorReport: d["error_bits"] = e.error_bits; break;
-        case slcan::EventKind::StateReport:
-            d["state"] = to_string(e.state);
-            d["rx_errors"] = e.rx_errors;
-            d["tx_errors"] = e.tx_errors;
-            break;
-        default: break;
-    }
-    if (!e.text.empty()) d["text"] = py::bytes(e.text.data(), e.text.size());
-    return d;
-}
+// A decoded event that owns its line bytes (Event::text is only valid during
+// the decoder's callback).
+struct EventRecord {
+    slcan::Event event;
+    std::string text;
+};
 
 }  // namespace
 
 void bind_slcan(py::module_& m) {
+    Record<SlcanStats>(m, "SlcanStats", "SLCAN link statistics (SlcanBus.stats), read-only.")
+        .field("acks", &SlcanStats::acks, "CR / z / Z answering a command")
+        .field("nacks", &SlcanStats::nacks, "BEL answering a command (or unsolicited)")
+        .field("ack_timeouts", &SlcanStats::ack_timeouts, "commands never answered within ack_timeout")
+        .field("echoes_suppressed", &SlcanStats::echoes_suppressed)
+        .field("link_downs", &SlcanStats::link_downs)
+        .field("reconnects", &SlcanStats::reconnects, "successful re-opens after a link down")
+        .field("partial_lines_dropped", &SlcanStats::partial_lines_dropped)
+        .field("status_replies", &SlcanStats::status_replies)
+        .field("last_status", &SlcanStats::last_status, "last `F` flags")
+        .field("link_up", &SlcanStats::link_up)
+        .field("version", &SlcanStats::version, "last `V` reply, e.g. 'V1013'")
+        .field("serial_number", &SlcanStats::serial_number, "last `N` reply");
+
+    Record<SlcanServerStats>(m, "SlcanServerStats", "SlcanServer statistics, read-only.")
+        .field("commands", &SlcanServerStats::commands)
+        .field("invalid_commands", &SlcanServerStats::invalid_commands,
+               "answered BEL because malformed/unknown/refused")
+        .field("transmitted", &SlcanServerStats::transmitted, "frames put on the bus for the peer")
+        .field("transmit_failed", &SlcanServerStats::transmit_failed, "the bus refused them (answered BEL)")
+        .field("forwarded", &SlcanServerStats::forwarded, "bus frames written to the peer")
+        .field("forward_dropped", &SlcanServerStats::forward_dropped, "queue full or peer not reading")
+        .field("open", &SlcanServerStats::open);
+
+    Record<slcan::DecoderCounters>(m, "SlcanDecoderCounters", "SlcanDecoder counters, read-only.")
+        .field("frames", &slcan::DecoderCounters::frames)
+        .field("rx_errors", &slcan::DecoderCounters::rx_errors, "malformed lines")
+        .field("rx_over_errors", &slcan::DecoderCounters::rx_over_errors, "lines longer than 32 bytes")
+        .field("ignored", &slcan::DecoderCounters::ignored, "unknown or unsupported non-frame lines")
+        .field("dropped_partial", &slcan::DecoderCounters::dropped_partial,
+               "partial lines dropped by discard_partial()");
+
+    py::enum_<slcan::EventKind>(m, "SlcanEventKind", "What an adapter->host SLCAN line was.")
+        .value("FRAME", slcan::EventKind::Frame)
+        .value("OK", slcan::EventKind::Ok)
+        .value("NACK", slcan::EventKind::Nack)
+        .value("TX_ACK", slcan::EventKind::TxAck)
+        .value("STATUS", slcan::EventKind::Status)
+        .value("VERSION", slcan::EventKind::Version)
+        .value("SERIAL", slcan::EventKind::Serial)
+        .value("ERROR_REPORT", slcan::EventKind::ErrorReport)
+        .value("STATE_REPORT", slcan::EventKind::StateReport)
+        .value("UNKNOWN", slcan::EventKind::Unknown)
+        .value("MALFORMED", slcan::EventKind::Malformed)
+        .value("OVERFLOW", slcan::EventKind::Overflow);
+
+    // Fields that do not apply to an event's kind hold their defaults (0, False, None).
+    Record<EventRecord>(m, "SlcanEvent", "One decoded adapter->host SLCAN line, read-only.")
+        .prop("kind", [](const EventRecord& r) { return r.event.kind; })
+        .prop("frame", [](const EventRecord& r) -> std::optional<Frame> {
+            if (r.event.kind != slcan::EventKind::Frame) return std::nullopt;
+            return r.event.frame;
+        }, "the frame (FRAME), else None")
+        .prop("timestamp_ms", [](const EventRecord& r) { return r.event.timestamp_ms; },
+              "adapter timestamp of a FRAME (Z1), else None")
+        .prop("extended", [](const EventRecord& r) { return r.event.extended; }, "TX_ACK: `Z` (extended)")
+        .prop("status", [](const EventRecord& r) { return r.event.status; }, "STATUS: the `F` flags")
+        .prop("state", [](const EventRecord& r) { return std::string(to_string(r.event.state)); },
+              "STATUS / STATE_REPORT: bus state, as Bus.state")
+        .prop("error_bits", [](const EventRecord& r) { return r.event.error_bits; }, "ERROR_REPORT")
+        .prop("rx_errors", [](const EventRecord& r) { return r.event.rx_errors; }, "STATE_REPORT")
+        .prop("tx_errors", [](const EventRecord& r) { return r.event.tx_errors; }, "STATE_REPORT")
+        .prop("text", [](const EventRecord& r) { return py::bytes(r.text); }, "the line's bytes (no terminator)");
+
     py::class_<SlcanBus, Bus, std::shared_ptr<SlcanBus>>(
         m, "SlcanBus", "A CAN bus through an SLCAN (Lawicel) adapter on a serial port.")
         .def("flush_tx",
@@ -95,7 +113,7 @@ void bind_slcan(py::module_& m) {
                  return b.query_status(t);
              },
              py::arg("timeout") = 1.0, "Send `F`, return the status flags (bus state is updated).")
-        .def_property_readonly("stats", [](const SlcanBus& b) { return stats_dict(b.stats()); })
+        .def_property_readonly("stats", &SlcanBus::stats, "SlcanStats (a snapshot)")
         .def_property_readonly("link_up", &SlcanBus::link_up);
 
     m.def("open_slcan",
@@ -158,7 +176,7 @@ void bind_slcan(py::module_& m) {
                                    return py::str(s.pty_path());
                                })
         .def_property_readonly("is_open", &SlcanServer::is_open)
-        .def_property_readonly("stats", [](const SlcanServer& s) { return server_stats_dict(s.stats()); })
+        .def_property_readonly("stats", &SlcanServer::stats, "SlcanServerStats (a snapshot)")
         .def("close", &SlcanServer::close, py::call_guard<py::gil_scoped_release>())
         .def("__enter__", [](py::object self) { return self; })
         .def("__exit__", [](SlcanServer& s, py::args) {
@@ -186,22 +204,17 @@ void bind_slcan(py::module_& m) {
         .def("feed",
              [](slcan::StreamDecoder& d, const py::bytes& data) {
                  std::string_view s = data;
-                 py::list out;
+                 std::vector<EventRecord> out;
                  d.feed(std::span(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()),
-                        [&](const slcan::Event& e) { out.append(event_dict(e)); });
+                        [&](const slcan::Event& e) {
+                            out.push_back({e, std::string(e.text)});
+                            out.back().event.text = {};
+                        });
                  return out;
              },
-             py::arg("data"), "Feed bytes; returns a list of event dicts (kind, frame, status, ...).")
+             py::arg("data"), "Feed bytes; returns the decoded SlcanEvents.")
         .def("discard_partial", &slcan::StreamDecoder::discard_partial)
         .def_property_readonly("pending", &slcan::StreamDecoder::pending)
-        .def_property_readonly("counters", [](const slcan::StreamDecoder& d) {
-            const auto& c = d.counters();
-            py::dict r;
-            r["frames"] = c.frames;
-            r["rx_errors"] = c.rx_errors;
-            r["rx_over_errors"] = c.rx_over_errors;
-            r["ignored"] = c.ignored;
-            r["dropped_partial"] = c.dropped_partial;
-            return r;
-        });
+        .def_property_readonly("counters", &slcan::StreamDecoder::counters, py::return_value_policy::copy,
+                               "SlcanDecoderCounters (a snapshot)");
 }

@@ -13,6 +13,7 @@
 namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::can;
+using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
 
 namespace {
@@ -25,35 +26,31 @@ Duration seconds_or(const py::object& t, Duration none_value) {
 }
 
 
-py::dict parser_stats_dict(const socketcand::ParserStats& s) {
-    py::dict d;
-    d["elements"] = s.elements;
-    d["bad_elements"] = s.bad_elements;
-    d["overlong"] = s.overlong;
-    d["interrupted"] = s.interrupted;
-    d["discarded_bytes"] = s.discarded_bytes;
-    return d;
-}
-
-py::dict server_stats_dict(const SocketcandServerStats& s) {
-    py::dict d;
-    d["clients_accepted"] = s.clients_accepted;
-    d["clients_active"] = s.clients_active;
-    d["clients_refused"] = s.clients_refused;
-    d["timeouts"] = s.timeouts;
-    d["frames_to_bus"] = s.frames_to_bus;
-    d["frames_to_clients"] = s.frames_to_clients;
-    d["queue_drops"] = s.queue_drops;
-    d["bus_send_retries"] = s.bus_send_retries;
-    d["bus_send_failures"] = s.bus_send_failures;
-    d["error_replies"] = s.error_replies;
-    d["bad_elements"] = s.bad_elements;
-    return d;
-}
-
 }  // namespace
 
 void bind_socketcand(py::module_& m) {
+    using socketcand::ParserStats;
+    Record<ParserStats>(m, "SocketcandParserStats", "The socketcand parser's view (SocketcandBus.parser_stats), read-only.")
+        .field("elements", &ParserStats::elements, "well-formed elements delivered")
+        .field("bad_elements", &ParserStats::bad_elements, "complete elements refused")
+        .field("overlong", &ParserStats::overlong, "elements abandoned at the length cap")
+        .field("interrupted", &ParserStats::interrupted, "elements cut short by a new '<'")
+        .field("discarded_bytes", &ParserStats::discarded_bytes, "non-blank bytes outside any element");
+
+    using Stats = SocketcandServerStats;
+    Record<Stats>(m, "SocketcandServerStats", "SocketcandServer statistics, read-only.")
+        .field("clients_accepted", &Stats::clients_accepted)
+        .field("clients_active", &Stats::clients_active)
+        .field("clients_refused", &Stats::clients_refused, "over max_clients or unknown channel")
+        .field("timeouts", &Stats::timeouts, "connections closed by a timeout")
+        .field("frames_to_bus", &Stats::frames_to_bus, "client sends put on the bus")
+        .field("frames_to_clients", &Stats::frames_to_clients, "frame elements written to clients")
+        .field("queue_drops", &Stats::queue_drops, "frames dropped for slow clients")
+        .field("bus_send_retries", &Stats::bus_send_retries)
+        .field("bus_send_failures", &Stats::bus_send_failures, "sends reported back with < error >")
+        .field("error_replies", &Stats::error_replies, "every < error ... > sent")
+        .field("bad_elements", &Stats::bad_elements, "malformed elements from clients");
+
     py::class_<SocketcandBus, Bus, std::shared_ptr<SocketcandBus>>(
         m, "SocketcandBus", "A CAN bus reached through a socketcand server (raw mode).")
         // Fast paths: try without giving up the GIL first (a frame is usually
@@ -83,8 +80,7 @@ void bind_socketcand(py::module_& m) {
         .def_property_readonly("link_up", &SocketcandBus::link_up)
         .def_property_readonly("link_down_reason", &SocketcandBus::link_down_reason)
         .def_property_readonly("last_server_error", &SocketcandBus::last_server_error)
-        .def_property_readonly("parser_stats",
-                               [](const SocketcandBus& b) { return parser_stats_dict(b.parser_stats()); })
+        .def_property_readonly("parser_stats", &SocketcandBus::parser_stats, "SocketcandParserStats (a snapshot)")
         .def_property_readonly("host", &SocketcandBus::host)
         .def_property_readonly("port", &SocketcandBus::port);
 
@@ -143,7 +139,7 @@ void bind_socketcand(py::module_& m) {
              py::arg("open_timeout") = 10.0, py::arg("bus_send_budget") = 0.02)
         .def_property_readonly("port", &SocketcandServer::port)
         .def_property_readonly("host", &SocketcandServer::host)
-        .def_property_readonly("stats", [](const SocketcandServer& s) { return server_stats_dict(s.stats()); })
+        .def_property_readonly("stats", &SocketcandServer::stats, "SocketcandServerStats (a snapshot)")
         .def_property_readonly("client_drops", &SocketcandServer::client_drops)
         .def("close", &SocketcandServer::close, py::call_guard<py::gil_scoped_release>())
         .def("__enter__", [](py::object self) { return self; })

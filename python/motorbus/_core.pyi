@@ -3,6 +3,7 @@ motorbus C++ core
 """
 from __future__ import annotations
 import collections.abc
+import enum
 from motorbus import ArcusBadSspd
 from motorbus import ArcusEnableRs485
 from motorbus import ArcusError
@@ -30,7 +31,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacSim', 'DmacUnknownCommand', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineDevice', 'LineLink', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'MotionState', 'MotorConfig', 'MotorModel', 'MotorbusError', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanServer', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandServer', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacSim', 'DmacUnknownCommand', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -100,6 +101,52 @@ class Frame:
     @timestamp_ns.setter
     def timestamp_ns(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
+class BusCounters:
+    """
+    A bus's counters (Bus.counters), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def bus_errors(self) -> int:
+        """
+        error frames / BEL / error states reported
+        """
+    @property
+    def ignored(self) -> int:
+        """
+        well-formed input not used (status lines etc.)
+        """
+    @property
+    def overruns(self) -> int:
+        """
+        adapter/medium reported overrun or line too long
+        """
+    @property
+    def parse_errors(self) -> int:
+        """
+        malformed input from the medium, discarded
+        """
+    @property
+    def rx_dropped(self) -> int:
+        """
+        received frames dropped because the recv() queue was full
+        """
+    @property
+    def rx_frames(self) -> int:
+        """
+        frames received from the medium
+        """
+    @property
+    def tx_dropped(self) -> int:
+        """
+        frames the medium lost (fault injection, adapter NACK)
+        """
+    @property
+    def tx_frames(self) -> int:
+        """
+        frames handed to the medium
+        """
 class Bus:
     """
     A CAN bus endpoint (open one with open_bus).
@@ -133,8 +180,10 @@ class Bus:
     def closed(self) -> bool:
         ...
     @property
-    def counters(self) -> dict:
-        ...
+    def counters(self) -> BusCounters:
+        """
+        BusCounters (a snapshot)
+        """
     @property
     def state(self) -> str:
         ...
@@ -179,6 +228,53 @@ class LogEntry:
     @property
     def time(self) -> float:
         ...
+class LogFormat:
+    """
+    Log file formats: candump (.log) and Vector ASC (.asc).
+    
+    Members:
+    
+      CANDUMP
+    
+      ASC
+    """
+    ASC: typing.ClassVar[LogFormat]
+    CANDUMP: typing.ClassVar[LogFormat]
+    __members__: typing.ClassVar[dict[str, LogFormat]]
+    @typing.overload
+    def __eq__(self, other: LogFormat) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: LogFormat) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
 class Recorder:
     """
     Writes every frame a bus receives to a candump or ASC log.
@@ -196,6 +292,259 @@ class Recorder:
     @property
     def count(self) -> int:
         ...
+class SlcanStats:
+    """
+    SLCAN link statistics (SlcanBus.stats), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def ack_timeouts(self) -> int:
+        """
+        commands never answered within ack_timeout
+        """
+    @property
+    def acks(self) -> int:
+        """
+        CR / z / Z answering a command
+        """
+    @property
+    def echoes_suppressed(self) -> int:
+        ...
+    @property
+    def last_status(self) -> int:
+        """
+        last `F` flags
+        """
+    @property
+    def link_downs(self) -> int:
+        ...
+    @property
+    def link_up(self) -> bool:
+        ...
+    @property
+    def nacks(self) -> int:
+        """
+        BEL answering a command (or unsolicited)
+        """
+    @property
+    def partial_lines_dropped(self) -> int:
+        ...
+    @property
+    def reconnects(self) -> int:
+        """
+        successful re-opens after a link down
+        """
+    @property
+    def serial_number(self) -> str:
+        """
+        last `N` reply
+        """
+    @property
+    def status_replies(self) -> int:
+        ...
+    @property
+    def version(self) -> str:
+        """
+        last `V` reply, e.g. 'V1013'
+        """
+class SlcanServerStats:
+    """
+    SlcanServer statistics, read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def commands(self) -> int:
+        ...
+    @property
+    def forward_dropped(self) -> int:
+        """
+        queue full or peer not reading
+        """
+    @property
+    def forwarded(self) -> int:
+        """
+        bus frames written to the peer
+        """
+    @property
+    def invalid_commands(self) -> int:
+        """
+        answered BEL because malformed/unknown/refused
+        """
+    @property
+    def open(self) -> bool:
+        ...
+    @property
+    def transmit_failed(self) -> int:
+        """
+        the bus refused them (answered BEL)
+        """
+    @property
+    def transmitted(self) -> int:
+        """
+        frames put on the bus for the peer
+        """
+class SlcanDecoderCounters:
+    """
+    SlcanDecoder counters, read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def dropped_partial(self) -> int:
+        """
+        partial lines dropped by discard_partial()
+        """
+    @property
+    def frames(self) -> int:
+        ...
+    @property
+    def ignored(self) -> int:
+        """
+        unknown or unsupported non-frame lines
+        """
+    @property
+    def rx_errors(self) -> int:
+        """
+        malformed lines
+        """
+    @property
+    def rx_over_errors(self) -> int:
+        """
+        lines longer than 32 bytes
+        """
+class SlcanEventKind:
+    """
+    What an adapter->host SLCAN line was.
+    
+    Members:
+    
+      FRAME
+    
+      OK
+    
+      NACK
+    
+      TX_ACK
+    
+      STATUS
+    
+      VERSION
+    
+      SERIAL
+    
+      ERROR_REPORT
+    
+      STATE_REPORT
+    
+      UNKNOWN
+    
+      MALFORMED
+    
+      OVERFLOW
+    """
+    ERROR_REPORT: typing.ClassVar[SlcanEventKind]
+    FRAME: typing.ClassVar[SlcanEventKind]
+    MALFORMED: typing.ClassVar[SlcanEventKind]
+    NACK: typing.ClassVar[SlcanEventKind]
+    OK: typing.ClassVar[SlcanEventKind]
+    OVERFLOW: typing.ClassVar[SlcanEventKind]
+    SERIAL: typing.ClassVar[SlcanEventKind]
+    STATE_REPORT: typing.ClassVar[SlcanEventKind]
+    STATUS: typing.ClassVar[SlcanEventKind]
+    TX_ACK: typing.ClassVar[SlcanEventKind]
+    UNKNOWN: typing.ClassVar[SlcanEventKind]
+    VERSION: typing.ClassVar[SlcanEventKind]
+    __members__: typing.ClassVar[dict[str, SlcanEventKind]]
+    @typing.overload
+    def __eq__(self, other: SlcanEventKind) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: SlcanEventKind) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class SlcanEvent:
+    """
+    One decoded adapter->host SLCAN line, read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def error_bits(self) -> int:
+        """
+        ERROR_REPORT
+        """
+    @property
+    def extended(self) -> bool:
+        """
+        TX_ACK: `Z` (extended)
+        """
+    @property
+    def frame(self) -> Frame | None:
+        """
+        the frame (FRAME), else None
+        """
+    @property
+    def kind(self) -> SlcanEventKind:
+        ...
+    @property
+    def rx_errors(self) -> int:
+        """
+        STATE_REPORT
+        """
+    @property
+    def state(self) -> str:
+        """
+        STATUS / STATE_REPORT: bus state, as Bus.state
+        """
+    @property
+    def status(self) -> int:
+        """
+        STATUS: the `F` flags
+        """
+    @property
+    def text(self) -> bytes:
+        """
+        the line's bytes (no terminator)
+        """
+    @property
+    def timestamp_ms(self) -> int | None:
+        """
+        adapter timestamp of a FRAME (Z1), else None
+        """
+    @property
+    def tx_errors(self) -> int:
+        """
+        STATE_REPORT
+        """
 class SlcanBus(Bus):
     """
     A CAN bus through an SLCAN (Lawicel) adapter on a serial port.
@@ -212,8 +561,10 @@ class SlcanBus(Bus):
     def link_up(self) -> bool:
         ...
     @property
-    def stats(self) -> dict:
-        ...
+    def stats(self) -> SlcanStats:
+        """
+        SlcanStats (a snapshot)
+        """
 class SlcanServer:
     """
     Serve a Bus as an SLCAN adapter on a new pty; SLCAN tools open `pty_path`.
@@ -235,8 +586,10 @@ class SlcanServer:
     def pty_path(self) -> typing.Any:
         ...
     @property
-    def stats(self) -> dict:
-        ...
+    def stats(self) -> SlcanServerStats:
+        """
+        SlcanServerStats (a snapshot)
+        """
 class SlcanDecoder:
     """
     Incremental adapter->host SLCAN decoder (bounded, never raises).
@@ -245,16 +598,104 @@ class SlcanDecoder:
         ...
     def discard_partial(self) -> bool:
         ...
-    def feed(self, data: bytes) -> list:
+    def feed(self, data: bytes) -> list[SlcanEvent]:
         """
-        Feed bytes; returns a list of event dicts (kind, frame, status, ...).
+        Feed bytes; returns the decoded SlcanEvents.
         """
     @property
-    def counters(self) -> dict:
-        ...
+    def counters(self) -> SlcanDecoderCounters:
+        """
+        SlcanDecoderCounters (a snapshot)
+        """
     @property
     def pending(self) -> int:
         ...
+class SocketcandParserStats:
+    """
+    The socketcand parser's view (SocketcandBus.parser_stats), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def bad_elements(self) -> int:
+        """
+        complete elements refused
+        """
+    @property
+    def discarded_bytes(self) -> int:
+        """
+        non-blank bytes outside any element
+        """
+    @property
+    def elements(self) -> int:
+        """
+        well-formed elements delivered
+        """
+    @property
+    def interrupted(self) -> int:
+        """
+        elements cut short by a new '<'
+        """
+    @property
+    def overlong(self) -> int:
+        """
+        elements abandoned at the length cap
+        """
+class SocketcandServerStats:
+    """
+    SocketcandServer statistics, read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def bad_elements(self) -> int:
+        """
+        malformed elements from clients
+        """
+    @property
+    def bus_send_failures(self) -> int:
+        """
+        sends reported back with < error >
+        """
+    @property
+    def bus_send_retries(self) -> int:
+        ...
+    @property
+    def clients_accepted(self) -> int:
+        ...
+    @property
+    def clients_active(self) -> int:
+        ...
+    @property
+    def clients_refused(self) -> int:
+        """
+        over max_clients or unknown channel
+        """
+    @property
+    def error_replies(self) -> int:
+        """
+        every < error ... > sent
+        """
+    @property
+    def frames_to_bus(self) -> int:
+        """
+        client sends put on the bus
+        """
+    @property
+    def frames_to_clients(self) -> int:
+        """
+        frame elements written to clients
+        """
+    @property
+    def queue_drops(self) -> int:
+        """
+        frames dropped for slow clients
+        """
+    @property
+    def timeouts(self) -> int:
+        """
+        connections closed by a timeout
+        """
 class SocketcandBus(Bus):
     """
     A CAN bus reached through a socketcand server (raw mode).
@@ -276,8 +717,10 @@ class SocketcandBus(Bus):
     def link_up(self) -> bool:
         ...
     @property
-    def parser_stats(self) -> dict:
-        ...
+    def parser_stats(self) -> SocketcandParserStats:
+        """
+        SocketcandParserStats (a snapshot)
+        """
     @property
     def port(self) -> int:
         ...
@@ -305,12 +748,102 @@ class SocketcandServer:
     def port(self) -> int:
         ...
     @property
-    def stats(self) -> dict:
-        ...
+    def stats(self) -> SocketcandServerStats:
+        """
+        SocketcandServerStats (a snapshot)
+        """
 class SocketCanBus(Bus):
     """
     A Linux AF_CAN raw socket (can0, vcan0, ...).
     """
+class LineCounters:
+    """
+    LineLink counters, read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def bytes_in(self) -> int:
+        """
+        read from the port (echo and stale bytes included)
+        """
+    @property
+    def bytes_out(self) -> int:
+        """
+        written, terminators included
+        """
+    @property
+    def echo_bytes(self) -> int:
+        """
+        own bytes skipped by echo suppression
+        """
+    @property
+    def echo_mismatches(self) -> int:
+        """
+        expected echo did not arrive as sent
+        """
+    @property
+    def overlong_lines(self) -> int:
+        """
+        replies longer than max_line (ReplyTooLong)
+        """
+    @property
+    def replies(self) -> int:
+        """
+        lines returned by transact()/read_line()
+        """
+    @property
+    def requests(self) -> int:
+        """
+        transact() + send() calls that wrote
+        """
+    @property
+    def stale_bytes(self) -> int:
+        """
+        discarded by the flush before a request
+        """
+    @property
+    def timeouts(self) -> int:
+        """
+        transact() calls that got no complete reply
+        """
+class LineServerCounters:
+    """
+    PtyLineServer counters, read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def bytes_in(self) -> int:
+        ...
+    @property
+    def bytes_out(self) -> int:
+        ...
+    @property
+    def device_errors(self) -> int:
+        """
+        a device broke its no-throw promise (reply dropped)
+        """
+    @property
+    def dropped_replies(self) -> int:
+        """
+        the client stopped reading; reply not written
+        """
+    @property
+    def lines(self) -> int:
+        """
+        complete request lines handed to the devices
+        """
+    @property
+    def overlong_lines(self) -> int:
+        """
+        request lines longer than every device accepts
+        """
+    @property
+    def replies(self) -> int:
+        """
+        non-empty replies written
+        """
 class Port:
     """
     A bidirectional byte stream (a serial device or one side of a pty).
@@ -411,8 +944,8 @@ class LineLink:
             discarded up to the terminator).  Concurrent calls are serialized.
         send(request)              write without waiting (broadcasts)
         read_line(timeout=None) -> bytes | None   one line (unsolicited); None on timeout
-        counters                   dict: bytes_in, bytes_out, requests, replies, timeouts,
-                                   stale_bytes, overlong_lines, echo_bytes, echo_mismatches
+        counters -> LineCounters   .bytes_in .bytes_out .requests .replies .timeouts
+                                   .stale_bytes .overlong_lines .echo_bytes .echo_mismatches
     """
     def __init__(self, port: Port, request_terminator: typing.Any = '\r', reply_terminators: typing.Any = ['\r\n'], max_line: typing.SupportsInt | typing.SupportsIndex = 256, reply_timeout: typing.Any = 0.5, flush_before_request: bool = True, echo_suppression: bool = False, turnaround: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
         ...
@@ -427,8 +960,10 @@ class LineLink:
         Sends request + terminator and returns the reply without its terminator. timeout None = the link's reply_timeout.
         """
     @property
-    def counters(self) -> dict:
-        ...
+    def counters(self) -> LineCounters:
+        """
+        LineCounters (a snapshot)
+        """
     @property
     def max_line(self) -> int:
         ...
@@ -483,7 +1018,7 @@ class PtyLineServer:
         resyncs at the next terminator.  baud > 0 paces both directions at 10 bit
         times per byte, so a pty behaves like a real line for benchmarks.  port=
         serves on an existing Port instead of a new pty (slave_path is then "").
-        Use as a context manager or call close(); counters is a dict.
+        Use as a context manager or call close(); counters is a LineServerCounters.
     """
     def __enter__(self) -> typing.Any:
         ...
@@ -499,8 +1034,10 @@ class PtyLineServer:
     def baud(self) -> int:
         ...
     @property
-    def counters(self) -> dict:
-        ...
+    def counters(self) -> LineServerCounters:
+        """
+        LineServerCounters (a snapshot)
+        """
     @property
     def running(self) -> bool:
         ...
@@ -1164,32 +1701,88 @@ class NodeInfo:
     @property
     def vendor_id(self) -> int | None:
         ...
+class NmtCommand(enum.IntEnum):
+    """
+    NMT command specifiers (CiA 301).
+    """
+    ENTER_PRE_OPERATIONAL: typing.ClassVar[NmtCommand]
+    RESET_COMMUNICATION: typing.ClassVar[NmtCommand]
+    RESET_NODE: typing.ClassVar[NmtCommand]
+    START: typing.ClassVar[NmtCommand]
+    STOP: typing.ClassVar[NmtCommand]
+    @classmethod
+    def __new__(cls, value):
+        ...
+    def __format__(self, format_spec):
+        ...
+class PdoProcedure:
+    """
+    How pdo_write_config writes a PDO.
+    
+    Members:
+    
+      CIA301 : disable, parameters, clear sub0, entries, set sub0, enable
+    
+      DIRECT : COB-ID, parameters, sub0 = n, entries (no disable/enable)
+    """
+    CIA301: typing.ClassVar[PdoProcedure]
+    DIRECT: typing.ClassVar[PdoProcedure]
+    __members__: typing.ClassVar[dict[str, PdoProcedure]]
+    @typing.overload
+    def __eq__(self, other: PdoProcedure) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: PdoProcedure) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
 class NmtMaster:
-    """
-    Sends NMT commands and tracks node states from heartbeats and boot-ups.
-    """
     def __init__(self, bus: Bus, own_node_id: typing.SupportsInt | typing.SupportsIndex | None = None) -> None:
         ...
     def raw_state(self, node: typing.SupportsInt | typing.SupportsIndex) -> int | None:
         ...
+    @typing.overload
+    def send(self, command: NmtCommand, node: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @typing.overload
     def send(self, command: typing.SupportsInt | typing.SupportsIndex, node: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     def set_callback(self, callback: typing.Any) -> None:
-        """
-        callback(node, old_state, new_state) on the bus thread.
-        """
+        ...
     def set_state(self, node: typing.SupportsInt | typing.SupportsIndex, state: str) -> None:
-        """
-        Sends the NMT command that puts `node` (0 = all) in `state`; RESET / RESET COMMUNICATION reset it.
-        """
+        ...
     def state(self, node: typing.SupportsInt | typing.SupportsIndex) -> str:
         ...
     def wait_for_boot(self, node: typing.SupportsInt | typing.SupportsIndex, timeout: typing.Any = 1.0) -> bool:
         ...
     def wait_for_heartbeat(self, node: typing.SupportsInt | typing.SupportsIndex, timeout: typing.Any = 1.0) -> str | None:
-        """
-        State reported by the next heartbeat or boot-up of `node`; None on timeout.
-        """
+        ...
     def wait_for_state(self, node: typing.SupportsInt | typing.SupportsIndex, state: str, timeout: typing.Any = 1.0) -> bool:
         ...
     @property
@@ -1675,11 +2268,79 @@ class SnlConfig:
     @tolerance.setter
     def tolerance(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
+class SnlActivity:
+    """
+    What kind of motion StepNLoop.begin() starts.
+    
+    Members:
+    
+      MOVE
+    
+      JOG
+    
+      HOME
+    
+      ZHOME
+    
+      LIMIT_HOME
+    
+      STOP
+    
+      ABORT
+    """
+    ABORT: typing.ClassVar[SnlActivity]
+    HOME: typing.ClassVar[SnlActivity]
+    JOG: typing.ClassVar[SnlActivity]
+    LIMIT_HOME: typing.ClassVar[SnlActivity]
+    MOVE: typing.ClassVar[SnlActivity]
+    STOP: typing.ClassVar[SnlActivity]
+    ZHOME: typing.ClassVar[SnlActivity]
+    __members__: typing.ClassVar[dict[str, SnlActivity]]
+    @typing.overload
+    def __eq__(self, other: SnlActivity) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: SnlActivity) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
 class StepNLoop:
     def __init__(self, config: SnlConfig = ...) -> None:
         ...
-    def begin(self, activity: str) -> bool:
+    @typing.overload
+    def begin(self, activity: SnlActivity) -> bool:
         ...
+    @typing.overload
+    def begin(self, activity: str) -> bool:
+        """
+        The activity by name: 'move', 'jog', 'home', 'zhome', 'limit_home', 'stop', 'abort'.
+        """
     def clear(self) -> None:
         ...
     def configure(self, arg0: SnlConfig) -> None:
@@ -1820,12 +2481,118 @@ class MotorConfig:
     @tick_ns.setter
     def tick_ns(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
+class MotorEventKind:
+    """
+    What a MotorEvent reports.
+    
+    Members:
+    
+      HOME_ON
+    
+      HOME_OFF
+    
+      MINUS_LIMIT_ON
+    
+      MINUS_LIMIT_OFF
+    
+      PLUS_LIMIT_ON
+    
+      PLUS_LIMIT_OFF
+    
+      INDEX
+    
+      STALLED
+    
+      RECOVERED
+    
+      LATCHED
+    
+      PROFILE_DONE
+    """
+    HOME_OFF: typing.ClassVar[MotorEventKind]
+    HOME_ON: typing.ClassVar[MotorEventKind]
+    INDEX: typing.ClassVar[MotorEventKind]
+    LATCHED: typing.ClassVar[MotorEventKind]
+    MINUS_LIMIT_OFF: typing.ClassVar[MotorEventKind]
+    MINUS_LIMIT_ON: typing.ClassVar[MotorEventKind]
+    PLUS_LIMIT_OFF: typing.ClassVar[MotorEventKind]
+    PLUS_LIMIT_ON: typing.ClassVar[MotorEventKind]
+    PROFILE_DONE: typing.ClassVar[MotorEventKind]
+    RECOVERED: typing.ClassVar[MotorEventKind]
+    STALLED: typing.ClassVar[MotorEventKind]
+    __members__: typing.ClassVar[dict[str, MotorEventKind]]
+    @typing.overload
+    def __eq__(self, other: MotorEventKind) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: MotorEventKind) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class MotorEvent:
+    """
+    One MotorModel event (MotorModel.add_listener), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def direction(self) -> int:
+        """
+        sign of the commanded velocity at t (0 at rest)
+        """
+    @property
+    def encoder(self) -> int:
+        ...
+    @property
+    def kind(self) -> MotorEventKind:
+        ...
+    @property
+    def physical(self) -> float:
+        """
+        rotor position at t (steps)
+        """
+    @property
+    def pulse(self) -> float:
+        """
+        pulse position at t
+        """
+    @property
+    def t_ns(self) -> int:
+        """
+        exact time of the event (ns)
+        """
 class MotorModel:
     def __init__(self, clock: Clock, config: MotorConfig = ...) -> None:
         ...
-    def add_listener(self, callback: collections.abc.Callable[[dict], None]) -> int:
+    def add_listener(self, callback: collections.abc.Callable[[MotorEvent], None]) -> int:
         """
-        callback(dict) for every event, called from update().
+        callback(MotorEvent) for every event, called from update().
         """
     def advance_to(self, t_ns: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
@@ -2868,7 +3635,9 @@ def heartbeat_decode(frame: Frame) -> typing.Any:
 def heartbeat_encode(node: typing.SupportsInt | typing.SupportsIndex, state: str) -> Frame:
     ...
 def jerk_limited_durations(cases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
-    ...
+    """
+    Rows: p0, v0, a0, target, vmax, amax, jmax; the duration of each row's plan.
+    """
 def monotonic_ns() -> int:
     """
     The monotonic clock frame timestamps use (ns).
@@ -2877,6 +3646,10 @@ def nmt_decode(frame: Frame) -> typing.Any:
     """
     (command, node) or None for anything that is not a valid NMT frame.
     """
+@typing.overload
+def nmt_encode(command: NmtCommand, node: typing.SupportsInt | typing.SupportsIndex) -> Frame:
+    ...
+@typing.overload
 def nmt_encode(command: typing.SupportsInt | typing.SupportsIndex, node: typing.SupportsInt | typing.SupportsIndex) -> Frame:
     ...
 def open_port(path: str, baud: typing.SupportsInt | typing.SupportsIndex = 0) -> Port:
@@ -2903,8 +3676,10 @@ def parse_candump_line(line: str) -> LogEntry | None:
     ...
 def pdo_read_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex) -> PdoConfig:
     ...
-def pdo_write_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex, cob_id: typing.SupportsInt | typing.SupportsIndex | None = None, enabled: bool = True, transmission_type: typing.SupportsInt | typing.SupportsIndex | None = None, inhibit_100us: typing.SupportsInt | typing.SupportsIndex | None = None, event_timer_ms: typing.SupportsInt | typing.SupportsIndex | None = None, sync_start: typing.SupportsInt | typing.SupportsIndex | None = None, mapping: collections.abc.Iterable | None = None, procedure: str = 'cia301') -> None:
-    ...
+def pdo_write_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex, cob_id: typing.SupportsInt | typing.SupportsIndex | None = None, enabled: bool = True, transmission_type: typing.SupportsInt | typing.SupportsIndex | None = None, inhibit_100us: typing.SupportsInt | typing.SupportsIndex | None = None, event_timer_ms: typing.SupportsInt | typing.SupportsIndex | None = None, sync_start: typing.SupportsInt | typing.SupportsIndex | None = None, mapping: collections.abc.Iterable | None = None, procedure: typing.Any = 'cia301') -> None:
+    """
+    procedure: a PdoProcedure or its name ('cia301', 'direct').
+    """
 def plan_jerk_limited(start: MotionState, target: typing.SupportsFloat | typing.SupportsIndex, limits: Limits) -> Profile:
     ...
 def plan_jerk_limited_velocity(start: MotionState, target_velocity: typing.SupportsFloat | typing.SupportsIndex, limits: Limits, hold: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> Profile:
@@ -2956,7 +3731,9 @@ def split_interpolation(axes: collections.abc.Sequence[Profile], period_ms: typi
 def sync_encode(counter: typing.SupportsInt | typing.SupportsIndex | None = None, cob_id: typing.SupportsInt | typing.SupportsIndex = 128) -> Frame:
     ...
 def synchronized_jerk_limited_durations(cases: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
-    ...
+    """
+    Rows: 3 axes x (p0, target, vmax, amax, jmax); the common duration of each row.
+    """
 def time_decode(frame: Frame) -> typing.Any:
     """
     Unix time in ms, or None.

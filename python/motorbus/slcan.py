@@ -11,9 +11,11 @@ See docs/slcan.md.
 from __future__ import annotations
 
 from . import _core, registry
-from ._core import SlcanBus, SlcanDecoder, SlcanServer, open_slcan, slcan_encode
+from ._core import (SlcanBus, SlcanDecoder, SlcanDecoderCounters, SlcanEvent, SlcanEventKind, SlcanServer,
+                    SlcanServerStats, SlcanStats, open_slcan, slcan_encode)
 
-__all__ = ["SlcanBus", "SlcanDecoder", "SlcanServer", "open_slcan", "slcan_encode",
+__all__ = ["SlcanBus", "SlcanDecoder", "SlcanDecoderCounters", "SlcanEvent", "SlcanEventKind", "SlcanServer",
+           "SlcanServerStats", "SlcanStats", "open_slcan", "slcan_encode",
            "STATUS_FLAGS", "SCHEME"]
 
 #: Bits of the ``F`` status reply (Lawicel CAN232/CANUSB manual, SJA1000 based).

@@ -29,7 +29,7 @@ def test_pyserial_client_against_our_server():
             ser.flush()
             ser.write(payload[100:] + b"\r")
             assert ser.read_until(b"\r\n", size=600) == b"E:" + payload + b"\r\n"
-        assert server.counters["lines"] == 2
+        assert server.counters.lines == 2
 
 
 def test_pyserial_device_against_our_line_link():

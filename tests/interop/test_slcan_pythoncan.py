@@ -98,8 +98,8 @@ def test_pythoncan_host_against_our_server(hub):
             for f in FRAMES:
                 peer.send(_to_frame(f))
             assert _pycan_recv_all(bus, len(FRAMES)) == FRAMES
-            assert server.stats["transmitted"] == len(FRAMES)
-            assert server.stats["transmit_failed"] == 0
+            assert server.stats.transmitted == len(FRAMES)
+            assert server.stats.transmit_failed == 0
         finally:
             bus.shutdown()
         deadline = time.monotonic() + 3
@@ -159,7 +159,7 @@ def test_pythoncan_host_against_our_slcanbus():
                 got.append(_frame_tuple(fr))
             assert got == FRAMES
             # python-can's C / S6 / O / bare CR lines were ignored, never parse errors
-            assert ours.counters["parse_errors"] == 0
+            assert ours.counters.parse_errors == 0
         finally:
             theirs.shutdown()
             ours.close()
@@ -199,12 +199,12 @@ def test_pythoncan_host_with_crlf_line_endings_loses_no_frame(hub):
             for f in FRAMES:
                 peer.send(_to_frame(f))
             assert _pycan_recv_all(bus, len(FRAMES)) == FRAMES
-            assert server.stats["transmitted"] == len(FRAMES)
+            assert server.stats.transmitted == len(FRAMES)
             # The only BELs are the three python-can's open sequence earns with CR
             # too (C, S6, "" for no data bitrate, O, O): C while closed, the empty
             # line and the second O.  Before the fix every frame after the first
             # drew one as well.
-            assert server.stats["invalid_commands"] == 3
+            assert server.stats.invalid_commands == 3
         finally:
             bus.shutdown()
 
@@ -231,7 +231,7 @@ def test_pyserial_host_writing_crlf_and_nul_padded_lines(hub):
             while (fr := peer.recv(timeout=0.5)) is not None:
                 got.append((fr.id, fr.data))
             assert got == [(0x100 + i, bytes((i, 0xFF - i))) for i in range(n) if i % 4 != 3]
-            assert server.stats["transmitted"] == n - n // 4
-            assert server.stats["invalid_commands"] == n // 4
+            assert server.stats.transmitted == n - n // 4
+            assert server.stats.invalid_commands == n // 4
         finally:
             port.close()

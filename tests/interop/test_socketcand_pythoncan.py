@@ -68,8 +68,8 @@ def test_pythoncan_sends_every_id_width_and_dlc_to_the_bus(served):
             got = node.recv(2)
             assert got is not None
             assert (got.id, got.extended, got.data) == (can_id, ext, payload(n))
-        assert server.stats["bad_elements"] == 0
-        assert wait_for(lambda: server.stats["frames_to_bus"] == len(CASES))
+        assert server.stats.bad_elements == 0
+        assert wait_for(lambda: server.stats.frames_to_bus == len(CASES))
     finally:
         pc.shutdown()
 
@@ -78,7 +78,7 @@ def test_pythoncan_receives_every_id_width_and_dlc_from_the_bus(served):
     server, node = served
     pc = pc_bus(server)
     try:
-        assert wait_for(lambda: server.stats["clients_active"] == 1)
+        assert wait_for(lambda: server.stats.clients_active == 1)
         before = time.time()
         for ext, can_id, n in CASES:
             node.send(Frame(can_id, payload(n), extended=ext))
@@ -98,7 +98,7 @@ def test_several_pythoncan_clients_see_each_others_frames(served):
     server, node = served
     clients = [pc_bus(server) for _ in range(3)]
     try:
-        assert wait_for(lambda: server.stats["clients_active"] == 3)
+        assert wait_for(lambda: server.stats.clients_active == 3)
         for k, sender in enumerate(clients):
             sender.send(can.Message(arbitration_id=0x100 + k, is_extended_id=False, data=[k, 0xEE]))
             for j, other in enumerate(clients):
@@ -120,7 +120,7 @@ def test_pythoncan_and_our_client_on_the_same_server(served):
     pc = pc_bus(server)
     ours = open_socketcand("127.0.0.1", server.port, "vcan0")
     try:
-        assert wait_for(lambda: server.stats["clients_active"] == 2)
+        assert wait_for(lambda: server.stats.clients_active == 2)
         time.sleep(0.005)
         ours.send(Frame(0x1FFFFFFF, b"\x01\x02\x03\x04\x05\x06\x07\x08", extended=True))
         msg = recv_data(pc)
@@ -161,7 +161,7 @@ def test_pythoncan_clients_answer_each_other_without_the_poll_stall(served):
     server, _node = served
     early, late = pc_bus(server), pc_bus(server)
     try:
-        assert wait_for(lambda: server.stats["clients_active"] == 2)
+        assert wait_for(lambda: server.stats.clients_active == 2)
         time.sleep(0.005)
         rounds = 20
         start = time.perf_counter()

@@ -3,6 +3,8 @@ import math
 import numpy as np
 import pytest
 
+import motorbus
+
 from motorbus import motion
 
 
@@ -92,7 +94,10 @@ def test_synchronized_axes_finish_together():
 
 def test_stepnloop_from_python():
     s = motion.StepNLoop()
+    with pytest.raises(motorbus.InvalidArgument):
+        s.begin("teleport")
     assert s.begin("move")
+    assert s.begin(motion.SnlActivity.MOVE)
     assert s.status == 1
     action, corr, idle = s.motion_done(300)
     assert (action, corr, idle) == (2, 300.0, False)
@@ -124,7 +129,7 @@ def test_motor_model_and_homing_on_sim_clock():
     cfg.plus_limit = motion.SwitchConfig(True, 20000)
     m = motion.MotorModel(clk, cfg)
     events = []
-    m.add_listener(lambda e: events.append(e["kind"]))
+    m.add_listener(events.append)
     h = motion.ArcusHoming(m, motion.ArcusProfileParams(hspd=3200, lspd=100, acc_ms=100),
                            motion.ArcusHomingOptions(rz=True))
     h.start("H", 1)
@@ -136,7 +141,10 @@ def test_motor_model_and_homing_on_sim_clock():
     assert h.result == 1  # Done
     assert m.pulse_count == 0
     assert m.physical_position == pytest.approx(5000, abs=1e-3)
-    assert "home_on" in events
+    kinds = [e.kind for e in events]
+    assert motion.MotorEventKind.HOME_ON in kinds
+    home = events[kinds.index(motion.MotorEventKind.HOME_ON)]
+    assert home.t_ns > 0 and home.direction == 1
     assert m.encoder == round(5000 * 4000 / 3200)
     with pytest.raises(ValueError):
         h.start("X", 1)

@@ -81,9 +81,9 @@ def test_python_line_device_on_server():
         link = LineLink(open_port(server.slave_path, 115200))
         assert link.transact("1PX") == b"E:1PX"
         assert link.transact(b"\xff\x00z") == b"E:\xff\x00z"
-        assert link.counters["replies"] == 2
-        assert link.counters["bytes_out"] == 4 + 4
-        assert server.counters["lines"] == 2
+        assert link.counters.replies == 2
+        assert link.counters.bytes_out == 4 + 4
+        assert server.counters.lines == 2
 
 
 def test_multidrop_each_device_decides():
@@ -95,7 +95,7 @@ def test_multidrop_each_device_decides():
         assert a.seen == [b"02READ", b"01READ"] and b.seen == a.seen
         with pytest.raises(motorbus.TimeoutError):
             link.transact("09READ", timeout=0.03)
-        assert link.counters["timeouts"] == 1
+        assert link.counters.timeouts == 1
 
 
 def test_a15_overlong_request_and_resync():
@@ -104,7 +104,7 @@ def test_a15_overlong_request_and_resync():
         link = LineLink(open_port(server.slave_path), reply_timeout=1.0)
         assert link.transact(b"1" + b"x" * 300) == b"1?"
         assert link.transact("1ok") == b"1=ok"
-        assert server.counters["overlong_lines"] == 1
+        assert server.counters.overlong_lines == 1
 
 
 def test_a3_reply_too_long_is_protocol_error_with_data():
@@ -116,7 +116,7 @@ def test_a3_reply_too_long_is_protocol_error_with_data():
             link.transact("Q")
         assert isinstance(ei.value, motorbus.ProtocolError)
         assert ei.value.data == b"0123456789ABCDEF"
-        assert link.counters["overlong_lines"] == 1
+        assert link.counters.overlong_lines == 1
         _reply_after_request(peer, b"ok\r\n")
         assert link.transact("Q") == b"ok"
 
@@ -132,12 +132,12 @@ def test_a1_a8_timeout_then_late_reply_flushed():
         threading.Thread(target=partial_reply).start()
         with pytest.raises(motorbus.TimeoutError):
             link.transact("A")
-        assert link.counters["timeouts"] == 1
+        assert link.counters.timeouts == 1
         peer.write(b"34\r\n")  # the late tail
         time.sleep(0.05)
         _reply_after_request(peer, b"fresh\r\n")
         assert link.transact("B", timeout=1.0) == b"fresh"
-        assert link.counters["stale_bytes"] == 4
+        assert link.counters.stale_bytes == 4
 
 
 def test_a11_terminator_sets():
@@ -164,7 +164,7 @@ def test_echo_suppression_and_turnaround():
         link = LineLink(open_port(server.slave_path), echo_suppression=True, turnaround=0.001,
                         reply_timeout=1.0)
         assert link.transact("01READ #POS") == b"ACK:01READ #POS"
-        assert link.counters["echo_bytes"] == len(b"01READ #POS\r")
+        assert link.counters.echo_bytes == len(b"01READ #POS\r")
 
 
 def test_device_exception_is_unraisable_and_server_survives():
@@ -236,7 +236,7 @@ def test_concurrent_python_threads_share_one_link():
         for t in threads:
             t.join()
         assert errors == []
-        assert link.counters["replies"] == 80
+        assert link.counters.replies == 80
 
 
 def test_link_down_when_adapter_unplugged():

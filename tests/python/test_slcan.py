@@ -9,7 +9,7 @@ import serial  # pyserial
 
 import motorbus
 from motorbus import _core
-from motorbus.slcan import SlcanDecoder, SlcanServer, open_slcan, slcan_encode
+from motorbus.slcan import SlcanDecoder, SlcanEventKind, SlcanServer, open_slcan, slcan_encode
 
 
 def _hub(tag: str) -> str:
@@ -28,13 +28,14 @@ def test_encode_every_kind():
 def test_decoder_hostile_rows_and_recovery():
     d = SlcanDecoder()
     events = d.feed(b"t8000\rt1239\rt12G0\rt1230EA60\r" + b"7" * 100 + b"\r\az\rF24\rt7ff1ab\r")
-    kinds = [e["kind"] for e in events]
-    assert kinds == ["malformed"] * 4 + ["overflow", "nack", "tx_ack", "status", "frame"]
-    assert events[7]["state"] == "error-passive"
-    f = events[8]["frame"]
+    K = SlcanEventKind
+    kinds = [e.kind for e in events]
+    assert kinds == [K.MALFORMED] * 4 + [K.OVERFLOW, K.NACK, K.TX_ACK, K.STATUS, K.FRAME]
+    assert events[7].state == "error-passive"
+    f = events[8].frame
     assert (f.id, f.data) == (0x7FF, b"\xab")  # lowercase accepted (L9)
     c = d.counters
-    assert (c["rx_errors"], c["rx_over_errors"], c["frames"]) == (4, 1, 1)
+    assert (c.rx_errors, c.rx_over_errors, c.frames) == (4, 1, 1)
     assert d.feed(b"t12") == [] and d.pending == 3
     assert d.discard_partial() and d.pending == 0
 
@@ -55,7 +56,7 @@ def test_server_with_pyserial_peer_answers_and_forwards():
         assert (got.id, got.extended, got.data) == (0x123, True, b"\xbe\xef")
         tty.write(b"t8000\r")  # L8 on the adapter side: refused
         assert tty.read(1) == b"\a"
-        assert server.stats["transmitted"] == 1
+        assert server.stats.transmitted == 1
 
 
 @pytest.mark.threaded
@@ -76,7 +77,7 @@ def test_open_slcan_through_server_both_directions():
                 peer.send(f)
             assert [bus.recv(timeout=2) for _ in frames] == frames
             assert bus.query_status(1.0) == 0
-            assert bus.stats["nacks"] == 0
+            assert bus.stats.nacks == 0
 
 
 @pytest.mark.threaded
@@ -181,8 +182,8 @@ def test_l10_nack_surfaces_as_protocol_error_with_the_frame():
             with pytest.raises(motorbus.ProtocolError) as info:
                 bus.flush_tx(2.0)
             assert "123#" in str(info.value)
-            assert bus.counters["tx_dropped"] == 1
-            assert (bus.stats["acks"], bus.stats["nacks"]) == (1, 1)
+            assert bus.counters.tx_dropped == 1
+            assert (bus.stats.acks, bus.stats.nacks) == (1, 1)
             bus.flush_tx(1.0)  # reported once
             # L12: F20 = error passive
             assert bus.query_status(1.0) == 0x20
@@ -200,7 +201,7 @@ def test_bad_lines_are_counted_and_the_next_frame_arrives():
             f = bus.recv(timeout=2)
             assert (f.id, f.data) == (0x123, b"\xca\xfe")
             c = bus.counters
-            assert (c["overruns"], c["parse_errors"], c["ignored"]) == (1, 3, 1)
+            assert (c.overruns, c.parse_errors, c.ignored) == (1, 3, 1)
     finally:
         adapter.close()
 

@@ -14,7 +14,7 @@ def test_open_bus_virtual_roundtrip_and_counters():
         assert f == Frame(0x123, b"\x01\x02")
         assert f.timestamp_ns > 0
         assert b.recv(0.01) is None
-        assert a.counters["tx_frames"] == 1 and b.counters["rx_frames"] == 1
+        assert a.counters.tx_frames == 1 and b.counters.rx_frames == 1
         assert a.state == "active"
     assert a.closed and a.state == "closed"
 
@@ -77,7 +77,7 @@ def test_faults_drop_every_nth():
         while (f := b.recv(0.05)) is not None:
             got.append(f.id)
         assert got == [0, 2, 4]
-        assert a.counters["tx_dropped"] == 3
+        assert a.counters.tx_dropped == 3
 
 
 def test_wire_time_mode_paces_frames():

@@ -125,6 +125,12 @@ std::optional<double> parse_asc_date(std::string_view s) {
 
 }  // namespace
 
+std::optional<LogFormat> log_format_from_name(std::string_view name) {
+    if (name == "candump" || name == "log") return LogFormat::Candump;
+    if (name == "asc") return LogFormat::Asc;
+    return std::nullopt;
+}
+
 LogFormat log_format_for(std::string_view path) {
     auto dot = path.rfind('.');
     if (dot != std::string_view::npos) {

@@ -18,6 +18,8 @@ namespace motorbus::can {
 enum class LogFormat { Candump, Asc };
 // ".asc" -> Asc, anything else (".log", ".candump") -> Candump.
 LogFormat log_format_for(std::string_view path);
+// "candump" (also "log", the file extension) or "asc"; nullopt if unknown.
+std::optional<LogFormat> log_format_from_name(std::string_view name);
 
 struct LogEntry {
     Frame frame;

@@ -59,6 +59,20 @@ std::uint32_t default_pdo_cob_id(bool tpdo, unsigned number, std::uint8_t node) 
     return (tpdo ? 0x180u : 0x200u) + 0x100u * (number - 1) + node;
 }
 
+const char* to_string(PdoProcedure p) {
+    switch (p) {
+        case PdoProcedure::Cia301: return "cia301";
+        case PdoProcedure::Direct: return "direct";
+    }
+    return "?";
+}
+
+std::optional<PdoProcedure> pdo_procedure_from_name(std::string_view name) {
+    for (auto p : {PdoProcedure::Cia301, PdoProcedure::Direct})
+        if (name == to_string(p)) return p;
+    return std::nullopt;
+}
+
 void write_pdo(SdoAccess& sdo, std::uint8_t node, const PdoConfig& cfg, PdoProcedure procedure) {
     const std::uint16_t comm = pdo_comm_index(cfg.tpdo, cfg.number);
     const std::uint16_t map = pdo_map_index(cfg.tpdo, cfg.number);

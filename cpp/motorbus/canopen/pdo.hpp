@@ -14,6 +14,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
@@ -144,6 +145,8 @@ enum class PdoProcedure {
     // sequence (manual appendix 3) and accept it.
     Direct,
 };
+const char* to_string(PdoProcedure p);                                 // "cia301", "direct"
+std::optional<PdoProcedure> pdo_procedure_from_name(std::string_view name);  // nullopt if unknown
 
 // Writes `cfg` to `node` over `sdo`; SDO errors propagate (SdoAbortError etc.).
 void write_pdo(SdoAccess& sdo, std::uint8_t node, const PdoConfig& cfg,

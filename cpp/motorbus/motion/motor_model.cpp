@@ -6,6 +6,24 @@
 
 namespace motorbus::motion {
 
+const char* to_string(MotorEvent::Kind k) {
+    using K = MotorEvent::Kind;
+    switch (k) {
+        case K::HomeOn: return "home_on";
+        case K::HomeOff: return "home_off";
+        case K::MinusLimitOn: return "minus_limit_on";
+        case K::MinusLimitOff: return "minus_limit_off";
+        case K::PlusLimitOn: return "plus_limit_on";
+        case K::PlusLimitOff: return "plus_limit_off";
+        case K::IndexPulse: return "index";
+        case K::Stalled: return "stalled";
+        case K::Recovered: return "recovered";
+        case K::Latched: return "latched";
+        case K::ProfileDone: return "profile_done";
+    }
+    return "?";
+}
+
 namespace {
 bool home_on(const SwitchConfig& c, double p) { return c.present && p >= c.lo && p <= c.hi; }
 bool minus_on(const SwitchConfig& c, double p) { return c.present && p <= c.lo; }

@@ -83,6 +83,8 @@ struct MotorEvent {
     std::int64_t encoder;
     int direction;      // sign of the commanded velocity at t (0 at rest)
 };
+// "home_on", "home_off", "minus_limit_on", ..., "index", "stalled", "recovered", "latched", "profile_done".
+const char* to_string(MotorEvent::Kind k);
 
 class MotorModel {
 public:

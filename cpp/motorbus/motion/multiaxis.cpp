@@ -105,4 +105,36 @@ std::vector<std::vector<long long>> split_interpolation(const std::vector<Profil
     return out;
 }
 
+std::vector<double> jerk_limited_durations(std::span<const double> rows) {
+    constexpr std::size_t kCols = 7;
+    if (rows.size() % kCols != 0) throw InvalidArgument("jerk_limited_durations: rows of 7 values");
+    std::vector<double> out;
+    out.reserve(rows.size() / kCols);
+    for (std::size_t i = 0; i < rows.size(); i += kCols) {
+        const double* c = rows.data() + i;
+        out.push_back(plan_jerk_limited(State{c[0], c[1], c[2], 0}, c[3], Limits{c[4], c[5], 0, c[6]}).duration());
+    }
+    return out;
+}
+
+std::vector<double> synchronized_jerk_limited_durations(std::span<const double> rows) {
+    constexpr std::size_t kCols = 15;
+    if (rows.size() % kCols != 0)
+        throw InvalidArgument("synchronized_jerk_limited_durations: rows of 15 values (3 axes x 5)");
+    std::vector<double> out;
+    out.reserve(rows.size() / kCols);
+    std::vector<double> s(3), t(3);
+    std::vector<Limits> l(3);
+    for (std::size_t i = 0; i < rows.size(); i += kCols) {
+        const double* c = rows.data() + i;
+        for (int k = 0; k < 3; ++k) {
+            s[k] = c[5 * k];
+            t[k] = c[5 * k + 1];
+            l[k] = Limits{c[5 * k + 2], c[5 * k + 3], 0, c[5 * k + 4]};
+        }
+        out.push_back(plan_synchronized_jerk_limited(s, t, l)[0].duration());
+    }
+    return out;
+}
+
 }  // namespace motorbus::motion

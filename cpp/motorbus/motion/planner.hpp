@@ -7,6 +7,7 @@
 // LimitExceeded naming the limit and the excess.
 #pragma once
 #include <array>
+#include <span>
 #include <vector>
 
 #include "motorbus/motion/profile.hpp"
@@ -90,6 +91,14 @@ std::vector<Profile> plan_synchronized(const std::vector<double>& start,
 std::vector<Profile> plan_synchronized_jerk_limited(const std::vector<double>& start,
                                                     const std::vector<double>& target,
                                                     const std::vector<Limits>& limits);
+
+// Batch duration queries (interop tests, benchmarks: no per-call overhead).
+// `rows` is row-major: 7 columns (p0, v0, a0, target, vmax, amax, jmax) for
+// plan_jerk_limited; 15 = 3 axes x (p0, target, vmax, amax, jmax) for
+// plan_synchronized_jerk_limited (the common duration).  InvalidArgument if
+// the size is not a multiple of the column count.
+std::vector<double> jerk_limited_durations(std::span<const double> rows);
+std::vector<double> synchronized_jerk_limited_durations(std::span<const double> rows);
 
 // Straight-line (phase-synchronised) move: one scalar path parameter s in
 // [0, 1] is planned under the tightest per-axis limit scaled by each axis's

@@ -4,6 +4,31 @@
 
 namespace motorbus::motion {
 
+namespace {
+constexpr SnlActivity kActivities[] = {SnlActivity::Move, SnlActivity::Jog,       SnlActivity::Home,
+                                       SnlActivity::ZHome, SnlActivity::LimitHome, SnlActivity::Stop,
+                                       SnlActivity::Abort};
+}  // namespace
+
+const char* to_string(SnlActivity a) {
+    switch (a) {
+        case SnlActivity::Move: return "move";
+        case SnlActivity::Jog: return "jog";
+        case SnlActivity::Home: return "home";
+        case SnlActivity::ZHome: return "zhome";
+        case SnlActivity::LimitHome: return "limit_home";
+        case SnlActivity::Stop: return "stop";
+        case SnlActivity::Abort: return "abort";
+    }
+    return "?";
+}
+
+std::optional<SnlActivity> snl_activity_from_name(std::string_view name) {
+    for (auto a : kActivities)
+        if (name == to_string(a)) return a;
+    return std::nullopt;
+}
+
 const char* snl_status_name(SnlStatus s) {
     switch (s) {
         case SnlStatus::Idle: return "IDLE";

@@ -21,6 +21,8 @@
 // (CLR/CLRS).  A new move in an error state is refused ("?State Error").
 #pragma once
 #include <cstdint>
+#include <optional>
+#include <string_view>
 
 namespace motorbus::motion {
 
@@ -60,6 +62,9 @@ struct SnlConfig {
 
 // What kind of motion is starting (selects the status shown while it runs).
 enum class SnlActivity { Move, Jog, Home, ZHome, LimitHome, Stop, Abort };
+// "move", "jog", "home", "zhome", "limit_home", "stop", "abort".
+const char* to_string(SnlActivity a);
+std::optional<SnlActivity> snl_activity_from_name(std::string_view name);  // nullopt if unknown
 
 enum class SnlAction {
     None,       // keep going

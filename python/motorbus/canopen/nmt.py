@@ -13,7 +13,6 @@ UNKNOWN (nothing heard, or a byte outside that set: never treated as running).
 """
 from __future__ import annotations
 
-import enum
 from typing import Callable, Optional
 
 from .. import _core
@@ -24,14 +23,7 @@ NMT_STATES = ("INITIALISING", "STOPPED", "OPERATIONAL", "PRE-OPERATIONAL", "UNKN
 
 nmt_encode = _core.nmt_encode
 nmt_decode = _core.nmt_decode
-
-
-class NmtCommand(enum.IntEnum):
-    START = 0x01
-    STOP = 0x02
-    ENTER_PRE_OPERATIONAL = 0x80
-    RESET_NODE = 0x81
-    RESET_COMMUNICATION = 0x82
+NmtCommand = _core.NmtCommand
 
 
 class NmtMaster:
@@ -41,8 +33,8 @@ class NmtMaster:
         self._m = _core.NmtMaster(bus, own_node_id)
         self._cb: Optional[Callable[[int, str, str], None]] = None
 
-    def send(self, command: int, node: int = 0) -> None:
-        self._m.send(int(command), node)
+    def send(self, command: "NmtCommand | int", node: int = 0) -> None:
+        self._m.send(command, node)
 
     def start(self, node: int = 0) -> None:
         self.send(NmtCommand.START, node)

@@ -86,8 +86,9 @@ def configure_pdo(sdo, node: int, *, tpdo: Optional[int] = None, rpdo: Optional[
                   cob_id: Optional[int] = None, enabled: bool = True,
                   transmission_type: Optional[int] = None, inhibit_100us: Optional[int] = None,
                   event_timer_ms: Optional[int] = None, sync_start: Optional[int] = None,
-                  mapping: Optional[Iterable[Entry]] = None, procedure: str = "cia301") -> None:
-    """Write a PDO's parameters and mapping. procedure='cia301' disables the PDO,
+                  mapping: Optional[Iterable[Entry]] = None,
+                  procedure: "str | _core.PdoProcedure" = "cia301") -> None:
+    """Write a PDO's parameters and mapping. procedure='cia301' (PdoProcedure.CIA301) disables the PDO,
     clears the mapping, writes the entries and re-enables it; 'direct' writes in
     the order devices such as the PMC007 document, without those steps."""
     if (tpdo is None) == (rpdo is None):

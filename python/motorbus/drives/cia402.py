@@ -345,13 +345,13 @@ class Cia402Sim:
         self.motor.halt()
         self._activity = "idle"
 
-    def _on_motor_event(self, event: dict) -> None:
+    def _on_motor_event(self, event: Any) -> None:
         # Called from motor.update() (our lock is held).  A limit switch met while
         # moving toward it stops the motor at once (CiA 402: internal limit active).
-        kind = event["kind"]
         if self._activity == "homing":
             return  # the homing methods use the switches themselves
-        if (kind == "minus_limit_on" and event["direction"] < 0) or (kind == "plus_limit_on" and event["direction"] > 0):
+        kind, Kind = event.kind, _core.MotorEventKind
+        if (kind == Kind.MINUS_LIMIT_ON and event.direction < 0) or (kind == Kind.PLUS_LIMIT_ON and event.direction > 0):
             self.motor.halt()
             self._limit_hit = True
             self._activity = "idle"

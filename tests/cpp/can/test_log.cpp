@@ -4,6 +4,14 @@
 
 using namespace motorbus::can;
 
+TEST(LogFormat, FromName) {
+    EXPECT_EQ(log_format_from_name("candump"), LogFormat::Candump);
+    EXPECT_EQ(log_format_from_name("log"), LogFormat::Candump);
+    EXPECT_EQ(log_format_from_name("asc"), LogFormat::Asc);
+    EXPECT_FALSE(log_format_from_name("ASC"));
+    EXPECT_FALSE(log_format_from_name("blf"));
+}
+
 TEST(CandumpLog, ParsesEveryFrameKind) {
     auto e = parse_candump_line("(1700000000.123456) can0 123#DEADBEEF R");
     ASSERT_TRUE(e);

@@ -18,6 +18,13 @@ using Bytes = std::vector<std::uint8_t>;
 
 // ---- codec ------------------------------------------------------------------
 
+TEST(PdoConfigure, ProcedureNames) {
+    EXPECT_EQ(pdo_procedure_from_name("cia301"), PdoProcedure::Cia301);
+    EXPECT_EQ(pdo_procedure_from_name("direct"), PdoProcedure::Direct);
+    EXPECT_STREQ(to_string(PdoProcedure::Direct), "direct");
+    EXPECT_FALSE(pdo_procedure_from_name("CiA301"));
+}
+
 TEST(PdoLayout, ByteAlignedLittleEndian) {
     PdoMapEntry m[] = {{0x6041, 0, 16}, {0x6064, 0, 32}, {0x6061, 0, 8}};
     PdoLayout l(m);

@@ -4,10 +4,30 @@
 #include <cmath>
 #include <random>
 
+#include "motorbus/errors.hpp"
 #include "motorbus/motion/planner.hpp"
 #include "motorbus/motion/steps.hpp"
 
 using namespace motorbus::motion;
+
+TEST(JerkLimited, BatchDurationsMatchSinglePlans) {
+    const std::vector<double> rows = {0, 0, 0, 100, 50, 200, 1000,  //
+                                      10, 5, 0, -40, 30, 100, 500};
+    auto d = jerk_limited_durations(rows);
+    ASSERT_EQ(d.size(), 2u);
+    EXPECT_DOUBLE_EQ(d[0], plan_jerk_limited(State{0, 0, 0, 0}, 100, Limits{50, 200, 0, 1000}).duration());
+    EXPECT_DOUBLE_EQ(d[1], plan_jerk_limited(State{10, 5, 0, 0}, -40, Limits{30, 100, 0, 500}).duration());
+    EXPECT_TRUE(jerk_limited_durations({}).empty());
+    EXPECT_THROW(jerk_limited_durations(std::span(rows.data(), 6)), motorbus::InvalidArgument);
+
+    const std::vector<double> sync = {0, 100, 50, 200, 1000, 0, 10, 50, 200, 1000, 5, -20, 40, 100, 800};
+    auto s = synchronized_jerk_limited_durations(sync);
+    ASSERT_EQ(s.size(), 1u);
+    auto p = plan_synchronized_jerk_limited({0, 0, 5}, {100, 10, -20},
+                                            {Limits{50, 200, 0, 1000}, Limits{50, 200, 0, 1000}, Limits{40, 100, 0, 800}});
+    EXPECT_DOUBLE_EQ(s[0], p[0].duration());
+    EXPECT_THROW(synchronized_jerk_limited_durations(std::span(sync.data(), 14)), motorbus::InvalidArgument);
+}
 
 TEST(JerkLimited, RampClosedForm) {
     Ramp r = jerk_limited_ramp(0, 10, 5, 10);  // reaches amax: t1 = 0.5, t2 = 1.5

@@ -19,6 +19,21 @@ constexpr Nanos kSec = 1'000'000'000;
 
 // ---- StepNLoop -------------------------------------------------------------------
 
+TEST(StepNLoop, ActivityNamesRoundTrip) {
+    for (auto a : {SnlActivity::Move, SnlActivity::Jog, SnlActivity::Home, SnlActivity::ZHome,
+                   SnlActivity::LimitHome, SnlActivity::Stop, SnlActivity::Abort})
+        EXPECT_EQ(snl_activity_from_name(to_string(a)), a);
+    EXPECT_EQ(snl_activity_from_name("limit_home"), SnlActivity::LimitHome);
+    EXPECT_FALSE(snl_activity_from_name("MOVE"));
+    EXPECT_FALSE(snl_activity_from_name(""));
+}
+
+TEST(MotorModel, EventKindNames) {
+    EXPECT_STREQ(to_string(MotorEvent::Kind::MinusLimitOn), "minus_limit_on");
+    EXPECT_STREQ(to_string(MotorEvent::Kind::IndexPulse), "index");
+    EXPECT_STREQ(to_string(MotorEvent::Kind::ProfileDone), "profile_done");
+}
+
 TEST(StepNLoop, StatusValuesMatchTables) {
     EXPECT_EQ(static_cast<int>(SnlStatus::Idle), 0);
     EXPECT_EQ(static_cast<int>(SnlStatus::StallError), 10);
