@@ -41,6 +41,21 @@ def stop_all() -> None:
 atexit.register(stop_all)
 
 
+def halt(how, stop, quick_stop, disable) -> None:
+    """Applies one of the safety words ("stop", "quick_stop", "disable"; None does
+    nothing) with the three ways a drive has; best effort while unwinding: a way
+    that fails (the link may be gone) falls back to the next harder one."""
+    if how is None:
+        return
+    ladder = {"stop": (stop, quick_stop, disable), "quick_stop": (quick_stop, disable), "disable": (disable,)}[how]
+    for step in ladder:
+        try:
+            step()
+            return
+        except Exception:  # noqa: BLE001 - try the next way
+            continue
+
+
 class StopsMotor:
     """Mixin for drive objects: ``with`` support that calls ``_stop_on_error()``
     when an exception leaves the block and ``close()`` in every case.  The

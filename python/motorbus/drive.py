@@ -400,18 +400,8 @@ class Drive(abc.ABC):
         self._halt(self.on_exit)
 
     def _halt(self, how: StopHow) -> None:
-        """Best effort while unwinding: a failed stop falls back to the next harder one."""
-        if how is None or self._closed:
-            return
-        ladder = {"stop": (self._stop, self._quick_stop, self._disable),
-                  "quick_stop": (self._quick_stop, self._disable),
-                  "disable": (self._disable,)}[how]
-        for step in ladder:
-            try:
-                step()
-                return
-            except Exception:  # noqa: BLE001 - the link may be gone; try the next way
-                continue
+        if not self._closed:
+            _stop_at_exit.halt(how, self._stop, self._quick_stop, self._disable)
 
     # ---- helpers -------------------------------------------------------------------------
     def _check_open(self) -> None:

@@ -8,11 +8,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def test_example_01_virtual_bus_python():
-    out = subprocess.run([sys.executable, str(ROOT / "examples" / "01_virtual_bus.py")], capture_output=True,
-                         text=True, timeout=60)
-    assert out.returncode == 0, out.stderr
-    assert "callback: 181#010203" in out.stdout
-    assert "logged: ['181#010203', '1ABCDEF0#FF']" in out.stdout
+    out = run_example("01_virtual_bus.py")
+    assert "callback: 181#010203" in out
+    assert "logged: ['181#010203', '1ABCDEF0#FF']" in out
 
 
 def test_notebook_cells_run_in_order(capsys):
@@ -24,6 +22,17 @@ def test_notebook_cells_run_in_order(capsys):
     out = capsys.readouterr().out
     assert "encoder 4000" in out
     assert "frame spacing at 250 kbit/s (us): [540.0, 540.0, 540.0]" in out
+
+
+def run_cpp_example(name):
+    """Output of build/dev/<name> (built with MOTORBUS_EXAMPLES=ON, as `make test` does)."""
+    exe = ROOT / "build" / "dev" / name
+    if not exe.exists():
+        import pytest
+        pytest.skip("C++ examples not built (MOTORBUS_EXAMPLES=OFF)")
+    out = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    return out.stdout
 
 
 def run_example(name):
@@ -53,14 +62,9 @@ def test_example_03_arcus_python():
 
 
 def test_example_03_arcus_cpp():
-    exe = ROOT / "build" / "dev" / "example_03_arcus"
-    if not exe.exists():
-        import pytest
-        pytest.skip("C++ examples not built (MOTORBUS_EXAMPLES=OFF)")
-    out = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60)
-    assert out.returncode == 0, out.stderr
-    assert "EX=1250 PX=1250 SLS=0" in out.stdout
-    assert "SLR=0.800 ID=DriveMax-CAN" in out.stdout
+    out = run_cpp_example("example_03_arcus")
+    assert "EX=1250 PX=1250 SLS=0" in out
+    assert "SLR=0.800 ID=DriveMax-CAN" in out
 
 
 def test_example_04_dmac_interpolation_python():
@@ -70,13 +74,8 @@ def test_example_04_dmac_interpolation_python():
 
 
 def test_example_04_dmac_interpolation_cpp():
-    exe = ROOT / "build" / "dev" / "example_04_dmac_interpolation"
-    if not exe.exists():
-        import pytest
-        pytest.skip("C++ examples not built (MOTORBUS_EXAMPLES=OFF)")
-    out = subprocess.run([str(exe)], capture_output=True, text=True, timeout=60)
-    assert out.returncode == 0, out.stderr
-    assert "x -10000 y 10000" in out.stdout
+    out = run_cpp_example("example_04_dmac_interpolation")
+    assert "x -10000 y 10000" in out
 
 
 def test_example_06_drive_api_python():

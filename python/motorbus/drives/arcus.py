@@ -216,18 +216,8 @@ class ArcusClient(_stop_at_exit.StopsMotor, ArcusClientBase):
         self._halt(self.on_exit)
 
     def _halt(self, how: Optional[str]) -> None:
-        """Best effort while unwinding: a failed stop falls back to the next harder one."""
-        if how is None or self._closed:
-            return
-        ladder = {"stop": (self.stop, self.abort, self.disable),
-                  "quick_stop": (self.abort, self.disable),
-                  "disable": (self.disable,)}[how]
-        for step in ladder:
-            try:
-                step()
-                return
-            except Exception:  # noqa: BLE001 - the link may be gone; try the next way
-                continue
+        if not self._closed:
+            _stop_at_exit.halt(how, self.stop, self.abort, self.disable)
 
     # ---- typed views of the status registers ----
     @property
