@@ -74,6 +74,23 @@ class BusServers:
         """One line per server: ``socketcand HOST:PORT CHANNEL`` or ``slcan PTY``."""
         return list(self._lines)
 
+    def report(self) -> list[str]:
+        """One line per server with what it forwarded and what it dropped (the
+        counters a person checks when a client says frames went missing)."""
+        out = []
+        for line, srv in zip(self._lines, self.servers):
+            st = srv.stats
+            if hasattr(st, "queue_drops"):   # socketcand
+                out.append(f"{line}: clients {st.clients_active} active / {st.clients_accepted} accepted, "
+                           f"to clients {st.frames_to_clients}, to bus {st.frames_to_bus}, "
+                           f"dropped {st.queue_drops} (per client {list(srv.client_drops)}), "
+                           f"bus send failures {st.bus_send_failures}, bad elements {st.bad_elements}")
+            else:                            # SLCAN adapter
+                out.append(f"{line}: commands {st.commands} ({st.invalid_commands} invalid), "
+                           f"transmitted {st.transmitted} (failed {st.transmit_failed}), "
+                           f"forwarded {st.forwarded}, dropped {st.forward_dropped}")
+        return out
+
     def close(self) -> None:
         for s in self.servers:
             s.close()

@@ -1,6 +1,6 @@
 """The ``motorbus`` command line (also ``python -m motorbus``).
 
-    motorbus bus serve SPEC [--socketcand HOST:PORT] [--slcan-pty] [--channel NAME]
+    motorbus bus serve SPEC [--socketcand HOST:PORT] [--slcan-pty] [--channel NAME]   (SIGUSR1: counters)
     motorbus bus dump SPEC [--count N] [--log FILE]
     motorbus bus play FILE SPEC [--speed X]
     motorbus sim serve [--pty] [--bus virtual:NAME] [--bitrate N] [--socketcand HOST:PORT]...
@@ -20,17 +20,22 @@ from . import _core
 from .bus import open_bus
 
 
-def _wait_for_signal() -> None:
-    """Blocks until SIGINT or SIGTERM, then returns (so servers close cleanly)."""
+def _wait_for_signal(on_usr1: Optional[Any] = None) -> None:
+    """Blocks until SIGINT or SIGTERM, then returns (so servers close cleanly);
+    SIGUSR1 calls ``on_usr1`` (a status report) and goes on waiting."""
     stop = threading.Event()
+    usr1 = threading.Event()
 
     def handler(signum: int, frame: Any) -> None:
-        stop.set()
+        (usr1 if signum == signal.SIGUSR1 else stop).set()
 
-    old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+    signals = [signal.SIGINT, signal.SIGTERM] + ([signal.SIGUSR1] if on_usr1 is not None else [])
+    old = {s: signal.signal(s, handler) for s in signals}
     try:
         while not stop.wait(0.2):
-            pass
+            if usr1.is_set():
+                usr1.clear()
+                on_usr1()
     finally:
         for s, h in old.items():
             signal.signal(s, h)
@@ -49,8 +54,15 @@ def cmd_bus_serve(args: argparse.Namespace) -> int:
     with BusServers(args.spec, socketcand=socketcand, slcan_ptys=args.slcan_pty, channel=args.channel) as servers:
         for line in servers.announce():
             _say(line)
-        _wait_for_signal()
+        _wait_for_signal(on_usr1=lambda: _report(servers))
+        _report(servers)
     return 0
+
+
+def _report(servers: Any) -> None:
+    """Counters and drops per server, on stderr (stdout carries the announce lines)."""
+    for line in servers.report():
+        print(line, file=sys.stderr, flush=True)
 
 
 def cmd_bus_dump(args: argparse.Namespace) -> int:
@@ -91,7 +103,10 @@ def cmd_sim_serve(args: argparse.Namespace) -> int:
                   store_dir=args.store_dir) as bench:
         for line in bench.announce():
             _say(line)
-        _wait_for_signal()
+        report = (lambda: _report(bench.can)) if bench.can is not None else None
+        _wait_for_signal(on_usr1=report)
+        if report is not None:
+            report()
     return 0
 
 

@@ -87,3 +87,31 @@ def test_socketcand_and_slcan_clients_see_each_other():
             sl.shutdown()
     finally:
         assert _stop(proc) == 0
+
+
+def test_counters_on_sigusr1_and_on_exit_and_the_channel_is_announced():
+    proc = _serve("virtual:cli-report", "--socketcand", "127.0.0.1:0", "--channel", "vcan7")
+    try:
+        ((kind, hostport, channel),) = _read_lines(proc, 1)
+        assert (kind, channel) == ("socketcand", "vcan7")
+        host, port = hostport.rsplit(":", 1)
+        a = can.Bus(interface="socketcand", host=host, port=int(port), channel="vcan7")
+        b = can.Bus(interface="socketcand", host=host, port=int(port), channel="vcan7")
+        try:
+            time.sleep(0.2)
+            for i in range(5):
+                a.send(can.Message(arbitration_id=0x123, is_extended_id=False, data=bytes([i])))
+            for i in range(5):
+                m = recv_id(b, 0x123, timeout=3.0, poll=0.2)
+                assert m is not None and bytes(m.data) == bytes([i])
+            proc.send_signal(signal.SIGUSR1)
+            line = proc.stderr.readline()
+            assert line.startswith(f"socketcand {hostport} vcan7: clients 2 active / 2 accepted"), line
+            assert "to bus 5," in line and "dropped 0" in line
+        finally:
+            a.shutdown()
+            b.shutdown()
+    finally:
+        assert _stop(proc) == 0
+    last = proc.stderr.read()
+    assert f"socketcand {hostport} vcan7:" in last and "to bus 5," in last
