@@ -163,11 +163,11 @@ class MotorbusCanBus(can.BusABC):
 
     @property
     def state(self) -> can.BusState:
-        """python-can's view of the motorbus state: error-passive -> PASSIVE, bus-off/closed -> ERROR."""
+        """python-can's view of the motorbus state: error-passive -> PASSIVE, bus-off/closed/link-down -> ERROR."""
         s = self._bus.state
         if s == "error-passive":
             return can.BusState.PASSIVE
-        if s in ("bus-off", "closed"):
+        if s in ("bus-off", "closed", "link-down"):
             return can.BusState.ERROR
         return can.BusState.ACTIVE
 

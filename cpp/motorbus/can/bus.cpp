@@ -13,6 +13,7 @@ const char* to_string(BusState s) {
         case BusState::ErrorPassive: return "error-passive";
         case BusState::BusOff: return "bus-off";
         case BusState::Closed: return "closed";
+        case BusState::LinkDown: return "link-down";
     }
     return "unknown";
 }

@@ -30,7 +30,9 @@ using Duration = std::chrono::nanoseconds;
 using Deadline = std::chrono::steady_clock::time_point;
 inline Deadline deadline_after(Duration d) { return std::chrono::steady_clock::now() + d; }
 
-enum class BusState { Active, ErrorWarning, ErrorPassive, BusOff, Closed };
+// LinkDown: the link to the adapter or server is gone (unplugged, killed) and the
+// backend is reconnecting; frames can neither be sent nor received meanwhile.
+enum class BusState { Active, ErrorWarning, ErrorPassive, BusOff, Closed, LinkDown };
 const char* to_string(BusState s);
 
 struct BusCounters {

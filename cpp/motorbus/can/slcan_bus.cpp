@@ -419,6 +419,7 @@ void SlcanBus::link_lost(const std::string&) {
         txbuf_frames_ = 0;
         port = port_;
     }
+    if (state() != BusState::Closed) set_state(BusState::LinkDown);
     cv_.notify_all();
     // Wakes a writer blocked on the dead port; the receive thread reconnects.
     if (port) port->close();
@@ -455,6 +456,7 @@ bool SlcanBus::reopen() {
             stats_.link_up = true;
             ++stats_.reconnects;
         }
+        if (state() == BusState::LinkDown) set_state(BusState::Active);
         cv_.notify_all();
         return true;
     } catch (const std::exception&) {

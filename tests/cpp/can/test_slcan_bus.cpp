@@ -452,8 +452,10 @@ TEST(SlcanBus, L14_LinkDownSurfacesAndReconnectsWithBackoff) {
         second = std::make_shared<FakePort>([](const std::string& l) { return lawicel(l); });
         return second;
     });
+    EXPECT_EQ(bus.state(), BusState::Active);
     first->unplug();
     ASSERT_TRUE(eventually([&] { return !bus.link_up(); }));
+    EXPECT_EQ(bus.state(), BusState::LinkDown);  // not "active" while the adapter is gone
     EXPECT_THROW(bus.send(Frame::make(1, std::vector<std::uint8_t>{})), LinkDown);
     EXPECT_EQ(bus.stats().link_downs, 1u);
     // No busy loop: with a 20-80 ms backoff, 300 ms allows a handful of tries.
@@ -463,6 +465,7 @@ TEST(SlcanBus, L14_LinkDownSurfacesAndReconnectsWithBackoff) {
     plugged = true;
     ASSERT_TRUE(eventually([&] { return bus.link_up(); }));
     EXPECT_EQ(bus.stats().reconnects, 1u);
+    EXPECT_EQ(bus.state(), BusState::Active);
     bus.send(Frame::make(0x42, std::vector<std::uint8_t>{7}));
     bus.flush_tx(2s);
     {
@@ -481,6 +484,8 @@ TEST(SlcanBus, L14_PtyHangupIsLinkDownWithoutReconnectFactory) {
     adapter.reset();  // closes the master: the slave reads EIO (USB unplug)
     pty.reset();
     ASSERT_TRUE(eventually([&] { return !bus.link_up(); }));
+    EXPECT_EQ(bus.state(), BusState::LinkDown);
+    EXPECT_STREQ(to_string(bus.state()), "link-down");
     EXPECT_THROW(bus.send(Frame::make(1, std::vector<std::uint8_t>{})), LinkDown);
     bus.close();  // returns promptly: the receive thread waits, it does not spin
     EXPECT_EQ(bus.state(), BusState::Closed);
