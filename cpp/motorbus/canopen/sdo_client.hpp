@@ -37,7 +37,8 @@ namespace motorbus::canopen {
 enum class TransferMode {
     Auto,       // upload: the server picks expedited/segmented; download: expedited if <= 4 bytes
     Segmented,  // download: segmented even for <= 4 bytes (upload: same as Auto)
-    Block,      // block transfer; falls back to segmented if the server refuses block mode
+    Block,      // block transfer; a server that refuses block mode is an SdoAbortError
+                // (0x05040001) unless fallback_to_segmented was asked for
 };
 
 constexpr Nanos kNoDeadline = std::numeric_limits<Nanos>::max();
@@ -48,7 +49,10 @@ struct SdoClientConfig {
     std::uint8_t block_size = 127;         // sub-block size we offer in block upload (1..127)
     bool block_crc = true;                 // offer CRC in block transfers
     std::uint8_t protocol_switch = 0;      // pst of block upload (0 = always block)
-    bool fallback_to_segmented = true;     // server refuses block mode -> retry segmented
+    // Server refuses block mode (abort 0x05040001 / 0x06010000 to the block
+    // initiate) -> retry the same transfer segmented (no CRC).  Off by default:
+    // a caller who asked for block gets block or SdoAbortError.
+    bool fallback_to_segmented = false;
     // Block upload: ack what arrived when a sub-block stalls for this fraction of
     // the timeout, so the server retransmits the rest (B12/B13).
     double subblock_timer_fraction = 0.7;
@@ -145,7 +149,9 @@ struct SdoClientOptions {
     std::size_t max_transfer = 1u << 20;
     std::uint8_t block_size = 127;
     bool block_crc = true;
-    bool fallback_to_segmented = true;
+    // Opt-in: a server that refuses block mode gets the transfer segmented
+    // (Python: SdoClient(..., block_fallback=True)).  Default: SdoAbortError.
+    bool fallback_to_segmented = false;
     // Idempotent reads are retried this many times after a timeout (writes never are).
     unsigned read_retries = 0;
     // Before sleeping, the caller polls (yielding the CPU) this long for the

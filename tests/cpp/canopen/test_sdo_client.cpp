@@ -340,6 +340,9 @@ TEST_F(ClientFixture, B13_LostSegmentRequestedAgain) {
 }
 
 TEST_F(ClientFixture, B16_FallBackToSegmented) {
+    SdoClientConfig opt_in;
+    opt_in.fallback_to_segmented = true;  // not the default (Hardening defect 4)
+    cli.set_config(opt_in);
     EXPECT_EQ(up(0x1008, 0, TransferMode::Block), Strs{"A4 08 10 00 7F 00 00 00"});
     EXPECT_EQ(rx("80 08 10 00 01 00 04 05"), Strs{"40 08 10 00 00 00 00 00"});
     EXPECT_EQ(rx("43 08 10 00 41 42 43 44"), Strs{});
@@ -360,4 +363,22 @@ TEST_F(ClientFixture, BlockUploadProtocolSwitchAccepted) {
     up(0x6001, 0, TransferMode::Block);
     EXPECT_EQ(rx("4F 01 60 00 08 00 00 00"), Strs{});
     EXPECT_EQ(hex(cli.result()), "08");
+}
+
+// Hardening (defect 4): a caller who asked for block gets block or an error.
+// By default a server that refuses block mode (0x05040001) is reported as
+// SdoAbortError 0x05040001; nothing is retried segmented behind its back.
+TEST_F(ClientFixture, BlockRefusedIsAnErrorByDefault) {
+    EXPECT_FALSE(SdoClientConfig{}.fallback_to_segmented);
+    EXPECT_FALSE(SdoClientOptions{}.fallback_to_segmented);
+    up(0x1008, 0, TransferMode::Block);
+    EXPECT_EQ(rx("80 08 10 00 01 00 04 05"), Strs{});  // no segmented initiate
+    ASSERT_EQ(cli.status(), SdoClientMachine::Status::Failed);
+    EXPECT_EQ(error<SdoAbortError>().code, 0x05040001u);
+    EXPECT_EQ(cli.counters().fallbacks, 0u);
+    down(0x2100, 0, H("01 02 03 04 05 06 07 08"), TransferMode::Block);
+    EXPECT_EQ(rx("80 00 21 00 01 00 04 05"), Strs{});
+    ASSERT_EQ(cli.status(), SdoClientMachine::Status::Failed);
+    EXPECT_EQ(error<SdoAbortError>().code, 0x05040001u);
+    EXPECT_EQ(cli.counters().fallbacks, 0u);
 }
