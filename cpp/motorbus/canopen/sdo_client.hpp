@@ -122,6 +122,7 @@ private:
     void start_segmented_download(Outbox& out);
     void start_plain_upload(Outbox& out);
     void block_upload_ack(Outbox& out);
+    void block_upload_repeat(Outbox& out);
 
     SdoClientConfig config_;
     SdoClientCounters counters_;
@@ -136,6 +137,11 @@ private:
     bool crc_ = false;
     std::uint8_t blksize_ = 0;
     std::uint8_t seq_ = 0;       // block: last in-order seqno received / sent
+    // Block upload: the last acknowledgement we sent (to repeat it when it is
+    // lost) and whether any segment arrived since it (or since the start command).
+    bool acked_ = false;
+    std::uint8_t last_ackseq_ = 0, last_ack_blksize_ = 0;
+    bool segment_since_ack_ = false;
     std::size_t sent_segments_ = 0;  // block download: segments in the current sub-block
     bool sent_last_ = false;         // block download: the current sub-block ends the data
     Nanos deadline_ = kNoDeadline;
