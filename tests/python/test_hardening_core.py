@@ -53,3 +53,50 @@ def test_load_eds_refuses_an_endless_file_fast():
     with pytest.raises(motorbus.InvalidArgument, match=r"/dev/zero.*16 MiB"):
         load_eds("/dev/zero")
     assert time.monotonic() - t0 < 2.0
+
+
+# ---- defects 1 and 11: invalid values are refused where they enter the core ---------------
+
+@pytest.mark.parametrize("kwargs,name", [({"rx_queue_size": 0}, "rx_queue_size"),
+                                         ({"tx_queue": 0, "bitrate": 500_000}, "tx_queue")])
+def test_bus_size_options_zero_refused(kwargs, name):
+    with pytest.raises(motorbus.InvalidArgument, match=name):
+        motorbus.open_bus(f"virtual:hardening-core-{next(_hub)}", **kwargs)
+
+
+@pytest.mark.parametrize("field", ["drop_probability", "corrupt_probability"])
+@pytest.mark.parametrize("p", [-0.1, 1.5, float("nan")])
+def test_fault_probability_outside_unit_interval_refused(field, p):
+    with motorbus.open_bus(f"virtual:hardening-core-{next(_hub)}") as bus:
+        with pytest.raises(motorbus.InvalidArgument, match=field):
+            bus.set_faults(**{field: p})
+        bus.set_faults(**{field: 1.0})
+
+
+@pytest.mark.parametrize("size", [0, 128, 255])
+def test_sdo_block_size_outside_1_127_refused(size):
+    with motorbus.open_bus(f"virtual:hardening-core-{next(_hub)}") as bus:
+        with pytest.raises(motorbus.InvalidArgument, match="block_size.*1-127"):
+            SdoClient(bus, 5, block_size=size)
+
+
+def test_duplicate_local_node_on_one_hub_refused():
+    name = f"hardening-core-{next(_hub)}"
+    with motorbus.open_bus(f"virtual:{name}") as a, motorbus.open_bus(f"virtual:{name}") as b:
+        od = ObjectDictionary()
+        od.add_variable(0x2000, "U8", "u8", "rw")
+        first = LocalNode(a, 5, od)
+        with pytest.raises(motorbus.InvalidArgument, match="node_id: 5"):
+            LocalNode(a, 5, od)
+        with pytest.raises(motorbus.InvalidArgument, match="node_id: 5"):
+            LocalNode(b, 5, od)
+        first.close()
+        LocalNode(b, 5, od).close()
+
+
+def test_heartbeat_period_below_1ms_refused():
+    from motorbus.canopen import HeartbeatProducer
+    with motorbus.open_bus(f"virtual:hardening-core-{next(_hub)}") as bus:
+        with pytest.raises(motorbus.InvalidArgument, match="1 ms"):
+            HeartbeatProducer(bus, 5, 1e-9)
+        HeartbeatProducer(bus, 5, 0.001)

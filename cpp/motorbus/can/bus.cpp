@@ -18,7 +18,10 @@ const char* to_string(BusState s) {
 }
 
 Bus::Bus(std::string channel, BusOptions options)
-    : options_(options), channel_(std::move(channel)) {}
+    : options_(options), channel_(std::move(channel)) {
+    if (options_.rx_queue_size == 0)
+        throw InvalidArgument("bus " + channel_ + " rx_queue_size: 0, must be >= 1 (frames kept for recv())");
+}
 
 Bus::~Bus() {
     // Derived classes must have called close() in their own destructor, while

@@ -48,7 +48,9 @@ using FrameCallback = std::function<void(const Frame&)>;
 using SubscriptionId = std::uint64_t;
 
 struct BusOptions {
-    std::size_t rx_queue_size = 65536;  // frames kept for recv(); the oldest is dropped past this
+    // Frames kept for recv(); the oldest is dropped past this.  >= 1
+    // (InvalidArgument otherwise: 0 used to pop from an empty queue).
+    std::size_t rx_queue_size = 65536;
     bool receive_own = false;           // deliver frames we sent back to recv()/subscribers
 };
 
@@ -93,6 +95,11 @@ public:
 
     // Stops the backend, wakes every waiter.  Idempotent.
     void close();
+
+    // Identity of the medium this endpoint is on: endpoints that see each
+    // other's frames as one bus share it (all endpoints of one virtual hub).
+    // Default: this bus object.  Lets a node-ID be claimed once per medium.
+    virtual const void* medium() const { return this; }
 
 protected:
     // Backend hooks ----------------------------------------------------------

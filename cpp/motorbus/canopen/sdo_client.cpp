@@ -464,6 +464,11 @@ SdoClient::SdoClient(can::Bus& bus, std::uint8_t node_id, SdoClientOptions optio
     response_id_ = options.response_id ? options.response_id : kDefaultResponseBase + node_id;
     if (request_id_ > can::kMaxStandardId || response_id_ > can::kMaxStandardId)
         throw InvalidArgument("SdoClient COB-IDs must be 11-bit");
+    if (options.block_size == 0 || options.block_size > kMaxBlockSize)
+        throw InvalidArgument("SdoClient block_size: " + std::to_string(options.block_size) +
+                              ", must be 1-127 (segments per sub-block, CiA 301)");
+    if (options.max_transfer == 0)
+        throw InvalidArgument("SdoClient max_transfer: 0, must be >= 1 byte");
     SdoClientConfig c;
     c.timeout_ns = options.timeout.count() > 0 ? options.timeout.count() : 1;
     c.max_transfer = options.max_transfer;

@@ -152,8 +152,8 @@ private:
 
 struct SdoClientOptions {
     std::chrono::nanoseconds timeout = std::chrono::seconds(1);
-    std::size_t max_transfer = 1u << 20;
-    std::uint8_t block_size = 127;
+    std::size_t max_transfer = 1u << 20;  // >= 1 (InvalidArgument otherwise)
+    std::uint8_t block_size = 127;        // 1-127 (InvalidArgument otherwise)
     bool block_crc = true;
     // Opt-in: a server that refuses block mode gets the transfer segmented
     // (Python: SdoClient(..., block_fallback=True)).  Default: SdoAbortError.
