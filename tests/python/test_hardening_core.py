@@ -100,3 +100,39 @@ def test_heartbeat_period_below_1ms_refused():
         with pytest.raises(motorbus.InvalidArgument, match="1 ms"):
             HeartbeatProducer(bus, 5, 1e-9)
         HeartbeatProducer(bus, 5, 0.001)
+
+
+# ---- defect 6: a dead socketcand link wakes its waiters --------------------------------------
+
+@pytest.mark.threaded
+def test_socketcand_waiting_recv_gets_linkdown_when_the_server_goes():
+    import threading
+    from motorbus.socketcand import SocketcandServer, open_socketcand
+    served = motorbus.open_bus(f"virtual:hardening-core-{next(_hub)}")
+    server = SocketcandServer(served, host="127.0.0.1", port=0)
+    bus = open_socketcand("127.0.0.1", server.port, "can0", keepalive=None)
+    outcome = []
+
+    def wait_forever():
+        try:
+            outcome.append(bus.recv(timeout=None))
+        except BaseException as e:  # noqa: BLE001 - the type is what we check
+            outcome.append(e)
+
+    t = threading.Thread(target=wait_forever, daemon=True)
+    t.start()
+    time.sleep(0.05)
+    t0 = time.monotonic()
+    server.close()
+    t.join(timeout=1.0)
+    try:
+        assert not t.is_alive(), "recv(timeout=None) still blocked 1 s after the server closed"
+        assert isinstance(outcome[0], motorbus.LinkDown), outcome
+        assert time.monotonic() - t0 < 1.0
+        with pytest.raises(motorbus.LinkDown):
+            bus.recv_many(timeout=None)
+        with pytest.raises(motorbus.LinkDown):
+            bus.send(motorbus.Frame(0x1, b""))
+    finally:
+        bus.close()
+        served.close()

@@ -67,7 +67,9 @@ public:
     void send(const Frame& frame, Duration timeout = std::chrono::seconds(1));
 
     // Next frame that passed the filters, or nullopt after `timeout`
-    // (a negative timeout waits forever).  Throws ClosedError once closed and drained.
+    // (a negative timeout waits forever).  Throws ClosedError once closed and
+    // drained, LinkDown once the backend lost its link and the queue is drained
+    // (a waiter is woken at once when the link dies).
     std::optional<Frame> recv(Duration timeout);
 
     // Up to `max` frames at once, oldest first: waits like recv() for the
@@ -115,6 +117,11 @@ protected:
     // Backends must call this at the end of their destructor-initiated close
     // path; derived destructors call close() themselves (virtual dispatch).
     void set_state(BusState s) { state_.store(s); }
+    // The medium is gone for good (TCP EOF, reset, keepalive silence): the
+    // state turns bus-off, send() refuses with LinkDown, and every recv() /
+    // recv_many() waiter -- now or later, once the queue is drained -- gets
+    // LinkDown(reason) instead of waiting forever.  Not for our own close().
+    void link_lost(const std::string& reason);
 
     // True while anyone is subscribed; lets a backend skip its thread hop
     // when there is no callback to run (frames then go straight to recv()).
@@ -155,6 +162,8 @@ private:
     std::condition_variable rx_cv_;
     std::deque<Frame> rx_queue_;
     std::vector<Filter> filters_;
+    std::atomic<bool> link_lost_{false};
+    std::string link_lost_reason_;  // rx_mutex_
 
     // subscribers: copy-on-write table, read under table_mutex_ by dispatch()
     std::mutex table_mutex_;
