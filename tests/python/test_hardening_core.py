@@ -136,3 +136,35 @@ def test_socketcand_waiting_recv_gets_linkdown_when_the_server_goes():
     finally:
         bus.close()
         served.close()
+
+
+# ---- defect 3: one serial line, one opener ---------------------------------------------------
+
+def test_pty_slave_opens_once_in_this_process_and_from_a_child():
+    import os
+    import subprocess
+    import sys
+    from motorbus.serial import PtyLineServer, PtyPair, open_port
+    with PtyPair() as pty:
+        first = open_port(pty.slave_path, 0)
+        with pytest.raises(motorbus.LinkDown, match=rf"{pty.slave_path}.*busy.*pid {os.getpid()}"):
+            open_port(pty.slave_path, 0)
+        child = subprocess.run(
+            [sys.executable, "-c",
+             "import sys, motorbus\n"
+             "from motorbus.serial import open_port\n"
+             "try:\n"
+             "    open_port(sys.argv[1], 0)\n"
+             "except motorbus.LinkDown as e:\n"
+             "    print(e); sys.exit(0)\n"
+             "sys.exit(1)\n", pty.slave_path],
+            capture_output=True, text=True, timeout=30)
+        assert child.returncode == 0, "the child opened a port this process holds"
+        assert f"pid {os.getpid()}" in child.stdout
+        first.close()
+        open_port(pty.slave_path, 0).close()  # free again once closed
+    with PtyLineServer([]) as server:
+        client = open_port(server.slave_path, 115200)
+        with pytest.raises(motorbus.LinkDown, match="busy"):
+            open_port(server.slave_path, 115200)
+        client.close()
