@@ -450,8 +450,9 @@ void bind_canopen(py::module_& m) {
     py::class_<SdoClient>(m, "SdoClient", "SDO client for one node (requests 0x600+n, responses 0x580+n).")
         .def(py::init([](can::Bus& bus, std::uint8_t node_id, double timeout, std::size_t max_transfer,
                          std::uint8_t block_size, unsigned read_retries, std::uint32_t request_id,
-                         std::uint32_t response_id) {
+                         std::uint32_t response_id, bool block_fallback) {
                  SdoClientOptions o;
+                 o.fallback_to_segmented = block_fallback;
                  o.timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9));
                  o.max_transfer = max_transfer;
                  o.block_size = block_size;
@@ -462,7 +463,7 @@ void bind_canopen(py::module_& m) {
              }),
              py::arg("bus"), py::arg("node_id"), py::arg("timeout") = 1.0, py::arg("max_transfer") = 1u << 20,
              py::arg("block_size") = 127, py::arg("read_retries") = 0, py::arg("request_id") = 0,
-             py::arg("response_id") = 0, py::keep_alive<1, 2>())
+             py::arg("response_id") = 0, py::arg("block_fallback") = false, py::keep_alive<1, 2>())
         .def("upload", [](SdoClient& c, std::uint16_t i, std::uint8_t s, bool block) {
                  Bytes b;
                  {

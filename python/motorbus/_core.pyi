@@ -1379,7 +1379,7 @@ class SdoClient:
     """
     SDO client for one node (requests 0x600+n, responses 0x580+n).
     """
-    def __init__(self, bus: Bus, node_id: typing.SupportsInt | typing.SupportsIndex, timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0, max_transfer: typing.SupportsInt | typing.SupportsIndex = 1048576, block_size: typing.SupportsInt | typing.SupportsIndex = 127, read_retries: typing.SupportsInt | typing.SupportsIndex = 0, request_id: typing.SupportsInt | typing.SupportsIndex = 0, response_id: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
+    def __init__(self, bus: Bus, node_id: typing.SupportsInt | typing.SupportsIndex, timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0, max_transfer: typing.SupportsInt | typing.SupportsIndex = 1048576, block_size: typing.SupportsInt | typing.SupportsIndex = 127, read_retries: typing.SupportsInt | typing.SupportsIndex = 0, request_id: typing.SupportsInt | typing.SupportsIndex = 0, response_id: typing.SupportsInt | typing.SupportsIndex = 0, block_fallback: bool = False) -> None:
         ...
     def download(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, data: typing.Any, block: bool = False, segmented: bool = False) -> None:
         ...

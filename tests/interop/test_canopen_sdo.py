@@ -118,7 +118,9 @@ def theirs_served():
     network.add_node(local)
     pc = can.Bus(interface="virtual", channel=channel)
     bus = motorbus.open_bus(pc)
-    sdo = SdoClient(bus, 6, timeout=1.0)
+    # canopen's LocalNode has no block server: block transfers reach it only
+    # through the explicit fall-back to segmented (off by default).
+    sdo = SdoClient(bus, 6, timeout=1.0, block_fallback=True)
     yield local, sdo
     bus.close()
     network.disconnect()

@@ -19,7 +19,10 @@ const char* to_string(BusState s) {
 }
 
 Bus::Bus(std::string channel, BusOptions options)
-    : options_(options), channel_(std::move(channel)) {}
+    : options_(options), channel_(std::move(channel)) {
+    if (options_.rx_queue_size == 0)
+        throw InvalidArgument("bus " + channel_ + " rx_queue_size: 0, must be >= 1 (frames kept for recv())");
+}
 
 Bus::~Bus() {
     // Derived classes must have called close() in their own destructor, while
@@ -43,17 +46,32 @@ void Bus::send(const Frame& frame, Duration timeout) {
     }
 }
 
+void Bus::link_lost(const std::string& reason) {
+    {
+        std::lock_guard lock(rx_mutex_);
+        if (link_lost_.load()) return;
+        link_lost_reason_ = reason;
+        link_lost_.store(true);
+    }
+    if (!closed_.load()) set_state(BusState::BusOff);
+    rx_cv_.notify_all();
+}
+
 // Waits until the recv() queue has a frame: false after `timeout` (negative =
-// forever); ClosedError once the bus is closed and the queue drained.
+// forever); ClosedError once the bus is closed and the queue drained, LinkDown
+// once the link is lost and the queue drained.
 bool Bus::wait_for_rx(std::unique_lock<std::mutex>& lock, Duration timeout) {
     if (!rx_queue_.empty()) return true;  // the common case under load: no clock read, no wait
-    auto ready = [&] { return !rx_queue_.empty() || closed_.load(); };
+    auto ready = [&] { return !rx_queue_.empty() || closed_.load() || link_lost_.load(); };
     if (timeout.count() < 0) {
         rx_cv_.wait(lock, ready);
     } else if (!rx_cv_.wait_for(lock, timeout, ready)) {
         return false;
     }
-    if (rx_queue_.empty()) throw ClosedError("bus " + channel_ + " is closed");
+    if (rx_queue_.empty()) {
+        if (closed_.load()) throw ClosedError("bus " + channel_ + " is closed");
+        throw LinkDown("bus " + channel_ + ": link down: " + link_lost_reason_);
+    }
     return true;
 }
 

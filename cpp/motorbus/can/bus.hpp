@@ -50,7 +50,9 @@ using FrameCallback = std::function<void(const Frame&)>;
 using SubscriptionId = std::uint64_t;
 
 struct BusOptions {
-    std::size_t rx_queue_size = 65536;  // frames kept for recv(); the oldest is dropped past this
+    // Frames kept for recv(); the oldest is dropped past this.  >= 1
+    // (InvalidArgument otherwise: 0 used to pop from an empty queue).
+    std::size_t rx_queue_size = 65536;
     bool receive_own = false;           // deliver frames we sent back to recv()/subscribers
 };
 
@@ -67,7 +69,9 @@ public:
     void send(const Frame& frame, Duration timeout = std::chrono::seconds(1));
 
     // Next frame that passed the filters, or nullopt after `timeout`
-    // (a negative timeout waits forever).  Throws ClosedError once closed and drained.
+    // (a negative timeout waits forever).  Throws ClosedError once closed and
+    // drained, LinkDown once the backend lost its link and the queue is drained
+    // (a waiter is woken at once when the link dies).
     std::optional<Frame> recv(Duration timeout);
 
     // Up to `max` frames at once, oldest first: waits like recv() for the
@@ -96,6 +100,11 @@ public:
     // Stops the backend, wakes every waiter.  Idempotent.
     void close();
 
+    // Identity of the medium this endpoint is on: endpoints that see each
+    // other's frames as one bus share it (all endpoints of one virtual hub).
+    // Default: this bus object.  Lets a node-ID be claimed once per medium.
+    virtual const void* medium() const { return this; }
+
 protected:
     // Backend hooks ----------------------------------------------------------
     virtual void do_send(const Frame& frame, Deadline deadline) = 0;
@@ -110,6 +119,11 @@ protected:
     // Backends must call this at the end of their destructor-initiated close
     // path; derived destructors call close() themselves (virtual dispatch).
     void set_state(BusState s) { state_.store(s); }
+    // The medium is gone for good (TCP EOF, reset, keepalive silence): the
+    // state turns bus-off, send() refuses with LinkDown, and every recv() /
+    // recv_many() waiter -- now or later, once the queue is drained -- gets
+    // LinkDown(reason) instead of waiting forever.  Not for our own close().
+    void link_lost(const std::string& reason);
 
     // True while anyone is subscribed; lets a backend skip its thread hop
     // when there is no callback to run (frames then go straight to recv()).
@@ -150,6 +164,8 @@ private:
     std::condition_variable rx_cv_;
     std::deque<Frame> rx_queue_;
     std::vector<Filter> filters_;
+    std::atomic<bool> link_lost_{false};
+    std::string link_lost_reason_;  // rx_mutex_
 
     // subscribers: copy-on-write table, read under table_mutex_ by dispatch()
     std::mutex table_mutex_;

@@ -173,9 +173,10 @@ void SocketcandBus::mark_link_down(const std::string& why) {
     }
     link_down_.store(true);
     tx_space_cv_.notify_all();
-    // No medium any more: Bus::send() refuses with LinkDown and state() shows it.
+    // No medium any more: Bus::send() refuses with LinkDown, state() shows it,
+    // and recv()/recv_many() waiters wake with LinkDown (never blocked forever).
     // (After close() the state stays Closed: our own shutdown is not a link failure.)
-    if (!closed()) set_state(BusState::BusOff);
+    if (!closed()) link_lost(why);
 }
 
 void SocketcandBus::account_parser() {

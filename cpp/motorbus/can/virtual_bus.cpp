@@ -207,6 +207,18 @@ private:
 };
 
 namespace {
+void check_faults(const FaultOptions& f) {
+    auto prob = [](const char* name, double p) {
+        if (!(p >= 0.0 && p <= 1.0))  // NaN fails both
+            throw InvalidArgument(std::string("virtual bus faults ") + name + ": " + std::to_string(p) +
+                                  ", must be in [0, 1]");
+    };
+    prob("drop_probability", f.drop_probability);
+    prob("corrupt_probability", f.corrupt_probability);
+    if (f.delay_ns < 0)
+        throw InvalidArgument("virtual bus faults delay: " + std::to_string(f.delay_ns) + " ns, must be >= 0");
+}
+
 std::mutex g_hubs_mutex;
 std::map<std::string, std::weak_ptr<VirtualHub>> g_hubs;
 }  // namespace
@@ -318,6 +330,7 @@ void VirtualBus::enqueue_rx(const Frame& f) {
 }
 
 void VirtualBus::set_faults(const FaultOptions& f) {
+    check_faults(f);
     std::lock_guard lock(impl_->mutex);
     impl_->faults = f;
     impl_->rng.seed(f.seed);
@@ -334,6 +347,8 @@ void VirtualBus::set_bus_off(bool off) {
 }
 
 double VirtualBus::bitrate() const { return impl_->hub->bitrate(); }
+
+const void* VirtualBus::medium() const { return impl_->hub.get(); }
 
 void VirtualBus::do_send(const Frame& frame, Deadline deadline) {
     Frame f = frame;
@@ -369,6 +384,10 @@ std::shared_ptr<VirtualBus> open_virtual(const std::string& name, const VirtualO
     if (name.empty()) throw InvalidArgument("virtual bus name: must not be empty");
     if (opts.bitrate < 0) throw InvalidArgument("virtual bus bitrate: must be >= 0");
     if (opts.rx_spin.count() < 0) throw InvalidArgument("virtual bus rx_spin: must be >= 0");
+    if (opts.tx_queue == 0) throw InvalidArgument("virtual bus tx_queue: 0, must be >= 1 (frames waiting for the wire)");
+    if (opts.rx_queue_size == 0)
+        throw InvalidArgument("virtual bus rx_queue_size: 0, must be >= 1 (frames kept for recv())");
+    check_faults(opts.faults);
     std::shared_ptr<VirtualHub> hub;
     {
         std::lock_guard lock(g_hubs_mutex);

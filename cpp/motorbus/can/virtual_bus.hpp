@@ -15,17 +15,19 @@
 
 namespace motorbus::can {
 
+// Checked by set_faults() and open_virtual(): probabilities in [0, 1], delay >= 0
+// (InvalidArgument naming the field otherwise).
 struct FaultOptions {
     unsigned drop_every = 0;           // drop every n-th frame sent (0 = never)
-    double drop_probability = 0.0;     // drop each frame with this probability
-    double corrupt_probability = 0.0;  // flip one random data bit with this probability
-    Nanos delay_ns = 0;                // extra latency before delivery
+    double drop_probability = 0.0;     // drop each frame with this probability, [0, 1]
+    double corrupt_probability = 0.0;  // flip one random data bit with this probability, [0, 1]
+    Nanos delay_ns = 0;                // extra latency before delivery, >= 0
     std::uint64_t seed = 0x5eed;       // for the probabilistic faults (reproducible)
 };
 
 struct VirtualOptions : BusOptions {
     double bitrate = 0.0;         // bit/s; 0 = no wire time.  All endpoints of a hub must agree.
-    std::size_t tx_queue = 64;    // frames waiting for the wire before send() blocks
+    std::size_t tx_queue = 64;    // frames waiting for the wire before send() blocks, >= 1
     FaultOptions faults;
     // How long an endpoint's receive thread polls for the next frame before it
     // sleeps.  Saves a thread wake-up per frame in request/response exchanges
@@ -45,6 +47,8 @@ public:
     // is received) and recovering.
     void set_bus_off(bool off);
     double bitrate() const;
+    // The hub: every endpoint of one hub is one medium.
+    const void* medium() const override;
 
 protected:
     void do_send(const Frame& frame, Deadline deadline) override;

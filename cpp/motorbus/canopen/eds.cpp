@@ -367,9 +367,23 @@ std::shared_ptr<ObjectDictionary> load_eds(const std::string& path, const EdsImp
                                            std::vector<std::string>* warnings) {
     std::ifstream f(path, std::ios::binary);
     if (!f) throw InvalidArgument("EDS: cannot read '" + path + "'");
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return parse_eds(ss.str(), options, warnings);
+    // Read at most the cap plus one byte: a bigger (or endless: /dev/zero, a
+    // FIFO) file is refused without reading further or growing past the cap.
+    std::string text;
+    std::size_t have = 0;
+    constexpr std::size_t kChunk = 64 * 1024;
+    while (f && have <= kMaxEdsFileBytes) {
+        text.resize(std::min(have + kChunk, kMaxEdsFileBytes + 1));
+        f.read(text.data() + have, static_cast<std::streamsize>(text.size() - have));
+        have += static_cast<std::size_t>(f.gcount());
+    }
+    if (have > kMaxEdsFileBytes)
+        throw InvalidArgument("EDS: '" + path + "' is larger than the " +
+                              std::to_string(kMaxEdsFileBytes >> 20) +
+                              " MiB an EDS/DCF file may have (kMaxEdsFileBytes); not read further");
+    if (f.bad()) throw InvalidArgument("EDS: cannot read '" + path + "'");
+    text.resize(have);
+    return parse_eds(text, options, warnings);
 }
 
 namespace {

@@ -37,7 +37,12 @@ struct EdsExportOptions {
 // sections at all or a line is not INI; skips (and reports) bad entries.
 std::shared_ptr<ObjectDictionary> parse_eds(std::string_view text, const EdsImportOptions& options = {},
                                             std::vector<std::string>* warnings = nullptr);
-// Reads a file (InvalidArgument naming the path if it cannot be read).
+// The largest EDS/DCF file load_eds reads (16 MiB; real files are a few
+// hundred kB).  A bigger file, or an endless one (/dev/zero, a FIFO), is
+// refused with InvalidArgument naming the file and the cap; reading stops there.
+inline constexpr std::size_t kMaxEdsFileBytes = std::size_t{16} << 20;
+// Reads a file (InvalidArgument naming the path if it cannot be read or is
+// larger than kMaxEdsFileBytes).
 std::shared_ptr<ObjectDictionary> load_eds(const std::string& path, const EdsImportOptions& options = {},
                                            std::vector<std::string>* warnings = nullptr);
 

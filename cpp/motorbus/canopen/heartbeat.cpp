@@ -169,11 +169,17 @@ void HeartbeatConsumer::stop() { timer_.stop(); }
 
 // ---- producer ---------------------------------------------------------------
 
+void HeartbeatProducer::check_period(std::chrono::nanoseconds period) {
+    if (period.count() != 0 && period < kMinHeartbeatPeriod)
+        throw InvalidArgument("heartbeat producer period: " + std::to_string(period.count()) +
+                              " ns, must be 0 (off) or >= 1 ms");
+}
+
 HeartbeatProducer::HeartbeatProducer(can::Bus& bus, Clock& clock, std::uint8_t node_id,
                                      std::chrono::nanoseconds period, std::function<NodeState()> state)
     : bus_(bus), clock_(clock), node_(node_id), period_(period.count()), state_(std::move(state)) {
     if (node_id == 0 || node_id > kMaxNodeId) throw InvalidArgument("heartbeat producer: node id must be 1-127");
-    if (period_ < 0) throw InvalidArgument("heartbeat producer: period must be >= 0");
+    check_period(period);
     if (!state_) throw InvalidArgument("heartbeat producer: state function required");
 }
 
@@ -185,7 +191,7 @@ void HeartbeatProducer::send_boot_up() {
 }
 
 void HeartbeatProducer::set_period(std::chrono::nanoseconds period) {
-    if (period.count() < 0) throw InvalidArgument("heartbeat producer: period must be >= 0");
+    check_period(period);
     {
         std::lock_guard l(mutex_);
         period_ = period.count();

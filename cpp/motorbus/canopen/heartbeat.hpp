@@ -111,9 +111,14 @@ private:
     TimerThread timer_;
 };
 
+// The shortest heartbeat period a producer accepts (0x1017 counts in ms; a
+// shorter one would flood the bus).  0 = off.
+inline constexpr std::chrono::nanoseconds kMinHeartbeatPeriod = std::chrono::milliseconds(1);
+
 class HeartbeatProducer {
 public:
     // Sends 0x700+node with state() every `period`; a period of 0 disables it.
+    // Other periods below kMinHeartbeatPeriod (1 ms) are InvalidArgument.
     HeartbeatProducer(can::Bus& bus, Clock& clock, std::uint8_t node_id,
                       std::chrono::nanoseconds period, std::function<NodeState()> state);
     ~HeartbeatProducer();
@@ -132,6 +137,7 @@ public:
     std::uint64_t send_failures() const { return timer_.failures(); }
 
 private:
+    static void check_period(std::chrono::nanoseconds period);
     can::Bus& bus_;
     Clock& clock_;
     std::uint8_t node_;

@@ -1,5 +1,6 @@
 #include "motorbus/canopen/local_node.hpp"
 
+#include <set>
 #include <algorithm>
 #include <cctype>
 #include <cstring>
@@ -37,6 +38,26 @@ std::optional<NmtState> nmt_state_from_name(std::string_view name) {
     return std::nullopt;
 }
 
+namespace {
+// (medium, node-ID) pairs served by a LocalNode in this process: two nodes
+// with one ID on one bus (or on two endpoints of one virtual hub) would both
+// answer every SDO request and NMT command.
+std::mutex g_claims_mutex;
+std::set<std::pair<const void*, std::uint8_t>> g_claims;
+}  // namespace
+
+void LocalNode::claim_node_id(can::Bus& bus, std::uint8_t node_id) {
+    std::lock_guard lock(g_claims_mutex);
+    if (!g_claims.emplace(bus.medium(), node_id).second)
+        throw InvalidArgument("LocalNode node_id: " + std::to_string(node_id) + " is already served on " +
+                              bus.channel() + " (one LocalNode per node-ID per bus; close the other first)");
+}
+
+void LocalNode::release_node_id(can::Bus& bus, std::uint8_t node_id) {
+    std::lock_guard lock(g_claims_mutex);
+    g_claims.erase({bus.medium(), node_id});
+}
+
 LocalNode::LocalNode(can::Bus& bus, std::uint8_t node_id, std::shared_ptr<ObjectDictionary> od,
                      LocalNodeOptions options)
     : bus_(bus),
@@ -46,11 +67,18 @@ LocalNode::LocalNode(can::Bus& bus, std::uint8_t node_id, std::shared_ptr<Object
       server_(*od_, options.sdo) {
     if (node_id == 0 || node_id > 127)  // N14
         throw InvalidArgument("LocalNode node_id: " + std::to_string(node_id) + ", must be 1-127");
-    if (od_->node_id() == 0) od_->set_node_id(node_id);
-    subs_.push_back(bus_.subscribe_id(0x000, false, [this](const can::Frame& f) { on_nmt_frame(f); }));
-    if (options_.serve_sdo)
-        subs_.push_back(bus_.subscribe_id(sdo::kDefaultRequestBase + node_id, false,
-                                          [this](const can::Frame& f) { on_sdo_frame(f); }));
+    claim_node_id(bus_, node_id);  // one LocalNode per node-ID per medium
+    try {
+        if (od_->node_id() == 0) od_->set_node_id(node_id);
+        subs_.push_back(bus_.subscribe_id(0x000, false, [this](const can::Frame& f) { on_nmt_frame(f); }));
+        if (options_.serve_sdo)
+            subs_.push_back(bus_.subscribe_id(sdo::kDefaultRequestBase + node_id, false,
+                                              [this](const can::Frame& f) { on_sdo_frame(f); }));
+    } catch (...) {
+        for (auto s : subs_) bus_.unsubscribe(s);
+        release_node_id(bus_, node_id);
+        throw;
+    }
     thread_ = std::thread([this] { worker(); });
     if (options_.send_boot_up) send_boot_up();
     transition(NmtState::PreOperational);
@@ -61,6 +89,7 @@ LocalNode::~LocalNode() { close(); }
 void LocalNode::close() {
     if (closed_.exchange(true)) return;
     for (auto s : subs_) bus_.unsubscribe(s);
+    release_node_id(bus_, node_id_);
     {
         std::lock_guard lock(mutex_);
         stopping_ = true;

@@ -128,6 +128,8 @@ public:
     void close();
 
 private:
+    static void claim_node_id(can::Bus& bus, std::uint8_t node_id);
+    static void release_node_id(can::Bus& bus, std::uint8_t node_id);
     void on_sdo_frame(const can::Frame& f);
     void on_nmt_frame(const can::Frame& f);
     void apply_nmt(NmtCommand c);

@@ -34,6 +34,8 @@ void SdoClientMachine::reset() {
     indicated_.reset();
     toggle_ = crc_ = sent_last_ = false;
     seq_ = 0;
+    acked_ = segment_since_ack_ = false;
+    last_ackseq_ = last_ack_blksize_ = 0;
     sent_segments_ = 0;
     deadline_ = sub_deadline_ = kNoDeadline;
     error_ = nullptr;
@@ -262,7 +264,24 @@ void SdoClientMachine::on_download(std::span<const std::uint8_t> p, Outbox& out)
 
 void SdoClientMachine::block_upload_ack(Outbox& out) {
     out.push_back(sdo::block_upload_ack(seq_, blksize_));
+    acked_ = true;
+    last_ackseq_ = seq_;
+    last_ack_blksize_ = blksize_;
+    segment_since_ack_ = false;
     seq_ = 0;
+}
+
+// Nothing arrived since our last frame of the block upload: that frame was
+// lost (or the server's answer was).  Repeat it as it was.  An acknowledgement
+// with ackseq 0 here would tell a server still waiting for the lost one that
+// none of the sub-block arrived: it resends it, and with the same sequence
+// numbers as a new sub-block the client would take it as new data.
+void SdoClientMachine::block_upload_repeat(Outbox& out) {
+    ++counters_.retransmit_requests;
+    if (!acked_)
+        out.push_back(block_upload_start());
+    else
+        out.push_back(sdo::block_upload_ack(last_ackseq_, last_ack_blksize_));
 }
 
 void SdoClientMachine::on_block_upload(std::span<const std::uint8_t> p, Nanos now, Outbox& out) {
@@ -322,6 +341,7 @@ void SdoClientMachine::on_block_upload(std::span<const std::uint8_t> p, Nanos no
     const bool last = p[0] & 0x80;
     if (seqno == 0) return fail_abort(ac::kSequenceNumber, out, p, "sequence number 0");
     arm_sub();
+    segment_since_ack_ = true;
     if (seqno == seq_ + 1) {
         if (indicated_ && data_.size() >= *indicated_ + (*indicated_ == 0 ? 1 : 0))  // C11
             return fail_abort(ac::kTooLong, out, p, "more data than indicated");
@@ -332,7 +352,7 @@ void SdoClientMachine::on_block_upload(std::span<const std::uint8_t> p, Nanos no
         if (last) {
             block_upload_ack(out);
             phase_ = Phase::BlkUpEnd;
-            sub_deadline_ = kNoDeadline;
+            arm_sub();  // repeats this acknowledgement if the end frame does not come
         } else if (seq_ >= blksize_) {
             block_upload_ack(out);
         }
@@ -420,11 +440,17 @@ void SdoClientMachine::on_timer(Nanos now, Outbox& out) {
         Bytes().swap(data_);
         return;
     }
-    if (phase_ == Phase::BlkUpSub && now >= sub_deadline_) {
+    if ((phase_ == Phase::BlkUpSub || phase_ == Phase::BlkUpEnd) && now >= sub_deadline_) {
+        sub_deadline_ = kNoDeadline;
+        if (phase_ == Phase::BlkUpEnd || !segment_since_ack_) {
+            // Our start command or last acknowledgement was lost (the server
+            // still waits for it): say the same again.
+            block_upload_repeat(out);
+            return;
+        }
         // B12: the server stalled mid sub-block; ack what arrived so it resends the rest.
         ++counters_.retransmit_requests;
         block_upload_ack(out);
-        sub_deadline_ = kNoDeadline;
     }
 }
 
@@ -438,6 +464,11 @@ SdoClient::SdoClient(can::Bus& bus, std::uint8_t node_id, SdoClientOptions optio
     response_id_ = options.response_id ? options.response_id : kDefaultResponseBase + node_id;
     if (request_id_ > can::kMaxStandardId || response_id_ > can::kMaxStandardId)
         throw InvalidArgument("SdoClient COB-IDs must be 11-bit");
+    if (options.block_size == 0 || options.block_size > kMaxBlockSize)
+        throw InvalidArgument("SdoClient block_size: " + std::to_string(options.block_size) +
+                              ", must be 1-127 (segments per sub-block, CiA 301)");
+    if (options.max_transfer == 0)
+        throw InvalidArgument("SdoClient max_transfer: 0, must be >= 1 byte");
     SdoClientConfig c;
     c.timeout_ns = options.timeout.count() > 0 ? options.timeout.count() : 1;
     c.max_transfer = options.max_transfer;
@@ -477,10 +508,15 @@ void SdoClient::send_out() {
 
 void SdoClient::on_frame(const can::Frame& f) {
     if (f.rtr || (f.flags & (can::kFlagError | can::kFlagLoopback))) return;
-    bool done;
+    bool done, sooner;
     {
         std::lock_guard lock(mutex_);
+        const Nanos before = machine_.next_deadline();
         machine_.on_frame(f.payload(), monotonic_ns(), outbox_);
+        // A timer armed earlier than the one the caller sleeps on (the block
+        // upload's sub-block timer) must wake it, or it fires only at the old
+        // deadline, racing with the transfer timeout.
+        sooner = machine_.next_deadline() < before;
         try {
             send_out();
         } catch (const std::exception&) {
@@ -493,6 +529,8 @@ void SdoClient::on_frame(const can::Frame& f) {
     // block on the mutex this thread still holds.
     if (done) {
         idle_.store(true, std::memory_order_release);
+        cv_.notify_all();
+    } else if (sooner) {
         cv_.notify_all();
     }
 }
@@ -515,7 +553,10 @@ void SdoClient::run(std::unique_lock<std::mutex>& lock) {
     while (machine_.busy()) {
         const Nanos dl = machine_.next_deadline();
         cv_.wait_until(lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dl)),
-                       [&] { return !machine_.busy() || monotonic_ns() >= machine_.next_deadline(); });
+                       [&] {
+                           return !machine_.busy() || machine_.next_deadline() < dl ||
+                                  monotonic_ns() >= machine_.next_deadline();
+                       });
         if (machine_.busy() && monotonic_ns() >= machine_.next_deadline()) {
             machine_.on_timer(monotonic_ns(), outbox_);
             try {

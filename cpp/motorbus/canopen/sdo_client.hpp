@@ -37,7 +37,8 @@ namespace motorbus::canopen {
 enum class TransferMode {
     Auto,       // upload: the server picks expedited/segmented; download: expedited if <= 4 bytes
     Segmented,  // download: segmented even for <= 4 bytes (upload: same as Auto)
-    Block,      // block transfer; falls back to segmented if the server refuses block mode
+    Block,      // block transfer; a server that refuses block mode is an SdoAbortError
+                // (0x05040001) unless fallback_to_segmented was asked for
 };
 
 constexpr Nanos kNoDeadline = std::numeric_limits<Nanos>::max();
@@ -48,7 +49,10 @@ struct SdoClientConfig {
     std::uint8_t block_size = 127;         // sub-block size we offer in block upload (1..127)
     bool block_crc = true;                 // offer CRC in block transfers
     std::uint8_t protocol_switch = 0;      // pst of block upload (0 = always block)
-    bool fallback_to_segmented = true;     // server refuses block mode -> retry segmented
+    // Server refuses block mode (abort 0x05040001 / 0x06010000 to the block
+    // initiate) -> retry the same transfer segmented (no CRC).  Off by default:
+    // a caller who asked for block gets block or SdoAbortError.
+    bool fallback_to_segmented = false;
     // Block upload: ack what arrived when a sub-block stalls for this fraction of
     // the timeout, so the server retransmits the rest (B12/B13).
     double subblock_timer_fraction = 0.7;
@@ -118,6 +122,7 @@ private:
     void start_segmented_download(Outbox& out);
     void start_plain_upload(Outbox& out);
     void block_upload_ack(Outbox& out);
+    void block_upload_repeat(Outbox& out);
 
     SdoClientConfig config_;
     SdoClientCounters counters_;
@@ -132,6 +137,11 @@ private:
     bool crc_ = false;
     std::uint8_t blksize_ = 0;
     std::uint8_t seq_ = 0;       // block: last in-order seqno received / sent
+    // Block upload: the last acknowledgement we sent (to repeat it when it is
+    // lost) and whether any segment arrived since it (or since the start command).
+    bool acked_ = false;
+    std::uint8_t last_ackseq_ = 0, last_ack_blksize_ = 0;
+    bool segment_since_ack_ = false;
     std::size_t sent_segments_ = 0;  // block download: segments in the current sub-block
     bool sent_last_ = false;         // block download: the current sub-block ends the data
     Nanos deadline_ = kNoDeadline;
@@ -142,10 +152,12 @@ private:
 
 struct SdoClientOptions {
     std::chrono::nanoseconds timeout = std::chrono::seconds(1);
-    std::size_t max_transfer = 1u << 20;
-    std::uint8_t block_size = 127;
+    std::size_t max_transfer = 1u << 20;  // >= 1 (InvalidArgument otherwise)
+    std::uint8_t block_size = 127;        // 1-127 (InvalidArgument otherwise)
     bool block_crc = true;
-    bool fallback_to_segmented = true;
+    // Opt-in: a server that refuses block mode gets the transfer segmented
+    // (Python: SdoClient(..., block_fallback=True)).  Default: SdoAbortError.
+    bool fallback_to_segmented = false;
     // Idempotent reads are retried this many times after a timeout (writes never are).
     unsigned read_retries = 0;
     // Before sleeping, the caller polls (yielding the CPU) this long for the

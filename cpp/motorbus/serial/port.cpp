@@ -3,6 +3,10 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/file.h>
+#include <sys/ioctl.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/eventfd.h>
 #include <termios.h>
 #include <unistd.h>
@@ -10,7 +14,9 @@
 #include <atomic>
 #include <cerrno>
 #include <climits>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <mutex>
 #include <shared_mutex>
 
@@ -97,6 +103,53 @@ void make_raw(int fd, const std::string& name) {
     if (::tcsetattr(fd, TCSANOW, &tio) != 0) throw InvalidArgument(errno_text(name + ": tcsetattr", errno));
 }
 
+// The PID holding a flock on the file `fd` is open on, from /proc/locks
+// ("1: FLOCK  ADVISORY  WRITE 1234 00:18:6 0 EOF"; dev as hex maj:min); 0 if unknown.
+int flock_holder(int fd) {
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) return 0;
+    std::ifstream locks("/proc/locks");
+    std::string line;
+    while (std::getline(locks, line)) {
+        if (line.find("->") != std::string::npos) continue;  // a waiter, not the holder
+        char kind[16] = {};
+        int pid = 0;
+        unsigned maj = 0, min = 0;
+        unsigned long ino = 0;
+        if (std::sscanf(line.c_str(), "%*d: %15s %*s %*s %d %x:%x:%lu", kind, &pid, &maj, &min, &ino) != 5)
+            continue;
+        if (std::string(kind) == "FLOCK" && maj == major(st.st_dev) && min == minor(st.st_dev) && ino == st.st_ino)
+            return pid;
+    }
+    return 0;
+}
+
+[[noreturn]] void throw_busy(const std::string& path, int holder, const char* how) {
+    std::string who = holder == 0              ? "another process"
+                      : holder == ::getpid()   ? "this process (pid " + std::to_string(holder) + ")"
+                                               : "pid " + std::to_string(holder);
+    throw PortBusy("serial port " + path + " is busy: already open by " + who + " (" + how +
+                       "); ports are opened exclusively",
+                   holder);
+}
+
+// Takes the port for us alone: flock (works for root too, and tells the
+// holder's PID through /proc/locks) and TIOCEXCL (other openers get EBUSY from
+// open() itself, unless they are root).  Closes `fd` and throws PortBusy when
+// someone else has it.
+void lock_exclusive(int fd, const std::string& path) {
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        const int err = errno;
+        if (err == EWOULDBLOCK) {
+            const int holder = flock_holder(fd);
+            ::close(fd);
+            throw_busy(path, holder, "flock");
+        }
+        // Filesystems without flock: TIOCEXCL below still guards the port.
+    }
+    ::ioctl(fd, TIOCEXCL);
+}
+
 timespec to_timespec(Duration d) {
     if (d.count() < 0) d = Duration::zero();
     timespec ts{};
@@ -112,6 +165,7 @@ struct TtyPort::Impl {
     int wake = -1;  // eventfd: signalled once by close(), never drained
     std::string name;
     bool is_device = false;
+    bool exclusive = false;  // TIOCEXCL set by us: cleared again on close
     std::atomic<bool> closed{false};
     std::atomic<std::int64_t> write_timeout_ns{-1};
     mutable std::shared_mutex io;  // shared by read/write; exclusive to close the fds
@@ -179,12 +233,22 @@ TtyPort::TtyPort(const std::string& path, unsigned baud) : impl_(std::make_uniqu
     int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
         int err = errno;
+        if (err == EBUSY) {  // TIOCEXCL of another holder: ask the lock table who
+            int holder = 0;
+            if (int probe = ::open(path.c_str(), O_PATH | O_CLOEXEC); probe >= 0) {
+                holder = flock_holder(probe);
+                ::close(probe);
+            }
+            throw_busy(path, holder, "TIOCEXCL");
+        }
         if (err == ENOENT || err == ENOTDIR || err == EACCES || err == ENXIO || err == ENODEV)
             throw InvalidArgument(errno_text("serial port " + path, err));
         throw LinkDown(errno_text("serial port " + path, err));
     }
+    lock_exclusive(fd, path);
     impl_->init(fd, path, true);
     impl_->is_device = true;
+    impl_->exclusive = true;
     if (baud != 0) {
         try {
             set_baud(baud);
@@ -260,6 +324,10 @@ void TtyPort::close() {
     std::uint64_t one = 1;
     [[maybe_unused]] auto w = ::write(impl_->wake, &one, sizeof one);
     std::unique_lock lk(impl_->io);  // waits for blocked readers/writers to leave
+    // The tty may outlive this descriptor (a PtyPair keeps its slave open):
+    // clear the exclusive flag so the next opener is not refused.  The flock
+    // goes with the descriptor.
+    if (impl_->exclusive) ::ioctl(impl_->fd, TIOCNXCL);
     ::close(impl_->fd);
     ::close(impl_->wake);
     impl_->fd = -1;

@@ -17,6 +17,16 @@ namespace motorbus::serial {
 
 using Duration = std::chrono::nanoseconds;
 
+// The port is already open elsewhere (another process, or another TtyPort in
+// this one): ports are opened exclusively (flock + TIOCEXCL), so two users
+// never read each other's replies.  The message names the port and, where the
+// kernel tells (/proc/locks), the holder's PID.  A LinkDown, so Python sees
+// motorbus.LinkDown (a ConnectionError).
+struct PortBusy : LinkDown {
+    PortBusy(const std::string& what, int holder) : LinkDown(what), holder_pid(holder) {}
+    int holder_pid;  // 0 when unknown
+};
+
 // A bidirectional byte stream.  Thread-safe for one reader + one writer.
 class Port {
 public:

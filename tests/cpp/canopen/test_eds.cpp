@@ -2,6 +2,10 @@
 // shape vendors ship (mixed case, $NODEID on either side, CompactSubObj).
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+
 #include "motorbus/canopen/eds.hpp"
 #include "test_sdo_util.hpp"
 
@@ -249,4 +253,36 @@ TEST(Eds, ExpressionsAndErrors) {
     EXPECT_THROW(parse_eds("[1000\nx=1\n"), InvalidArgument);
     EXPECT_THROW(parse_eds("just text\n"), InvalidArgument);
     EXPECT_THROW(load_eds("/nonexistent/file.eds"), InvalidArgument);
+}
+
+// Hardening (defect 9): load_eds reads at most kMaxEdsFileBytes and refuses a
+// bigger file with an error naming the file and the cap, without reading on.
+TEST(EdsHardening, EndlessFileRefusedFastAtTheCap) {
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+        load_eds("/dev/zero");
+        FAIL() << "load_eds(/dev/zero) returned";
+    } catch (const InvalidArgument& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("/dev/zero"), std::string::npos) << what;
+        EXPECT_NE(what.find("16 MiB"), std::string::npos) << what;
+    }
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(2));
+    EXPECT_EQ(kMaxEdsFileBytes, std::size_t{16} << 20);
+}
+
+TEST(EdsHardening, FileJustOverTheCapRefusedAtTheCapAccepted) {
+    const std::string path = ::testing::TempDir() + "/motorbus_big.eds";
+    {
+        std::ofstream f(path, std::ios::binary);
+        std::string head = "[1000]\nParameterName=Device type\nDataType=0x0007\nAccessType=ro\nDefaultValue=0\n";
+        f << head << std::string(kMaxEdsFileBytes - head.size(), ';');
+    }
+    EXPECT_NO_THROW(load_eds(path));  // exactly the cap: read
+    {
+        std::ofstream f(path, std::ios::binary | std::ios::app);
+        f << ';';
+    }
+    EXPECT_THROW(load_eds(path), InvalidArgument);  // one byte more: refused
+    std::remove(path.c_str());
 }

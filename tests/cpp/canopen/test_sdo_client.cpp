@@ -340,6 +340,9 @@ TEST_F(ClientFixture, B13_LostSegmentRequestedAgain) {
 }
 
 TEST_F(ClientFixture, B16_FallBackToSegmented) {
+    SdoClientConfig opt_in;
+    opt_in.fallback_to_segmented = true;  // not the default (Hardening defect 4)
+    cli.set_config(opt_in);
     EXPECT_EQ(up(0x1008, 0, TransferMode::Block), Strs{"A4 08 10 00 7F 00 00 00"});
     EXPECT_EQ(rx("80 08 10 00 01 00 04 05"), Strs{"40 08 10 00 00 00 00 00"});
     EXPECT_EQ(rx("43 08 10 00 41 42 43 44"), Strs{});
@@ -360,4 +363,71 @@ TEST_F(ClientFixture, BlockUploadProtocolSwitchAccepted) {
     up(0x6001, 0, TransferMode::Block);
     EXPECT_EQ(rx("4F 01 60 00 08 00 00 00"), Strs{});
     EXPECT_EQ(hex(cli.result()), "08");
+}
+
+// Hardening (defect 4): a caller who asked for block gets block or an error.
+// By default a server that refuses block mode (0x05040001) is reported as
+// SdoAbortError 0x05040001; nothing is retried segmented behind its back.
+TEST_F(ClientFixture, BlockRefusedIsAnErrorByDefault) {
+    EXPECT_FALSE(SdoClientConfig{}.fallback_to_segmented);
+    EXPECT_FALSE(SdoClientOptions{}.fallback_to_segmented);
+    up(0x1008, 0, TransferMode::Block);
+    EXPECT_EQ(rx("80 08 10 00 01 00 04 05"), Strs{});  // no segmented initiate
+    ASSERT_EQ(cli.status(), SdoClientMachine::Status::Failed);
+    EXPECT_EQ(error<SdoAbortError>().code, 0x05040001u);
+    EXPECT_EQ(cli.counters().fallbacks, 0u);
+    down(0x2100, 0, H("01 02 03 04 05 06 07 08"), TransferMode::Block);
+    EXPECT_EQ(rx("80 00 21 00 01 00 04 05"), Strs{});
+    ASSERT_EQ(cli.status(), SdoClientMachine::Status::Failed);
+    EXPECT_EQ(error<SdoAbortError>().code, 0x05040001u);
+    EXPECT_EQ(cli.counters().fallbacks, 0u);
+}
+
+// Hardening (defect 7): the acknowledgement of a complete sub-block is lost.
+// The server still waits for it; the client's sub-block timer must repeat the
+// same acknowledgement (ackseq = the sub-block's last segment), never ackseq 0,
+// which makes the server resend the old sub-block as if it were new data.
+TEST_F(ClientFixture, LostSubblockAckIsRepeatedNotZeroed) {
+    SdoClientConfig c;
+    c.block_size = 2;
+    cli.set_config(c);
+    Bytes v(28);
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = static_cast<std::uint8_t>(i);
+    auto seg = [&](std::uint8_t seq, std::size_t k, bool last = false) {
+        return hex(sdo::block_segment(seq, std::span(v).subspan(k * 7, 7), last));
+    };
+    up(0x2201, 0, TransferMode::Block);
+    rx("C6 01 22 00 1C 00 00 00");
+    rx(seg(1, 0));
+    EXPECT_EQ(rx(seg(2, 1)), Strs{"A2 02 02 00 00 00 00 00"});  // this ack is lost
+    EXPECT_EQ(tick(now + kSec * 7 / 10), Strs{"A2 02 02 00 00 00 00 00"});
+    // The server got the repeat and sends the second sub-block.
+    rx(seg(1, 2));
+    EXPECT_EQ(rx(seg(2, 3, true)), Strs{"A2 02 02 00 00 00 00 00"});
+    EXPECT_EQ(rx(hex(sdo::block_upload_end(0, sdo::crc16(v)))), Strs{"A1 00 00 00 00 00 00 00"});
+    EXPECT_EQ(cli.result(), v);
+}
+
+// The acknowledgement of the last sub-block is lost: the client waits for the
+// end frame, the server for the ack.  The timer repeats the ack.
+TEST_F(ClientFixture, LostFinalAckIsRepeated) {
+    Bytes v(10, 0x33);
+    up(0x2201, 0, TransferMode::Block);
+    rx("C6 01 22 00 0A 00 00 00");
+    rx(hex(sdo::block_segment(1, std::span(v).subspan(0, 7), false)));
+    EXPECT_EQ(rx(hex(sdo::block_segment(2, std::span(v).subspan(7, 3), true))), Strs{"A2 02 7F 00 00 00 00 00"});
+    EXPECT_EQ(tick(now + kSec * 7 / 10), Strs{"A2 02 7F 00 00 00 00 00"});
+    EXPECT_EQ(rx(hex(sdo::block_upload_end(4, sdo::crc16(v)))), Strs{"A1 00 00 00 00 00 00 00"});
+    EXPECT_EQ(cli.result(), v);
+}
+
+// The start command (0xA3) is lost: nothing arrives, the server still waits
+// for it.  The timer repeats the start command (an ack would be refused).
+TEST_F(ClientFixture, LostStartCommandIsRepeated) {
+    up(0x2201, 0, TransferMode::Block);
+    EXPECT_EQ(rx("C6 01 22 00 03 00 00 00"), Strs{"A3 00 00 00 00 00 00 00"});
+    EXPECT_EQ(tick(now + kSec * 7 / 10), Strs{"A3 00 00 00 00 00 00 00"});
+    EXPECT_EQ(rx("81 01 02 03 00 00 00 00"), Strs{"A2 01 7F 00 00 00 00 00"});
+    EXPECT_EQ(rx(hex(sdo::block_upload_end(4, sdo::crc16(H("01 02 03"))))), Strs{"A1 00 00 00 00 00 00 00"});
+    EXPECT_EQ(hex(cli.result()), "01 02 03");
 }

@@ -1,0 +1,90 @@
+// Hardening (defects 1 and 11): every size/count option and fault probability
+// is validated where it enters the C++ core, so a bad value is an
+// InvalidArgument naming the option and its range, never a hang or a corrupt heap.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "motorbus/can/external_bus.hpp"
+#include "motorbus/can/virtual_bus.hpp"
+#include "motorbus/errors.hpp"
+
+using namespace motorbus;
+using namespace motorbus::can;
+
+namespace {
+
+template <class F>
+std::string invalid_message(F&& f) {
+    try {
+        f();
+    } catch (const InvalidArgument& e) {
+        return e.what();
+    } catch (const std::exception& e) {
+        return std::string("wrong exception: ") + e.what();
+    }
+    return "no exception";
+}
+
+}  // namespace
+
+TEST(HardeningOptions, RxQueueSizeZeroRefusedOnEveryBus) {
+    VirtualOptions v;
+    v.rx_queue_size = 0;
+    auto m = invalid_message([&] { open_virtual("hardening-rxq", v); });
+    EXPECT_NE(m.find("rx_queue_size"), std::string::npos) << m;
+    EXPECT_NE(m.find(">= 1"), std::string::npos) << m;
+    BusOptions b;
+    b.rx_queue_size = 0;
+    m = invalid_message([&] { ExternalBus("ext", [](const Frame&, Deadline) {}, {}, b); });
+    EXPECT_NE(m.find("rx_queue_size"), std::string::npos) << m;
+}
+
+TEST(HardeningOptions, RxQueueSizeOneKeepsTheNewestFrame) {
+    VirtualOptions v;
+    v.rx_queue_size = 1;
+    auto a = open_virtual("hardening-rxq1", v);
+    auto b = open_virtual("hardening-rxq1", v);
+    for (std::uint32_t id = 1; id <= 3; ++id) a->send(Frame::make(id, {}));
+    auto f = b->recv(std::chrono::seconds(1));
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->id, 3u);
+    EXPECT_EQ(b->counters().rx_dropped, 2u);
+}
+
+TEST(HardeningOptions, VirtualTxQueueZeroRefused) {
+    VirtualOptions v;
+    v.bitrate = 500'000;
+    v.tx_queue = 0;
+    auto m = invalid_message([&] { open_virtual("hardening-txq", v); });
+    EXPECT_NE(m.find("tx_queue"), std::string::npos) << m;
+}
+
+TEST(HardeningOptions, FaultProbabilitiesOutsideZeroOneRefused) {
+    auto bus = open_virtual("hardening-faults");
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (double p : {-0.1, 1.5, nan}) {
+        FaultOptions f;
+        f.drop_probability = p;
+        auto m = invalid_message([&] { bus->set_faults(f); });
+        EXPECT_NE(m.find("drop_probability"), std::string::npos) << p << ": " << m;
+        EXPECT_NE(m.find("[0, 1]"), std::string::npos) << m;
+        FaultOptions c;
+        c.corrupt_probability = p;
+        m = invalid_message([&] { bus->set_faults(c); });
+        EXPECT_NE(m.find("corrupt_probability"), std::string::npos) << p << ": " << m;
+    }
+    FaultOptions d;
+    d.delay_ns = -1;
+    EXPECT_NE(invalid_message([&] { bus->set_faults(d); }).find("delay"), std::string::npos);
+    VirtualOptions v;
+    v.faults.drop_probability = 2.0;
+    EXPECT_NE(invalid_message([&] { open_virtual("hardening-faults2", v); }).find("drop_probability"),
+              std::string::npos);
+    FaultOptions ok;
+    ok.drop_probability = 1.0;
+    ok.corrupt_probability = 0.0;
+    EXPECT_NO_THROW(bus->set_faults(ok));
+}
