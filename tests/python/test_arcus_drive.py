@@ -27,7 +27,8 @@ class Served:
 
     def open(self, **kw):
         kw.setdefault("units", MM)
-        d = motorbus.open_drive("arcus", line=self.path, address="01", **kw)
+        kw.setdefault("line", self.path)
+        d = motorbus.open_drive("arcus", address="01", **kw)
         # Short, brisk moves: well under a second of real time.
         d.params["HSPD"] = 20000
         d.params["ACC"] = 20
@@ -225,10 +226,13 @@ def test_store_keeps_stored_params_over_a_power_cycle(tmp_path):
     ("disable", False, False),     # EO=0: no motion is done
 ])
 def test_on_error_words(served, how, moving_after, enabled_after):
-    watch = arcus.ArcusClient(served.path, "01", on_exit=None)
+    # One line shared by the watching client and the Drive: the port is exclusive
+    # (a second process or object opening the same path is refused).
+    line = open_line(served.path)
+    watch = arcus.ArcusClient(line, "01", on_exit=None)
     try:
-        with pytest.raises(RuntimeError):
-            with served.open(on_error=how) as d:
+        with pytest.raises(RuntimeError, match="boom"):
+            with served.open(on_error=how, line=line) as d:
                 d.params["DEC"] = 500
                 d.params["EDEC"] = True
                 d.enable()
@@ -236,11 +240,12 @@ def test_on_error_words(served, how, moving_after, enabled_after):
                 raise RuntimeError("boom")
         assert watch.moving is moving_after
         assert watch.enabled is enabled_after
+        with pytest.raises(motorbus.InvalidArgument):
+            served.open(on_error="abort", line=line)
     finally:
         watch.abort()
         watch.close()
-    with pytest.raises(motorbus.InvalidArgument):
-        served.open(on_error="abort")
+        line.port.close()
 
 
 def test_link_loss_raises_link_down():
