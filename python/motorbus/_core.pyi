@@ -31,7 +31,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacSim', 'DmacUnknownCommand', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacSim', 'DmacUnknownCommand', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -2747,6 +2747,59 @@ class ArcusProfileParams:
     @snl_ratio.setter
     def snl_ratio(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
+class ArcusPhase:
+    """
+    Where an ArcusMotion is in its move (MST bits 0..2).
+    
+    Members:
+    
+      IDLE
+    
+      ACCEL
+    
+      CONST : at constant speed
+    
+      DECEL
+    """
+    ACCEL: typing.ClassVar[ArcusPhase]
+    CONST: typing.ClassVar[ArcusPhase]
+    DECEL: typing.ClassVar[ArcusPhase]
+    IDLE: typing.ClassVar[ArcusPhase]
+    __members__: typing.ClassVar[dict[str, ArcusPhase]]
+    @typing.overload
+    def __eq__(self, other: ArcusPhase) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: ArcusPhase) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
 class ArcusMotion:
     def __init__(self, params: ArcusProfileParams = ..., sspdm: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
@@ -2764,8 +2817,10 @@ class ArcusMotion:
         """
     def moving(self, t: typing.SupportsFloat | typing.SupportsIndex) -> bool:
         ...
-    def phase(self, t: typing.SupportsFloat | typing.SupportsIndex) -> str:
-        ...
+    def phase(self, t: typing.SupportsFloat | typing.SupportsIndex) -> ArcusPhase:
+        """
+        The ArcusPhase at time t (MST bits 0..2).
+        """
     def set_params(self, arg0: ArcusProfileParams) -> ArcusProfileParams:
         ...
     def set_sspdm(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
@@ -2797,6 +2852,53 @@ class ArcusHoming:
     @property
     def snl_status(self) -> int:
         ...
+class ArcusCommandInfo:
+    """
+    One row of the Arcus command table (arcus_commands()), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def action(self) -> bool:
+        """
+        a bare command answering OK ("J+")
+        """
+    @property
+    def argument(self) -> bool:
+        """
+        takes a value glued to the name ("X1000")
+        """
+    @property
+    def description(self) -> str:
+        ...
+    @property
+    def indexed(self) -> int:
+        """
+        highest 1-based index (DI6 -> 6), 0 when not indexed
+        """
+    @property
+    def motion(self) -> bool:
+        """
+        refused with ?Moving / ?State Error when busy or in error
+        """
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def query(self) -> bool:
+        """
+        answers the bare name ("HSPD" -> value)
+        """
+    @property
+    def set(self) -> bool:
+        """
+        takes NAME=value
+        """
+    @property
+    def stored(self) -> bool:
+        """
+        written to flash by STORE (Table 7.10)
+        """
 class ArcusSim(LineDevice):
     """
     A simulated Arcus DMX-CAN answering ASCII lines (a LineDevice for PtyLineServer).
@@ -2844,6 +2946,36 @@ class ArcusSim(LineDevice):
         ...
     @property
     def store_path(self) -> str:
+        ...
+class ArcusClientCounters:
+    """
+    ArcusClient counters (ArcusClient.counters), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def device_errors(self) -> int:
+        """
+        Table 11.1 error replies
+        """
+    @property
+    def noise_lines(self) -> int:
+        """
+        lines of non-printable bytes skipped (A10)
+        """
+    @property
+    def protocol_errors(self) -> int:
+        ...
+    @property
+    def requests(self) -> int:
+        ...
+    @property
+    def retries(self) -> int:
+        """
+        queries sent again after a timeout
+        """
+    @property
+    def timeouts(self) -> int:
         ...
 class ArcusClientBase:
     """
@@ -2965,7 +3097,7 @@ class ArcusClientBase:
     def comm_mode(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     @property
-    def counters(self) -> dict:
+    def counters(self) -> ArcusClientCounters:
         ...
     @property
     def current(self) -> int:
@@ -3554,7 +3686,7 @@ def arcus_build_request(address: typing.SupportsInt | typing.SupportsIndex, comm
     """
 def arcus_check_strict(params: ArcusProfileParams) -> None:
     ...
-def arcus_commands() -> list:
+def arcus_commands() -> list[ArcusCommandInfo]:
     """
     The command table (Table 11.0 plus the commands the sections describe).
     """
