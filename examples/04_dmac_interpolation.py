@@ -23,7 +23,7 @@ with PtyLineServer(sims) as server:
               for k in range(41)]
     segments = [[b[0] - a[0], b[1] - a[1]] for a, b in zip(points, points[1:])]
     stats = stream_interpolation([x, y], segments, interpol_time_ms=50, fifo_size=16, sleep=sleep)
-    print(f"segments {stats['segments']}, xon_errors {stats['xon_errors']}, underruns {stats['underruns']}")
+    print(f"segments {stats.segments}, xon_errors {stats.xon_errors}, underruns {stats.underruns}")
     clock.advance(3_000_000_000)                       # let the path finish
     print(f"x {x.position} y {y.position}")            # -10000 and +10000 from the start
     x.close(); y.close()

@@ -16,6 +16,7 @@
 namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::arcus;
+using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
 
 namespace {
@@ -138,6 +139,11 @@ void bind_arcus_motion(py::module_& m) {
     }, py::arg("params"), "(effective params, window number, [adjustments]) after Appendix A.");
     m.def("arcus_check_strict", &arcus_check_strict, py::arg("params"));
     m.attr("ARCUS_MAX_MOVE_DISTANCE") = kArcusMaxMoveDistance;
+    py::enum_<ArcusPhase>(m, "ArcusPhase", "Where an ArcusMotion is in its move (MST bits 0..2).")
+        .value("IDLE", ArcusPhase::Idle)
+        .value("ACCEL", ArcusPhase::Accel)
+        .value("CONST", ArcusPhase::Const, "at constant speed")
+        .value("DECEL", ArcusPhase::Decel);
     py::class_<ArcusMotion>(m, "ArcusMotion")
         .def(py::init<ArcusProfileParams, int>(), py::arg("params") = ArcusProfileParams{}, py::arg("sspdm") = 0)
         .def("set_params", [](ArcusMotion& a, const ArcusProfileParams& p) { return a.set_params(p).params; })
@@ -156,14 +162,7 @@ void bind_arcus_motion(py::module_& m) {
         .def("abort", &ArcusMotion::abort, py::arg("t"))
         .def_property_readonly("profile", &ArcusMotion::profile, py::return_value_policy::copy)
         .def("moving", &ArcusMotion::moving, py::arg("t"))
-        .def("phase", [](const ArcusMotion& a, double t) {
-            switch (a.phase(t)) {
-                case ArcusPhase::Accel: return "accel";
-                case ArcusPhase::Const: return "const";
-                case ArcusPhase::Decel: return "decel";
-                default: return "idle";
-            }
-        }, py::arg("t"));
+        .def("phase", &ArcusMotion::phase, py::arg("t"), "The ArcusPhase at time t (MST bits 0..2).");
 
     py::class_<ArcusHomingOptions>(m, "ArcusHomingOptions")
         .def(py::init([](double hca, double lca, bool rz) { return ArcusHomingOptions{hca, lca, rz}; }),
@@ -201,24 +200,25 @@ void bind_arcus(py::module_& m) {
             return py::make_tuple(r.address ? py::cast(*r.address) : py::none(), r.body);
         },
         py::arg("raw"), "(address or None, body) of one reply without its NUL; ProtocolError on bytes it never sends.");
+    auto text = [](std::string_view CommandInfo::*f) {
+        return [f](const CommandInfo& c) { return std::string(c.*f); };
+    };
+    auto form = [](unsigned bit) { return [bit](const CommandInfo& c) { return bool(c.forms & bit); }; };
+    Record<CommandInfo>(m, "ArcusCommandInfo", "One row of the Arcus command table (arcus_commands()), read-only.")
+        .prop("name", text(&CommandInfo::name))
+        .prop("query", form(kQuery), "answers the bare name (\"HSPD\" -> value)")
+        .prop("set", form(kSet), "takes NAME=value")
+        .prop("action", form(kAction), "a bare command answering OK (\"J+\")")
+        .prop("argument", form(kArgument), "takes a value glued to the name (\"X1000\")")
+        .field("indexed", &CommandInfo::index_max, "highest 1-based index (DI6 -> 6), 0 when not indexed")
+        .field("motion", &CommandInfo::motion, "refused with ?Moving / ?State Error when busy or in error")
+        .field("stored", &CommandInfo::stored, "written to flash by STORE (Table 7.10)")
+        .prop("description", text(&CommandInfo::description));
     m.def(
         "arcus_commands",
         [] {
-            py::list out;
-            for (const auto& c : command_table()) {
-                py::dict d;
-                d["name"] = std::string(c.name);
-                d["query"] = bool(c.forms & kQuery);
-                d["set"] = bool(c.forms & kSet);
-                d["action"] = bool(c.forms & kAction);
-                d["argument"] = bool(c.forms & kArgument);
-                d["indexed"] = c.index_max;
-                d["motion"] = c.motion;
-                d["stored"] = c.stored;
-                d["description"] = std::string(c.description);
-                out.append(d);
-            }
-            return out;
+            auto t = command_table();
+            return std::vector<CommandInfo>(t.begin(), t.end());
         },
         "The command table (Table 11.0 plus the commands the sections describe).");
     m.def(
@@ -272,6 +272,14 @@ void bind_arcus(py::module_& m) {
         .def_property_readonly("snl_status", &Sim::snl_status)
         .def_property_readonly("busy", &Sim::busy);
 
+    Record<ClientCounters>(m, "ArcusClientCounters", "ArcusClient counters (ArcusClient.counters), read-only.")
+        .field("requests", &ClientCounters::requests)
+        .field("timeouts", &ClientCounters::timeouts)
+        .field("retries", &ClientCounters::retries, "queries sent again after a timeout")
+        .field("protocol_errors", &ClientCounters::protocol_errors)
+        .field("device_errors", &ClientCounters::device_errors, "Table 11.1 error replies")
+        .field("noise_lines", &ClientCounters::noise_lines, "lines of non-printable bytes skipped (A10)");
+
     using C = Client;
     auto rel = py::call_guard<py::gil_scoped_release>();
     // Property accessors release the GIL like the methods (each is a line transaction).
@@ -289,18 +297,7 @@ void bind_arcus(py::module_& m) {
           }),
           py::arg("link"), py::arg("address") = 1, py::arg("timeout") = py::none(), py::arg("query_retries") = 1)
         .def_property_readonly("address", &C::address)
-        .def_property_readonly("counters",
-                               [](const C& cl) {
-                                   auto k = cl.counters();
-                                   py::dict d;
-                                   d["requests"] = k.requests;
-                                   d["timeouts"] = k.timeouts;
-                                   d["retries"] = k.retries;
-                                   d["protocol_errors"] = k.protocol_errors;
-                                   d["device_errors"] = k.device_errors;
-                                   d["noise_lines"] = k.noise_lines;
-                                   return d;
-                               })
+        .def_property_readonly("counters", &C::counters)
         .def("command", &C::command, py::arg("command"), py::arg("idempotent") = false, rel)
         .def("query", &C::query, py::arg("name"), rel)
         .def("set", &C::set, py::arg("name"), py::arg("value"), rel)

@@ -16,6 +16,7 @@
 namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::dmac;
+using motorbus::py_helpers::Record;
 
 namespace {
 
@@ -26,7 +27,11 @@ Var var_arg(const std::string& name) {
     return *v;
 }
 
-Radix radix_arg(const std::string& r) {
+// A DmacRadix or its name ('dec'/'d', 'hex'/'h', 'bin'/'b').
+Radix radix_arg(const py::object& o) {
+    if (py::isinstance<Radix>(o)) return o.cast<Radix>();
+    if (!py::isinstance<py::str>(o)) throw InvalidArgument("radix: a DmacRadix or 'dec', 'hex', 'bin'");
+    auto r = o.cast<std::string>();
     if (r == "dec" || r == "d" || r.empty()) return Radix::Dec;
     if (r == "hex" || r == "h") return Radix::Hex;
     if (r == "bin" || r == "b") return Radix::Bin;
@@ -60,21 +65,6 @@ std::function<void(DmacClient&, T)> dmac_setter(void (DmacClient::*f)(T)) {
         py::gil_scoped_release nogil;
         (c.*f)(v);
     };
-}
-
-py::dict state_dict(const SimState& s) {
-    py::dict d;
-    d["now_ms"] = s.now_ms;
-    d["position"] = s.position;
-    d["speed"] = s.speed;
-    d["status"] = s.status;
-    d["error"] = s.error;
-    d["line"] = s.line;
-    d["sequencer_running"] = s.sequencer_running;
-    d["fifo_count"] = s.fifo_count;
-    d["interpolating"] = s.interpolating;
-    d["power"] = s.power;
-    return d;
 }
 
 }  // namespace
@@ -131,38 +121,62 @@ void bind_dmac(py::module_& m) {
     py_errors::translate<CommandRejected, fill_rejected>(m.attr("DmacCommandRejected"));
 
     // ---- codec helpers ---------------------------------------------------------------
-    m.def("dmac_format_value", [](std::int32_t v, const std::string& r) { return format_value(v, radix_arg(r)); },
-          py::arg("value"), py::arg("radix") = "dec", "'+123', 'h0000007B' or 'b00000000 ... 01111011'.");
+    py::enum_<Radix>(m, "DmacRadix", "How a DMAC value is written: +123, h0000007B or b00000000 ... 01111011.")
+        .value("DEC", Radix::Dec)
+        .value("HEX", Radix::Hex)
+        .value("BIN", Radix::Bin);
+    Record<ReadReply>(m, "DmacReadReply", "One parsed 'aa#MNE[.bit]=value' reply (dmac_parse_read_reply), read-only.")
+        .field("address", &ReadReply::address)
+        .field("mnemonic", &ReadReply::mnemonic, "'#ATI'")
+        .field("bit", &ReadReply::bit, "0 for a whole-variable read")
+        .field("value", &ReadReply::value)
+        .field("radix", &ReadReply::radix);
+    Record<VarInfo>(m, "DmacVariableInfo", "One DMAC variable (dmac_variable()), read-only.")
+        .field("name", &VarInfo::name, "'#ACCEL_TIME'")
+        .field("mnemonic", &VarInfo::mnemonic, "'#ATI'")
+        .field("stored", &VarInfo::stored, "survives power cycle / MODULE_RESET")
+        .field("read_only", &VarInfo::read_only)
+        .field("factory", &VarInfo::factory, "value after MODULE_RESET ALL (stored) or reset (volatile)")
+        .field("min", &VarInfo::min, "lowest value a write accepts")
+        .field("max", &VarInfo::max, "highest value a write accepts")
+        .field("dmac34_only", &VarInfo::dmac34_only, "exists on the DMAC34 only");
+    Record<VersionInfo>(m, "DmacVersionInfo", "A parsed REQUEST_VERSION banner (DmacClient.request_version()), read-only.")
+        .field("address", &VersionInfo::address)
+        .field("version", &VersionInfo::version, "1 in v1.7")
+        .field("release", &VersionInfo::release, "7 in v1.7")
+        .field("code", &VersionInfo::code, "'H142'")
+        .field("model", &VersionInfo::model, "from the code table, e.g. 'DMAC34 standard'")
+        .field("ident", &VersionInfo::ident, "the text between the quotes")
+        .field("manufacturer", &VersionInfo::manufacturer)
+        .field("product", &VersionInfo::product)
+        .field("serial", &VersionInfo::serial)
+        .field("manufacturing_date", &VersionInfo::manufacturing_date)
+        .field("revision_date", &VersionInfo::revision_date)
+        .field("phase", &VersionInfo::phase, "'6A'")
+        .field("boot", &VersionInfo::boot, "'v1.1'");
+    m.def("dmac_format_value", [](std::int32_t v, const py::object& r) { return format_value(v, radix_arg(r)); },
+          py::arg("value"), py::arg("radix") = Radix::Dec,
+          "'+123', 'h0000007B' or 'b00000000 ... 01111011'; radix is a DmacRadix or 'dec'/'hex'/'bin'.");
     m.def(
-        "dmac_parse_read_reply",
-        [](const py::bytes& b) -> py::object {
-            auto r = parse_read_reply(std::string(b));
-            if (!r) return py::none();
-            py::dict d;
-            d["address"] = r->address;
-            d["mnemonic"] = r->mnemonic;
-            d["bit"] = r->bit;
-            d["value"] = r->value;
-            d["radix"] = r->radix == Radix::Dec ? "dec" : r->radix == Radix::Hex ? "hex" : "bin";
-            return d;
-        },
-        py::arg("reply"), "Parses 'aa#MNE[.bit]=value' strictly; None when it breaks the grammar.");
+        "dmac_parse_read_reply", [](const py::bytes& b) { return parse_read_reply(std::string(b)); },
+        py::arg("reply"), "Parses 'aa#MNE[.bit]=value' strictly into a DmacReadReply; None when it breaks the grammar.");
     m.def("dmac_status_names", [](std::uint32_t s) { return status_names(s); }, py::arg("status"));
     m.def("dmac_error_names", [](std::uint32_t e) { return error_names(e); }, py::arg("error"));
-    m.def("dmac_variable", [](const std::string& name) {
-        const VarInfo& vi = var_info(var_arg(name));
-        py::dict d;
-        d["name"] = vi.name;
-        d["mnemonic"] = vi.mnemonic;
-        d["stored"] = vi.stored;
-        d["read_only"] = vi.read_only;
-        d["factory"] = vi.factory;
-        d["min"] = vi.min;
-        d["max"] = vi.max;
-        return d;
-    }, py::arg("name"));
+    m.def("dmac_variable", [](const std::string& name) { return var_info(var_arg(name)); }, py::arg("name"),
+          "The DmacVariableInfo of a variable, by full name or mnemonic ('#ACCEL_TIME', 'ATI').");
 
     // ---- simulator -----------------------------------------------------------------
+    Record<SimState>(m, "DmacSimState", "A snapshot of a DmacSim (DmacSim.state()), read-only.")
+        .field("now_ms", &SimState::now_ms, "device time (ms)")
+        .field("position", &SimState::position, "#POSITION (1/10000 rev)")
+        .field("speed", &SimState::speed, "#SPEED (0.01 rpm, signed)")
+        .field("status", &SimState::status, "#STATUS bits")
+        .field("error", &SimState::error, "#ERROR bits")
+        .field("line", &SimState::line, "sequencer line running (0 = stopped)")
+        .field("sequencer_running", &SimState::sequencer_running)
+        .field("fifo_count", &SimState::fifo_count, "interpolation segments queued")
+        .field("interpolating", &SimState::interpolating)
+        .field("power", &SimState::power, "the motor is powered");
     py::class_<DmacSim, serial::LineDevice, std::shared_ptr<DmacSim>>(
         m, "DmacSim",
         "A simulated DMAC module (a LineDevice: serve it with PtyLineServer). Device time runs on `clock` "
@@ -197,14 +211,7 @@ void bind_dmac(py::module_& m) {
              py::arg("positive_end_switch") = py::none(), py::arg("negative_end_switch") = py::none(),
              py::arg("end_switch_active_low") = false, py::arg("reference_switch") = py::none())
         .def("poll", &DmacSim::poll, py::call_guard<py::gil_scoped_release>(), "Catch up with the clock.")
-        .def("state", [](DmacSim& s) {
-            SimState st;
-            {
-                py::gil_scoped_release nogil;
-                st = s.state();
-            }
-            return state_dict(st);
-        })
+        .def("state", &DmacSim::state, py::call_guard<py::gil_scoped_release>(), "A DmacSimState snapshot.")
         .def("read", [](DmacSim& s, const std::string& var) { return s.read(var_arg(var)); }, py::arg("variable"),
              py::call_guard<py::gil_scoped_release>())
         .def_property_readonly("address", &DmacSim::address)
@@ -233,6 +240,11 @@ void bind_dmac(py::module_& m) {
         .def_property_readonly("lines_rejected", &DmacSim::lines_rejected);
 
     // ---- client --------------------------------------------------------------------
+    Record<ClientCounters>(m, "DmacClientCounters", "DmacClient counters (DmacClient.counters), read-only.")
+        .field("transactions", &ClientCounters::transactions)
+        .field("stray_lines", &ClientCounters::stray_lines, "lines that were not the awaited reply (late, misrouted)")
+        .field("xon_errors", &ClientCounters::xon_errors, "MOVE_INTERPOL refused: FIFO full")
+        .field("device_resets", &ClientCounters::device_resets, "version banners seen unsolicited");
     using C = DmacClient;
     auto rel = py::call_guard<py::gil_scoped_release>();
     // Readings and simple settings are properties (the native facade convention).
@@ -258,15 +270,7 @@ void bind_dmac(py::module_& m) {
              py::arg("link"), py::arg("address") = 0, py::kw_only(), py::arg("baud") = 38400, py::arg("verify") = true,
              py::arg("timeout") = py::none(), py::arg("sleep") = py::none())
         .def_property_readonly("address", &C::address)
-        .def_property_readonly("counters", [](const C& c) {
-            auto k = c.counters();
-            py::dict d;
-            d["transactions"] = k.transactions;
-            d["stray_lines"] = k.stray_lines;
-            d["xon_errors"] = k.xon_errors;
-            d["device_resets"] = k.device_resets;
-            return d;
-        })
+        .def_property_readonly("counters", &C::counters)
         .def("command", [](C& c, const std::string& cmd) { c.command(cmd); }, py::arg("command"), rel)
         .def("raw", [](C& c, const std::string& f, bool expect) {
             std::string r;
@@ -277,8 +281,13 @@ void bind_dmac(py::module_& m) {
             return py::bytes(r);
         },
              py::arg("frame"), py::arg("expect_reply") = true)
-        .def("read", [](C& c, const std::string& v, const std::string& r) { return c.read(var_arg(v), radix_arg(r)); },
-             py::arg("variable"), py::arg("radix") = "dec", rel)
+        .def("read", [](C& c, const std::string& v, const py::object& r) {
+                 Var var = var_arg(v);
+                 Radix rx = radix_arg(r);
+                 py::gil_scoped_release nogil;
+                 return c.read(var, rx);
+             }, py::arg("variable"), py::arg("radix") = Radix::Dec,
+             "READ a variable; radix is a DmacRadix or 'dec'/'hex'/'bin' (default DmacRadix.DEC).")
         .def("read_bit", [](C& c, const std::string& v, int bit) { return c.read_bit(var_arg(v), bit); },
              py::arg("variable"), py::arg("bit"), rel)
         .def("write", [](C& c, const std::string& v, std::int32_t x) { c.write(var_arg(v), x); }, py::arg("variable"),
@@ -391,28 +400,7 @@ void bind_dmac(py::module_& m) {
         .def("module_reset", &C::module_reset, py::arg("factory") = false, rel)
         .def("set_address", &C::set_address, py::arg("address"), rel)
         .def("set_baudrate", &C::set_baudrate, py::arg("baud"), rel)
-        .def("request_version", [](C& c) {
-            VersionInfo v;
-            {
-                py::gil_scoped_release nogil;
-                v = c.request_version();
-            }
-            py::dict d;
-            d["address"] = v.address;
-            d["version"] = v.version;
-            d["release"] = v.release;
-            d["code"] = v.code;
-            d["model"] = v.model;
-            d["ident"] = v.ident;
-            d["manufacturer"] = v.manufacturer;
-            d["product"] = v.product;
-            d["serial"] = v.serial;
-            d["manufacturing_date"] = v.manufacturing_date;
-            d["revision_date"] = v.revision_date;
-            d["phase"] = v.phase;
-            d["boot"] = v.boot;
-            return d;
-        })
+        .def("request_version", &C::request_version, rel, "REQUEST_VERSION, parsed into a DmacVersionInfo.")
         .def("wait_idle", [](C& c, double timeout, double poll) {
             auto t = motorbus::py_helpers::seconds_to_ns(py::float_(timeout));
             auto p = motorbus::py_helpers::seconds_to_ns(py::float_(poll));
@@ -436,6 +424,13 @@ void bind_dmac(py::module_& m) {
         synchro(*link, k);
     }, py::arg("link"), py::arg("what"), "Global SYNCHRO ON|OFF|TOP|INTERPOL (no reply).");
 
+    Record<StreamStats>(m, "DmacStreamStats", "What dmac_stream_interpolation did, read-only.")
+        .field("segments", &StreamStats::segments, "segments queued per axis")
+        .field("frames", &StreamStats::frames, "MOVE_INTERPOL frames sent (all axes, retries included)")
+        .field("xon_errors", &StreamStats::xon_errors, "refusals on a full FIFO")
+        .field("min_level_after_start", &StreamStats::min_level_after_start,
+               "lowest FIFO level seen once moving (0 = underrun)")
+        .field("underruns", &StreamStats::underruns, "times an axis reported an empty FIFO before the end");
     m.def("dmac_stream_interpolation",
           [](std::vector<std::shared_ptr<C>> axes, const std::vector<std::vector<long long>>& segments,
              int interpol_time_ms, int fifo_size, const py::object& sleep, const py::object& backoff) {
@@ -451,13 +446,7 @@ void bind_dmac(py::module_& m) {
                   py::gil_scoped_release nogil;
                   s = stream_interpolation(raw, segments, o);
               }
-              py::dict d;
-              d["segments"] = s.segments;
-              d["frames"] = s.frames;
-              d["xon_errors"] = s.xon_errors;
-              d["min_level_after_start"] = s.min_level_after_start;
-              d["underruns"] = s.underruns;
-              return d;
+              return s;
           },
           py::arg("axes"), py::arg("segments"), py::arg("interpol_time_ms") = 100, py::arg("fifo_size") = 64,
           py::arg("sleep") = py::none(), py::arg("backoff") = py::none(),

@@ -31,7 +31,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacSim', 'DmacUnknownCommand', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -2747,6 +2747,59 @@ class ArcusProfileParams:
     @snl_ratio.setter
     def snl_ratio(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
+class ArcusPhase:
+    """
+    Where an ArcusMotion is in its move (MST bits 0..2).
+    
+    Members:
+    
+      IDLE
+    
+      ACCEL
+    
+      CONST : at constant speed
+    
+      DECEL
+    """
+    ACCEL: typing.ClassVar[ArcusPhase]
+    CONST: typing.ClassVar[ArcusPhase]
+    DECEL: typing.ClassVar[ArcusPhase]
+    IDLE: typing.ClassVar[ArcusPhase]
+    __members__: typing.ClassVar[dict[str, ArcusPhase]]
+    @typing.overload
+    def __eq__(self, other: ArcusPhase) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: ArcusPhase) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
 class ArcusMotion:
     def __init__(self, params: ArcusProfileParams = ..., sspdm: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
@@ -2764,8 +2817,10 @@ class ArcusMotion:
         """
     def moving(self, t: typing.SupportsFloat | typing.SupportsIndex) -> bool:
         ...
-    def phase(self, t: typing.SupportsFloat | typing.SupportsIndex) -> str:
-        ...
+    def phase(self, t: typing.SupportsFloat | typing.SupportsIndex) -> ArcusPhase:
+        """
+        The ArcusPhase at time t (MST bits 0..2).
+        """
     def set_params(self, arg0: ArcusProfileParams) -> ArcusProfileParams:
         ...
     def set_sspdm(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
@@ -2797,6 +2852,53 @@ class ArcusHoming:
     @property
     def snl_status(self) -> int:
         ...
+class ArcusCommandInfo:
+    """
+    One row of the Arcus command table (arcus_commands()), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def action(self) -> bool:
+        """
+        a bare command answering OK ("J+")
+        """
+    @property
+    def argument(self) -> bool:
+        """
+        takes a value glued to the name ("X1000")
+        """
+    @property
+    def description(self) -> str:
+        ...
+    @property
+    def indexed(self) -> int:
+        """
+        highest 1-based index (DI6 -> 6), 0 when not indexed
+        """
+    @property
+    def motion(self) -> bool:
+        """
+        refused with ?Moving / ?State Error when busy or in error
+        """
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def query(self) -> bool:
+        """
+        answers the bare name ("HSPD" -> value)
+        """
+    @property
+    def set(self) -> bool:
+        """
+        takes NAME=value
+        """
+    @property
+    def stored(self) -> bool:
+        """
+        written to flash by STORE (Table 7.10)
+        """
 class ArcusSim(LineDevice):
     """
     A simulated Arcus DMX-CAN answering ASCII lines (a LineDevice for PtyLineServer).
@@ -2844,6 +2946,36 @@ class ArcusSim(LineDevice):
         ...
     @property
     def store_path(self) -> str:
+        ...
+class ArcusClientCounters:
+    """
+    ArcusClient counters (ArcusClient.counters), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def device_errors(self) -> int:
+        """
+        Table 11.1 error replies
+        """
+    @property
+    def noise_lines(self) -> int:
+        """
+        lines of non-printable bytes skipped (A10)
+        """
+    @property
+    def protocol_errors(self) -> int:
+        ...
+    @property
+    def requests(self) -> int:
+        ...
+    @property
+    def retries(self) -> int:
+        """
+        queries sent again after a timeout
+        """
+    @property
+    def timeouts(self) -> int:
         ...
 class ArcusClientBase:
     """
@@ -2965,7 +3097,7 @@ class ArcusClientBase:
     def comm_mode(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     @property
-    def counters(self) -> dict:
+    def counters(self) -> ArcusClientCounters:
         ...
     @property
     def current(self) -> int:
@@ -3172,6 +3304,236 @@ class DmacMotion:
     @property
     def profile(self) -> Profile:
         ...
+class DmacRadix:
+    """
+    How a DMAC value is written: +123, h0000007B or b00000000 ... 01111011.
+    
+    Members:
+    
+      DEC
+    
+      HEX
+    
+      BIN
+    """
+    BIN: typing.ClassVar[DmacRadix]
+    DEC: typing.ClassVar[DmacRadix]
+    HEX: typing.ClassVar[DmacRadix]
+    __members__: typing.ClassVar[dict[str, DmacRadix]]
+    @typing.overload
+    def __eq__(self, other: DmacRadix) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: DmacRadix) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class DmacReadReply:
+    """
+    One parsed 'aa#MNE[.bit]=value' reply (dmac_parse_read_reply), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def address(self) -> int:
+        ...
+    @property
+    def bit(self) -> int:
+        """
+        0 for a whole-variable read
+        """
+    @property
+    def mnemonic(self) -> str:
+        """
+        '#ATI'
+        """
+    @property
+    def radix(self) -> DmacRadix:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class DmacVariableInfo:
+    """
+    One DMAC variable (dmac_variable()), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def dmac34_only(self) -> bool:
+        """
+        exists on the DMAC34 only
+        """
+    @property
+    def factory(self) -> int:
+        """
+        value after MODULE_RESET ALL (stored) or reset (volatile)
+        """
+    @property
+    def max(self) -> int:
+        """
+        highest value a write accepts
+        """
+    @property
+    def min(self) -> int:
+        """
+        lowest value a write accepts
+        """
+    @property
+    def mnemonic(self) -> str:
+        """
+        '#ATI'
+        """
+    @property
+    def name(self) -> str:
+        """
+        '#ACCEL_TIME'
+        """
+    @property
+    def read_only(self) -> bool:
+        ...
+    @property
+    def stored(self) -> bool:
+        """
+        survives power cycle / MODULE_RESET
+        """
+class DmacVersionInfo:
+    """
+    A parsed REQUEST_VERSION banner (DmacClient.request_version()), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def address(self) -> int:
+        ...
+    @property
+    def boot(self) -> str:
+        """
+        'v1.1'
+        """
+    @property
+    def code(self) -> str:
+        """
+        'H142'
+        """
+    @property
+    def ident(self) -> str:
+        """
+        the text between the quotes
+        """
+    @property
+    def manufacturer(self) -> str:
+        ...
+    @property
+    def manufacturing_date(self) -> str:
+        ...
+    @property
+    def model(self) -> str:
+        """
+        from the code table, e.g. 'DMAC34 standard'
+        """
+    @property
+    def phase(self) -> str:
+        """
+        '6A'
+        """
+    @property
+    def product(self) -> str:
+        ...
+    @property
+    def release(self) -> int:
+        """
+        7 in v1.7
+        """
+    @property
+    def revision_date(self) -> str:
+        ...
+    @property
+    def serial(self) -> str:
+        ...
+    @property
+    def version(self) -> int:
+        """
+        1 in v1.7
+        """
+class DmacSimState:
+    """
+    A snapshot of a DmacSim (DmacSim.state()), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def error(self) -> int:
+        """
+        #ERROR bits
+        """
+    @property
+    def fifo_count(self) -> int:
+        """
+        interpolation segments queued
+        """
+    @property
+    def interpolating(self) -> bool:
+        ...
+    @property
+    def line(self) -> int:
+        """
+        sequencer line running (0 = stopped)
+        """
+    @property
+    def now_ms(self) -> int:
+        """
+        device time (ms)
+        """
+    @property
+    def position(self) -> int:
+        """
+        #POSITION (1/10000 rev)
+        """
+    @property
+    def power(self) -> bool:
+        """
+        the motor is powered
+        """
+    @property
+    def sequencer_running(self) -> bool:
+        ...
+    @property
+    def speed(self) -> int:
+        """
+        #SPEED (0.01 rpm, signed)
+        """
+    @property
+    def status(self) -> int:
+        """
+        #STATUS bits
+        """
 class DmacSim(LineDevice):
     """
     A simulated DMAC module (a LineDevice: serve it with PtyLineServer). Device time runs on `clock` (a SimClock in tests); nothing runs in the background.
@@ -3206,8 +3568,10 @@ class DmacSim(LineDevice):
         """
         Temperature in 0.1 degC; CPU > 120 degC or driver/motor > 85 degC latches a thermal fault.
         """
-    def state(self) -> dict:
-        ...
+    def state(self) -> DmacSimState:
+        """
+        A DmacSimState snapshot.
+        """
     @property
     def address(self) -> int:
         ...
@@ -3223,6 +3587,30 @@ class DmacSim(LineDevice):
     @property
     def reply_terminator(self) -> bytes:
         ...
+class DmacClientCounters:
+    """
+    DmacClient counters (DmacClient.counters), read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def device_resets(self) -> int:
+        """
+        version banners seen unsolicited
+        """
+    @property
+    def stray_lines(self) -> int:
+        """
+        lines that were not the awaited reply (late, misrouted)
+        """
+    @property
+    def transactions(self) -> int:
+        ...
+    @property
+    def xon_errors(self) -> int:
+        """
+        MOVE_INTERPOL refused: FIFO full
+        """
 class DmacClient:
     """
     Typed DMAC commands over a LineLink (one client per module address).
@@ -3263,8 +3651,10 @@ class DmacClient:
         ...
     def raw(self, frame: str, expect_reply: bool = True) -> bytes:
         ...
-    def read(self, variable: str, radix: str = 'dec') -> int:
-        ...
+    def read(self, variable: str, radix: typing.Any = ...) -> int:
+        """
+        READ a variable; radix is a DmacRadix or 'dec'/'hex'/'bin' (default DmacRadix.DEC).
+        """
     def read_bit(self, variable: str, bit: typing.SupportsInt | typing.SupportsIndex) -> bool:
         ...
     def read_sequence(self, first: typing.SupportsInt | typing.SupportsIndex, last: typing.SupportsInt | typing.SupportsIndex) -> list[str]:
@@ -3273,8 +3663,10 @@ class DmacClient:
         ...
     def reference(self, on: bool) -> None:
         ...
-    def request_version(self) -> dict:
-        ...
+    def request_version(self) -> DmacVersionInfo:
+        """
+        REQUEST_VERSION, parsed into a DmacVersionInfo.
+        """
     def s_curve(self, on: bool) -> None:
         ...
     def set_address(self, address: typing.SupportsInt | typing.SupportsIndex) -> None:
@@ -3346,7 +3738,7 @@ class DmacClient:
         #CAPTURE: #POSITION at the last IN5 rising edge.
         """
     @property
-    def counters(self) -> dict:
+    def counters(self) -> DmacClientCounters:
         ...
     @property
     def cpu_temperature(self) -> int:
@@ -3480,6 +3872,37 @@ class DmacClient:
     @torque_ratio.setter
     def torque_ratio(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
+class DmacStreamStats:
+    """
+    What dmac_stream_interpolation did, read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def frames(self) -> int:
+        """
+        MOVE_INTERPOL frames sent (all axes, retries included)
+        """
+    @property
+    def min_level_after_start(self) -> int:
+        """
+        lowest FIFO level seen once moving (0 = underrun)
+        """
+    @property
+    def segments(self) -> int:
+        """
+        segments queued per axis
+        """
+    @property
+    def underruns(self) -> int:
+        """
+        times an axis reported an empty FIFO before the end
+        """
+    @property
+    def xon_errors(self) -> int:
+        """
+        refusals on a full FIFO
+        """
 class Pmc007ProfileParams:
     def __init__(self, speed: typing.SupportsFloat | typing.SupportsIndex = 1000.0, start_speed: typing.SupportsFloat | typing.SupportsIndex = 400.0, stop_speed: typing.SupportsFloat | typing.SupportsIndex = 0.0, accel_gear: typing.SupportsInt | typing.SupportsIndex = 0, decel_gear: typing.SupportsInt | typing.SupportsIndex = 0, microstepping: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
@@ -3554,7 +3977,7 @@ def arcus_build_request(address: typing.SupportsInt | typing.SupportsIndex, comm
     """
 def arcus_check_strict(params: ArcusProfileParams) -> None:
     ...
-def arcus_commands() -> list:
+def arcus_commands() -> list[ArcusCommandInfo]:
     """
     The command table (Table 11.0 plus the commands the sections describe).
     """
@@ -3592,13 +4015,13 @@ def decode_value(data_type: DataType, data: bytes) -> typing.Any:
     """
 def dmac_error_names(error: typing.SupportsInt | typing.SupportsIndex) -> list[str]:
     ...
-def dmac_format_value(value: typing.SupportsInt | typing.SupportsIndex, radix: str = 'dec') -> str:
+def dmac_format_value(value: typing.SupportsInt | typing.SupportsIndex, radix: typing.Any = ...) -> str:
     """
-    '+123', 'h0000007B' or 'b00000000 ... 01111011'.
+    '+123', 'h0000007B' or 'b00000000 ... 01111011'; radix is a DmacRadix or 'dec'/'hex'/'bin'.
     """
-def dmac_parse_read_reply(reply: bytes) -> typing.Any:
+def dmac_parse_read_reply(reply: bytes) -> DmacReadReply | None:
     """
-    Parses 'aa#MNE[.bit]=value' strictly; None when it breaks the grammar.
+    Parses 'aa#MNE[.bit]=value' strictly into a DmacReadReply; None when it breaks the grammar.
     """
 def dmac_position_profile(start: MotionState, target: typing.SupportsFloat | typing.SupportsIndex, params: DmacProfileParams) -> Profile:
     ...
@@ -3608,7 +4031,7 @@ def dmac_speed_profile(start: MotionState, speed: typing.SupportsFloat | typing.
     ...
 def dmac_status_names(status: typing.SupportsInt | typing.SupportsIndex) -> list[str]:
     ...
-def dmac_stream_interpolation(axes: collections.abc.Sequence[DmacClient], segments: collections.abc.Sequence[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]], interpol_time_ms: typing.SupportsInt | typing.SupportsIndex = 100, fifo_size: typing.SupportsInt | typing.SupportsIndex = 64, sleep: typing.Any = None, backoff: typing.Any = None) -> dict:
+def dmac_stream_interpolation(axes: collections.abc.Sequence[DmacClient], segments: collections.abc.Sequence[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]], interpol_time_ms: typing.SupportsInt | typing.SupportsIndex = 100, fifo_size: typing.SupportsInt | typing.SupportsIndex = 64, sleep: typing.Any = None, backoff: typing.Any = None) -> DmacStreamStats:
     """
     Streams segments[k][axis] to every axis, starting them with SYNCHRO INTERPOL.
     """
@@ -3616,8 +4039,10 @@ def dmac_synchro(link: LineLink, what: str) -> None:
     """
     Global SYNCHRO ON|OFF|TOP|INTERPOL (no reply).
     """
-def dmac_variable(name: str) -> dict:
-    ...
+def dmac_variable(name: str) -> DmacVariableInfo:
+    """
+    The DmacVariableInfo of a variable, by full name or mnemonic ('#ACCEL_TIME', 'ATI').
+    """
 def emcy_code_text(code: typing.SupportsInt | typing.SupportsIndex) -> str:
     ...
 def emcy_decode(frame: Frame) -> typing.Any:

@@ -90,7 +90,8 @@ def serial_bench(quick: bool) -> None:
             m.move_to(goal)
             pos = m.wait_idle(timeout=10)
             print(f"  DMAC 00 MOVE_TO {goal} -> #POSITION={pos}, status {m.status}")
-            print(f"  DMAC 00 version: {m.request_version()}")
+            v = m.request_version()
+            print(f"  DMAC 00 version: {v.product} v{v.version}.{v.release} ({v.code}, {v.model}), serial {v.serial}")
     finally:
         _stop(proc)
 

@@ -117,7 +117,7 @@ def test_accel_scaling_example(line):
     silent(ser, f"00#ACCEL_TIME:={ex['ACCEL_TIME_ms']}, "
                 f"#HIGH_SPEED:={ex['HIGH_SPEED']}, MOVE_SPEED {ex['MOVE_SPEED']}")
     clock.advance(int(ex["accel_time_s"] * 1e9) - 2_000_000)
-    assert sims[0].state()["speed"] < ex["MOVE_SPEED"]
+    assert sims[0].state().speed < ex["MOVE_SPEED"]
     clock.advance(2_000_000)
     assert ask(ser, "00READ #SPEED") == f"00#SPE=+{ex['MOVE_SPEED']}".encode() + CRLF
 

@@ -68,11 +68,11 @@ def test_a3_overlong_reply(rig):
 
 def test_a5_unknown_command_is_typed_and_not_retried(rig):
     dev, c, _ = rig
-    before = c.counters["requests"]
+    before = c.counters.requests
     with pytest.raises(motorbus._core.ArcusUnknownCommand) as e:
         c.command("FOO", idempotent=True)
     assert e.value.reply == "?FOO" and e.value.command == "FOO"
-    assert c.counters["requests"] == before + 1
+    assert c.counters.requests == before + 1
 
 
 def test_a6_reply_for_another_address(rig):
@@ -129,7 +129,7 @@ def test_a10_noise_is_skipped_and_counted(rig):
     dev, c, _ = rig
     dev.mangle = lambda r: b"\xff\xfe\0\x80\0" + r
     assert c.position == 0
-    assert c.counters["noise_lines"] == 2
+    assert c.counters.noise_lines == 2
     dev.mangle = None
     assert c.high_speed == 1000
 

@@ -60,11 +60,11 @@ def test_sim_profile_times_on_sim_clock():
     sim.on_line(b"00BRAKE OFF")
     sim.on_line(b"00MOVE_SPEED 30000")  # ATI 1000 ms, HSP 60000: 0.5 s to 30000
     clock.advance(250 * MS)
-    assert abs(sim.state()["speed"] - 15000) <= 100
+    assert abs(sim.state().speed - 15000) <= 100
     clock.advance(250 * MS)
     assert sim.on_line(b"00READ #SPEED") == b"00#SPE=+30000\r\n"
     sim.on_line(b"00HALT")
-    assert sim.state()["speed"] == 0
+    assert sim.state().speed == 0
 
 
 def test_sim_end_stop_switches_stop_the_axis_on_the_switch():
@@ -75,7 +75,7 @@ def test_sim_end_stop_switches_stop_the_axis_on_the_switch():
     sim.on_line(b"00BRAKE OFF, HARD_ENDS ALL, MOVE_SPEED 6000")
     clock.advance(2000 * MS)
     assert sim.on_line(b"00READ #POSITION") == b"00#POS=+2500\r\n"
-    status = sim.state()["status"]
+    status = sim.state().status
     assert status & (1 << 16)          # bit 17: hard positive end-stop
     assert status & (1 << 31)          # bit 32: abnormal stop
     assert sim.on_line(b"00READ #SPEED") == b"00#SPE=+0\r\n"
@@ -118,7 +118,7 @@ def test_client_typed_moves_status_and_errors(bus):
     assert not c0.error
     assert dmac.status_names(0x13000800) == ["s_curve", "power_on", "movement", "busy"]
     v = c0.request_version()
-    assert (v["code"], v["product"], v["version"], v["release"]) == ("H142", "DMAC34-1", 1, 7)
+    assert (v.code, v.product, v.version, v.release) == ("H142", "DMAC34-1", 1, 7)
 
 
 def test_client_variables_and_bits(bus):
@@ -181,11 +181,11 @@ def test_interpolation_streaming_three_axes(bus):
     segments = [[300, -100, 50]] * 80
     stats = stream_interpolation(clients, segments, interpol_time_ms=10, fifo_size=8,
                                  sleep=lambda s: clock.advance(int(s * 1e9)))
-    assert stats["segments"] == 80
-    assert stats["xon_errors"] > 0
-    assert stats["underruns"] == 0
+    assert stats.segments == 80
+    assert stats.xon_errors > 0
+    assert stats.underruns == 0
     clock.advance(2000 * MS)
-    assert [s.state()["position"] for s in sims] == [24000, -8000, 4000]
+    assert [s.state().position for s in sims] == [24000, -8000, 4000]
 
 
 def test_synchro_on_top(bus):
@@ -211,9 +211,9 @@ def test_context_manager_stops_on_exception(bus):
             raise RuntimeError("operator error")
     clock.advance(50 * MS)
     st = sims[0].state()
-    assert 0 < st["speed"] < 60000  # decelerating after STOP
+    assert 0 < st.speed < 60000  # decelerating after STOP
     clock.advance(2000 * MS)
-    assert sims[0].state()["speed"] == 0
+    assert sims[0].state().speed == 0
 
 
 def test_exit_time_stop_from_another_process():
@@ -231,9 +231,9 @@ def test_exit_time_stop_from_another_process():
         subprocess.run([sys.executable, "-c", script], env=env, check=True, timeout=30)
         clock.advance(100 * MS)
         st = sim.state()
-        assert st["speed"] < 30000 * 0.25  # STOP arrived: it ramps down instead of up
+        assert st.speed < 30000 * 0.25  # STOP arrived: it ramps down instead of up
         clock.advance(2000 * MS)
-        assert sim.state()["speed"] == 0
+        assert sim.state().speed == 0
 
 
 # ---- HOSTILE_INPUTS 2.9 (A-rows) from Python --------------------------------------------
@@ -278,7 +278,7 @@ def test_a8_a10_a13_stray_lines_are_skipped_and_counted():
         c = DmacClient(open_line(server.slave_path, timeout=0.2), address=0)
         assert c.position == 0
         k = c.counters
-        assert k["stray_lines"] == 2 and k["device_resets"] == 1
+        assert k.stray_lines == 2 and k.device_resets == 1
         c.close()
 
 
@@ -302,3 +302,18 @@ def test_a15_sim_resyncs_after_overlong_and_binary():
     assert sim.on_overlong() == b""
     assert sim.on_line(b"00#ERROR:=0, READ #POS") == b"00#POS=+0\r\n"
     assert sim.lines_rejected >= 3
+
+
+def test_codec_records_and_radix_enum():
+    r = dmac.parse_read_reply(b"05#ATI=h000001F4")
+    assert isinstance(r, dmac.DmacReadReply)
+    assert (r.address, r.mnemonic, r.bit, r.value, r.radix) == (5, "#ATI", 0, 500, dmac.DmacRadix.HEX)
+    assert dmac.parse_read_reply(b"5#ATI=+1") is None          # one address digit: not the grammar
+    with pytest.raises(AttributeError):
+        r.value = 1                                            # read-only
+    assert dmac.format_value(500, r.radix) == dmac.format_value(500, "hex") == "h000001F4"
+    v = dmac.variable_info("HSP")
+    assert isinstance(v, dmac.DmacVariableInfo) and (v.name, v.mnemonic) == ("#HIGH_SPEED", "#HSP")
+    assert "DmacVariableInfo(name='#HIGH_SPEED'" in repr(v)
+    with pytest.raises(motorbus.InvalidArgument):
+        dmac.format_value(1, "octal")

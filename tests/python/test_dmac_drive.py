@@ -113,7 +113,7 @@ def test_exception_in_with_stops_and_link_loss_raises_linkdown():
             d.enable()
             d.jog(1000.0)
             raise RuntimeError("boom")
-    assert not sim.state()["status"] & int(DmacStatus.MOVEMENT)   # HALT: at rest at once
+    assert not sim.state().status & int(DmacStatus.MOVEMENT)   # HALT: at rest at once
     d2 = open_drive("dmac", line=server.slave_path, address="00")
     server.close()
     with pytest.raises(motorbus.LinkDown):

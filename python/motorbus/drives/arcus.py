@@ -18,10 +18,13 @@ import os
 from typing import Any, Optional, Union
 
 from .. import _core, _stop_at_exit
-from .._core import ArcusClientBase, ArcusSim  # noqa: F401  (re-exported)
+from .._core import ArcusClientBase, ArcusClientCounters, ArcusCommandInfo, ArcusPhase, ArcusSim  # noqa: F401  (re-exported)
 
 __all__ = [
     "ArcusClient",
+    "ArcusClientCounters",
+    "ArcusCommandInfo",
+    "ArcusPhase",
     "ArcusSim",
     "MotorStatus",
     "SnlStatus",

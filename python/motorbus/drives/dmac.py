@@ -30,6 +30,13 @@ from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params
 from ..registry import DrivePlugin
 
 DmacSim = _core.DmacSim
+DmacSimState = _core.DmacSimState
+DmacRadix = _core.DmacRadix
+DmacReadReply = _core.DmacReadReply
+DmacVariableInfo = _core.DmacVariableInfo
+DmacVersionInfo = _core.DmacVersionInfo
+DmacClientCounters = _core.DmacClientCounters
+DmacStreamStats = _core.DmacStreamStats
 UnknownCommand = _core.DmacUnknownCommand
 CommandRejected = _core.DmacCommandRejected
 format_value = _core.dmac_format_value
@@ -134,10 +141,17 @@ __all__ = [
     "DEFAULT_ADDRESS",
     "DEFAULT_BAUD",
     "DmacClient",
+    "DmacClientCounters",
     "DmacDrive",
     "DmacErrorWord",
+    "DmacRadix",
+    "DmacReadReply",
     "DmacSim",
+    "DmacSimState",
     "DmacStatus",
+    "DmacStreamStats",
+    "DmacVariableInfo",
+    "DmacVersionInfo",
     "FAULTS",
     "HomingFailed",
     "LINE_SETTINGS",
@@ -293,12 +307,13 @@ def synchro(link: Any, what: str) -> None:
 
 def stream_interpolation(axes: Sequence[DmacClient], segments: Iterable[Sequence[int]],
                          interpol_time_ms: int = 100, fifo_size: int = 64, sleep: Any = None,
-                         backoff: Optional[float] = None) -> dict:
+                         backoff: Optional[float] = None) -> "_core.DmacStreamStats":
     """Stream ``segments[k][axis]`` (MOVE_INTERPOL offsets) to every axis.
 
     Pre-fills each FIFO, starts all axes with the global SYNCHRO INTERPOL, then
-    keeps every FIFO fed, backing off on XON_ERROR.  Returns counters
-    (``xon_errors``, ``underruns``, ``min_level_after_start``...).
+    keeps every FIFO fed, backing off on XON_ERROR.  Returns a read-only
+    ``DmacStreamStats`` (``.segments``, ``.xon_errors``, ``.underruns``,
+    ``.min_level_after_start``...).
     """
     return _core.dmac_stream_interpolation(list(axes), [list(map(int, s)) for s in segments],
                                            interpol_time_ms, fifo_size, sleep, backoff)
@@ -359,10 +374,10 @@ class DmacParams(Params):
             v = variable_info(name)
         except _core.InvalidArgument:
             return None
-        canonical = v["name"]
-        writable = not v["read_only"] and canonical not in ("#STATUS",)
-        return ParamInfo(name=canonical, type="int", minimum=v["min"], maximum=v["max"],
-                         unit=_UNITS.get(canonical, ""), default=v["factory"], persists=bool(v["stored"]),
+        canonical = v.name
+        writable = not v.read_only and canonical not in ("#STATUS",)
+        return ParamInfo(name=canonical, type="int", minimum=v.min, maximum=v.max,
+                         unit=_UNITS.get(canonical, ""), default=v.factory, persists=v.stored,
                          writable=writable, description=_DESCRIPTIONS.get(canonical, ""))
 
     def _read(self, info: ParamInfo) -> Any:
