@@ -43,11 +43,14 @@ def bench_motorbus(port: int, reads: int) -> float:
         sdo = SdoClient(bus, NODE, timeout=1.0)
         for _ in range(WARMUP):
             assert sdo.read_u32(INDEX) == VALUE
+        lat = []
         t0 = time.perf_counter()
         for _ in range(reads):
+            t = time.perf_counter()
             if sdo.read_u32(INDEX) != VALUE:
                 raise SystemExit("motorbus: wrong value")
-        return reads / (time.perf_counter() - t0)
+            lat.append(time.perf_counter() - t)
+        return reads / (time.perf_counter() - t0), lat
 
 
 def bench_canopen(port: int, reads: int) -> float:
@@ -60,13 +63,22 @@ def bench_canopen(port: int, reads: int) -> float:
         want = VALUE.to_bytes(4, "little")
         for _ in range(WARMUP):
             assert node.sdo.upload(INDEX, 0) == want
+        lat = []
         t0 = time.perf_counter()
         for _ in range(reads):
+            t = time.perf_counter()
             if node.sdo.upload(INDEX, 0) != want:
                 raise SystemExit("canopen: wrong value")
-        return reads / (time.perf_counter() - t0)
+            lat.append(time.perf_counter() - t)
+        return reads / (time.perf_counter() - t0), lat
     finally:
         network.disconnect()
+
+
+def _pct(lat: list) -> str:
+    s = sorted(lat)
+    return "median / p99 / max %.0f / %.0f / %.0f us" % (s[len(s) // 2] * 1e6, s[int(len(s) * 0.99)] * 1e6,
+                                                          s[-1] * 1e6)
 
 
 def main() -> None:
@@ -87,11 +99,13 @@ def main() -> None:
         node = subprocess.Popen([sys.executable, __file__, "--node", str(port)],
                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         assert node.stdout.readline().strip() == "ready"
-        mb = bench_motorbus(port, args.reads)
-        co = bench_canopen(port, args.canopen_reads)
+        mb, mb_lat = bench_motorbus(port, args.reads)
+        co, co_lat = bench_canopen(port, args.canopen_reads)
         print(f"SDO expedited reads between two processes via `motorbus bus serve --socketcand` (127.0.0.1)")
-        print(f"  motorbus SdoClient  / motorbus socketcand client : {mb:9.0f} reads/s ({args.reads} reads)")
-        print(f"  canopen SdoClient   / python-can socketcand      : {co:9.0f} reads/s ({args.canopen_reads} reads)")
+        print(f"  motorbus SdoClient  / motorbus socketcand client : {mb:9.0f} reads/s ({args.reads} reads), "
+              f"{_pct(mb_lat)}")
+        print(f"  canopen SdoClient   / python-can socketcand      : {co:9.0f} reads/s ({args.canopen_reads} reads), "
+              f"{_pct(co_lat)}")
         print(f"  ratio motorbus / canopen: {mb / co:.1f}x")
     finally:
         if node is not None:
