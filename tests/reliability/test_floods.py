@@ -5,7 +5,7 @@ import os
 import struct
 import time
 
-import pytest
+
 
 import motorbus
 from motorbus import Frame

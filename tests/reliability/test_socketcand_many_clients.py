@@ -8,6 +8,7 @@ import threading
 import time
 
 import can
+import logging
 import pytest
 
 import motorbus
@@ -26,12 +27,14 @@ DEADLINE = size(60, 1800)    # seconds before a missing frame is a failure (neve
 
 # PC_LOSS: python-can 4.6.1's `socketcand` client loses about one frame in a few thousand when
 # several senders stream to it while it also sends (seen here: 3-5 of 2 x 21 000 frames per run,
-# the same frame at both python-can clients).  The server is not the cause: motorbus clients and
-# raw-socket readers with an exact parser (tests/reliability/test_socketcand_many_clients.py's
-# _Raw, /tmp diagnostics described in docs/reliability.md) receive every frame of the same run.
+# often the same frame at both python-can clients).  The server is not the cause: the motorbus
+# clients of the same run receive every frame, and so does a raw-socket reader with an exact
+# parser that sends one element per send() as python-can does (docs/reliability.md).
 # So python-can receivers are checked for order and duplicates, and their losses are counted and
 # printed, not failed on.
 PC_LOSS_TOLERATED = True
+
+logging.getLogger("can").setLevel(logging.ERROR)  # python-can warns on every partial read
 
 BASE = 0x100
 ABRUPT_BASE = 0x200
