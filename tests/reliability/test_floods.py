@@ -5,8 +5,6 @@ import os
 import struct
 import time
 
-
-
 import motorbus
 from motorbus import Frame
 from motorbus.socketcand import SocketcandServer, open_socketcand
