@@ -14,7 +14,7 @@ export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := 1
 CCACHE := $(shell command -v ccache >/dev/null && echo -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache)
 
-.PHONY: demo test deps venv build cpp-test py-test sanitize fuzz fuzz-smoke bench stubs clean
+.PHONY: demo test deps venv build cpp-test py-test sanitize fuzz fuzz-smoke bench soak stubs clean
 
 demo: build
 	$(PY) -m motorbus demo
@@ -54,6 +54,10 @@ fuzz: deps
 
 fuzz-smoke: deps
 	bash tools/fuzz.sh run 5
+
+# tests/reliability scaled up (long; the default pytest run holds their bounded form).
+soak: build
+	MOTORBUS_SOAK=1 $(PY) -m pytest -q -p no:cacheprovider tests/reliability
 
 bench: build
 	bash tools/bench.sh $(PY)
