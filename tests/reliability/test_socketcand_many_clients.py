@@ -207,7 +207,8 @@ def test_many_clients_full_rate_then_abrupt_disconnects():
         per_receiver = (len(senders) - 1) * (N1 + N2)
         print(f"\n[socketcand-many] {MB_CLIENTS} motorbus + {PC_CLIENTS} python-can clients, "
               f"{len(senders)} x ({N1}+{N2}) frames, {per_receiver} per receiver: 0 lost, 0 dup/reordered; "
-              f"{ABRUPT} raw clients RST after {cut} frames; server queue_drops={server.stats.queue_drops}; "
+              f"{ABRUPT} raw clients RST after {cut} frames; server queue_drops={server.stats.queue_drops} "
+              f"(per connected client {server.client_drops}); "
               f"python-can receivers lost {pc_lost_frames} frames in {len(pc_lost)} streams {pc_lost[:4]}")
     finally:
         for r in raws:
