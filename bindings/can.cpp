@@ -18,6 +18,7 @@ using namespace motorbus::can;
 using motorbus::py_helpers::PyCallable;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::interruptible_wait;
 
 namespace {
 
@@ -102,15 +103,18 @@ void bind_can(py::module_& m) {
         .def("recv",
              [](Bus& b, const py::object& timeout) {
                  auto t = seconds_to_ns(timeout);
-                 py::gil_scoped_release nogil;
-                 return b.recv(t);
+                 return interruptible_wait(t, [&](std::chrono::nanoseconds d) { return b.recv(d); });
              },
              py::arg("timeout") = py::none())
         .def("recv_many",
              [](Bus& b, std::size_t max, const py::object& timeout) {
                  auto t = seconds_to_ns(timeout);
-                 py::gil_scoped_release nogil;
-                 return b.recv_many(max, t);
+                 auto got = interruptible_wait(t, [&](std::chrono::nanoseconds d) -> std::optional<std::vector<Frame>> {
+                     auto v = b.recv_many(max, d);
+                     if (v.empty()) return std::nullopt;
+                     return v;
+                 });
+                 return got ? std::move(*got) : std::vector<Frame>{};
              },
              py::arg("max") = 1024, py::arg("timeout") = py::none(),
              "Up to max frames, oldest first: waits like recv() for the first, then takes what is "

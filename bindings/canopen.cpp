@@ -19,6 +19,8 @@ namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::canopen;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::Blocking;
+using motorbus::py_helpers::blocking_call;
 
 namespace {
 
@@ -465,50 +467,40 @@ void bind_canopen(py::module_& m) {
              py::arg("response_id") = 0, py::keep_alive<1, 2>())
         .def("upload", [](SdoClient& c, std::uint16_t i, std::uint8_t s, bool block) {
                  Bytes b;
-                 {
-                     py::gil_scoped_release nogil;
-                     b = c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto);
-                 }
+                 b = blocking_call([&] { return c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto); });
                  return to_bytes(b);
              },
              py::arg("index"), py::arg("subindex") = 0, py::arg("block") = false)
         .def("download", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const py::object& data, bool block,
                             bool segmented) {
                  Bytes b = from_buffer(data);
-                 py::gil_scoped_release nogil;
-                 c.download(i, s, b, mode_of(block, segmented));
+                 blocking_call([&] { c.download(i, s, b, mode_of(block, segmented)); });
              },
              py::arg("index"), py::arg("subindex"), py::arg("data"), py::arg("block") = false,
              py::arg("segmented") = false)
 #define MB_RW(T, name)                                                                         \
-    .def("read_" #name, &SdoClient::read_##name, py::arg("index"), py::arg("subindex") = 0,    \
-         py::call_guard<py::gil_scoped_release>())                                             \
-    .def("write_" #name, &SdoClient::write_##name, py::arg("index"), py::arg("subindex"),      \
-         py::arg("value"), py::call_guard<py::gil_scoped_release>())
+    .def("read_" #name, &Blocking<&SdoClient::read_##name>::call, py::arg("index"),            \
+         py::arg("subindex") = 0)                                                              \
+    .def("write_" #name, &Blocking<&SdoClient::write_##name>::call, py::arg("index"),          \
+         py::arg("subindex"), py::arg("value"))
         MB_RW(std::uint8_t, u8) MB_RW(std::uint16_t, u16) MB_RW(std::uint32_t, u32) MB_RW(std::uint64_t, u64)
         MB_RW(std::int8_t, i8) MB_RW(std::int16_t, i16) MB_RW(std::int32_t, i32) MB_RW(std::int64_t, i64)
         MB_RW(float, f32) MB_RW(double, f64)
 #undef MB_RW
-        .def("read_string", &SdoClient::read_string, py::arg("index"), py::arg("subindex") = 0,
-             py::call_guard<py::gil_scoped_release>())
+        .def("read_string", &Blocking<&SdoClient::read_string>::call, py::arg("index"), py::arg("subindex") = 0)
         .def("write_string", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const std::string& v) {
-                 py::gil_scoped_release nogil;
-                 c.write_string(i, s, v);
+                 blocking_call([&] { c.write_string(i, s, v); });
              },
              py::arg("index"), py::arg("subindex"), py::arg("value"))
         .def("read_domain", [](SdoClient& c, std::uint16_t i, std::uint8_t s, bool block) {
                  Bytes b;
-                 {
-                     py::gil_scoped_release nogil;
-                     b = c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto);
-                 }
+                 b = blocking_call([&] { return c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto); });
                  return to_bytes(b);
              },
              py::arg("index"), py::arg("subindex") = 0, py::arg("block") = false)
         .def("write_domain", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const py::object& data, bool block) {
                  Bytes b = from_buffer(data);
-                 py::gil_scoped_release nogil;
-                 c.download(i, s, b, block ? TransferMode::Block : TransferMode::Auto);
+                 blocking_call([&] { c.download(i, s, b, block ? TransferMode::Block : TransferMode::Auto); });
              },
              py::arg("index"), py::arg("subindex"), py::arg("data"), py::arg("block") = false)
         .def_property("timeout",

@@ -33,6 +33,7 @@ using namespace motorbus;
 using namespace motorbus::canopen;
 using motorbus::py_helpers::PyCallable;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::blocking_call;
 
 namespace {
 
@@ -367,8 +368,7 @@ void bind_canopen_services(py::module_& m) {
                  check_node(node, false);
                  auto want = node_state_of(st);
                  auto to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 return b.wait_for_state(static_cast<std::uint8_t>(node), want, to);
+                 return blocking_call([&] { return b.wait_for_state(static_cast<std::uint8_t>(node), want, to); });
              }, py::arg("node"), py::arg("state"), py::arg("timeout") = 1.0)
         .def("set_state", [](NmtMaster& b, int node, const std::string& state) {
                  check_node(node, true);
@@ -383,18 +383,14 @@ void bind_canopen_services(py::module_& m) {
                  check_node(node, false);
                  auto to = timeout_of(t);
                  std::optional<NodeState> s;
-                 {
-                     py::gil_scoped_release nogil;
-                     s = b.wait_for_heartbeat(static_cast<std::uint8_t>(node), to);
-                 }
+                 s = blocking_call([&] { return b.wait_for_heartbeat(static_cast<std::uint8_t>(node), to); });
                  if (!s) return std::nullopt;
                  return std::string(to_string(*s));
              }, py::arg("node"), py::arg("timeout") = 1.0)
         .def("wait_for_boot", [](NmtMaster& b, int node, const py::object& t) {
                  check_node(node, false);
                  auto to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 return b.wait_for_boot(static_cast<std::uint8_t>(node), to);
+                 return blocking_call([&] { return b.wait_for_boot(static_cast<std::uint8_t>(node), to); });
              }, py::arg("node"), py::arg("timeout") = 1.0)
         .def("set_callback", [](NmtMaster& b, py::object cb) {
                  if (cb.is_none()) { b.on_state_change = nullptr; return; }
@@ -488,10 +484,7 @@ void bind_canopen_services(py::module_& m) {
                  check_node(node, true);
                  auto to = timeout_of(t);
                  std::optional<EmcyMessage> r;
-                 {
-                     py::gil_scoped_release nogil;
-                     r = b.wait(static_cast<std::uint8_t>(node), to);
-                 }
+                 r = blocking_call([&] { return b.wait(static_cast<std::uint8_t>(node), to); });
                  if (!r) return py::none();
                  return py::cast(*r);
              }, py::arg("node") = 0, py::arg("timeout") = 1.0)
@@ -600,8 +593,7 @@ void bind_canopen_services(py::module_& m) {
         .def_property_readonly("short_frames", [](PdoReceiver& b) { return b.short_frames(); })
         .def("wait_newer", [](PdoReceiver& b, std::uint64_t after, const py::object& t) {
                  auto to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 return b.wait_newer(after, to);
+                 return blocking_call([&] { return b.wait_newer(after, to); });
              }, py::arg("after"), py::arg("timeout") = 1.0)
         .def("request", [](PdoReceiver& b) { py::gil_scoped_release nogil; b.request(); })
         .def("set_callback", [](PdoReceiver& b, py::object cb) {
@@ -696,52 +688,43 @@ void bind_canopen_services(py::module_& m) {
         .def("use_statusword_pdo", [](Cia402Host& b, PdoReceiver* rx) { b.use_statusword_pdo(rx); },
              py::arg("receiver"), py::keep_alive<1, 2>(),
              "Wait on this TPDO receiver's statusword (0x6041 must be mapped); None = poll over SDO.")
-        .def_property_readonly("statusword", [](Cia402Host& b) { py::gil_scoped_release nogil; return b.read_statusword(); })
+        .def_property_readonly("statusword", [](Cia402Host& b) { return blocking_call([&] { return b.read_statusword(); }); })
         .def_property_readonly("state", [](Cia402Host& b) {
                  Cia402State s;
-                 {
-                     py::gil_scoped_release nogil;
-                     s = b.state();
-                 }
+                 s = blocking_call([&] { return b.state(); });
                  return std::string(to_string(s));
              })
-        .def("write_controlword", [](Cia402Host& b, std::uint16_t c) { py::gil_scoped_release nogil; b.write_controlword(c); })
+        .def("write_controlword", [](Cia402Host& b, std::uint16_t c) { blocking_call([&] { b.write_controlword(c); }); })
         .def("go_to", [](Cia402Host& b, const std::string& s) {
                  auto t = cia402_state_of(s);
-                 py::gil_scoped_release nogil;
-                 b.go_to(t);
+                 blocking_call([&] { b.go_to(t); });
              }, py::arg("state"))
-        .def("fault_reset", [](Cia402Host& b) { py::gil_scoped_release nogil; b.fault_reset(); })
-        .def("quick_stop", [](Cia402Host& b) { py::gil_scoped_release nogil; b.quick_stop(); })
+        .def("fault_reset", [](Cia402Host& b) { blocking_call([&] { b.fault_reset(); }); })
+        .def("quick_stop", [](Cia402Host& b) { blocking_call([&] { b.quick_stop(); }); })
         .def("wait_statusword", [](Cia402Host& b, std::uint16_t mask, std::uint16_t value, const py::object& t) {
                  std::optional<std::chrono::nanoseconds> to;
                  if (!t.is_none()) to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 return b.wait_statusword(mask, value, to);
+                 return blocking_call([&] { return b.wait_statusword(mask, value, to); });
              }, py::arg("mask"), py::arg("value"), py::arg("timeout") = py::none())
         .def("set_mode", [](Cia402Host& b, int mode) {
-                 py::gil_scoped_release nogil;
-                 b.set_mode(static_cast<OpMode>(mode));
+                 blocking_call([&] { b.set_mode(static_cast<OpMode>(mode)); });
              }, py::arg("mode"))
-        .def_property_readonly("mode", [](Cia402Host& b) { py::gil_scoped_release nogil; return static_cast<int>(b.mode()); })
+        .def_property_readonly("mode", [](Cia402Host& b) { return blocking_call([&] { return static_cast<int>(b.mode()); }); })
         .def("move_to", [](Cia402Host& b, std::int32_t target, bool relative, bool immediate) {
-                 py::gil_scoped_release nogil;
-                 b.move_to(target, relative, immediate);
+                 blocking_call([&] { b.move_to(target, relative, immediate); });
              }, py::arg("target"), py::arg("relative") = false, py::arg("immediate") = true)
         .def("wait_target_reached", [](Cia402Host& b, const py::object& t) {
                  std::optional<std::chrono::nanoseconds> to;
                  if (!t.is_none()) to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 b.wait_target_reached(to);
+                 blocking_call([&] { b.wait_target_reached(to); });
              }, py::arg("timeout") = py::none())
-        .def("set_velocity", [](Cia402Host& b, std::int32_t v) { py::gil_scoped_release nogil; b.set_velocity(v); })
+        .def("set_velocity", [](Cia402Host& b, std::int32_t v) { blocking_call([&] { b.set_velocity(v); }); })
         .def("home", [](Cia402Host& b, std::optional<int> method, const py::object& t) {
                  std::optional<std::chrono::nanoseconds> to;
                  if (!t.is_none()) to = timeout_of(t);
                  std::optional<std::int8_t> mth;
                  if (method) mth = static_cast<std::int8_t>(*method);
-                 py::gil_scoped_release nogil;
-                 b.home(mth, to);
+                 blocking_call([&] { b.home(mth, to); });
              }, py::arg("method") = py::none(), py::arg("timeout") = py::none());
 
     py::class_<Cia402Device, std::shared_ptr<Cia402Device>>(m, "Cia402Device",
@@ -825,10 +808,7 @@ void bind_canopen_services(py::module_& m) {
               o.probe_sdo = probe_sdo;
               o.read_identity = identity;
               std::vector<ScanResult> res;
-              {
-                  py::gil_scoped_release nogil;
-                  res = scan_network(*bus, o);
-              }
+              res = blocking_call([&] { return scan_network(*bus, o); });
               return res;
           }, py::arg("bus"), py::arg("first") = 1, py::arg("last") = 127, py::arg("sdo_timeout") = 0.2,
           py::arg("listen") = 0.0, py::arg("probe_sdo") = true, py::arg("identity") = true);

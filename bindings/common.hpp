@@ -2,12 +2,18 @@
 #pragma once
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
+#include <thread>
+#include <type_traits>
 #include <vector>
+
+#include "motorbus/runtime/interrupt.hpp"
 
 namespace motorbus::py_helpers {
 namespace py = pybind11;
@@ -21,6 +27,77 @@ inline std::chrono::nanoseconds seconds_to_ns(const py::object& t) {
     if (s > 1e9) return std::chrono::nanoseconds(-1);
     return std::chrono::nanoseconds(static_cast<std::int64_t>(s * 1e9));
 }
+
+// ---- blocking calls: GIL released, Ctrl-C live, safe at interpreter exit ----------
+//
+// Every call that may block goes through blocking_call() (an opaque C++ wait)
+// or interruptible_wait() (a wait the binding can slice itself).  On the main
+// thread (the only one Python delivers signals to) the wait wakes every
+// kInterruptSlice (50 ms), takes the GIL and runs PyErr_CheckSignals(): a
+// pending KeyboardInterrupt (or whatever a signal handler raised) abandons the
+// wait and propagates.  C++ waits inside the core see the same check through
+// motorbus::InterruptScope (cpp/motorbus/runtime/interrupt.hpp).
+//
+// Thrown through C++ frames by the interrupt check; the Python error is set.
+struct PythonErrorPending {};
+
+inline void check_python_signals() {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw PythonErrorPending{};
+}
+
+inline bool on_main_python_thread() {
+    // Caller holds the GIL.  threading.main_thread() never changes.
+    static const unsigned long main_ident =
+        py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
+    return PyThread_get_thread_ident() == main_ident;
+}
+
+// Runs fn() (a wait inside the C++ core) with the GIL released and Ctrl-C live.
+template <class F>
+decltype(auto) blocking_call(F&& fn) {
+    const bool main = on_main_python_thread();
+    try {
+        py::gil_scoped_release nogil;
+        if (!main) return fn();
+        InterruptScope interrupt(&check_python_signals);
+        return fn();
+    } catch (const PythonErrorPending&) {
+        throw py::error_already_set();
+    }
+}
+
+// A wait the binding slices itself: slice(d) waits at most d (>= 0, or the
+// whole `timeout` off the main thread, negative = forever) and returns a
+// std::optional, nullopt for "nothing yet".  Returns nullopt after `timeout`
+// (negative = never).
+template <class Slice>
+auto interruptible_wait(std::chrono::nanoseconds timeout, Slice&& slice) {
+    using Result = std::invoke_result_t<Slice&, std::chrono::nanoseconds>;
+    return blocking_call([&]() -> Result {
+        if (!interruptible()) return slice(timeout);
+        using SC = std::chrono::steady_clock;
+        const bool forever = timeout.count() < 0;
+        const auto deadline = forever ? SC::time_point::max() : SC::now() + timeout;
+        for (;;) {
+            std::chrono::nanoseconds d = kInterruptSlice;
+            if (!forever) d = std::min<std::chrono::nanoseconds>(d, std::max(deadline - SC::now(), SC::duration::zero()));
+            if (Result r = slice(d)) return r;
+            if (!forever && SC::now() >= deadline) return Result{};
+            interruption_point();
+        }
+    });
+}
+
+// A member function bound as a blocking call: .def("read_u8", &Blocking<&SdoClient::read_u8>::call, ...).
+template <auto M>
+struct Blocking;
+template <class C, class R, class... A, R (C::*M)(A...)>
+struct Blocking<M> {
+    static R call(C& self, A... a) {
+        return blocking_call([&]() -> R { return (self.*M)(std::forward<A>(a)...); });
+    }
+};
 
 // Holds a Python callable so it can be called and released from C++ threads:
 // the GIL is taken for the call and for the final decref.

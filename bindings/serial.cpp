@@ -17,6 +17,8 @@ using namespace motorbus;
 using namespace motorbus::serial;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::blocking_call;
+using motorbus::py_helpers::interruptible_wait;
 
 namespace {
 
@@ -190,12 +192,12 @@ void bind_serial(py::module_& m) {
                 if (size == 0 || size > (1u << 20)) throw InvalidArgument("read size: must be in [1, 1048576]");
                 auto t = seconds_to_ns(timeout);
                 std::string buf(size, '\0');
-                std::size_t n;
-                {
-                    py::gil_scoped_release nogil;
-                    n = p.read({reinterpret_cast<std::uint8_t*>(buf.data()), buf.size()}, t);
-                }
-                return py::bytes(buf.data(), n);
+                auto n = interruptible_wait(t, [&](std::chrono::nanoseconds d) -> std::optional<std::size_t> {
+                    std::size_t got = p.read({reinterpret_cast<std::uint8_t*>(buf.data()), buf.size()}, d);
+                    if (got == 0) return std::nullopt;
+                    return got;
+                });
+                return py::bytes(buf.data(), n.value_or(0));
             },
             py::arg("size") = 4096, py::arg("timeout") = py::none(),
             "Returns what is available (b'' on timeout); waits up to `timeout` s for the first byte "
@@ -299,10 +301,7 @@ void bind_serial(py::module_& m) {
                 std::optional<std::chrono::nanoseconds> t;
                 if (!timeout.is_none()) t = seconds_to_ns(timeout);
                 std::string reply;
-                {
-                    py::gil_scoped_release nogil;
-                    reply = l.transact(req, t);
-                }
+                reply = blocking_call([&] { return l.transact(req, t); });
                 return to_py(reply);
             },
             py::arg("request"), py::arg("timeout") = py::none(),
@@ -321,10 +320,7 @@ void bind_serial(py::module_& m) {
             [](LineLink& l, const py::object& timeout) -> py::object {
                 auto t = timeout.is_none() ? l.options().reply_timeout : seconds_to_ns(timeout);
                 std::optional<std::string> line;
-                {
-                    py::gil_scoped_release nogil;
-                    line = l.read_line(t);
-                }
+                line = blocking_call([&] { return l.read_line(t); });
                 if (!line) return py::none();
                 return to_py(*line);
             },

@@ -1,6 +1,8 @@
+#include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/canopen/sdo_client.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <cstdio>
 #include <cstring>
 #include <thread>
@@ -514,7 +516,16 @@ void SdoClient::run(std::unique_lock<std::mutex>& lock) {
     }
     while (machine_.busy()) {
         const Nanos dl = machine_.next_deadline();
-        cv_.wait_until(lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dl)),
+        // An interrupted wait (Ctrl-C) leaves no transfer behind; the server
+        // drops its side at its own timeout.
+        struct ResetUnlessDone {
+            SdoClientMachine& m;
+            int uncaught = std::uncaught_exceptions();
+            ~ResetUnlessDone() {
+                if (std::uncaught_exceptions() > uncaught) m.reset();
+            }
+        } reset_on_throw{machine_};
+        interruptible_wait_until(cv_, lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dl)),
                        [&] { return !machine_.busy() || monotonic_ns() >= machine_.next_deadline(); });
         if (machine_.busy() && monotonic_ns() >= machine_.next_deadline()) {
             machine_.on_timer(monotonic_ns(), outbox_);
