@@ -38,10 +38,29 @@ inline std::chrono::nanoseconds seconds_to_ns(const py::object& t) {
 // wait and propagates.  C++ waits inside the core see the same check through
 // motorbus::InterruptScope (cpp/motorbus/runtime/interrupt.hpp).
 //
+// A thread that comes back from C++ while the interpreter finalizes (a daemon
+// thread in recv(None) at exit) must not take the GIL: CPython would end the
+// thread from inside the GIL request (pthread_exit), whose forced unwind through
+// a destructor aborts the process ("terminate called").  Such a thread parks
+// until the process is gone instead.
+
+inline bool interpreter_finalizing() {
+#if PY_VERSION_HEX >= 0x030D0000
+    return Py_IsFinalizing() != 0;
+#else
+    return _Py_IsFinalizing() != 0;
+#endif
+}
+
+[[noreturn]] inline void park_until_exit() {
+    for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
+}
+
 // Thrown through C++ frames by the interrupt check; the Python error is set.
 struct PythonErrorPending {};
 
 inline void check_python_signals() {
+    if (interpreter_finalizing()) park_until_exit();
     py::gil_scoped_acquire gil;
     if (PyErr_CheckSignals() != 0) throw PythonErrorPending{};
 }
@@ -53,17 +72,55 @@ inline bool on_main_python_thread() {
     return PyThread_get_thread_ident() == main_ident;
 }
 
+// Releases the GIL; reacquire() takes it back, or parks the thread if the
+// interpreter finalizes.  reacquire() is an ordinary call, not a destructor: a
+// thread already queued for the GIL when finalization starts is ended by CPython
+// with a forced unwind, which may pass through ordinary frames (and pybind11's
+// dispatcher rethrows it) but aborts the process in a noexcept one.
+class GilRelease {
+public:
+    GilRelease() : state_(PyEval_SaveThread()) {}
+    void reacquire() {
+        if (!state_) return;
+        PyThreadState* s = state_;
+        state_ = nullptr;
+        if (interpreter_finalizing()) park_until_exit();
+        PyEval_RestoreThread(s);
+    }
+    ~GilRelease() { reacquire(); }  // only if a path forgot reacquire()
+    GilRelease(const GilRelease&) = delete;
+    GilRelease& operator=(const GilRelease&) = delete;
+
+private:
+    PyThreadState* state_;
+};
+
 // Runs fn() (a wait inside the C++ core) with the GIL released and Ctrl-C live.
 template <class F>
 decltype(auto) blocking_call(F&& fn) {
+    using R = std::invoke_result_t<F&>;
     const bool main = on_main_python_thread();
-    try {
-        py::gil_scoped_release nogil;
+    GilRelease nogil;
+    auto run = [&]() -> R {
         if (!main) return fn();
         InterruptScope interrupt(&check_python_signals);
         return fn();
+    };
+    try {
+        if constexpr (std::is_void_v<R>) {
+            run();
+            nogil.reacquire();
+        } else {
+            R r = run();
+            nogil.reacquire();
+            return r;
+        }
     } catch (const PythonErrorPending&) {
+        nogil.reacquire();
         throw py::error_already_set();
+    } catch (...) {
+        nogil.reacquire();
+        throw;
     }
 }
 
@@ -106,6 +163,7 @@ public:
     explicit PyCallable(py::function f) : f_(new py::function(std::move(f)), Release{}) {}
     template <class... A>
     void operator()(A&&... args) const {
+        if (interpreter_finalizing()) return;  // taking the GIL now would end this thread
         py::gil_scoped_acquire gil;
         try {
             (*f_)(std::forward<A>(args)...);

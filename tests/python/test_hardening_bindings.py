@@ -79,3 +79,35 @@ def test_ctrl_c_interrupts_blocking_call(case):
     assert elapsed < 1.0, f"{case}: SIGINT took {elapsed:.2f} s to land"
     assert rc != 0
 
+
+# ---------------------------------------------------------------------------
+# A thread blocked in the core when the interpreter exits
+
+_EXIT_CHILD = """
+import atexit, threading, time
+from motorbus import _core
+bus = _core.open_virtual("exit")
+port = _core.PtyPair()
+def recv():
+    try:
+        bus.recv(None)
+    except Exception:
+        pass
+def read():
+    try:
+        port.port.read(16, None)
+    except Exception:
+        pass
+threading.Thread(target=recv, daemon=True).start()
+threading.Thread(target=read, daemon=True).start()
+# Closing at exit wakes the blocked threads while the interpreter finalizes.
+atexit.register(bus.close)
+atexit.register(port.close)
+time.sleep(0.05)
+"""
+
+
+def test_thread_blocked_in_recv_at_exit_does_not_abort():
+    for _ in range(20):
+        r = subprocess.run([sys.executable, "-c", _EXIT_CHILD], capture_output=True, text=True, timeout=30)
+        assert r.returncode == 0 and "terminate" not in r.stderr, (r.returncode, r.stderr)
