@@ -18,6 +18,9 @@ using namespace motorbus::can;
 using motorbus::py_helpers::PyCallable;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::interruptible_wait;
 
 namespace {
@@ -95,9 +98,9 @@ void bind_can(py::module_& m) {
     py::class_<Bus, std::shared_ptr<Bus>>(m, "Bus", "A CAN bus endpoint (open one with open_bus).")
         .def("send",
              [](Bus& b, const Frame& f, const py::object& timeout) {
-                 auto t = seconds_to_ns(timeout);
+                 auto t = finite_forever(seconds_to_ns(timeout));
                  py::gil_scoped_release nogil;
-                 b.send(f, t.count() < 0 ? std::chrono::hours(24 * 365) : t);
+                 b.send(f, t);
              },
              py::arg("frame"), py::arg("timeout") = 1.0)
         .def("recv",
@@ -160,7 +163,7 @@ void bind_can(py::module_& m) {
                  f.drop_every = drop_every;
                  f.drop_probability = drop_probability;
                  f.corrupt_probability = corrupt_probability;
-                 f.delay_ns = static_cast<Nanos>(delay * 1e9);
+                 f.delay_ns = duration_arg(delay, "delay").count();
                  f.seed = seed;
                  b.set_faults(f);
              },
@@ -179,9 +182,7 @@ void bind_can(py::module_& m) {
               o.tx_queue = tx_queue;
               o.rx_queue_size = rx_queue_size;
               o.receive_own = receive_own;
-              // NaN has no duration: pass it on as negative, which open_virtual refuses.
-              o.rx_spin = std::chrono::duration_cast<std::chrono::microseconds>(
-                  std::chrono::duration<double>(std::isnan(rx_spin) ? -1.0 : rx_spin));
+              o.rx_spin = std::chrono::duration_cast<std::chrono::microseconds>(duration_arg(rx_spin, "rx_spin"));
               return open_virtual(name, o);
           },
           py::arg("name"), py::arg("bitrate") = 0.0, py::arg("tx_queue") = 64,

@@ -19,6 +19,9 @@ namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::canopen;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::Blocking;
 using motorbus::py_helpers::blocking_call;
 
@@ -454,7 +457,7 @@ void bind_canopen(py::module_& m) {
                          std::uint8_t block_size, unsigned read_retries, std::uint32_t request_id,
                          std::uint32_t response_id) {
                  SdoClientOptions o;
-                 o.timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9));
+                 o.timeout = finite_forever(duration_arg(timeout, "timeout", Forever::Allowed));
                  o.max_transfer = max_transfer;
                  o.block_size = block_size;
                  o.read_retries = read_retries;
@@ -504,11 +507,17 @@ void bind_canopen(py::module_& m) {
              },
              py::arg("index"), py::arg("subindex"), py::arg("data"), py::arg("block") = false)
         .def_property("timeout",
-                      [](const SdoClient& c) { return static_cast<double>(c.options().timeout.count()) / 1e9; },
-                      [](SdoClient& c, double t) {
+                      [](const SdoClient& c) {
+                          auto t = c.options().timeout;
+                          return t >= py_helpers::kFiniteForever ? std::numeric_limits<double>::infinity()
+                                                                 : static_cast<double>(t.count()) / 1e9;
+                      },
+                      [](SdoClient& c, const py::object& t) {
+                          auto ns = finite_forever(duration_arg(t, "timeout", Forever::Allowed));
                           py::gil_scoped_release nogil;
-                          c.set_timeout(std::chrono::nanoseconds(static_cast<std::int64_t>(t * 1e9)));
-                      })
+                          c.set_timeout(ns);
+                      },
+                      "Seconds per response; inf (or None) = wait forever (Ctrl-C still interrupts).")
         .def_property_readonly("node_id", &SdoClient::node_id)
         .def_property_readonly("request_id", &SdoClient::request_id)
         .def_property_readonly("response_id", &SdoClient::response_id)
@@ -520,7 +529,8 @@ void bind_canopen(py::module_& m) {
         .def(py::init([](can::Bus& bus, std::uint8_t node_id, std::shared_ptr<ObjectDictionary> od,
                          double sdo_timeout, bool block_transfer, bool send_boot_up) {
                  LocalNodeOptions o;
-                 o.sdo.timeout_ns = static_cast<Nanos>(sdo_timeout * 1e9);
+                 o.sdo.timeout_ns = duration_arg(sdo_timeout, "sdo_timeout").count();
+                 if (o.sdo.timeout_ns <= 0) throw InvalidArgument("sdo_timeout: must be > 0 seconds");
                  o.sdo.block_transfer = block_transfer;
                  o.send_boot_up = send_boot_up;
                  py::gil_scoped_release nogil;

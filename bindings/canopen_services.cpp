@@ -33,6 +33,9 @@ using namespace motorbus;
 using namespace motorbus::canopen;
 using motorbus::py_helpers::PyCallable;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::blocking_call;
 
 namespace {
@@ -56,9 +59,9 @@ std::shared_ptr<T> make_service(Keep keep, A&&... args) {
 
 ClockPtr clock_or_real(const ClockPtr& c) { return c ? c : std::make_shared<RealClock>(); }
 
+// A blocking call's timeout: None/inf = forever (a finite 31 years for the core).
 std::chrono::nanoseconds timeout_of(const py::object& t) {
-    auto ns = seconds_to_ns(t);
-    return ns.count() < 0 ? std::chrono::hours(24 * 365) : ns;
+    return finite_forever(duration_arg(t, "timeout", Forever::Allowed));
 }
 
 py::bytes to_bytes(std::span<const std::uint8_t> b) {
@@ -410,8 +413,9 @@ void bind_canopen_services(py::module_& m) {
              }), py::arg("bus"), py::arg("clock") = nullptr)
         .def("monitor", [](HeartbeatConsumer& b, int node, double timeout) {
                  check_node(node, false);
-                 if (!(timeout > 0)) throw InvalidArgument("heartbeat timeout must be > 0 s");
-                 b.monitor(static_cast<std::uint8_t>(node), std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9)));
+                 auto t = duration_arg(timeout, "timeout");
+                 if (t.count() <= 0) throw InvalidArgument("timeout: a heartbeat timeout must be > 0 s");
+                 b.monitor(static_cast<std::uint8_t>(node), t);
              }, py::arg("node"), py::arg("timeout"))
         .def("forget", [](HeartbeatConsumer& b, int node) { check_node(node, false); b.forget(static_cast<std::uint8_t>(node)); })
         .def("health", [](HeartbeatConsumer& b, int node) { check_node(node, false); return b.health(static_cast<std::uint8_t>(node)); })
@@ -433,6 +437,7 @@ void bind_canopen_services(py::module_& m) {
     py::class_<HeartbeatProducer, std::shared_ptr<HeartbeatProducer>>(m, "HeartbeatProducer")
         .def(py::init([](BusPtr bus, int node, double period, py::object state, ClockPtr clock) {
                  check_node(node, false);
+                 const auto period_ns = duration_arg(period, "period");
                  clock = clock_or_real(clock);
                  std::function<NodeState()> fn;
                  if (py::isinstance<py::str>(state)) {
@@ -451,7 +456,7 @@ void bind_canopen_services(py::module_& m) {
                      };
                  }
                  return make_service<HeartbeatProducer>(std::pair(bus, clock), *bus, *clock, static_cast<std::uint8_t>(node),
-                                                        std::chrono::nanoseconds(static_cast<std::int64_t>(period * 1e9)), fn);
+                                                        period_ns, fn);
                  
              }), py::arg("bus"), py::arg("node"), py::arg("period"), py::arg("state") = "OPERATIONAL",
              py::arg("clock") = nullptr)
@@ -526,9 +531,10 @@ void bind_canopen_services(py::module_& m) {
     py::class_<SyncProducer, std::shared_ptr<SyncProducer>>(m, "SyncProducer",
         "SYNC on a C++ thread; jitter() reports the period error statistics.")
         .def(py::init([](BusPtr bus, double period, int overflow, std::uint32_t cob_id) {
-                 if (!(period > 0)) throw InvalidArgument("SYNC period must be > 0 s");
+                 const auto period_ns = duration_arg(period, "period");
+                 if (period_ns.count() <= 0) throw InvalidArgument("period: a SYNC period must be > 0 s");
                  if (overflow < 0 || overflow > 240) throw InvalidArgument("SYNC counter overflow must be 0 or 2-240");
-                 return make_service<SyncProducer>(bus, *bus, std::chrono::nanoseconds(static_cast<std::int64_t>(period * 1e9)),
+                 return make_service<SyncProducer>(bus, *bus, period_ns,
                                                    static_cast<std::uint8_t>(overflow), cob_id);
                  
              }), py::arg("bus"), py::arg("period"), py::arg("counter_overflow") = 0, py::arg("cob_id") = kSyncCobId)
@@ -681,8 +687,8 @@ void bind_canopen_services(py::module_& m) {
                  auto box = make_sdo(sdo, node);
                  SdoAccess& access = *box.access;  // owned by box, which the host keeps
                  Cia402HostOptions o;
-                 o.timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9));
-                 o.sdo_poll = std::chrono::nanoseconds(static_cast<std::int64_t>(poll * 1e9));
+                 o.timeout = finite_forever(duration_arg(timeout, "timeout", Forever::Allowed));
+                 o.sdo_poll = duration_arg(poll, "poll");
                  return make_service<Cia402Host>(std::move(box), access, static_cast<std::uint8_t>(node), o);
              }), py::arg("sdo"), py::arg("node"), py::arg("timeout") = 2.0, py::arg("poll") = 0.005)
         .def("use_statusword_pdo", [](Cia402Host& b, PdoReceiver* rx) { b.use_statusword_pdo(rx); },
@@ -803,8 +809,8 @@ void bind_canopen_services(py::module_& m) {
               ScanOptions o;
               o.first = static_cast<std::uint8_t>(first);
               o.last = static_cast<std::uint8_t>(last);
-              o.sdo_timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(sdo_timeout * 1e9));
-              o.listen = std::chrono::nanoseconds(static_cast<std::int64_t>(listen * 1e9));
+              o.sdo_timeout = duration_arg(sdo_timeout, "sdo_timeout");
+              o.listen = duration_arg(listen, "listen");
               o.probe_sdo = probe_sdo;
               o.read_identity = identity;
               std::vector<ScanResult> res;

@@ -13,19 +13,59 @@
 #include <type_traits>
 #include <vector>
 
+#include "motorbus/errors.hpp"
 #include "motorbus/runtime/interrupt.hpp"
 
 namespace motorbus::py_helpers {
 namespace py = pybind11;
 
-// Python timeouts are float seconds; None means "wait forever" (-1 ns).
-inline std::chrono::nanoseconds seconds_to_ns(const py::object& t) {
-    if (t.is_none()) return std::chrono::nanoseconds(-1);
-    double s = t.cast<double>();
-    if (std::isnan(s)) throw py::value_error("timeout: NaN is not a duration");
-    if (s < 0) s = 0;
-    if (s > 1e9) return std::chrono::nanoseconds(-1);
+// ---- durations: one rule for every Python duration (seconds) -------------------
+//
+//   * a number of seconds >= 0 (int, float, anything with __float__);
+//   * NaN, negative, or not a number: InvalidArgument naming the argument;
+//   * Forever::Allowed (the timeout of a blocking call, which Ctrl-C can end):
+//     None, inf and anything above kMaxSeconds wait forever -> kForever (-1 ns,
+//     the core's "no deadline"); use finite_forever() for an API that adds the
+//     duration to the current time;
+//   * Forever::Refused (periods, delays, server-side and poll intervals): None,
+//     inf and anything above kMaxSeconds are InvalidArgument.
+enum class Forever : bool { Refused, Allowed };
+inline constexpr double kMaxSeconds = 1e9;  // ~31.7 years: seconds * 1e9 stays far inside int64 ns
+inline constexpr std::chrono::nanoseconds kForever{-1};
+inline constexpr std::chrono::nanoseconds kFiniteForever{static_cast<std::int64_t>(kMaxSeconds * 1e9)};
+
+inline std::chrono::nanoseconds duration_arg(double s, const char* name, Forever forever = Forever::Refused) {
+    if (std::isnan(s)) throw InvalidArgument(std::string(name) + ": NaN is not a duration");
+    if (s < 0) throw InvalidArgument(std::string(name) + ": must be >= 0 seconds, got " + std::to_string(s));
+    if (s > kMaxSeconds) {
+        if (forever == Forever::Allowed) return kForever;
+        throw InvalidArgument(std::string(name) + (std::isinf(s) ? ": must be finite" : ": too large (at most 1e9 seconds)"));
+    }
     return std::chrono::nanoseconds(static_cast<std::int64_t>(s * 1e9));
+}
+
+inline std::chrono::nanoseconds duration_arg(const py::handle& v, const char* name, Forever forever = Forever::Refused) {
+    if (v.is_none()) {
+        if (forever == Forever::Allowed) return kForever;
+        throw InvalidArgument(std::string(name) + ": None is not a duration here (a number of seconds)");
+    }
+    const double s = PyFloat_AsDouble(v.ptr());
+    if (s == -1.0 && PyErr_Occurred()) {
+        const bool overflow = PyErr_ExceptionMatches(PyExc_OverflowError);
+        PyErr_Clear();
+        if (overflow) return duration_arg(std::numeric_limits<double>::infinity(), name, forever);
+        throw InvalidArgument(std::string(name) + ": expected a number of seconds, got " +
+                              py::str(py::type::handle_of(v).attr("__name__")).cast<std::string>());
+    }
+    return duration_arg(s, name, forever);
+}
+
+// kForever -> a duration an API can add to the current time.
+inline std::chrono::nanoseconds finite_forever(std::chrono::nanoseconds d) { return d.count() < 0 ? kFiniteForever : d; }
+
+// A blocking call's timeout: None/inf = forever (-1 ns).  Kept for the vendor bindings.
+inline std::chrono::nanoseconds seconds_to_ns(const py::object& t, const char* name = "timeout") {
+    return duration_arg(t, name, Forever::Allowed);
 }
 
 // ---- blocking calls: GIL released, Ctrl-C live, safe at interpreter exit ----------

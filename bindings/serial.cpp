@@ -17,6 +17,9 @@ using namespace motorbus;
 using namespace motorbus::serial;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::blocking_call;
 using motorbus::py_helpers::interruptible_wait;
 
@@ -131,10 +134,6 @@ private:
     std::vector<py::object> keep_;
 };
 
-std::chrono::nanoseconds nonneg_seconds(double s, const char* what) {
-    if (!(s >= 0) || s > 1e6) throw InvalidArgument(std::string(what) + ": must be in [0, 1e6] seconds");
-    return std::chrono::nanoseconds(static_cast<std::int64_t>(s * 1e9));
-}
 
 }  // namespace
 
@@ -284,10 +283,10 @@ void bind_serial(py::module_& m) {
                      for (auto t : reply_terminators) o.reply_terminators.push_back(bytes_arg(t, "reply_terminators"));
                  }
                  o.max_line = max_line;
-                 o.reply_timeout = seconds_to_ns(reply_timeout);
+                 o.reply_timeout = seconds_to_ns(reply_timeout, "reply_timeout");
                  o.flush_before_request = flush_before_request;
                  o.echo_suppression = echo_suppression;
-                 o.turnaround = nonneg_seconds(turnaround, "turnaround");
+                 o.turnaround = duration_arg(turnaround, "turnaround");
                  return std::make_shared<LineLink>(std::move(port), std::move(o));
              }),
              py::arg("port"), py::arg("request_terminator") = "\r",

@@ -111,3 +111,107 @@ def test_thread_blocked_in_recv_at_exit_does_not_abort():
     for _ in range(20):
         r = subprocess.run([sys.executable, "-c", _EXIT_CHILD], capture_output=True, text=True, timeout=30)
         assert r.returncode == 0 and "terminate" not in r.stderr, (r.returncode, r.stderr)
+
+
+# ---------------------------------------------------------------------------
+# Durations: NaN and negative are refused everywhere; inf waits forever where a
+# blocking call's timeout can (Ctrl-C ends it) and is refused everywhere else.
+
+INF, NAN = float("inf"), float("nan")
+
+
+@pytest.fixture
+def vbus():
+    b = _core.open_virtual("durations")
+    yield b
+    b.close()
+
+
+def test_sdo_client_timeout_inf_waits_for_the_answer():
+    # Before: timeout=inf overflowed to a negative deadline and gave up at once.
+    elapsed, _, err = _interrupt_child(
+        "b = _core.open_virtual('sig'); c = _core.SdoClient(b, 5, timeout=float('inf')); ready(); c.upload(0x1000)")
+    assert "KeyboardInterrupt" in err, err
+    assert elapsed < 1.0
+
+
+def test_sdo_client_timeout_values(vbus):
+    assert _core.SdoClient(vbus, 5, timeout=INF).timeout == INF
+    c = _core.SdoClient(vbus, 6, timeout=0.25)
+    assert c.timeout == 0.25
+    for bad in (NAN, -1.0):
+        with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+            _core.SdoClient(vbus, 7, timeout=bad)
+        with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+            c.timeout = bad
+
+
+@pytest.mark.parametrize("bad", [-1.0, NAN, INF, 1e300, 0.0])
+def test_local_node_sdo_timeout_must_be_positive_and_finite(vbus, bad):
+    with pytest.raises(motorbus.InvalidArgument, match="sdo_timeout"):
+        _core.LocalNode(vbus, 5, _core.ObjectDictionary(), sdo_timeout=bad)
+
+
+@pytest.mark.parametrize("bad", [NAN, -1.0, INF])
+def test_set_faults_delay_refused(vbus, bad):
+    with pytest.raises(motorbus.InvalidArgument, match="delay"):
+        vbus.set_faults(delay=bad)
+
+
+def test_open_virtual_rx_spin_inf_refused():
+    with pytest.raises(motorbus.InvalidArgument, match="rx_spin"):
+        _core.open_virtual("durations-spin", rx_spin=INF)
+
+
+@pytest.mark.parametrize("bad", [NAN, -1.0])
+def test_blocking_timeouts_refuse_nan_and_negative(vbus, bad):
+    with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+        vbus.recv(timeout=bad)
+    with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+        vbus.recv_many(4, timeout=bad)
+    with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+        vbus.send(_core.Frame(1), timeout=bad)
+    with _core.PtyPair() as p:
+        with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+            p.port.read(4, timeout=bad)
+    with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+        _core.NmtMaster(vbus).wait_for_boot(5, timeout=bad)
+
+
+def test_blocking_timeouts_zero_polls(vbus):
+    assert vbus.recv(timeout=0) is None
+    assert vbus.recv_many(4, timeout=0.0) == []
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    ({"turnaround": INF}, "turnaround"), ({"turnaround": NAN}, "turnaround"), ({"reply_timeout": NAN}, "reply_timeout")])
+def test_line_link_durations(kwargs, name):
+    with _core.PtyPair() as p:
+        with pytest.raises(motorbus.InvalidArgument, match=name):
+            _core.LineLink(p.port, **kwargs)
+
+
+def test_canopen_service_durations(vbus):
+    c = _core.SdoClient(vbus, 5)
+    with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+        _core.Cia402Host(c, 5, timeout=NAN)
+    with pytest.raises(motorbus.InvalidArgument, match="poll"):
+        _core.Cia402Host(c, 5, poll=INF)
+    with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+        _core.HeartbeatConsumer(vbus).monitor(5, INF)
+    for bad in (INF, NAN):
+        with pytest.raises(motorbus.InvalidArgument, match="period"):
+            _core.HeartbeatProducer(vbus, 5, bad)
+        with pytest.raises(motorbus.InvalidArgument, match="period"):
+            _core.SyncProducer(vbus, bad)
+    with pytest.raises(motorbus.InvalidArgument, match="sdo_timeout"):
+        _core.scan_network(vbus, sdo_timeout=NAN)
+    with pytest.raises(motorbus.InvalidArgument, match="listen"):
+        _core.scan_network(vbus, listen=INF)
+
+
+def test_server_durations(vbus):
+    with pytest.raises(motorbus.InvalidArgument, match="bus_send_timeout"):
+        _core.SlcanServer(vbus, bus_send_timeout=INF)
+    with pytest.raises(motorbus.InvalidArgument, match="idle_timeout"):
+        _core.SocketcandServer(vbus, idle_timeout=NAN)
