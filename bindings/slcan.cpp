@@ -100,7 +100,7 @@ void bind_slcan(py::module_& m) {
         m, "SlcanBus", "A CAN bus through an SLCAN (Lawicel) adapter on a serial port.")
         .def("flush_tx",
              [](SlcanBus& b, double timeout) {
-                 auto t = finite_forever(duration_arg(timeout, "timeout", Forever::Allowed));
+                 auto t = duration_arg(timeout, "timeout");  // finite: these core waits are not interruptible
                  py::gil_scoped_release nogil;
                  b.flush_tx(t);
              },
@@ -108,7 +108,7 @@ void bind_slcan(py::module_& m) {
              "Wait until the adapter answered every command; ProtocolError if it refused frames.")
         .def("query_status",
              [](SlcanBus& b, double timeout) {
-                 auto t = finite_forever(duration_arg(timeout, "timeout", Forever::Allowed));
+                 auto t = duration_arg(timeout, "timeout");  // finite: these core waits are not interruptible
                  py::gil_scoped_release nogil;
                  return b.query_status(t);
              },

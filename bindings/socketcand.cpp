@@ -15,6 +15,7 @@ using namespace motorbus;
 using namespace motorbus::can;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::interruptible_wait;
 using motorbus::py_helpers::duration_arg;
 using motorbus::py_helpers::finite_forever;
 using motorbus::py_helpers::Forever;
@@ -76,8 +77,7 @@ void bind_socketcand(py::module_& m) {
                  if (auto f = b.recv(Duration::zero())) return f;
                  auto t = seconds_to_ns(timeout);
                  if (t.count() == 0) return std::nullopt;
-                 py::gil_scoped_release nogil;
-                 return b.recv(t);
+                 return interruptible_wait(t, [&](std::chrono::nanoseconds d) { return b.recv(d); });
              },
              py::arg("timeout") = py::none())
         .def_property_readonly("link_up", &SocketcandBus::link_up)

@@ -44,6 +44,8 @@ BLOCKING = {
                                "h = _core.Cia402Host(c, 5, timeout=1e6); ready(); h.wait_statusword(0xffff, 0x1234, None)"),
     "nmt_wait_for_boot": "b = _core.open_virtual('sig'); m = _core.NmtMaster(b); ready(); m.wait_for_boot(5, None)",
     "emcy_wait": "b = _core.open_virtual('sig'); e = _core.EmcyConsumer(b); ready(); e.wait(0, None)",
+    "socketcand_recv": ("b = _core.open_virtual('sig'); s = _core.SocketcandServer(b, channel='can0'); "
+                        "c = _core.open_socketcand('127.0.0.1', s.port, 'can0'); ready(); c.recv(None)"),
 }
 
 
