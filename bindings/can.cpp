@@ -22,6 +22,9 @@ using motorbus::py_helpers::duration_arg;
 using motorbus::py_helpers::finite_forever;
 using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::interruptible_wait;
+using motorbus::py_helpers::arg_cast;
+using motorbus::py_helpers::arg_iterable;
+using motorbus::py_helpers::not_none;
 
 namespace {
 
@@ -39,8 +42,8 @@ Frame frame_from_py(std::uint32_t id, const py::object& data, bool extended, boo
             bytes = py::bytes(data).cast<std::string>();
         } else {
             // any iterable of ints 0..255
-            for (auto item : data) {
-                int v = item.cast<int>();
+            for (auto item : arg_iterable(data, "frame data", "bytes or an iterable of ints 0-255")) {
+                int v = arg_cast<int>(item, "frame data", "ints 0-255");
                 if (v < 0 || v > 255)
                     throw InvalidArgument("frame data: byte value " + std::to_string(v) +
                                           " is outside 0-255");
@@ -48,7 +51,7 @@ Frame frame_from_py(std::uint32_t id, const py::object& data, bool extended, boo
             }
         }
     }
-    int rtr_dlc = dlc.is_none() ? -1 : dlc.cast<int>();
+    int rtr_dlc = dlc.is_none() ? -1 : arg_cast<int>(dlc, "frame dlc", "an int 0-8 or None");
     if (!rtr && rtr_dlc >= 0 && static_cast<std::size_t>(rtr_dlc) != bytes.size())
         throw InvalidArgument("frame dlc: " + std::to_string(rtr_dlc) + " does not match " +
                               std::to_string(bytes.size()) + " data bytes");
@@ -228,13 +231,14 @@ void bind_can(py::module_& m) {
     auto fmt = [](const py::object& f) -> std::optional<LogFormat> {
         if (f.is_none()) return std::nullopt;
         if (py::isinstance<LogFormat>(f)) return f.cast<LogFormat>();
-        auto s = f.cast<std::string>();
+        auto s = arg_cast<std::string>(f, "log format", "a LogFormat, 'candump' or 'asc'");
         if (auto v = log_format_from_name(s)) return v;
         throw InvalidArgument("log format: '" + s + "' (expected 'candump' or 'asc')");
     };
     py::class_<Recorder>(m, "Recorder", "Writes every frame a bus receives to a candump or ASC log.")
         .def(py::init([fmt](std::shared_ptr<Bus> bus, const std::string& path, const py::object& format,
                             const std::string& channel) {
+                 not_none(bus, "bus");
                  return std::make_unique<Recorder>(std::move(bus), path, fmt(format), channel);
              }),
              py::arg("bus"), py::arg("path"), py::arg("format") = py::none(), py::arg("channel") = "can0")

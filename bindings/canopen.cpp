@@ -24,6 +24,8 @@ using motorbus::py_helpers::finite_forever;
 using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::Blocking;
 using motorbus::py_helpers::blocking_call;
+using motorbus::py_helpers::arg_cast;
+using motorbus::py_helpers::py_type_name;
 
 namespace {
 
@@ -53,6 +55,9 @@ Bytes from_buffer(const py::object& o) {
         auto s = o.cast<std::string>();
         return Bytes(s.begin(), s.end());
     }
+    if (!py::isinstance<py::bytes>(o) && !py::isinstance<py::bytearray>(o) && !py::isinstance<py::memoryview>(o) &&
+        !PyObject_CheckBuffer(o.ptr()))
+        throw InvalidArgument("data: expected bytes, bytearray, memoryview or str, got " + py_type_name(o));
     std::string s = py::bytes(o).cast<std::string>();
     return Bytes(s.begin(), s.end());
 }
@@ -60,14 +65,14 @@ Bytes from_buffer(const py::object& o) {
 DataType type_from_py(const py::object& o) {
     if (py::isinstance<DataType>(o)) return o.cast<DataType>();
     if (py::isinstance<py::int_>(o)) {
-        auto c = o.cast<unsigned>();
-        if (!is_known_type(static_cast<std::uint16_t>(c)))
-            throw InvalidArgument("data type: 0x" + std::to_string(c) + " is not a CiA 301 basic type");
+        auto c = arg_cast<unsigned>(o, "data_type", "a DataType, its code or its name");
+        if (c > 0xFFFF || !is_known_type(static_cast<std::uint16_t>(c)))
+            throw InvalidArgument("data_type: 0x" + std::to_string(c) + " is not a CiA 301 basic type");
         return static_cast<DataType>(c);
     }
-    std::string n = o.cast<std::string>();
+    std::string n = arg_cast<std::string>(o, "data_type", "a DataType, its code or its name");
     if (auto dt = data_type_from_name(n)) return *dt;
-    throw InvalidArgument("data type: '" + n + "' unknown (e.g. 'u32', 'UNSIGNED32', DataType.UNSIGNED32)");
+    throw InvalidArgument("data_type: '" + n + "' unknown (e.g. 'u32', 'UNSIGNED32', DataType.UNSIGNED32)");
 }
 
 Access access_from_py(const std::string& s) {

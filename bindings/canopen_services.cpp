@@ -37,6 +37,7 @@ using motorbus::py_helpers::duration_arg;
 using motorbus::py_helpers::finite_forever;
 using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::blocking_call;
+using motorbus::py_helpers::not_none;
 
 namespace {
 
@@ -349,6 +350,7 @@ void bind_canopen_services(py::module_& m) {
     // Wrapped by motorbus.canopen.nmt.NmtMaster, which carries the docstrings.
     py::class_<NmtMaster, std::shared_ptr<NmtMaster>>(m, "NmtMaster")
         .def(py::init([](BusPtr bus, std::optional<int> own) {
+                 not_none(bus, "bus");
                  if (own) check_node(*own, false);
                  return make_service<NmtMaster>(bus, *bus, own ? std::optional<std::uint8_t>(static_cast<std::uint8_t>(*own))
                                                                : std::nullopt);
@@ -408,6 +410,7 @@ void bind_canopen_services(py::module_& m) {
     py::class_<HeartbeatConsumer, std::shared_ptr<HeartbeatConsumer>>(m, "HeartbeatConsumer",
         "Per-node heartbeat supervision: started / lost / back / reset / state events.")
         .def(py::init([](BusPtr bus, ClockPtr clock) {
+                 not_none(bus, "bus");
                  clock = clock_or_real(clock);
                  return make_service<HeartbeatConsumer>(std::pair(bus, clock), *bus, *clock);
              }), py::arg("bus"), py::arg("clock") = nullptr)
@@ -436,6 +439,7 @@ void bind_canopen_services(py::module_& m) {
 
     py::class_<HeartbeatProducer, std::shared_ptr<HeartbeatProducer>>(m, "HeartbeatProducer")
         .def(py::init([](BusPtr bus, int node, double period, py::object state, ClockPtr clock) {
+                 not_none(bus, "bus");
                  check_node(node, false);
                  const auto period_ns = duration_arg(period, "period");
                  clock = clock_or_real(clock);
@@ -475,6 +479,7 @@ void bind_canopen_services(py::module_& m) {
     py::class_<EmcyConsumer, std::shared_ptr<EmcyConsumer>>(m, "EmcyConsumer",
         "Collects EMCY messages: bounded history and active codes per node.")
         .def(py::init([](BusPtr bus, std::size_t history) {
+                 not_none(bus, "bus");
                  return make_service<EmcyConsumer>(bus, *bus, history);
              }), py::arg("bus"), py::arg("history") = 32)
         .def("history", [](EmcyConsumer& b, int node) {
@@ -503,6 +508,7 @@ void bind_canopen_services(py::module_& m) {
 
     py::class_<EmcyProducer, std::shared_ptr<EmcyProducer>>(m, "EmcyProducer")
         .def(py::init([](BusPtr bus, int node, std::uint16_t inhibit, std::size_t queue, ClockPtr clock) {
+                 not_none(bus, "bus");
                  check_node(node, false);
                  clock = clock_or_real(clock);
                  return make_service<EmcyProducer>(std::pair(bus, clock), *bus, *clock, static_cast<std::uint8_t>(node),
@@ -531,6 +537,7 @@ void bind_canopen_services(py::module_& m) {
     py::class_<SyncProducer, std::shared_ptr<SyncProducer>>(m, "SyncProducer",
         "SYNC on a C++ thread; jitter() reports the period error statistics.")
         .def(py::init([](BusPtr bus, double period, int overflow, std::uint32_t cob_id) {
+                 not_none(bus, "bus");
                  const auto period_ns = duration_arg(period, "period");
                  if (period_ns.count() <= 0) throw InvalidArgument("period: a SYNC period must be > 0 s");
                  if (overflow < 0 || overflow > 240) throw InvalidArgument("SYNC counter overflow must be 0 or 2-240");
@@ -590,6 +597,7 @@ void bind_canopen_services(py::module_& m) {
     py::class_<PdoReceiver, std::shared_ptr<PdoReceiver>>(m, "PdoReceiver",
         "Receives a device's TPDO on the bus and keeps the latest values.")
         .def(py::init([](BusPtr bus, std::uint32_t cob_id, const py::iterable& entries) {
+                 not_none(bus, "bus");
                  return make_service<PdoReceiver>(bus, *bus, cob_id, entries_from(entries));
              }), py::arg("bus"), py::arg("cob_id"), py::arg("entries"))
         .def_property_readonly("values", [](PdoReceiver& b) { return b.values(); })
@@ -610,6 +618,7 @@ void bind_canopen_services(py::module_& m) {
 
     py::class_<PdoSender, std::shared_ptr<PdoSender>>(m, "PdoSender")
         .def(py::init([](BusPtr bus, std::uint32_t cob_id, const py::iterable& entries) {
+                 not_none(bus, "bus");
                  return make_service<PdoSender>(bus, *bus, cob_id, entries_from(entries));
              }), py::arg("bus"), py::arg("cob_id"), py::arg("entries"))
         .def("send", [](PdoSender& b, const std::vector<std::int64_t>& values, const py::object& t) {
@@ -805,6 +814,7 @@ void bind_canopen_services(py::module_& m) {
     // ---- scanner ------------------------------------------------------------------
     m.def("scan_network", [](BusPtr bus, int first, int last, double sdo_timeout, double listen, bool probe_sdo,
                              bool identity) {
+              not_none(bus, "bus");
               if (first < 1 || last > 127 || first > last) throw InvalidArgument("scan range must be within 1-127");
               ScanOptions o;
               o.first = static_cast<std::uint8_t>(first);

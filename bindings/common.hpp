@@ -68,6 +68,43 @@ inline std::chrono::nanoseconds seconds_to_ns(const py::object& t, const char* n
     return duration_arg(t, name, Forever::Allowed);
 }
 
+// ---- typed argument errors --------------------------------------------------------
+//
+// A bad argument raises InvalidArgument naming it (see docs/architecture.md);
+// pybind11's "incompatible function arguments" TypeError stays only for what
+// overload resolution rejects.  Functions taking py::object convert with these.
+
+inline std::string py_type_name(const py::handle& h) {
+    return py::str(py::type::handle_of(h).attr("__name__")).cast<std::string>();
+}
+
+// h.cast<T>(), or InvalidArgument("<name>: expected <expected>, got <type>").
+template <class T>
+T arg_cast(const py::handle& h, const char* name, const char* expected) {
+    try {
+        return h.cast<T>();
+    } catch (const py::cast_error&) {
+    } catch (const py::error_already_set& e) {
+        if (!e.matches(PyExc_TypeError) && !e.matches(PyExc_OverflowError) && !e.matches(PyExc_ValueError)) throw;
+    }
+    throw InvalidArgument(std::string(name) + ": expected " + expected + ", got " + py_type_name(h) +
+                          (py::isinstance<py::int_>(h) || py::isinstance<py::float_>(h) ? " " + py::repr(h).cast<std::string>() : ""));
+}
+
+// An iterable argument, or InvalidArgument naming it.
+inline py::iterable arg_iterable(const py::handle& h, const char* name, const char* expected) {
+    if (!py::isinstance<py::iterable>(h) || py::isinstance<py::str>(h) || py::isinstance<py::bytes>(h))
+        throw InvalidArgument(std::string(name) + ": expected " + expected + ", got " + py_type_name(h));
+    return py::reinterpret_borrow<py::iterable>(h);
+}
+
+// pybind11 turns None into a null holder: refuse it before anything dereferences it.
+template <class P>
+const P& not_none(const P& p, const char* name) {
+    if (!p) throw InvalidArgument(std::string(name) + ": None (an object is required)");
+    return p;
+}
+
 // ---- blocking calls: GIL released, Ctrl-C live, safe at interpreter exit ----------
 //
 // Every call that may block goes through blocking_call() (an opaque C++ wait)

@@ -22,6 +22,7 @@ using motorbus::py_helpers::finite_forever;
 using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::blocking_call;
 using motorbus::py_helpers::interruptible_wait;
+using motorbus::py_helpers::arg_iterable;
 
 namespace {
 
@@ -280,7 +281,8 @@ void bind_serial(py::module_& m) {
                  if (py::isinstance<py::str>(reply_terminators) || py::isinstance<py::bytes>(reply_terminators)) {
                      o.reply_terminators.push_back(bytes_arg(reply_terminators, "reply_terminators"));
                  } else {
-                     for (auto t : reply_terminators) o.reply_terminators.push_back(bytes_arg(t, "reply_terminators"));
+                     for (auto t : arg_iterable(reply_terminators, "reply_terminators", "str, bytes or a list of them"))
+                         o.reply_terminators.push_back(bytes_arg(t, "reply_terminators"));
                  }
                  o.max_line = max_line;
                  o.reply_timeout = seconds_to_ns(reply_timeout, "reply_timeout");

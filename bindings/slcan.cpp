@@ -14,6 +14,8 @@ using namespace motorbus;
 using namespace motorbus::can;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::arg_cast;
+using motorbus::py_helpers::not_none;
 using motorbus::py_helpers::duration_arg;
 using motorbus::py_helpers::finite_forever;
 using motorbus::py_helpers::Forever;
@@ -133,7 +135,7 @@ void bind_slcan(py::module_& m) {
               o.tty_baud = tty_baud;
               o.tx_coalesce = duration_arg(tx_coalesce, "tx_coalesce");
               if (!btr.is_none()) {
-                  auto v = btr.cast<unsigned>();
+                  auto v = arg_cast<unsigned>(btr, "btr", "an int 0-0xFFFF or None");
                   if (v > 0xFFFF) throw InvalidArgument("btr: BTR0<<8|BTR1 must be 0-0xFFFF");
                   o.btr = static_cast<std::uint16_t>(v);
               }
@@ -161,7 +163,8 @@ void bind_slcan(py::module_& m) {
                  o.identity.version = version;
                  o.identity.serial = serial_number;
                  o.bus_send_timeout = duration_arg(bus_send_timeout, "bus_send_timeout");
-                 std::string path = port.is_none() ? std::string() : port.cast<std::string>();
+                 not_none(bus, "bus");
+                 std::string path = port.is_none() ? std::string() : arg_cast<std::string>(port, "port", "a device path or None");
                  py::gil_scoped_release nogil;
                  if (path.empty()) return std::make_shared<SlcanServer>(std::move(bus), o);
                  return std::make_shared<SlcanServer>(std::move(bus), serial::open_port(path, baud), o);
@@ -189,7 +192,7 @@ void bind_slcan(py::module_& m) {
           [](const Frame& f, const py::object& timestamp_ms) {
               std::optional<std::uint16_t> ts;
               if (!timestamp_ms.is_none()) {
-                  auto v = timestamp_ms.cast<unsigned>();
+                  auto v = arg_cast<unsigned>(timestamp_ms, "timestamp_ms", "an int 0-59999 or None");
                   if (v > slcan::kMaxTimestamp) throw InvalidArgument("slcan timestamp: must be 0-59999 ms");
                   ts = static_cast<std::uint16_t>(v);
               }

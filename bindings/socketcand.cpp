@@ -16,6 +16,7 @@ using namespace motorbus::can;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
 using motorbus::py_helpers::interruptible_wait;
+using motorbus::py_helpers::not_none;
 using motorbus::py_helpers::duration_arg;
 using motorbus::py_helpers::finite_forever;
 using motorbus::py_helpers::Forever;
@@ -123,6 +124,7 @@ void bind_socketcand(py::module_& m) {
                          std::size_t client_queue, const py::object& idle_timeout,
                          const py::object& element_timeout, const py::object& open_timeout,
                          const py::object& bus_send_budget) {
+                 not_none(bus, "bus");
                  SocketcandServerOptions o;
                  o.host = host;
                  o.port = port;

@@ -217,3 +217,143 @@ def test_server_durations(vbus):
         _core.SlcanServer(vbus, bus_send_timeout=INF)
     with pytest.raises(motorbus.InvalidArgument, match="idle_timeout"):
         _core.SocketcandServer(vbus, idle_timeout=NAN)
+
+
+# ---------------------------------------------------------------------------
+# Typed argument errors.  Rule (docs/architecture.md): a bad argument raises
+# motorbus.InvalidArgument (a ValueError) naming it; pybind11's own TypeError
+# "incompatible function arguments" stays for a wrong number of arguments or an
+# argument of a type no overload takes.  Never RuntimeError("Unable to cast"),
+# KeyError, AttributeError, a bare TypeError from inside a call, or a crash.
+
+BAD_VALUES = ["x", None, -1, 2**70, float("nan"), b"", object()]
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda b: _core.Frame(1, dlc="x"), "dlc"),
+    (lambda b: _core.Frame(1, data=["a"]), "data"),
+    (lambda b: _core.Frame(1, data=5), "data"),
+    (lambda b: b.set_filters([{"mask": 1}]), "can_id"),
+    (lambda b: b.set_filters(["x"]), "filters"),
+    (lambda b: b.set_filters(5), "filters"),
+    (lambda b: b.recv(timeout="x"), "timeout"),
+    (lambda b: _core.LineLink(_core.PtyPair().port, reply_terminators=5), "reply_terminators"),
+    (lambda b: _core.ObjectDictionary().add_variable(0x2000, "v", 1.5), "data_type"),
+    (lambda b: _core.SdoClient(b, 5).download(0x2000, 0, 5), "data"),
+    (lambda b: _core.SlcanServer(b, port=5), "port"),
+    (lambda b: _core.slcan_encode(_core.Frame(1), timestamp_ms="x"), "timestamp_ms"),
+    (lambda b: _core.Recorder(b, "/dev/null", format=5), "format"),
+    (lambda b: _core.EmcyConsumer(None), "bus"),
+    (lambda b: _core.NmtMaster(None), "bus"),
+    (lambda b: _core.HeartbeatConsumer(None), "bus"),
+    (lambda b: _core.scan_network(None), "bus"),
+    (lambda b: _core.Recorder(None, "/dev/null"), "bus"),
+])
+def test_bad_argument_is_invalid_argument_naming_it(vbus, call, name):
+    with pytest.raises(motorbus.InvalidArgument, match=name):
+        call(vbus)
+
+
+_SWEEP = r'''
+import json, re, sys
+import motorbus
+from motorbus import _core
+BAD = [("x"), None, -1, 2**70, float("nan"), b"", object()]
+SKIP = {"play", "open_port", "TtyPort"}          # real devices / replays
+bus = _core.open_virtual("sweep")
+pty = _core.PtyPair()
+link = _core.LineLink(pty.port)
+FIX = {"bool": False, "str": "x", "bytes": b"", "object": b"", "float": 0.1, "int": 1,
+       "motorbus._core.Bus": bus, "motorbus._core.VirtualBus": bus, "motorbus._core.Port": pty.port,
+       "motorbus._core.Frame": _core.Frame(1), "motorbus._core.LineLink": link,
+       "collections.abc.Sequence[object]": [], "collections.abc.Sequence[str]": [],
+       "motorbus._core.Clock": None, "motorbus._core.Clock | None": None}
+INSTANCES = {"Bus": bus, "Port": pty.port, "LineLink": link, "SdoClient": _core.SdoClient(bus, 5, 0.01),
+             "ObjectDictionary": _core.ObjectDictionary()}
+
+def sample(ann):
+    ann = ann.strip()
+    if "SupportsFloat" in ann: return 0.1
+    if "SupportsInt" in ann: return 1
+    if ann in FIX: return FIX[ann]
+    if ann.endswith("| None"): return None
+    raise KeyError(ann)
+
+def split(s):
+    out, depth, cur = [], 0, ""
+    for ch in s:
+        depth += ch in "[(" ; depth -= ch in "])"
+        if ch == "," and depth == 0:
+            out.append(cur.strip()); cur = ""
+        else:
+            cur += ch
+    return out + ([cur.strip()] if cur.strip() else [])
+
+def signatures(f):
+    for line in (f.__doc__ or "").splitlines():
+        m = re.match(r"^(?:\d+\. )?\w+\((.*)\) ->", line.strip())
+        if not m: continue
+        params = []
+        for p in split(m.group(1)):
+            if p.startswith("self") or p.startswith("*"): continue
+            name, _, ann = p.partition(":")
+            ann, eq, default = ann.partition("=")
+            if eq:
+                if "timeout" in name or name.strip() in ("delay", "poll", "period", "listen"): default = "0.01"
+                try: value = eval(default.strip(), vars(_core))
+                except Exception: break
+            else:
+                try: value = sample(ann)
+                except KeyError: break
+            params.append((name.strip(), value))
+        else:
+            yield params
+
+def targets():
+    for cname, inst in INSTANCES.items():
+        for mn in dir(type(inst)):
+            if not mn.startswith("_") and mn != "close" and callable(getattr(inst, mn)):
+                yield cname + "." + mn, getattr(inst, mn), getattr(inst, mn)
+    for name, obj in sorted(vars(_core).items()):
+        if name.startswith("_") or name in SKIP: continue
+        if isinstance(obj, type):
+            if not issubclass(obj, BaseException): yield name, obj, obj.__init__
+        elif callable(obj):
+            yield name, obj, obj
+
+escapes, calls = [], 0
+for name, obj, f in targets():
+    for params in signatures(f):
+        for i, (pname, _) in enumerate(params):
+            for v in BAD:
+                # None / huge mean "wait forever" for a timeout: not a bad value there.
+                if "timeout" in pname and (v is None or v == 2**70): continue
+                args = [value for _, value in params]
+                args[i] = v
+                calls += 1
+                try:
+                    r = obj(*args)
+                    if hasattr(r, "close"): r.close()
+                except motorbus.MotorbusError:
+                    pass
+                except TypeError as e:
+                    if "incompatible" not in str(e):
+                        escapes.append([name, pname, repr(v)[:20], type(e).__name__, str(e)[:120]])
+                except Exception as e:
+                    escapes.append([name, pname, repr(v)[:20], type(e).__name__, str(e)[:120]])
+print(json.dumps({"calls": calls, "escapes": escapes}))
+'''
+
+
+def test_wrong_typed_arguments_sweep(tmp_path):
+    """Every public constructor/function of motorbus._core (and the methods of a few
+    core objects), each argument in turn replaced by a wrong-typed value: only
+    MotorbusError or pybind11's overload-resolution TypeError may come out (in a
+    child, so a crash fails the test instead of the run)."""
+    import json
+    r = subprocess.run([sys.executable, "-c", _SWEEP], capture_output=True, text=True, timeout=300,
+                       cwd=tmp_path)  # a Recorder in the sweep writes a file named "x"
+    assert r.returncode == 0, r.stderr[-3000:]
+    out = json.loads(r.stdout.strip().splitlines()[-1])
+    assert out["calls"] > 2000
+    assert out["escapes"] == [], "\n".join(" ".join(e) for e in out["escapes"])
