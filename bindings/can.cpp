@@ -18,6 +18,13 @@ using namespace motorbus::can;
 using motorbus::py_helpers::PyCallable;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
+using motorbus::py_helpers::interruptible_wait;
+using motorbus::py_helpers::arg_cast;
+using motorbus::py_helpers::arg_iterable;
+using motorbus::py_helpers::not_none;
 
 namespace {
 
@@ -35,8 +42,8 @@ Frame frame_from_py(std::uint32_t id, const py::object& data, bool extended, boo
             bytes = py::bytes(data).cast<std::string>();
         } else {
             // any iterable of ints 0..255
-            for (auto item : data) {
-                int v = item.cast<int>();
+            for (auto item : arg_iterable(data, "frame data", "bytes or an iterable of ints 0-255")) {
+                int v = arg_cast<int>(item, "frame data", "ints 0-255");
                 if (v < 0 || v > 255)
                     throw InvalidArgument("frame data: byte value " + std::to_string(v) +
                                           " is outside 0-255");
@@ -44,7 +51,7 @@ Frame frame_from_py(std::uint32_t id, const py::object& data, bool extended, boo
             }
         }
     }
-    int rtr_dlc = dlc.is_none() ? -1 : dlc.cast<int>();
+    int rtr_dlc = dlc.is_none() ? -1 : arg_cast<int>(dlc, "frame dlc", "an int 0-8 or None");
     if (!rtr && rtr_dlc >= 0 && static_cast<std::size_t>(rtr_dlc) != bytes.size())
         throw InvalidArgument("frame dlc: " + std::to_string(rtr_dlc) + " does not match " +
                               std::to_string(bytes.size()) + " data bytes");
@@ -94,23 +101,26 @@ void bind_can(py::module_& m) {
     py::class_<Bus, std::shared_ptr<Bus>>(m, "Bus", "A CAN bus endpoint (open one with open_bus).")
         .def("send",
              [](Bus& b, const Frame& f, const py::object& timeout) {
-                 auto t = seconds_to_ns(timeout);
+                 auto t = finite_forever(seconds_to_ns(timeout));
                  py::gil_scoped_release nogil;
-                 b.send(f, t.count() < 0 ? std::chrono::hours(24 * 365) : t);
+                 b.send(f, t);
              },
              py::arg("frame"), py::arg("timeout") = 1.0)
         .def("recv",
              [](Bus& b, const py::object& timeout) {
                  auto t = seconds_to_ns(timeout);
-                 py::gil_scoped_release nogil;
-                 return b.recv(t);
+                 return interruptible_wait(t, [&](std::chrono::nanoseconds d) { return b.recv(d); });
              },
              py::arg("timeout") = py::none())
         .def("recv_many",
              [](Bus& b, std::size_t max, const py::object& timeout) {
                  auto t = seconds_to_ns(timeout);
-                 py::gil_scoped_release nogil;
-                 return b.recv_many(max, t);
+                 auto got = interruptible_wait(t, [&](std::chrono::nanoseconds d) -> std::optional<std::vector<Frame>> {
+                     auto v = b.recv_many(max, d);
+                     if (v.empty()) return std::nullopt;
+                     return v;
+                 });
+                 return got ? std::move(*got) : std::vector<Frame>{};
              },
              py::arg("max") = 1024, py::arg("timeout") = py::none(),
              "Up to max frames, oldest first: waits like recv() for the first, then takes what is "
@@ -156,7 +166,7 @@ void bind_can(py::module_& m) {
                  f.drop_every = drop_every;
                  f.drop_probability = drop_probability;
                  f.corrupt_probability = corrupt_probability;
-                 f.delay_ns = static_cast<Nanos>(delay * 1e9);
+                 f.delay_ns = duration_arg(delay, "delay").count();
                  f.seed = seed;
                  b.set_faults(f);
              },
@@ -175,9 +185,7 @@ void bind_can(py::module_& m) {
               o.tx_queue = tx_queue;
               o.rx_queue_size = rx_queue_size;
               o.receive_own = receive_own;
-              // NaN has no duration: pass it on as negative, which open_virtual refuses.
-              o.rx_spin = std::chrono::duration_cast<std::chrono::microseconds>(
-                  std::chrono::duration<double>(std::isnan(rx_spin) ? -1.0 : rx_spin));
+              o.rx_spin = std::chrono::duration_cast<std::chrono::microseconds>(duration_arg(rx_spin, "rx_spin"));
               return open_virtual(name, o);
           },
           py::arg("name"), py::arg("bitrate") = 0.0, py::arg("tx_queue") = 64,
@@ -223,13 +231,14 @@ void bind_can(py::module_& m) {
     auto fmt = [](const py::object& f) -> std::optional<LogFormat> {
         if (f.is_none()) return std::nullopt;
         if (py::isinstance<LogFormat>(f)) return f.cast<LogFormat>();
-        auto s = f.cast<std::string>();
+        auto s = arg_cast<std::string>(f, "log format", "a LogFormat, 'candump' or 'asc'");
         if (auto v = log_format_from_name(s)) return v;
         throw InvalidArgument("log format: '" + s + "' (expected 'candump' or 'asc')");
     };
     py::class_<Recorder>(m, "Recorder", "Writes every frame a bus receives to a candump or ASC log.")
         .def(py::init([fmt](std::shared_ptr<Bus> bus, const std::string& path, const py::object& format,
                             const std::string& channel) {
+                 not_none(bus, "bus");
                  return std::make_unique<Recorder>(std::move(bus), path, fmt(format), channel);
              }),
              py::arg("bus"), py::arg("path"), py::arg("format") = py::none(), py::arg("channel") = "can0")

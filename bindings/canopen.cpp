@@ -19,6 +19,13 @@ namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::canopen;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
+using motorbus::py_helpers::Blocking;
+using motorbus::py_helpers::blocking_call;
+using motorbus::py_helpers::arg_cast;
+using motorbus::py_helpers::py_type_name;
 
 namespace {
 
@@ -48,6 +55,9 @@ Bytes from_buffer(const py::object& o) {
         auto s = o.cast<std::string>();
         return Bytes(s.begin(), s.end());
     }
+    if (!py::isinstance<py::bytes>(o) && !py::isinstance<py::bytearray>(o) && !py::isinstance<py::memoryview>(o) &&
+        !PyObject_CheckBuffer(o.ptr()))
+        throw InvalidArgument("data: expected bytes, bytearray, memoryview or str, got " + py_type_name(o));
     std::string s = py::bytes(o).cast<std::string>();
     return Bytes(s.begin(), s.end());
 }
@@ -55,14 +65,14 @@ Bytes from_buffer(const py::object& o) {
 DataType type_from_py(const py::object& o) {
     if (py::isinstance<DataType>(o)) return o.cast<DataType>();
     if (py::isinstance<py::int_>(o)) {
-        auto c = o.cast<unsigned>();
-        if (!is_known_type(static_cast<std::uint16_t>(c)))
-            throw InvalidArgument("data type: 0x" + std::to_string(c) + " is not a CiA 301 basic type");
+        auto c = arg_cast<unsigned>(o, "data_type", "a DataType, its code or its name");
+        if (c > 0xFFFF || !is_known_type(static_cast<std::uint16_t>(c)))
+            throw InvalidArgument("data_type: 0x" + std::to_string(c) + " is not a CiA 301 basic type");
         return static_cast<DataType>(c);
     }
-    std::string n = o.cast<std::string>();
+    std::string n = arg_cast<std::string>(o, "data_type", "a DataType, its code or its name");
     if (auto dt = data_type_from_name(n)) return *dt;
-    throw InvalidArgument("data type: '" + n + "' unknown (e.g. 'u32', 'UNSIGNED32', DataType.UNSIGNED32)");
+    throw InvalidArgument("data_type: '" + n + "' unknown (e.g. 'u32', 'UNSIGNED32', DataType.UNSIGNED32)");
 }
 
 Access access_from_py(const std::string& s) {
@@ -453,7 +463,10 @@ void bind_canopen(py::module_& m) {
                          std::uint32_t response_id, bool block_fallback) {
                  SdoClientOptions o;
                  o.fallback_to_segmented = block_fallback;
-                 o.timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9));
+                 // 0 would time every transfer out before its first response; inf waits
+                 // forever (Ctrl-C still ends it).
+                 if (timeout == 0) throw InvalidArgument("SdoClient timeout: must be > 0 s (inf = wait forever)");
+                 o.timeout = finite_forever(duration_arg(timeout, "timeout", Forever::Allowed));
                  o.max_transfer = max_transfer;
                  o.block_size = block_size;
                  o.read_retries = read_retries;
@@ -466,58 +479,54 @@ void bind_canopen(py::module_& m) {
              py::arg("response_id") = 0, py::arg("block_fallback") = false, py::keep_alive<1, 2>())
         .def("upload", [](SdoClient& c, std::uint16_t i, std::uint8_t s, bool block) {
                  Bytes b;
-                 {
-                     py::gil_scoped_release nogil;
-                     b = c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto);
-                 }
+                 b = blocking_call([&] { return c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto); });
                  return to_bytes(b);
              },
              py::arg("index"), py::arg("subindex") = 0, py::arg("block") = false)
         .def("download", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const py::object& data, bool block,
                             bool segmented) {
                  Bytes b = from_buffer(data);
-                 py::gil_scoped_release nogil;
-                 c.download(i, s, b, mode_of(block, segmented));
+                 blocking_call([&] { c.download(i, s, b, mode_of(block, segmented)); });
              },
              py::arg("index"), py::arg("subindex"), py::arg("data"), py::arg("block") = false,
              py::arg("segmented") = false)
 #define MB_RW(T, name)                                                                         \
-    .def("read_" #name, &SdoClient::read_##name, py::arg("index"), py::arg("subindex") = 0,    \
-         py::call_guard<py::gil_scoped_release>())                                             \
-    .def("write_" #name, &SdoClient::write_##name, py::arg("index"), py::arg("subindex"),      \
-         py::arg("value"), py::call_guard<py::gil_scoped_release>())
+    .def("read_" #name, &Blocking<&SdoClient::read_##name>::call, py::arg("index"),            \
+         py::arg("subindex") = 0)                                                              \
+    .def("write_" #name, &Blocking<&SdoClient::write_##name>::call, py::arg("index"),          \
+         py::arg("subindex"), py::arg("value"))
         MB_RW(std::uint8_t, u8) MB_RW(std::uint16_t, u16) MB_RW(std::uint32_t, u32) MB_RW(std::uint64_t, u64)
         MB_RW(std::int8_t, i8) MB_RW(std::int16_t, i16) MB_RW(std::int32_t, i32) MB_RW(std::int64_t, i64)
         MB_RW(float, f32) MB_RW(double, f64)
 #undef MB_RW
-        .def("read_string", &SdoClient::read_string, py::arg("index"), py::arg("subindex") = 0,
-             py::call_guard<py::gil_scoped_release>())
+        .def("read_string", &Blocking<&SdoClient::read_string>::call, py::arg("index"), py::arg("subindex") = 0)
         .def("write_string", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const std::string& v) {
-                 py::gil_scoped_release nogil;
-                 c.write_string(i, s, v);
+                 blocking_call([&] { c.write_string(i, s, v); });
              },
              py::arg("index"), py::arg("subindex"), py::arg("value"))
         .def("read_domain", [](SdoClient& c, std::uint16_t i, std::uint8_t s, bool block) {
                  Bytes b;
-                 {
-                     py::gil_scoped_release nogil;
-                     b = c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto);
-                 }
+                 b = blocking_call([&] { return c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto); });
                  return to_bytes(b);
              },
              py::arg("index"), py::arg("subindex") = 0, py::arg("block") = false)
         .def("write_domain", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const py::object& data, bool block) {
                  Bytes b = from_buffer(data);
-                 py::gil_scoped_release nogil;
-                 c.download(i, s, b, block ? TransferMode::Block : TransferMode::Auto);
+                 blocking_call([&] { c.download(i, s, b, block ? TransferMode::Block : TransferMode::Auto); });
              },
              py::arg("index"), py::arg("subindex"), py::arg("data"), py::arg("block") = false)
         .def_property("timeout",
-                      [](const SdoClient& c) { return static_cast<double>(c.options().timeout.count()) / 1e9; },
-                      [](SdoClient& c, double t) {
+                      [](const SdoClient& c) {
+                          auto t = c.options().timeout;
+                          return t >= py_helpers::kFiniteForever ? std::numeric_limits<double>::infinity()
+                                                                 : static_cast<double>(t.count()) / 1e9;
+                      },
+                      [](SdoClient& c, const py::object& t) {
+                          auto ns = finite_forever(duration_arg(t, "timeout", Forever::Allowed));
                           py::gil_scoped_release nogil;
-                          c.set_timeout(std::chrono::nanoseconds(static_cast<std::int64_t>(t * 1e9)));
-                      })
+                          c.set_timeout(ns);
+                      },
+                      "Seconds per response; inf (or None) = wait forever (Ctrl-C still interrupts).")
         .def_property_readonly("node_id", &SdoClient::node_id)
         .def_property_readonly("request_id", &SdoClient::request_id)
         .def_property_readonly("response_id", &SdoClient::response_id)
@@ -529,7 +538,8 @@ void bind_canopen(py::module_& m) {
         .def(py::init([](can::Bus& bus, std::uint8_t node_id, std::shared_ptr<ObjectDictionary> od,
                          double sdo_timeout, bool block_transfer, bool send_boot_up) {
                  LocalNodeOptions o;
-                 o.sdo.timeout_ns = static_cast<Nanos>(sdo_timeout * 1e9);
+                 o.sdo.timeout_ns = duration_arg(sdo_timeout, "sdo_timeout").count();
+                 if (o.sdo.timeout_ns <= 0) throw InvalidArgument("sdo_timeout: must be > 0 seconds");
                  o.sdo.block_transfer = block_transfer;
                  o.send_boot_up = send_boot_up;
                  py::gil_scoped_release nogil;

@@ -33,6 +33,11 @@ using namespace motorbus;
 using namespace motorbus::canopen;
 using motorbus::py_helpers::PyCallable;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
+using motorbus::py_helpers::blocking_call;
+using motorbus::py_helpers::not_none;
 
 namespace {
 
@@ -55,9 +60,9 @@ std::shared_ptr<T> make_service(Keep keep, A&&... args) {
 
 ClockPtr clock_or_real(const ClockPtr& c) { return c ? c : std::make_shared<RealClock>(); }
 
+// A blocking call's timeout: None/inf = forever (a finite 31 years for the core).
 std::chrono::nanoseconds timeout_of(const py::object& t) {
-    auto ns = seconds_to_ns(t);
-    return ns.count() < 0 ? std::chrono::hours(24 * 365) : ns;
+    return finite_forever(duration_arg(t, "timeout", Forever::Allowed));
 }
 
 py::bytes to_bytes(std::span<const std::uint8_t> b) {
@@ -345,6 +350,7 @@ void bind_canopen_services(py::module_& m) {
     // Wrapped by motorbus.canopen.nmt.NmtMaster, which carries the docstrings.
     py::class_<NmtMaster, std::shared_ptr<NmtMaster>>(m, "NmtMaster")
         .def(py::init([](BusPtr bus, std::optional<int> own) {
+                 not_none(bus, "bus");
                  if (own) check_node(*own, false);
                  return make_service<NmtMaster>(bus, *bus, own ? std::optional<std::uint8_t>(static_cast<std::uint8_t>(*own))
                                                                : std::nullopt);
@@ -367,8 +373,7 @@ void bind_canopen_services(py::module_& m) {
                  check_node(node, false);
                  auto want = node_state_of(st);
                  auto to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 return b.wait_for_state(static_cast<std::uint8_t>(node), want, to);
+                 return blocking_call([&] { return b.wait_for_state(static_cast<std::uint8_t>(node), want, to); });
              }, py::arg("node"), py::arg("state"), py::arg("timeout") = 1.0)
         .def("set_state", [](NmtMaster& b, int node, const std::string& state) {
                  check_node(node, true);
@@ -383,18 +388,14 @@ void bind_canopen_services(py::module_& m) {
                  check_node(node, false);
                  auto to = timeout_of(t);
                  std::optional<NodeState> s;
-                 {
-                     py::gil_scoped_release nogil;
-                     s = b.wait_for_heartbeat(static_cast<std::uint8_t>(node), to);
-                 }
+                 s = blocking_call([&] { return b.wait_for_heartbeat(static_cast<std::uint8_t>(node), to); });
                  if (!s) return std::nullopt;
                  return std::string(to_string(*s));
              }, py::arg("node"), py::arg("timeout") = 1.0)
         .def("wait_for_boot", [](NmtMaster& b, int node, const py::object& t) {
                  check_node(node, false);
                  auto to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 return b.wait_for_boot(static_cast<std::uint8_t>(node), to);
+                 return blocking_call([&] { return b.wait_for_boot(static_cast<std::uint8_t>(node), to); });
              }, py::arg("node"), py::arg("timeout") = 1.0)
         .def("set_callback", [](NmtMaster& b, py::object cb) {
                  if (cb.is_none()) { b.on_state_change = nullptr; return; }
@@ -409,13 +410,15 @@ void bind_canopen_services(py::module_& m) {
     py::class_<HeartbeatConsumer, std::shared_ptr<HeartbeatConsumer>>(m, "HeartbeatConsumer",
         "Per-node heartbeat supervision: started / lost / back / reset / state events.")
         .def(py::init([](BusPtr bus, ClockPtr clock) {
+                 not_none(bus, "bus");
                  clock = clock_or_real(clock);
                  return make_service<HeartbeatConsumer>(std::pair(bus, clock), *bus, *clock);
              }), py::arg("bus"), py::arg("clock") = nullptr)
         .def("monitor", [](HeartbeatConsumer& b, int node, double timeout) {
                  check_node(node, false);
-                 if (!(timeout > 0)) throw InvalidArgument("heartbeat timeout must be > 0 s");
-                 b.monitor(static_cast<std::uint8_t>(node), std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9)));
+                 auto t = duration_arg(timeout, "timeout");
+                 if (t.count() <= 0) throw InvalidArgument("timeout: a heartbeat timeout must be > 0 s");
+                 b.monitor(static_cast<std::uint8_t>(node), t);
              }, py::arg("node"), py::arg("timeout"))
         .def("forget", [](HeartbeatConsumer& b, int node) { check_node(node, false); b.forget(static_cast<std::uint8_t>(node)); })
         .def("health", [](HeartbeatConsumer& b, int node) { check_node(node, false); return b.health(static_cast<std::uint8_t>(node)); })
@@ -436,7 +439,9 @@ void bind_canopen_services(py::module_& m) {
 
     py::class_<HeartbeatProducer, std::shared_ptr<HeartbeatProducer>>(m, "HeartbeatProducer")
         .def(py::init([](BusPtr bus, int node, double period, py::object state, ClockPtr clock) {
+                 not_none(bus, "bus");
                  check_node(node, false);
+                 const auto period_ns = duration_arg(period, "period");
                  clock = clock_or_real(clock);
                  std::function<NodeState()> fn;
                  if (py::isinstance<py::str>(state)) {
@@ -455,7 +460,7 @@ void bind_canopen_services(py::module_& m) {
                      };
                  }
                  return make_service<HeartbeatProducer>(std::pair(bus, clock), *bus, *clock, static_cast<std::uint8_t>(node),
-                                                        std::chrono::nanoseconds(static_cast<std::int64_t>(period * 1e9)), fn);
+                                                        period_ns, fn);
                  
              }), py::arg("bus"), py::arg("node"), py::arg("period"), py::arg("state") = "OPERATIONAL",
              py::arg("clock") = nullptr)
@@ -474,6 +479,7 @@ void bind_canopen_services(py::module_& m) {
     py::class_<EmcyConsumer, std::shared_ptr<EmcyConsumer>>(m, "EmcyConsumer",
         "Collects EMCY messages: bounded history and active codes per node.")
         .def(py::init([](BusPtr bus, std::size_t history) {
+                 not_none(bus, "bus");
                  return make_service<EmcyConsumer>(bus, *bus, history);
              }), py::arg("bus"), py::arg("history") = 32)
         .def("history", [](EmcyConsumer& b, int node) {
@@ -488,10 +494,7 @@ void bind_canopen_services(py::module_& m) {
                  check_node(node, true);
                  auto to = timeout_of(t);
                  std::optional<EmcyMessage> r;
-                 {
-                     py::gil_scoped_release nogil;
-                     r = b.wait(static_cast<std::uint8_t>(node), to);
-                 }
+                 r = blocking_call([&] { return b.wait(static_cast<std::uint8_t>(node), to); });
                  if (!r) return py::none();
                  return py::cast(*r);
              }, py::arg("node") = 0, py::arg("timeout") = 1.0)
@@ -505,6 +508,7 @@ void bind_canopen_services(py::module_& m) {
 
     py::class_<EmcyProducer, std::shared_ptr<EmcyProducer>>(m, "EmcyProducer")
         .def(py::init([](BusPtr bus, int node, std::uint16_t inhibit, std::size_t queue, ClockPtr clock) {
+                 not_none(bus, "bus");
                  check_node(node, false);
                  clock = clock_or_real(clock);
                  return make_service<EmcyProducer>(std::pair(bus, clock), *bus, *clock, static_cast<std::uint8_t>(node),
@@ -533,9 +537,11 @@ void bind_canopen_services(py::module_& m) {
     py::class_<SyncProducer, std::shared_ptr<SyncProducer>>(m, "SyncProducer",
         "SYNC on a C++ thread; jitter() reports the period error statistics.")
         .def(py::init([](BusPtr bus, double period, int overflow, std::uint32_t cob_id) {
-                 if (!(period > 0)) throw InvalidArgument("SYNC period must be > 0 s");
+                 not_none(bus, "bus");
+                 const auto period_ns = duration_arg(period, "period");
+                 if (period_ns.count() <= 0) throw InvalidArgument("period: a SYNC period must be > 0 s");
                  if (overflow < 0 || overflow > 240) throw InvalidArgument("SYNC counter overflow must be 0 or 2-240");
-                 return make_service<SyncProducer>(bus, *bus, std::chrono::nanoseconds(static_cast<std::int64_t>(period * 1e9)),
+                 return make_service<SyncProducer>(bus, *bus, period_ns,
                                                    static_cast<std::uint8_t>(overflow), cob_id);
                  
              }), py::arg("bus"), py::arg("period"), py::arg("counter_overflow") = 0, py::arg("cob_id") = kSyncCobId)
@@ -591,6 +597,7 @@ void bind_canopen_services(py::module_& m) {
     py::class_<PdoReceiver, std::shared_ptr<PdoReceiver>>(m, "PdoReceiver",
         "Receives a device's TPDO on the bus and keeps the latest values.")
         .def(py::init([](BusPtr bus, std::uint32_t cob_id, const py::iterable& entries) {
+                 not_none(bus, "bus");
                  return make_service<PdoReceiver>(bus, *bus, cob_id, entries_from(entries));
              }), py::arg("bus"), py::arg("cob_id"), py::arg("entries"))
         .def_property_readonly("values", [](PdoReceiver& b) { return b.values(); })
@@ -600,8 +607,7 @@ void bind_canopen_services(py::module_& m) {
         .def_property_readonly("short_frames", [](PdoReceiver& b) { return b.short_frames(); })
         .def("wait_newer", [](PdoReceiver& b, std::uint64_t after, const py::object& t) {
                  auto to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 return b.wait_newer(after, to);
+                 return blocking_call([&] { return b.wait_newer(after, to); });
              }, py::arg("after"), py::arg("timeout") = 1.0)
         .def("request", [](PdoReceiver& b) { py::gil_scoped_release nogil; b.request(); })
         .def("set_callback", [](PdoReceiver& b, py::object cb) {
@@ -612,6 +618,7 @@ void bind_canopen_services(py::module_& m) {
 
     py::class_<PdoSender, std::shared_ptr<PdoSender>>(m, "PdoSender")
         .def(py::init([](BusPtr bus, std::uint32_t cob_id, const py::iterable& entries) {
+                 not_none(bus, "bus");
                  return make_service<PdoSender>(bus, *bus, cob_id, entries_from(entries));
              }), py::arg("bus"), py::arg("cob_id"), py::arg("entries"))
         .def("send", [](PdoSender& b, const std::vector<std::int64_t>& values, const py::object& t) {
@@ -689,59 +696,50 @@ void bind_canopen_services(py::module_& m) {
                  auto box = make_sdo(sdo, node);
                  SdoAccess& access = *box.access;  // owned by box, which the host keeps
                  Cia402HostOptions o;
-                 o.timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(timeout * 1e9));
-                 o.sdo_poll = std::chrono::nanoseconds(static_cast<std::int64_t>(poll * 1e9));
+                 o.timeout = finite_forever(duration_arg(timeout, "timeout", Forever::Allowed));
+                 o.sdo_poll = duration_arg(poll, "poll");
                  return make_service<Cia402Host>(std::move(box), access, static_cast<std::uint8_t>(node), o);
              }), py::arg("sdo"), py::arg("node"), py::arg("timeout") = 2.0, py::arg("poll") = 0.005)
         .def("use_statusword_pdo", [](Cia402Host& b, PdoReceiver* rx) { b.use_statusword_pdo(rx); },
              py::arg("receiver"), py::keep_alive<1, 2>(),
              "Wait on this TPDO receiver's statusword (0x6041 must be mapped); None = poll over SDO.")
-        .def_property_readonly("statusword", [](Cia402Host& b) { py::gil_scoped_release nogil; return b.read_statusword(); })
+        .def_property_readonly("statusword", [](Cia402Host& b) { return blocking_call([&] { return b.read_statusword(); }); })
         .def_property_readonly("state", [](Cia402Host& b) {
                  Cia402State s;
-                 {
-                     py::gil_scoped_release nogil;
-                     s = b.state();
-                 }
+                 s = blocking_call([&] { return b.state(); });
                  return std::string(to_string(s));
              })
-        .def("write_controlword", [](Cia402Host& b, std::uint16_t c) { py::gil_scoped_release nogil; b.write_controlword(c); })
+        .def("write_controlword", [](Cia402Host& b, std::uint16_t c) { blocking_call([&] { b.write_controlword(c); }); })
         .def("go_to", [](Cia402Host& b, const std::string& s) {
                  auto t = cia402_state_of(s);
-                 py::gil_scoped_release nogil;
-                 b.go_to(t);
+                 blocking_call([&] { b.go_to(t); });
              }, py::arg("state"))
-        .def("fault_reset", [](Cia402Host& b) { py::gil_scoped_release nogil; b.fault_reset(); })
-        .def("quick_stop", [](Cia402Host& b) { py::gil_scoped_release nogil; b.quick_stop(); })
+        .def("fault_reset", [](Cia402Host& b) { blocking_call([&] { b.fault_reset(); }); })
+        .def("quick_stop", [](Cia402Host& b) { blocking_call([&] { b.quick_stop(); }); })
         .def("wait_statusword", [](Cia402Host& b, std::uint16_t mask, std::uint16_t value, const py::object& t) {
                  std::optional<std::chrono::nanoseconds> to;
                  if (!t.is_none()) to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 return b.wait_statusword(mask, value, to);
+                 return blocking_call([&] { return b.wait_statusword(mask, value, to); });
              }, py::arg("mask"), py::arg("value"), py::arg("timeout") = py::none())
         .def("set_mode", [](Cia402Host& b, int mode) {
-                 py::gil_scoped_release nogil;
-                 b.set_mode(static_cast<OpMode>(mode));
+                 blocking_call([&] { b.set_mode(static_cast<OpMode>(mode)); });
              }, py::arg("mode"))
-        .def_property_readonly("mode", [](Cia402Host& b) { py::gil_scoped_release nogil; return static_cast<int>(b.mode()); })
+        .def_property_readonly("mode", [](Cia402Host& b) { return blocking_call([&] { return static_cast<int>(b.mode()); }); })
         .def("move_to", [](Cia402Host& b, std::int32_t target, bool relative, bool immediate) {
-                 py::gil_scoped_release nogil;
-                 b.move_to(target, relative, immediate);
+                 blocking_call([&] { b.move_to(target, relative, immediate); });
              }, py::arg("target"), py::arg("relative") = false, py::arg("immediate") = true)
         .def("wait_target_reached", [](Cia402Host& b, const py::object& t) {
                  std::optional<std::chrono::nanoseconds> to;
                  if (!t.is_none()) to = timeout_of(t);
-                 py::gil_scoped_release nogil;
-                 b.wait_target_reached(to);
+                 blocking_call([&] { b.wait_target_reached(to); });
              }, py::arg("timeout") = py::none())
-        .def("set_velocity", [](Cia402Host& b, std::int32_t v) { py::gil_scoped_release nogil; b.set_velocity(v); })
+        .def("set_velocity", [](Cia402Host& b, std::int32_t v) { blocking_call([&] { b.set_velocity(v); }); })
         .def("home", [](Cia402Host& b, std::optional<int> method, const py::object& t) {
                  std::optional<std::chrono::nanoseconds> to;
                  if (!t.is_none()) to = timeout_of(t);
                  std::optional<std::int8_t> mth;
                  if (method) mth = static_cast<std::int8_t>(*method);
-                 py::gil_scoped_release nogil;
-                 b.home(mth, to);
+                 blocking_call([&] { b.home(mth, to); });
              }, py::arg("method") = py::none(), py::arg("timeout") = py::none());
 
     py::class_<Cia402Device, std::shared_ptr<Cia402Device>>(m, "Cia402Device",
@@ -816,19 +814,17 @@ void bind_canopen_services(py::module_& m) {
     // ---- scanner ------------------------------------------------------------------
     m.def("scan_network", [](BusPtr bus, int first, int last, double sdo_timeout, double listen, bool probe_sdo,
                              bool identity) {
+              not_none(bus, "bus");
               if (first < 1 || last > 127 || first > last) throw InvalidArgument("scan range must be within 1-127");
               ScanOptions o;
               o.first = static_cast<std::uint8_t>(first);
               o.last = static_cast<std::uint8_t>(last);
-              o.sdo_timeout = std::chrono::nanoseconds(static_cast<std::int64_t>(sdo_timeout * 1e9));
-              o.listen = std::chrono::nanoseconds(static_cast<std::int64_t>(listen * 1e9));
+              o.sdo_timeout = duration_arg(sdo_timeout, "sdo_timeout");
+              o.listen = duration_arg(listen, "listen");
               o.probe_sdo = probe_sdo;
               o.read_identity = identity;
               std::vector<ScanResult> res;
-              {
-                  py::gil_scoped_release nogil;
-                  res = scan_network(*bus, o);
-              }
+              res = blocking_call([&] { return scan_network(*bus, o); });
               return res;
           }, py::arg("bus"), py::arg("first") = 1, py::arg("last") = 127, py::arg("sdo_timeout") = 0.2,
           py::arg("listen") = 0.0, py::arg("probe_sdo") = true, py::arg("identity") = true);

@@ -7,6 +7,16 @@ namespace py = pybind11;
 using namespace motorbus;
 
 void bind_runtime(py::module_& m) {
+    // Safety net for argument conversions no helper names (common.hpp arg_cast):
+    // a pybind11 cast failure inside a call is a bad argument, not a RuntimeError.
+    static py::handle invalid_argument = py::object(m.attr("InvalidArgument")).release();
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const py::cast_error& e) {
+            PyErr_SetString(invalid_argument.ptr(), e.what());
+        }
+    });
     m.def("monotonic_ns", &monotonic_ns, "The monotonic clock frame timestamps use (ns).");
     py::class_<Clock, std::shared_ptr<Clock>>(m, "Clock")
         .def("now", &Clock::now, "Current time in ns.")

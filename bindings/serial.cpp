@@ -17,6 +17,12 @@ using namespace motorbus;
 using namespace motorbus::serial;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
+using motorbus::py_helpers::blocking_call;
+using motorbus::py_helpers::interruptible_wait;
+using motorbus::py_helpers::arg_iterable;
 
 namespace {
 
@@ -129,10 +135,6 @@ private:
     std::vector<py::object> keep_;
 };
 
-std::chrono::nanoseconds nonneg_seconds(double s, const char* what) {
-    if (!(s >= 0) || s > 1e6) throw InvalidArgument(std::string(what) + ": must be in [0, 1e6] seconds");
-    return std::chrono::nanoseconds(static_cast<std::int64_t>(s * 1e9));
-}
 
 }  // namespace
 
@@ -190,12 +192,12 @@ void bind_serial(py::module_& m) {
                 if (size == 0 || size > (1u << 20)) throw InvalidArgument("read size: must be in [1, 1048576]");
                 auto t = seconds_to_ns(timeout);
                 std::string buf(size, '\0');
-                std::size_t n;
-                {
-                    py::gil_scoped_release nogil;
-                    n = p.read({reinterpret_cast<std::uint8_t*>(buf.data()), buf.size()}, t);
-                }
-                return py::bytes(buf.data(), n);
+                auto n = interruptible_wait(t, [&](std::chrono::nanoseconds d) -> std::optional<std::size_t> {
+                    std::size_t got = p.read({reinterpret_cast<std::uint8_t*>(buf.data()), buf.size()}, d);
+                    if (got == 0) return std::nullopt;
+                    return got;
+                });
+                return py::bytes(buf.data(), n.value_or(0));
             },
             py::arg("size") = 4096, py::arg("timeout") = py::none(),
             "Returns what is available (b'' on timeout); waits up to `timeout` s for the first byte "
@@ -279,13 +281,14 @@ void bind_serial(py::module_& m) {
                  if (py::isinstance<py::str>(reply_terminators) || py::isinstance<py::bytes>(reply_terminators)) {
                      o.reply_terminators.push_back(bytes_arg(reply_terminators, "reply_terminators"));
                  } else {
-                     for (auto t : reply_terminators) o.reply_terminators.push_back(bytes_arg(t, "reply_terminators"));
+                     for (auto t : arg_iterable(reply_terminators, "reply_terminators", "str, bytes or a list of them"))
+                         o.reply_terminators.push_back(bytes_arg(t, "reply_terminators"));
                  }
                  o.max_line = max_line;
-                 o.reply_timeout = seconds_to_ns(reply_timeout);
+                 o.reply_timeout = seconds_to_ns(reply_timeout, "reply_timeout");
                  o.flush_before_request = flush_before_request;
                  o.echo_suppression = echo_suppression;
-                 o.turnaround = nonneg_seconds(turnaround, "turnaround");
+                 o.turnaround = duration_arg(turnaround, "turnaround");
                  return std::make_shared<LineLink>(std::move(port), std::move(o));
              }),
              py::arg("port"), py::arg("request_terminator") = "\r",
@@ -299,10 +302,7 @@ void bind_serial(py::module_& m) {
                 std::optional<std::chrono::nanoseconds> t;
                 if (!timeout.is_none()) t = seconds_to_ns(timeout);
                 std::string reply;
-                {
-                    py::gil_scoped_release nogil;
-                    reply = l.transact(req, t);
-                }
+                reply = blocking_call([&] { return l.transact(req, t); });
                 return to_py(reply);
             },
             py::arg("request"), py::arg("timeout") = py::none(),
@@ -321,10 +321,7 @@ void bind_serial(py::module_& m) {
             [](LineLink& l, const py::object& timeout) -> py::object {
                 auto t = timeout.is_none() ? l.options().reply_timeout : seconds_to_ns(timeout);
                 std::optional<std::string> line;
-                {
-                    py::gil_scoped_release nogil;
-                    line = l.read_line(t);
-                }
+                line = blocking_call([&] { return l.read_line(t); });
                 if (!line) return py::none();
                 return to_py(*line);
             },

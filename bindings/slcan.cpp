@@ -14,13 +14,15 @@ using namespace motorbus;
 using namespace motorbus::can;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::arg_cast;
+using motorbus::py_helpers::not_none;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
 
 namespace {
 
-Duration secs(double s) {
-    if (!(s >= 0)) throw InvalidArgument("duration: must be >= 0 seconds");
-    return std::chrono::nanoseconds(static_cast<std::int64_t>(s * 1e9));
-}
+
 
 // A decoded event that owns its line bytes (Event::text is only valid during
 // the decoder's callback).
@@ -100,7 +102,7 @@ void bind_slcan(py::module_& m) {
         m, "SlcanBus", "A CAN bus through an SLCAN (Lawicel) adapter on a serial port.")
         .def("flush_tx",
              [](SlcanBus& b, double timeout) {
-                 auto t = secs(timeout);
+                 auto t = duration_arg(timeout, "timeout");  // finite: these core waits are not interruptible
                  py::gil_scoped_release nogil;
                  b.flush_tx(t);
              },
@@ -108,7 +110,7 @@ void bind_slcan(py::module_& m) {
              "Wait until the adapter answered every command; ProtocolError if it refused frames.")
         .def("query_status",
              [](SlcanBus& b, double timeout) {
-                 auto t = secs(timeout);
+                 auto t = duration_arg(timeout, "timeout");  // finite: these core waits are not interruptible
                  py::gil_scoped_release nogil;
                  return b.query_status(t);
              },
@@ -127,13 +129,13 @@ void bind_slcan(py::module_& m) {
               o.listen_only = listen_only;
               o.wait_for_acks = wait_for_acks;
               o.tx_window = tx_window;
-              o.ack_timeout = secs(ack_timeout);
-              o.open_timeout = secs(open_timeout);
-              o.status_poll = secs(status_poll);
+              o.ack_timeout = duration_arg(ack_timeout, "ack_timeout");
+              o.open_timeout = duration_arg(open_timeout, "open_timeout");
+              o.status_poll = duration_arg(status_poll, "status_poll");
               o.tty_baud = tty_baud;
-              o.tx_coalesce = secs(tx_coalesce);
+              o.tx_coalesce = duration_arg(tx_coalesce, "tx_coalesce");
               if (!btr.is_none()) {
-                  auto v = btr.cast<unsigned>();
+                  auto v = arg_cast<unsigned>(btr, "btr", "an int 0-0xFFFF or None");
                   if (v > 0xFFFF) throw InvalidArgument("btr: BTR0<<8|BTR1 must be 0-0xFFFF");
                   o.btr = static_cast<std::uint16_t>(v);
               }
@@ -160,8 +162,9 @@ void bind_slcan(py::module_& m) {
                  o.queue_size = queue_size;
                  o.identity.version = version;
                  o.identity.serial = serial_number;
-                 o.bus_send_timeout = secs(bus_send_timeout);
-                 std::string path = port.is_none() ? std::string() : port.cast<std::string>();
+                 o.bus_send_timeout = duration_arg(bus_send_timeout, "bus_send_timeout");
+                 not_none(bus, "bus");
+                 std::string path = port.is_none() ? std::string() : arg_cast<std::string>(port, "port", "a device path or None");
                  py::gil_scoped_release nogil;
                  if (path.empty()) return std::make_shared<SlcanServer>(std::move(bus), o);
                  return std::make_shared<SlcanServer>(std::move(bus), serial::open_port(path, baud), o);
@@ -189,7 +192,7 @@ void bind_slcan(py::module_& m) {
           [](const Frame& f, const py::object& timestamp_ms) {
               std::optional<std::uint16_t> ts;
               if (!timestamp_ms.is_none()) {
-                  auto v = timestamp_ms.cast<unsigned>();
+                  auto v = arg_cast<unsigned>(timestamp_ms, "timestamp_ms", "an int 0-59999 or None");
                   if (v > slcan::kMaxTimestamp) throw InvalidArgument("slcan timestamp: must be 0-59999 ms");
                   ts = static_cast<std::uint16_t>(v);
               }

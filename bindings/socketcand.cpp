@@ -15,14 +15,19 @@ using namespace motorbus;
 using namespace motorbus::can;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
+using motorbus::py_helpers::interruptible_wait;
+using motorbus::py_helpers::not_none;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::finite_forever;
+using motorbus::py_helpers::Forever;
 
 namespace {
 
-// Python seconds -> Duration; None -> `none_value`.
-Duration seconds_or(const py::object& t, Duration none_value) {
+// Python seconds -> Duration; None -> `none_value`; inf -> forever only where
+// `none_value` is itself "no limit" (a finite 31 years), else InvalidArgument.
+Duration seconds_or(const py::object& t, const char* name, Duration none_value, Forever forever) {
     if (t.is_none()) return none_value;
-    auto ns = seconds_to_ns(t);
-    return ns.count() < 0 ? std::chrono::hours(24 * 365) : ns;
+    return finite_forever(duration_arg(t, name, forever));
 }
 
 
@@ -73,8 +78,7 @@ void bind_socketcand(py::module_& m) {
                  if (auto f = b.recv(Duration::zero())) return f;
                  auto t = seconds_to_ns(timeout);
                  if (t.count() == 0) return std::nullopt;
-                 py::gil_scoped_release nogil;
-                 return b.recv(t);
+                 return interruptible_wait(t, [&](std::chrono::nanoseconds d) { return b.recv(d); });
              },
              py::arg("timeout") = py::none())
         .def_property_readonly("link_up", &SocketcandBus::link_up)
@@ -93,9 +97,9 @@ void bind_socketcand(py::module_& m) {
             SocketcandOptions o;
             o.receive_own = receive_own;
             o.rx_queue_size = rx_queue_size;
-            o.connect_timeout = seconds_or(connect_timeout, std::chrono::hours(1));
-            o.handshake_timeout = seconds_or(handshake_timeout, std::chrono::hours(1));
-            o.keepalive_period = seconds_or(keepalive, Duration::zero());
+            o.connect_timeout = seconds_or(connect_timeout, "connect_timeout", std::chrono::hours(1), Forever::Allowed);
+            o.handshake_timeout = seconds_or(handshake_timeout, "handshake_timeout", std::chrono::hours(1), Forever::Allowed);
+            o.keepalive_period = seconds_or(keepalive, "keepalive", Duration::zero(), Forever::Refused);
             o.keepalive_misses = keepalive_misses;
             o.tcp_keepalive = tcp_keepalive;
             o.tx_buffer_bytes = tx_buffer_bytes;
@@ -120,16 +124,17 @@ void bind_socketcand(py::module_& m) {
                          std::size_t client_queue, const py::object& idle_timeout,
                          const py::object& element_timeout, const py::object& open_timeout,
                          const py::object& bus_send_budget) {
+                 not_none(bus, "bus");
                  SocketcandServerOptions o;
                  o.host = host;
                  o.port = port;
                  o.channel = channel;
                  o.max_clients = max_clients;
                  o.client_queue = client_queue;
-                 o.idle_timeout = seconds_or(idle_timeout, Duration::zero());
-                 o.element_timeout = seconds_or(element_timeout, std::chrono::hours(24 * 365));
-                 o.open_timeout = seconds_or(open_timeout, std::chrono::hours(24 * 365));
-                 o.bus_send_budget = seconds_or(bus_send_budget, Duration::zero());
+                 o.idle_timeout = seconds_or(idle_timeout, "idle_timeout", Duration::zero(), Forever::Refused);
+                 o.element_timeout = seconds_or(element_timeout, "element_timeout", std::chrono::hours(24 * 365), Forever::Allowed);
+                 o.open_timeout = seconds_or(open_timeout, "open_timeout", std::chrono::hours(24 * 365), Forever::Allowed);
+                 o.bus_send_budget = seconds_or(bus_send_budget, "bus_send_budget", Duration::zero(), Forever::Refused);
                  py::gil_scoped_release nogil;
                  return std::make_shared<SocketcandServer>(std::move(bus), o);
              }),

@@ -1447,9 +1447,11 @@ class SdoClient:
         ...
     @property
     def timeout(self) -> float:
-        ...
+        """
+        Seconds per response; inf (or None) = wait forever (Ctrl-C still interrupts).
+        """
     @timeout.setter
-    def timeout(self, arg1: typing.SupportsFloat | typing.SupportsIndex) -> None:
+    def timeout(self, arg1: typing.Any) -> None:
         ...
 class LocalNode:
     """

@@ -1,3 +1,4 @@
+#include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/canopen/cia402.hpp"
 
 #include <thread>
@@ -162,7 +163,7 @@ std::uint16_t Cia402Host::wait_statusword(std::uint16_t mask, std::uint16_t valu
             // Event-driven: sleep until the next TPDO carrying the statusword.
             sw_pdo_->wait_newer(seen, std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - now));
         } else {
-            std::this_thread::sleep_for(std::min<std::chrono::nanoseconds>(
+            interruptible_sleep_for(std::min<std::chrono::nanoseconds>(
                 opt_.sdo_poll, std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - now)));
         }
     }
@@ -191,7 +192,7 @@ void Cia402Host::wait_leave(Cia402State cur, int transition) {
         if (sw_pdo_ && seen > 0)
             sw_pdo_->wait_newer(seen, left);
         else
-            std::this_thread::sleep_for(std::min(opt_.sdo_poll, left));
+            interruptible_sleep_for(std::min(opt_.sdo_poll, left));
     }
 }
 
@@ -238,7 +239,7 @@ void Cia402Host::set_mode(OpMode m) {
     while (mode() != m) {
         if (std::chrono::steady_clock::now() >= deadline)
             throw TimeoutError(std::string("CiA 402: 0x6061 did not follow mode ") + to_string(m));
-        std::this_thread::sleep_for(opt_.sdo_poll);
+        interruptible_sleep_for(opt_.sdo_poll);
     }
 }
 
@@ -274,7 +275,7 @@ void Cia402Host::wait_target_reached(std::optional<std::chrono::nanoseconds> tim
         if (sw_pdo_ && sw_pdo_->received() > 0)
             sw_pdo_->wait_newer(sw_pdo_->received(), left);
         else
-            std::this_thread::sleep_for(std::min(opt_.sdo_poll, left));
+            interruptible_sleep_for(std::min(opt_.sdo_poll, left));
     }
 }
 
@@ -303,7 +304,7 @@ void Cia402Host::home(std::optional<std::int8_t> method, std::optional<std::chro
         if (sw_pdo_ && sw_pdo_->received() > 0)
             sw_pdo_->wait_newer(sw_pdo_->received(), left);
         else
-            std::this_thread::sleep_for(std::min(opt_.sdo_poll, left));
+            interruptible_sleep_for(std::min(opt_.sdo_poll, left));
     }
     write_controlword(cw::kEnableOperation);
 }

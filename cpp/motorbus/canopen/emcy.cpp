@@ -1,3 +1,4 @@
+#include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/canopen/emcy.hpp"
 
 #include <algorithm>
@@ -136,7 +137,7 @@ std::optional<EmcyMessage> EmcyConsumer::wait(std::uint8_t node, std::chrono::na
             }
         return false;
     };
-    cv_.wait_for(l, timeout, take);
+    interruptible_wait_for(cv_, l, timeout, take);
     return found;
 }
 

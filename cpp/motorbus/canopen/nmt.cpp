@@ -1,3 +1,4 @@
+#include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/canopen/nmt.hpp"
 
 #include <cctype>
@@ -183,7 +184,7 @@ std::optional<std::uint8_t> NmtMaster::raw_state(std::uint8_t node) const {
 bool NmtMaster::wait_for_state(std::uint8_t node, NodeState want, std::chrono::nanoseconds timeout) {
     if (node == 0 || node > kMaxNodeId) throw InvalidArgument("node id must be 1-127");
     std::unique_lock l(mutex_);
-    return cv_.wait_for(l, timeout, [&] {
+    return interruptible_wait_for(cv_, l, timeout, [&] {
         return raw_[node] >= 0 && node_state_from_byte(static_cast<std::uint8_t>(raw_[node])) == want;
     });
 }
@@ -192,14 +193,14 @@ bool NmtMaster::wait_for_boot(std::uint8_t node, std::chrono::nanoseconds timeou
     if (node == 0 || node > kMaxNodeId) throw InvalidArgument("node id must be 1-127");
     std::unique_lock l(mutex_);
     const auto start = boots_[node];
-    return cv_.wait_for(l, timeout, [&] { return boots_[node] != start; });
+    return interruptible_wait_for(cv_, l, timeout, [&] { return boots_[node] != start; });
 }
 
 std::optional<NodeState> NmtMaster::wait_for_heartbeat(std::uint8_t node, std::chrono::nanoseconds timeout) {
     if (node == 0 || node > kMaxNodeId) throw InvalidArgument("node id must be 1-127");
     std::unique_lock l(mutex_);
     const auto start = heard_[node];
-    if (!cv_.wait_for(l, timeout, [&] { return heard_[node] != start; })) return std::nullopt;
+    if (!interruptible_wait_for(cv_, l, timeout, [&] { return heard_[node] != start; })) return std::nullopt;
     return node_state_from_byte(static_cast<std::uint8_t>(raw_[node]));
 }
 

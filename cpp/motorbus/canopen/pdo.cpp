@@ -1,3 +1,4 @@
+#include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/canopen/pdo.hpp"
 
 #include "motorbus/canopen/nmt.hpp"
@@ -192,7 +193,7 @@ std::uint64_t PdoReceiver::received() const {
 
 std::optional<std::uint64_t> PdoReceiver::wait_newer(std::uint64_t after, std::chrono::nanoseconds timeout) {
     std::unique_lock l(m_);
-    if (!cv_.wait_for(l, timeout, [&] { return count_ > after; })) return std::nullopt;
+    if (!interruptible_wait_for(cv_, l, timeout, [&] { return count_ > after; })) return std::nullopt;
     return count_;
 }
 

@@ -1,6 +1,8 @@
+#include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/canopen/sdo_client.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <cstdio>
 #include <cstring>
 #include <thread>
@@ -552,8 +554,19 @@ void SdoClient::run(std::unique_lock<std::mutex>& lock) {
     }
     while (machine_.busy()) {
         const Nanos dl = machine_.next_deadline();
-        cv_.wait_until(lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dl)),
+        // An interrupted wait (Ctrl-C) leaves no transfer behind; the server
+        // drops its side at its own timeout.
+        struct ResetUnlessDone {
+            SdoClientMachine& m;
+            int uncaught = std::uncaught_exceptions();
+            ~ResetUnlessDone() {
+                if (std::uncaught_exceptions() > uncaught) m.reset();
+            }
+        } reset_on_throw{machine_};
+        interruptible_wait_until(cv_, lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dl)),
                        [&] {
+                           // A timer armed after we went to sleep (next_deadline() < dl)
+                           // must wake us too, or it fires only at the old deadline.
                            return !machine_.busy() || machine_.next_deadline() < dl ||
                                   monotonic_ns() >= machine_.next_deadline();
                        });

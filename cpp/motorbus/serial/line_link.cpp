@@ -4,6 +4,7 @@
 #include <mutex>
 #include <thread>
 
+#include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/serial/line_framer.hpp"
 #include "motorbus/serial/port.hpp"
 
@@ -128,9 +129,11 @@ struct LineLink::Impl {
                 auto now = Clock::now();
                 wait = now >= deadline ? Duration::zero() : std::chrono::duration_cast<Duration>(deadline - now);
             }
+            if (interruptible() && (wait.count() < 0 || wait > kInterruptSlice)) wait = kInterruptSlice;
             std::size_t n = port->read(buf, wait);
             if (n == 0) {
                 if (!forever && Clock::now() >= deadline) return std::nullopt;
+                interruption_point();
                 continue;
             }
             c.bytes_in += n;
@@ -164,12 +167,22 @@ std::string LineLink::transact(std::string_view request, std::optional<Duration>
         // RS-485: our transceiver drives the bus until the last stop bit is out,
         // then needs the turn-around time before the drive may answer.
         d.port->drain();
-        std::this_thread::sleep_for(d.options.turnaround);
+        interruptible_sleep_for(d.options.turnaround);
     }
     Duration t = timeout.value_or(d.options.reply_timeout);
     bool forever = t.count() < 0;
     auto deadline = Clock::now() + (forever ? Duration::zero() : t);
-    auto line = d.next_line(deadline, forever);
+    std::optional<FramedLine> line;
+    try {
+        line = d.next_line(deadline, forever);
+    } catch (...) {
+        // Interrupted (or the link failed): the partial reply goes, as after a timeout.
+        d.framer.reset();
+        d.pending.clear();
+        d.echo.clear();
+        d.echo_pos = 0;
+        throw;
+    }
     if (!line) {
         if (d.framer.discarding()) {
             // The cap was already exceeded: that is the real diagnosis.
