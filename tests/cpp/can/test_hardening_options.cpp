@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "../invalid_message.hpp"
 #include "motorbus/can/external_bus.hpp"
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/errors.hpp"
@@ -14,21 +15,7 @@
 using namespace motorbus;
 using namespace motorbus::can;
 
-namespace {
-
-template <class F>
-std::string invalid_message(F&& f) {
-    try {
-        f();
-    } catch (const InvalidArgument& e) {
-        return e.what();
-    } catch (const std::exception& e) {
-        return std::string("wrong exception: ") + e.what();
-    }
-    return "no exception";
-}
-
-}  // namespace
+using motorbus::test::invalid_message;
 
 TEST(HardeningOptions, RxQueueSizeZeroRefusedOnEveryBus) {
     VirtualOptions v;

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "../invalid_message.hpp"
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/canopen/heartbeat.hpp"
 #include "motorbus/canopen/local_node.hpp"
@@ -16,17 +17,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-template <class F>
-std::string invalid_message(F&& f) {
-    try {
-        f();
-    } catch (const InvalidArgument& e) {
-        return e.what();
-    } catch (const std::exception& e) {
-        return std::string("wrong exception: ") + e.what();
-    }
-    return "no exception";
-}
+using motorbus::test::invalid_message;
 
 std::shared_ptr<ObjectDictionary> small_od() {
     auto od = std::make_shared<ObjectDictionary>();
