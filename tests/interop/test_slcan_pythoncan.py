@@ -69,6 +69,21 @@ def _pycan_recv_all(bus: can.BusABC, n: int) -> list:
     return got
 
 
+def _exchange_every_frame(bus, peer):
+    """Every FRAMES entry python-can -> adapter -> virtual bus, then back; exact and in order."""
+    for f in FRAMES:
+        bus.send(_to_msg(f))
+    got = []
+    for _ in FRAMES:
+        fr = peer.recv(timeout=3.0)
+        assert fr is not None, f"bus received only {len(got)} of {len(FRAMES)}"
+        got.append(_frame_tuple(fr))
+    assert got == FRAMES
+    for f in FRAMES:
+        peer.send(_to_frame(f))
+    assert _pycan_recv_all(bus, len(FRAMES)) == FRAMES
+
+
 @pytest.fixture
 def hub():
     name = f"slcan-interop-{os.getpid()}-{id(object())}"
@@ -85,19 +100,7 @@ def test_pythoncan_host_against_our_server(hub):
     with SlcanServer(inner) as server:
         bus = can.Bus(interface="slcan", channel=server.pty_path, bitrate=500000, sleep_after_open=0)
         try:
-            # python-can -> server -> virtual bus
-            for f in FRAMES:
-                bus.send(_to_msg(f))
-            got = []
-            for _ in FRAMES:
-                fr = peer.recv(timeout=3.0)
-                assert fr is not None, f"bus received only {len(got)} of {len(FRAMES)}"
-                got.append(_frame_tuple(fr))
-            assert got == FRAMES
-            # virtual bus -> server -> python-can
-            for f in FRAMES:
-                peer.send(_to_frame(f))
-            assert _pycan_recv_all(bus, len(FRAMES)) == FRAMES
+            _exchange_every_frame(bus, peer)
             assert server.stats.transmitted == len(FRAMES)
             assert server.stats.transmit_failed == 0
         finally:
@@ -188,17 +191,7 @@ def test_pythoncan_host_with_crlf_line_endings_loses_no_frame(hub):
             while not server.is_open and time.monotonic() < deadline:
                 time.sleep(0.01)
             assert server.is_open
-            for f in FRAMES:
-                bus.send(_to_msg(f))
-            got = []
-            for _ in FRAMES:
-                fr = peer.recv(timeout=3.0)
-                assert fr is not None, f"bus received only {len(got)} of {len(FRAMES)}"
-                got.append(_frame_tuple(fr))
-            assert got == FRAMES
-            for f in FRAMES:
-                peer.send(_to_frame(f))
-            assert _pycan_recv_all(bus, len(FRAMES)) == FRAMES
+            _exchange_every_frame(bus, peer)
             assert server.stats.transmitted == len(FRAMES)
             # The only BELs are the three python-can's open sequence earns with CR
             # too (C, S6, "" for no data bitrate, O, O): C while closed, the empty
