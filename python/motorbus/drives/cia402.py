@@ -217,9 +217,7 @@ class Cia402Sim:
                 return int(round(self.motor.pulse_position))
             if index == 0x606C:
                 return int(round(self.motor.pulse_velocity))
-            if index == 0x6061:
-                return self.device.mode
-            if index == 0x6060:
+            if index in (0x6060, 0x6061):  # the mode asked for is the mode in effect
                 return self.device.mode
             if index == 0x60FD:
                 m = self.motor
@@ -370,8 +368,7 @@ class Cia402Sim:
             if self._limit_hit or self.motor.minus_limit_active or self.motor.plus_limit_active:
                 bits |= _SW_INTERNAL_LIMIT
             if mode == OpMode.PROFILE_POSITION:
-                if self._pp is None or (not self.motor.moving and self._pp.target_reached(self._now_s())) \
-                        or not self.motor.moving:
+                if not self.motor.moving:  # the set-point (and any buffered one) is played out
                     bits |= _SW_TARGET_REACHED
             elif mode == OpMode.PROFILE_VELOCITY:
                 target = float(self._values[(0x60FF, 0)])
@@ -383,9 +380,8 @@ class Cia402Sim:
                     bits |= _SW_TARGET_REACHED
                 if h is not None and h.error:
                     bits |= _SW_BIT13
-            else:
-                if not self.motor.moving:
-                    bits |= _SW_TARGET_REACHED
+            elif not self.motor.moving:
+                bits |= _SW_TARGET_REACHED
             self.device.set_status_bits(_SIM_BITS, bits)
             sw = self.device.statusword
             if mode == OpMode.HOMING:
