@@ -150,7 +150,7 @@ void bind_slcan(py::module_& m) {
           py::arg("open_timeout") = 1.0, py::arg("status_poll") = 0.0, py::arg("tty_baud") = 115200,
           py::arg("btr") = py::none(), py::arg("receive_own") = false,
           py::arg("rx_queue_size") = 65536, py::arg("tx_coalesce") = 20e-6,
-          "Open an SLCAN adapter at `path` (C, Sn, [Z1], O) as a Bus; reconnects after unplug.");
+          "Open an SLCAN adapter at `path` (C, Sn, [Z1], O) as a Bus; bitrate 0 keeps the adapter's rate (no Sn); reconnects after unplug.");
 
     py::class_<SlcanServer, std::shared_ptr<SlcanServer>>(
         m, "SlcanServer",

@@ -4085,7 +4085,7 @@ def open_port(path: str, baud: typing.SupportsInt | typing.SupportsIndex = 0) ->
     """
 def open_slcan(path: str, bitrate: typing.SupportsInt | typing.SupportsIndex = 500000, timestamps: bool = False, echo_suppression: bool = False, listen_only: bool = False, wait_for_acks: bool = True, tx_window: typing.SupportsInt | typing.SupportsIndex = 16, ack_timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0, open_timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0, status_poll: typing.SupportsFloat | typing.SupportsIndex = 0.0, tty_baud: typing.SupportsInt | typing.SupportsIndex = 115200, btr: typing.Any = None, receive_own: bool = False, rx_queue_size: typing.SupportsInt | typing.SupportsIndex = 65536, tx_coalesce: typing.SupportsFloat | typing.SupportsIndex = 2e-05) -> SlcanBus:
     """
-    Open an SLCAN adapter at `path` (C, Sn, [Z1], O) as a Bus; reconnects after unplug.
+    Open an SLCAN adapter at `path` (C, Sn, [Z1], O) as a Bus; bitrate 0 keeps the adapter's rate (no Sn); reconnects after unplug.
     """
 def open_socketcan(iface: str, receive_own: bool = False, rx_queue_size: typing.SupportsInt | typing.SupportsIndex = 65536, kernel_filters: typing.Any = None, error_frames: bool = True, fd: bool = False) -> SocketCanBus:
     """

@@ -18,10 +18,14 @@ const char* to_string(BusState s) {
     return "unknown";
 }
 
+void check_options(const BusOptions& options, const std::string& channel) {
+    if (options.rx_queue_size == 0)
+        throw InvalidArgument("bus " + channel + " rx_queue_size: 0, must be >= 1 (frames kept for recv())");
+}
+
 Bus::Bus(std::string channel, BusOptions options)
     : options_(options), channel_(std::move(channel)) {
-    if (options_.rx_queue_size == 0)
-        throw InvalidArgument("bus " + channel_ + " rx_queue_size: 0, must be >= 1 (frames kept for recv())");
+    check_options(options_, channel_);
 }
 
 Bus::~Bus() {

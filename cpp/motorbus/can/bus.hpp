@@ -56,6 +56,10 @@ struct BusOptions {
     bool receive_own = false;           // deliver frames we sent back to recv()/subscribers
 };
 
+// Throws InvalidArgument naming the field (and `channel`) for a value no bus can
+// work with.  Every bus constructor calls it; the fuzz target fuzz/options.cpp too.
+void check_options(const BusOptions& options, const std::string& channel);
+
 class Bus {
 public:
     explicit Bus(std::string channel, BusOptions options = {});

@@ -20,16 +20,31 @@ std::span<const std::uint8_t> as_bytes(const char* p, std::size_t n) {
 }
 }  // namespace
 
+void check_options(const SlcanOptions& o) {
+    // 0 is a documented choice: leave the adapter's configured rate alone (no S command).
+    if (o.bitrate != 0 && !o.btr && !slcan::bitrate_code(o.bitrate))
+        throw InvalidArgument("slcan bitrate: " + std::to_string(o.bitrate) +
+                              " has no Sn code (10k 20k 50k 100k 125k 250k 500k 750k/800k 1M); "
+                              "use btr for other rates, or 0 to keep the adapter's rate");
+    if (o.tx_window == 0) throw InvalidArgument("slcan tx_window: must be >= 1");
+    const std::pair<const char*, Duration> durations[] = {
+        {"ack_timeout", o.ack_timeout},   {"open_timeout", o.open_timeout},
+        {"status_poll", o.status_poll},   {"partial_line_timeout", o.partial_line_timeout},
+        {"echo_window", o.echo_window},   {"tx_coalesce", o.tx_coalesce},
+        {"reconnect_min", o.reconnect_min}, {"reconnect_max", o.reconnect_max}};
+    for (const auto& [name, d] : durations)
+        if (d.count() < 0) throw InvalidArgument(std::string("slcan ") + name + ": must be >= 0");
+    if (o.reconnect_min > o.reconnect_max)
+        throw InvalidArgument("slcan reconnect_min: longer than reconnect_max");
+    check_options(o.bus, "slcan");
+}
+
 SlcanBus::SlcanBus(std::shared_ptr<serial::Port> port, SlcanOptions options, PortFactory reconnect)
     : Bus(port ? "slcan:" + port->name() : "slcan", options.bus),
       opts_(std::move(options)),
       factory_(std::move(reconnect)) {
     if (!port) throw InvalidArgument("slcan: no port");
-    if (opts_.bitrate != 0 && !opts_.btr && !slcan::bitrate_code(opts_.bitrate))
-        throw InvalidArgument("slcan bitrate: " + std::to_string(opts_.bitrate) +
-                              " has no Sn code (10k 20k 50k 100k 125k 250k 500k 750k/800k 1M); "
-                              "use btr for other rates");
-    if (opts_.tx_window == 0) throw InvalidArgument("slcan tx_window: must be >= 1");
+    check_options(opts_);
     if (auto* tty = dynamic_cast<serial::TtyPort*>(port.get()))
         tty->set_write_timeout(std::chrono::seconds(2));
     try {

@@ -60,6 +60,10 @@ struct SlcanOptions {
     BusOptions bus;
 };
 
+// Throws InvalidArgument naming the field: a bit rate with no Sn code (and no
+// btr), an empty tx window, a negative duration, reconnect_min > reconnect_max.
+void check_options(const SlcanOptions& options);
+
 struct SlcanStats {
     std::uint64_t acks = 0;               // CR / z / Z answering a command
     std::uint64_t nacks = 0;              // BEL answering a command (or unsolicited)

@@ -9,6 +9,27 @@ namespace motorbus::can {
 using slcan::Command;
 using slcan::CommandKind;
 
+namespace {
+// `V1013` / `NMB01`: the command letter then 4 printable characters; anything
+// else would break the reply framing (a CR) or what SLCAN tools parse.
+void check_identity_field(const std::string& value, char letter, const char* field) {
+    bool ok = value.size() == 5 && value[0] == letter;
+    for (std::size_t i = 1; ok && i < value.size(); ++i)
+        ok = value[i] > 0x20 && value[i] < 0x7F;
+    if (!ok)
+        throw InvalidArgument(std::string("SlcanServer ") + field + ": '" + value + "', must be '" + letter +
+                              "' followed by 4 printable characters (the adapter's reply)");
+}
+}  // namespace
+
+void check_options(const SlcanServerOptions& o) {
+    if (o.queue_size == 0) throw InvalidArgument("SlcanServer queue_size: must be >= 1");
+    if (o.bus_send_timeout.count() < 0) throw InvalidArgument("SlcanServer bus_send_timeout: must be >= 0");
+    if (o.write_timeout.count() < 0) throw InvalidArgument("SlcanServer write_timeout: must be >= 0");
+    check_identity_field(o.identity.version, 'V', "version");
+    check_identity_field(o.identity.serial, 'N', "serial_number");
+}
+
 SlcanServer::SlcanServer(std::shared_ptr<Bus> bus, SlcanServerOptions options)
     : bus_(std::move(bus)), opts_(std::move(options)), session_(opts_.identity) {
     if (!bus_) throw InvalidArgument("SlcanServer: no bus");
@@ -27,7 +48,7 @@ SlcanServer::SlcanServer(std::shared_ptr<Bus> bus, std::shared_ptr<serial::Port>
 }
 
 void SlcanServer::start() {
-    if (opts_.queue_size == 0) throw InvalidArgument("SlcanServer queue_size: must be >= 1");
+    check_options(opts_);
     if (auto* tty = dynamic_cast<serial::TtyPort*>(port_.get())) tty->set_write_timeout(opts_.write_timeout);
     queue_.reserve(1024);
     sub_ = bus_->subscribe(Filter{}, [this](const Frame& f) { on_bus_frame(f); });

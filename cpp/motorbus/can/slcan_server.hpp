@@ -31,6 +31,11 @@ struct SlcanServerOptions {
     Duration write_timeout = std::chrono::seconds(1);  // peer not reading: drop the batch
 };
 
+// Throws InvalidArgument naming the field: queue_size 0, a negative duration,
+// an identity the V/N replies cannot carry (V or N and exactly 4 printable
+// characters, as an adapter answers).
+void check_options(const SlcanServerOptions& options);
+
 struct SlcanServerStats {
     std::uint64_t commands = 0;
     std::uint64_t invalid_commands = 0;   // answered BEL because malformed/unknown/refused

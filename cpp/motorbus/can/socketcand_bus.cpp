@@ -47,6 +47,22 @@ void write_all(int fd, const std::string& s, Deadline deadline) {
 
 }  // namespace
 
+void check_options(const SocketcandOptions& o) {
+    if (o.keepalive_misses < 1) throw InvalidArgument("keepalive_misses: must be >= 1");
+    if (o.tx_buffer_bytes == 0)
+        throw InvalidArgument("tx_buffer_bytes: 0, must be >= 1 (unsent bytes before send() waits)");
+    if (o.max_element < socketcand::kMinMaxElement || o.max_element > socketcand::kMaxMaxElement)
+        throw InvalidArgument("max_element: " + std::to_string(o.max_element) + ", must be " +
+                              std::to_string(socketcand::kMinMaxElement) + "-" +
+                              std::to_string(socketcand::kMaxMaxElement) + " bytes (a frame element must fit)");
+    const std::pair<const char*, Duration> durations[] = {{"connect_timeout", o.connect_timeout},
+                                                          {"handshake_timeout", o.handshake_timeout},
+                                                          {"keepalive_period", o.keepalive_period}};
+    for (const auto& [name, d] : durations)
+        if (d.count() < 0) throw InvalidArgument(std::string(name) + ": must be >= 0");
+    check_options(static_cast<const BusOptions&>(o), "socketcand");
+}
+
 SocketcandBus::SocketcandBus(const std::string& host, std::uint16_t port, const std::string& channel,
                              const SocketcandOptions& options)
     : Bus("socketcand:" + host + ":" + std::to_string(port) + "/" + channel, options),
@@ -54,12 +70,8 @@ SocketcandBus::SocketcandBus(const std::string& host, std::uint16_t port, const 
       host_(host),
       port_(port),
       parser_(options.max_element) {
-    if (channel.empty() || channel.size() > socketcand::kMaxChannelName)
-        throw InvalidArgument("socketcand channel: '" + channel + "' must be 1-16 characters");
-    for (char c : channel)
-        if (c == '<' || c == '>' || c == ' ' || static_cast<unsigned char>(c) < 0x21)
-            throw InvalidArgument("socketcand channel: '" + channel + "' contains a blank or < >");
-    if (options.keepalive_misses < 1) throw InvalidArgument("keepalive_misses: must be >= 1");
+    socketcand::check_channel_name(channel, "socketcand channel");
+    check_options(options);
     sock_ = net::tcp_connect(host, port, deadline_after(options.connect_timeout));
     net::set_nodelay(sock_.get());
     if (options.tcp_keepalive) {

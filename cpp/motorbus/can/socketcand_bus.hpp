@@ -37,6 +37,11 @@ struct SocketcandOptions : BusOptions {
     std::size_t max_element = socketcand::kDefaultMaxElement;
 };
 
+// Throws InvalidArgument naming the field: keepalive_misses < 1, an empty
+// transmit buffer (every send() would wait for room that never comes), a
+// max_element a frame element cannot fit in, a negative duration.
+void check_options(const SocketcandOptions& options);
+
 class SocketcandBus final : public Bus {
 public:
     // Connects and completes the handshake (< hi >, < open CHANNEL >, < ok >,

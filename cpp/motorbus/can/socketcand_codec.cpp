@@ -1,4 +1,5 @@
 #include "motorbus/can/socketcand_codec.hpp"
+#include "motorbus/errors.hpp"
 
 #include <algorithm>
 #include <array>
@@ -468,6 +469,15 @@ const char* parse_element(std::string_view element, Element& out) {
     out.kind = ElementKind::Unknown;
     out.text.assign(word.substr(0, 32));
     return nullptr;
+}
+
+void check_channel_name(const std::string& channel, const char* field) {
+    if (channel.empty() || channel.size() > socketcand::kMaxChannelName)
+        throw InvalidArgument(std::string(field) + ": '" + channel + "' must be 1-16 characters");
+    for (char c : channel)
+        if (c == '<' || c == '>' || c == ' ' || static_cast<unsigned char>(c) < 0x21 ||
+            static_cast<unsigned char>(c) == 0x7F)
+            throw InvalidArgument(std::string(field) + ": '" + channel + "' contains a blank, a control character or < >");
 }
 
 ElementParser::ElementParser(std::size_t max_element)

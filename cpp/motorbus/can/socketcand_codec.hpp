@@ -71,6 +71,14 @@ struct ParserStats {
 // 64 space-separated bytes (~230 chars); socketcand itself allows 8290, python-can 200.
 constexpr std::size_t kDefaultMaxElement = 1024;
 constexpr std::size_t kMaxChannelName = 16;  // protocol.md: "at maximum 16 characters"
+// The range accepted for a max_element option: the longest frame element
+// (`< frame 1FFFFFFF 4294967295.999999 0011223344556677 >`, 55 bytes) must fit.
+constexpr std::size_t kMinMaxElement = 64;
+constexpr std::size_t kMaxMaxElement = 65535;
+// A channel (bus) name a socketcand peer can open: 1-16 printable characters, no
+// blank and no < or > (they would end the `< open name >` element).  Throws
+// InvalidArgument naming `field`.
+void check_channel_name(const std::string& channel, const char* field);
 
 // Parses one complete element, `<` through `>` inclusive.  Returns the reason
 // on failure (the element is then empty/undefined).

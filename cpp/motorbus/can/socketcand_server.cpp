@@ -62,12 +62,27 @@ struct SocketcandServer::Conn {
     bool closing = false;               // close once `out` is flushed
 };
 
+void check_options(const SocketcandServerOptions& o) {
+    if (o.max_clients == 0) throw InvalidArgument("max_clients: 0, must be >= 1 (0 would refuse every client)");
+    if (o.client_queue == 0) throw InvalidArgument("client_queue: must be >= 1");
+    if (!o.channel.empty()) socketcand::check_channel_name(o.channel, "channel");  // empty = any name
+    if (o.max_element < socketcand::kMinMaxElement || o.max_element > socketcand::kMaxMaxElement)
+        throw InvalidArgument("max_element: " + std::to_string(o.max_element) + ", must be " +
+                              std::to_string(socketcand::kMinMaxElement) + "-" +
+                              std::to_string(socketcand::kMaxMaxElement) + " bytes");
+    const std::pair<const char*, Duration> durations[] = {{"idle_timeout", o.idle_timeout},
+                                                          {"element_timeout", o.element_timeout},
+                                                          {"open_timeout", o.open_timeout},
+                                                          {"bus_send_budget", o.bus_send_budget}};
+    for (const auto& [name, d] : durations)
+        if (d.count() < 0) throw InvalidArgument(std::string(name) + ": must be >= 0");
+    if (o.socket_send_buffer < 0) throw InvalidArgument("socket_send_buffer: must be >= 0 (0 = kernel default)");
+}
+
 SocketcandServer::SocketcandServer(std::shared_ptr<Bus> bus, SocketcandServerOptions options)
     : bus_(std::move(bus)), opts_(std::move(options)) {
     if (!bus_) throw InvalidArgument("SocketcandServer: bus is null");
-    if (opts_.client_queue == 0) throw InvalidArgument("client_queue: must be >= 1");
-    if (opts_.channel.size() > socketcand::kMaxChannelName)
-        throw InvalidArgument("channel: longer than 16 characters");
+    check_options(opts_);
     listen_ = net::tcp_listen(opts_.host, opts_.port, port_);
     wall_offset_ns_ = realtime_ns() - monotonic_ns();
     io_thread_ = std::thread([this] { io_loop(); });

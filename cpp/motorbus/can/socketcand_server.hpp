@@ -49,6 +49,11 @@ struct SocketcandServerOptions {
     int socket_send_buffer = 0;  // SO_SNDBUF for client sockets in bytes; 0 = kernel default
 };
 
+// Throws InvalidArgument naming the field: max_clients or client_queue 0, a
+// channel name no client could open, a max_element out of range, a negative
+// duration or send buffer.
+void check_options(const SocketcandServerOptions& options);
+
 struct SocketcandServerStats {
     std::uint64_t clients_accepted = 0;
     std::uint64_t clients_active = 0;

@@ -1,6 +1,7 @@
 #include "motorbus/can/virtual_bus.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -207,18 +208,6 @@ private:
 };
 
 namespace {
-void check_faults(const FaultOptions& f) {
-    auto prob = [](const char* name, double p) {
-        if (!(p >= 0.0 && p <= 1.0))  // NaN fails both
-            throw InvalidArgument(std::string("virtual bus faults ") + name + ": " + std::to_string(p) +
-                                  ", must be in [0, 1]");
-    };
-    prob("drop_probability", f.drop_probability);
-    prob("corrupt_probability", f.corrupt_probability);
-    if (f.delay_ns < 0)
-        throw InvalidArgument("virtual bus faults delay: " + std::to_string(f.delay_ns) + " ns, must be >= 0");
-}
-
 std::mutex g_hubs_mutex;
 std::map<std::string, std::weak_ptr<VirtualHub>> g_hubs;
 }  // namespace
@@ -330,7 +319,7 @@ void VirtualBus::enqueue_rx(const Frame& f) {
 }
 
 void VirtualBus::set_faults(const FaultOptions& f) {
-    check_faults(f);
+    check_options(f);
     std::lock_guard lock(impl_->mutex);
     impl_->faults = f;
     impl_->rng.seed(f.seed);
@@ -380,14 +369,32 @@ void VirtualBus::do_send(const Frame& frame, Deadline deadline) {
                            std::to_string(impl_->opts.tx_queue) + " frames waiting for the wire)");
 }
 
-std::shared_ptr<VirtualBus> open_virtual(const std::string& name, const VirtualOptions& opts) {
-    if (name.empty()) throw InvalidArgument("virtual bus name: must not be empty");
-    if (opts.bitrate < 0) throw InvalidArgument("virtual bus bitrate: must be >= 0");
+void check_options(const FaultOptions& f) {
+    auto prob = [](const char* name, double p) {
+        if (!(p >= 0.0 && p <= 1.0))  // NaN fails both
+            throw InvalidArgument(std::string("virtual bus faults ") + name + ": " + std::to_string(p) +
+                                  ", must be in [0, 1]");
+    };
+    prob("drop_probability", f.drop_probability);
+    prob("corrupt_probability", f.corrupt_probability);
+    if (f.delay_ns < 0)
+        throw InvalidArgument("virtual bus faults delay: " + std::to_string(f.delay_ns) + " ns, must be >= 0");
+}
+
+void check_options(const VirtualOptions& opts) {
+    if (!(opts.bitrate >= 0) || std::isinf(opts.bitrate))  // NaN fails the comparison
+        throw InvalidArgument("virtual bus bitrate: " + std::to_string(opts.bitrate) +
+                              ", must be a finite number >= 0 (0 = no wire time)");
     if (opts.rx_spin.count() < 0) throw InvalidArgument("virtual bus rx_spin: must be >= 0");
     if (opts.tx_queue == 0) throw InvalidArgument("virtual bus tx_queue: 0, must be >= 1 (frames waiting for the wire)");
     if (opts.rx_queue_size == 0)
         throw InvalidArgument("virtual bus rx_queue_size: 0, must be >= 1 (frames kept for recv())");
-    check_faults(opts.faults);
+    check_options(opts.faults);
+}
+
+std::shared_ptr<VirtualBus> open_virtual(const std::string& name, const VirtualOptions& opts) {
+    if (name.empty()) throw InvalidArgument("virtual bus name: must not be empty");
+    check_options(opts);
     std::shared_ptr<VirtualHub> hub;
     {
         std::lock_guard lock(g_hubs_mutex);

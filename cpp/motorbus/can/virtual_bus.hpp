@@ -35,6 +35,11 @@ struct VirtualOptions : BusOptions {
     std::chrono::microseconds rx_spin{20};
 };
 
+// Throw InvalidArgument naming the field for values no virtual bus can work with
+// (a probability outside [0, 1], a negative delay or bitrate, an empty queue).
+void check_options(const FaultOptions& faults);
+void check_options(const VirtualOptions& options);
+
 class VirtualHub;
 
 class VirtualBus final : public Bus {

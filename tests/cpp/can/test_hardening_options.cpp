@@ -9,6 +9,10 @@
 
 #include "../invalid_message.hpp"
 #include "motorbus/can/external_bus.hpp"
+#include "motorbus/can/slcan_bus.hpp"
+#include "motorbus/can/slcan_server.hpp"
+#include "motorbus/can/socketcand_bus.hpp"
+#include "motorbus/can/socketcand_server.hpp"
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/errors.hpp"
 
@@ -74,4 +78,65 @@ TEST(HardeningOptions, FaultProbabilitiesOutsideZeroOneRefused) {
     ok.drop_probability = 1.0;
     ok.corrupt_probability = 0.0;
     EXPECT_NO_THROW(bus->set_faults(ok));
+}
+
+// C3-C7 of docs/reliability.md: options that were accepted and left an object
+// that could never work.  check_options() is what every constructor calls.
+TEST(HardeningOptions, SocketcandClientOptionsRefusedByName) {
+    SocketcandOptions o;
+    o.tx_buffer_bytes = 0;  // C3: send() would wait for room forever
+    EXPECT_NE(invalid_message([&] { check_options(o); }).find("tx_buffer_bytes"), std::string::npos);
+    o = {};
+    o.max_element = 10;  // no frame element fits
+    EXPECT_NE(invalid_message([&] { check_options(o); }).find("max_element"), std::string::npos);
+    o = {};
+    o.keepalive_period = -std::chrono::seconds(1);
+    EXPECT_NE(invalid_message([&] { check_options(o); }).find("keepalive_period"), std::string::npos);
+    o = {};
+    o.rx_queue_size = 0;
+    EXPECT_NE(invalid_message([&] { check_options(o); }).find("rx_queue_size"), std::string::npos);
+    EXPECT_NO_THROW(check_options(SocketcandOptions{}));
+}
+
+TEST(HardeningOptions, SocketcandServerOptionsRefusedByName) {
+    SocketcandServerOptions o;
+    o.max_clients = 0;  // C5
+    EXPECT_NE(invalid_message([&] { check_options(o); }).find("max_clients"), std::string::npos);
+    for (const char* bad : {"a b", "a<b", "tab\there", "seventeen-chars-x"}) {  // C6
+        o = {};
+        o.channel = bad;
+        EXPECT_NE(invalid_message([&] { check_options(o); }).find("channel"), std::string::npos) << bad;
+    }
+    o = {};
+    o.channel = "";  // = accept any name
+    EXPECT_NO_THROW(check_options(o));
+    o.channel = "can0";
+    EXPECT_NO_THROW(check_options(o));
+}
+
+TEST(HardeningOptions, SlcanServerIdentityMustFitTheReplies) {
+    SlcanServerOptions o;
+    EXPECT_NO_THROW(check_options(o));  // V1013 / NMB01
+    for (const char* bad : {"toolong-version", "V12", "X1013", "V10\r3", ""}) {  // C7
+        o = {};
+        o.identity.version = bad;
+        EXPECT_NE(invalid_message([&] { check_options(o); }).find("version"), std::string::npos) << bad;
+    }
+    o = {};
+    o.identity.serial = "toolong-serial";
+    EXPECT_NE(invalid_message([&] { check_options(o); }).find("serial_number"), std::string::npos);
+}
+
+TEST(HardeningOptions, SlcanClientOptionsRefusedByName) {
+    SlcanOptions o;
+    o.bitrate = 0;  // documented: keep the adapter's rate
+    EXPECT_NO_THROW(check_options(o));
+    o.bitrate = 83333;
+    EXPECT_NE(invalid_message([&] { check_options(o); }).find("bitrate"), std::string::npos);
+    o = {};
+    o.reconnect_min = std::chrono::seconds(10);
+    EXPECT_NE(invalid_message([&] { check_options(o); }).find("reconnect_min"), std::string::npos);
+    o = {};
+    o.ack_timeout = -std::chrono::milliseconds(1);
+    EXPECT_NE(invalid_message([&] { check_options(o); }).find("ack_timeout"), std::string::npos);
 }

@@ -154,6 +154,20 @@ TEST(SlcanBus, OpenSequenceIsCloseBitrateTimestampsOpen) {
     EXPECT_TRUE(eventually([&] { return adapter.lines().size() == 5 && adapter.lines().back() == "C"; }));
 }
 
+// bitrate 0 is the documented "keep the adapter's rate": no S command at all.
+TEST(SlcanBus, BitrateZeroKeepsTheAdaptersRate) {
+    serial::PtyPair pty;
+    ScriptedAdapter adapter(pty.port(), [](const std::string& l) { return lawicel(l); });
+    auto opts = fast_opts();
+    opts.bitrate = 0;
+    SlcanBus bus(pty.open_slave(), opts);
+    auto lines = adapter.lines();
+    ASSERT_EQ(lines.size(), 2u);
+    EXPECT_EQ(lines[0], "C");
+    EXPECT_EQ(lines[1], "O");
+    bus.close();
+}
+
 TEST(SlcanBus, OpenFailsWithTypedErrors) {
     serial::PtyPair pty;
     {
