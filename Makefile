@@ -50,7 +50,7 @@ sanitize: deps
 	bash tools/sanitize.sh $(PY)
 
 fuzz: deps
-	bash tools/fuzz.sh run 60
+	bash tools/fuzz.sh runs 10000000
 
 fuzz-smoke: deps
 	bash tools/fuzz.sh run 5

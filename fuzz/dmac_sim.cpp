@@ -23,6 +23,7 @@ bool data_len_odd(std::size_t size) { return (size & 1u) != 0; }
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     auto clock = std::make_shared<SimClock>();
     SimOptions options{.address = 1};
+    options.line_delay_in_real_time = false;  // no wire: 3 ms per reply would be the whole run
     // End-stop switches on the axis, so HARD_ENDS stops at switch edges get fuzzed too.
     options.positive_end_switch = motion::SwitchConfig{true, 20000, 0, false};
     options.negative_end_switch = motion::SwitchConfig{true, -20000, 0, data_len_odd(size)};

@@ -1002,7 +1002,8 @@ std::string DmacSim::on_line(std::string_view line) {
     // #LINE_DELAY (5.13): the module waits that long after the end of the
     // command before it answers.  A wire-level delay, so real time whatever
     // the device clock is; taken outside the lock.
-    if (!reply.empty() && delay_us > 0) std::this_thread::sleep_for(std::chrono::microseconds(delay_us));
+    if (!reply.empty() && delay_us > 0 && options_.line_delay_in_real_time)
+        std::this_thread::sleep_for(std::chrono::microseconds(delay_us));
     return reply;
 }
 

@@ -64,6 +64,10 @@ struct SimOptions {
     motion::SwitchConfig negative_end_switch{false, 0, 0, false};
     // A reference switch on IN5 (REFERENCE, CAPTURE): active on [lo, hi).
     motion::SwitchConfig reference_switch{false, 0, 0, false};
+    // #LINE_DELAY is a wire-level wait before each reply, so it is real time
+    // whatever the device clock is.  A caller with no wire (the fuzz target,
+    // which runs the line handler thousands of times a second) turns it off.
+    bool line_delay_in_real_time = true;
 };
 
 // Snapshot of what a test usually asserts on.
