@@ -257,8 +257,7 @@ void bind_can(py::module_& m) {
     }, py::arg("path"), "Reads a candump (.log) or ASC (.asc) file: (entries, bad_line_count).");
     m.def("parse_candump_line", &parse_candump_line, py::arg("line"));
     m.def("play", [](Bus& bus, const std::vector<LogEntry>& entries, double speed) {
-        py::gil_scoped_release nogil;
-        return play(bus, entries, speed);
+        return motorbus::py_helpers::blocking_call([&] { return play(bus, entries, speed); });  // Ctrl-C stops it
     }, py::arg("bus"), py::arg("entries"), py::arg("speed") = 1.0,
        "Replays entries onto bus: speed 1.0 = original timing, 0 = as fast as possible.");
 }

@@ -1,6 +1,7 @@
 // Bindings for cpp/motorbus/runtime: clocks.
 #include <pybind11/pybind11.h>
 
+#include "common.hpp"
 #include "motorbus/runtime/clock.hpp"
 
 namespace py = pybind11;
@@ -20,8 +21,9 @@ void bind_runtime(py::module_& m) {
     m.def("monotonic_ns", &monotonic_ns, "The monotonic clock frame timestamps use (ns).");
     py::class_<Clock, std::shared_ptr<Clock>>(m, "Clock")
         .def("now", &Clock::now, "Current time in ns.")
-        .def("sleep_until", &Clock::sleep_until, py::arg("t_ns"),
-             py::call_guard<py::gil_scoped_release>())
+        .def("sleep_until",
+             [](Clock& c, Nanos t) { return motorbus::py_helpers::blocking_call([&] { return c.sleep_until(t); }); },
+             py::arg("t_ns"), "Wait until clock time t_ns; False if cancel() ended the wait. Ctrl-C interrupts.")
         .def("cancel", &Clock::cancel)
         .def_property_readonly("simulated", &Clock::simulated);
     py::class_<RealClock, Clock, std::shared_ptr<RealClock>>(m, "RealClock").def(py::init<>());

@@ -17,6 +17,7 @@ using motorbus::py_helpers::seconds_to_ns;
 using motorbus::py_helpers::arg_cast;
 using motorbus::py_helpers::not_none;
 using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::blocking_call;
 using motorbus::py_helpers::finite_forever;
 using motorbus::py_helpers::Forever;
 
@@ -101,18 +102,17 @@ void bind_slcan(py::module_& m) {
     py::class_<SlcanBus, Bus, std::shared_ptr<SlcanBus>>(
         m, "SlcanBus", "A CAN bus through an SLCAN (Lawicel) adapter on a serial port.")
         .def("flush_tx",
-             [](SlcanBus& b, double timeout) {
-                 auto t = duration_arg(timeout, "timeout");  // finite: these core waits are not interruptible
-                 py::gil_scoped_release nogil;
-                 b.flush_tx(t);
+             [](SlcanBus& b, const py::object& timeout) {
+                 auto t = finite_forever(duration_arg(timeout, "timeout", Forever::Allowed));
+                 blocking_call([&] { b.flush_tx(t); });
              },
              py::arg("timeout") = 1.0,
-             "Wait until the adapter answered every command; ProtocolError if it refused frames.")
+             "Wait until the adapter answered every command (None = forever; Ctrl-C interrupts); "
+             "ProtocolError if it refused frames.")
         .def("query_status",
-             [](SlcanBus& b, double timeout) {
-                 auto t = duration_arg(timeout, "timeout");  // finite: these core waits are not interruptible
-                 py::gil_scoped_release nogil;
-                 return b.query_status(t);
+             [](SlcanBus& b, const py::object& timeout) {
+                 auto t = finite_forever(duration_arg(timeout, "timeout", Forever::Allowed));
+                 return blocking_call([&] { return b.query_status(t); });
              },
              py::arg("timeout") = 1.0, "Send `F`, return the status flags (bus state is updated).")
         .def_property_readonly("stats", &SlcanBus::stats, "SlcanStats (a snapshot)")

@@ -17,6 +17,9 @@ namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::arcus;
 using motorbus::py_helpers::Record;
+using motorbus::py_helpers::blocking_call;
+using motorbus::py_helpers::duration_arg;
+using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::seconds_to_ns;
 
 namespace {
@@ -93,7 +96,7 @@ SimOptions sim_options(int address, int response_type, const std::string& store_
     o.world.z_position = z_position;
     o.world.start_position = start_position;
     if (!(tick > 0) || tick > 1) throw InvalidArgument("tick: must be in (0, 1] seconds");
-    o.tick_ns = static_cast<std::int64_t>(tick * 1e9);
+    o.tick_ns = duration_arg(tick, "tick").count();
     return o;
 }
 
@@ -363,10 +366,10 @@ void bind_arcus(py::module_& m) {
         .def_property("limit_correction", get(&C::limit_correction), put(&C::set_limit_correction))
         .def(
             "wait_idle",
-            [](C& cl, const py::object& timeout, double poll) {
-                auto t = seconds_to_ns(timeout);
-                py::gil_scoped_release nogil;
-                cl.wait_idle(t, std::chrono::nanoseconds(static_cast<std::int64_t>(poll * 1e9)));
+            [](C& cl, const py::object& timeout, const py::object& poll) {
+                auto t = duration_arg(timeout, "timeout", Forever::Allowed);  // None/inf = forever
+                auto p = duration_arg(poll, "poll");
+                blocking_call([&] { cl.wait_idle(t, p); });  // Ctrl-C interrupts the polling
             },
             py::arg("timeout"), py::arg("poll") = 0.005)
         .def_property("enabled", get(&C::enabled), put(&C::enable))

@@ -401,13 +401,14 @@ void bind_dmac(py::module_& m) {
         .def("set_address", &C::set_address, py::arg("address"), rel)
         .def("set_baudrate", &C::set_baudrate, py::arg("baud"), rel)
         .def("request_version", &C::request_version, rel, "REQUEST_VERSION, parsed into a DmacVersionInfo.")
-        .def("wait_idle", [](C& c, double timeout, double poll) {
-            auto t = motorbus::py_helpers::seconds_to_ns(py::float_(timeout));
-            auto p = motorbus::py_helpers::seconds_to_ns(py::float_(poll));
-            py::gil_scoped_release nogil;
-            return c.wait_idle(t, p);
+        .def("wait_idle", [](C& c, const py::object& timeout, const py::object& poll) {
+            using namespace motorbus::py_helpers;
+            auto t = duration_arg(timeout, "timeout", Forever::Allowed);
+            auto p = duration_arg(poll, "poll");
+            return blocking_call([&] { return c.wait_idle(t, p); });
         }, py::arg("timeout"), py::arg("poll") = 0.01,
-             "Polls #STATUS until not busy; returns the position. TimeoutError after `timeout` s.")
+             "Polls #STATUS until not busy; returns the position. TimeoutError after `timeout` s "
+             "(None = wait forever; Ctrl-C interrupts).")
         .def("upload_sequence", &C::upload_sequence, py::arg("lines"), py::arg("first") = 1,
              py::arg("verify_readback") = true, rel)
         .def("read_sequence_line", &C::read_sequence_line, py::arg("n"), rel)

@@ -40,7 +40,9 @@ class Clock:
         Current time in ns.
         """
     def sleep_until(self, t_ns: typing.SupportsInt | typing.SupportsIndex) -> bool:
-        ...
+        """
+        Wait until clock time t_ns; False if cancel() ended the wait. Ctrl-C interrupts.
+        """
     @property
     def simulated(self) -> bool:
         ...
@@ -549,11 +551,11 @@ class SlcanBus(Bus):
     """
     A CAN bus through an SLCAN (Lawicel) adapter on a serial port.
     """
-    def flush_tx(self, timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> None:
+    def flush_tx(self, timeout: typing.Any = 1.0) -> None:
         """
-        Wait until the adapter answered every command; ProtocolError if it refused frames.
+        Wait until the adapter answered every command (None = forever; Ctrl-C interrupts); ProtocolError if it refused frames.
         """
-    def query_status(self, timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> int:
+    def query_status(self, timeout: typing.Any = 1.0) -> int:
         """
         Send `F`, return the status flags (bus state is updated).
         """
@@ -3051,7 +3053,7 @@ class ArcusClientBase:
         ...
     def sync_on(self) -> None:
         ...
-    def wait_idle(self, timeout: typing.Any, poll: typing.SupportsFloat | typing.SupportsIndex = 0.005) -> None:
+    def wait_idle(self, timeout: typing.Any, poll: typing.Any = 0.005) -> None:
         ...
     @property
     def _latch_status_raw(self) -> int:
@@ -3715,9 +3717,9 @@ class DmacClient:
         ...
     def user_var(self, n: typing.SupportsInt | typing.SupportsIndex) -> int:
         ...
-    def wait_idle(self, timeout: typing.SupportsFloat | typing.SupportsIndex, poll: typing.SupportsFloat | typing.SupportsIndex = 0.01) -> int:
+    def wait_idle(self, timeout: typing.Any, poll: typing.Any = 0.01) -> int:
         """
-        Polls #STATUS until not busy; returns the position. TimeoutError after `timeout` s.
+        Polls #STATUS until not busy; returns the position. TimeoutError after `timeout` s (None = wait forever; Ctrl-C interrupts).
         """
     def write(self, variable: str, value: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...

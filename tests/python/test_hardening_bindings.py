@@ -44,6 +44,26 @@ BLOCKING = {
                                "h = _core.Cia402Host(c, 5, timeout=1e6); ready(); h.wait_statusword(0xffff, 0x1234, None)"),
     "nmt_wait_for_boot": "b = _core.open_virtual('sig'); m = _core.NmtMaster(b); ready(); m.wait_for_boot(5, None)",
     "emcy_wait": "b = _core.open_virtual('sig'); e = _core.EmcyConsumer(b); ready(); e.wait(0, None)",
+    # Vendor clients poll the drive; every poll is an interruption point (timeout None = forever).
+    "arcus_wait_idle": ("from motorbus.drives.arcus import make_sim, ArcusClient, open_line; "
+                        "s = _core.PtyLineServer([make_sim('01')], 0, None); "
+                        "c = ArcusClient(open_line(s.slave_path, baud=0, timeout=0.5), 1); "
+                        "c.enable(); c.jog(1); ready(); c.wait_idle(None)"),
+    "dmac_wait_idle": ("from motorbus.drives.dmac import make_sim, DmacClient, open_line; "
+                       "s = _core.PtyLineServer([make_sim('00')], 0, None); "
+                       "c = DmacClient(open_line(s.slave_path, baud=38400, timeout=0.5), address=0); "
+                       "c.brake(False); c.move_speed(20000); ready(); c.wait_idle(None)"),
+    # An SLCAN adapter that acknowledges the open sequence and then goes silent.
+    "slcan_query_status": ("import threading; p = _core.PtyPair(); "
+                           "threading.Thread(target=lambda: [p.port.write(b'\\r') for _ in range(3) "
+                           "if p.port.read(64, 5.0)], daemon=True).start(); "
+                           "b = motorbus.slcan.open_slcan(p.slave_path, bitrate=0); ready(); b.query_status(None)"),
+    "clock_sleep_until": "c = _core.RealClock(); ready(); c.sleep_until(c.now() + 10**12)",
+    "sim_clock_sleep_until": "c = _core.SimClock(); ready(); c.sleep_until(10**9)",
+    "log_play": ("b = _core.open_virtual('sig'); "
+                 "import tempfile, os; f = tempfile.NamedTemporaryFile('w', suffix='.log', delete=False); "
+                 "f.write('(0.000000) vcan0 123#01\\n(1000.000000) vcan0 123#02\\n'); f.close(); "
+                 "e, _ = _core.read_log(f.name); os.unlink(f.name); ready(); _core.play(b, e)"),
     "socketcand_recv": ("b = _core.open_virtual('sig'); s = _core.SocketcandServer(b, channel='can0'); "
                         "c = _core.open_socketcand('127.0.0.1', s.port, 'can0'); ready(); c.recv(None)"),
 }

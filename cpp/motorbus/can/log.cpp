@@ -1,5 +1,6 @@
 #include "motorbus/can/log.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <thread>
 
 #include "motorbus/errors.hpp"
+#include "motorbus/runtime/interrupt.hpp"
 
 namespace motorbus::can {
 
@@ -415,8 +417,11 @@ std::size_t play(Bus& bus, const std::vector<LogEntry>& entries, double speed, D
     for (const auto& e : entries) {
         if (speed > 0) {
             // Absolute schedule from the first frame: no drift accumulates.
-            const double offset = std::max(0.0, (e.time - first) / speed);
-            std::this_thread::sleep_until(t0 + std::chrono::nanoseconds(static_cast<std::int64_t>(offset * 1e9)));
+            // Clamped to a year: a log's timestamps are data (a corrupt one must not
+            // overflow the conversion), and a gap that long is never meant literally.
+            const double offset = std::clamp((e.time - first) / speed, 0.0, 365.0 * 86400.0);
+            const auto due = t0 + std::chrono::nanoseconds(static_cast<std::int64_t>(offset * 1e9));
+            interruptible_sleep_for(due - std::chrono::steady_clock::now());  // Ctrl-C from Python
         }
         if (bus.closed()) break;
         Frame f = e.frame;

@@ -4,6 +4,7 @@
 #include <array>
 
 #include "motorbus/errors.hpp"
+#include "motorbus/runtime/interrupt.hpp"
 
 namespace motorbus::can {
 
@@ -250,7 +251,7 @@ void SlcanBus::write_command(const std::string& text, char kind, Deadline deadli
 
 void SlcanBus::flush_tx(Duration timeout) {
     std::unique_lock lock(mutex_);
-    if (!cv_.wait_for(lock, timeout, [&] {
+    if (!interruptible_wait_for(cv_, lock, timeout, [&] {
             return stop_ || !link_up_ || (pending_.empty() && txbuf_.empty() && !writing_);
         }))
         throw TimeoutError("slcan " + channel() + ": " + std::to_string(pending_.size()) +
@@ -278,7 +279,7 @@ std::uint8_t SlcanBus::query_status(Duration timeout) {
     const auto deadline = deadline_after(timeout);
     write_command("F", 'F', deadline);
     std::unique_lock lock(mutex_);
-    if (!cv_.wait_until(lock, deadline, [&] { return stop_ || stats_.status_replies != before; }))
+    if (!interruptible_wait_until(cv_, lock, deadline, [&] { return stop_ || stats_.status_replies != before; }))
         throw TimeoutError("slcan " + channel() + ": no answer to 'F'");
     if (stop_) throw ClosedError("slcan " + channel() + " is closed");
     return stats_.last_status;

@@ -1,11 +1,14 @@
 #include "motorbus/runtime/clock.hpp"
 
+#include "motorbus/runtime/interrupt.hpp"
+
 namespace motorbus {
 
 bool RealClock::sleep_until(Nanos t) {
     std::unique_lock lock(mutex_);
     auto deadline = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(t));
-    cv_.wait_until(lock, deadline, [&] { return cancelled_; });
+    // Interruptible: a Python caller (sleep_until from the bindings) gets Ctrl-C.
+    interruptible_wait_until(cv_, lock, deadline, [&] { return cancelled_; });
     return !cancelled_;
 }
 
@@ -24,7 +27,8 @@ Nanos SimClock::now() const {
 
 bool SimClock::sleep_until(Nanos t) {
     std::unique_lock lock(mutex_);
-    cv_.wait(lock, [&] { return cancelled_ || now_ >= t; });
+    interruptible_wait_until(cv_, lock, std::chrono::steady_clock::time_point::max(),
+                             [&] { return cancelled_ || now_ >= t; });
     return !cancelled_;
 }
 

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <thread>
 
+#include "motorbus/runtime/interrupt.hpp"
+
 namespace motorbus::arcus {
 
 namespace {
@@ -240,14 +242,16 @@ std::int64_t Client::limit_correction() { return query("LCA"); }
 void Client::set_limit_correction(std::int64_t steps) { set("LCA", steps); }
 
 void Client::wait_idle(serial::Duration timeout, serial::Duration poll) {
-    auto deadline = std::chrono::steady_clock::now() + timeout;
+    // A negative timeout waits forever; each poll is an interruption point (Ctrl-C).
+    const bool forever = timeout.count() < 0;
+    const auto deadline = std::chrono::steady_clock::now() + (forever ? serial::Duration::zero() : timeout);
     for (;;) {
         if (!moving()) return;
-        if (std::chrono::steady_clock::now() >= deadline)
+        if (!forever && std::chrono::steady_clock::now() >= deadline)
             throw TimeoutError("arcus: still moving after " +
                                std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count()) +
                                " ms");
-        std::this_thread::sleep_for(poll);
+        interruptible_sleep_for(poll);
     }
 }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <thread>
 
+#include "motorbus/runtime/interrupt.hpp"
+
 namespace motorbus::dmac {
 namespace {
 
@@ -49,7 +51,7 @@ int DmacClient::check_family(int n, int count, const char* name) {
 
 void DmacClient::sleep(Duration d) {
     if (options_.sleep) options_.sleep(d);
-    else std::this_thread::sleep_for(d);
+    else interruptible_sleep_for(d);  // an interruption point (Ctrl-C) on every poll
 }
 
 Duration DmacClient::reply_wait() const {
@@ -311,7 +313,7 @@ std::int32_t DmacClient::wait_idle(Duration timeout, Duration poll) {
     Duration waited{0};
     for (;;) {
         if (!status().busy()) return position();
-        if (waited >= timeout)
+        if (timeout.count() >= 0 && waited >= timeout)  // negative: wait forever
             throw TimeoutError("DMAC " + std::to_string(options_.address) + ": still moving after " +
                                std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count()) +
                                " ms");
@@ -436,7 +438,7 @@ StreamStats stream_interpolation(std::vector<DmacClient*> axes, const std::vecto
     if (segments.empty()) return st;
     auto wait = [&](Duration d) {
         if (o.sleep) o.sleep(d);
-        else std::this_thread::sleep_for(d);
+        else interruptible_sleep_for(d);
     };
     const Duration backoff = o.backoff.count() > 0 ? o.backoff
                                                    : std::chrono::microseconds(o.interpol_time_ms * 250);
