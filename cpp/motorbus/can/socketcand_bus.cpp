@@ -51,10 +51,7 @@ void check_options(const SocketcandOptions& o) {
     if (o.keepalive_misses < 1) throw InvalidArgument("keepalive_misses: must be >= 1");
     if (o.tx_buffer_bytes == 0)
         throw InvalidArgument("tx_buffer_bytes: 0, must be >= 1 (unsent bytes before send() waits)");
-    if (o.max_element < socketcand::kMinMaxElement || o.max_element > socketcand::kMaxMaxElement)
-        throw InvalidArgument("max_element: " + std::to_string(o.max_element) + ", must be " +
-                              std::to_string(socketcand::kMinMaxElement) + "-" +
-                              std::to_string(socketcand::kMaxMaxElement) + " bytes (a frame element must fit)");
+    socketcand::check_max_element(o.max_element);
     const std::pair<const char*, Duration> durations[] = {{"connect_timeout", o.connect_timeout},
                                                           {"handshake_timeout", o.handshake_timeout},
                                                           {"keepalive_period", o.keepalive_period}};

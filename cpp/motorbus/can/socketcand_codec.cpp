@@ -480,6 +480,13 @@ void check_channel_name(const std::string& channel, const char* field) {
             throw InvalidArgument(std::string(field) + ": '" + channel + "' contains a blank, a control character or < >");
 }
 
+void check_max_element(std::size_t max_element) {
+    if (max_element < kMinMaxElement || max_element > kMaxMaxElement)
+        throw InvalidArgument("max_element: " + std::to_string(max_element) + ", must be " +
+                              std::to_string(kMinMaxElement) + "-" + std::to_string(kMaxMaxElement) +
+                              " bytes (a frame element must fit)");
+}
+
 ElementParser::ElementParser(std::size_t max_element)
     : max_element_(std::clamp<std::size_t>(max_element, 8, 65535)) {
     buffer_.reserve(max_element_);

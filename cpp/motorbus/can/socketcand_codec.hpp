@@ -79,6 +79,8 @@ constexpr std::size_t kMaxMaxElement = 65535;
 // blank and no < or > (they would end the `< open name >` element).  Throws
 // InvalidArgument naming `field`.
 void check_channel_name(const std::string& channel, const char* field);
+// A max_element option in [kMinMaxElement, kMaxMaxElement]; InvalidArgument otherwise.
+void check_max_element(std::size_t max_element);
 
 // Parses one complete element, `<` through `>` inclusive.  Returns the reason
 // on failure (the element is then empty/undefined).

@@ -66,10 +66,7 @@ void check_options(const SocketcandServerOptions& o) {
     if (o.max_clients == 0) throw InvalidArgument("max_clients: 0, must be >= 1 (0 would refuse every client)");
     if (o.client_queue == 0) throw InvalidArgument("client_queue: must be >= 1");
     if (!o.channel.empty()) socketcand::check_channel_name(o.channel, "channel");  // empty = any name
-    if (o.max_element < socketcand::kMinMaxElement || o.max_element > socketcand::kMaxMaxElement)
-        throw InvalidArgument("max_element: " + std::to_string(o.max_element) + ", must be " +
-                              std::to_string(socketcand::kMinMaxElement) + "-" +
-                              std::to_string(socketcand::kMaxMaxElement) + " bytes");
+    socketcand::check_max_element(o.max_element);
     const std::pair<const char*, Duration> durations[] = {{"idle_timeout", o.idle_timeout},
                                                           {"element_timeout", o.element_timeout},
                                                           {"open_timeout", o.open_timeout},
