@@ -7,6 +7,7 @@
                        [--slcan-pty]... --drive KIND:ADDR[,ADDR...]... [--baud N] [--store-dir DIR]
     motorbus drives
     motorbus demo
+    motorbus status|move|home|stop|config ... BENCH [--sim]   (python/motorbus/cli_bench.py)
 """
 from __future__ import annotations
 
@@ -171,6 +172,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     dl = sub.add_parser("drives", help="list the registered drive kinds")
     dl.set_defaults(func=cmd_drives)
+
+    from . import cli_bench
+    cli_bench.add_commands(sub)
 
     dm = sub.add_parser("demo", help="run the simulated bench demo")
     dm.add_argument("--quick", action="store_true", help="shorter run (used by the tests)")

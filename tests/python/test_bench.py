@@ -1,0 +1,265 @@
+"""Bench files and motorbus.Bench: one axis of every registered kind, simulated behind
+the transport a real bench uses (ptys, socketcand on 127.0.0.1); every kind of mistake
+in a file named by file:line: key; the bench commands of the command line."""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+import motorbus
+from motorbus import Bench, BenchFileError, registry
+
+from test_drive_api import KINDS  # per-kind address, parameters, homing method, sim options
+
+
+def _toml_value(v):
+    if isinstance(v, str):
+        return f'"{v}"'
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f'"{k}" = {_toml_value(x)}' for k, x in v.items()) + " }"
+    return repr(v)
+
+
+def _every_kind_file(tmp_path, params: dict) -> tuple[str, dict]:
+    """A bench file with one axis per registered kind; returns (path, {axis: Kind})."""
+    text = ["# every registered kind, one axis each", "[bus.can0]", 'spec = "socketcan:can0"', ""]
+    axes = {}
+    for kind in sorted(registry.drive_kinds()):
+        if kind not in KINDS:
+            pytest.fail(f"kind {kind!r} has no entry in tests/python/test_drive_api.py KINDS")
+        k = KINDS[kind]
+        plugin = registry.drive_plugin(kind)
+        name = kind.replace("-", "_")
+        if plugin.transport == "serial":
+            text += [f"[line.{name}]", f'port = "/dev/ttyUSB-{name}"', ""]
+        text += [f"[axis.{name}]", f'kind = "{kind}"',
+                 f'{"line" if plugin.transport == "serial" else "bus"} = "{name if plugin.transport == "serial" else "can0"}"',
+                 f'address = "{k.address}"', f'units = {{ name = "mm", scale = {k.scale} }}']
+        if params.get(kind):
+            text.append(f"params = {_toml_value(params[kind])}")
+        if k.sim_options:
+            text.append(f"sim = {_toml_value(k.sim_options)}")
+        if k.open_options:
+            text.append(f"options = {_toml_value(k.open_options)}")
+        text.append("")
+        axes[name] = k
+    path = tmp_path / "bench.toml"
+    path.write_text("\n".join(text))
+    return str(path), axes
+
+
+def _setup_params(kind) -> dict:
+    """What the shared Drive API test's setup() writes, captured as a params table."""
+    class Capture:
+        def __init__(self):
+            self.params = {}
+    c = Capture()
+    if kind.setup:
+        kind.setup(c)
+    return c.params
+
+
+@pytest.fixture
+def every_kind(tmp_path):
+    params = {k: _setup_params(KINDS[k]) for k in registry.drive_kinds() if k in KINDS}
+    return _every_kind_file(tmp_path, params)
+
+
+def test_every_registered_kind_loads_simulated_and_moves_homes_stops(every_kind):
+    path, axes = every_kind
+    with Bench.load(path, sim=True) as bench:
+        assert list(bench) == list(axes)
+        changed = bench.apply()            # the file's parameters written through each protocol
+        assert bench.diff() == []
+        assert {c.axis for c in changed} <= set(axes)
+        for name, k in axes.items():
+            d = bench[name]
+            assert d.kind == k.kind and d.units.name == "mm"
+            d.enable()
+            assert d.status.enabled
+            d.move_to(5.0, timeout=20)
+            assert d.position == pytest.approx(5.0, abs=k.scale), name
+            d.home(k.home, timeout=30)
+            assert d.status.homed, name
+            d.jog(k.jog)
+            time.sleep(0.05)
+            d.stop()
+            d.wait_idle(timeout=10)
+            assert not d.status.moving, name
+
+
+def test_status_command_shows_every_axis(every_kind):
+    path, axes = every_kind
+    out = subprocess.run([sys.executable, "-m", "motorbus", "status", path, "--sim"], capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    rows = out.stdout.splitlines()
+    assert rows[0].split()[:4] == ["axis", "kind", "position", "units"]
+    for name, k in axes.items():
+        assert any(r.split()[:2] == [name, k.kind] for r in rows[2:]), out.stdout
+
+
+def test_with_block_stops_every_axis_on_an_exception(every_kind):
+    path, axes = every_kind
+    with pytest.raises(RuntimeError):
+        with Bench.load(path, sim=True) as bench:
+            for name, k in axes.items():
+                bench[name].enable()
+                bench[name].jog(k.jog)
+            time.sleep(0.1)
+            assert all(bench[n].status.moving for n in axes)
+            drives = bench.axes
+            raise RuntimeError("test script failed mid-move")
+    assert bench.closed and all(d.closed for d in drives.values())
+    # The simulators outlive the bench object: none of them is still turning.
+    for name, sim in bench.sims.items():
+        pos = _sim_position(sim)
+        time.sleep(0.1)
+        assert _sim_position(sim) == pos, name
+
+
+def _sim_position(sim):
+    for attr in ("position", "motor_position"):
+        v = getattr(sim, attr, None)
+        if v is not None:
+            return v() if callable(v) else v
+    state = sim.state() if callable(getattr(sim, "state", None)) else None
+    return getattr(state, "position", None)
+
+
+# ---- mistakes, each named by file:line: key ---------------------------------------------------
+
+GOOD = """\
+[bus.can0]
+spec = "virtual:bench-test"
+
+[line.rs485]
+port = "/dev/ttyUSB0"
+
+[axis.x]
+kind = "arcus"
+line = "rs485"
+address = 1
+units = { name = "mm", scale = 0.0025 }
+
+[axis.z]
+kind = "cia402"
+bus = "can0"
+address = 5
+"""
+
+
+def _error(tmp_path, text: str) -> BenchFileError:
+    p = tmp_path / "bad.toml"
+    p.write_text(text)
+    with pytest.raises(BenchFileError) as e:
+        Bench.load(p, sim=True)
+    assert str(e.value).startswith(f"{p}:"), str(e.value)
+    return e.value
+
+
+def test_the_good_file_loads(tmp_path):
+    p = tmp_path / "good.toml"
+    p.write_text(GOOD)
+    with Bench.load(p, sim=True) as bench:
+        assert list(bench) == ["x", "z"]
+        assert bench["x"].units.scale == 0.0025
+
+
+@pytest.mark.parametrize("old,new,line,key,says", [
+    ('kind = "arcus"', 'kind = "arcos"', 8, "axis.x.kind", "registered: "),
+    ("address = 1", "address = 100", 10, "axis.x.address", ""),
+    ("address = 5", "address = 128", 16, "axis.z.address", ""),
+    ('bus = "can0"', 'bus = "can1"', 15, "axis.z.bus", "buses: can0"),
+    ('line = "rs485"', 'bus = "can0"', 9, "axis.x.bus", "use line"),
+    ("scale = 0.0025", "scale = 0", 11, "axis.x.units.scale", "non-zero"),
+    ('units = { name = "mm", scale = 0.0025 }', 'units = "mm"', 11, "axis.x.units", "scale"),
+    ("address = 5", 'address = 5\nspeed = 3', 17, "axis.z.speed", "unknown key"),
+    ('spec = "virtual:bench-test"', "spec = 5", 2, "bus.can0.spec", "string"),
+    ("address = 1", 'address = 1\nparams = { NOPE = 1 }', 11, "axis.x.params.NOPE", "no parameter"),
+])
+def test_each_mistake_names_file_line_and_key(tmp_path, old, new, line, key, says):
+    assert old in GOOD
+    e = _error(tmp_path, GOOD.replace(old, new, 1))
+    assert (e.line, e.key) == (line, key), str(e)
+    assert says in str(e)
+
+
+def test_unknown_kind_lists_the_registered_ones(tmp_path):
+    e = _error(tmp_path, GOOD.replace('kind = "arcus"', 'kind = "arcos"'))
+    for kind in registry.drive_kinds():
+        assert kind in str(e)
+
+
+def test_bad_toml_names_its_line(tmp_path):
+    e = _error(tmp_path, GOOD.replace("address = 5", "address = = 5"))
+    assert e.line == 16 and "bad TOML" in str(e)
+
+
+def test_missing_axis_section_and_unknown_section(tmp_path):
+    assert "at least one axis" in str(_error(tmp_path, '[bus.can0]\nspec = "virtual:x"\n'))
+    e = _error(tmp_path, GOOD + '\n[motor.q]\nkind = "x"\n')
+    assert e.key == "motor" and e.line == 18
+
+
+def test_from_dict_and_missing_link(tmp_path):
+    with pytest.raises(BenchFileError, match="axis.x.line: no \\[line.rs485\\]"):
+        Bench.from_dict({"axis": {"x": {"kind": "arcus", "line": "rs485", "address": 1}}}, sim=True)
+
+
+# ---- configuration and the command line ---------------------------------------------------------
+
+def _cli(*args, timeout=60):
+    return subprocess.run([sys.executable, "-m", "motorbus", *args], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def test_config_diff_apply_read(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text(GOOD.replace("address = 1", "address = 1\nparams = { HSPD = 12000, ACC = 50 }"))
+    with Bench.load(p, sim=True) as bench:
+        assert {(c.name, c.file_value) for c in bench.diff()} == {("HSPD", 12000), ("ACC", 50)}
+        bench.apply(["x"])
+        assert bench.diff() == []
+        assert bench.read_params(["x"]) == {"x": {"HSPD": 12000, "ACC": 50}}
+        assert "LSPD" in bench.read_params(["x"], all_params=True)["x"]
+    r = _cli("config", "diff", str(p), "--sim")        # a fresh simulated twin: factory values again
+    assert r.returncode == 3 and "HSPD" in r.stdout, r
+    r = _cli("config", "apply", str(p), "--sim")
+    assert r.returncode == 0 and "2 parameter(s) written" in r.stdout, r
+
+
+def test_cli_move_and_exit_codes(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text(GOOD)
+    r = _cli("move", str(p), "x", "0.5", "--sim")
+    assert r.returncode == 0 and r.stdout.strip() == "x: 0.5 mm", r
+    r = _cli("move", str(p), "nope", "1", "--sim")
+    assert r.returncode == 2 and "no axis 'nope'" in r.stderr, r
+    bad = tmp_path / "bad.toml"
+    bad.write_text(GOOD.replace("address = 5", "address = 500"))
+    r = _cli("status", str(bad), "--sim")
+    assert r.returncode == 2 and f"{bad}:16: axis.z.address" in r.stderr, r
+
+
+def test_ctrl_c_during_a_cli_move_stops_the_axis(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text(GOOD)
+    child = subprocess.Popen([sys.executable, "-m", "motorbus", "move", str(p), "x", "100", "--sim"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.5)   # the bench is up and the move (40 000 steps at 1 000 steps/s) under way
+    assert child.poll() is None
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=20)
+    assert child.returncode == 130, (out, err)
+    assert "axis stopped" in err
+    pos = float(out.split()[1])
+    assert 0 < pos < 100
