@@ -395,6 +395,10 @@ void bind_serial(py::module_& m) {
         .def(py::init<const std::vector<py::object>&, unsigned, std::shared_ptr<Port>>(),
              py::arg("devices") = std::vector<py::object>{}, py::arg("baud") = 0, py::arg("port") = nullptr)
         .def("attach", &PyLineServer::attach, py::arg("device"))
+        .def_property(
+            "enforce_baud", [](PyLineServer& s) { return s.get().enforce_baud(); },
+            [](PyLineServer& s, bool on) { s.get().set_enforce_baud(on); },
+            "With baud > 0: requests sent at another rate arrive garbled (no device answers them).")
         .def("close", &PyLineServer::close)
         .def_property_readonly("slave_path", [](PyLineServer& s) { return s.get().slave_path(); })
         .def_property_readonly("baud", [](PyLineServer& s) { return s.get().baud(); })

@@ -1041,6 +1041,14 @@ class PtyLineServer:
         LineServerCounters (a snapshot)
         """
     @property
+    def enforce_baud(self) -> bool:
+        """
+        With baud > 0: requests sent at another rate arrive garbled (no device answers them).
+        """
+    @enforce_baud.setter
+    def enforce_baud(self, arg1: bool) -> None:
+        ...
+    @property
     def running(self) -> bool:
         ...
     @property

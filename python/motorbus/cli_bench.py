@@ -5,6 +5,7 @@
     motorbus home BENCH AXIS [--method M] [--timeout S] [--sim]
     motorbus stop BENCH [AXIS...] [--quick] [--sim]
     motorbus config read|diff|apply|store BENCH [--axis NAME]... [--all] [--sim]
+    motorbus scan [--serial PORT]... [--can SPEC]... [--kind KIND]... [--write BENCH] [--timeout S]
 
 Exit codes: 0 done; 1 a drive refused or failed (the message says which axis
 and why); 2 the command line or the bench file is wrong (``file:line: key:
@@ -157,6 +158,29 @@ def cmd_config(args: argparse.Namespace) -> int:
     return _with_bench(args, work)
 
 
+def cmd_scan(args: argparse.Namespace) -> int:
+    from .discovery import discover
+
+    if not args.serial and not args.can:
+        print("motorbus scan: give --serial PORT and/or --can SPEC", file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        result = discover(args.serial or (), args.can or (), kinds=args.kind, timeout=args.timeout,
+                          reply_timeout=args.reply_timeout, progress=not args.quiet)
+    except _core.InvalidArgument as e:
+        print(f"motorbus: {e}", file=sys.stderr)
+        return EXIT_USAGE
+    rows = [(f.kind, f.address, f.line or f.bus, f.baud or "", ", ".join(f"{k}={v}" for k, v in f.identity.items()))
+            for f in result.found]
+    _say(table(rows, ("kind", "address", "where", "baud", "identity")) if rows else "no drive answered")
+    for s in result.skipped:
+        print(f"motorbus: not probed (time budget or port): {s}", file=sys.stderr)
+    if args.write:
+        result.write(args.write)
+        _say(f"wrote {args.write}")
+    return EXIT_OK
+
+
 def add_commands(sub: Any) -> None:
     """Adds the bench commands to the top-level parser's subparsers."""
     def bench_parser(name: str, help: str) -> argparse.ArgumentParser:
@@ -183,6 +207,15 @@ def add_commands(sub: Any) -> None:
     p.add_argument("axes", nargs="*", metavar="AXIS")
     p.add_argument("--quick", action="store_true", help="the fastest stop the drive has")
     p.set_defaults(func=cmd_stop)
+    p = sub.add_parser("scan", help="find the drives on serial lines and CAN buses (reads only)")
+    p.add_argument("--serial", action="append", metavar="PORT", help="a serial port to sweep; repeatable")
+    p.add_argument("--can", action="append", metavar="SPEC", help="an open_bus spec to scan; repeatable")
+    p.add_argument("--kind", action="append", help="only these kinds (default: every registered kind)")
+    p.add_argument("--write", metavar="BENCH", help="write a bench file for what was found")
+    p.add_argument("--timeout", type=float, default=300.0, help="time budget for the whole scan (s)")
+    p.add_argument("--reply-timeout", type=float, default=0.05, help="wait per serial address (s)")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.set_defaults(func=cmd_scan)
     p = sub.add_parser("config", help="read, compare, apply or store the bench file's drive parameters")
     p.add_argument("action", choices=("read", "diff", "apply", "store"))
     p.add_argument("bench", metavar="BENCH")

@@ -39,6 +39,15 @@ class DrivePlugin:
       max line) a line server and a LineLink need.
     * ``check_address(text) -> str``: the canonical form of an address, or
       InvalidArgument naming the problem.
+    * Discovery (``motorbus.discover``; it never moves a motor nor writes a
+      parameter): ``probe(link, address) -> dict | None`` asks one address for
+      its identity (``{"model": ..., "firmware": ..., "serial": ...}``, what the
+      protocol gives) over a LineLink framed with ``line_settings`` (serial) or
+      a Bus (CAN kinds that are not CANopen); ``probe_addresses`` and
+      ``probe_bauds`` are what a sweep tries.  CANopen kinds set
+      ``canopen_match(node) -> int`` instead: a score for a node found by the
+      CANopen scan (``NodeInfo``: device type, vendor id, product code...), 0 =
+      not this kind; the highest score names the node's kind.
     """
 
     kind: str
@@ -54,6 +63,10 @@ class DrivePlugin:
     #: Options make_sim takes per served drive from ``sim serve --store-dir``: a
     #: function (store_dir, address) -> dict of options.
     store_options: Optional[Callable[[str, str], dict]] = None
+    probe: Optional[Callable[..., Optional[dict]]] = None
+    probe_addresses: tuple = ()
+    probe_bauds: tuple = ()
+    canopen_match: Optional[Callable[[Any], int]] = None
 
     def __post_init__(self) -> None:
         if self.transport not in ("serial", "can"):

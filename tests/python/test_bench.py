@@ -127,12 +127,17 @@ def test_with_block_stops_every_axis_on_an_exception(every_kind):
 
 
 def _sim_position(sim):
-    for attr in ("position", "motor_position"):
-        v = getattr(sim, attr, None)
-        if v is not None:
-            return v() if callable(v) else v
-    state = sim.state() if callable(getattr(sim, "state", None)) else None
-    return getattr(state, "position", None)
+    """Where a simulator's motor is, whatever the kind exposes (never None: a
+    comparison of two Nones would prove nothing)."""
+    for holder in (sim, getattr(sim, "motor", None)):
+        for attr in ("physical_position", "pulse_position"):
+            v = getattr(holder, attr, None)
+            if v is not None:
+                return v() if callable(v) else v
+    state = getattr(sim, "state", None)
+    if callable(state):
+        return state().position
+    raise AssertionError(f"test_bench: no way to read the motor position of {sim!r}")
 
 
 # ---- mistakes, each named by file:line: key ---------------------------------------------------

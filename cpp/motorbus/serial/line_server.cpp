@@ -133,6 +133,12 @@ void PtyLineServer::run() {
             std::size_t n = port_->read(buf, owns_port_ ? std::chrono::nanoseconds(-1) : kBorrowedPoll);
             if (n == 0) continue;
             c_.bytes_in += n;
+            if (baud_ && owns_port_ && enforce_baud_.load()) {
+                // The pty master reports the speed the client set on its side.
+                auto* tty = dynamic_cast<TtyPort*>(port_.get());
+                if (tty && tty->baud() != baud_)
+                    for (std::size_t i = 0; i < n; ++i) buf[i] = static_cast<std::uint8_t>((buf[i] ^ 0x55u) | 0x80u);
+            }
             if (baud_) rx_done = std::max(rx_done, Clock::now()) + byte_time * static_cast<long>(n);
             refresh();
             std::span<const std::uint8_t> in(buf.data(), n);

@@ -39,6 +39,12 @@ public:
     PtyLineServer(const PtyLineServer&) = delete;
     PtyLineServer& operator=(const PtyLineServer&) = delete;
 
+    // A paced pty line (baud > 0) that also checks the client's speed: bytes
+    // sent while the client's side of the pty is set to another rate arrive
+    // garbled, as a UART at the wrong rate reads framing errors, so devices
+    // never answer them (what discovery meets on a real line).  Off by default.
+    void set_enforce_baud(bool on) { enforce_baud_.store(on); }
+    bool enforce_baud() const { return enforce_baud_.load(); }
     // Adds a device to the multi-drop line; every device sees every line.
     void attach(std::shared_ptr<LineDevice> device);
     // The path a client opens ("" when serving on an existing port).
@@ -61,6 +67,7 @@ private:
     std::shared_ptr<Port> port_;
     bool owns_port_ = false;
     unsigned baud_ = 0;
+    std::atomic<bool> enforce_baud_{false};
     std::string no_path_;
 
     std::mutex devices_mutex_;

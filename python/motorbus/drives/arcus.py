@@ -578,6 +578,16 @@ def open_drive(*, line: Any, bus: Any = None, address: str = "01", units: Option
 _SIM_OPTIONS = ("response_type", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
                 "start_position", "tick")
 
+def probe(line: "_core.LineLink", address: str) -> Optional[dict]:
+    """Discovery: the product id and firmware of the drive at `address`, or None.
+    Reads only (ID, VER): never moves the motor nor writes a parameter."""
+    client = ArcusClient(line, address, on_error=None, on_exit=None, query_retries=0)
+    try:
+        return {"model": client.id, "firmware": client.version}
+    finally:
+        client.close()   # a shared LineLink stays open
+
+
 PLUGIN = DrivePlugin(
     kind="arcus",
     description="Arcus DMX-CAN integrated stepper, ASCII over RS-232/RS-485 (StepNLoop closed loop)",
@@ -590,4 +600,7 @@ PLUGIN = DrivePlugin(
     default_baud=9600,
     sim_options=_SIM_OPTIONS + ("store_path",),
     store_options=lambda store_dir, address: {"store_path": os.path.join(store_dir, f"arcus-{address}.store")},
+    probe=probe,
+    probe_addresses=tuple(f"{a:02d}" for a in range(1, 100)),   # DN 01-99
+    probe_bauds=(9600, 19200, 38400, 57600, 115200),              # the DB settings
 )

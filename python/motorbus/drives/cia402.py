@@ -648,4 +648,6 @@ PLUGIN = DrivePlugin(
     check_address=_check_node,
     default_address="1",
     sim_options=("steps_per_rev", "home", "minus_limit", "plus_limit", "heartbeat_ms", "start_position"),
+    # Any node whose device type (0x1000) names profile 402; vendor kinds score higher.
+    canopen_match=lambda node: 1 if node.profile == 402 else 0,
 )

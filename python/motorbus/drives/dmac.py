@@ -548,6 +548,19 @@ def _open(*, line: Any, bus: Any = None, address: str = DEFAULT_ADDRESS, units: 
     return DmacDrive(client, units=units, on_error=on_error, on_exit=on_exit, close_native=client.close)
 
 
+def probe(line: "_core.LineLink", address: str) -> Optional[dict]:
+    """Discovery: REQUEST_VERSION of the module at `address`, or None.  Reads only."""
+    client = DmacClient(line, address=int(address), verify=False, on_error=None, on_exit=None)
+    try:
+        # Presence first, on the link's short reply timeout (the sweep's cost per
+        # empty address); the long REQUEST_VERSION banner only where a module is.
+        client.raw(f"{int(address):02d}READ #STATUS", True)
+        v = client.request_version()
+        return {"model": v.model, "firmware": f"v{v.version}.{v.release}", "serial": v.serial}
+    finally:
+        client.close()
+
+
 PLUGIN = DrivePlugin(
     kind="dmac",
     description="Midi Ingénierie DMAC17/23/34 brushless modules, ASCII protocol over RS-232/RS-485",
@@ -560,4 +573,7 @@ PLUGIN = DrivePlugin(
     default_baud=DEFAULT_BAUD,
     sim_options=SIM_OPTIONS,
     store_options=None,
+    probe=probe,
+    probe_addresses=tuple(f"{a:02d}" for a in range(64)),   # 00-63
+    probe_bauds=BAUDRATES,
 )
