@@ -477,7 +477,7 @@ std::uint32_t Sim::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t
                 co.active_mode = co.mode;
                 co.setpoint_ack = co.buffered = false;
                 co.homing_started = co.homing_attained = co.homing_error = false;
-                co.pv_pending = co.active_mode == 3;
+                co.pv_pending = false;
             }
             break;
         case 0x607A: co.target_position = static_cast<std::int32_t>(v); break;
@@ -500,11 +500,15 @@ std::uint32_t Sim::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t
         case 0x60FF: {
             const std::int32_t before = co.target_velocity;
             co.target_velocity = static_cast<std::int32_t>(v);
-            if (co.state == CoState::OperationEnabled && co.active_mode == 3 && !(co.cw & kHalt) &&
-                before != co.target_velocity) {
+            if (co.state == CoState::OperationEnabled && co.active_mode == 3 && !(co.cw & kHalt)) {
                 // A new speed or direction: decelerate, then run at the new value (no on-the-fly change).
-                if (s.motor->moving()) cmd("STOP");
-                co.pv_pending = true;
+                const bool moving = s.motor->moving() || s.job != Job::None;
+                if (moving && before != co.target_velocity) {
+                    cmd("STOP");
+                    co.pv_pending = true;
+                } else if (!moving) {
+                    co.pv_pending = true;
+                }
             }
             break;
         }
@@ -555,7 +559,7 @@ void Sim::controlword(std::uint16_t v) {
         co.active_mode = co.mode;
         co.setpoint_ack = co.buffered = false;
         co.homing_started = co.homing_attained = co.homing_error = false;
-        co.pv_pending = co.active_mode == 3;
+        co.pv_pending = false;  // PV runs on a 60FFh write or a halt release
     };
     auto exit_mode = [&] {
         co.buffered = co.pv_pending = false;
