@@ -362,6 +362,13 @@ class ArcusCanopenDrive(Cia402Drive):
         self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
         self.native.write_controlword(int(Controlword.ENABLE_OPERATION) | (1 << 4))
 
+    def _jog(self, velocity: float) -> None:
+        # Refused before anything is sent when the drive cannot run; a jog that the
+        # drive takes and then ends in a limit error is a fault seen in status.
+        self._refused("jog")
+        self._use_mode(OpMode.PROFILE_VELOCITY)
+        self.native.set_velocity(int(round(velocity)))
+
     def _homing_done(self) -> bool:
         sw = self.native.statusword
         if (sw & 0x4F) == 0x08:
