@@ -219,6 +219,32 @@ def test_profile_position_relative_and_set_of_set_points(clock):
     assert read(sim, 0x6064, signed=True) == 1000
 
 
+def test_a_buffered_set_point_starts_the_instant_the_move_before_it_ends(clock):
+    sim = ac.make_sim(NODE, clock)
+    for index, value in ((0x6081, 20000), (0x6082, 100), (0x6083, 20), (0x6084, 20)):
+        ok(write(sim, index, 0, value, 4), index)
+    _enable(sim, 1)
+    # One relative 500-count move alone: how long it takes, to the millisecond.
+    ok(write(sim, 0x607A, 0, 500, 4), 0x607A)
+    ok(write(sim, 0x6040, 0, 0x5F, 2), 0x6040)
+    ok(write(sim, 0x6040, 0, 0x4F, 2), 0x6040)
+    single = 0
+    while not read(sim, 0x6041) & 0x0400:
+        clock.advance(1 * MS)
+        single += 1
+    assert read(sim, 0x6064) == 500
+    # The same move twice as a set of set-points, nobody looking in between: the
+    # second starts where the first ended, so both are done after 2 x single.
+    ok(write(sim, 0x6040, 0, 0x5F, 2), 0x6040)
+    ok(write(sim, 0x6040, 0, 0x4F, 2), 0x6040)
+    clock.advance(2 * MS)
+    ok(write(sim, 0x6040, 0, 0x7F, 2), 0x6040)
+    assert read(sim, 0x6041) & 0x1000
+    ok(write(sim, 0x6040, 0, 0x4F, 2), 0x6040)
+    clock.advance((2 * single - 2) * MS)
+    assert read(sim, 0x6064) == 1500 and read(sim, 0x6041) & 0x0400
+
+
 def test_profile_velocity_halt_and_polarity(clock):
     sim = ac.make_sim(NODE, clock)
     ok(write(sim, 0x6083, 0, 10, 4), 0x6083)

@@ -240,7 +240,7 @@ std::string Sim::command(std::string_view cmd) {
 std::string Sim::handle(const Request& req) {
     State& s = *s_;
     SimEngine e(s, options_);
-    Nanos now = clock_.now();
+    Nanos now = at_.value_or(clock_.now());
     e.advance(now);
     motion::MotorModel& m = *s.motor;
 

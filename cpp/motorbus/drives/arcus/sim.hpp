@@ -127,6 +127,9 @@ private:
     void controlword(std::uint16_t value);
     void canopen_service();  // buffered set-points, PV restarts, error -> Fault
     void send_frames(const std::vector<can::Frame>& frames);
+    // While set, the firmware runs a command at this (past) instant rather than
+    // at clock.now(): a buffered set-point starts exactly where the previous move ended.
+    std::optional<Nanos> at_;
     std::mutex bus_mutex_;
     std::shared_ptr<can::Bus> bus_;
     std::vector<can::SubscriptionId> subs_;

@@ -256,7 +256,28 @@ std::vector<can::Frame> Sim::canopen_frame(const can::Frame& f, bool& reset) {
     if (f.id != 0x600u + static_cast<std::uint32_t>(s.active_nid)) return {};
     if (f.len != 8) return {};  // not an SDO request (CiA 301: always 8 bytes)
     const int node = s.active_nid;
-    SimEngine(s, options_).advance(clock_.now());
+    const Nanos now = clock_.now();
+    SimEngine e(s, options_);
+    CanopenState& co = s.co;
+    if (co.state == CoState::OperationEnabled && co.active_mode == 1 && co.buffered && !(co.cw & kHalt) &&
+        s.job == Job::Target && s.motor->moving()) {
+        // A set of set-points: the buffered one starts the instant the running
+        // move ends (B-A12), even when nobody looked at the drive then.
+        const Nanos end = s.motor->profile_start() +
+                          static_cast<Nanos>(std::ceil(s.motor->profile().duration() * 1e9));
+        if (end < now) {
+            e.advance(end);
+            at_ = s.motor->time();
+            try {
+                canopen_service();
+            } catch (...) {
+                at_.reset();
+                throw;
+            }
+            at_.reset();
+        }
+    }
+    e.advance(now);
     canopen_service();
 
     const std::uint8_t cs = f.data[0];
