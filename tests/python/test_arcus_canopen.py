@@ -392,3 +392,30 @@ def test_plugin_and_drive_adapter_say_there_is_no_watchdog():
         ac.make_sim(1, heartbeat_ms=100)
     with pytest.raises(motorbus.InvalidArgument, match="protocol"):
         ac.make_sim(1, protocol="modbus")
+
+
+def test_latch_captures_positions_on_di2(clock):
+    sim = ac.make_sim(NODE, clock)
+    _enable(sim, 3)
+    ok(write(sim, 0x60FF, 0, 2000, 4), 0x60FF)
+    clock.advance(300 * MS)
+    assert read(sim, 0x2008) == 0
+    ok(write(sim, 0x2007, 0, 1, 1), 0x2007)
+    assert read(sim, 0x2008) == 1                                     # armed, waiting
+    at = sim.encoder_position
+    sim.set_input(2, True)
+    assert read(sim, 0x2008) == 2                                     # triggered
+    assert read(sim, 0x2009, 2, signed=True) == at
+    assert read(sim, 0x60FD) & (1 << 17)                              # DI2 in 60FDh bit 17
+    clock.advance(100 * MS)
+    assert read(sim, 0x2009, 2, signed=True) == at                    # the counters ran on, the latch did not
+
+
+def test_sim_serve_store_dir_gives_each_node_its_flash_file(tmp_path):
+    from motorbus.sim import SimBench
+    with SimBench(["arcus-canopen:3"], bus="virtual:arcus-canopen-store", store_dir=str(tmp_path)) as bench:
+        sim = bench.sims[("arcus-canopen", "3")]
+        assert sim.store_path == str(tmp_path / "arcus-canopen-3.store")
+        sdo_reply = sim.on_can_frame(_core.Frame(0x603, bytes([0x2F, 0x0E, 0x20, 0, 1, 0, 0, 0])))
+        assert bytes(sdo_reply[0].data)[0] == 0x60
+    assert (tmp_path / "arcus-canopen-3.store").read_text().count("CM=2") == 1
