@@ -80,7 +80,7 @@ def test_example_04_dmac_interpolation_cpp():
 
 def test_example_06_drive_api_python():
     out = run_example("06_drive_api.py")
-    assert "kinds: arcus, cia402, dmac" in out
+    assert "kinds: arcus, arcus-canopen, cia402, dmac" in out
     for kind in ("arcus", "dmac", "cia402"):
         assert f"{kind}: at 3.50 mm, enabled=True moving=False fault=False" in out, out
 
