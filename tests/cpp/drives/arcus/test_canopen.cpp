@@ -136,26 +136,33 @@ TEST(ArcusCanopen, D1D4D6StateMachineRows) {
 }
 
 TEST(ArcusCanopen, AccelerationIsClampedToAppendixAWhenTheMoveStarts) {
-    // E-A12: HSPD 20 000, LSPD 100 -> ACC at most 19 900 ms.  The SDO write keeps
-    // the written value; the move ramps for the clamped time.
-    motorbus::arcus::SimOptions o = CanBench::can_options();
-    o.snl = false;  // pulses: the window table is in PPS
-    CanBench b(o);
-    ASSERT_EQ(b.write(0x2001, 1, 0, 4)[0], 0x60);
-    ASSERT_EQ(b.write(0x6081, 0, 20000, 4)[0], 0x60);
-    ASSERT_EQ(b.write(0x6082, 0, 100, 4)[0], 0x60);
-    ASSERT_EQ(b.write(0x6083, 0, 30000, 4)[0], 0x60);
-    ASSERT_EQ(b.write(0x6084, 0, 30000, 4)[0], 0x60);
-    EXPECT_EQ(b.read(0x6083), 30000u);
-    ASSERT_EQ(b.write(0x6060, 0, 3, 1)[0], 0x60);
-    b.cw(0x0006);
-    b.cw(0x0007);
-    b.cw(0x000F);
-    ASSERT_EQ(b.write(0x60FF, 0, 20000, 4)[0], 0x60);
-    b.run_ms(19890);
-    EXPECT_LT(b.read(0x606C), 20000u);
-    b.run_ms(20);
-    EXPECT_EQ(b.read(0x606C), 20000u);
+    // E-A12: HSPD 20 000, LSPD 100 -> ACC at most 19 900 ms; HSPD 900 000,
+    // LSPD 1000 -> 23 050 ms.  The SDO write keeps the written value; the move
+    // ramps for the clamped time.
+    struct Example {
+        std::uint32_t hspd, lspd;
+        int max_acc_ms;
+    };
+    for (const Example ex : {Example{20000, 100, 19900}, Example{900000, 1000, 23050}}) {
+        motorbus::arcus::SimOptions o = CanBench::can_options();
+        o.snl = false;  // pulses: the window table is in PPS
+        o.world.plus_limit.reset();
+        CanBench b(o);
+        ASSERT_EQ(b.write(0x6081, 0, ex.hspd, 4)[0], 0x60);
+        ASSERT_EQ(b.write(0x6082, 0, ex.lspd, 4)[0], 0x60);
+        ASSERT_EQ(b.write(0x6083, 0, 30000, 4)[0], 0x60);
+        ASSERT_EQ(b.write(0x6084, 0, 30000, 4)[0], 0x60);
+        EXPECT_EQ(b.read(0x6083), 30000u);
+        ASSERT_EQ(b.write(0x6060, 0, 3, 1)[0], 0x60);
+        b.cw(0x0006);
+        b.cw(0x0007);
+        b.cw(0x000F);
+        ASSERT_EQ(b.write(0x60FF, 0, ex.hspd, 4)[0], 0x60);
+        b.run_ms(ex.max_acc_ms - 10);
+        EXPECT_LT(b.read(0x606C), ex.hspd) << ex.hspd;
+        b.run_ms(20);
+        EXPECT_EQ(b.read(0x606C), ex.hspd) << ex.hspd;
+    }
 }
 
 TEST(ArcusCanopen, ObjectTableHas41IndicesAndEveryReadableEntryAnswers) {
