@@ -419,3 +419,17 @@ def test_sim_serve_store_dir_gives_each_node_its_flash_file(tmp_path):
         sdo_reply = sim.on_can_frame(_core.Frame(0x603, bytes([0x2F, 0x0E, 0x20, 0, 1, 0, 0, 0])))
         assert bytes(sdo_reply[0].data)[0] == 0x60
     assert (tmp_path / "arcus-canopen-3.store").read_text().count("CM=2") == 1
+
+
+def test_the_shipped_eds_is_generated_from_the_table_and_canopen_reads_it():
+    import pathlib
+
+    import canopen
+    path = pathlib.Path(__file__).parents[2] / "cpp/motorbus/drives/arcus/canopen.eds"
+    assert path.read_text() == ac.eds_text()   # regenerate: python -c "...ac.eds_text()" > canopen.eds
+    od = canopen.import_od(str(path))
+    entries = {(o.index, o.subindex) for obj in od.values()
+               for o in (obj.values() if isinstance(obj, (canopen.objectdictionary.ODRecord,
+                                                           canopen.objectdictionary.ODArray)) else [obj])}
+    assert entries == {(r[0], r[1]) for r in ac.OBJECTS}
+    assert od[0x6402].default == 768 and od[0x1018][3].default == 112 and od[0x2004][2].default == 1500
