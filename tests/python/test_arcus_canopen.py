@@ -343,6 +343,21 @@ def test_stall_is_a_fault(clock):
     assert read(sim, 0x2003) == 10                                     # stall error
 
 
+def test_a_mode_written_while_moving_takes_over_once_idle(clock):
+    sim = ac.make_sim(NODE, clock)
+    ok(write(sim, 0x6083, 0, 10, 4), 0x6083)
+    ok(write(sim, 0x6084, 0, 10, 4), 0x6084)
+    _enable(sim, 3)
+    ok(write(sim, 0x60FF, 0, 3000, 4), 0x60FF)
+    clock.advance(50 * MS)
+    ok(write(sim, 0x6060, 0, 1, 1), 0x6060)
+    assert read(sim, 0x6061) == 3                                     # still running in PV
+    ok(write(sim, 0x6040, 0, 0x10F, 2), 0x6040)                       # halt
+    clock.advance(50 * MS)
+    assert read(sim, 0x6061) == 1                                     # idle: PP took over
+    assert read(sim, 0x606C) == 0
+
+
 def test_quick_stop_stops_at_once_and_disables(clock):
     sim = ac.make_sim(NODE, clock)
     _enable(sim, 3)
@@ -362,7 +377,7 @@ def test_native_client_names_types_and_handshakes():
             host = ac.ArcusCanopen(bus, NODE, timeout=1.0, on_error=None, on_exit=None)
             assert host.snl_status is ac.SnlStatus.IDLE
             assert host.comm_type is ac.CommType.CAN and host.bit_rate is ac.BitRate.K125
-            assert host.run_current == 1500 and host.snl_tolerance == 10
+            assert host.run_current == 1500 and host.snl_tolerance == 10 and host.counts_per_rev == 4000
             host.run_current = 1800
             assert host.run_current == 1800
             with pytest.raises(motorbus.InvalidArgument, match="outside 100..2500"):

@@ -198,6 +198,12 @@ class ArcusCanopen(Cia402):
     digital_outputs = _prop(0x60FE)
     del _prop
 
+    @property
+    def counts_per_rev(self) -> int:
+        """Position units per motor revolution: 4000 encoder counts with StepNLoop on,
+        3200 pulses (16 microsteps of a 1.8 deg motor) with it off (manual 000 §7)."""
+        return 4000 if self.read(0x2001, 1) else 3200
+
     # ---- handshakes ----
     def _handshake(self, index: int, what: str, timeout: float) -> None:
         self.write(index, 0, 1)
@@ -345,6 +351,12 @@ class ArcusCanopenDrive(Cia402Drive):
     capabilities = frozenset({Capability.POSITION, Capability.VELOCITY, Capability.HOMING, Capability.ENCODER,
                               Capability.STORE})
     has_watchdog = False
+
+    def _refused(self, what: str) -> None:
+        state = self.native.state
+        if state != "OPERATION ENABLED":
+            raise _core.DriveFault(f"arcus-canopen: {what} refused in state {state} (enable() first"
+                                   f"{', clear_faults()' if state == 'FAULT' else ''})")
 
     def _snl_text(self) -> str:
         try:

@@ -737,6 +737,14 @@ void Sim::canopen_service() {
     }
     if (co.state != CoState::OperationEnabled) return;
     const bool idle = !s.motor->moving() && s.job == Job::None;
+    if (idle && co.mode != co.active_mode) {
+        // A 6060h written while the motor ran takes over once it is idle (B-A10).
+        co.active_mode = co.mode;
+        co.setpoint_ack = co.buffered = false;
+        co.homing_started = co.homing_attained = co.homing_error = false;
+        co.pv_pending = false;
+        return;
+    }
     if (co.active_mode == 6 && co.homing_started && !co.homing_attained && !co.homing_error && idle) {
         const bool ok = s.homing && s.homing->result() == motion::HomingResult::Done;
         co.homing_attained = ok;
