@@ -352,6 +352,8 @@ def test_a_mode_written_while_moving_takes_over_once_idle(clock):
     clock.advance(50 * MS)
     ok(write(sim, 0x6060, 0, 1, 1), 0x6060)
     assert read(sim, 0x6061) == 3                                     # still running in PV
+    # StepNLoop cannot be switched while the motor runs (the units would change under it).
+    assert write(sim, 0x2001, 1, 0, 4) == bytes.fromhex("80 01 20 01 22 00 00 08")
     ok(write(sim, 0x6040, 0, 0x10F, 2), 0x6040)                       # halt
     clock.advance(50 * MS)
     assert read(sim, 0x6061) == 1                                     # idle: PP took over

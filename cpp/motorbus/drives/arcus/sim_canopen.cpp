@@ -24,6 +24,7 @@ constexpr std::uint32_t kAbortSizeHigh = 0x06070012;
 constexpr std::uint32_t kAbortSizeLow = 0x06070013;
 constexpr std::uint32_t kAbortNoSub = 0x06090011;
 constexpr std::uint32_t kAbortRange = 0x06090030;
+constexpr std::uint32_t kAbortDeviceState = 0x08000022;
 
 constexpr std::int64_t kU32 = 0xFFFFFFFFll;
 constexpr std::int64_t kI32Min = std::numeric_limits<std::int32_t>::min();
@@ -459,7 +460,8 @@ std::uint32_t Sim::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t
         case 0x2000: cmd(line("EDO", v)); break;
         case 0x2001: {
             static const char* names[] = {"", "SL", "SLA", "SLT", "SLM", "SLE"};
-            if (!cmd(line(names[sub], v))) return kAbortRange;  // SL while moving
+            // The firmware refuses SL only while moving: "not in the present device state".
+            if (!cmd(line(names[sub], v))) return kAbortDeviceState;
             break;
         }
         case 0x2004: {
