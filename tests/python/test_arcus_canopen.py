@@ -450,3 +450,44 @@ def test_the_shipped_eds_is_generated_from_the_table_and_canopen_reads_it():
                                                            canopen.objectdictionary.ODArray)) else [obj])}
     assert entries == {(r[0], r[1]) for r in ac.OBJECTS}
     assert od[0x6402].default == 768 and od[0x1018][3].default == 112 and od[0x2004][2].default == 1500
+
+
+def test_the_same_drive_api_script_through_both_personas_of_one_drive(tmp_path):
+    """The Drive API on the ASCII persona (pty), then, after CM=2 + store + power cycle,
+    on the CANopen persona (virtual bus) of the same simulated drive: same positions."""
+    units = motorbus.Units("mm", 0.01)
+
+    def script(drive, home_method, speed_params) -> list:
+        for name, value in speed_params.items():
+            drive.params[name] = value
+        drive.enable()
+        drive.move_to(10.0, timeout=10)
+        out = [drive.position]
+        drive.move_by(-3.0, timeout=10)
+        out.append(drive.position)
+        drive.home(home_method, timeout=20)
+        out.append(drive.position)
+        drive.move_to(2.5, timeout=10)
+        out.append(drive.position)
+        return out
+
+    with motorbus.open_bus("virtual:arcus-both") as sim_bus:
+        sim = ac.make_sim(NODE, protocol="ascii", store_path=str(tmp_path / "flash"), bus=sim_bus, eo_boot=True)
+        pty = _core.PtyLineServer([sim.core], 0, None)
+        try:
+            with motorbus.open_drive("arcus", line=pty.slave_path, address="01", units=units) as axis:
+                by_ascii = script(axis, "HL+", {"HSPD": 20000, "LSPD": 2000, "ACC": 20, "DEC": 20})
+                # Back to where the shaft started (home is 8000 steps = 100 mm out), so the
+                # second persona starts from the same place: the power cycle zeroes the counters.
+                axis.move_to(-100.0, timeout=10)
+                assert sim.physical_position == 0
+                axis.params["CM"] = 2
+                axis.store()
+            sim.power_cycle()
+            with motorbus.open_drive("arcus-canopen", bus="virtual:arcus-both", address=NODE, units=units) as axis:
+                by_canopen = script(axis, 19, {"0x6081": 20000, "0x6082": 2000, "0x6083": 20, "0x6084": 20,
+                                               "0x6099:01": 20000, "0x6099:02": 2000, "0x609A": 20})
+        finally:
+            pty.close()
+            sim.close()
+    assert by_ascii == by_canopen == [10.0, 7.0, 0.0, 2.5]
