@@ -343,6 +343,28 @@ def test_stall_is_a_fault(clock):
     assert read(sim, 0x2003) == 10                                     # stall error
 
 
+def test_profile_velocity_changes_speed_on_the_fly_and_reverses_through_a_stop(clock):
+    sim = ac.make_sim(NODE, clock)
+    ok(write(sim, 0x6083, 0, 10, 4), 0x6083)
+    ok(write(sim, 0x6084, 0, 10, 4), 0x6084)
+    _enable(sim, 3)
+    ok(write(sim, 0x60FF, 0, 4000, 4), 0x60FF)
+    clock.advance(100 * MS)
+    assert read(sim, 0x606C, signed=True) == 4000
+    ok(write(sim, 0x60FF, 0, 8000, 4), 0x60FF)
+    speeds = []
+    for _ in range(40):
+        clock.advance(5 * MS)
+        speeds.append(read(sim, 0x606C, signed=True))
+    assert min(speeds) >= 4000 and speeds[-1] == 8000                # never stopped on the way
+    ok(write(sim, 0x60FF, 0, -2000, 4), 0x60FF)
+    speeds = []
+    for _ in range(80):
+        clock.advance(5 * MS)
+        speeds.append(read(sim, 0x606C, signed=True))
+    assert 0 in speeds and speeds[-1] == -2000                        # a reversal goes through 0
+
+
 def test_a_mode_written_while_moving_takes_over_once_idle(clock):
     sim = ac.make_sim(NODE, clock)
     ok(write(sim, 0x6083, 0, 10, 4), 0x6083)

@@ -524,11 +524,27 @@ std::uint32_t Sim::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t
             const std::int32_t before = co.target_velocity;
             co.target_velocity = static_cast<std::int32_t>(v);
             if (co.state == CoState::OperationEnabled && co.active_mode == 3 && !(co.cw & kHalt)) {
-                // A new speed or direction: decelerate, then run at the new value (no on-the-fly change).
                 const bool moving = s.motor->moving() || s.job != Job::None;
                 if (moving && before != co.target_velocity) {
-                    cmd("STOP");
-                    co.pv_pending = true;
+                    // Same direction: change the speed on the fly (what ASCII SSPD does, in the
+                    // window of the new speed).  A reversal or a stop: decelerate, then restart.
+                    const double vel_sign = (s.cfg.cpol & 0x40) ? -1.0 : 1.0;
+                    const double now_v = vel_sign * before, new_v = vel_sign * co.target_velocity;
+                    bool changed = false;
+                    if (s.job == Job::Jog && !s.stopping && s.arcus_profile && new_v != 0 && now_v * new_v > 0) {
+                        const double pps = std::fabs(new_v) * (e.snl_on() ? e.slr() : 1.0);
+                        if (pps >= 1 && pps <= 6'000'000) {
+                            s.arcus.set_sspdm(arcus_window_for_hspd(pps).sspdm_first);
+                            if (s.arcus.change_speed(e.arcus_time(), std::fabs(new_v)) == ArcusReply::Ok) {
+                                s.motor->revise(s.arcus.profile());
+                                changed = true;
+                            }
+                        }
+                    }
+                    if (!changed) {
+                        cmd("STOP");
+                        co.pv_pending = true;
+                    }
                 } else if (!moving) {
                     co.pv_pending = true;
                 }
