@@ -312,6 +312,25 @@ def test_homing_35_and_limit_homing(clock):
     assert sim.physical_position < 0                                  # it went to the negative limit
 
 
+@pytest.mark.parametrize("method, side", [(17, 1), (18, -1)])
+def test_limit_homing_goes_to_the_manuals_limit_and_backs_off_by_the_home_offset(clock, method, side):
+    sim = ac.make_sim(NODE, clock, minus_limit=-3000.0, plus_limit=3000.0)
+    ok(write(sim, 0x607C, 0, 500, 4), 0x607C)                         # counts (StepNLoop on): 400 steps
+    ok(write(sim, 0x6098, 0, method, 1), 0x6098)
+    for sub, value in ((1, 20000), (2, 2000)):
+        ok(write(sim, 0x6099, sub, value, 4), 0x6099, sub)
+    ok(write(sim, 0x609A, 0, 20, 4), 0x609A)
+    _enable(sim, 6)
+    ok(write(sim, 0x6040, 0, 0x1F, 2), 0x6040)
+    for _ in range(2000):
+        clock.advance(5 * MS)
+        if read(sim, 0x6041) & 0x1400 == 0x1400:
+            break
+    assert read(sim, 0x6041) & 0x3400 == 0x1400
+    assert read(sim, 0x6064) == 0
+    assert sim.physical_position == pytest.approx(side * (3000 - 400), abs=2)
+
+
 def test_limit_error_is_a_fault_until_the_clear_error_handshake(clock):
     sim = ac.make_sim(NODE, clock)
     _enable(sim, 3)
