@@ -439,6 +439,31 @@ def test_native_client_names_types_and_handshakes():
         sim.close()
 
 
+def test_drive_move_while_moving_is_refused_typed_like_the_ascii_persona():
+    with motorbus.open_bus("virtual:arcus-canopen-busy") as simbus:
+        sim = ac.make_sim(NODE, bus=simbus)
+        with motorbus.open_drive("arcus-canopen", bus="virtual:arcus-canopen-busy", address=NODE,
+                                 timeout=0.2) as axis:
+            axis.params["0x6081"] = 2000
+            axis.enable()
+            axis.move_to(100000, wait=False)
+            with pytest.raises(motorbus.DriveFault, match="while the motor moves"):
+                axis.move_to(10)
+            with pytest.raises(motorbus.DriveFault, match="while the motor moves"):
+                axis.jog(1000)
+            axis.stop()
+            axis.wait_idle(timeout=5)
+            axis.jog(1000)
+            with pytest.raises(motorbus.DriveFault, match="while the motor moves"):
+                axis.move_by(10)
+            axis.stop()
+            axis.wait_idle(timeout=5)
+            at = axis.position
+            axis.move_by(10, timeout=5)
+            assert axis.position == at + 10
+        sim.close()
+
+
 def test_plugin_and_drive_adapter_say_there_is_no_watchdog():
     plugin = motorbus.registry.drive_plugin("arcus-canopen")
     assert plugin.transport == "can" and plugin.check_address(" 5 ") == "5"

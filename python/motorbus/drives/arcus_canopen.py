@@ -374,11 +374,34 @@ class ArcusCanopenDrive(Cia402Drive):
         self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
         self.native.write_controlword(int(Controlword.ENABLE_OPERATION) | (1 << 4))
 
+    def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
+        # A single set-point (controlword bit 5 = 0), as the ASCII persona's X: manual 000
+        # makes bit 5 = 1 a buffered "set of set-points" (native.move_to(..., immediate=True)).
+        try:
+            self._use_mode(OpMode.PROFILE_POSITION)
+            if velocity is not None:
+                self._u32(0x6081, velocity)  # stays the profile velocity for later moves too
+            self.native.move_to(int(round(target)), relative=relative, immediate=False)
+        except _core.TimeoutError:
+            # Not acknowledged: say why (checked only on failure: it costs SDO reads).
+            self._refused("move")
+            if self._velocity() != 0:
+                raise _core.DriveFault("arcus-canopen: move refused while the motor moves (the drive takes "
+                                       "a single set-point once the move is done; stop() first)") from None
+            raise
+
     def _jog(self, velocity: float) -> None:
         # Refused before anything is sent when the drive cannot run; a jog that the
         # drive takes and then ends in a limit error is a fault seen in status.
         self._refused("jog")
-        self._use_mode(OpMode.PROFILE_VELOCITY)
+        try:
+            self._use_mode(OpMode.PROFILE_VELOCITY)
+        except _core.TimeoutError:
+            # 6061h follows a new mode only once the motor is idle (B-A10).
+            if self._velocity() != 0:
+                raise _core.DriveFault("arcus-canopen: jog refused while the motor moves a set-point "
+                                       "(stop() first)") from None
+            raise
         self.native.set_velocity(int(round(velocity)))
 
     def _homing_done(self) -> bool:
