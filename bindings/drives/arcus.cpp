@@ -82,8 +82,15 @@ void register_errors(py::module_& m) {
 
 SimOptions sim_options(int address, int response_type, const std::string& store_path, bool eo_boot, bool snl,
                        std::pair<double, double> home, std::optional<double> minus_limit,
-                       std::optional<double> plus_limit, double z_position, double start_position, double tick) {
+                       std::optional<double> plus_limit, double z_position, double start_position, double tick,
+                       int comm_type = 0, int node_id = 1, double store_time = 0, double clear_time = 0) {
     SimOptions o;
+    o.comm_type = comm_type;
+    o.node_id = node_id;
+    if (!(store_time >= 0) || !(clear_time >= 0) || store_time > 60 || clear_time > 60)
+        throw InvalidArgument("store_time/clear_time: must be in [0, 60] seconds");
+    o.store_ns = static_cast<std::int64_t>(store_time * 1e9);
+    o.clear_ns = static_cast<std::int64_t>(clear_time * 1e9);
     o.address = address;
     o.response_type = response_type;
     o.store_path = store_path;
@@ -236,17 +243,20 @@ void bind_arcus(py::module_& m) {
         m, "ArcusSim", "A simulated Arcus DMX-CAN answering ASCII lines (a LineDevice for PtyLineServer).")
         .def(py::init([](std::shared_ptr<Clock> clock, int address, int response_type, const std::string& store_path,
                          bool eo_boot, bool snl, std::pair<double, double> home, std::optional<double> minus_limit,
-                         std::optional<double> plus_limit, double z_position, double start_position, double tick) {
+                         std::optional<double> plus_limit, double z_position, double start_position, double tick,
+                         int comm_type, int node_id, double store_time, double clear_time) {
                  if (!clock) clock = std::make_shared<RealClock>();
                  return std::make_shared<Sim>(clock, sim_options(address, response_type, store_path, eo_boot, snl,
                                                                   home, minus_limit, plus_limit, z_position,
-                                                                  start_position, tick));
+                                                                  start_position, tick, comm_type, node_id,
+                                                                  store_time, clear_time));
              }),
              py::arg("clock") = nullptr, py::arg("address") = 1, py::arg("response_type") = 0,
              py::arg("store_path") = "", py::arg("eo_boot") = false, py::arg("snl") = true,
              py::arg("home") = std::pair<double, double>{8000, 8400}, py::arg("minus_limit") = -400000.0,
              py::arg("plus_limit") = 400000.0, py::arg("z_position") = 1600.0, py::arg("start_position") = 0.0,
-             py::arg("tick") = 1e-4)
+             py::arg("tick") = 1e-4, py::arg("comm_type") = 0, py::arg("node_id") = 1, py::arg("store_time") = 0.0,
+             py::arg("clear_time") = 0.0)
         .def(
             "on_line", [](Sim& s, const py::object& line) {
                 std::string l = bytes_or_str(line, "line");
@@ -273,7 +283,26 @@ void bind_arcus(py::module_& m) {
         .def_property_readonly("encoder_position", &Sim::encoder_position)
         .def_property_readonly("motor_status", &Sim::motor_status)
         .def_property_readonly("snl_status", &Sim::snl_status)
-        .def_property_readonly("busy", &Sim::busy);
+        .def_property_readonly("busy", &Sim::busy)
+        // The CANopen front end (one drive, two front ends).
+        .def("attach_can", &Sim::attach_can, py::arg("bus"), py::call_guard<py::gil_scoped_release>(),
+             "Serve the CANopen persona on `bus` (answers while the communication type in effect is CAN).")
+        .def("detach_can", &Sim::detach_can, py::call_guard<py::gil_scoped_release>())
+        .def("on_can_frame", &Sim::on_can_frame, py::arg("frame"), py::call_guard<py::gil_scoped_release>(),
+             "One CAN frame in, the frames the drive answers out (what attach_can runs per frame).")
+        .def_property_readonly("active_protocol", &Sim::active_protocol,
+                               "Communication type in effect: 0 RS-232, 1 RS-485, 2 CAN (200Ah at the last boot).")
+        .def_property_readonly("can_node_id", &Sim::can_node_id)
+        .def_property_readonly("can_bit_rate", &Sim::can_bit_rate);
+
+    m.def("arcus_canopen_objects", [] {
+        py::list out;
+        for (const auto& o : canopen_objects())
+            out.append(py::make_tuple(o.index, o.sub, o.name, o.type, o.access, o.default_value, o.low, o.high,
+                                      o.unit, o.persists));
+        return out;
+    }, "The DMX-CAN object dictionary the simulator serves (Table 10.1): (index, sub, name, type, access, "
+       "default, low, high, unit, persists) tuples.");
 
     Record<ClientCounters>(m, "ArcusClientCounters", "ArcusClient counters (ArcusClient.counters), read-only.")
         .field("requests", &ClientCounters::requests)

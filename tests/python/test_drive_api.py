@@ -62,6 +62,15 @@ def _arcus_fault(sim: Any, drive: Any) -> None:
     drive.jog(-10.0)                 # ...and a jog into it latches a limit error
 
 
+def _arcus_canopen_setup(drive: Any) -> None:
+    drive.params["0x6081"] = 20000   # profile velocity, counts/s (StepNLoop on)
+    drive.params["0x6083"] = 20      # ms (manual 000: accelerations are times)
+    drive.params["0x6084"] = 20
+    drive.params["0x6099:01"] = 20000  # home switch speed
+    drive.params["0x6099:02"] = 2000   # zero position speed
+    drive.params["0x609A"] = 20
+
+
 def _dmac_setup(drive: Any) -> None:
     drive.params["#LOW_SPEED"] = 60000   # 0.01 rpm: the reference search speed
 
@@ -74,6 +83,8 @@ KINDS = {
                   param="HSPD", value=15000, jog=50.0, home="HL+", setup=_arcus_setup),
     "cia402": Kind("cia402", "5", 0.01, fault=lambda sim, drive: sim.inject_fault(0x5441),
                    param="0x6081", value=25000, jog=50.0, home=19, setup=_cia402_setup),
+    "arcus-canopen": Kind("arcus-canopen", "1", 0.01, fault=_arcus_fault, unfault=lambda sim: sim.force_limit(-1, None),
+                          param="0x2004:02", value=1200, jog=50.0, home=19, setup=_arcus_canopen_setup),
 }
 
 

@@ -80,6 +80,15 @@ def test_example_04_dmac_interpolation_cpp():
 
 def test_example_06_drive_api_python():
     out = run_example("06_drive_api.py")
-    assert "kinds: arcus, cia402, dmac" in out
+    assert "kinds: arcus, arcus-canopen, cia402, dmac" in out
     for kind in ("arcus", "dmac", "cia402"):
         assert f"{kind}: at 3.50 mm, enabled=True moving=False fault=False" in out, out
+
+
+def test_example_08_arcus_canopen_python():
+    out = run_example("08_arcus_canopen.py")
+    assert "serial: 0 (0 = RS-232), protocol 0" in out
+    assert "after store + power cycle: protocol 2 serial reply b''" in out
+    assert "run current over CANopen (2004h:02): 1200 mA" in out
+    assert "moved to 1000.0 counts, state OPERATION ENABLED" in out
+    assert "homed at 0.0 StepNLoop IDLE" in out

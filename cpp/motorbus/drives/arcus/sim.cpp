@@ -7,399 +7,10 @@
 #include <map>
 #include <sstream>
 
-#include "motorbus/drives/arcus/profile.hpp"
-#include "motorbus/drives/arcus/homing.hpp"
-#include "motorbus/motion/motor_model.hpp"
-#include "motorbus/motion/stepnloop.hpp"
+#include "motorbus/drives/arcus/sim_core.hpp"
 
 namespace motorbus::arcus {
 
-namespace {
-
-// The DMX-CAN's own StepNLoop ratio: 3200 steps per 4000 counts (SLR 0.800).
-constexpr std::int64_t kFactorySlrMilli = 800;
-constexpr std::int64_t kSyncMax = (1 << 27) - 1;  // SYNP is a 28-bit signed number
-
-// Flash contents (Table 7.10) with the Table 7.11 factory defaults.
-struct Flash {
-    std::int64_t br = 5, cm = 0, curi = 1000, curr = 1600, curt = 500, db = 1, dn = 1,
-                 doboot = 7, edo = 1, eoboot = 0, lca = 1000, pol = 0, rt = 0, sl = 1,
-                 sla = 10, sle = 1000, slm = 5, slt = 20, nid = 1, slr = kFactorySlrMilli;
-
-    std::map<std::string, std::int64_t*> fields() {
-        return {{"BR", &br},     {"CM", &cm},         {"CURI", &curi}, {"CURR", &curr},
-                {"CURT", &curt}, {"DB", &db},         {"DN", &dn},     {"DOBOOT", &doboot},
-                {"EDO", &edo},   {"EOBOOT", &eoboot}, {"LCA", &lca},   {"POL", &pol},
-                {"RT", &rt},     {"SL", &sl},         {"SLA", &sla},   {"SLE", &sle},
-                {"SLM", &slm},   {"SLR", &slr},       {"SLT", &slt},   {"NID", &nid}};
-    }
-};
-
-// What the axis is doing, for SLS and for what happens when the motion ends.
-enum class Job { None, Target, Correct, Jog, Stop, Home };
-
-// The world as the motor model sees it.  The switches read active where they
-// are actuated; POL bits 4 and 5 invert that at run time.
-motion::MotorConfig motor_config(const SimOptions& o) {
-    const SimWorld& w = o.world;
-    motion::MotorConfig c;  // 3200 steps and 4000 counts per rev: the DMX-CAN's
-    c.index_position = w.z_position;
-    c.index_width_steps = w.z_width;
-    c.home = motion::SwitchConfig{true, w.home_lo, w.home_hi, false};
-    c.minus_limit = motion::SwitchConfig{w.minus_limit.has_value(), w.minus_limit.value_or(0), 0, false};
-    c.plus_limit = motion::SwitchConfig{w.plus_limit.has_value(), w.plus_limit.value_or(0), 0, false};
-    c.tick_ns = o.tick_ns;
-    return c;
-}
-
-}  // namespace
-
-struct Sim::State {
-    Flash flash;       // what STORE writes / boot reads
-    Flash cfg;         // live values of the stored items
-    int active_address = 1;
-    int active_rt = 0;
-
-    // Volatile parameters (not in Table 7.10; reset at boot).
-    std::int64_t hspd = 1000, lspd = 100, acc = 300, dec = 300, edec = 0, scv = 0, hca = 100,
-                 rz = 0, sspdm = 0, inc_mode = 0, eo = 0, user_do = 0, lt = 0, synp = 0,
-                 sync_cond = 1;
-    bool sync_on = false, sync_hit = false;
-    std::int64_t ltp = 0, lte = 0;
-
-    // The motor and its world (rotor, encoder, switches, Z, latch, jam).  It
-    // outlives power cycles: the shaft stays where it is.
-    std::unique_ptr<motion::MotorModel> motor;
-    // X, J, T, SSPD, STOP: the profile model; the motor runs its profile
-    // while arcus_profile is true.
-    ArcusMotion arcus{ArcusProfileParams{}};
-    bool arcus_profile = false;
-    // H, HL, L, Z, ZH (declared after the motor: destroyed before it).
-    std::unique_ptr<ArcusHoming> homing;
-    int homing_listener = 0;  // runs after the homing's own listener
-    int home_direction = 1;   // physical direction of the search
-
-    Job job = Job::None;
-    bool stopping = false;
-    motion::StepNLoop snl{motion::SnlConfig{}};  // the position verification state machine (errors 8..11)
-    bool minus_err = false, plus_err = false;
-
-    bool blocked = false;
-    // The running (or last) motion is an SLM correction: Table 7.5 runs it on
-    // idle current.
-    bool idle_current_motion = false;
-    unsigned inputs = 0;  // DI1..DI6 actuated
-    Nanos idle_since = 0;
-};
-
-// ------------------------------------------------------------------------------
-// Everything below runs with mutex_ held.
-using State = Sim::State;
-
-// The drive's firmware around the motor model: the sim's behaviour, split out
-// of the class so the header stays small.
-class SimEngine {
-public:
-    SimEngine(State& s, const SimOptions& o) : s(s), o(o) {}
-    State& s;
-    const SimOptions& o;
-
-    motion::MotorModel& m() const { return *s.motor; }
-    bool snl_on() const { return s.cfg.sl != 0; }
-    // SLR: pulses per encoder count, the ratio StepNLoop converts with.
-    double slr() const { return static_cast<double>(s.cfg.slr) / 1000.0; }
-    // Position units: encoder counts with StepNLoop (SLR pulses each), pulses
-    // without; POL bit 1 reverses.
-    double steps_per_unit() const { return (snl_on() ? slr() : 1.0) * ((s.cfg.pol & 2) ? -1.0 : 1.0); }
-    int physical_direction(double units_direction) const {
-        const double d = units_direction * steps_per_unit();
-        return d > 0 ? 1 : (d < 0 ? -1 : 0);
-    }
-    std::int64_t pulse() const { return m().pulse_count(); }
-    std::int64_t encoder() const { return m().encoder(); }
-    std::int64_t delta() const { return snl_on() ? pulse() - encoder() : 0; }
-    bool latch_in() const { return bool(s.inputs & 2u) != bool(s.cfg.pol & 64); }
-
-    // POL, SL, EO and the jam into the motor model.
-    void apply_wiring() {
-        using motion::Switch;
-        m().set_steps_per_unit(steps_per_unit());
-        m().set_switch_inverted(Switch::Home, (s.cfg.pol & 32) != 0);
-        m().set_switch_inverted(Switch::MinusLimit, (s.cfg.pol & 16) != 0);
-        m().set_switch_inverted(Switch::PlusLimit, (s.cfg.pol & 16) != 0);
-        apply_jam();
-    }
-    // An unpowered (EO=0) or blocked rotor stays put while the pulses go out.
-    void apply_jam() { m().set_jammed(s.blocked || !s.eo); }
-
-    ArcusProfileParams profile_params(double hspd_override = -1) const {
-        ArcusProfileParams ap;
-        ap.snl_ratio = snl_on() ? slr() : 1.0;
-        // arcus_effective refuses speeds outside 1..6 000 000 PPS; the sim
-        // validates HSPD/LSPD itself, so only clamp what unit conversion moved.
-        const double min_units = 1.0 / ap.snl_ratio;
-        const double max_units = 6'000'000.0 / ap.snl_ratio;
-        const double hspd = hspd_override > 0 ? hspd_override : static_cast<double>(s.hspd);
-        ap.hspd = std::clamp(hspd, min_units, max_units);
-        ap.lspd = std::clamp(static_cast<double>(std::min(s.lspd, s.hspd)), 1e-6, ap.hspd);
-        ap.acc_ms = std::max(static_cast<double>(s.acc), 1e-3);
-        ap.dec_ms = std::max(static_cast<double>(s.dec), 1e-3);
-        ap.edec = s.edec != 0;
-        ap.scv = s.scv != 0;
-        return ap;
-    }
-    void configure_arcus(double hspd_override = -1) {
-        s.arcus.set_params(profile_params(hspd_override));
-        s.arcus.set_sspdm(static_cast<int>(std::clamp<std::int64_t>(s.sspdm, 0, 9)));
-    }
-    void command_arcus() {
-        m().command(s.arcus.profile());
-        s.arcus_profile = true;
-    }
-    double arcus_time() const { return m().profile_time(m().time()); }
-
-    int sls() const {
-        if (!snl_on()) return 12;
-        if (s.snl.in_error()) return static_cast<int>(s.snl.status());
-        switch (s.job) {
-            case Job::None: return 0;
-            case Job::Target: return s.stopping ? 3 : 1;
-            case Job::Correct: return 2;
-            case Job::Jog: return s.stopping ? 3 : 5;
-            case Job::Stop: return 3;
-            case Job::Home: return s.homing ? s.homing->snl_status() : 6;
-        }
-        return 0;
-    }
-
-    // MST bits 0..2.
-    ArcusPhase phase() const {
-        if (!m().moving()) return ArcusPhase::Idle;
-        if (s.arcus_profile) return s.arcus.phase(arcus_time());
-        const double v = m().pulse_velocity(), a = m().commanded_acceleration() * (steps_per_unit() > 0 ? 1 : -1);
-        if (v * a > 0) return ArcusPhase::Accel;
-        if (v * a < 0) return ArcusPhase::Decel;
-        return ArcusPhase::Const;
-    }
-
-    std::int64_t mst() const {
-        std::int64_t v = 0;
-        const auto ph = phase();
-        if (ph == ArcusPhase::Const) v |= 1;
-        if (ph == ArcusPhase::Accel) v |= 2;
-        if (ph == ArcusPhase::Decel) v |= 4;
-        if (m().home_active()) v |= 8;
-        if (m().minus_limit_active()) v |= 16;
-        if (m().plus_limit_active()) v |= 32;
-        if (s.minus_err) v |= 64;
-        if (s.plus_err) v |= 128;
-        if (latch_in()) v |= 256;
-        if (m().index_active()) v |= 512;
-        return v;
-    }
-
-    bool in_position() const {
-        return snl_on() && !m().moving() && !s.snl.in_error() && std::llabs(delta()) <= s.cfg.slt;
-    }
-
-    std::int64_t outputs() const {
-        std::int64_t v = s.user_do & 7;
-        bool dedicated = snl_on() && s.cfg.edo;
-        if (dedicated) {
-            // POL bit 7 inverts the in-position output, bit 8 the alarm (Table 7.2).
-            const bool in_pos = in_position() != ((s.cfg.pol & 128) != 0);
-            const bool alarm = s.snl.in_error() != ((s.cfg.pol & 256) != 0);
-            v = (v & ~std::int64_t{5}) | (in_pos ? 1 : 0) | (alarm ? 4 : 0);
-        }
-        if (s.sync_on) {
-            // EQUAL is a pulse "only when the encoder position and sync position
-            // are equal"; LESS/GREATER stay on once the condition occurred.
-            const bool on = s.sync_cond == 1 ? encoder() == s.synp : s.sync_hit;
-            v = (v & ~std::int64_t{2}) | (on ? 2 : 0);
-        }
-        return v;
-    }
-
-    std::int64_t current(Nanos now) const {
-        if (!s.eo) return 0;
-        bool running = m().moving() || now - s.idle_since < s.cfg.curt * 1'000'000;
-        return running && !s.idle_current_motion ? s.cfg.curr : s.cfg.curi;
-    }
-
-    void configure_snl() {
-        motion::SnlConfig c;
-        c.enabled = snl_on();
-        c.tolerance = static_cast<std::uint32_t>(s.cfg.slt);
-        c.error_range = static_cast<std::uint32_t>(s.cfg.sle);
-        c.max_attempts = static_cast<std::uint32_t>(s.cfg.sla);
-        c.idle_tolerance = static_cast<std::uint32_t>(s.cfg.slm);
-        c.ratio = slr();
-        s.snl.configure(c);
-    }
-
-    // Table 7.7, motor idle: in position, a correction move, or an error.
-    void verify_position(bool idle = false) {
-        if (!snl_on()) return;
-        const double d = static_cast<double>(pulse() - encoder());
-        auto dec = idle ? s.snl.idle_check(d) : s.snl.motion_done(d);
-        if (dec.action != motion::SnlAction::Correct) return;
-        // Re-run the remaining distance at low speed from where the encoder says we are.
-        const double target = m().pulse_position();
-        const double from = target - dec.correction;
-        m().set_pulse_position(from);
-        configure_arcus(static_cast<double>(std::min(s.lspd, s.hspd)));
-        s.idle_current_motion = dec.idle_current;
-        s.job = Job::Correct;
-        s.stopping = false;
-        if (s.arcus.move(from, target) == ArcusReply::Ok) command_arcus();
-        if (!m().moving()) s.job = Job::None;
-    }
-
-    // The motion stopped without a target to verify.
-    void end_job(Nanos t) {
-        s.job = Job::None;
-        s.stopping = false;
-        s.idle_since = t;
-        s.snl.end_without_verification();
-    }
-
-    // A limit in the direction of travel stops the motor at once and latches
-    // the limit error (MST bits 6/7, SLS 11).
-    void limit_stop(int side, Nanos t) {
-        if (s.homing && s.homing->running()) s.homing->abort();
-        m().halt();
-        (side > 0 ? s.plus_err : s.minus_err) = true;
-        s.snl.limit_hit();
-        end_job(t);
-    }
-    // Motion starting into a limit that is already active: the event that
-    // would announce it never comes.
-    void check_limit_at_start(int physical_dir, Nanos t) {
-        if (physical_dir > 0 && m().plus_limit_active()) limit_stop(1, t);
-        else if (physical_dir < 0 && m().minus_limit_active()) limit_stop(-1, t);
-    }
-
-    void check_sync(std::int64_t a, std::int64_t b) {
-        bool hit = false;
-        switch (s.sync_cond) {
-            case 1: hit = std::min(a, b) <= s.synp && s.synp <= std::max(a, b); break;
-            case 2: hit = b < s.synp; break;
-            case 3: hit = b > s.synp; break;
-        }
-        if (hit) s.sync_hit = true;
-    }
-
-    // ---- the motor's events ----
-    void on_event(const motion::MotorEvent& e) {
-        using K = motion::MotorEvent::Kind;
-        switch (e.kind) {
-            case K::PlusLimitOn:
-            case K::MinusLimitOn: {
-                const int side = e.kind == K::PlusLimitOn ? 1 : -1;
-                if (e.direction != side) break;
-                // Limit homing runs onto its limit on purpose: ArcusHoming backs off.
-                if (s.job == Job::Home && s.homing && s.homing->running() &&
-                    s.homing->method() == ArcusHoming::Method::L && side == s.home_direction)
-                    break;
-                limit_stop(side, e.t);
-                break;
-            }
-            case K::ProfileDone:
-                motion_done(e.t);
-                break;
-            default:
-                break;
-        }
-    }
-
-    void motion_done(Nanos t) {
-        s.idle_since = t;
-        switch (s.job) {
-            case Job::Target:
-            case Job::Correct:
-                s.job = Job::None;
-                s.stopping = false;
-                verify_position();
-                break;
-            case Job::Jog:
-            case Job::Stop:
-                end_job(t);
-                break;
-            case Job::Home:  // the homing's own listener decides; after_homing_event ends the job
-            case Job::None:
-                break;
-        }
-    }
-
-    // Runs after ArcusHoming's listener.
-    void after_homing_event(const motion::MotorEvent& e) {
-        if (s.job == Job::Home && s.homing && !s.homing->running()) end_homing(e.t);
-    }
-
-    void end_homing(Nanos t) {
-        if (s.homing->result() == motion::HomingResult::LimitError) {
-            (s.home_direction > 0 ? s.plus_err : s.minus_err) = true;
-            s.snl.limit_hit();
-        }
-        end_job(t);
-    }
-
-    void start_homing(ArcusHoming::Method method, int dir, Nanos now) {
-        if (s.homing) s.homing.reset();
-        if (s.homing_listener) m().remove_listener(s.homing_listener);
-        ArcusHomingOptions ho;
-        ho.hca = static_cast<double>(s.hca);
-        ho.lca = static_cast<double>(s.cfg.lca);
-        ho.rz = s.rz != 0;
-        ho.zero_encoder = true;  // PX and EX both read 0 at home
-        s.homing = std::make_unique<ArcusHoming>(m(), profile_params(), ho);
-        State* sp = &s;
-        const SimOptions* op = &o;
-        s.homing_listener =
-            m().add_listener([sp, op](const motion::MotorEvent& e) { SimEngine(*sp, *op).after_homing_event(e); });
-        s.job = Job::Home;
-        s.stopping = false;
-        s.arcus_profile = false;
-        s.home_direction = physical_direction(dir);
-        s.homing->start(method, dir);
-        if (!s.homing->running()) end_homing(now);
-    }
-
-    // The drive's sampling of the encoder between events: the StepNLoop
-    // delta (stall error 10) and the DO2 sync comparator.
-    void sample(std::int64_t enc_prev) {
-        if (s.sync_on && !s.sync_hit) check_sync(enc_prev, encoder());
-        if (snl_on() && m().moving() &&
-            s.snl.monitor(static_cast<double>(pulse() - encoder())).action == motion::SnlAction::StopNow) {
-            if (s.homing && s.homing->running()) s.homing->abort();
-            m().halt();  // stall error (10)
-            s.job = Job::None;
-            s.stopping = false;
-            s.idle_since = m().time();
-        }
-    }
-
-    // Brings the motor to `now`.  The delta only changes while the rotor is
-    // held (a follower rotor keeps it constant between events), and the sync
-    // comparator only matters while armed: only then is the motion sampled
-    // every tick; otherwise the model runs from event to event.
-    void advance(Nanos now) {
-        while (m().time() < now) {
-            const bool sampled =
-                m().moving() && ((s.sync_on && !s.sync_hit) || (snl_on() && (s.blocked || !s.eo)));
-            if (!sampled) {
-                m().advance_to(now);
-                break;
-            }
-            // A long unobserved stretch is sampled at most ~1e6 times.
-            const Nanos span = now - m().time();
-            const Nanos step = std::min<Nanos>(span, std::max<Nanos>(o.tick_ns, span / 1'000'000));
-            const std::int64_t enc_prev = encoder();
-            m().advance_to(m().time() + step);
-            sample(enc_prev);
-        }
-    }
-};
 
 // ------------------------------------------------------------------------------
 
@@ -415,7 +26,13 @@ Sim::Sim(Clock& clock, SimOptions options)
     State* sp = s_.get();
     const SimOptions* op = &options_;
     s_->motor->add_listener([sp, op](const motion::MotorEvent& e) { SimEngine(*sp, *op).on_event(e); });
-    power_cycle();
+    if (options_.comm_type < 0 || options_.comm_type > 2)
+        throw InvalidArgument("arcus sim comm_type: must be 0 (RS-232), 1 (RS-485) or 2 (CAN)");
+    if (options_.node_id < 1 || options_.node_id > 127) throw InvalidArgument("arcus sim node_id: must be 1..127");
+    if (options_.store_ns < 0 || options_.clear_ns < 0)
+        throw InvalidArgument("arcus sim store/clear duration: must be >= 0");
+    std::lock_guard lock(mutex_);
+    boot();
 }
 
 Sim::Sim(std::shared_ptr<Clock> clock, SimOptions options)
@@ -423,7 +40,7 @@ Sim::Sim(std::shared_ptr<Clock> clock, SimOptions options)
     clock_owner_ = std::move(clock);
 }
 
-Sim::~Sim() = default;
+Sim::~Sim() { detach_can(); }
 
 namespace {
 
@@ -459,7 +76,16 @@ void save_flash(const std::string& path, Flash f) {
 }  // namespace
 
 void Sim::power_cycle() {
-    std::lock_guard lock(mutex_);
+    std::optional<can::Frame> boot_up;
+    {
+        std::lock_guard lock(mutex_);
+        boot();
+        boot_up = boot_up_frame();
+    }
+    if (boot_up) send_frames({*boot_up});
+}
+
+void Sim::boot() {
     State& s = *s_;
     const Nanos now = clock_.now();
     SimEngine(s, options_).advance(now);
@@ -476,10 +102,22 @@ void Sim::power_cycle() {
     s.flash.rt = options_.response_type;
     s.flash.eoboot = options_.eo_boot ? 1 : 0;
     s.flash.sl = options_.snl ? 1 : 0;
+    s.flash.cm = options_.comm_type;
+    s.flash.nid = options_.node_id;
+    if (options_.comm_type == 2) {
+        // A unit set up for CANopen: the CANopen tables' defaults (Tables 8.11,
+        // 8.21; DESIGN.md follows them for the CANopen persona).
+        s.flash.slt = 10;
+        s.flash.curr = 1500;
+        s.flash.curi = 500;
+    }
     load_flash(options_.store_path, s.flash);
     s.cfg = s.flash;
     s.active_address = static_cast<int>(std::clamp<std::int64_t>(s.cfg.dn, 1, 99));
     s.active_rt = s.cfg.rt ? 1 : 0;
+    s.active_cm = static_cast<int>(std::clamp<std::int64_t>(s.cfg.cm, 0, 2));
+    s.active_nid = static_cast<int>(std::clamp<std::int64_t>(s.cfg.nid, 1, 127));
+    s.active_br = static_cast<int>(s.cfg.br);
     s.eo = s.cfg.eoboot ? 1 : 0;
     s.user_do = s.cfg.doboot & 7;
     motion::MotorModel& m = *s.motor;
@@ -578,6 +216,8 @@ std::string Sim::on_line(std::string_view line) {
     if (!req) return "";
     try {
         std::lock_guard lock(mutex_);
+        // Stored as CAN and power-cycled: the serial line is silent (B-A01).
+        if (s_->active_cm == 2) return "";
         if (req->address != kBroadcast && req->address != s_->active_address) return "";
         std::string body = handle(*req);
         if (req->address == kBroadcast) return "";
@@ -587,11 +227,20 @@ std::string Sim::on_line(std::string_view line) {
     }
 }
 
+// The firmware's command interpreter, reached by the CANopen front end: both
+// front ends end in the same commands on the same state.  mutex_ held.
+std::string Sim::command(std::string_view cmd) {
+    Request req;
+    req.address = s_->active_address;
+    req.command = std::string(cmd);
+    return handle(req);
+}
+
 // Runs one command; returns the reply body.  mutex_ held.
 std::string Sim::handle(const Request& req) {
     State& s = *s_;
     SimEngine e(s, options_);
-    Nanos now = clock_.now();
+    Nanos now = at_.value_or(clock_.now());
     e.advance(now);
     motion::MotorModel& m = *s.motor;
 

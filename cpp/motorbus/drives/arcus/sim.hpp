@@ -1,5 +1,9 @@
-// Simulated Arcus DMX-CAN on its ASCII line (RS-232 point-to-point or RS-485
-// multi-drop).  Answers every command of codec.hpp the way manual 000 says,
+// Simulated Arcus DMX-CAN: one drive with two front ends.  On its ASCII line
+// (RS-232 point-to-point or RS-485 multi-drop) it is a LineDevice; attached to
+// a CAN bus (attach_can) it is a CiA DSP-402 node served by SDO (manual 000
+// chapters 8 and 10, sim_canopen.cpp).  Which of the two answers is the stored
+// communication type (CM / 200Ah) read at power-up: a factory-fresh unit talks
+// RS-232, a unit stored as CAN answers on CAN and not on its serial line.  Answers every command of codec.hpp the way manual 000 says,
 // with the motion model running on a motorbus::Clock so tests drive time with
 // SimClock.  Device time advances lazily: every request (and every test hook)
 // first integrates the axis up to clock.now().
@@ -10,6 +14,10 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
+
+#include "motorbus/can/bus.hpp"
+#include "motorbus/can/frame.hpp"
 
 #include "motorbus/drives/arcus/codec.hpp"
 #include "motorbus/runtime/clock.hpp"
@@ -37,7 +45,31 @@ struct SimOptions {
     bool snl = true;            // Table 7.11 ships SL=1
     SimWorld world;
     std::int64_t tick_ns = 100'000;  // integration step
+    // Factory communication type (CM / 200Ah): 0 RS-232 (the real factory
+    // setting), 1 RS-485, 2 CAN (a unit configured for CANopen).  A store file
+    // overrides it.  With 2 the CANopen tables' defaults (Tables 8.11, 8.21)
+    // are the factory values, with 0/1 the ASCII ones (Table 7.11).
+    int comm_type = 0;
+    int node_id = 1;              // factory NID / 200Ch
+    std::int64_t store_ns = 0;    // 200Eh reads 1 this long after a store request
+    std::int64_t clear_ns = 0;    // 200Dh reads 1 this long after a clear request
 };
+
+// One entry of the CANopen object dictionary (manual 000 Table 10.1 with the
+// defaults of Tables 8.1-8.75; spec can-drives.md §3.2).  The simulator serves
+// exactly these; the Python client names and types them from this table.
+struct CanopenObject {
+    std::uint16_t index;
+    std::uint8_t sub;
+    const char* name;
+    const char* type;    // U8 U16 U32 I8 I16 I32 VISIBLE_STRING
+    const char* access;  // ro, rw, wo, const
+    std::int64_t default_value;  // factory / power-on value (CAN persona)
+    std::int64_t low, high;      // accepted range of a write (rw / wo)
+    const char* unit;
+    bool persists;  // saved by the 200Eh store (Table 8.40)
+};
+const std::vector<CanopenObject>& canopen_objects();
 
 class Sim : public serial::LineDevice {
 public:
@@ -68,10 +100,39 @@ public:
     bool busy();                       // outputting pulses
     std::string store_path() const;
 
+    // ---- the CANopen front end (sim_canopen.cpp) ----
+    // Serves the node on `bus` (kept alive until detach_can).  It answers only
+    // while the communication type in effect is CAN; the boot-up frame
+    // 0x700+n [00] is sent now and at every power cycle.
+    void attach_can(std::shared_ptr<can::Bus> bus);
+    void detach_can();  // idempotent
+    // One received frame in, the frames the drive answers out (SDO replies);
+    // an NMT reset node power-cycles the drive (its boot-up is in the result).
+    // What attach_can runs for each frame; public for tests and the fuzzer.
+    std::vector<can::Frame> on_can_frame(const can::Frame& frame);
+    int active_protocol() const;  // communication type in effect: 0, 1 or 2
+    int can_node_id() const;      // node-ID in effect (200Ch at the last boot)
+    int can_bit_rate() const;     // bit-rate code in effect (200Bh at the last boot)
+
     struct State;  // opaque; public only so the implementation's helpers can name it
 
 private:
     std::string handle(const Request& req);
+    std::string command(std::string_view cmd);  // the firmware's command interpreter, lock held
+    void boot();                                // power-up, lock held
+    std::vector<can::Frame> canopen_frame(const can::Frame& frame, bool& reset);  // lock held
+    std::optional<can::Frame> boot_up_frame() const;  // lock held
+    std::uint32_t od_read(std::uint16_t index, std::uint8_t sub, std::uint32_t& value, int& size);
+    std::uint32_t od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, int size);
+    void controlword(std::uint16_t value);
+    void canopen_service();  // buffered set-points, PV restarts, error -> Fault
+    void send_frames(const std::vector<can::Frame>& frames);
+    // While set, the firmware runs a command at this (past) instant rather than
+    // at clock.now(): a buffered set-point starts exactly where the previous move ended.
+    std::optional<Nanos> at_;
+    std::mutex bus_mutex_;
+    std::shared_ptr<can::Bus> bus_;
+    std::vector<can::SubscriptionId> subs_;
     mutable std::mutex mutex_;
     std::shared_ptr<Clock> clock_owner_;
     Clock& clock_;

@@ -1,0 +1,520 @@
+"""The Arcus DMX-CAN-23 over CANopen (CiA DSP-402, SDO only): client, simulator, Drive adapter.
+
+    import motorbus
+    with motorbus.open_drive("arcus-canopen", bus="socketcand:127.0.0.1:29536/can0", address=1) as axis:
+        axis.enable()
+        axis.move_to(4000)                  # profile position (encoder counts with StepNLoop)
+        axis.home(19)                       # manual 000's method 19: home input, positive
+        axis.params["Run current"] = 1200   # 2004h:02, by name or "0x2004:02"
+
+It is the same drive as the ASCII kind ``arcus``: one simulator (``_core.ArcusSim``)
+with two front ends.  Which one answers is the communication type stored in
+200Ah (ASCII ``CM``) at the last power-up: a factory-fresh unit talks RS-232;
+``make_sim(1, protocol="canopen")`` gives a unit set up for CAN.
+
+The native client :class:`ArcusCanopen` is the generic CiA 402 host
+(``motorbus.canopen.Cia402``) plus the Arcus objects 2000h-200Eh, typed and
+named, the manual's homing methods and the clear-error (200Dh) and store (200Eh)
+handshakes.  The manual documents no heartbeat, PDO or EMCY: the drive has no
+communication watchdog.  On a cut cable the motor finishes (or keeps running)
+what it was last told; the adapter stops it when the ``with`` block fails or
+the program exits, and the next call raises ``LinkDown``/``TimeoutError``.
+"""
+from __future__ import annotations
+
+import enum
+import time
+from typing import Any, Optional, Union
+
+from .. import _core
+from ..canopen.cia402 import Cia402, Controlword, OpMode
+from ..drive import Capability, DriveStatus, ParamInfo, Params, Units
+from ..registry import DrivePlugin
+from .cia402 import Cia402Drive
+
+__all__ = ["ArcusCanopen", "ArcusCanopenDrive", "ArcusCanopenSim", "ArcusHomingMethod", "BitRate",
+           "CommType", "SnlStatus", "OBJECTS", "PLUGIN", "make_sim", "open"]
+
+# (index, sub, name, type, access, default, low, high, unit, persists): the OD the
+# simulator serves (Table 10.1), from the C++ table.
+OBJECTS = [tuple(row) for row in _core.arcus_canopen_objects()]
+_BY_KEY = {(r[0], r[1]): r for r in OBJECTS}
+_SIZES = {"U8": 1, "I8": 1, "U16": 2, "I16": 2, "U32": 4, "I32": 4}
+
+_SW_TARGET_REACHED = 1 << 10
+_SW_BIT12 = 1 << 12
+_SW_BIT13 = 1 << 13
+_CW_HALT = 1 << 8
+
+
+class ArcusHomingMethod(enum.IntEnum):
+    """6098h as manual 000 §8 defines it (its directions, not CiA 402's: C-A06)."""
+    HOME_Z_POSITIVE = 7
+    HOME_Z_NEGATIVE = 11
+    LIMIT_POSITIVE = 17
+    LIMIT_NEGATIVE = 18
+    HOME_POSITIVE = 19
+    HOME_NEGATIVE = 20
+    Z_POSITIVE = 33
+    Z_NEGATIVE = 34
+    CURRENT_POSITION = 35
+
+
+class CommType(enum.IntEnum):
+    """200Ah (in effect after a store and a power cycle)."""
+    RS232 = 0
+    RS485 = 1
+    CAN = 2
+
+
+class BitRate(enum.IntEnum):
+    """200Bh codes (Table 8.36; no 25 kbit/s)."""
+    K10 = 1
+    K20 = 2
+    K50 = 3
+    K100 = 4
+    K125 = 5
+    K250 = 6
+    K500 = 7
+    K800 = 8
+    M1 = 9
+
+
+class SnlStatus(enum.IntEnum):
+    """2003h StepNLoop status (Table 8.14)."""
+    IDLE = 0
+    MOVING = 1
+    CORRECTING = 2
+    STOPPING = 3
+    ABORTING = 4
+    JOGGING = 5
+    HOMING = 6
+    Z_HOMING = 7
+    CORRECTION_RANGE_ERROR = 8
+    CORRECTION_ATTEMPT_ERROR = 9
+    STALL_ERROR = 10
+    LIMIT_ERROR = 11
+    NOT_AVAILABLE = 12
+    LIMIT_HOMING = 13
+
+
+def _check_node(address: Union[str, int]) -> str:
+    text = str(address).strip()
+    try:
+        node = int(text, 0)
+    except ValueError:
+        raise _core.InvalidArgument(f"arcus-canopen address: a node-ID 1..127 (200Ch), not {address!r}") from None
+    if not 1 <= node <= 127:
+        raise _core.InvalidArgument(f"arcus-canopen address: node-ID {node} is outside 1..127")
+    return str(node)
+
+
+def _encode(row: tuple, value: int) -> bytes:
+    index, sub, name, dtype, access, default, low, high = row[:8]
+    if not isinstance(value, int) or isinstance(value, bool):
+        raise _core.InvalidArgument(f"arcus-canopen {name} (0x{index:04X}:{sub:02X}): an integer, not {value!r}")
+    if not low <= value <= high:
+        raise _core.InvalidArgument(f"arcus-canopen {name} (0x{index:04X}:{sub:02X}): {value} is outside "
+                                    f"{low}..{high}")
+    return int(value).to_bytes(_SIZES[dtype], "little", signed=dtype.startswith("I"))
+
+
+def _decode(row: tuple, data: bytes) -> Any:
+    dtype = row[3]
+    if dtype == "VISIBLE_STRING":
+        return data.decode("latin-1")
+    return int.from_bytes(data, "little", signed=dtype.startswith("I"))
+
+
+class ArcusCanopen(Cia402):
+    """The DMX-CAN's CANopen persona from the host: the CiA 402 state machine of
+    :class:`motorbus.canopen.Cia402` plus the Arcus objects, typed and named.
+
+    ``ArcusCanopen(bus, node=1, timeout=1.0)``; every access is one expedited SDO
+    (the drive knows no other transfer)."""
+
+    def read(self, index: int, sub: int = 0) -> Any:
+        """One object of Table 10.1, decoded by its type."""
+        row = _BY_KEY.get((index, sub))
+        if row is None:
+            raise _core.InvalidArgument(f"arcus-canopen: 0x{index:04X}:{sub:02X} is not in the object dictionary")
+        return _decode(row, bytes(self.sdo.upload(index, sub)))
+
+    def write(self, index: int, sub: int, value: int) -> None:
+        """One writable object, range-checked against the manual before it is sent."""
+        row = _BY_KEY.get((index, sub))
+        if row is None:
+            raise _core.InvalidArgument(f"arcus-canopen: 0x{index:04X}:{sub:02X} is not in the object dictionary")
+        if row[4] not in ("rw", "wo"):
+            raise _core.InvalidArgument(f"arcus-canopen {row[2]} (0x{index:04X}:{sub:02X}) is read-only")
+        self.sdo.download(index, sub, _encode(row, value))
+
+    # ---- Arcus objects (2000h-200Eh) ----
+    def _prop(index: int, sub: int = 0, wrap: Any = None, doc: str = ""):  # noqa: N805 - class-body helper
+        def get(self: "ArcusCanopen") -> Any:
+            v = self.read(index, sub)
+            return wrap(v) if wrap is not None else v
+
+        def put(self: "ArcusCanopen", value: Any) -> None:
+            self.write(index, sub, int(value))
+        row = _BY_KEY[(index, sub)]
+        writable = row[4] in ("rw", "wo")
+        return property(get, put if writable else None, doc=doc or f"{row[2]} (0x{index:04X}:{sub:02X})")
+
+    alarm_in_position_enable = _prop(0x2000, 0, bool)
+    snl_enable = _prop(0x2001, 1, bool, "StepNLoop on: positions and speeds are encoder counts (4000/rev)")
+    snl_max_attempts = _prop(0x2001, 2)
+    snl_tolerance = _prop(0x2001, 3)
+    snl_idle_tolerance = _prop(0x2001, 4)
+    snl_error_range = _prop(0x2001, 5)
+    snl_delta = _prop(0x2002)
+    snl_status = _prop(0x2003, 0, SnlStatus)
+    current = _prop(0x2004, 1, doc="Real-time current, mA (run current while moving, idle current after idle time)")
+    run_current = _prop(0x2004, 2)
+    idle_current = _prop(0x2004, 3)
+    idle_time = _prop(0x2004, 4)
+    output_boot_state = _prop(0x2005)
+    enable_boot_state = _prop(0x2006, 0, bool)
+    latch_enable = _prop(0x2007, 0, bool)
+    latch_status = _prop(0x2008)
+    latched_pulse_position = _prop(0x2009, 1)
+    latched_encoder_position = _prop(0x2009, 2)
+    comm_type = _prop(0x200A, 0, CommType, "200Ah: in effect after store() and a power cycle")
+    bit_rate = _prop(0x200B, 0, BitRate, "200Bh: in effect after store() and a power cycle")
+    node_id = _prop(0x200C, 0, doc="200Ch: in effect after store() and a power cycle")
+    home_offset = _prop(0x607C)
+    polarity = _prop(0x607E, 0, doc="607Eh: bit 7 negates positions, bit 6 velocities")
+    motion_profile_type = _prop(0x6086, 0, doc="0 trapezoidal, 1 S-curve")
+    profile_velocity = _prop(0x6081)
+    end_velocity = _prop(0x6082)
+    profile_acceleration = _prop(0x6083, 0, doc="ms to reach 6081h (clamped to Appendix A at the move)")
+    profile_deceleration = _prop(0x6084, 0, doc="ms from 6081h to 6082h")
+    home_switch_speed = _prop(0x6099, 1)
+    home_zero_speed = _prop(0x6099, 2)
+    homing_acceleration = _prop(0x609A)
+    position = _prop(0x6064, 0, doc="6064h: pulses (StepNLoop off) or encoder counts (on)")
+    velocity = _prop(0x606C)
+    digital_inputs = _prop(0x60FD)
+    digital_outputs = _prop(0x60FE)
+    del _prop
+
+    @property
+    def counts_per_rev(self) -> int:
+        """Position units per motor revolution: 4000 encoder counts with StepNLoop on,
+        3200 pulses (16 microsteps of a 1.8 deg motor) with it off (manual 000 §7)."""
+        return 4000 if self.read(0x2001, 1) else 3200
+
+    # ---- handshakes ----
+    def _handshake(self, index: int, what: str, timeout: float) -> None:
+        self.write(index, 0, 1)
+        deadline = time.monotonic() + timeout
+        while self.read(index, 0) != 0:
+            if time.monotonic() > deadline:
+                raise _core.TimeoutError(f"arcus-canopen: {what} (0x{index:04X}) still reads 1 after {timeout} s")
+            time.sleep(0.002)
+
+    def clear_errors(self, timeout: float = 1.0) -> None:
+        """200Dh: the drive clears limit, StepNLoop and motor errors and resets the
+        object to 0 (Fig. 8.1); waits for that, then resets the CiA 402 fault."""
+        self._handshake(0x200D, "clear error", timeout)
+        if self.state == "FAULT":
+            self.fault_reset()
+
+    def store(self, timeout: float = 2.0) -> None:
+        """200Eh: saves Table 8.40's objects to flash (Fig. 8.2); 200Ah/200Bh/200Ch
+        take effect at the next power cycle."""
+        self._handshake(0x200E, "store", timeout)
+
+    def home_arcus(self, method: Union[int, ArcusHomingMethod, None] = None, timeout: float = 30.0) -> None:
+        """Homing with manual 000's methods (7, 11, 17-20, 33-35), waited for."""
+        if method is not None:
+            method = ArcusHomingMethod(int(method)) if int(method) in set(ArcusHomingMethod) else method
+            if not isinstance(method, ArcusHomingMethod):
+                raise _core.InvalidArgument(f"arcus-canopen home: method 7, 11, 17-20 or 33-35, not {method!r}")
+        self.set_mode(OpMode.HOMING)
+        self.home(None if method is None else int(method), timeout)
+
+
+class ArcusCanopenSim:
+    """One simulated DMX-CAN (``_core.ArcusSim``) served on a CAN bus.
+
+    ``core`` is the whole drive: the same object answers ASCII lines
+    (``core.on_line``, a LineDevice for the pty server) while its stored
+    communication type is RS-232/485, and SDO on the bus while it is CAN."""
+
+    def __init__(self, core: Any) -> None:
+        self.core = core
+        self.bus: Optional[_core.Bus] = None
+
+    def attach(self, bus: _core.Bus) -> "ArcusCanopenSim":
+        """Serve the CAN front end on ``bus`` (boot-up 0x700+n sent now when CAN is in effect)."""
+        self.core.attach_can(bus)
+        self.bus = bus
+        return self
+
+    def close(self) -> None:
+        self.core.detach_can()
+        self.bus = None
+
+    def __getattr__(self, name: str) -> Any:  # test hooks: force_limit, power_cycle, positions...
+        return getattr(self.core, name)
+
+
+_SIM_OPTIONS = ("protocol", "store_path", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
+                "start_position", "tick", "store_time", "clear_time", "ascii_address")
+
+
+def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, *,
+             bus: Optional[_core.Bus] = None, protocol: str = "canopen", ascii_address: int = 1,
+             **options: Any) -> ArcusCanopenSim:
+    """A simulated DMX-CAN at node-ID ``address``.  ``protocol="canopen"``: a unit set
+    up for CAN (200Ah = 2, the CANopen tables' defaults); ``"ascii"``: factory-fresh
+    (RS-232).  A ``store_path`` file written by either persona overrides both.
+    Other options: those of ``_core.ArcusSim`` (home, limits, snl, eo_boot, tick...)."""
+    unknown = set(options) - set(_SIM_OPTIONS)
+    if unknown:
+        raise _core.InvalidArgument(f"arcus-canopen sim options: unknown {sorted(unknown)}; known {sorted(_SIM_OPTIONS)}")
+    if protocol not in ("canopen", "ascii"):
+        raise _core.InvalidArgument(f"arcus-canopen sim protocol: 'canopen' or 'ascii', not {protocol!r}")
+    node = int(_check_node(address))
+    core = _core.ArcusSim(clock, address=int(ascii_address), node_id=node,
+                          comm_type=2 if protocol == "canopen" else 0, **options)
+    sim = ArcusCanopenSim(core)
+    if bus is not None:
+        sim.attach(bus)
+    return sim
+
+
+# ---- the Drive adapter ----------------------------------------------------------------
+
+def _key(index: int, sub: int) -> str:
+    return f"0x{index:04X}" + (f":{sub:02X}" if sub else "")
+
+
+class ArcusCanopenParams(Params):
+    """Objects by index (``"0x6081"``, ``"0x2001:03"``, ``"2001h:03"``) or by name
+    (``"Run current"``), read and written by SDO."""
+
+    def _names(self) -> list[str]:
+        return [_key(r[0], r[1]) for r in OBJECTS]
+
+    def _key(self, name: str) -> str:
+        name = super()._key(name).strip()
+        for r in OBJECTS:
+            if name.lower() == r[2].lower():
+                return _key(r[0], r[1])
+        text = name[:-1] if name.lower().endswith("h") and ":" not in name else name
+        idx, _, sub = text.partition(":")
+        idx = idx[:-1] if idx.lower().endswith("h") else idx
+        try:
+            return _key(int(idx, 16), int(sub, 16) if sub else 0)
+        except ValueError:
+            return name
+
+    def _row(self, name: str) -> Optional[tuple]:
+        for r in OBJECTS:
+            if _key(r[0], r[1]) == name:
+                return r
+        return None
+
+    def _info(self, name: str) -> Optional[ParamInfo]:
+        r = self._row(name)
+        if r is None:
+            return None
+        index, sub, n, dtype, access, default, low, high, unit, persists = r
+        writable = access in ("rw", "wo")
+        return ParamInfo(name=name, type="str" if dtype == "VISIBLE_STRING" else "int",
+                         minimum=low if writable else None, maximum=high if writable else None, unit=unit,
+                         default=default, persists=bool(persists), writable=writable, description=n)
+
+    def _read(self, info: ParamInfo) -> Any:
+        r = self._row(info.name)
+        return self._drive.native.read(r[0], r[1])
+
+    def _write(self, info: ParamInfo, value: Any) -> None:
+        r = self._row(info.name)
+        self._drive.native.write(r[0], r[1], int(value))
+
+
+class ArcusCanopenDrive(Cia402Drive):
+    """A DMX-CAN on CANopen behind :class:`motorbus.Drive` (the generic CiA 402
+    adapter with the Arcus differences: no watchdog, no 603Fh, the manual's
+    homing methods, clear-error and store handshakes).
+
+    Native units: encoder counts and counts/s with StepNLoop on (2001h:01 = 1, the
+    default), pulses and pulses/s with it off.  No watchdog (the manual documents
+    no heartbeat): on link loss the motor keeps doing what it was last told and
+    the next call raises; the adapter stops it when a ``with`` block fails or the
+    program exits (``on_error``/``on_exit``)."""
+
+    kind = "arcus-canopen"
+    capabilities = frozenset({Capability.POSITION, Capability.VELOCITY, Capability.HOMING, Capability.ENCODER,
+                              Capability.STORE})
+    has_watchdog = False
+
+    def _refused(self, what: str) -> None:
+        state = self.native.state
+        if state != "OPERATION ENABLED":
+            raise _core.DriveFault(f"arcus-canopen: {what} refused in state {state} (enable() first"
+                                   f"{', clear_faults()' if state == 'FAULT' else ''})")
+
+    def _snl_text(self) -> str:
+        try:
+            return SnlStatus(self.native.read(0x2003)).name
+        except ValueError:
+            return "?"
+
+    def _home(self, method: Any) -> None:
+        self._operation_enabled()
+        self._use_mode(OpMode.HOMING)
+        if method is not None:
+            if isinstance(method, bool) or not isinstance(method, int) or int(method) not in set(ArcusHomingMethod):
+                raise _core.InvalidArgument(f"arcus-canopen home: method 7, 11, 17-20 or 33-35, not {method!r}")
+            self.native.write(0x6098, 0, int(method))
+        self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
+        self.native.write_controlword(int(Controlword.ENABLE_OPERATION) | (1 << 4))
+
+    def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
+        # A single set-point (controlword bit 5 = 0), as the ASCII persona's X: manual 000
+        # makes bit 5 = 1 a buffered "set of set-points" (native.move_to(..., immediate=True)).
+        try:
+            self._use_mode(OpMode.PROFILE_POSITION)
+            if velocity is not None:
+                self._u32(0x6081, velocity)  # stays the profile velocity for later moves too
+            self.native.move_to(int(round(target)), relative=relative, immediate=False)
+        except _core.TimeoutError:
+            # Not acknowledged: say why (checked only on failure: it costs SDO reads).
+            self._refused("move")
+            if self._velocity() != 0:
+                raise _core.DriveFault("arcus-canopen: move refused while the motor moves (the drive takes "
+                                       "a single set-point once the move is done; stop() first)") from None
+            raise
+
+    def _jog(self, velocity: float) -> None:
+        # Refused before anything is sent when the drive cannot run; a jog that the
+        # drive takes and then ends in a limit error is a fault seen in status.
+        self._refused("jog")
+        try:
+            self._use_mode(OpMode.PROFILE_VELOCITY)
+        except _core.TimeoutError:
+            # 6061h follows a new mode only once the motor is idle (B-A10).
+            if self._velocity() != 0:
+                raise _core.DriveFault("arcus-canopen: jog refused while the motor moves a set-point "
+                                       "(stop() first)") from None
+            raise
+        self.native.set_velocity(int(round(velocity)))
+
+    def _homing_done(self) -> bool:
+        sw = self.native.statusword
+        if (sw & 0x4F) == 0x08:
+            raise _core.DriveFault(f"arcus-canopen: fault during homing (StepNLoop status {self._snl_text()})")
+        if sw & _SW_BIT13:
+            self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
+            raise _core.DriveFault("arcus-canopen: homing error (statusword bit 13)")
+        if (sw & (_SW_BIT12 | _SW_TARGET_REACHED)) == (_SW_BIT12 | _SW_TARGET_REACHED):
+            self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
+            return True
+        return False
+
+    def _is_idle(self) -> bool:
+        sw = self.native.statusword
+        if (sw & 0x4F) == 0x08:
+            raise _core.DriveFault(f"arcus-canopen: fault while moving (StepNLoop status {self._snl_text()})")
+        return bool(sw & _SW_TARGET_REACHED) and self._velocity() == 0
+
+    def _clear_faults(self) -> None:
+        self.native.clear_errors()
+
+    def _store(self) -> None:
+        self.native.store()
+
+    def _status(self) -> DriveStatus:
+        sw = self.native.statusword
+        state = _core.cia402_decode_statusword(sw)
+        inputs = self.native.read(0x60FD)
+        velocity = self._velocity()
+        mode = self._mode
+        fault = state in ("FAULT", "FAULT REACTION ACTIVE")
+        at_target = bool(sw & _SW_TARGET_REACHED)
+        homed = mode == OpMode.HOMING and bool(sw & _SW_BIT12)
+        self._homed = getattr(self, "_homed", False) or homed
+        text = (f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}, "
+                f"StepNLoop {self._snl_text()}")
+        return DriveStatus(enabled=state == "OPERATION ENABLED", moving=velocity != 0 or not at_target,
+                           homed=self._homed, fault=fault, at_target=at_target,
+                           limit_positive=bool(inputs & 2), limit_negative=bool(inputs & 1), raw=sw, text=text)
+
+    def _make_params(self) -> Params:
+        return ArcusCanopenParams(self)
+
+    def start_watchdog(self, *args: Any, **kwargs: Any) -> None:
+        raise _core.InvalidArgument("arcus-canopen: the DMX-CAN documents no heartbeat; it has no watchdog")
+
+
+def open(*, line: Any = None, bus: Any = None, address: str = "1", units: Optional[Units] = None,
+         timeout: float = 1.0, on_error: Optional[str] = "quick_stop",
+         on_exit: Optional[str] = "quick_stop") -> ArcusCanopenDrive:  # noqa: A001 - the plugin's verb
+    """``open_drive("arcus-canopen", bus=..., address=1)``."""
+    from ..bus import open_bus
+
+    if line is not None:
+        raise _core.InvalidArgument("arcus-canopen: a CAN drive takes bus=, not line= (the ASCII persona is 'arcus')")
+    if bus is None:
+        raise _core.InvalidArgument("arcus-canopen: bus= (a bus or a bus address) is required")
+    owns = isinstance(bus, str)
+    b = open_bus(bus) if owns else bus
+    try:
+        host = ArcusCanopen(b, int(_check_node(address)), timeout=timeout, on_error=None, on_exit=None)
+        drive = ArcusCanopenDrive(host, units=units, on_error=on_error, on_exit=on_exit,
+                                  close_native=b.close if owns else None)
+    except Exception:
+        if owns:
+            b.close()
+        raise
+    return drive
+
+
+PLUGIN = DrivePlugin(
+    kind="arcus-canopen",
+    description="Arcus DMX-CAN integrated stepper, CANopen CiA DSP-402 by SDO (the CAN persona of 'arcus')",
+    transport="can",
+    open=open,
+    make_sim=make_sim,
+    check_address=_check_node,
+    default_address="1",
+    sim_options=_SIM_OPTIONS,
+    store_options=lambda store_dir, address: {"store_path": __import__("os").path.join(
+        store_dir, f"arcus-canopen-{address}.store")},
+)
+
+
+def object_dictionary() -> "_core.ObjectDictionary":
+    """Table 10.1 as a motorbus ObjectDictionary (types, access, defaults, ranges), for
+    tools and for the EDS (:func:`eds_text`).  The simulator serves the same table."""
+    od = _core.ObjectDictionary()
+    records = sorted({r[0] for r in OBJECTS if r[1] != 0})
+    names = {0x1018: "Identity", 0x2001: "StepNLoop parameters", 0x2004: "Driver settings",
+             0x2009: "Latch positions", 0x6099: "Homing speeds"}
+    for index in records:
+        od.add_record(index, names.get(index, f"0x{index:04X}"))
+    for (index, sub, name, dtype, access, default, low, high, _unit, _persists) in OBJECTS:
+        if index in records and sub == 0:
+            continue  # the record's "number of entries" comes with the record
+        kwargs: dict = {"access": access}
+        if dtype == "VISIBLE_STRING":
+            kwargs["default"] = "DMC"
+        else:
+            kwargs["default"] = int(default)
+            if access in ("rw", "wo"):
+                kwargs.update(low=int(low), high=int(high))
+        dt = {"I8": "I8", "I16": "I16", "I32": "I32"}.get(dtype, dtype)
+        if index in records:
+            od.add_member(index, sub, name, dt, **kwargs)
+        else:
+            od.add_variable(index, name, dt, **kwargs)
+    return od
+
+
+def eds_text() -> str:
+    """The DMX-CAN's EDS as generated from Table 10.1 (``cpp/motorbus/drives/arcus/canopen.eds``)."""
+    return object_dictionary().to_eds()
