@@ -34,6 +34,7 @@ import itertools
 import math
 import os
 import re
+import time
 import tomllib
 from dataclasses import dataclass, field
 from typing import Any, Iterator, Mapping, Optional, Sequence
@@ -42,7 +43,7 @@ from . import _core, registry
 from .bus import open_bus
 from .drive import Drive, DriveStatus, Units
 
-__all__ = ["Bench", "BenchFileError", "AxisConfig", "ParamDiff"]
+__all__ = ["Bench", "BenchFileError", "AxisConfig", "ParamDiff", "StartReport"]
 
 _SECTIONS = ("bus", "line", "axis")
 _BUS_KEYS = {"spec"}
@@ -132,6 +133,20 @@ class ParamDiff:
     name: str
     file_value: Any
     drive_value: Any
+
+
+@dataclass(frozen=True)
+class StartReport:
+    """How closely ``Bench.move_together`` started its axes.
+
+    ``offsets[axis]``: seconds from the first axis's command being accepted to this
+    axis's (0 for the first); ``skew`` = the largest offset.  ``method`` says how the
+    start was made ("software": commands sent back to back, each axis starting when
+    its own command arrives)."""
+
+    method: str
+    offsets: dict
+    skew: float
 
 
 class _Checker:
@@ -418,6 +433,30 @@ class Bench:
     def select(self, names: Optional[Sequence[str]] = None) -> dict[str, Drive]:
         """The named axes (all when ``names`` is empty), each name checked."""
         return {n: self[n] for n in names} if names else self.axes
+
+    def move_together(self, targets: Mapping[str, float], *, relative: bool = False,
+                      velocity: Optional[float] = None, wait: bool = True,
+                      timeout: Optional[float] = None) -> StartReport:
+        """Starts moves on several axes as close together as the links allow and
+        reports the measured skew.  The commands go back to back (serial axes of one
+        line in turn, CAN axes as fast as the bus answers); a drive-level
+        synchronised start (DMAC SYNCHRO, a SYNC-triggered CANopen start) is not
+        used yet, so the skew is what one command round trip per axis costs."""
+        drives = {name: self[name] for name in targets}
+        if not drives:
+            raise _core.InvalidArgument("move_together: no axis given")
+        offsets: dict[str, float] = {}
+        t0: Optional[float] = None
+        for name, d in drives.items():
+            move = d.move_by if relative else d.move_to
+            move(targets[name], velocity=velocity, wait=False)
+            now = time.perf_counter()
+            t0 = now if t0 is None else t0
+            offsets[name] = now - t0
+        if wait:
+            for d in drives.values():
+                d.wait_idle(timeout)
+        return StartReport("software", offsets, max(offsets.values()))
 
     def status(self) -> dict[str, DriveStatus]:
         return {name: d.status for name, d in self._axes.items()}

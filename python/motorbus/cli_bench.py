@@ -6,6 +6,7 @@
     motorbus stop BENCH [AXIS...] [--quick] [--sim]
     motorbus config read|diff|apply|store BENCH [--axis NAME]... [--all] [--sim]
     motorbus scan [--serial PORT]... [--can SPEC]... [--kind KIND]... [--write BENCH] [--timeout S]
+    motorbus terminal BENCH AXIS [--sim]     (the drive's own protocol, line by line, with history)
 
 Exit codes: 0 done; 1 a drive refused or failed (the message says which axis
 and why); 2 the command line or the bench file is wrong (``file:line: key:
@@ -16,6 +17,7 @@ bench's simulated twin (every axis replaced by its simulator).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from typing import Any, Callable, Optional, Sequence
 
@@ -181,6 +183,51 @@ def cmd_scan(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def cmd_terminal(args: argparse.Namespace) -> int:
+    """Reads lines (a prompt with history on a terminal, plain lines from a pipe), sends
+    each in the axis's own protocol and prints the answer; errors are printed and the
+    console goes on.  `quit`, `exit` or end of input leave (the axis is stopped)."""
+    interactive = sys.stdin.isatty()
+    history = os.path.expanduser("~/.motorbus_history")
+    if interactive:
+        try:
+            import readline
+            try:
+                readline.read_history_file(history)
+            except OSError:
+                pass
+        except ImportError:  # pragma: no cover - readline is in every CPython on Linux
+            readline = None  # type: ignore[assignment]
+
+    def work(bench: Bench) -> int:
+        d = bench[args.axis]
+        if interactive:
+            _say(f"{args.axis}: {d.kind} — its own protocol; 'quit' leaves")
+        while True:
+            try:
+                line = input(f"{args.axis}> " if interactive else "")
+            except EOFError:
+                break
+            except KeyboardInterrupt:
+                print()
+                continue
+            if line.strip() in ("quit", "exit"):
+                break
+            if not line.strip():
+                continue
+            try:
+                _say(d.console(line))
+            except _core.MotorbusError as e:
+                _say(f"! {type(e).__name__}: {e}")
+        if interactive and readline is not None:
+            try:
+                readline.write_history_file(history)
+            except OSError:
+                pass
+        return EXIT_OK
+    return _with_bench(args, work)
+
+
 def add_commands(sub: Any) -> None:
     """Adds the bench commands to the top-level parser's subparsers."""
     def bench_parser(name: str, help: str) -> argparse.ArgumentParser:
@@ -216,6 +263,9 @@ def add_commands(sub: Any) -> None:
     p.add_argument("--reply-timeout", type=float, default=0.05, help="wait per serial address (s)")
     p.add_argument("--quiet", action="store_true", help="no progress output")
     p.set_defaults(func=cmd_scan)
+    p = bench_parser("terminal", "an interactive console in the axis's own protocol, with history")
+    p.add_argument("axis")
+    p.set_defaults(func=cmd_terminal)
     p = sub.add_parser("config", help="read, compare, apply or store the bench file's drive parameters")
     p.add_argument("action", choices=("read", "diff", "apply", "store"))
     p.add_argument("bench", metavar="BENCH")

@@ -272,6 +272,10 @@ class Drive(abc.ABC):
     def _close(self) -> None:
         """Release what the vendor opened (the native client); the link is closed by Drive."""
 
+    def _console(self, line: str) -> str:
+        """One request in the drive's own protocol -> its answer as text (`console`)."""
+        raise _core.InvalidArgument(f"{self.kind}: this drive has no protocol console")
+
     # ---- commands ------------------------------------------------------------------
     def enable(self) -> None:
         """Power the motor (the drive holds position)."""
@@ -335,6 +339,16 @@ class Drive(abc.ABC):
         """Clear latched faults (limit errors, drive faults) so it accepts motion again."""
         self._check_open()
         self._clear_faults()
+
+    def console(self, line: str) -> str:
+        """Sends one request in the drive's own protocol and returns the answer as text:
+        what ``motorbus terminal`` types (ASCII commands for serial drives, SDO reads and
+        writes for CANopen drives...; the vendor's docs give the syntax).  Bypasses the
+        Drive's bookkeeping: a move started here is not known to ``wait_idle``."""
+        self._check_open()
+        if not isinstance(line, str):
+            raise _core.InvalidArgument(f"{self.kind} console: a line of text, not {type(line).__name__}")
+        return self._console(line.strip())
 
     def store(self) -> None:
         """Persist the parameters in the drive's non-volatile memory."""

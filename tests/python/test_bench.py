@@ -268,3 +268,55 @@ def test_ctrl_c_during_a_cli_move_stops_the_axis(tmp_path):
     assert "axis stopped" in err
     pos = float(out.split()[1])
     assert 0 < pos < 100
+
+
+def test_move_together_reports_the_skew(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text(GOOD.replace("[axis.z]", '[axis.w]\nkind = "arcus"\nline = "rs485"\naddress = 2\n'
+                                          'units = { name = "mm", scale = 0.0025 }\n\n[axis.z]'))
+    with Bench.load(p, sim=True) as bench:
+        for d in bench.axes.values():
+            d.enable()
+        report = bench.move_together({"x": 1.0, "w": 2.0, "z": 300}, timeout=30)
+        assert report.method == "software"
+        assert list(report.offsets) == ["x", "w", "z"] and report.offsets["x"] == 0
+        assert report.skew == max(report.offsets.values()) > 0
+        assert bench["x"].position == pytest.approx(1.0, abs=0.0025)
+        assert bench["w"].position == pytest.approx(2.0, abs=0.0025)
+        assert bench["z"].position == pytest.approx(300, abs=1)
+
+
+def test_console_speaks_each_drives_own_protocol(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text(GOOD)
+    with Bench.load(p, sim=True) as bench:
+        x, z = bench["x"], bench["z"]
+        assert x.console("HSPD=4321") == "OK" and x.console("HSPD") == "4321"
+        assert x.params["HSPD"] == 4321
+        with pytest.raises(motorbus.MotorbusError):
+            x.console("FOO")
+        assert z.console("w 0x6081 20000 u32") == "OK"
+        assert z.console("r 0x6081 u32") == "20000"
+        assert z.console("r 0x6041").startswith("40 06")
+        with pytest.raises(motorbus.SdoAbortError):
+            z.console("r 0x9999")
+        with pytest.raises(motorbus.InvalidArgument, match="INDEX"):
+            z.console("bogus")
+
+
+def test_terminal_command_reads_lines_and_keeps_going_after_errors(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text(GOOD)
+    r = subprocess.run([sys.executable, "-m", "motorbus", "terminal", str(p), "x", "--sim"],
+                       input="HSPD=2500\nFOO\nHSPD\nquit\n", capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines() == ["OK", "! ArcusUnknownCommand: arcus: FOO -> ?FOO", "2500"]
+
+
+def test_dmac_console(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text('[line.l]\nport = "/dev/ttyUSB9"\n[axis.y]\nkind = "dmac"\nline = "l"\naddress = 3\n')
+    with Bench.load(p, sim=True) as bench:
+        y = bench["y"]
+        assert y.console("#HIGH_SPEED:=50000") == "OK"
+        assert y.console("READ #HIGH_SPEED") == "03#HSP=+50000"   # the manual's short name in replies

@@ -548,6 +548,11 @@ class ArcusDrive(_drive.Drive):
     def _make_params(self) -> _drive.Params:
         return ArcusParams(self)
 
+    def _console(self, line: str) -> str:
+        # The ASCII command as typed (HSPD, HSPD=5000, X1000, MST...), framed and
+        # addressed by the client; the reply body, or the drive's refusal as an error.
+        return self.native.command(line)
+
     def _close(self) -> None:
         self.native.close()
 

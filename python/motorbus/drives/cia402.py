@@ -606,6 +606,11 @@ class Cia402Drive(Drive):
                            homed=self._homed, fault=fault, at_target=at_target,
                            limit_positive=bool(inputs & 2), limit_negative=bool(inputs & 1), raw=sw, text=text)
 
+    def _console(self, line: str) -> str:
+        # SDO reads and writes by index (motorbus.canopen.console has the syntax).
+        from ..canopen.console import sdo_console
+        return sdo_console(self.native.sdo, line)
+
     def _make_params(self) -> Params:
         return Cia402Params(self)
 

@@ -417,6 +417,15 @@ class DmacDrive(Drive):
     def _make_params(self) -> Params:
         return DmacParams(self)
 
+    def _console(self, line: str) -> str:
+        # READ/REQUEST_* answer; every other DMAC command is silent, so it is sent
+        # with the client's #ERROR check and "OK" stands for "accepted".
+        if line.upper().startswith(("READ", "REQUEST")):
+            reply = self.native.raw(f"{self.native.address:02d}{line}", True)
+            return reply.decode("ascii", "replace").strip()
+        self.native.command(line)
+        return "OK"
+
     def _enable(self) -> None:
         if self.native.is_dmac34:
             self.native.brake(False)
