@@ -149,6 +149,10 @@ std::optional<LogEntry> parse_candump_line(std::string_view line) {
     LogEntry e;
     if (p[0].size() < 3 || p[0].front() != '(' || p[0].back() != ')') return std::nullopt;
     if (!parse_double(p[0].substr(1, p[0].size() - 2), e.time)) return std::nullopt;
+    // An interface name is printable text: a control byte (NUL, ESC...) inside it
+    // would not survive being written back (found by fuzz_can_log at 3.4 M runs).
+    for (char c : p[1])
+        if (static_cast<unsigned char>(c) < 0x21 || static_cast<unsigned char>(c) == 0x7F) return std::nullopt;
     e.channel = std::string(p[1]);
     if (p.size() == 4) {
         if (p[3] == "R" || p[3] == "r") e.rx = true;

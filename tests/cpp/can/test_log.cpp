@@ -38,6 +38,16 @@ TEST(CandumpLog, RejectsMalformedLines) {
         EXPECT_FALSE(parse_candump_line(bad)) << bad;
 }
 
+// fuzz_can_log, 10 M run: a NUL in the interface name parsed, then did not
+// survive format -> parse.  Interface names are printable text.
+TEST(CandumpLog, ControlBytesInTheInterfaceNameAreRefused) {
+    using namespace std::string_literals;
+    EXPECT_FALSE(parse_candump_line("(5) \0 1ec#Bc"s));
+    EXPECT_FALSE(parse_candump_line("(5) can\x1b" "0 123#00"s));
+    EXPECT_FALSE(parse_candump_line("(5) can\x7f 123#00"s));
+    EXPECT_TRUE(parse_candump_line("(5) can0 123#00"s));
+}
+
 TEST(CandumpLog, FormatRoundTrip) {
     LogEntry e{Frame::make(0x7FF, std::vector<std::uint8_t>{1, 2}), 12.25, "can0", false};
     EXPECT_EQ(format_candump_line(e), "(12.250000) can0 7FF#0102 T");
