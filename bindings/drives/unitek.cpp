@@ -231,6 +231,7 @@ void bind_unitek(py::module_& m) {
             if (device == d.device) return continuous_current_num(d, amps);
         throw InvalidArgument("unitek device: 'DS 205/405', 'DS 412' or 'DS 420', not '" + device + "'");
     }, py::arg("device"), py::arg("amps"));
+    m.def("unitek_sim_default_table", &sim_default_table);
     m.def("unitek_event_status_mask", &event_status_mask, py::arg("mask"));
 
     // ---- codec ----
@@ -410,7 +411,7 @@ void bind_unitek(py::module_& m) {
                  c.dummy = static_cast<std::uint8_t>(dummy);
                  auto h = std::make_unique<SimHolder>();
                  h->clock = clock;
-                 h->sim = std::make_unique<UnitekSim>(*clock, c, table ? *table : RegisterTable::builtin());
+                 h->sim = std::make_unique<UnitekSim>(*clock, c, table ? *table : sim_default_table());
                  return h;
              }),
              py::arg("clock"), py::arg("rx_id") = kDefaultRxId, py::arg("tx_id") = kDefaultTxId,

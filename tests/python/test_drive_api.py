@@ -74,6 +74,10 @@ KINDS = {
                   param="HSPD", value=15000, jog=50.0, home="HL+", setup=_arcus_setup),
     "cia402": Kind("cia402", "5", 0.01, fault=lambda sim, drive: sim.inject_fault(0x5441),
                    param="0x6081", value=25000, jog=50.0, home=19, setup=_cia402_setup),
+    "unitek": Kind("unitek", "0x201", 0.01, fault=lambda sim, drive: sim.set_hardware_enable(False),
+                   unfault=lambda sim: sim.set_hardware_enable(True), param="ACC_RAMP", value=200, jog=50.0,
+                   setup=lambda drive: drive.params.__setitem__("ACC_RAMP", 20),  # ms to N max
+                   sim_options={"calibrated": True}),
 }
 
 

@@ -35,6 +35,10 @@ inline constexpr std::uint8_t kRegPosDest = 0x6E;      // POS_DEST
 inline constexpr std::uint8_t kRegEeprom = 0x84;       // write EEPROM
 inline constexpr std::uint8_t kRegTorqueCmd = 0x90;    // TORQUE-CMD
 inline constexpr std::uint8_t kRegA8 = 0xA8;           // unnamed, §5.2's request example
+// Not in 002: the actual position, which any position adapter needs.  NDrive's
+// register list (outside this manual) has it; the sim serves it and the Python
+// adapter adds it from its TOML file (python/motorbus/drives/unitek_ndrive.toml).
+inline constexpr std::uint8_t kRegPosActual = 0x6D;
 
 inline constexpr std::uint32_t kDefaultRxId = 0x201;
 inline constexpr std::uint32_t kDefaultTxId = 0x181;

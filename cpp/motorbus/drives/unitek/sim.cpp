@@ -30,6 +30,21 @@ bool builtin_command(std::uint8_t regid) {
 }
 }  // namespace
 
+RegisterTable sim_default_table() {
+    RegisterTable t = RegisterTable::builtin();
+    Register r;
+    r.regid = kRegPosActual;
+    r.name = "POS_IST";
+    r.bits = 32;
+    r.is_signed = true;
+    r.access = Access::ReadOnly;
+    r.quantity = Quantity::Position;
+    r.unit = "rev";
+    r.description = "actual position (NDrive list, not in 002)";
+    t.add(r);
+    return t;
+}
+
 void SimConfig::validate() const {
     if (rx_id < kRxIdMin || rx_id > kRxIdMax) throw InvalidArgument("unitek sim rx_id: 0x201..0x27F");
     if (tx_id < kTxIdMin || tx_id > kTxIdMax) throw InvalidArgument("unitek sim tx_id: 0x181..0x1FF");
@@ -363,6 +378,10 @@ std::uint32_t UnitekSim::status_locked() {
 std::int64_t UnitekSim::value_locked(std::uint8_t regid) {
     switch (regid) {
         case kRegStatus: return status_locked() & 0xFFFF;  // C-U02: 16 bits in a read reply
+        case kRegPosActual: {
+            const double p = std::clamp(motor_.pulse_position(), -2147483647.0, 2147483647.0);
+            return static_cast<std::int64_t>(std::llround(p));
+        }
         case kRegSpeedActual: {
             const double num = motor_.pulse_velocity() / unitek_num_to_counts_per_s(1.0, ramps_locked());
             return static_cast<std::int64_t>(std::llround(std::clamp(num, -kFull, kFull)));

@@ -62,9 +62,12 @@ struct SimCounters {
     std::uint64_t events_out = 0;
 };
 
+// The sim's registers: the documented ones plus POS_IST (0x6D, actual position, 32-bit signed, read-only).
+RegisterTable sim_default_table();
+
 class UnitekSim {
 public:
-    UnitekSim(Clock& clock, SimConfig cfg = {}, RegisterTable table = RegisterTable::builtin());
+    UnitekSim(Clock& clock, SimConfig cfg = {}, RegisterTable table = sim_default_table());
     ~UnitekSim();
     UnitekSim(const UnitekSim&) = delete;
     UnitekSim& operator=(const UnitekSim&) = delete;
