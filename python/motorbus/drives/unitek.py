@@ -54,8 +54,13 @@ from .. import _core
 from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params, Units
 from ..registry import DrivePlugin
 
-__all__ = ["Reg", "Status", "ModeBit", "Unitek", "UnitekDrive", "UnitekSim", "Stream", "PLUGIN", "make_sim",
+__all__ = ["FrameError", "UnknownRegister", "CyclicLimit", "Reg", "Status", "ModeBit", "Unitek", "UnitekDrive", "UnitekSim", "Stream", "PLUGIN", "make_sim",
            "open", "builtin_registers", "load_registers", "ndrive_registers", "REVOLUTIONS"]
+
+#: Typed errors (also motorbus._core.Unitek*).
+FrameError = _core.UnitekFrameError          # a frame breaking the protocol; .byte, .data
+UnknownRegister = _core.UnitekUnknownRegister  # REGID not in the table; .regid
+CyclicLimit = _core.UnitekCyclicLimit        # a 9th cyclic register
 
 COUNTS_PER_REV = 65536
 FULL_SCALE = 32767
