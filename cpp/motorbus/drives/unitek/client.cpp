@@ -70,18 +70,21 @@ UnitekClient::~UnitekClient() {
 }
 
 void UnitekClient::close() {
-    if (closed_.exchange(true)) return;
+    if (closing_.exchange(true)) return;
     std::vector<std::uint8_t> regids;
     {
         std::lock_guard l(m_);
         for (auto& [id, s] : streams_) regids.push_back(id);
     }
+    // The drive would keep sending what we subscribed to: stop it (best effort,
+    // the bus may be gone already).
     for (auto id : regids) {
         try {
             send(encode_request(id, kIntervalStop));
         } catch (const Error&) {
         }
     }
+    closed_ = true;
     bus_.unsubscribe(sub_);
     std::lock_guard l(m_);
     for (auto& [id, s] : streams_) s->active = false;

@@ -144,6 +144,7 @@ private:
     StatusCallback status_cb_;
     ClientCounters counters_;
     std::atomic<bool> closed_{false};
+    std::atomic<bool> closing_{false};
 };
 
 }  // namespace motorbus::unitek

@@ -392,6 +392,18 @@ TEST(UnitekClient, HostileRepliesAreCountedNotUsed) {  // R1, R4
     EXPECT_THROW(r.client->read(kRegMode), InvalidArgument);  // write-only
 }
 
+TEST(UnitekClient, CloseStopsItsStreams) {
+    Rig r;
+    r.client->subscribe(kRegSpeedActual, 10);
+    r.client->subscribe(kRegStatus, 20);
+    r.sync();
+    EXPECT_EQ(r.sim->cyclic().size(), 2u);
+    r.client->close();
+    r.sync();
+    EXPECT_TRUE(r.sim->cyclic().empty());
+    EXPECT_THROW(r.client->write(kRegSpeedCmd, 0), ClosedError);
+}
+
 TEST(UnitekClient, ReadTimesOutWithoutADrive) {
     auto bus = can::open_virtual("unitek-lonely");
     ClientOptions o;
