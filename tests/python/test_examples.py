@@ -83,3 +83,18 @@ def test_example_06_drive_api_python():
     assert "kinds: arcus, cia402, dmac" in out
     for kind in ("arcus", "dmac", "cia402"):
         assert f"{kind}: at 3.50 mm, enabled=True moving=False fault=False" in out, out
+
+
+def test_example_09_unitek_python():
+    out = run_example("09_unitek.py")
+    assert "KERN_STATUS 0x0181" in out and "ACC_RAMP 1000 ms" in out
+    assert "stream 0x30: 21 samples, periods 10.0..10.0 ms, lost 0" in out
+    assert "speed 300.0 rpm after 200 ms" in out
+    assert "position 1.000 rev, Tol True" in out
+
+
+def test_example_09_unitek_cpp():
+    out = run_cpp_example("example_09_unitek")
+    assert "KERN_STATUS 0x0181" in out and "ACC_RAMP 1000 ms" in out
+    assert "stream 0x30: 21 samples, last period 10.0 ms, lost 0, speed 3277 num" in out
+    assert "position 65536 num, Tol 1" in out
