@@ -477,6 +477,21 @@ void bind_unitek(py::module_& m) {
             for (auto [k, v] : h.sim->eeprom()) out[k] = v;
             return out;
         })
+        .def("on_eeprom_store", [](SimHolder& h, const py::object& callback) {
+            if (callback.is_none()) return h.sim->on_eeprom_store(nullptr);
+            auto f = hold(callback.cast<py::function>());
+            h.sim->on_eeprom_store([f](const std::map<std::uint8_t, std::int64_t>& values) {
+                if (py_helpers::interpreter_finalizing()) return;
+                py::gil_scoped_acquire gil;
+                try {
+                    py::dict d;
+                    for (auto [k, v] : values) d[py::int_(k)] = v;
+                    (*f)(d);
+                } catch (py::error_already_set& e) {
+                    e.discard_as_unraisable("motorbus unitek EEPROM store callback");
+                }
+            });
+        }, py::arg("callback"), "callback(dict regid -> value) after each EEPROM store (0x84)")
         .def("load_eeprom", [](SimHolder& h, const std::map<int, std::int64_t>& values) {
             std::map<std::uint8_t, std::int64_t> in;
             for (auto [k, v] : values) in[regid_arg(k)] = v;

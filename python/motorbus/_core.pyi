@@ -4310,6 +4310,10 @@ class UnitekSim:
         ...
     def load_eeprom(self, values: collections.abc.Mapping[typing.SupportsInt | typing.SupportsIndex, typing.SupportsInt | typing.SupportsIndex]) -> None:
         ...
+    def on_eeprom_store(self, callback: typing.Any) -> None:
+        """
+        callback(dict regid -> value) after each EEPROM store (0x84)
+        """
     def on_frame(self, frame: Frame) -> None:
         ...
     def power_cycle(self) -> None:

@@ -211,3 +211,28 @@ def test_plugin_and_addresses():
     with pytest.raises(motorbus.InvalidArgument, match="unknown"):
         unitek.make_sim("0x201", colour=1)
     assert not unitek.UnitekDrive.has_watchdog
+
+
+def test_eeprom_file_survives_a_new_sim(tmp_path):
+    path = tmp_path / "unitek.json"
+    name = f"virtual:unitek-py-{next(_names)}"
+    with motorbus.open_bus(name) as sim_bus, motorbus.open_bus(name) as host_bus:
+        sim = unitek.make_sim("0x201", bus=sim_bus, store_path=str(path))
+        d = Unitek(host_bus, 0x201)
+        d.write(Reg.ACC_RAMP, 777)
+        d.set_receive_id(0x222)
+        d.store_eeprom(0)
+        end = time.monotonic() + 2
+        while not path.exists():
+            assert time.monotonic() < end
+            time.sleep(0.005)
+        d.close()
+        sim.close()
+    again = unitek.make_sim("0x201", store_path=str(path))   # the next power-up reads the file
+    assert again.rx_id == 0x222 and again.value(Reg.ACC_RAMP) == 777
+    again.close()
+    options = motorbus.registry.drive_plugin("unitek").store_options(str(tmp_path), "0x201")
+    assert options == {"store_path": str(tmp_path / "unitek-0x201.eeprom.json")}  # sim serve --store-dir
+    path.write_text("[1, 2]")
+    with pytest.raises(motorbus.InvalidArgument, match="EEPROM"):
+        unitek.make_sim("0x201", store_path=str(path))

@@ -415,20 +415,22 @@ class Unitek:
 
 _SIM_OPTIONS = ("n_max_rpm", "acc_ramp_ms", "dec_ramp_ms", "position_control", "speed_control", "calibrated",
                 "tol_num", "minus_limit_num", "plus_limit_num", "torque_continuous_num", "dummy", "tx_id",
-                "registers", "t_out_ms")
+                "registers", "t_out_ms", "store_path")
 
 
 class UnitekSim:
     """A simulated UNITEK servo (C++ ``UnitekSim``; see cpp/motorbus/drives/unitek/sim.hpp).
 
     Inputs for tests: ``set_hardware_enable``, ``force_limit(±1, True/False/None)``,
-    ``set_calibrated``, ``force_icns``, ``power_cycle``.  On a SimClock call
+    ``set_calibrated``, ``force_icns``, ``power_cycle``.  ``store_path``: a JSON file the
+    EEPROM store (0x84) writes and the next sim reads at start (``sim serve --store-dir``).
+    On a SimClock call
     ``service()`` after advancing the clock.  ``t_out_ms`` models NDrive's T-Out:
     with no frame on the receive id for that long while enabled, the drive
     disables itself (0 = off, the default: 002 does not say what T-Out does)."""
 
     def __init__(self, rx_id: int = 0x201, clock: Any = None, *, registers: Any = None, t_out_ms: float = 0,
-                 **options: Any) -> None:
+                 store_path: Optional[str] = None, **options: Any) -> None:
         self.clock = clock if clock is not None else _core.RealClock()
         table = _core.unitek_sim_default_table()
         if registers is not None:
@@ -441,6 +443,31 @@ class UnitekSim:
             raise _core.InvalidArgument("unitek sim t_out_ms: >= 0")
         self._watch: Optional[threading.Thread] = None
         self._closing = threading.Event()
+        self.store_path = store_path
+        if store_path:
+            self._load_store(Path(store_path))
+            self._core.on_eeprom_store(self._save_store)
+
+    def _load_store(self, path: Path) -> None:
+        """The EEPROM of the last run (a JSON of REGID -> value), as a power cycle reads it."""
+        import json
+
+        if not path.exists():
+            return
+        try:
+            values = {int(k, 0): int(v) for k, v in json.loads(path.read_text()).items()}
+        except (ValueError, AttributeError, TypeError) as e:
+            raise _core.InvalidArgument(f"unitek sim store {path}: not an EEPROM file ({e})") from None
+        self._core.load_eeprom(values)
+
+    def _save_store(self, values: dict) -> None:
+        import json
+        import os
+
+        path = Path(self.store_path)
+        tmp = path.with_suffix(path.suffix + ".tmp")
+        tmp.write_text(json.dumps({f"0x{k:02X}": v for k, v in sorted(values.items())}, indent=1))
+        os.replace(tmp, path)
 
     def attach(self, bus: Any) -> "UnitekSim":
         self._core.attach(bus)
@@ -683,4 +710,5 @@ PLUGIN = DrivePlugin(
     check_address=check_address,
     default_address="0x201",
     sim_options=_SIM_OPTIONS,
+    store_options=lambda store_dir, address: {"store_path": str(Path(store_dir) / f"unitek-{address}.eeprom.json")},
 )

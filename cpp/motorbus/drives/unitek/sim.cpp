@@ -189,6 +189,8 @@ Nanos UnitekSim::service() {
 
 void UnitekSim::on_frame(const can::Frame& f) {
     std::vector<can::Frame> out;
+    std::optional<std::map<std::uint8_t, std::int64_t>> stored;
+    std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb;
     {
         std::lock_guard l(m_);
         if (f.extended || f.rtr || f.is_fd() || (f.flags & can::kFlagError) || f.id != rx_id_) {
@@ -209,8 +211,20 @@ void UnitekSim::on_frame(const can::Frame& f) {
             handle_locked(*t, out);
             check_events_locked(out);
         }
+        if (eeprom_dirty_ && eeprom_cb_) {
+            eeprom_dirty_ = false;
+            stored = eeprom_;
+            cb = eeprom_cb_;
+        }
     }
     send(out);
+    if (cb) {
+        try {
+            cb(*stored);
+        } catch (...) {
+            // A host that cannot save its file must not take the drive down.
+        }
+    }
     if (timer_) timer_->poke();
 }
 
@@ -305,6 +319,7 @@ void UnitekSim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
             for (auto id : {kRegAccRamp, kRegEventMask, kRegRxId}) eeprom_[id] = regs_[id];
             for (const auto& row : table_.rows())  // user registers (an NDrive list) persist too
                 if (row.writable() && !builtin_command(row.regid)) eeprom_[row.regid] = regs_[row.regid];
+            eeprom_dirty_ = true;
             break;
         default: break;
     }
@@ -479,6 +494,11 @@ std::uint64_t UnitekSim::sent(std::uint8_t regid) const {
 SimCounters UnitekSim::counters() const {
     std::lock_guard l(m_);
     return counters_;
+}
+
+void UnitekSim::on_eeprom_store(std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb) {
+    std::lock_guard l(m_);
+    eeprom_cb_ = std::move(cb);
 }
 
 std::map<std::uint8_t, std::int64_t> UnitekSim::eeprom() const {

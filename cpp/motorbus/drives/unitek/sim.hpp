@@ -103,6 +103,9 @@ public:
     const SimConfig& config() const { return cfg_; }
     std::map<std::uint8_t, std::int64_t> eeprom() const;
     void load_eeprom(const std::map<std::uint8_t, std::int64_t>& values);  // a stored file, before use
+    // Called (outside the sim's lock, on the thread that handled 0x84) with the
+    // EEPROM contents after each store: lets a host keep them in a file.
+    void on_eeprom_store(std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb);
 
 private:
     struct Slot {
@@ -148,6 +151,8 @@ private:
     SimCounters counters_;
 
     std::function<void(const can::Frame&)> out_;
+    std::function<void(const std::map<std::uint8_t, std::int64_t>&)> eeprom_cb_;
+    bool eeprom_dirty_ = false;
     can::Bus* bus_ = nullptr;
     can::SubscriptionId sub_ = 0;
     std::unique_ptr<canopen::TimerThread> timer_;
