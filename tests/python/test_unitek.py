@@ -236,3 +236,35 @@ def test_eeprom_file_survives_a_new_sim(tmp_path):
     path.write_text("[1, 2]")
     with pytest.raises(motorbus.InvalidArgument, match="EEPROM"):
         unitek.make_sim("0x201", store_path=str(path))
+
+
+def test_bad_arguments_are_typed(rig):
+    drive, sim, clock, bus = rig
+    with pytest.raises(motorbus.InvalidArgument, match="interval"):
+        drive.subscribe(Reg.SPEED_IST, 0)
+    with pytest.raises(motorbus.InvalidArgument, match="interval"):
+        drive.subscribe(Reg.SPEED_IST, 255)
+    with pytest.raises(motorbus.InvalidArgument, match="capacity"):
+        drive.subscribe(Reg.SPEED_IST, 10, capacity=0)
+    with pytest.raises(motorbus.InvalidArgument, match="timeout"):
+        drive.read(Reg.SPEED_IST, timeout=-1)
+    with pytest.raises(motorbus.InvalidArgument, match="regid"):
+        drive.write(300, 1)
+    with pytest.raises(motorbus.InvalidArgument, match="EEPROM level"):
+        drive.store_eeprom(3)
+    with pytest.raises(motorbus.InvalidArgument, match="0x201..0x27F"):
+        drive.set_receive_id(0x300)
+    with pytest.raises(motorbus.InvalidArgument, match="bus"):
+        _core.UnitekClient(None)
+    with pytest.raises(motorbus.InvalidArgument, match="clock"):
+        _core.UnitekSim(None)
+    with pytest.raises(motorbus.InvalidArgument, match="rx_id"):
+        _core.UnitekSim(clock, rx_id=0x100)
+    with pytest.raises(motorbus.InvalidArgument, match="N max"):
+        unitek.make_sim("0x201", n_max_rpm=0)
+    with pytest.raises(motorbus.InvalidArgument, match="device"):
+        Unitek(bus, 0x201, device="DS 999")
+    with pytest.raises(motorbus.InvalidArgument, match="on_error"):
+        Unitek(bus, 0x201, on_error="explode")
+    with pytest.raises(motorbus.InvalidArgument, match="bits 16 or 32"):
+        _core.unitek_encode_write(0x31, 1, 24)

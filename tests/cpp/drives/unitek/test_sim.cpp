@@ -214,6 +214,35 @@ TEST(UnitekSim, NinthRegisterIgnoredBySim) {  // B-U08
     EXPECT_EQ(sim.cyclic().size(), 8u);
 }
 
+TEST(UnitekSim, OnceOnACyclicRegisterKeepsTheStream) {  // B-U07
+    SimClock clock;
+    UnitekSim sim(clock);
+    std::vector<can::Frame> out;
+    sim.set_output([&](const can::Frame& f) { out.push_back(f); });
+    sim.on_frame(can::Frame::make(0x201, Bytes{0x3D, 0x30, 0x0A}));  // every 10 ms, first at once
+    EXPECT_EQ(out.size(), 1u);
+    clock.advance(5'000'000);
+    sim.on_frame(can::Frame::make(0x201, Bytes{0x3D, 0x30, 0x00}));  // once: answered, stream kept
+    EXPECT_EQ(out.size(), 2u);
+    clock.advance(5'000'000);
+    sim.service();
+    EXPECT_EQ(out.size(), 3u);  // the stream's own phase: t = 10 ms
+    ASSERT_EQ(sim.cyclic().size(), 1u);
+    sim.on_frame(can::Frame::make(0x201, Bytes{0x3D, 0x30, 0x14}));  // repeated: 20 ms, restarts now
+    EXPECT_EQ(out.size(), 4u);
+    clock.advance(19'000'000);
+    sim.service();
+    EXPECT_EQ(out.size(), 4u);
+    clock.advance(1'000'000);
+    sim.service();
+    EXPECT_EQ(out.size(), 5u);
+    // A late service catches up every due frame, in order, each with its own due time.
+    clock.advance(100'000'000);
+    sim.service();
+    ASSERT_EQ(out.size(), 10u);
+    for (std::size_t i = 6; i < out.size(); ++i) EXPECT_EQ(out[i].timestamp_ns - out[i - 1].timestamp_ns, 20'000'000);
+}
+
 TEST(UnitekSim, Example10EventOnTol) {
     Rig r;
     r.sim->set_calibrated(true);
