@@ -82,6 +82,9 @@ def test_home_needs_the_calibrated_bit(rig):
 
 def test_disable_and_store(rig):
     drive, sim = rig
+    values = dict(drive.params)                  # every readable register, read once
+    assert values["KERN_STATUS"] == 0x0181 and "MODE" not in values
+    drive.params["MODE"] = 0                     # write-only, by name
     drive.params["ACC_RAMP"] = 123
     drive.store()
     wait(lambda: sim.eeprom()[0x35] == 123)

@@ -519,10 +519,12 @@ def make_sim(address: Union[str, int] = "0x201", clock: Any = None, *, bus: Any 
 # ---- the Drive adapter ---------------------------------------------------------------------
 
 class UnitekParams(Params):
-    """The register table by name (num values)."""
+    """The register table by name (num values).  Iteration lists the readable registers
+    (so ``dict(drive.params)`` works); write-only ones (MODE, CAN_ID_RX, EEPROM_WRITE) can
+    still be written by name."""
 
     def _names(self) -> list[str]:
-        return [r.name for r in self._drive.native.table.rows()]
+        return [r.name for r in self._drive.native.table.rows() if r.readable]
 
     def _info(self, name: str) -> Optional[ParamInfo]:
         table = self._drive.native.table
