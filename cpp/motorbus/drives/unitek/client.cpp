@@ -20,10 +20,17 @@ RingBuffer::RingBuffer(std::size_t capacity) : cap_(capacity), t_(capacity), v_(
         throw InvalidArgument("unitek ring capacity: 1..268435456 samples, not " + std::to_string(capacity));
 }
 
+// Slots are accessed through atomic_ref (plain int64 storage, so numpy can view it):
+// a reader that races a lapping writer gets a stale or a new sample, never a torn one,
+// and read() counts such samples as lost.
 void RingBuffer::push(Nanos t, std::int64_t v) {
     const std::uint64_t k = written_.load(std::memory_order_relaxed);
-    t_[k % cap_] = t;
-    v_[k % cap_] = v;
+    // Seqlock pairing with read(): a reader that sees these slot stores also sees
+    // started_ > k, and so knows the slot's older sample (k - capacity) is gone.
+    started_.store(k + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    std::atomic_ref<Nanos>(t_[k % cap_]).store(t, std::memory_order_relaxed);
+    std::atomic_ref<std::int64_t>(v_[k % cap_]).store(v, std::memory_order_relaxed);
     written_.store(k + 1, std::memory_order_release);
 }
 
@@ -36,16 +43,22 @@ std::size_t RingBuffer::read(std::uint64_t& cursor, Nanos* t, std::int64_t* v, s
     }
     std::size_t n = 0;
     while (cursor < end && n < max) {
-        t[n] = t_[cursor % cap_];
-        v[n] = v_[cursor % cap_];
+        t[n] = std::atomic_ref<Nanos>(const_cast<Nanos&>(t_[cursor % cap_])).load(std::memory_order_relaxed);
+        v[n] = std::atomic_ref<std::int64_t>(const_cast<std::int64_t&>(v_[cursor % cap_])).load(std::memory_order_relaxed);
         ++n;
         ++cursor;
     }
-    // The writer may have lapped the samples just copied: count them lost too.
-    const std::uint64_t after = written_.load(std::memory_order_acquire);
+    // The writer may have lapped the samples just copied (the oldest first): drop
+    // that prefix and count it lost, so what is returned is exactly what was written.
+    // `started_` also covers a sample the writer is half-way through.
+    std::atomic_thread_fence(std::memory_order_acquire);
+    const std::uint64_t after = started_.load(std::memory_order_relaxed);
     if (after > cap_ && cursor - n < after - cap_) {
-        const std::uint64_t bad = std::min<std::uint64_t>(n, after - cap_ - (cursor - n));
+        const std::size_t bad = static_cast<std::size_t>(std::min<std::uint64_t>(n, after - cap_ - (cursor - n)));
         lost += bad;
+        std::copy(t + bad, t + n, t);
+        std::copy(v + bad, v + n, v);
+        n -= bad;
     }
     return n;
 }

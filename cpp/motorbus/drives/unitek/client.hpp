@@ -46,7 +46,8 @@ private:
     std::size_t cap_;
     std::vector<Nanos> t_;
     std::vector<std::int64_t> v_;
-    std::atomic<std::uint64_t> written_{0};
+    std::atomic<std::uint64_t> written_{0};  // samples complete
+    std::atomic<std::uint64_t> started_{0};  // samples begun (written_ or written_ + 1)
 };
 
 using SampleCallback = std::function<void(std::uint8_t regid, Nanos t, std::int64_t value)>;
