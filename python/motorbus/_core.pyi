@@ -25,13 +25,16 @@ from motorbus import MotorbusError
 from motorbus import ProtocolError
 from motorbus import ReplyTooLong
 from motorbus import TimeoutError
+from motorbus import UnitekCyclicLimit
+from motorbus import UnitekFrameError
+from motorbus import UnitekUnknownRegister
 from motorbus.canopen import SdoAbortError
 from motorbus.canopen import SdoProtocolError
 from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekRampParams', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -3996,6 +3999,392 @@ class UnitekRampParams:
     @n_max_rpm.setter
     def n_max_rpm(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
+class UnitekAccess:
+    """
+    Members:
+    
+      RW
+    
+      RO
+    
+      WO
+    """
+    RO: typing.ClassVar[UnitekAccess]
+    RW: typing.ClassVar[UnitekAccess]
+    WO: typing.ClassVar[UnitekAccess]
+    __members__: typing.ClassVar[dict[str, UnitekAccess]]
+    @typing.overload
+    def __eq__(self, other: UnitekAccess) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: UnitekAccess) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class UnitekQuantity:
+    """
+    Members:
+    
+      RAW
+    
+      SPEED
+    
+      POSITION
+    
+      CURRENT
+    
+      TORQUE
+    
+      TIME
+    """
+    CURRENT: typing.ClassVar[UnitekQuantity]
+    POSITION: typing.ClassVar[UnitekQuantity]
+    RAW: typing.ClassVar[UnitekQuantity]
+    SPEED: typing.ClassVar[UnitekQuantity]
+    TIME: typing.ClassVar[UnitekQuantity]
+    TORQUE: typing.ClassVar[UnitekQuantity]
+    __members__: typing.ClassVar[dict[str, UnitekQuantity]]
+    @typing.overload
+    def __eq__(self, other: UnitekQuantity) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: UnitekQuantity) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class UnitekRegister:
+    """
+    One row of the UNITEK register table.
+    """
+    def __init__(self, regid: typing.SupportsInt | typing.SupportsIndex, name: str, bits: typing.SupportsInt | typing.SupportsIndex = 16, signed: bool = False, access: UnitekAccess = ..., quantity: UnitekQuantity = ..., unit: str = '', scale: typing.SupportsFloat | typing.SupportsIndex = 1.0, min: typing.SupportsInt | typing.SupportsIndex | None = None, max: typing.SupportsInt | typing.SupportsIndex | None = None, description: str = '') -> None:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def from_raw(self, raw: typing.SupportsInt | typing.SupportsIndex, bits: typing.SupportsInt | typing.SupportsIndex) -> int:
+        ...
+    @property
+    def access(self) -> UnitekAccess:
+        ...
+    @property
+    def bits(self) -> int:
+        ...
+    @property
+    def description(self) -> str:
+        ...
+    @property
+    def max(self) -> int:
+        ...
+    @property
+    def min(self) -> int:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def quantity(self) -> UnitekQuantity:
+        ...
+    @property
+    def readable(self) -> bool:
+        ...
+    @property
+    def regid(self) -> int:
+        ...
+    @property
+    def scale(self) -> float:
+        ...
+    @property
+    def signed(self) -> bool:
+        ...
+    @property
+    def unit(self) -> str:
+        ...
+    @property
+    def writable(self) -> bool:
+        ...
+class UnitekRegisterTable:
+    """
+    The UNITEK REGIDs: the 12 documented ones, extendable.
+    """
+    def __contains__(self, arg0: typing.Any) -> bool:
+        ...
+    def __getitem__(self, arg0: typing.Any) -> UnitekRegister:
+        ...
+    def __init__(self, builtin: bool = True) -> None:
+        ...
+    def __len__(self) -> int:
+        ...
+    def add(self, register: UnitekRegister) -> None:
+        ...
+    def rows(self) -> list[UnitekRegister]:
+        ...
+class UnitekScalings:
+    """
+    §6.1 scalings: N max, 65536 num/rev, device current.
+    """
+    def __init__(self, n_max_rpm: typing.SupportsFloat | typing.SupportsIndex = 3000.0, counts_per_rev: typing.SupportsFloat | typing.SupportsIndex = 65536.0, i_max_num: typing.SupportsFloat | typing.SupportsIndex = 160.0, i_max_a: typing.SupportsFloat | typing.SupportsIndex = 10.0) -> None:
+        ...
+    def to_num(self, register: UnitekRegister, value: typing.SupportsFloat | typing.SupportsIndex) -> int:
+        ...
+    def to_physical(self, register: UnitekRegister, num: typing.SupportsInt | typing.SupportsIndex) -> float:
+        ...
+    @property
+    def counts_per_rev(self) -> float:
+        ...
+    @property
+    def i_max_a(self) -> float:
+        ...
+    @property
+    def i_max_num(self) -> float:
+        ...
+    @property
+    def n_max_rpm(self) -> float:
+        ...
+class UnitekStream:
+    """
+    One cyclic register: a ring of (timestamp ns, value num) filled by the bus thread.
+    """
+    def read(self, max: typing.SupportsInt | typing.SupportsIndex = -1) -> tuple:
+        """
+        (timestamps int64 ns, values int64 num) received since the last read, oldest first
+        """
+    @property
+    def active(self) -> bool:
+        ...
+    @property
+    def capacity(self) -> int:
+        ...
+    @property
+    def count(self) -> int:
+        """
+        samples received since the subscription
+        """
+    @property
+    def interval_ms(self) -> int:
+        ...
+    @property
+    def lost(self) -> int:
+        """
+        samples overwritten before read() took them
+        """
+    @property
+    def regid(self) -> int:
+        ...
+    @property
+    def times(self) -> numpy.typing.NDArray[numpy.int64]:
+        """
+        the whole ring (zero-copy, read-only use; sample k at k % capacity)
+        """
+    @property
+    def values(self) -> numpy.typing.NDArray[numpy.int64]:
+        ...
+class UnitekClientCounters:
+    @property
+    def callback_errors(self) -> int:
+        ...
+    @property
+    def rejected(self) -> int:
+        ...
+    @property
+    def replies(self) -> int:
+        ...
+    @property
+    def unsolicited(self) -> int:
+        ...
+class UnitekClient:
+    """
+    UNITEK register protocol client over a CAN bus (see client.hpp).
+    """
+    def __init__(self, bus: Bus, rx_id: typing.SupportsInt | typing.SupportsIndex = 513, tx_id: typing.SupportsInt | typing.SupportsIndex = 385, timeout: typing.Any = 0.2, table: UnitekRegisterTable | None = None, clock: Clock = None) -> None:
+        ...
+    def add_register(self, register: UnitekRegister) -> None:
+        ...
+    def close(self) -> None:
+        ...
+    def disable(self) -> None:
+        ...
+    def enable(self) -> None:
+        ...
+    def on_status(self, callback: typing.Any) -> None:
+        ...
+    def read(self, regid: typing.SupportsInt | typing.SupportsIndex, timeout: typing.Any = None) -> int:
+        ...
+    def set_events(self, on: bool, mask: typing.SupportsInt | typing.SupportsIndex | None = None) -> None:
+        ...
+    def set_receive_id(self, rx_id: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def store_eeprom(self, level: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
+        ...
+    def subscribe(self, regid: typing.SupportsInt | typing.SupportsIndex, interval_ms: typing.SupportsInt | typing.SupportsIndex, capacity: typing.SupportsInt | typing.SupportsIndex = 65536, callback: typing.Any = None) -> UnitekStream:
+        ...
+    def unsubscribe(self, regid: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def write(self, regid: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def write_raw(self, regid: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex, bits: typing.SupportsInt | typing.SupportsIndex = 16) -> None:
+        ...
+    @property
+    def counters(self) -> UnitekClientCounters:
+        ...
+    @property
+    def cyclic(self) -> list[tuple[int, int]]:
+        ...
+    @property
+    def events(self) -> int:
+        ...
+    @property
+    def last_event_status(self) -> int | None:
+        ...
+    @property
+    def mode(self) -> int:
+        ...
+    @property
+    def rx_id(self) -> int:
+        ...
+    @property
+    def table(self) -> UnitekRegisterTable:
+        ...
+    @property
+    def tx_id(self) -> int:
+        ...
+class UnitekSimCounters:
+    @property
+    def cyclic_refused(self) -> int:
+        ...
+    @property
+    def events_out(self) -> int:
+        ...
+    @property
+    def frames_in(self) -> int:
+        ...
+    @property
+    def frames_out(self) -> int:
+        ...
+    @property
+    def ignored(self) -> int:
+        ...
+    @property
+    def malformed(self) -> int:
+        ...
+    @property
+    def refused(self) -> int:
+        ...
+    @property
+    def unknown(self) -> int:
+        ...
+class UnitekSim:
+    """
+    A simulated UNITEK servo on the register protocol (see sim.hpp).
+    """
+    def __init__(self, clock: Clock, rx_id: typing.SupportsInt | typing.SupportsIndex = 513, tx_id: typing.SupportsInt | typing.SupportsIndex = 385, n_max_rpm: typing.SupportsFloat | typing.SupportsIndex = 3000.0, acc_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0, dec_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0, position_control: bool = True, speed_control: bool = True, calibrated: bool = False, tol_num: typing.SupportsInt | typing.SupportsIndex = 64, minus_limit_num: typing.SupportsFloat | typing.SupportsIndex | None = -6553600.0, plus_limit_num: typing.SupportsFloat | typing.SupportsIndex | None = 6553600.0, torque_continuous_num: typing.SupportsInt | typing.SupportsIndex = 32767, dummy: typing.SupportsInt | typing.SupportsIndex = 0, table: UnitekRegisterTable | None = None) -> None:
+        ...
+    def attach(self, bus: Bus) -> None:
+        ...
+    def close(self) -> None:
+        ...
+    def eeprom(self) -> dict[int, int]:
+        ...
+    def force_icns(self, active: bool | None) -> None:
+        ...
+    def force_limit(self, direction: typing.SupportsInt | typing.SupportsIndex, active: bool | None) -> None:
+        ...
+    def load_eeprom(self, values: collections.abc.Mapping[typing.SupportsInt | typing.SupportsIndex, typing.SupportsInt | typing.SupportsIndex]) -> None:
+        ...
+    def on_eeprom_store(self, callback: typing.Any) -> None:
+        """
+        callback(dict regid -> value) after each EEPROM store (0x84)
+        """
+    def on_frame(self, frame: Frame) -> None:
+        ...
+    def power_cycle(self) -> None:
+        ...
+    def sent(self, regid: typing.SupportsInt | typing.SupportsIndex) -> int:
+        ...
+    def service(self) -> int:
+        """
+        emit every frame due by the clock's now; returns the next due time (ns, -1 none)
+        """
+    def set_calibrated(self, on: bool) -> None:
+        ...
+    def set_hardware_enable(self, on: bool) -> None:
+        ...
+    def value(self, regid: typing.SupportsInt | typing.SupportsIndex) -> int:
+        ...
+    @property
+    def counters(self) -> UnitekSimCounters:
+        ...
+    @property
+    def cyclic(self) -> list[tuple[int, int]]:
+        ...
+    @property
+    def n_max_rpm(self) -> float:
+        ...
+    @property
+    def position_num(self) -> float:
+        ...
+    @property
+    def rx_id(self) -> int:
+        ...
+    @property
+    def speed_num(self) -> float:
+        ...
+    @property
+    def status(self) -> int:
+        ...
+    @property
+    def tx_id(self) -> int:
+        ...
 def abort_text(code: typing.SupportsInt | typing.SupportsIndex) -> typing.Any:
     """
     CiA 301 text for an SDO abort code (None if unknown).
@@ -4201,6 +4590,28 @@ def time_decode(frame: Frame) -> typing.Any:
     Unix time in ms, or None.
     """
 def time_encode(unix_ms: typing.SupportsInt | typing.SupportsIndex) -> Frame:
+    ...
+def unitek_continuous_current_num(device: str, amps: typing.SupportsFloat | typing.SupportsIndex) -> int:
+    ...
+def unitek_decode_from_drive(data: typing.Any) -> tuple[int, int, int]:
+    """
+    (regid, raw value, bits) of a frame from the drive; UnitekFrameError unless DLC 4 or 6
+    """
+def unitek_decode_to_drive(data: typing.Any) -> tuple[int, int, int]:
+    """
+    (regid, raw value, bits) as the drive evaluates the frame; UnitekFrameError for DLC < 3 or > 8
+    """
+def unitek_device_currents() -> list:
+    ...
+def unitek_encode_reply(regid: typing.SupportsInt | typing.SupportsIndex, raw: typing.SupportsInt | typing.SupportsIndex, bits: typing.SupportsInt | typing.SupportsIndex = 16, dummy: typing.SupportsInt | typing.SupportsIndex = 0) -> bytes:
+    ...
+def unitek_encode_request(regid: typing.SupportsInt | typing.SupportsIndex, interval: typing.SupportsInt | typing.SupportsIndex) -> bytes:
+    ...
+def unitek_encode_write(regid: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex, bits: typing.SupportsInt | typing.SupportsIndex = 16) -> bytes:
+    ...
+def unitek_event_status_mask(mask: typing.SupportsInt | typing.SupportsIndex) -> int:
+    ...
+def unitek_sim_default_table() -> UnitekRegisterTable:
     ...
 def unitek_speed_profile(start: MotionState, speed_num: typing.SupportsFloat | typing.SupportsIndex, params: UnitekRampParams, hold: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> Profile:
     ...

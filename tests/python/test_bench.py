@@ -130,7 +130,7 @@ def _sim_position(sim):
     """Where a simulator's motor is, whatever the kind exposes (never None: a
     comparison of two Nones would prove nothing)."""
     for holder in (sim, getattr(sim, "motor", None)):
-        for attr in ("physical_position", "pulse_position"):
+        for attr in ("physical_position", "pulse_position", "position_num"):
             v = getattr(holder, attr, None)
             if v is not None:
                 return v() if callable(v) else v

@@ -85,6 +85,10 @@ KINDS = {
                    param="0x6081", value=25000, jog=50.0, home=19, setup=_cia402_setup),
     "arcus-canopen": Kind("arcus-canopen", "1", 0.01, fault=_arcus_fault, unfault=lambda sim: sim.force_limit(-1, None),
                           param="0x2004:02", value=1200, jog=50.0, home=19, setup=_arcus_canopen_setup),
+    "unitek": Kind("unitek", "0x201", 0.01, fault=lambda sim, drive: sim.set_hardware_enable(False),
+                   unfault=lambda sim: sim.set_hardware_enable(True), param="ACC_RAMP", value=200, jog=50.0,
+                   setup=lambda drive: drive.params.__setitem__("ACC_RAMP", 20),  # ms to N max
+                   sim_options={"calibrated": True}),
 }
 
 

@@ -4,6 +4,8 @@ import pathlib
 import subprocess
 import sys
 
+import motorbus
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
@@ -80,7 +82,9 @@ def test_example_04_dmac_interpolation_cpp():
 
 def test_example_06_drive_api_python():
     out = run_example("06_drive_api.py")
-    assert "kinds: arcus, arcus-canopen, cia402, dmac" in out
+    # The example lists the registry: every in-tree kind, and whatever else is installed.
+    assert "kinds: " + ", ".join(sorted(motorbus.drive_kinds())) in out
+    assert {"arcus", "arcus-canopen", "cia402", "dmac", "unitek"} <= set(motorbus.drive_kinds())
     for kind in ("arcus", "dmac", "cia402"):
         assert f"{kind}: at 3.50 mm, enabled=True moving=False fault=False" in out, out
 
@@ -92,3 +96,16 @@ def test_example_08_arcus_canopen_python():
     assert "run current over CANopen (2004h:02): 1200 mA" in out
     assert "moved to 1000.0 counts, state OPERATION ENABLED" in out
     assert "homed at 0.0 StepNLoop IDLE" in out
+def test_example_09_unitek_python():
+    out = run_example("09_unitek.py")
+    assert "KERN_STATUS 0x0181" in out and "ACC_RAMP 1000 ms" in out
+    assert "stream 0x30: 21 samples, periods 10.0..10.0 ms, lost 0" in out
+    assert "speed 300.0 rpm after 200 ms" in out
+    assert "position 1.000 rev, Tol True" in out
+
+
+def test_example_09_unitek_cpp():
+    out = run_cpp_example("example_09_unitek")
+    assert "KERN_STATUS 0x0181" in out and "ACC_RAMP 1000 ms" in out
+    assert "stream 0x30: 21 samples, last period 10.0 ms, lost 0, speed 3277 num" in out
+    assert "position 65536 num, Tol 1" in out

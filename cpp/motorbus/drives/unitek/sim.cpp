@@ -1,0 +1,522 @@
+#include "motorbus/drives/unitek/sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "motorbus/motion/planner.hpp"
+
+namespace motorbus::unitek {
+
+namespace {
+constexpr double kFull = 32767.0;
+constexpr double kHoldForever = 1.0e6;  // s: a speed command holds until the next command
+
+motion::MotorConfig motor_config(const SimConfig& c) {
+    motion::MotorConfig m;
+    m.steps_per_rev = kUnitekCountsPerRev;  // a servo: the "steps" are the position num
+    m.counts_per_rev = kUnitekCountsPerRev;
+    if (c.minus_limit_num) m.minus_limit = {true, *c.minus_limit_num, 0, false, false};
+    if (c.plus_limit_num) m.plus_limit = {true, *c.plus_limit_num, 0, false, false};
+    m.tick_ns = 250'000;
+    return m;
+}
+
+bool builtin_command(std::uint8_t regid) {
+    // Set-points and one-shot commands are not parameters: EEPROM does not keep them.
+    switch (regid) {
+        case kRegSpeedCmd: case kRegTorqueCmd: case kRegPosDest: case kRegMode: case kRegEeprom: return true;
+        default: return false;
+    }
+}
+}  // namespace
+
+RegisterTable sim_default_table() {
+    RegisterTable t = RegisterTable::builtin();
+    Register r;
+    r.regid = kRegPosActual;
+    r.name = "POS_IST";
+    r.bits = 32;
+    r.is_signed = true;
+    r.access = Access::ReadOnly;
+    r.quantity = Quantity::Position;
+    r.unit = "rev";
+    r.description = "actual position (NDrive list, not in 002)";
+    t.add(r);
+    return t;
+}
+
+void SimConfig::validate() const {
+    if (rx_id < kRxIdMin || rx_id > kRxIdMax) throw InvalidArgument("unitek sim rx_id: 0x201..0x27F");
+    if (tx_id < kTxIdMin || tx_id > kTxIdMax) throw InvalidArgument("unitek sim tx_id: 0x181..0x1FF");
+    UnitekRampParams{n_max_rpm, acc_ramp_ms, dec_ramp_ms}.validate();
+    if (tol_num < 0) throw InvalidArgument("unitek sim tol_num: >= 0");
+    if (minus_limit_num && plus_limit_num && !(*minus_limit_num < *plus_limit_num))
+        throw InvalidArgument("unitek sim limits: minus_limit_num must be below plus_limit_num");
+    if (torque_continuous_num < 0 || torque_continuous_num > 32767)
+        throw InvalidArgument("unitek sim torque_continuous_num: 0..32767");
+}
+
+UnitekSim::UnitekSim(Clock& clock, SimConfig cfg, RegisterTable table)
+    : clock_(clock), cfg_((cfg.validate(), cfg)), table_(std::move(table)), motor_(clock, motor_config(cfg_)),
+      rx_id_(cfg_.rx_id), calibrated_(cfg_.calibrated) {
+    reset_ram_locked();
+    regs_[kRegAccRamp] = static_cast<std::int64_t>(std::llround(cfg_.acc_ramp_ms));
+    regs_[kRegRxId] = rx_id_;
+    eeprom_ = {{kRegAccRamp, regs_[kRegAccRamp]}, {kRegEventMask, kDefaultEventMask}, {kRegRxId, rx_id_}};
+    last_status_ = status_locked();
+}
+
+UnitekSim::~UnitekSim() { close(); }
+
+void UnitekSim::reset_ram_locked() {
+    for (const auto& r : table_.rows()) regs_[r.regid] = 0;
+    regs_[kRegEventMask] = kDefaultEventMask;
+    mode_ = 0;
+    slots_.clear();
+    activity_ = Activity::Idle;
+}
+
+void UnitekSim::attach(can::Bus& bus) {
+    std::lock_guard l(m_);
+    if (bus_ != nullptr) throw InvalidArgument("unitek sim: already attached");
+    bus_ = &bus;
+    out_ = [this](const can::Frame& f) {
+        if (bus_ != nullptr && !bus_->closed()) bus_->send(f, std::chrono::milliseconds(100));
+    };
+    // All standard ids: the receive id can change at run time (0x68).
+    sub_ = bus.subscribe(can::Filter{0, 0, false, true}, [this](const can::Frame& f) { on_frame(f); });
+    timer_ = std::make_unique<canopen::TimerThread>();
+    // service() asks for 1 ms while something moves or events are on; idle, 10 ms is enough.
+    timer_->start(clock_, [this](Nanos) { return service(); }, 10'000'000);
+}
+
+void UnitekSim::set_output(std::function<void(const can::Frame&)> out) {
+    std::lock_guard l(m_);
+    out_ = std::move(out);
+}
+
+void UnitekSim::close() {
+    if (timer_) timer_->stop();
+    can::Bus* bus = nullptr;
+    {
+        std::lock_guard l(m_);
+        bus = bus_;
+    }
+    if (bus != nullptr && sub_ != 0) bus->unsubscribe(sub_);
+    std::lock_guard l(m_);
+    sub_ = 0;
+    bus_ = nullptr;
+    out_ = nullptr;
+}
+
+void UnitekSim::send(const std::vector<can::Frame>& frames) {
+    std::function<void(const can::Frame&)> out;
+    {
+        std::lock_guard l(m_);
+        out = out_;
+    }
+    if (!out) return;
+    for (const auto& f : frames) {
+        try {
+            out(f);
+        } catch (const Error&) {
+            // A full or closed bus: a real drive's frame is lost the same way.
+        }
+    }
+}
+
+// ---- time ------------------------------------------------------------------------------
+
+motion::State UnitekSim::state_locked() {
+    return motion::State{motor_.pulse_position(), motor_.pulse_velocity(), 0, 0};
+}
+
+UnitekRampParams UnitekSim::ramps_locked() const {
+    const auto acc = regs_.count(kRegAccRamp) ? static_cast<double>(regs_.at(kRegAccRamp)) : cfg_.acc_ramp_ms;
+    return UnitekRampParams{cfg_.n_max_rpm, acc, cfg_.dec_ramp_ms};
+}
+
+std::vector<can::Frame> UnitekSim::advance_locked(Nanos now) {
+    std::vector<can::Frame> out;
+    // Cyclic frames in time order; the motor is advanced to each frame's time so
+    // the value is the one of that instant.
+    while (!slots_.empty()) {
+        auto it = std::min_element(slots_.begin(), slots_.end(),
+                                   [](const Slot& a, const Slot& b) { return a.next < b.next; });
+        if (it->next > now) break;
+        motor_.advance_to(std::max(it->next, motor_.time()));
+        limits_locked();
+        check_events_locked(out);
+        const auto regid = it->regid;
+        it->next += it->period;
+        emit_reply_locked(regid, out);
+    }
+    motor_.advance_to(std::max(now, motor_.time()));
+    limits_locked();
+    check_events_locked(out);
+    return out;
+}
+
+void UnitekSim::limits_locked() {
+    // The drive's limit reaction: a motion towards an active limit switch stops
+    // (seen at the sim's evaluation times: at most one service period late).
+    if (!motor_.moving()) return;
+    const double v = motor_.pulse_velocity();
+    if ((v > 0 && motor_.plus_limit_active()) || (v < 0 && motor_.minus_limit_active())) {
+        motor_.halt();
+        activity_ = Activity::Idle;
+    }
+}
+
+Nanos UnitekSim::service() {
+    std::vector<can::Frame> out;
+    Nanos next = -1;
+    {
+        std::lock_guard l(m_);
+        out = advance_locked(clock_.now());
+        for (const auto& s : slots_) next = next < 0 ? s.next : std::min(next, s.next);
+        // While moving or with events on, look again within a millisecond.
+        if (motor_.moving() || (mode_ & kModeEvents)) {
+            const Nanos soon = clock_.now() + 1'000'000;
+            next = next < 0 ? soon : std::min(next, soon);
+        }
+    }
+    send(out);
+    return next;
+}
+
+// ---- frames ------------------------------------------------------------------------------
+
+void UnitekSim::on_frame(const can::Frame& f) {
+    std::vector<can::Frame> out;
+    std::optional<std::map<std::uint8_t, std::int64_t>> stored;
+    std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb;
+    {
+        std::lock_guard l(m_);
+        if (f.extended || f.rtr || f.is_fd() || (f.flags & can::kFlagError) || f.id != rx_id_) {
+            // B-U20: the drive reads its own receive id only.  Our own transmit id
+            // and every other node's traffic land here too (one subscription for all ids).
+            if (f.id != cfg_.tx_id) ++counters_.ignored;
+            return;
+        }
+        ++counters_.frames_in;
+        out = advance_locked(clock_.now());
+        std::optional<ToDrive> t;
+        try {
+            t = decode_to_drive(f.payload());
+        } catch (const FrameError&) {
+            ++counters_.malformed;  // B-U03: DLC < 3 ignored
+        }
+        if (t) {
+            handle_locked(*t, out);
+            check_events_locked(out);
+        }
+        if (eeprom_dirty_ && eeprom_cb_) {
+            eeprom_dirty_ = false;
+            stored = eeprom_;
+            cb = eeprom_cb_;
+        }
+    }
+    send(out);
+    if (cb) {
+        try {
+            cb(*stored);
+        } catch (...) {
+            // A host that cannot save its file must not take the drive down.
+        }
+    }
+    if (timer_) timer_->poke();
+}
+
+void UnitekSim::handle_locked(const ToDrive& t, std::vector<can::Frame>& out) {
+    if (!t.is_request()) {
+        write_locked(t.regid, t.value, t.value_bits);
+        return;
+    }
+    const auto regid = t.request_regid();
+    const auto interval = t.request_interval();
+    const Register* r = table_.find(regid);
+    if (r == nullptr || !r->readable()) {
+        ++counters_.unknown;  // B-U22: no reply
+        return;
+    }
+    auto slot = std::find_if(slots_.begin(), slots_.end(), [&](const Slot& s) { return s.regid == regid; });
+    const Nanos now = clock_.now();
+    if (interval == kIntervalOnce) {
+        emit_reply_locked(regid, out);  // a cyclic entry keeps running (B-U07)
+    } else if (interval == kIntervalStop) {
+        if (slot != slots_.end()) slots_.erase(slot);  // not cyclic: nothing to stop
+    } else {
+        const Nanos period = static_cast<Nanos>(interval) * 1'000'000;
+        if (slot != slots_.end()) {
+            slot->period = period;  // a repeated request replaces the period
+            slot->next = now + period;
+        } else if (static_cast<int>(slots_.size()) < kMaxCyclic) {
+            slots_.push_back({regid, period, now + period});
+        } else {
+            ++counters_.cyclic_refused;  // B-U08: a 9th register is ignored
+            return;
+        }
+        emit_reply_locked(regid, out);  // the first frame at once
+    }
+}
+
+void UnitekSim::emit_reply_locked(std::uint8_t regid, std::vector<can::Frame>& out) {
+    const Register* r = table_.find(regid);
+    if (r == nullptr) return;
+    const std::int64_t v = value_locked(regid);
+    const auto bytes = encode_reply(regid, static_cast<std::uint32_t>(v), r->bits, cfg_.dummy);
+    out.push_back(can::Frame::make(cfg_.tx_id, bytes));
+    out.back().timestamp_ns = motor_.time();
+    ++sent_[regid];
+    ++counters_.frames_out;
+}
+
+void UnitekSim::check_events_locked(std::vector<can::Frame>& out) {
+    const std::uint32_t st = status_locked();
+    const std::uint32_t changed = st ^ last_status_;
+    last_status_ = st;
+    if (!(mode_ & kModeEvents) || changed == 0) return;
+    const auto mask = event_status_mask(static_cast<std::uint16_t>(regs_[kRegEventMask]));
+    if ((changed & mask) == 0) return;
+    // C-U02: the event carries the complete status, 32 bits (DLC 6).
+    out.push_back(can::Frame::make(cfg_.tx_id, encode_reply(kRegStatus, st, 32, cfg_.dummy)));
+    ++counters_.events_out;
+    ++counters_.frames_out;
+}
+
+// ---- writes ------------------------------------------------------------------------------
+
+void UnitekSim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
+    const Register* r = table_.find(regid);
+    if (r == nullptr) {
+        ++counters_.unknown;  // no NACK exists: ignored
+        return;
+    }
+    if (!r->writable()) {
+        ++counters_.refused;
+        return;
+    }
+    // B-U03: a 16-bit register takes the low 16 bits of a 32-bit write; a 32-bit
+    // register written with 16 bits sign-extends when signed.
+    const std::int64_t v = r->from_raw(raw, std::min(bits, r->bits));
+    if (v < r->lo() || v > r->hi()) {
+        ++counters_.refused;  // out of range: ignored, no state change
+        return;
+    }
+    switch (regid) {
+        case kRegMode: {
+            const auto old = mode_;
+            mode_ = static_cast<std::uint16_t>(v);
+            if ((mode_ & kModeEvents) && !(old & kModeEvents)) last_status_ = status_locked();  // no frame at activation
+            apply_enable_locked();
+            break;
+        }
+        case kRegRxId:
+            rx_id_ = static_cast<std::uint32_t>(v);  // effective at once (B-U12)
+            break;
+        case kRegEeprom:
+            for (auto id : {kRegAccRamp, kRegEventMask, kRegRxId}) eeprom_[id] = regs_[id];
+            for (const auto& row : table_.rows())  // user registers (an NDrive list) persist too
+                if (row.writable() && !builtin_command(row.regid)) eeprom_[row.regid] = regs_[row.regid];
+            eeprom_dirty_ = true;
+            break;
+        default: break;
+    }
+    if (regid == kRegRxId) regs_[regid] = rx_id_;
+    else regs_[regid] = v;
+    const bool enabled = (status_locked() & kStatusEna) != 0;
+    switch (regid) {
+        case kRegSpeedCmd:
+            if (enabled) {
+                activity_ = Activity::Speed;
+                speed_locked(static_cast<double>(v), 1.0);
+            }
+            break;
+        case kRegTorqueCmd:
+            if (enabled) {
+                activity_ = Activity::Torque;
+                // No load: the rotor accelerates to N max at a rate proportional to the torque.
+                if (v == 0) speed_locked(0, 1.0);
+                else speed_locked(v > 0 ? kFull : -kFull, kFull / std::fabs(static_cast<double>(v)));
+            }
+            break;
+        case kRegPosDest:
+            if (enabled) {
+                activity_ = Activity::Position;
+                const auto p = ramps_locked();
+                const double full = unitek_num_to_counts_per_s(kFull, p);
+                motion::Limits lim;
+                lim.max_velocity = full;
+                lim.max_acceleration = full / std::max(p.acc_ramp_ms, 1.0) * 1000.0;
+                lim.max_deceleration = full / std::max(p.dec_ramp_ms, 1.0) * 1000.0;
+                motor_.command(motion::plan_trapezoid(state_locked(), static_cast<double>(v), lim));
+            }
+            break;
+        default: break;
+    }
+}
+
+void UnitekSim::speed_locked(double num, double ramp_scale) {
+    auto p = ramps_locked();
+    p.acc_ramp_ms = std::min(p.acc_ramp_ms * ramp_scale, 32767.0);
+    motor_.command(unitek_speed_profile(state_locked(), num, p, kHoldForever));
+}
+
+void UnitekSim::apply_enable_locked() {
+    if (!(status_locked() & kStatusEna) && motor_.moving()) {
+        // The power stage is off: the sim stops the rotor where it is (no load model to coast).
+        motor_.halt();
+        activity_ = Activity::Idle;
+    }
+}
+
+// ---- reads ---------------------------------------------------------------------------------
+
+std::uint32_t UnitekSim::status_locked() {
+    std::uint32_t s = 0;
+    if (!(mode_ & kModeDisable) && hw_enable_) s |= kStatusEna;
+    if (motor_.plus_limit_active()) s |= kStatusLimPlus;
+    if (motor_.minus_limit_active()) s |= kStatusLimMinus;
+    if (cfg_.position_control) s |= kStatusPositionControl;
+    if (cfg_.speed_control) s |= kStatusSpeedControl;
+    if (calibrated_) s |= kStatusCal;
+    const bool icns = icns_forced_ ? *icns_forced_
+                                   : (activity_ == Activity::Torque &&
+                                      std::llabs(regs_[kRegTorqueCmd]) > cfg_.torque_continuous_num);
+    if (icns) s |= kStatusIcns;
+    if (activity_ == Activity::Position && !motor_.moving() &&
+        std::fabs(motor_.pulse_position() - static_cast<double>(regs_[kRegPosDest])) <= static_cast<double>(cfg_.tol_num))
+        s |= kStatusTol;
+    return s;
+}
+
+std::int64_t UnitekSim::value_locked(std::uint8_t regid) {
+    switch (regid) {
+        case kRegStatus: return status_locked() & 0xFFFF;  // C-U02: 16 bits in a read reply
+        case kRegPosActual: {
+            const double p = std::clamp(motor_.pulse_position(), -2147483647.0, 2147483647.0);
+            return static_cast<std::int64_t>(std::llround(p));
+        }
+        case kRegSpeedActual: {
+            const double num = motor_.pulse_velocity() / unitek_num_to_counts_per_s(1.0, ramps_locked());
+            return static_cast<std::int64_t>(std::llround(std::clamp(num, -kFull, kFull)));
+        }
+        default: {
+            auto it = regs_.find(regid);
+            return it == regs_.end() ? 0 : it->second;
+        }
+    }
+}
+
+// ---- inputs / introspection ----------------------------------------------------------------------
+
+#define UNITEK_SIM_LOCKED(body)                        \
+    std::vector<can::Frame> out_frames;                \
+    {                                                  \
+        std::lock_guard l(m_);                         \
+        out_frames = advance_locked(clock_.now());     \
+        body;                                          \
+        check_events_locked(out_frames);               \
+    }                                                  \
+    send(out_frames)
+
+void UnitekSim::set_hardware_enable(bool on) {
+    UNITEK_SIM_LOCKED(hw_enable_ = on; apply_enable_locked());
+}
+
+void UnitekSim::force_limit(int direction, std::optional<bool> active) {
+    if (direction != 1 && direction != -1) throw InvalidArgument("unitek sim force_limit: direction +1 or -1");
+    UNITEK_SIM_LOCKED({
+        motor_.force_switch(direction > 0 ? motion::Switch::PlusLimit : motion::Switch::MinusLimit, active);
+        // A limit switch stops a motion towards it (the drive's own limit reaction).
+        if (active.value_or(false) && motor_.moving() && motor_.pulse_velocity() * direction > 0) motor_.halt();
+    });
+}
+
+void UnitekSim::set_calibrated(bool on) { UNITEK_SIM_LOCKED(calibrated_ = on); }
+
+void UnitekSim::force_icns(std::optional<bool> active) { UNITEK_SIM_LOCKED(icns_forced_ = active); }
+
+void UnitekSim::power_cycle() {
+    std::lock_guard l(m_);
+    motor_.advance_to(std::max(clock_.now(), motor_.time()));
+    motor_.halt();
+    reset_ram_locked();
+    for (const auto& [id, v] : eeprom_) regs_[id] = v;
+    rx_id_ = static_cast<std::uint32_t>(regs_[kRegRxId]);
+    last_status_ = status_locked();
+}
+
+std::uint32_t UnitekSim::status() {
+    std::lock_guard l(m_);
+    motor_.advance_to(std::max(clock_.now(), motor_.time()));
+    return status_locked();
+}
+
+std::int64_t UnitekSim::value(std::uint8_t regid) {
+    table_.at(regid);
+    std::lock_guard l(m_);
+    motor_.advance_to(std::max(clock_.now(), motor_.time()));
+    return regid == kRegStatus ? status_locked() : value_locked(regid);
+}
+
+double UnitekSim::position_num() {
+    std::lock_guard l(m_);
+    motor_.advance_to(std::max(clock_.now(), motor_.time()));
+    return motor_.pulse_position();
+}
+
+double UnitekSim::speed_num() {
+    std::lock_guard l(m_);
+    motor_.advance_to(std::max(clock_.now(), motor_.time()));
+    return motor_.pulse_velocity() / unitek_num_to_counts_per_s(1.0, ramps_locked());
+}
+
+std::uint32_t UnitekSim::rx_id() const {
+    std::lock_guard l(m_);
+    return rx_id_;
+}
+
+std::vector<std::pair<std::uint8_t, int>> UnitekSim::cyclic() const {
+    std::lock_guard l(m_);
+    std::vector<std::pair<std::uint8_t, int>> out;
+    for (const auto& s : slots_) out.emplace_back(s.regid, static_cast<int>(s.period / 1'000'000));
+    return out;
+}
+
+std::uint64_t UnitekSim::sent(std::uint8_t regid) const {
+    std::lock_guard l(m_);
+    auto it = sent_.find(regid);
+    return it == sent_.end() ? 0 : it->second;
+}
+
+SimCounters UnitekSim::counters() const {
+    std::lock_guard l(m_);
+    return counters_;
+}
+
+void UnitekSim::on_eeprom_store(std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb) {
+    std::lock_guard l(m_);
+    eeprom_cb_ = std::move(cb);
+}
+
+std::map<std::uint8_t, std::int64_t> UnitekSim::eeprom() const {
+    std::lock_guard l(m_);
+    return eeprom_;
+}
+
+void UnitekSim::load_eeprom(const std::map<std::uint8_t, std::int64_t>& values) {
+    {
+        std::lock_guard l(m_);
+        for (const auto& [id, v] : values) {
+            const Register* r = table_.find(id);
+            if (r == nullptr || !r->writable() || v < r->lo() || v > r->hi())
+                throw InvalidArgument("unitek sim eeprom: register " + std::to_string(id) + " value out of place");
+            eeprom_[id] = v;
+        }
+    }
+    power_cycle();
+}
+
+}  // namespace motorbus::unitek

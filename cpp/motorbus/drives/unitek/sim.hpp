@@ -1,0 +1,161 @@
+// A simulated UNITEK BAMOCAR/BAMOBIL/DS servo on the register protocol (002 manual).
+//
+// The drive listens on its receive id (0x201) and answers on its transmit id
+// (0x181).  Writes are never acknowledged (B-U05).  `3D <REGID> <t>` reads a
+// register once (t = 0), every t ms (1..254, at most 8 registers, a repeated
+// request replaces the period, the first frame goes out at once) or stops it
+// (0xFF).  With MODE bit 4 set, KERN_STATUS is sent (DLC 6) whenever a status
+// bit selected by the event mask (0x52) changes.  The motion runs on a
+// motion::MotorModel on the sim's Clock: speed control with the ACC ramp,
+// position control to POS_DEST (Tol = in the position window), a torque
+// command (no load: the rotor accelerates to N max at a rate proportional to
+// the torque), enable by MODE bit 2 and a hardware enable input, limit
+// switches, the calibration bit and the continuous current limit (Icns).
+// EEPROM (0x84) keeps the parameters over power_cycle().
+//
+// Time: the sim is evaluated when a frame arrives and by a timer thread; on a
+// SimClock a test calls service() after advancing the clock to get every frame
+// due by then, in time order, before it returns.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include "motorbus/can/bus.hpp"
+#include "motorbus/canopen/timer_thread.hpp"
+#include "motorbus/drives/unitek/codec.hpp"
+#include "motorbus/drives/unitek/profile.hpp"
+#include "motorbus/motion/motor_model.hpp"
+#include "motorbus/runtime/clock.hpp"
+
+namespace motorbus::unitek {
+
+struct SimConfig {
+    std::uint32_t rx_id = kDefaultRxId;
+    std::uint32_t tx_id = kDefaultTxId;
+    double n_max_rpm = 3000;         // N max: 32767 num
+    double acc_ramp_ms = 1000;       // 0x35 at the factory
+    double dec_ramp_ms = 1000;       // NDrive's deceleration ramp (not on this manual's bus)
+    bool position_control = true;    // KERN_STATUS bit 7 (B-U23: an NDrive setting)
+    bool speed_control = true;       // KERN_STATUS bit 8
+    bool calibrated = false;         // Cal (bit 12); ex 8 reads 0x0181: not calibrated
+    std::int64_t tol_num = 64;       // position window of Tol (num)
+    std::optional<double> minus_limit_num = -100.0 * 65536;  // limit switch positions (num); nullopt = none
+    std::optional<double> plus_limit_num = 100.0 * 65536;
+    std::int64_t torque_continuous_num = 32767;  // |torque| above this: Icns (continuous current limit)
+    std::uint8_t dummy = 0x00;       // the reply's dummy byte (B-U04: unspecified, 0x00)
+    void validate() const;           // InvalidArgument naming the field
+};
+
+struct SimCounters {
+    std::uint64_t frames_in = 0;       // frames on the receive id
+    std::uint64_t ignored = 0;         // other ids, RTR, extended ids
+    std::uint64_t malformed = 0;       // DLC < 3
+    std::uint64_t unknown = 0;         // unknown REGID (write or read)
+    std::uint64_t refused = 0;         // write to a read-only register / value out of range
+    std::uint64_t cyclic_refused = 0;  // a 9th cyclic register
+    std::uint64_t frames_out = 0;
+    std::uint64_t events_out = 0;
+};
+
+// The sim's registers: the documented ones plus POS_IST (0x6D, actual position, 32-bit signed, read-only).
+RegisterTable sim_default_table();
+
+class UnitekSim {
+public:
+    UnitekSim(Clock& clock, SimConfig cfg = {}, RegisterTable table = sim_default_table());
+    ~UnitekSim();
+    UnitekSim(const UnitekSim&) = delete;
+    UnitekSim& operator=(const UnitekSim&) = delete;
+
+    // Serve on `bus` (subscribes to the receive id, starts the timer thread).
+    void attach(can::Bus& bus);
+    // Output without a bus (fuzzing, unit tests): every frame the drive sends.
+    void set_output(std::function<void(const can::Frame&)> out);
+    void close();
+
+    // A frame seen on the bus (public for tests and fuzzing; not id-filtered by the caller).
+    void on_frame(const can::Frame& f);
+    // Emits every cyclic / event frame due by clock.now(); returns the next due time (-1: none).
+    Nanos service();
+
+    // ---- sim inputs ----
+    void set_hardware_enable(bool on);
+    void force_limit(int direction, std::optional<bool> active);  // +1 / -1; nullopt: follow the position
+    void set_calibrated(bool on);
+    void force_icns(std::optional<bool> active);
+    void power_cycle();  // EEPROM values back, RAM values lost, cyclic/events off, motor stopped
+
+    // ---- introspection ----
+    std::uint32_t status();
+    std::int64_t value(std::uint8_t regid);   // the register as a read would return it; UnknownRegister
+    double position_num();
+    double speed_num();
+    std::uint32_t rx_id() const;
+    std::uint32_t tx_id() const { return cfg_.tx_id; }
+    std::vector<std::pair<std::uint8_t, int>> cyclic() const;  // (REGID, period ms)
+    std::uint64_t sent(std::uint8_t regid) const;               // frames sent for REGID
+    SimCounters counters() const;
+    const SimConfig& config() const { return cfg_; }
+    std::map<std::uint8_t, std::int64_t> eeprom() const;
+    void load_eeprom(const std::map<std::uint8_t, std::int64_t>& values);  // a stored file, before use
+    // Called (outside the sim's lock, on the thread that handled 0x84) with the
+    // EEPROM contents after each store: lets a host keep them in a file.
+    void on_eeprom_store(std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb);
+
+private:
+    struct Slot {
+        std::uint8_t regid;
+        Nanos period;
+        Nanos next;
+    };
+    enum class Activity { Idle, Speed, Position, Torque };
+
+    std::vector<can::Frame> advance_locked(Nanos now);  // cyclic + events up to now, motor to now
+    void emit_reply_locked(std::uint8_t regid, std::vector<can::Frame>& out);
+    void check_events_locked(std::vector<can::Frame>& out);
+    void handle_locked(const ToDrive& t, std::vector<can::Frame>& out);
+    void write_locked(std::uint8_t regid, std::uint32_t raw, int bits);
+    void apply_enable_locked();
+    void limits_locked();
+    void speed_locked(double num, double ramp_scale);
+    std::uint32_t status_locked();
+    std::int64_t value_locked(std::uint8_t regid);
+    motion::State state_locked();
+    UnitekRampParams ramps_locked() const;
+    void send(const std::vector<can::Frame>& frames);
+    void reset_ram_locked();
+
+    Clock& clock_;
+    SimConfig cfg_;
+    RegisterTable table_;
+    mutable std::mutex m_;
+    motion::MotorModel motor_;
+    std::map<std::uint8_t, std::int64_t> regs_;    // RAM values of the table's registers
+    std::map<std::uint8_t, std::int64_t> eeprom_;  // stored by 0x84
+    std::vector<Slot> slots_;
+    std::map<std::uint8_t, std::uint64_t> sent_;
+    std::uint32_t rx_id_;
+    std::uint16_t mode_ = 0;
+    bool hw_enable_ = true;
+    bool calibrated_;
+    std::optional<bool> icns_forced_;
+    std::optional<bool> limit_forced_[2];  // [0] minus, [1] plus
+    Activity activity_ = Activity::Idle;
+    std::uint32_t last_status_ = 0;
+    bool events_armed_ = false;
+    SimCounters counters_;
+
+    std::function<void(const can::Frame&)> out_;
+    std::function<void(const std::map<std::uint8_t, std::int64_t>&)> eeprom_cb_;
+    bool eeprom_dirty_ = false;
+    can::Bus* bus_ = nullptr;
+    can::SubscriptionId sub_ = 0;
+    std::unique_ptr<canopen::TimerThread> timer_;
+};
+
+}  // namespace motorbus::unitek

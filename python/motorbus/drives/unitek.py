@@ -1,0 +1,716 @@
+"""UNITEK BAMOCAR / BAMOBIL / DS servo controllers on their CAN register protocol.
+
+    import motorbus
+    from motorbus.drives.unitek import Unitek, Reg, Status
+
+    bus = motorbus.open_bus("socketcand:127.0.0.1:29536/can0")
+    with Unitek(bus, rx_id=0x201) as drive:          # stops the motor when the block fails
+        drive.write(Reg.ACC_RAMP, 1000)               # ms; writes are never acknowledged...
+        assert drive.read(Reg.ACC_RAMP) == 1000       # ...so read back what matters
+        drive.speed_rpm = 300                         # SPEED_CMD from rpm via N max
+        stream = drive.subscribe(Reg.SPEED_IST, 1)    # every 1 ms into a numpy ring
+        t_ns, num = stream.read()                     # filled by the C++ receive thread
+        drive.unsubscribe(Reg.SPEED_IST)
+
+The protocol is not CANopen (002 §4.1): one REGID byte and a little-endian
+value, to the drive on its receive id (0x201..0x27F), from the drive on its
+transmit id (0x181..0x1FF; here ``rx_id - 0x80`` unless given, the pairing of
+the manual's defaults and of its example 9, 0x210/0x190).  ``open_drive("unitek",
+bus=..., address="0x201")`` gives the shared Drive API; ``make_sim("0x201")`` a
+simulated servo; ``motorbus sim serve --drive unitek:0x201`` serves one.
+
+Registers are data: :func:`builtin_registers` (the 12 documented REGIDs),
+extended with :func:`load_registers` from a TOML file (the manual says the full
+map lives in NDrive).  Format::
+
+    [[register]]
+    regid = 0x6D            # required
+    name = "POS_IST"        # required
+    bits = 32               # 16 (default) or 32
+    signed = true
+    access = "ro"           # rw (default) | ro | wo
+    quantity = "position"   # raw (default) | speed | position | current | torque | time
+    unit = "rev"
+    scale = 1.0             # raw/time: physical = num * scale
+    min = -100              # optional range (both or neither)
+    max = 100
+    description = "..."
+
+Link loss: the drive's only time-out monitor is "T-Out" in NDrive's CAN-Setup
+(002 Fig. 6-1), not reachable over CAN and not described further.  The
+adapter therefore does not claim a watchdog (``has_watchdog = False``): when
+the link is lost the drive keeps the last set-point (a jog keeps turning)
+unless T-Out was set in NDrive, and the next call raises ``LinkDown`` or
+``TimeoutError``.  The simulator models T-Out only when asked (``t_out_ms``).
+"""
+from __future__ import annotations
+
+import enum
+import threading
+from pathlib import Path
+from typing import Any, Callable, Optional, Sequence, Union
+
+from .. import _core
+from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params, Units
+from ..registry import DrivePlugin
+
+__all__ = ["FrameError", "UnknownRegister", "CyclicLimit", "Reg", "Status", "ModeBit", "Unitek", "UnitekDrive", "UnitekSim", "Stream", "PLUGIN", "make_sim",
+           "open", "builtin_registers", "load_registers", "ndrive_registers", "REVOLUTIONS"]
+
+#: Typed errors (also motorbus._core.Unitek*).
+FrameError = _core.UnitekFrameError          # a frame breaking the protocol; .byte, .data
+UnknownRegister = _core.UnitekUnknownRegister  # REGID not in the table; .regid
+CyclicLimit = _core.UnitekCyclicLimit        # a 9th cyclic register
+
+COUNTS_PER_REV = 65536
+FULL_SCALE = 32767
+#: User units of revolutions for open_drive(..., units=REVOLUTIONS).
+REVOLUTIONS = Units("rev", 1.0 / COUNTS_PER_REV)
+_NDRIVE_TOML = Path(__file__).with_name("unitek_ndrive.toml")
+
+
+class Reg(enum.IntEnum):
+    """The REGIDs of the 002 manual (and POS_IST from the NDrive list)."""
+
+    SPEED_IST = 0x30
+    SPEED_CMD = 0x31
+    ACC_RAMP = 0x35
+    READ = 0x3D
+    KERN_STATUS = 0x40
+    MODE = 0x51
+    EVENT_MASK = 0x52
+    CAN_ID_RX = 0x68
+    POS_IST = 0x6D
+    POS_DEST = 0x6E
+    EEPROM_WRITE = 0x84
+    TORQUE_CMD = 0x90
+    REG_A8 = 0xA8
+
+
+class Status(enum.IntFlag):
+    """KERN_STATUS (0x40).  ICNS has no documented bit: bit 5 is this project's reading."""
+
+    ENA = 1 << 0
+    LIM_PLUS = 1 << 2
+    LIM_MINUS = 1 << 3
+    ICNS = 1 << 5
+    POSITION_CONTROL = 1 << 7
+    SPEED_CONTROL = 1 << 8
+    CAL = 1 << 12
+    TOL = 1 << 13
+
+
+class ModeBit(enum.IntFlag):
+    """MODE (0x51)."""
+
+    DISABLE = 1 << 2
+    EVENTS = 1 << 4
+
+
+_QUANTITIES = {"raw": _core.UnitekQuantity.RAW, "speed": _core.UnitekQuantity.SPEED,
+               "position": _core.UnitekQuantity.POSITION, "current": _core.UnitekQuantity.CURRENT,
+               "torque": _core.UnitekQuantity.TORQUE, "time": _core.UnitekQuantity.TIME}
+_ACCESS = {"rw": _core.UnitekAccess.RW, "ro": _core.UnitekAccess.RO, "wo": _core.UnitekAccess.WO}
+_ROW_KEYS = {"regid", "name", "bits", "signed", "access", "quantity", "unit", "scale", "min", "max", "description"}
+
+
+def builtin_registers() -> Any:
+    """The documented REGIDs as a register table (a copy you may extend)."""
+    return _core.UnitekRegisterTable()
+
+
+def _rows_from_toml(data: dict, where: str) -> list:
+    rows = data.get("register", [])
+    if not isinstance(rows, list):
+        raise _core.InvalidArgument(f"{where}: [[register]] must be an array of tables")
+    out = []
+    for i, row in enumerate(rows):
+        label = f"{where}: register #{i + 1}"
+        if not isinstance(row, dict):
+            raise _core.InvalidArgument(f"{label}: not a table")
+        unknown = set(row) - _ROW_KEYS
+        if unknown:
+            raise _core.InvalidArgument(f"{label}: unknown keys {sorted(unknown)} (known: {sorted(_ROW_KEYS)})")
+        for key in ("regid", "name"):
+            if key not in row:
+                raise _core.InvalidArgument(f"{label}: '{key}' is required")
+        regid, name = row["regid"], row["name"]
+        if isinstance(regid, bool) or not isinstance(regid, int):
+            raise _core.InvalidArgument(f"{label}: regid must be an integer, not {regid!r}")
+        if not isinstance(name, str):
+            raise _core.InvalidArgument(f"{label}: name must be a string")
+        quantity = str(row.get("quantity", "raw")).lower()
+        access = str(row.get("access", "rw")).lower()
+        if quantity not in _QUANTITIES:
+            raise _core.InvalidArgument(f"{label} ({name}): quantity {quantity!r} not one of {sorted(_QUANTITIES)}")
+        if access not in _ACCESS:
+            raise _core.InvalidArgument(f"{label} ({name}): access {access!r} not one of {sorted(_ACCESS)}")
+        try:
+            out.append(_core.UnitekRegister(
+                regid, name, bits=int(row.get("bits", 16)), signed=bool(row.get("signed", False)),
+                access=_ACCESS[access], quantity=_QUANTITIES[quantity], unit=str(row.get("unit", "")),
+                scale=float(row.get("scale", 1.0)), min=row.get("min"), max=row.get("max"),
+                description=str(row.get("description", ""))))
+        except _core.InvalidArgument as e:
+            raise _core.InvalidArgument(f"{label} ({name}): {e}") from None
+        except (TypeError, ValueError) as e:
+            raise _core.InvalidArgument(f"{label} ({name}): {e}") from None
+    return out
+
+
+def load_registers(path: Union[str, Path], table: Any = None) -> Any:
+    """Adds the rows of a TOML register list to ``table`` (default: a copy of the
+    built-in table) and returns it.  Bad rows raise InvalidArgument naming the row."""
+    import tomllib
+
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except OSError as e:
+        raise _core.InvalidArgument(f"unitek registers {p}: {e.strerror or e}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise _core.InvalidArgument(f"unitek registers {p}: not TOML ({e})") from None
+    t = table if table is not None else builtin_registers()
+    for row in _rows_from_toml(data, str(p)):
+        t.add(row)
+    return t
+
+
+def ndrive_registers() -> Any:
+    """The built-in table plus the NDrive rows motorbus ships (POS_IST)."""
+    return load_registers(_NDRIVE_TOML)
+
+
+def _regid(reg: Union[int, str, Reg], table: Any) -> int:
+    if isinstance(reg, str):
+        return int(table[reg].regid)
+    if isinstance(reg, bool) or not isinstance(reg, int):
+        raise _core.InvalidArgument(f"unitek register: a REGID or a name, not {reg!r}")
+    return int(reg)
+
+
+def check_address(address: Union[str, int]) -> str:
+    """The drive's receive id, 0x201..0x27F: an int, or hex text as the manual writes
+    ids ("201", "0x201"); canonical form ``0x201``."""
+    if isinstance(address, bool):
+        raise _core.InvalidArgument(f"unitek address: a receive id 0x201..0x27F, not {address!r}")
+    if isinstance(address, int):
+        value = address
+    else:
+        text = str(address).strip().lower()
+        digits = text[2:] if text.startswith("0x") else text
+        try:
+            value = int(digits, 16)
+        except ValueError:
+            raise _core.InvalidArgument(f"unitek address: a receive id 0x201..0x27F, not {address!r}") from None
+    if not 0x201 <= value <= 0x27F:
+        raise _core.InvalidArgument(f"unitek address: receive id 0x{value:X} is outside 0x201..0x27F")
+    return f"0x{value:03X}"
+
+
+def _tx_for(rx_id: int) -> int:
+    return rx_id - 0x80
+
+
+# ---- streams ----------------------------------------------------------------------------
+
+class Stream:
+    """A cyclic register: ``read()`` -> (timestamps ns, values num) as numpy int64 arrays;
+    ``physical()`` the same values converted by the register's scaling."""
+
+    def __init__(self, core: Any, register: Any, scalings: Any) -> None:
+        self._core = core
+        self.register = register
+        self._scalings = scalings
+
+    regid = property(lambda self: self._core.regid)
+    interval_ms = property(lambda self: self._core.interval_ms)
+    active = property(lambda self: self._core.active)
+    count = property(lambda self: self._core.count)
+    lost = property(lambda self: self._core.lost)
+    capacity = property(lambda self: self._core.capacity)
+
+    def read(self, max: int = -1) -> tuple:  # noqa: A002 - mirrors the core
+        return self._core.read(max)
+
+    def physical(self, values: Any) -> Any:
+        """num -> the register's unit (rpm, rev, %, A, ms), vectorised."""
+        import numpy as np
+
+        one = self._scalings.to_physical(self.register, 1)
+        return np.asarray(values, dtype=float) * one
+
+    def __repr__(self) -> str:
+        return f"<unitek Stream 0x{self.regid:02X} every {self.interval_ms} ms, {self.count} samples>"
+
+
+# ---- the native client ------------------------------------------------------------------
+
+class Unitek:
+    """The register protocol of one drive (see the module doc).
+
+    ``on_error`` / ``on_exit`` ("stop", "quick_stop", "disable" or None) say what the
+    ``with`` block does to the motor when it ends by an exception / normally."""
+
+    def __init__(self, bus: Any, rx_id: int = 0x201, tx_id: Optional[int] = None, *, timeout: float = 0.2,
+                 registers: Any = None, n_max_rpm: float = 3000.0, device: str = "DS 205/405",
+                 clock: Any = None, on_error: Optional[str] = "stop", on_exit: Optional[str] = None) -> None:
+        for name, how in (("on_error", on_error), ("on_exit", on_exit)):
+            if how not in ("stop", "quick_stop", "disable", None):
+                raise _core.InvalidArgument(f"{name}: one of 'stop', 'quick_stop', 'disable' or None, not {how!r}")
+        currents = {d["device"]: d for d in _core.unitek_device_currents()}
+        if device not in currents:
+            raise _core.InvalidArgument(f"unitek device: one of {sorted(currents)}, not {device!r}")
+        d = currents[device]
+        self.scalings = _core.UnitekScalings(n_max_rpm=n_max_rpm, i_max_num=d["i_max_num"], i_max_a=d["i_max_a"])
+        if registers is None:
+            table = ndrive_registers()
+        elif isinstance(registers, (str, Path)):
+            table = load_registers(registers, ndrive_registers())
+        else:
+            table = registers
+        rx = int(check_address(rx_id), 16)
+        self._core = _core.UnitekClient(bus, rx_id=rx, tx_id=_tx_for(rx) if tx_id is None else tx_id,
+                                        timeout=timeout, table=table, clock=clock)
+        self.on_error = on_error
+        self.on_exit = on_exit
+        self._streams: dict[int, Stream] = {}
+        self._lock = threading.Lock()
+
+    # ---- registers ----
+    @property
+    def table(self) -> Any:
+        return self._core.table
+
+    def register(self, reg: Union[int, str]) -> Any:
+        return self.table[_regid(reg, self.table)]
+
+    def write(self, reg: Union[int, str], value: int) -> None:
+        """Writes ``value`` (num).  Never acknowledged by the drive (read back where it matters)."""
+        self._core.write(_regid(reg, self.table), value)
+
+    def read(self, reg: Union[int, str], timeout: Optional[float] = None) -> int:
+        """Reads once (``3D REGID 00``); TimeoutError when the drive does not answer."""
+        return self._core.read(_regid(reg, self.table), timeout)
+
+    def write_physical(self, reg: Union[int, str], value: float) -> None:
+        """Writes ``value`` in the register's unit (rpm, rev, %, A, ms)."""
+        r = self.register(reg)
+        self.write(r.regid, self.scalings.to_num(r, value))
+
+    def read_physical(self, reg: Union[int, str], timeout: Optional[float] = None) -> float:
+        r = self.register(reg)
+        return self.scalings.to_physical(r, self.read(r.regid, timeout))
+
+    def add_register(self, register: Any) -> None:
+        self._core.add_register(register)
+
+    # ---- cyclic ----
+    def subscribe(self, reg: Union[int, str], interval_ms: int, capacity: int = 65536,
+                  callback: Optional[Callable[[int, int, int], None]] = None) -> Stream:
+        """Every ``interval_ms`` (1..254) into a numpy ring; ``callback(regid, t_ns, value)`` too if given
+        (it runs on the bus thread and takes the GIL: keep it short, or use the ring alone).
+        The 9th register raises UnitekCyclicLimit."""
+        regid = _regid(reg, self.table)
+        core = self._core.subscribe(regid, interval_ms, capacity, callback)
+        with self._lock:
+            s = self._streams.get(regid)
+            if s is None:
+                s = self._streams[regid] = Stream(core, self.table[regid], self.scalings)
+            return s
+
+    def unsubscribe(self, reg: Union[int, str]) -> None:
+        regid = _regid(reg, self.table)
+        self._core.unsubscribe(regid)
+        with self._lock:
+            self._streams.pop(regid, None)
+
+    @property
+    def cyclic(self) -> list:
+        return self._core.cyclic
+
+    # ---- MODE / events ----
+    def enable(self) -> None:
+        self._core.enable()
+
+    def disable(self) -> None:
+        self._core.disable()
+
+    def set_events(self, on: bool, mask: Optional[int] = None) -> None:
+        """MODE bit 4: KERN_STATUS is sent on every change of a bit the mask selects."""
+        self._core.set_events(on, mask)
+
+    def on_status(self, callback: Optional[Callable[[Status, int], None]]) -> None:
+        if callback is None:
+            self._core.on_status(None)
+        else:
+            self._core.on_status(lambda st, t: callback(Status(st), t))
+
+    @property
+    def last_event_status(self) -> Optional[Status]:
+        st = self._core.last_event_status
+        return None if st is None else Status(st)
+
+    @property
+    def mode(self) -> ModeBit:
+        return ModeBit(self._core.mode)
+
+    def set_receive_id(self, rx_id: int) -> None:
+        """0x68: the drive listens on ``rx_id`` at once (persistent after store_eeprom)."""
+        self._core.set_receive_id(int(check_address(rx_id), 16))
+
+    def store_eeprom(self, level: int = 0) -> None:
+        self._core.store_eeprom(level)
+
+    # ---- typed shortcuts ----
+    @property
+    def status(self) -> Status:
+        return Status(self.read(Reg.KERN_STATUS))
+
+    @property
+    def speed_rpm(self) -> float:
+        return self.read_physical(Reg.SPEED_IST)
+
+    @speed_rpm.setter
+    def speed_rpm(self, rpm: float) -> None:
+        self.write_physical(Reg.SPEED_CMD, rpm)
+
+    @property
+    def position_rev(self) -> float:
+        return self.read_physical(Reg.POS_IST)
+
+    def move_to_rev(self, rev: float) -> None:
+        self.write_physical(Reg.POS_DEST, rev)
+
+    def torque_percent(self, percent: float) -> None:
+        self.write_physical(Reg.TORQUE_CMD, percent)
+
+    def stop(self) -> None:
+        """Speed command 0: the drive decelerates on its ramp."""
+        self.write(Reg.SPEED_CMD, 0)
+
+    rx_id = property(lambda self: self._core.rx_id)
+    tx_id = property(lambda self: self._core.tx_id)
+    counters = property(lambda self: self._core.counters)
+
+    def close(self) -> None:
+        """Stops every cyclic transmission this client started and lets go of the bus."""
+        self._core.close()
+
+    def __enter__(self) -> "Unitek":
+        return self
+
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        how = self.on_error if exc_type is not None else self.on_exit
+        try:
+            if how in ("stop", "quick_stop"):
+                self.stop()
+            elif how == "disable":
+                self.disable()
+        finally:
+            self.close()
+
+
+# ---- the simulator ------------------------------------------------------------------------
+
+_SIM_OPTIONS = ("n_max_rpm", "acc_ramp_ms", "dec_ramp_ms", "position_control", "speed_control", "calibrated",
+                "tol_num", "minus_limit_num", "plus_limit_num", "torque_continuous_num", "dummy", "tx_id",
+                "registers", "t_out_ms", "store_path")
+
+
+class UnitekSim:
+    """A simulated UNITEK servo (C++ ``UnitekSim``; see cpp/motorbus/drives/unitek/sim.hpp).
+
+    Inputs for tests: ``set_hardware_enable``, ``force_limit(±1, True/False/None)``,
+    ``set_calibrated``, ``force_icns``, ``power_cycle``.  ``store_path``: a JSON file the
+    EEPROM store (0x84) writes and the next sim reads at start (``sim serve --store-dir``).
+    On a SimClock call
+    ``service()`` after advancing the clock.  ``t_out_ms`` models NDrive's T-Out:
+    with no frame on the receive id for that long while enabled, the drive
+    disables itself (0 = off, the default: 002 does not say what T-Out does)."""
+
+    def __init__(self, rx_id: int = 0x201, clock: Any = None, *, registers: Any = None, t_out_ms: float = 0,
+                 store_path: Optional[str] = None, **options: Any) -> None:
+        self.clock = clock if clock is not None else _core.RealClock()
+        table = _core.unitek_sim_default_table()
+        if registers is not None:
+            table = load_registers(registers, table)
+        options.setdefault("tx_id", _tx_for(rx_id))
+        self._core = _core.UnitekSim(self.clock, rx_id=rx_id, table=table, **options)
+        self.rx = rx_id
+        self._t_out = float(t_out_ms)
+        if self._t_out < 0:
+            raise _core.InvalidArgument("unitek sim t_out_ms: >= 0")
+        self._watch: Optional[threading.Thread] = None
+        self._closing = threading.Event()
+        self.store_path = store_path
+        if store_path:
+            self._load_store(Path(store_path))
+            self._core.on_eeprom_store(self._save_store)
+
+    def _load_store(self, path: Path) -> None:
+        """The EEPROM of the last run (a JSON of REGID -> value), as a power cycle reads it."""
+        import json
+
+        if not path.exists():
+            return
+        try:
+            values = {int(k, 0): int(v) for k, v in json.loads(path.read_text()).items()}
+        except (ValueError, AttributeError, TypeError) as e:
+            raise _core.InvalidArgument(f"unitek sim store {path}: not an EEPROM file ({e})") from None
+        self._core.load_eeprom(values)
+
+    def _save_store(self, values: dict) -> None:
+        import json
+        import os
+
+        path = Path(self.store_path)
+        tmp = path.with_suffix(path.suffix + ".tmp")
+        tmp.write_text(json.dumps({f"0x{k:02X}": v for k, v in sorted(values.items())}, indent=1))
+        os.replace(tmp, path)
+
+    def attach(self, bus: Any) -> "UnitekSim":
+        self._core.attach(bus)
+        if self._t_out > 0:
+            self._watch = threading.Thread(target=self._t_out_loop, name="unitek-sim-t-out", daemon=True)
+            self._watch.start()
+        return self
+
+    def _t_out_loop(self) -> None:
+        last = self._core.counters.frames_in
+        last_t = self.clock.now()
+        while not self._closing.wait(0.005):
+            n = self._core.counters.frames_in
+            now = self.clock.now()
+            if n != last:
+                last, last_t = n, now
+            elif now - last_t > self._t_out * 1e6 and self._core.status & Status.ENA:
+                self._core.set_hardware_enable(False)  # the monitor trips: power stage off
+                self.t_out_tripped = True
+
+    t_out_tripped = False
+
+    def close(self) -> None:
+        self._closing.set()
+        self._core.close()
+        if self._watch is not None:
+            self._watch.join(timeout=1)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._core, name)
+
+    @property
+    def status_flags(self) -> Status:
+        return Status(self._core.status)
+
+
+def make_sim(address: Union[str, int] = "0x201", clock: Any = None, *, bus: Any = None, **options: Any) -> UnitekSim:
+    """A simulated UNITEK servo on receive id ``address`` (transmit id = address - 0x80 unless
+    ``tx_id``); attached to ``bus`` when given.  Options: see :class:`UnitekSim`."""
+    unknown = set(options) - set(_SIM_OPTIONS)
+    if unknown:
+        raise _core.InvalidArgument(f"unitek sim options: unknown {sorted(unknown)}; known {sorted(_SIM_OPTIONS)}")
+    sim = UnitekSim(int(check_address(address), 16), clock, **options)
+    if bus is not None:
+        sim.attach(bus)
+    return sim
+
+
+# ---- the Drive adapter ---------------------------------------------------------------------
+
+class UnitekParams(Params):
+    """The register table by name (num values).  Iteration lists the readable registers
+    (so ``dict(drive.params)`` works); write-only ones (MODE, CAN_ID_RX, EEPROM_WRITE) can
+    still be written by name."""
+
+    def _names(self) -> list[str]:
+        return [r.name for r in self._drive.native.table.rows() if r.readable]
+
+    def _info(self, name: str) -> Optional[ParamInfo]:
+        table = self._drive.native.table
+        if name not in table:
+            return None
+        r = table[name]
+        return ParamInfo(name=r.name, type="int", minimum=r.min, maximum=r.max, unit="num", persists=False,
+                         writable=r.writable, description=f"0x{r.regid:02X} {r.description}")
+
+    def _read(self, info: ParamInfo) -> Any:
+        return self._drive.native.read(info.name)
+
+    def _write(self, info: ParamInfo, value: Any) -> None:
+        self._drive.native.write(info.name, int(value))
+
+
+class UnitekDrive(Drive):
+    """The Drive API over a UNITEK servo.  Native units: position num (65536 per
+    revolution), velocity num/s of position (a speed command is num of N max).
+
+    * move_to / move_by: POS_DEST (position control); finished when Tol (bit 12+1)
+      is set and the speed is 0.  The positioning speed is an NDrive parameter (no
+      REGID in 002): ``velocity=`` is refused.
+    * jog: SPEED_CMD from num/s via N max; stop / quick_stop: SPEED_CMD 0 (the
+      drive's ramp; the protocol has no faster stop but disable).
+    * torque: ``drive.torque(percent)`` (TORQUE_CMD).
+    * home: no homing REGID in 002: ``home()`` requires the calibrated bit (Cal,
+      the drive knows its absolute position) and positions to 0.
+    * fault: the adapter asked for enable but KERN_STATUS has no Ena (hardware
+      enable missing or the drive's own protection); ``clear_faults`` writes MODE
+      again.
+    """
+
+    kind = "unitek"
+    capabilities = frozenset({Capability.POSITION, Capability.VELOCITY, Capability.HOMING, Capability.TORQUE,
+                              Capability.STORE, Capability.ENCODER})
+    has_watchdog = False
+
+    def __init__(self, native: Unitek, *, units: Optional[Units] = None, on_error: Optional[str] = "stop",
+                 on_exit: Optional[str] = "stop", close_native: Any = None) -> None:
+        super().__init__(native, units=units, on_error=on_error, on_exit=on_exit, close_native=close_native)
+        self._want_enabled = False
+        self._activity: Optional[str] = None
+        n_max = native.scalings.n_max_rpm
+        self._counts_per_s_per_num = n_max / 60.0 * COUNTS_PER_REV / FULL_SCALE
+
+    # ---- helpers ----
+    def _st(self) -> Status:
+        return self.native.status
+
+    def _require_enabled(self, what: str) -> None:
+        st = self._st()
+        if not st & Status.ENA:
+            why = "fault: Ena is 0 although enabled" if self._want_enabled else "disabled"
+            raise _core.DriveFault(f"unitek: {what} refused, drive {why} (KERN_STATUS 0x{int(st):04X}; "
+                                   f"{'clear_faults()/hardware enable' if self._want_enabled else 'enable() first'})")
+
+    # ---- Drive ----
+    def _enable(self) -> None:
+        self.native.enable()
+        self._want_enabled = True
+
+    def _disable(self) -> None:
+        self.native.disable()
+        self._want_enabled = False
+        self._activity = None
+
+    def _move_to(self, target: float, velocity: Optional[float]) -> None:
+        if velocity is not None:
+            raise _core.InvalidArgument("unitek: velocity= is not supported: the positioning speed is an NDrive "
+                                        "parameter (002 has no REGID for it)")
+        self._require_enabled("move")
+        num = int(round(target))
+        if not -2147483647 <= num <= 2147483647:
+            raise _core.InvalidArgument(f"unitek: position {num} is outside ±2147483647 num (POS_DEST)")
+        self.native.write(Reg.POS_DEST, num)
+        self._activity = "position"
+
+    def _jog(self, velocity: float) -> None:
+        self._require_enabled("jog")
+        num = int(round(velocity / self._counts_per_s_per_num))
+        if abs(num) > FULL_SCALE:
+            raise _core.InvalidArgument(f"unitek: jog velocity {velocity:g} num/s is above N max "
+                                        f"({FULL_SCALE * self._counts_per_s_per_num:g} num/s)")
+        self.native.write(Reg.SPEED_CMD, num)
+        self._activity = "speed"
+
+    def torque(self, percent: float) -> None:
+        """Torque command in % of the drive's maximum (TORQUE_CMD, ±32767 = ±100 %)."""
+        self._check_open()
+        self._require_enabled("torque")
+        self.native.torque_percent(self._number("torque", percent))
+        self._activity = "torque"
+
+    def _stop(self) -> None:
+        self.native.write(Reg.SPEED_CMD, 0)
+        self._activity = "speed"
+
+    def _quick_stop(self) -> None:
+        self._stop()
+
+    def _home(self, method: Any) -> None:
+        if method not in (None, "calibrated"):
+            raise _core.InvalidArgument(f"unitek home: method None or 'calibrated', not {method!r}")
+        st = self._st()
+        if not st & Status.CAL:
+            raise _core.DriveFault("unitek home: the drive is not calibrated (KERN_STATUS bit 12 Cal = 0); "
+                                   "calibrate it with NDrive")
+        self._move_to(0, None)
+
+    def _homing_done(self) -> bool:
+        return self._is_idle()
+
+    def _clear_faults(self) -> None:
+        if self._want_enabled:
+            self.native.enable()
+
+    def _store(self) -> None:
+        self.native.store_eeprom(0)
+
+    def _position(self) -> float:
+        return float(self.native.read(Reg.POS_IST))
+
+    def _velocity(self) -> float:
+        return self.native.read(Reg.SPEED_IST) * self._counts_per_s_per_num
+
+    def _is_idle(self) -> bool:
+        st = self._st()
+        if self._want_enabled and not st & Status.ENA:
+            raise _core.DriveFault(f"unitek: drive lost Ena while moving (KERN_STATUS 0x{int(st):04X})")
+        if self._activity == "position" and not st & Status.TOL:
+            return False
+        return self.native.read(Reg.SPEED_IST) == 0
+
+    def _status(self) -> DriveStatus:
+        st = self._st()
+        speed = self.native.read(Reg.SPEED_IST)
+        at_target = bool(st & Status.TOL)
+        fault = self._want_enabled and not st & Status.ENA
+        moving = speed != 0 or (self._activity == "position" and not at_target and not fault)
+        names = [f.name for f in Status if f & st] or ["none"]
+        text = f"KERN_STATUS 0x{int(st):04X} ({' '.join(names)})"
+        if fault:
+            text += ", fault: no Ena although enabled (hardware enable?)"
+        return DriveStatus(enabled=bool(st & Status.ENA), moving=moving, homed=bool(st & Status.CAL), fault=fault,
+                           at_target=at_target, limit_positive=bool(st & Status.LIM_PLUS),
+                           limit_negative=bool(st & Status.LIM_MINUS), raw=int(st), text=text)
+
+    def _make_params(self) -> Params:
+        return UnitekParams(self)
+
+    def _close(self) -> None:
+        self.native.close()
+
+
+def open(*, line: Any = None, bus: Any = None, address: Union[str, int] = "0x201",  # noqa: A001 - the plugin's verb
+         units: Optional[Units] = None, timeout: float = 0.2, on_error: Optional[str] = "stop",
+         on_exit: Optional[str] = "stop", tx_id: Optional[int] = None, registers: Any = None,
+         n_max_rpm: float = 3000.0, device: str = "DS 205/405") -> UnitekDrive:
+    """``open_drive("unitek", bus=..., address="0x201")``."""
+    from ..bus import open_bus
+
+    if bus is None:
+        raise _core.InvalidArgument("unitek: a CAN drive needs bus=")
+    owns = isinstance(bus, str)
+    b = open_bus(bus) if owns else bus
+    try:
+        native = Unitek(b, int(check_address(address), 16), tx_id, timeout=timeout, registers=registers,
+                        n_max_rpm=n_max_rpm, device=device, on_error=None, on_exit=None)
+        drive = UnitekDrive(native, units=units, on_error=on_error, on_exit=on_exit,
+                            close_native=b.close if owns else None)
+    except Exception:
+        if owns:
+            b.close()
+        raise
+    return drive
+
+
+PLUGIN = DrivePlugin(
+    kind="unitek",
+    description="UNITEK BAMOCAR/BAMOBIL/DS servo on its CAN register protocol (REGID, not CANopen)",
+    transport="can",
+    open=open,
+    make_sim=make_sim,
+    check_address=check_address,
+    default_address="0x201",
+    sim_options=_SIM_OPTIONS,
+    store_options=lambda store_dir, address: {"store_path": str(Path(store_dir) / f"unitek-{address}.eeprom.json")},
+)
