@@ -703,6 +703,16 @@ def open(*, line: Any = None, bus: Any = None, address: Union[str, int] = "0x201
     return drive
 
 
+def probe(bus: Any, address: str) -> Optional[dict]:
+    """Discovery: reads KERN_STATUS once from the drive on receive id `address` (the
+    documented registers name no model or firmware).  Reads only; starts no stream."""
+    client = Unitek(bus, int(check_address(address), 16), timeout=0.05, on_error=None, on_exit=None)
+    try:
+        return {"kern_status": f"0x{client.read(Reg.KERN_STATUS):04X}"}
+    finally:
+        client.close()
+
+
 PLUGIN = DrivePlugin(
     kind="unitek",
     description="UNITEK BAMOCAR/BAMOBIL/DS servo on its CAN register protocol (REGID, not CANopen)",
@@ -713,4 +723,6 @@ PLUGIN = DrivePlugin(
     default_address="0x201",
     sim_options=_SIM_OPTIONS,
     store_options=lambda store_dir, address: {"store_path": str(Path(store_dir) / f"unitek-{address}.eeprom.json")},
+    probe=probe,
+    probe_addresses=tuple(f"0x{i:03X}" for i in range(0x201, 0x280)),   # the receive-id range
 )
