@@ -56,10 +56,10 @@ echo "fuzz: ${#targets[@]} targets, $MODE $AMOUNT each, $JOBS at once ($(date -u
 failed=0
 running=0
 for f in "${targets[@]}"; do
+  # A failing target does not stop the others: a long run reports every finding.
   if (( running >= JOBS )); then wait -n || failed=1; running=$((running - 1)); fi
-  (( failed )) && break
   one "$f" & running=$((running + 1))
 done
 while (( running > 0 )); do wait -n || failed=1; running=$((running - 1)); done
-(( failed )) && { echo "fuzz: a target failed (report above)"; exit 1; }
+(( failed )) && { echo "fuzz: a target failed (its report is above; the crashing input is in ./crash-*)"; exit 1; }
 echo "fuzz: ${#targets[@]} targets ran ($MODE $AMOUNT each) without a crash"
