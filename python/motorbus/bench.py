@@ -140,9 +140,10 @@ class StartReport:
     """How closely ``Bench.move_together`` started its axes.
 
     ``offsets[axis]``: seconds from the first axis's command being accepted to this
-    axis's (0 for the first); ``skew`` = the largest offset.  ``method`` says how the
-    start was made ("software": commands sent back to back, each axis starting when
-    its own command arrives)."""
+    axis's (0 for the first; axes started by their drives' own trigger share one
+    offset); ``skew`` = the largest offset.  ``method``: "software" (commands sent
+    back to back, each axis starting when its own command arrives), the drives'
+    own method ("DMAC SYNCHRO TOP"), or both joined by " + "."""
 
     method: str
     offsets: dict
@@ -437,26 +438,53 @@ class Bench:
     def move_together(self, targets: Mapping[str, float], *, relative: bool = False,
                       velocity: Optional[float] = None, wait: bool = True,
                       timeout: Optional[float] = None) -> StartReport:
-        """Starts moves on several axes as close together as the links allow and
-        reports the measured skew.  The commands go back to back (serial axes of one
-        line in turn, CAN axes as fast as the bus answers); a drive-level
-        synchronised start (DMAC SYNCHRO, a SYNC-triggered CANopen start) is not
-        used yet, so the skew is what one command round trip per axis costs."""
+        """Starts moves on several axes together and reports how closely.
+
+        Axes of one kind sharing a line or bus whose plugin offers a drive-level
+        synchronised start (``DrivePlugin.synchronised_start``: DMAC ``SYNCHRO``)
+        start on the drives' own trigger: their offsets are 0 by construction (one
+        broadcast).  The others get a software start: commands back to back, each
+        axis starting when its own command arrives; their offsets are measured
+        (seconds from the first command accepted to this axis's).  A group started
+        by its drives counts as one command in that sequence."""
         drives = {name: self[name] for name in targets}
         if not drives:
             raise _core.InvalidArgument("move_together: no axis given")
+        groups: dict[tuple, list[str]] = {}
+        for name in drives:
+            cfg = self.config[name]
+            groups.setdefault((cfg.kind, cfg.line, cfg.bus), []).append(name)
         offsets: dict[str, float] = {}
+        methods: list[str] = []
         t0: Optional[float] = None
-        for name, d in drives.items():
-            move = d.move_by if relative else d.move_to
-            move(targets[name], velocity=velocity, wait=False)
-            now = time.perf_counter()
-            t0 = now if t0 is None else t0
-            offsets[name] = now - t0
+
+        def command(name: str) -> None:
+            d = drives[name]
+            (d.move_by if relative else d.move_to)(targets[name], velocity=velocity, wait=False)
+
+        for (kind, line, bus), names in groups.items():
+            sync = registry.drive_plugin(kind).synchronised_start
+            if sync is not None and len(names) > 1:
+                link = self.lines[line] if line else self.buses[bus]
+                with sync(link, [drives[n] for n in names]) as how:
+                    for n in names:
+                        command(n)
+                now = time.perf_counter()
+                t0 = now if t0 is None else t0
+                offsets.update({n: now - t0 for n in names})
+                methods.append(how)
+                continue
+            for n in names:
+                command(n)
+                now = time.perf_counter()
+                t0 = now if t0 is None else t0
+                offsets[n] = now - t0
+            methods.append("software")
         if wait:
             for d in drives.values():
                 d.wait_idle(timeout)
-        return StartReport("software", offsets, max(offsets.values()))
+        method = methods[0] if len(set(methods)) == 1 else " + ".join(dict.fromkeys(methods))
+        return StartReport(method, offsets, max(offsets.values()))
 
     def status(self) -> dict[str, DriveStatus]:
         return {name: d.status for name, d in self._axes.items()}

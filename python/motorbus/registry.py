@@ -48,6 +48,7 @@ class DrivePlugin:
       ``canopen_match(node) -> int`` instead: a score for a node found by the
       CANopen scan (``NodeInfo``: device type, vendor id, product code...), 0 =
       not this kind; the highest score names the node's kind.
+    * ``synchronised_start(link, drives)``: see the field's comment.
     """
 
     kind: str
@@ -67,6 +68,10 @@ class DrivePlugin:
     probe_addresses: tuple = ()
     probe_bauds: tuple = ()
     canopen_match: Optional[Callable[[Any], int]] = None
+    #: A drive-level synchronised start for axes of this kind sharing one link:
+    #: ``synchronised_start(link, drives)`` is a context manager; moves commanded
+    #: inside it start together when it exits (``Bench.move_together`` uses it).
+    synchronised_start: Optional[Callable[..., Any]] = None
 
     def __post_init__(self) -> None:
         if self.transport not in ("serial", "can"):

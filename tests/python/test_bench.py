@@ -320,3 +320,45 @@ def test_dmac_console(tmp_path):
         y = bench["y"]
         assert y.console("#HIGH_SPEED:=50000") == "OK"
         assert y.console("READ #HIGH_SPEED") == "03#HSP=+50000"   # the manual's short name in replies
+
+
+TWO_DMAC = """\
+[line.l]
+port = "/dev/ttyUSB9"
+[axis.a]
+kind = "dmac"
+line = "l"
+address = 1
+params = { "#HIGH_SPEED" = 50000 }
+[axis.b]
+kind = "dmac"
+line = "l"
+address = 2
+params = { "#HIGH_SPEED" = 50000 }
+[line.r]
+port = "/dev/ttyUSB8"
+[axis.x]
+kind = "arcus"
+line = "r"
+address = 1
+"""
+
+
+def test_move_together_uses_the_drives_own_synchronised_start(tmp_path):
+    p = tmp_path / "b.toml"
+    p.write_text(TWO_DMAC)
+    with Bench.load(p, sim=True) as bench:
+        bench.apply()
+        for d in bench.axes.values():
+            d.enable()
+        report = bench.move_together({"a": 200000, "b": 200000, "x": 1000}, wait=False)
+        assert report.method == "DMAC SYNCHRO TOP + software"
+        assert report.offsets["a"] == report.offsets["b"] == 0.0 < report.offsets["x"]
+        time.sleep(0.2)
+        # One SYNCHRO TOP started both modules: mid-ramp they are at the same place
+        # (a software start puts them tens of increments apart, one round trip).
+        pa, pb = bench.sims["a"].state().position, bench.sims["b"].state().position
+        assert pa > 0 and abs(pa - pb) <= 2, (pa, pb)
+        for d in bench.axes.values():
+            d.wait_idle(30)
+        assert bench["a"].position == bench["b"].position == 200000

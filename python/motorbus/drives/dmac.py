@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import enum
 import math
-from typing import Any, Iterable, Optional, Sequence
+import contextlib
+from typing import Any, Iterable, Iterator, Optional, Sequence
 
 from .. import _core, _stop_at_exit
 from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params
@@ -305,6 +306,23 @@ def synchro(link: Any, what: str) -> None:
     _core.dmac_synchro(link, what)
 
 
+@contextlib.contextmanager
+def synchronised_start(link: Any, drives: Sequence[Any]) -> Iterator[str]:
+    """Moves commanded inside the block are held by every module of the line
+    (``SYNCHRO ON``) and start on one broadcast ``SYNCHRO TOP`` when it exits: the
+    modules start on the same bytes of the wire.  Yields the method's name."""
+    synchro(link, "ON")
+    try:
+        yield "DMAC SYNCHRO TOP"
+    except BaseException:
+        synchro(link, "OFF")
+        for d in drives:       # held moves must not start later by surprise
+            d.stop()
+        raise
+    synchro(link, "TOP")
+    synchro(link, "OFF")
+
+
 def stream_interpolation(axes: Sequence[DmacClient], segments: Iterable[Sequence[int]],
                          interpol_time_ms: int = 100, fifo_size: int = 64, sleep: Any = None,
                          backoff: Optional[float] = None) -> "_core.DmacStreamStats":
@@ -582,6 +600,7 @@ PLUGIN = DrivePlugin(
     default_baud=DEFAULT_BAUD,
     sim_options=SIM_OPTIONS,
     store_options=None,
+    synchronised_start=synchronised_start,
     probe=probe,
     probe_addresses=tuple(f"{a:02d}" for a in range(64)),   # 00-63
     probe_bauds=BAUDRATES,
