@@ -197,6 +197,7 @@ void LocalNode::apply_nmt(NmtCommand c) {
                         for (auto& [sub, var] : obj->subs) var->reset_to_default();
                 }
             }
+            if (options_.on_reset) options_.on_reset(c);
             if (options_.send_boot_up) send_boot_up();
             return transition(NmtState::PreOperational);
         }

@@ -83,6 +83,11 @@ struct LocalNodeOptions {
     // NMT reset node restores 0x2000-0x9FFF (and reset communication 0x1000-0x1FFF)
     // to their defaults before the new boot-up.
     bool reset_restores_defaults = true;
+    // Called on the bus thread after an NMT reset node / reset communication
+    // put the node in Initialising (and restored the defaults when asked), before
+    // the boot-up: a device whose reset differs from CiA 301 (e.g. one that keeps
+    // or reloads values from its own flash) applies it here.  Empty = nothing.
+    std::function<void(NmtCommand)> on_reset{};
 };
 
 struct LocalNodeCounters {
