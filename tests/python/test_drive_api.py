@@ -62,6 +62,10 @@ def _arcus_fault(sim: Any, drive: Any) -> None:
     drive.jog(-10.0)                 # ...and a jog into it latches a limit error
 
 
+def _pmc007_setup(drive: Any) -> None:
+    drive.params["maximum_speed"] = 20000   # 6003h, pps: the run speed of position moves
+
+
 def _dmac_setup(drive: Any) -> None:
     drive.params["#LOW_SPEED"] = 60000   # 0.01 rpm: the reference search speed
 
@@ -74,6 +78,8 @@ KINDS = {
                   param="HSPD", value=15000, jog=50.0, home="HL+", setup=_arcus_setup),
     "cia402": Kind("cia402", "5", 0.01, fault=lambda sim, drive: sim.inject_fault(0x5441),
                    param="0x6081", value=25000, jog=50.0, home=19, setup=_cia402_setup),
+    "pmc007": Kind("pmc007", "5", 0.01, fault=lambda sim, drive: sim.inject_error(1),  # UVLO
+                   param="start_speed", value=500, jog=50.0, home="ext1", setup=_pmc007_setup),
 }
 
 
