@@ -1373,6 +1373,11 @@ class LocalNodeCounters:
     def sdo(self) -> SdoServerCounters:
         ...
     @property
+    def sdo_bad_dlc(self) -> int:
+        """
+        SDO requests with DLC != 8 dropped (sdo_require_dlc8)
+        """
+    @property
     def sdo_while_stopped(self) -> int:
         ...
 class SdoClient:

@@ -245,6 +245,11 @@ void LocalNode::on_sdo_frame(const can::Frame& f) {
         ++sdo_stopped_;
         return;
     }
+    if (options_.sdo_require_dlc8 && f.len != 8) {
+        std::lock_guard lock(mutex_);
+        ++sdo_bad_dlc_;
+        return;
+    }
     {
         std::lock_guard lock(sdo_mutex_);
         if (server_.handles_inline(f.payload())) {
@@ -325,6 +330,7 @@ LocalNodeCounters LocalNode::counters() const {
     c.nmt_commands = nmt_commands_;
     c.nmt_ignored = nmt_ignored_;
     c.sdo_while_stopped = sdo_stopped_;
+    c.sdo_bad_dlc = sdo_bad_dlc_;
     return c;
 }
 
