@@ -85,6 +85,7 @@ void Pmc007Sim::attach(can::Bus& bus) {
     if (node_) throw InvalidArgument("pmc007 sim " + std::to_string(node_id_) + ": already attached");
     canopen::LocalNodeOptions o;
     o.reset_restores_defaults = false;  // B-P27/B-P28: the device's own reset rules (on_reset)
+    o.sdo_require_dlc8 = true;          // B-P06 [P]: SDO requests with DLC != 8 are ignored
     o.on_reset = [this](canopen::NmtCommand c) { on_reset(c); };
     bus_ = &bus;
     node_ = std::make_unique<canopen::LocalNode>(bus, node_id_, od_, o);
