@@ -89,12 +89,89 @@ void Pmc007Sim::attach(can::Bus& bus) {
     o.on_reset = [this](canopen::NmtCommand c) { on_reset(c); };
     bus_ = &bus;
     node_ = std::make_unique<canopen::LocalNode>(bus, node_id_, od_, o);
+    attach_locked_services(*node_);
+}
+
+void Pmc007Sim::attach_locked_services(canopen::LocalNode& n) {
     canopen::PdoServiceOptions po;
     po.strict = false;  // B-P32: the manual's sequence changes a valid PDO in place
-    pdo_ = canopen::PdoService::attach(*node_, po);
-    hb_ = canopen::HeartbeatService::attach(*node_, {.consumer_entries = 3, .producer_ms = 0});
+    pdo_ = canopen::PdoService::attach(n, po);
+    hb_ = canopen::HeartbeatService::attach(n, {.consumer_entries = 3, .producer_ms = 0});
     ticker_ = std::make_shared<Ticker>(*this);
-    node_->add_service(ticker_);
+    n.add_service(ticker_);
+}
+
+void Pmc007Sim::schedule_node_id_switch() {
+    // Called on the bus thread in the middle of the NMT reset: the node cannot be
+    // replaced from there, so a helper thread does it once the reset is over.
+    std::lock_guard lock(m_);
+    if (!node_ || u(0x2002) == node_id_) return;
+    if (renode_.joinable()) {
+        if (!renode_done_) return;  // one switch at a time
+        renode_.join();             // finished: reaping it does not wait
+    }
+    const auto id = static_cast<std::uint8_t>(u(0x2002));
+    renode_done_ = false;
+    renode_ = std::thread([this, id] {
+        switch_node_id(id);
+        renode_done_ = true;
+    });
+}
+
+void Pmc007Sim::switch_node_id(std::uint8_t new_id) {
+    canopen::LocalNode* old = nullptr;
+    {
+        std::lock_guard lock(m_);
+        old = node_.get();
+    }
+    if (!old) return;
+    for (int i = 0; i < 500 && old->nmt_state() != NmtState::PreOperational; ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const std::uint8_t old_id = node_id_;
+    // Predefined COB-IDs ($NODEID+...) follow the node-ID when they still hold the old default.
+    std::vector<std::pair<const OdRow*, std::int64_t>> moved;
+    for (const auto& r : pmc007_od_rows())
+        if (r.node_offset >= 0) {
+            const std::int64_t cur = u(r.index, r.sub);
+            if ((cur & 0x7FF) == r.node_offset + old_id) moved.push_back({&r, (cur & ~0x7FFLL) | (r.node_offset + new_id)});
+        }
+    od_->set_node_id(new_id);
+    t_publishing = true;
+    for (auto& [r, v] : moved) set(r->index, r->sub, v);
+    t_publishing = false;
+    std::unique_ptr<canopen::LocalNode> fresh;
+    try {
+        canopen::LocalNodeOptions o;
+        o.reset_restores_defaults = false;
+        o.sdo_require_dlc8 = true;
+        o.on_reset = [this](canopen::NmtCommand c) { on_reset(c); };
+        fresh = std::make_unique<canopen::LocalNode>(*bus_, new_id, od_, o);
+    } catch (const std::exception&) {
+        // The ID is taken on this bus: stay on the old one (and put the COB-IDs back).
+        od_->set_node_id(old_id);
+        t_publishing = true;
+        for (auto& [r, v] : moved) set(r->index, r->sub, (v & ~0x7FFLL) | (r->node_offset + old_id));
+        t_publishing = false;
+        return;
+    }
+    std::unique_ptr<canopen::LocalNode> gone;
+    {
+        std::lock_guard lock(m_);
+        retired_.push_back(pdo_);
+        retired_.push_back(hb_);
+        retired_.push_back(ticker_);
+        gone = std::move(node_);
+        node_ = std::move(fresh);
+        node_id_ = new_id;
+    }
+    gone->close();
+    {
+        std::lock_guard lock(m_);
+        retired_.push_back(std::shared_ptr<canopen::LocalNode>(std::move(gone)));
+    }
+    // The new node is in PRE-OPERATIONAL with its boot-up sent; its services:
+    std::lock_guard lock(m_);
+    attach_locked_services(*node_);
 }
 
 bool Pmc007Sim::attached() const {
@@ -103,6 +180,7 @@ bool Pmc007Sim::attached() const {
 }
 
 void Pmc007Sim::close() {
+    if (renode_.joinable() && renode_.get_id() != std::this_thread::get_id()) renode_.join();
     std::unique_ptr<canopen::LocalNode> n;
     {
         std::lock_guard lock(m_);
@@ -222,6 +300,13 @@ void Pmc007Sim::power_cycle() {
         n->set_nmt_state(NmtState::Initialising);
         n->send_boot_up();
         n->set_nmt_state(NmtState::PreOperational);
+        schedule_node_id_switch();
+        std::thread t;
+        {
+            std::lock_guard lock(m_);
+            t = std::move(renode_);
+        }
+        if (t.joinable()) t.join();
     }
 }
 
@@ -232,6 +317,7 @@ void Pmc007Sim::on_reset(canopen::NmtCommand c) {
         std::lock_guard lock(m_);
         baud_index_ = static_cast<std::uint8_t>(u(0x2003));  // B-P27: the RAM values take effect
     }
+    schedule_node_id_switch();  // B-P36: node-ID from 2002h (RAM on reset comm, flash on reset node)
 }
 
 // ---- state --------------------------------------------------------------------------

@@ -19,11 +19,13 @@
 // calls it after advancing a SimClock.
 #pragma once
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <thread>
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
@@ -118,6 +120,11 @@ private:
     };
     std::uint32_t on_write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> d);
     void on_reset(canopen::NmtCommand c);
+    // B-P27/B-P36: a node-ID written to 2002h takes effect at reset communication
+    // (or at power-up once saved): the node is served again under the new ID.
+    void schedule_node_id_switch();
+    void switch_node_id(std::uint8_t new_id);
+    void attach_locked_services(canopen::LocalNode& n);
     void publish();
     void load_power_up(bool cold);
     void update_locked();
@@ -146,6 +153,9 @@ private:
     std::shared_ptr<canopen::PdoService> pdo_;
     std::shared_ptr<canopen::HeartbeatService> hb_;
     std::shared_ptr<canopen::NodeService> ticker_;
+    std::thread renode_;
+    std::atomic<bool> renode_done_{false};
+    std::vector<std::shared_ptr<void>> retired_;  // replaced nodes/services: their OD listeners stay valid
 
     std::map<std::pair<std::uint16_t, std::uint8_t>, canopen::Bytes> flash_;
     std::vector<std::uint32_t> flash_program_, ram_program_;

@@ -343,3 +343,31 @@ TEST_F(SimFixture, NmtStoppedSilencesSdo) {
     std::this_thread::sleep_for(30ms);
     EXPECT_EQ(sdo->read_u8(0x6001, 0), 0);
 }
+
+// B-P36 / B-P27: 2002h is a RAM copy until reset communication, then the node
+// answers under the new ID (boot-up 0x709) with its predefined COB-IDs moved;
+// unsaved, a reset node brings the flash value (5) back.
+TEST_F(SimFixture, NodeIdTakesEffectAtResetCommunication) {
+    sdo->write_u8(0x2002, 0, 9);
+    EXPECT_EQ(sdo->read_u8(0x2002, 0), 9);
+    EXPECT_EQ(sim->node_id(), 5);
+    auto boot = host->recv(std::chrono::milliseconds(0));  // drain
+    while (boot) boot = host->recv(std::chrono::milliseconds(0));
+    host->send(can::Frame::make(0, std::vector<std::uint8_t>{0x82, 5}));
+    bool seen = false;
+    for (int i = 0; i < 100 && !seen; ++i) {
+        auto f = host->recv(std::chrono::milliseconds(20));
+        seen = f && f->id == 0x709 && f->len == 1 && f->data[0] == 0;
+    }
+    EXPECT_TRUE(seen);
+    for (int i = 0; i < 100 && sim->node_id() != 9; ++i) std::this_thread::sleep_for(5ms);
+    canopen::SdoClient at9(*host, 9);
+    EXPECT_EQ(at9.read_u32(0x1800, 1), 0x189u);
+    EXPECT_EQ(at9.read_u32(0x1014, 0), 0x89u);
+    canopen::SdoClient quick(*host, 5, {.timeout = 100ms});
+    EXPECT_THROW(quick.read_u8(0x6001, 0), canopen::SdoTimeout);
+    host->send(can::Frame::make(0, std::vector<std::uint8_t>{0x81, 9}));  // reset node: flash says 5
+    for (int i = 0; i < 200 && sim->node_id() != 5; ++i) std::this_thread::sleep_for(5ms);
+    EXPECT_EQ(sim->node_id(), 5);
+    EXPECT_EQ(sdo->read_u8(0x2002, 0), 5);
+}
