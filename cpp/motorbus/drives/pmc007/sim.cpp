@@ -31,7 +31,9 @@ public:
     explicit Ticker(Pmc007Sim& sim) : sim_(sim) {}
     Nanos on_timer(canopen::LocalNode&, Nanos now) override {
         sim_.poll();
-        return now + 2'000'000;
+        // 2 ms while something changes by itself (a move, a program, a debounce),
+        // else 20 ms: an idle node on a big bus costs little.
+        return now + (sim_.active() ? 2'000'000 : 20'000'000);
     }
 
 private:
@@ -340,6 +342,14 @@ std::int32_t Pmc007Sim::position() {
 double Pmc007Sim::velocity() {
     std::lock_guard lock(m_);
     return motor_.moving() ? motor_.pulse_velocity() : 0.0;
+}
+
+bool Pmc007Sim::active() {
+    std::lock_guard lock(m_);
+    if (motor_.moving() || running_ || bootloader_pending_) return true;
+    for (const auto& p : pending_)
+        if (p) return true;
+    return false;
 }
 
 bool Pmc007Sim::busy() {

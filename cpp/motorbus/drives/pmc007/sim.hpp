@@ -90,6 +90,7 @@ public:
     std::int32_t position();                                // 600Ch
     double velocity();                                      // pps, signed
     bool busy();
+    bool active();  // moving, running a program or debouncing an input
     bool enabled();
     std::uint16_t gpio_value();                             // 6012h (1 = low)
     std::uint8_t active_baud_index() const { return baud_index_; }
