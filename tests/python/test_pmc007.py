@@ -155,3 +155,29 @@ def test_make_sim_refuses_unknown_options_and_bad_nodes():
     with pytest.raises(motorbus.InvalidArgument, match="1..127"):
         pmc007.make_sim(128)
     assert pmc007.PLUGIN.check_address(" 7 ") == "7"
+
+
+def test_rpdo_and_numpy_tpdo_stream(rig):
+    sim, c, clock = rig
+    rx = c.configure_rpdo(1, ["motor_position"])
+    tx = c.configure_tpdo(1, ["motor_position", "controller_status"], transmission_type=255)
+    stream = c.tpdo_stream(tx, capacity=8)
+    c.nmt(0x01)
+    for p in (100, 200, 300):
+        c.send_rpdo(rx, {"motor_position": p})
+        for _ in range(200):
+            if sim.position == p:
+                break
+            threading.Event().wait(0.005)
+        assert sim.position == p
+    for _ in range(200):
+        if 300 in stream.values()["motor_position"]:
+            break
+        threading.Event().wait(0.005)
+    v = stream.values()
+    assert v.dtype.names == ("t", "motor_position", "controller_status")
+    assert list(v["motor_position"][-3:]) == [100, 200, 300]
+    assert (v["t"][1:] >= v["t"][:-1]).all()
+    stream.close()
+    with pytest.raises(motorbus.InvalidArgument, match="needs a value"):
+        c.send_rpdo(rx, {})

@@ -145,6 +145,7 @@ class Pmc007:
         self.sdo = _core.SdoClient(bus, self.node, timeout=timeout)
         self.on_error, self.on_exit = on_error, on_exit
         self._pdo_rx: dict = {}
+        self._rpdo_tx: dict = {}
         self._closed = False
 
     # ---- objects by name ----
@@ -370,6 +371,47 @@ class Pmc007:
         self._pdo_rx[cob] = entries
         return cob
 
+    def configure_rpdo(self, n: int, mapping: Iterable[Union[str, tuple]], *, cob_id: Optional[int] = None,
+                       transmission_type: int = 255) -> int:
+        """RPDO ``n`` (1..4) in the same order: COB-ID, type, sub0 = count, entries.  Only the
+        writable mappable objects (6000h, 6001h, 600Ch, 6012h) can be mapped.  Returns the COB-ID."""
+        if not 1 <= int(n) <= 4:
+            raise _core.InvalidArgument(f"pmc007: RPDO number 1..4, not {n!r}")
+        comm, mp = 0x1400 + n - 1, 0x1600 + n - 1
+        cob = int(cob_id) if cob_id is not None else 0x200 + 0x100 * (n - 1) + self.node
+        self.sdo.download(comm, 1, cob.to_bytes(4, "little"))
+        self.sdo.download(comm, 2, int(transmission_type).to_bytes(1, "little"))
+        entries = []
+        for item in mapping:
+            row = OBJECTS[self.resolve(item)]
+            entries.append((row["index"] << 16) | (row["sub"] << 8) | (8 * _SIZES[row["type"]]))
+        self.sdo.download(mp, 0, bytes([len(entries)]))
+        for i, e in enumerate(entries, 1):
+            self.sdo.download(mp, i, e.to_bytes(4, "little"))
+        self._rpdo_tx[cob] = entries
+        return cob
+
+    def send_rpdo(self, cob_id: int, values: dict) -> None:
+        """One RPDO frame on ``cob_id`` (configured by configure_rpdo) with {object name: value}."""
+        entries = self._rpdo_tx.get(int(cob_id))
+        if entries is None:
+            raise _core.InvalidArgument(f"pmc007: RPDO 0x{cob_id:X} was not configured by this client")
+        data = b""
+        for e in entries:
+            key = _BY_INDEX[(e >> 16, (e >> 8) & 0xFF)]
+            if key not in values:
+                raise _core.InvalidArgument(f"pmc007: RPDO 0x{cob_id:X} needs a value for {key!r}")
+            data += int(values[key]).to_bytes((e & 0xFF) // 8, "little", signed=OBJECTS[key]["type"] == "I32")
+        self.bus.send(_core.Frame(int(cob_id), data))
+
+    def tpdo_stream(self, cob_id: int, capacity: int = 100_000) -> "TpdoStream":
+        """The TPDO's values as numpy arrays: a ring of ``capacity`` frames, one field per mapped
+        object plus ``t`` (the frame's receive time, s).  ``stream.values()`` is a copy, oldest first."""
+        entries = self._pdo_rx.get(int(cob_id))
+        if entries is None:
+            raise _core.InvalidArgument(f"pmc007: TPDO 0x{cob_id:X} was not configured by this client")
+        return TpdoStream(self, int(cob_id), entries, int(capacity))
+
     def on_tpdo(self, cob_id: int, callback: Callable[[dict], None]) -> int:
         """Typed callback {object name: value} for every TPDO frame on ``cob_id``
         (as configured by configure_tpdo).  Returns the subscription id."""
@@ -412,6 +454,59 @@ class Pmc007:
     def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
         self._halt(self.on_error if exc_type is not None else self.on_exit)
         self.close()
+
+
+class TpdoStream:
+    """numpy ring buffer of one TPDO's decoded values (see Pmc007.tpdo_stream); ``close()`` stops it."""
+
+    _DTYPES = {"U8": "u1", "U16": "u2", "U32": "u4", "I32": "i4"}
+
+    def __init__(self, client: Pmc007, cob_id: int, entries: list, capacity: int) -> None:
+        import numpy as np
+
+        if capacity < 1:
+            raise _core.InvalidArgument("pmc007: tpdo_stream capacity must be >= 1")
+        self._keys = [_BY_INDEX[(e >> 16, (e >> 8) & 0xFF)] for e in entries]
+        self._sizes = [(e & 0xFF) // 8 for e in entries]
+        fields = [("t", "f8")] + [(k, self._DTYPES[OBJECTS[k]["type"]]) for k in self._keys]
+        self.dtype = np.dtype(fields)
+        self._buf = np.zeros(capacity, dtype=self.dtype)
+        self._n = 0
+        self._lock = threading.Lock()
+        self._client = client
+        self._sub = client.bus.subscribe(self._on_frame, cob_id, 0x7FF)
+
+    def _on_frame(self, frame: Any) -> None:
+        data, pos = bytes(frame.data), 0
+        row = [frame.timestamp_ns / 1e9]
+        for k, size in zip(self._keys, self._sizes):
+            row.append(int.from_bytes(data[pos:pos + size], "little", signed=OBJECTS[k]["type"] == "I32"))
+            pos += size
+        with self._lock:
+            self._buf[self._n % len(self._buf)] = tuple(row)
+            self._n += 1
+
+    def __len__(self) -> int:
+        return min(self._n, len(self._buf))
+
+    @property
+    def received(self) -> int:
+        return self._n
+
+    def values(self) -> Any:
+        import numpy as np
+
+        with self._lock:
+            n, cap = self._n, len(self._buf)
+            if n <= cap:
+                return self._buf[:n].copy()
+            i = n % cap
+            return np.concatenate([self._buf[i:], self._buf[:i]])
+
+    def close(self) -> None:
+        if self._sub is not None:
+            self._client.bus.unsubscribe(self._sub)
+            self._sub = None
 
 
 # ---- simulator -------------------------------------------------------------------------
