@@ -83,3 +83,18 @@ def test_example_06_drive_api_python():
     assert "kinds: arcus, cia402, dmac" in out
     for kind in ("arcus", "dmac", "cia402"):
         assert f"{kind}: at 3.50 mm, enabled=True moving=False fault=False" in out, out
+
+
+def test_example_07_pmc007_python():
+    out = run_example("07_pmc007.py")
+    assert "status: <ControllerStatus.BUSY: 8>" in out
+    assert "position 3200 busy False" in out
+    assert "program: 080003E8 03000000 010001F4 10100000 0B000000 12100003 0E000002 verified True" in out
+    assert "after the program: position 1700 counter 3 running False" in out
+
+
+def test_example_07_pmc007_cpp():
+    out = run_cpp_example("example_07_pmc007")
+    assert "6001h=0x08" in out
+    assert "position 3200 busy 0" in out
+    assert "after the program: position 1700 counter 3" in out
