@@ -541,6 +541,14 @@ void Pmc007Sim::on_motor_event(const motion::MotorEvent& e) {
 }
 
 void Pmc007Sim::emcy_locked(std::uint16_t code) {
+    // 1003h history, newest first [CiA 301]: which errors the PMC007 logs is not documented;
+    // the sim logs what it signals by EMCY.
+    {
+        const auto n = std::min<std::int64_t>(u(0x1003, 0) + 1, 7);
+        for (std::uint8_t k = static_cast<std::uint8_t>(n); k > 1; --k) set(0x1003, k, u(0x1003, k - 1));
+        set(0x1003, 1, code);
+        set(0x1003, 0, n);
+    }
     if (!node_ || node_->nmt_state() == NmtState::Stopped || node_->nmt_state() == NmtState::Initialising) return;
     const Nanos now = monotonic_ns();
     const Nanos inhibit = Nanos(u(0x1015)) * 100'000;  // 100 us units

@@ -371,3 +371,53 @@ TEST_F(SimFixture, NodeIdTakesEffectAtResetCommunication) {
     EXPECT_EQ(sim->node_id(), 5);
     EXPECT_EQ(sdo->read_u8(0x2002, 0), 5);
 }
+
+// B-P45: RESET_EN jumps to its target on a low pulse of GPI1 and stops the
+// rotation; PAUSE_EN toggles pause on GPI2 without stopping an issued rotation.
+TEST_F(SimFixture, ResetAndPauseInputs) {
+    sdo->write_u16(0x601A, 0, 0);  // no debounce: edges act at once
+    auto words = assemble("RESET_EN 1,5\nPAUSE_EN 1,0\nVSET 0,1000\nDIR 0,1\nROT 0,1000\nWAIT 1,0\nCNTI\nJMP 0,4\n");
+    for (std::size_t i = 0; i < words.size(); ++i) {
+        sdo->write_u8(0x6019, 1, static_cast<std::uint8_t>(i));
+        sdo->write_u32(0x6019, 2, words[i]);
+    }
+    sdo->write_u8(0x6018, 1, static_cast<std::uint8_t>(words.size()));
+    sdo->write_u8(0x6018, 2, 1);
+    advance(0.5);
+    EXPECT_EQ(sim->position(), 500);
+    sim->set_input(1, false);  // GPI2 low: pause (the rotation goes on)
+    sim->set_input(1, true);
+    advance(1.0);
+    EXPECT_EQ(sim->position(), 1000);
+    EXPECT_EQ(sim->program_counter_value(), 0u);  // paused at WAIT's successor
+    sim->set_input(1, false);  // resume
+    sim->set_input(1, true);
+    advance(0.25);
+    EXPECT_EQ(sim->program_counter_value(), 1u);
+    EXPECT_TRUE(sim->busy());
+    const auto at_reset = sim->position();
+    sim->set_input(0, false);  // GPI1 low: the rotation stops, pointer := 5 (WAIT 1,0)...
+    // ...which passes at once (stopped), CNTI, JMP 0,4: a new ROT from where it stopped.
+    EXPECT_EQ(sim->program_counter_value(), 2u);
+    EXPECT_EQ(sim->program_pointer(), 5u);
+    advance(0.5);
+    EXPECT_EQ(sim->position(), at_reset + 500);
+}
+
+TEST_F(SimFixture, EmcyHistoryAndBootloader) {
+    sim->inject_error(err::kAoc);
+    sim->inject_error(err::kTsd);
+    EXPECT_EQ(sdo->read_u8(0x1003, 0), 2);
+    EXPECT_EQ(sdo->read_u32(0x1003, 1), 0x4200u);  // newest first
+    EXPECT_EQ(sdo->read_u32(0x1003, 2), 0x2300u);
+    sdo->write_u8(0x1003, 0, 0);
+    EXPECT_EQ(sdo->read_u32(0x1003, 1), 0u);
+    sdo->write_u8(0x2007, 0, 1);  // B-P39: bootloader, the application goes quiet
+    for (int i = 0; i < 100 && !sim->in_bootloader(); ++i) std::this_thread::sleep_for(5ms);
+    EXPECT_TRUE(sim->in_bootloader());
+    canopen::SdoClient quick(*host, 5, {.timeout = 100ms});
+    EXPECT_THROW(quick.read_u8(0x6001, 0), canopen::SdoTimeout);
+    sim->power_cycle();
+    EXPECT_FALSE(sim->in_bootloader());
+    EXPECT_EQ(sdo->read_u8(0x6001, 0), 0);
+}
