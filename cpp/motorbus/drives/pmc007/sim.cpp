@@ -98,7 +98,8 @@ void Pmc007Sim::attach_locked_services(canopen::LocalNode& n) {
     canopen::PdoServiceOptions po;
     po.strict = false;  // B-P32: the manual's sequence changes a valid PDO in place
     pdo_ = canopen::PdoService::attach(n, po);
-    hb_ = canopen::HeartbeatService::attach(n, {.consumer_entries = 3, .producer_ms = 0});
+    // 1016h consumers: the manual documents no reaction to a lost heartbeat: EMCY 8130h only [P].
+    hb_ = canopen::HeartbeatService::attach(n, {.consumer_entries = 3, .producer_ms = 0, .error_behaviour_without_1029 = 1});
     ticker_ = std::make_shared<Ticker>(*this);
     n.add_service(ticker_);
 }

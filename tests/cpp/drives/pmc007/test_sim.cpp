@@ -421,3 +421,22 @@ TEST_F(SimFixture, EmcyHistoryAndBootloader) {
     EXPECT_FALSE(sim->in_bootloader());
     EXPECT_EQ(sdo->read_u8(0x6001, 0), 0);
 }
+
+// 1016h consumer: the manual documents no reaction to a lost heartbeat [P]:
+// EMCY 8130h, no NMT state change (the motor is not stopped either).
+TEST_F(SimFixture, LostConsumerHeartbeatOnlyEmcy) {
+    sdo->write_u32(0x1016, 1, 0x00010032);  // node 1, 50 ms
+    sdo->write_i32(0x6003, 0, 1000);
+    sdo->write_u32(0x6004, 0, 100000);
+    host->send(can::Frame::make(0, std::vector<std::uint8_t>{0x01, 5}));
+    std::uint8_t beat = 0x05;
+    host->send(can::Frame::make(0x701, std::span(&beat, 1)));
+    bool emcy = false;
+    for (int i = 0; i < 100 && !emcy; ++i) {
+        auto f = host->recv(std::chrono::milliseconds(20));
+        emcy = f && f->id == 0x85 && f->data[0] == 0x30 && f->data[1] == 0x81;
+    }
+    EXPECT_TRUE(emcy);
+    EXPECT_EQ(sim->node()->nmt_state(), canopen::NmtState::Operational);
+    EXPECT_TRUE(sim->busy());
+}
