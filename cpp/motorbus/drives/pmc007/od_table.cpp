@@ -146,6 +146,7 @@ std::vector<OdRow> make_rows() {
     var(0x601B, "Stall set", U8, RW, false, ROM, 0, 0, 1);
     var(0x601C, "Absolute displacement command", S32, RW, false, RAM, 0, -2147483647, 2147483647);
     var(0x6020, "Stop stepping command", U8, RW, false, RAM, 0, 0, 0);
+    t.back().alt_size = 4;  // [D] App.1 UNSIGNED8, §4.5.7 UNSIGNED32: both accepted
     var(0x6021, "Encoder CPR", U16, RW, false, ROM, 500);
     var(0x6022, "Position save value", S32, RO, false, ROM, 0);
     var(0x6023, "Closed-loop KP", U8, RW, false, ROM, 48, 1, 255);
@@ -206,6 +207,7 @@ std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id)
                 spec.default_value = std::uint64_t(d);
         }
         if (r.expr) spec.default_expr = r.expr;
+        spec.alt_size = r.alt_size;
         if (r.parent) {
             if (!made[r.index]) {
                 const bool array = r.index == 0x1003 || r.index == 0x1016 || (r.index >= 0x1600 && r.index <= 0x1603) ||

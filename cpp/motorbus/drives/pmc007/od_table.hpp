@@ -36,6 +36,7 @@ struct OdRow {
     const char* text = nullptr;    // default of a VISIBLE_STRING
     const char* expr = nullptr;    // "$NODEID+0x180" style default for the EDS
     std::int64_t node_offset = -1; // >= 0: default = node_offset + node-ID
+    std::size_t alt_size = 0;      // a second size the manual lists (6020h: U8 and U32)
 };
 
 // Every index:sub of the spec (73 indices, 210 entries), in index order.

@@ -192,6 +192,11 @@ TEST_F(SimFixture, SpeedModeStopAndRelease) {
     EXPECT_NEAR(sim->velocity(), 800, 1e-6);
     sdo->write_u8(0x6020, 0, 0);  // B-P14
     EXPECT_FALSE(sim->busy());
+    sdo->write_i32(0x6003, 0, 800);
+    EXPECT_TRUE(sim->busy());
+    sdo->write_u32(0x6020, 0, 0);  // [D] the U32 form of 6020h (§4.5.7) is accepted too
+    EXPECT_FALSE(sim->busy());
+    EXPECT_EQ(sdo->upload(0x6020, 0).size(), 1u);  // read back as 1 byte
     sdo->write_i32(0x6003, 0, -800);
     advance(1);
     EXPECT_TRUE(sim->busy());
