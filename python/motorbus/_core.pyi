@@ -3953,7 +3953,7 @@ class Pmc007Sim:
     """
     A simulated CQPUSI PMC007 CANopen node (see sim.hpp).
     """
-    def __init__(self, node_id: typing.SupportsInt | typing.SupportsIndex = 5, clock: Clock = None, steps_per_rev: typing.SupportsFloat | typing.SupportsIndex = 200.0, pull_out_speed: typing.SupportsFloat | typing.SupportsIndex = 0.0, ext1_switch: tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex] | None = None) -> None:
+    def __init__(self, node_id: typing.SupportsInt | typing.SupportsIndex = 5, clock: Clock = None, steps_per_rev: typing.SupportsFloat | typing.SupportsIndex = 200.0, pull_out_speed: typing.SupportsFloat | typing.SupportsIndex = 0.0, ext1_switch: tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex] | None = None, store_path: str = '') -> None:
         ...
     def attach(self, bus: Bus) -> None:
         ...

@@ -181,3 +181,20 @@ def test_rpdo_and_numpy_tpdo_stream(rig):
     stream.close()
     with pytest.raises(motorbus.InvalidArgument, match="needs a value"):
         c.send_rpdo(rx, {})
+
+
+def test_sim_serve_store_dir_keeps_the_flash(tmp_path):
+    from motorbus.sim import make_sim as make_any_sim
+    name = f"virtual:pmc007-py-store-{next(_names)}"
+    with motorbus.open_bus(name) as sim_bus, motorbus.open_bus(name) as host_bus:
+        sim = make_any_sim("pmc007", "5", store_dir=str(tmp_path))
+        sim.attach(sim_bus)
+        c = Pmc007(host_bus, 5)
+        c["start_speed"] = 321
+        c.save()
+        c.close()
+        sim.close()
+    assert (tmp_path / "pmc007-5.flash").exists()
+    again = make_any_sim("pmc007", "5", store_dir=str(tmp_path))
+    assert int.from_bytes(again.od["Start speed"].raw, "little") == 321
+    again.close()

@@ -516,8 +516,9 @@ def make_sim(address: Union[str, int] = "5", clock: Optional[_core.Clock] = None
     """A simulated PMC007 at node ``address`` (``_core.Pmc007Sim``); attached to ``bus`` when given.
     Options: ``steps_per_rev`` (200), ``pull_out_speed`` (0 = never stalls by speed),
     ``ext1_switch=(lo, hi)``: a switch wired to EXT1, low while the position is inside
-    (default (-1e9, -1000): a home switch on the negative side, for homing into EXT1)."""
-    known = {"steps_per_rev", "pull_out_speed", "ext1_switch"}
+    (default (-1e9, -1000): a home switch on the negative side, for homing into EXT1),
+    ``store_path``: the file holding the sim's flash between runs (2007h=2, 6019h:03, 602Ah)."""
+    known = {"steps_per_rev", "pull_out_speed", "ext1_switch", "store_path"}
     options.setdefault("ext1_switch", (-1e9, -1000.0))
     unknown = set(options) - known
     if unknown:
@@ -742,5 +743,6 @@ PLUGIN = DrivePlugin(
     make_sim=make_sim,
     check_address=_check_node,
     default_address="5",
-    sim_options=("steps_per_rev", "pull_out_speed", "ext1_switch"),
+    sim_options=("steps_per_rev", "pull_out_speed", "ext1_switch", "store_path"),
+    store_options=lambda store_dir, address: {"store_path": os.path.join(store_dir, f"pmc007-{address}.flash")},
 )

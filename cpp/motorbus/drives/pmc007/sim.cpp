@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
 
 #include "motorbus/canopen/emcy.hpp"
 #include "motorbus/errors.hpp"
@@ -77,6 +80,7 @@ Pmc007Sim::Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions option
             return 0;
         });
     motor_.add_listener([this](const motion::MotorEvent& e) { on_motor_event(e); });
+    read_store();
     load_power_up(true);
 }
 
@@ -248,10 +252,76 @@ void Pmc007Sim::publish() {
 
 // ---- power / reset ----------------------------------------------------------------
 
+// The store file: one line per ROM object "rom IIII SS hexbytes", "program w w ...",
+// "position n".  Unknown or malformed lines are skipped (a damaged file = factory values).
+void Pmc007Sim::write_store_locked() {
+    if (opt_.store_path.empty()) return;
+    std::ostringstream out;
+    for (const auto& [k, bytes] : flash_) {
+        char head[24];
+        std::snprintf(head, sizeof head, "rom %04X %02X ", k.first, k.second);
+        out << head;
+        for (auto b : bytes) {
+            char h[4];
+            std::snprintf(h, sizeof h, "%02X", b);
+            out << h;
+        }
+        out << "\n";
+    }
+    out << "program";
+    for (auto w : flash_program_) out << " " << w;
+    out << "\nposition " << saved_position_ << "\n";
+    const std::string tmp = opt_.store_path + ".tmp";
+    {
+        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+        if (!f) return;  // [P] a store that cannot be written keeps the RAM state only
+        f << out.str();
+    }
+    std::rename(tmp.c_str(), opt_.store_path.c_str());
+}
+
+void Pmc007Sim::read_store() {
+    if (opt_.store_path.empty()) return;
+    std::ifstream f(opt_.store_path, std::ios::binary);
+    if (!f) return;
+    std::string line;
+    while (std::getline(f, line) && line.size() < 4096) {
+        std::istringstream in(line);
+        std::string word;
+        in >> word;
+        if (word == "rom") {
+            std::string idx, sub, hex;
+            in >> idx >> sub >> hex;
+            try {
+                const auto i = static_cast<std::uint16_t>(std::stoul(idx, nullptr, 16));
+                const auto s = static_cast<std::uint8_t>(std::stoul(sub, nullptr, 16));
+                auto it = flash_.find({i, s});
+                if (it == flash_.end() || hex.size() != 2 * it->second.size()) continue;
+                Bytes b;
+                for (std::size_t k = 0; k < hex.size(); k += 2)
+                    b.push_back(static_cast<std::uint8_t>(std::stoul(hex.substr(k, 2), nullptr, 16)));
+                if (od_->at(i, s)->check_size_for_write(b.size()) == 0) it->second = b;
+            } catch (const std::exception&) {
+            }
+        } else if (word == "program") {
+            std::vector<std::uint32_t> w;
+            std::uint64_t v;
+            while (w.size() < kMaxProgram && in >> v) w.push_back(static_cast<std::uint32_t>(v));
+            flash_program_ = w;
+        } else if (word == "position") {
+            std::int64_t v = 0;
+            if (in >> v) saved_position_ = static_cast<std::int32_t>(v);
+        }
+    }
+}
+
 void Pmc007Sim::load_power_up(bool cold) {
     {
         std::lock_guard lock(m_);
-        if (!cold && u(0x602A) == 1) saved_position_ = static_cast<std::int32_t>(position());  // B-P17
+        if (!cold && u(0x602A) == 1) {  // B-P17: written to EEPROM at power loss
+            saved_position_ = static_cast<std::int32_t>(position());
+            write_store_locked();
+        }
         motor_.halt();
         errors_ = 0;
         latched_ = 0;
@@ -615,6 +685,7 @@ std::uint32_t Pmc007Sim::on_write(std::uint16_t index, std::uint8_t sub, std::sp
             } else if (v == 2) {  // B-P37: every ROM object to flash
                 for (const auto& r : pmc007_od_rows())
                     if (r.storage == Storage::Rom) flash_[{r.index, r.sub}] = od_->at(r.index, r.sub)->get();
+                write_store_locked();
             } else if (v == 3) {  // B-P38 / C-P19: factory values into the working copy only
                 for (const auto& r : pmc007_od_rows())
                     if (r.storage == Storage::Rom && !(r.index >= 0x1400 && r.index <= 0x1BFF))
@@ -687,6 +758,7 @@ std::uint32_t Pmc007Sim::on_write(std::uint16_t index, std::uint8_t sub, std::sp
                 ram_program_[ptr] = static_cast<std::uint32_t>(v);
             } else if (sub == 3 && v == 1) {
                 flash_program_ = ram_program_;
+                write_store_locked();
             } else if (sub == 5 && v == 1) {
                 const auto ptr = static_cast<std::size_t>(u(0x6019, 1));
                 if (ptr < ram_program_.size()) exec_locked(ram_program_[ptr], true);

@@ -25,6 +25,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -63,6 +64,9 @@ struct Pmc007SimOptions {
     // A switch wired to EXT1 (pulls it low while lo <= position <= hi), e.g. the
     // home/limit switch an external-stop homing runs into.  nullopt = none.
     std::optional<std::pair<double, double>> ext1_switch{};
+    // Where the "flash" lives between runs (ROM objects saved by 2007h=2, the
+    // offline program saved by 6019h:03, the 602Ah position); "" = memory only.
+    std::string store_path{};
 };
 
 class Pmc007Sim {
@@ -128,6 +132,8 @@ private:
     void attach_locked_services(canopen::LocalNode& n);
     void publish();
     void load_power_up(bool cold);
+    void write_store_locked();
+    void read_store();
     void update_locked();
     std::uint32_t start_move_locked(std::int64_t delta);
     bool refused_locked() const;

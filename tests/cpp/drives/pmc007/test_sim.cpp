@@ -3,6 +3,7 @@
 // a SimClock advanced by the test.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -444,4 +445,31 @@ TEST_F(SimFixture, LostConsumerHeartbeatOnlyEmcy) {
     EXPECT_TRUE(emcy);
     EXPECT_EQ(sim->node()->nmt_state(), canopen::NmtState::Operational);
     EXPECT_TRUE(sim->busy());
+}
+
+// Pmc007SimOptions::store_path: the flash outlives the simulator object.
+TEST(Pmc007Store, FlashSurvivesANewSimulator) {
+    const std::string path = ::testing::TempDir() + "pmc007-store-test.flash";
+    std::remove(path.c_str());
+    SimClock clock;
+    Pmc007SimOptions o;
+    o.store_path = path;
+    {
+        Pmc007Sim sim(5, clock, o);
+        auto& od = sim.od();
+        std::uint8_t v[2] = {0x2C, 0x01};  // 300
+        ASSERT_EQ(od.at(0x6006, 0)->remote_write(std::span(v, 2)), 0u);
+        std::uint8_t save = 2;
+        ASSERT_EQ(od.at(0x2007, 0)->remote_write(std::span(&save, 1)), 0u);
+        std::uint8_t w[4] = {0x80, 0x0C, 0x00, 0x01};  // ROT 0,3200
+        ASSERT_EQ(od.at(0x6019, 2)->remote_write(std::span(w, 4)), 0u);
+        std::uint8_t one = 1;
+        ASSERT_EQ(od.at(0x6019, 3)->remote_write(std::span(&one, 1)), 0u);
+        std::uint8_t v2[2] = {0xF4, 0x01};  // 500, not saved
+        ASSERT_EQ(od.at(0x6006, 0)->remote_write(std::span(v2, 2)), 0u);
+    }
+    Pmc007Sim again(5, clock, o);
+    EXPECT_EQ(again.od().at(0x6006, 0)->get_u64(), 300u);
+    EXPECT_EQ(again.flash_program(), std::vector<std::uint32_t>{0x01000C80u});
+    std::remove(path.c_str());
 }
