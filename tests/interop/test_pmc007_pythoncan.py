@@ -48,7 +48,7 @@ def wait_for(bus: can.BusABC, cob_id: int, timeout: float = 3.0) -> can.Message:
 
 @pytest.fixture(scope="module")
 def served():
-    proc = subprocess.Popen([sys.executable, "-m", "motorbus", "sim", "serve", "--drive", "pmc007:5"],
+    proc = subprocess.Popen([sys.executable, "-m", "motorbus", "sim", "serve", "--drive", "pmc007:5,6"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     word, hostport, channel = proc.stdout.readline().split()
     assert word == "socketcand" and channel == "can0"
@@ -116,6 +116,12 @@ def test_e_p06_to_e_p12_tpdo_with_the_manuals_sequence(bus):
     again = wait_for(bus, 0x187, timeout=2.5)
     assert bytes(again.data) == frame("03 00") and time.monotonic() - t0 < 2.0
     bus.send(can.Message(arbitration_id=0x000, data=[0x80, 0x05], is_extended_id=False))  # back to pre-op
+
+
+def test_the_second_served_node_answers_on_its_own_ids(bus):
+    # `--drive pmc007:5,6`: node 6 on 0x606/0x586, its own TPDO1 default 0x186.
+    assert bytes(exchange(bus, frame("40 00 18 01 00 00 00 00"), node=6).data) == frame("43 00 18 01 86 01 00 00")
+    assert bytes(exchange(bus, frame("40 14 10 00 00 00 00 00"), node=6).data) == frame("43 14 10 00 86 00 00 00")
 
 
 def test_e_p05_step_refused_while_an_external_stop_is_latched():

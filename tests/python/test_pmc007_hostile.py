@@ -152,3 +152,16 @@ def test_emcy_on_a_fault_bit(raw):
     sim.inject_error(0x10)                       # AOC
     got = r.reply(0x085, timeout=1)
     assert got is not None and got[:2] == (0x2300).to_bytes(2, "little") and got[3] == 0x10
+
+
+def test_s11_s13_segmented_download_size_and_toggle(raw):
+    sim, r = raw
+    # S11: segmented initiate for 6006h (2 bytes) announcing 4 bytes -> 06070012 at initiate.
+    assert r.sdo(bytes.fromhex("21 06 60 00 04 00 00 00")) == bytes.fromhex("80 06 60 00 12 00 07 06")
+    still_fine(r)
+    # S13: a segmented download to 1006h (4 bytes) whose first segment has toggle 1 -> 05030000.
+    assert r.sdo(bytes.fromhex("21 06 10 00 04 00 00 00")) == bytes.fromhex("60 06 10 00 00 00 00 00")
+    assert r.sdo(bytes.fromhex("17 01 02 03 04 00 00 00")) == bytes.fromhex("80 06 10 00 00 00 03 05")
+    still_fine(r)
+    # Nothing was committed.
+    assert r.sdo(bytes.fromhex("40 06 10 00 00 00 00 00")) == bytes.fromhex("43 06 10 00 00 00 00 00")
