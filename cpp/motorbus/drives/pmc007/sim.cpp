@@ -92,6 +92,7 @@ void Pmc007Sim::attach(can::Bus& bus) {
     canopen::LocalNodeOptions o;
     o.reset_restores_defaults = false;  // B-P27/B-P28: the device's own reset rules (on_reset)
     o.sdo_require_dlc8 = true;          // B-P06 [P]: SDO requests with DLC != 8 are ignored
+    o.sdo.block_transfer = false;       // B-P05 [P]: no block transfer (05040001)
     o.on_reset = [this](canopen::NmtCommand c) { on_reset(c); };
     bus_ = &bus;
     node_ = std::make_unique<canopen::LocalNode>(bus, node_id_, od_, o);
@@ -151,6 +152,7 @@ void Pmc007Sim::switch_node_id(std::uint8_t new_id) {
         canopen::LocalNodeOptions o;
         o.reset_restores_defaults = false;
         o.sdo_require_dlc8 = true;
+        o.sdo.block_transfer = false;
         o.on_reset = [this](canopen::NmtCommand c) { on_reset(c); };
         fresh = std::make_unique<canopen::LocalNode>(*bus_, new_id, od_, o);
     } catch (const std::exception&) {
