@@ -30,6 +30,7 @@ import enum
 import os
 import re
 import threading
+import time
 from typing import Any, Callable, Iterable, Optional, Union
 
 from .. import _core
@@ -685,15 +686,19 @@ class Pmc007Drive(Drive):
     def _position(self) -> float:
         return float(self.native.position)
 
+    #: Seconds between the two position samples a velocity reading takes.
+    velocity_window: float = 0.01
+
     def _velocity(self) -> float:
-        # The PMC007 reports no actual speed: the commanded run speed while busy.
+        # The PMC007 has no actual-speed object: the speed is measured from the position
+        # counter (600Ch) over velocity_window seconds while the motor is busy, else 0.
         n = self.native
         if not n.busy:
             return 0.0
-        speed = n.speed
-        if self._speed_mode:
-            return float(speed)
-        return float(abs(speed) if n.direction == 1 else -abs(speed))
+        t0, p0 = time.monotonic(), n.position
+        time.sleep(self.velocity_window)
+        t1, p1 = time.monotonic(), n.position
+        return (p1 - p0) / (t1 - t0) if t1 > t0 else 0.0
 
     def _status(self) -> DriveStatus:
         n = self.native
