@@ -88,14 +88,14 @@ Pmc007Sim::~Pmc007Sim() { close(); }
 
 void Pmc007Sim::attach(can::Bus& bus) {
     std::lock_guard lock(m_);
-    if (node_) throw InvalidArgument("pmc007 sim " + std::to_string(node_id_) + ": already attached");
+    if (node_) throw InvalidArgument("pmc007 sim " + std::to_string(node_id_.load()) + ": already attached");
     canopen::LocalNodeOptions o;
     o.reset_restores_defaults = false;  // B-P27/B-P28: the device's own reset rules (on_reset)
     o.sdo_require_dlc8 = true;          // B-P06 [P]: SDO requests with DLC != 8 are ignored
     o.sdo.block_transfer = false;       // B-P05 [P]: no block transfer (05040001)
     o.on_reset = [this](canopen::NmtCommand c) { on_reset(c); };
     bus_ = &bus;
-    node_ = std::make_unique<canopen::LocalNode>(bus, node_id_, od_, o);
+    node_ = std::make_unique<canopen::LocalNode>(bus, node_id_.load(), od_, o);
     attach_locked_services(*node_);
 }
 
@@ -630,7 +630,7 @@ void Pmc007Sim::emcy_locked(std::uint16_t code) {
     std::uint8_t er = errors_ ? 0x01 : 0;
     if (code >= 0xFF00) er |= 0x80;  // manufacturer-specific
     const std::uint8_t status = static_cast<std::uint8_t>(latched_ | (motor_.moving() ? st::kBusy : 0));
-    auto f = canopen::encode_emcy(node_id_, code, er, {errors_, status, 0, 0, 0});
+    auto f = canopen::encode_emcy(node_id_.load(), code, er, {errors_, status, 0, 0, 0});
     try {
         node_->send(f);
         ++emcy_sent_;

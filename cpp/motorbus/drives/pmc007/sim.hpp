@@ -148,8 +148,8 @@ private:
     std::int64_t u(std::uint16_t i, std::uint8_t s = 0) const;
     void set(std::uint16_t i, std::uint8_t s, std::int64_t v);
 
-    std::uint8_t node_id_;
-    std::uint8_t baud_index_ = 4;
+    std::atomic<std::uint8_t> node_id_;
+    std::atomic<std::uint8_t> baud_index_{4};
     Clock& clock_;
     Pmc007SimOptions opt_;
     std::shared_ptr<canopen::ObjectDictionary> od_;
@@ -174,9 +174,10 @@ private:
     std::uint16_t levels_ = 0x7FF;  // electrical level of each port, 1 = high
     std::array<std::optional<Pending>, 11> pending_{};
     bool jammed_ = false;
-    bool bootloader_ = false, bootloader_pending_ = false;
+    std::atomic<bool> bootloader_{false};
+    bool bootloader_pending_ = false;
     std::int32_t saved_position_ = 0;  // 6022h "EEPROM"
-    std::uint64_t emcy_sent_ = 0;
+    std::atomic<std::uint64_t> emcy_sent_{0};
     Nanos last_emcy_ = -1;
     std::uint8_t last_emcy_bits_ = 0;
     bool publishing_ = false;
