@@ -86,27 +86,56 @@ Pmc007Sim::Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions option
 
 Pmc007Sim::~Pmc007Sim() { close(); }
 
-void Pmc007Sim::attach(can::Bus& bus) {
-    std::lock_guard lock(m_);
-    if (node_) throw InvalidArgument("pmc007 sim " + std::to_string(node_id_.load()) + ": already attached");
+canopen::LocalNodeOptions Pmc007Sim::node_options() {
     canopen::LocalNodeOptions o;
     o.reset_restores_defaults = false;  // B-P27/B-P28: the device's own reset rules (on_reset)
     o.sdo_require_dlc8 = true;          // B-P06 [P]: SDO requests with DLC != 8 are ignored
     o.sdo.block_transfer = false;       // B-P05 [P]: no block transfer (05040001)
     o.on_reset = [this](canopen::NmtCommand c) { on_reset(c); };
-    bus_ = &bus;
-    node_ = std::make_unique<canopen::LocalNode>(bus, node_id_.load(), od_, o);
-    attach_locked_services(*node_);
+    return o;
 }
 
-void Pmc007Sim::attach_locked_services(canopen::LocalNode& n) {
+// Nodes and services are made and destroyed without the sim's lock held: their
+// threads call into the sim (hooks, timer) and would otherwise wait on it while
+// we wait on them.
+void Pmc007Sim::attach(can::Bus& bus) {
+    {
+        std::lock_guard lock(m_);
+        if (node_ || attaching_)
+            throw InvalidArgument("pmc007 sim " + std::to_string(node_id_.load()) + ": already attached");
+        attaching_ = true;
+        bus_ = &bus;
+    }
+    std::unique_ptr<canopen::LocalNode> n;
+    Services sv;
+    try {
+        n = std::make_unique<canopen::LocalNode>(bus, node_id_.load(), od_, node_options());
+        sv = make_services(*n);
+    } catch (...) {
+        std::lock_guard lock(m_);
+        attaching_ = false;
+        bus_ = nullptr;
+        throw;
+    }
+    std::lock_guard lock(m_);
+    node_ = std::move(n);
+    pdo_ = sv.pdo;
+    hb_ = sv.hb;
+    ticker_ = sv.ticker;
+    attaching_ = false;
+}
+
+Pmc007Sim::Services Pmc007Sim::make_services(canopen::LocalNode& n) {
+    Services sv;
     canopen::PdoServiceOptions po;
     po.strict = false;  // B-P32: the manual's sequence changes a valid PDO in place
-    pdo_ = canopen::PdoService::attach(n, po);
+    sv.pdo = canopen::PdoService::attach(n, po);
     // 1016h consumers: the manual documents no reaction to a lost heartbeat: EMCY 8130h only [P].
-    hb_ = canopen::HeartbeatService::attach(n, {.consumer_entries = 3, .producer_ms = 0, .error_behaviour_without_1029 = 1});
-    ticker_ = std::make_shared<Ticker>(*this);
-    n.add_service(ticker_);
+    sv.hb = canopen::HeartbeatService::attach(
+        n, {.consumer_entries = 3, .producer_ms = 0, .error_behaviour_without_1029 = 1});
+    sv.ticker = std::make_shared<Ticker>(*this);
+    n.add_service(sv.ticker);
+    return sv;
 }
 
 void Pmc007Sim::schedule_node_id_switch() {
@@ -148,13 +177,10 @@ void Pmc007Sim::switch_node_id(std::uint8_t new_id) {
     for (auto& [r, v] : moved) set(r->index, r->sub, v);
     t_publishing = false;
     std::unique_ptr<canopen::LocalNode> fresh;
+    Services sv;
     try {
-        canopen::LocalNodeOptions o;
-        o.reset_restores_defaults = false;
-        o.sdo_require_dlc8 = true;
-        o.sdo.block_transfer = false;
-        o.on_reset = [this](canopen::NmtCommand c) { on_reset(c); };
-        fresh = std::make_unique<canopen::LocalNode>(*bus_, new_id, od_, o);
+        fresh = std::make_unique<canopen::LocalNode>(*bus_, new_id, od_, node_options());
+        sv = make_services(*fresh);  // the new node is PRE-OPERATIONAL with its boot-up sent
     } catch (const std::exception&) {
         // The ID is taken on this bus: stay on the old one (and put the COB-IDs back).
         od_->set_node_id(old_id);
@@ -171,16 +197,14 @@ void Pmc007Sim::switch_node_id(std::uint8_t new_id) {
         retired_.push_back(ticker_);
         gone = std::move(node_);
         node_ = std::move(fresh);
+        pdo_ = sv.pdo;
+        hb_ = sv.hb;
+        ticker_ = sv.ticker;
         node_id_ = new_id;
     }
     gone->close();
-    {
-        std::lock_guard lock(m_);
-        retired_.push_back(std::shared_ptr<canopen::LocalNode>(std::move(gone)));
-    }
-    // The new node is in PRE-OPERATIONAL with its boot-up sent; its services:
     std::lock_guard lock(m_);
-    attach_locked_services(*node_);
+    retired_.push_back(std::shared_ptr<canopen::LocalNode>(std::move(gone)));
 }
 
 bool Pmc007Sim::attached() const {
@@ -191,16 +215,15 @@ bool Pmc007Sim::attached() const {
 void Pmc007Sim::close() {
     if (renode_.joinable() && renode_.get_id() != std::this_thread::get_id()) renode_.join();
     std::unique_ptr<canopen::LocalNode> n;
+    Services sv;
     {
         std::lock_guard lock(m_);
         n = std::move(node_);
+        sv = {std::move(pdo_), std::move(hb_), std::move(ticker_)};
+        bus_ = nullptr;
     }
     if (n) n->close();
-    std::lock_guard lock(m_);
-    pdo_.reset();
-    hb_.reset();
-    ticker_.reset();
-    bus_ = nullptr;
+    sv = {};  // destroyed without the lock (they unsubscribe from the bus)
 }
 
 // ---- values -------------------------------------------------------------------

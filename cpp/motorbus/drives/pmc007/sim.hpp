@@ -129,7 +129,13 @@ private:
     // (or at power-up once saved): the node is served again under the new ID.
     void schedule_node_id_switch();
     void switch_node_id(std::uint8_t new_id);
-    void attach_locked_services(canopen::LocalNode& n);
+    struct Services {
+        std::shared_ptr<canopen::PdoService> pdo;
+        std::shared_ptr<canopen::HeartbeatService> hb;
+        std::shared_ptr<canopen::NodeService> ticker;
+    };
+    Services make_services(canopen::LocalNode& n);
+    canopen::LocalNodeOptions node_options();
     void publish();
     void load_power_up(bool cold);
     void write_store_locked();
@@ -160,6 +166,7 @@ private:
     std::shared_ptr<canopen::PdoService> pdo_;
     std::shared_ptr<canopen::HeartbeatService> hb_;
     std::shared_ptr<canopen::NodeService> ticker_;
+    bool attaching_ = false;
     std::thread renode_;
     std::atomic<bool> renode_done_{false};
     std::vector<std::shared_ptr<void>> retired_;  // replaced nodes/services: their OD listeners stay valid
