@@ -450,6 +450,7 @@ void bind_canopen(py::module_& m) {
         .def_readonly("nmt_commands", &LocalNodeCounters::nmt_commands, "applied")
         .def_readonly("nmt_ignored", &LocalNodeCounters::nmt_ignored, "wrong DLC, other node, unknown command")
         .def_readonly("sdo_while_stopped", &LocalNodeCounters::sdo_while_stopped)
+        .def_readonly("sdo_bad_dlc", &LocalNodeCounters::sdo_bad_dlc, "SDO requests with DLC != 8 dropped (sdo_require_dlc8)")
         .def("__repr__", [](const LocalNodeCounters& c) {
             return "LocalNodeCounters(nmt_commands=" + u64s(c.nmt_commands) + ", nmt_ignored=" + u64s(c.nmt_ignored) +
                    ", sdo_while_stopped=" + u64s(c.sdo_while_stopped) + ", sdo=" +

@@ -1,13 +1,48 @@
-// Bindings for cpp/motorbus/drives/pmc007: so far its profile model.
+// Bindings for cpp/motorbus/drives/pmc007: the profile model, the object
+// dictionary table (the one source of the sim's OD and the shipped EDS), the
+// offline-program codec and the simulator.  Conversions and GIL release only.
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "motorbus/drives/pmc007/od_table.hpp"
 #include "motorbus/drives/pmc007/profile.hpp"
+#include "motorbus/drives/pmc007/program.hpp"
+#include "motorbus/drives/pmc007/sim.hpp"
 
 namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::motion;
 using namespace motorbus::pmc007;
+
+namespace {
+// The clock must outlive the simulator that holds a reference to it.
+struct ClockHolder {
+    std::shared_ptr<Clock> clock;
+};
+struct BoundSim : ClockHolder, Pmc007Sim {
+    BoundSim(std::shared_ptr<Clock> c, std::uint8_t node, Pmc007SimOptions o)
+        : ClockHolder{c ? std::move(c) : std::make_shared<RealClock>()}, Pmc007Sim(node, *clock, o) {}
+};
+
+const char* type_code(canopen::DataType t) {
+    switch (t) {
+        case canopen::DataType::Unsigned8: return "U8";
+        case canopen::DataType::Unsigned16: return "U16";
+        case canopen::DataType::Unsigned32: return "U32";
+        case canopen::DataType::Integer32: return "I32";
+        case canopen::DataType::VisibleString: return "VISIBLE_STRING";
+        default: return "?";
+    }
+}
+const char* storage_name(Storage s) {
+    switch (s) {
+        case Storage::Rom: return "rom";
+        case Storage::Ram: return "ram";
+        case Storage::Const: return "const";
+    }
+    return "?";
+}
+}  // namespace
 
 void bind_pmc007(py::module_& m) {
     m.def("pmc007_gear_acceleration", &pmc007_gear_acceleration, py::arg("gear"));
@@ -32,4 +67,92 @@ void bind_pmc007(py::module_& m) {
     m.def("pmc007_speed_profile", &pmc007_speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
           py::arg("hold") = 0.0);
 
+    // ---- the object dictionary table ----
+    m.def(
+        "pmc007_od_rows",
+        [] {
+            py::list out;
+            for (const auto& r : pmc007_od_rows()) {
+                py::object def = r.text ? py::object(py::str(r.text)) : py::object(py::int_(r.def));
+                out.append(py::make_tuple(r.index, r.sub, r.name, r.parent ? py::object(py::str(r.parent)) : py::none(),
+                                          type_code(r.type), canopen::access_name(r.access), r.pdo,
+                                          storage_name(r.storage), def,
+                                          r.low ? py::object(py::int_(*r.low)) : py::none(),
+                                          r.high ? py::object(py::int_(*r.high)) : py::none()));
+            }
+            return out;
+        },
+        "Every object of the PMC007 dictionary: (index, sub, name, parent, type, access, pdo_mappable, storage, "
+        "default, low, high).");
+    m.def("pmc007_eds", &pmc007_eds, "The EDS text generated from the table (node-ID as $NODEID).");
+
+    // ---- offline program codec ----
+    m.def("pmc007_assemble", [](const std::string& text) { return assemble(text); }, py::arg("text"),
+          "Mnemonic text -> 32-bit words (the spec's reading of the encoding).");
+    m.def("pmc007_disassemble", [](const std::vector<std::uint32_t>& w) { return disassemble(w); }, py::arg("words"));
+    m.def("pmc007_disassemble_word", &disassemble_word, py::arg("word"));
+    m.def(
+        "pmc007_encode",
+        [](const std::string& mnem, int option, std::int64_t data) {
+            auto op = opcode_from_mnemonic(mnem);
+            if (!op) throw InvalidArgument("pmc007 program: unknown instruction '" + mnem + "'");
+            if (option < 0 || option > 15) throw InvalidArgument("pmc007 program: option must be 0..15");
+            if (data < 0 || data > 0xFFFFF) throw InvalidArgument("pmc007 program: data must be 0..1048575");
+            return encode({*op, std::uint8_t(option), std::uint32_t(data)});
+        },
+        py::arg("mnemonic"), py::arg("option") = 0, py::arg("data") = 0);
+    m.def(
+        "pmc007_decode",
+        [](std::uint32_t word) -> py::object {
+            auto ins = decode(word);
+            if (!ins) return py::none();
+            return py::make_tuple(mnemonic(ins->op), ins->option, ins->data);
+        },
+        py::arg("word"), "(mnemonic, option, data), or None for an unknown opcode.");
+
+    // ---- the simulator ----
+    auto rel = py::call_guard<py::gil_scoped_release>();
+    py::class_<BoundSim, std::shared_ptr<BoundSim>>(m, "Pmc007Sim",
+                                                    "A simulated CQPUSI PMC007 CANopen node (see sim.hpp).")
+        .def(py::init([](int node_id, std::shared_ptr<Clock> clock, double steps_per_rev, double pull_out_speed,
+                         std::optional<std::pair<double, double>> ext1_switch, std::string store_path) {
+                 if (node_id < 1 || node_id > 127)
+                     throw InvalidArgument("pmc007 sim: node-ID must be 1..127, not " + std::to_string(node_id));
+                 Pmc007SimOptions o;
+                 o.steps_per_rev = steps_per_rev;
+                 o.pull_out_speed = pull_out_speed;
+                 o.ext1_switch = ext1_switch;
+                 o.store_path = std::move(store_path);
+                 return std::make_shared<BoundSim>(std::move(clock), std::uint8_t(node_id), o);
+             }),
+             py::arg("node_id") = 5, py::arg("clock") = nullptr, py::arg("steps_per_rev") = 200.0,
+             py::arg("pull_out_speed") = 0.0, py::arg("ext1_switch") = py::none(),
+             py::arg("store_path") = "")
+        .def("attach", [](BoundSim& s, can::Bus& bus) { py::gil_scoped_release nogil; s.attach(bus); },
+             py::arg("bus"), py::keep_alive<1, 2>())
+        .def("close", &BoundSim::close, rel)
+        .def_property_readonly("attached", &BoundSim::attached)
+        .def("power_cycle", &BoundSim::power_cycle)
+        .def("poll", &BoundSim::poll, rel)
+        .def_property_readonly("node_id", &BoundSim::node_id)
+        .def_property_readonly("error_status", &BoundSim::error_status)
+        .def_property_readonly("controller_status", &BoundSim::controller_status)
+        .def_property_readonly("position", &BoundSim::position)
+        .def_property_readonly("velocity", &BoundSim::velocity)
+        .def_property_readonly("busy", &BoundSim::busy)
+        .def_property_readonly("enabled", &BoundSim::enabled)
+        .def_property_readonly("gpio_value", &BoundSim::gpio_value)
+        .def_property_readonly("active_baud_index", &BoundSim::active_baud_index)
+        .def_property_readonly("od", &BoundSim::od_ptr)
+        .def_property_readonly("flash_program", &BoundSim::flash_program)
+        .def_property_readonly("ram_program", &BoundSim::ram_program)
+        .def_property_readonly("program_running", &BoundSim::program_running)
+        .def_property_readonly("program_pointer", &BoundSim::program_pointer)
+        .def_property_readonly("program_counter", &BoundSim::program_counter_value)
+        .def_property_readonly("emcy_sent", &BoundSim::emcy_sent)
+        .def_property_readonly("in_bootloader", &BoundSim::in_bootloader)
+        .def("set_jammed", &BoundSim::set_jammed, py::arg("jammed"))
+        .def("set_input", &BoundSim::set_input, py::arg("bit"), py::arg("high"), rel,
+             "Electrical level of input port `bit` (6012h bit 0..10; 7 EXT1, 8 EXT2, 9 ENC1/EXT3).")
+        .def("inject_error", &BoundSim::inject_error, py::arg("bits"), rel, "Latch 6000h error bits (EMCY sent).");
 }

@@ -34,7 +34,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_convert_position', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -1385,6 +1385,11 @@ class LocalNodeCounters:
     @property
     def sdo(self) -> SdoServerCounters:
         ...
+    @property
+    def sdo_bad_dlc(self) -> int:
+        """
+        SDO requests with DLC != 8 dropped (sdo_require_dlc8)
+        """
     @property
     def sdo_while_stopped(self) -> int:
         ...
@@ -3978,6 +3983,84 @@ class Pmc007ProfileParams:
     @stop_speed.setter
     def stop_speed(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
+class Pmc007Sim:
+    """
+    A simulated CQPUSI PMC007 CANopen node (see sim.hpp).
+    """
+    def __init__(self, node_id: typing.SupportsInt | typing.SupportsIndex = 5, clock: Clock = None, steps_per_rev: typing.SupportsFloat | typing.SupportsIndex = 200.0, pull_out_speed: typing.SupportsFloat | typing.SupportsIndex = 0.0, ext1_switch: tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex] | None = None, store_path: str = '') -> None:
+        ...
+    def attach(self, bus: Bus) -> None:
+        ...
+    def close(self) -> None:
+        ...
+    def inject_error(self, bits: typing.SupportsInt | typing.SupportsIndex) -> None:
+        """
+        Latch 6000h error bits (EMCY sent).
+        """
+    def poll(self) -> None:
+        ...
+    def power_cycle(self) -> None:
+        ...
+    def set_input(self, bit: typing.SupportsInt | typing.SupportsIndex, high: bool) -> None:
+        """
+        Electrical level of input port `bit` (6012h bit 0..10; 7 EXT1, 8 EXT2, 9 ENC1/EXT3).
+        """
+    def set_jammed(self, jammed: bool) -> None:
+        ...
+    @property
+    def active_baud_index(self) -> int:
+        ...
+    @property
+    def attached(self) -> bool:
+        ...
+    @property
+    def busy(self) -> bool:
+        ...
+    @property
+    def controller_status(self) -> int:
+        ...
+    @property
+    def emcy_sent(self) -> int:
+        ...
+    @property
+    def enabled(self) -> bool:
+        ...
+    @property
+    def error_status(self) -> int:
+        ...
+    @property
+    def flash_program(self) -> list[int]:
+        ...
+    @property
+    def gpio_value(self) -> int:
+        ...
+    @property
+    def in_bootloader(self) -> bool:
+        ...
+    @property
+    def node_id(self) -> int:
+        ...
+    @property
+    def od(self) -> ObjectDictionary:
+        ...
+    @property
+    def position(self) -> int:
+        ...
+    @property
+    def program_counter(self) -> int:
+        ...
+    @property
+    def program_pointer(self) -> int:
+        ...
+    @property
+    def program_running(self) -> bool:
+        ...
+    @property
+    def ram_program(self) -> list[int]:
+        ...
+    @property
+    def velocity(self) -> float:
+        ...
 class UnitekRampParams:
     def __init__(self, n_max_rpm: typing.SupportsFloat | typing.SupportsIndex = 3000.0, acc_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0, dec_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0) -> None:
         ...
@@ -4553,12 +4636,34 @@ def play(bus: Bus, entries: collections.abc.Sequence[LogEntry], speed: typing.Su
     """
     Replays entries onto bus: speed 1.0 = original timing, 0 = as fast as possible.
     """
+def pmc007_assemble(text: str) -> list[int]:
+    """
+    Mnemonic text -> 32-bit words (the spec's reading of the encoding).
+    """
 def pmc007_convert_position(position: typing.SupportsFloat | typing.SupportsIndex, from_setting: typing.SupportsInt | typing.SupportsIndex, to_setting: typing.SupportsInt | typing.SupportsIndex) -> float:
+    ...
+def pmc007_decode(word: typing.SupportsInt | typing.SupportsIndex) -> typing.Any:
+    """
+    (mnemonic, option, data), or None for an unknown opcode.
+    """
+def pmc007_disassemble(words: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]) -> str:
+    ...
+def pmc007_disassemble_word(word: typing.SupportsInt | typing.SupportsIndex) -> str:
+    ...
+def pmc007_eds() -> str:
+    """
+    The EDS text generated from the table (node-ID as $NODEID).
+    """
+def pmc007_encode(mnemonic: str, option: typing.SupportsInt | typing.SupportsIndex = 0, data: typing.SupportsInt | typing.SupportsIndex = 0) -> int:
     ...
 def pmc007_gear_acceleration(gear: typing.SupportsInt | typing.SupportsIndex) -> float:
     ...
 def pmc007_microsteps(setting: typing.SupportsInt | typing.SupportsIndex) -> int:
     ...
+def pmc007_od_rows() -> list:
+    """
+    Every object of the PMC007 dictionary: (index, sub, name, parent, type, access, pdo_mappable, storage, default, low, high).
+    """
 def pmc007_position_profile(start: MotionState, target: typing.SupportsFloat | typing.SupportsIndex, params: Pmc007ProfileParams) -> Profile:
     ...
 def pmc007_speed_profile(start: MotionState, speed: typing.SupportsFloat | typing.SupportsIndex, params: Pmc007ProfileParams, hold: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> Profile:

@@ -270,6 +270,14 @@ class _Checker:
                           options=self.table(t, "options", *path), sim=self.table(t, "sim", *path))
 
     def one_kind_per_line(self, axes: dict[str, AxisConfig], lines: dict) -> None:
+        # Two axes answering to one address on one bus would both answer every request.
+        on_bus: dict[tuple, AxisConfig] = {}
+        for a in axes.values():
+            if a.bus is not None:
+                first = on_bus.setdefault((a.bus, a.address), a)
+                if first is not a:
+                    raise self.fail(f"address {a.address} is also axis {first.name!r} ({first.kind}) "
+                                    f"on bus {a.bus!r}", "axis", a.name, "address")
         # One RS-485 line speaks one protocol: the framing is the kind's.
         seen: dict[str, AxisConfig] = {}
         for a in axes.values():

@@ -3,6 +3,7 @@ the transport a real bench uses (ptys, socketcand on 127.0.0.1); every kind of m
 in a file named by file:line: key; the bench commands of the command line."""
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import subprocess
@@ -32,11 +33,18 @@ def _every_kind_file(tmp_path, params: dict) -> tuple[str, dict]:
     """A bench file with one axis per registered kind; returns (path, {axis: Kind})."""
     text = ["# every registered kind, one axis each", "[bus.can0]", 'spec = "socketcan:can0"', ""]
     axes = {}
+    taken: set = set()    # node-IDs on the one bus: two kinds may default to the same one
     for kind in sorted(registry.drive_kinds()):
         if kind not in KINDS:
             pytest.fail(f"kind {kind!r} has no entry in tests/python/test_drive_api.py KINDS")
         k = KINDS[kind]
         plugin = registry.drive_plugin(kind)
+        if plugin.transport == "can" and k.address.isdigit():
+            node = int(k.address)
+            while node in taken:
+                node += 1
+            taken.add(node)
+            k = dataclasses.replace(k, address=str(node))
         name = kind.replace("-", "_")
         if plugin.transport == "serial":
             text += [f"[line.{name}]", f'port = "/dev/ttyUSB-{name}"', ""]
@@ -130,7 +138,7 @@ def _sim_position(sim):
     """Where a simulator's motor is, whatever the kind exposes (never None: a
     comparison of two Nones would prove nothing)."""
     for holder in (sim, getattr(sim, "motor", None)):
-        for attr in ("physical_position", "pulse_position", "position_num"):
+        for attr in ("physical_position", "pulse_position", "position_num", "position"):
             v = getattr(holder, attr, None)
             if v is not None:
                 return v() if callable(v) else v
@@ -190,6 +198,8 @@ def test_the_good_file_loads(tmp_path):
     ("address = 5", 'address = 5\nspeed = 3', 17, "axis.z.speed", "unknown key"),
     ('spec = "virtual:bench-test"', "spec = 5", 2, "bus.can0.spec", "string"),
     ("address = 1", 'address = 1\nparams = { NOPE = 1 }', 11, "axis.x.params.NOPE", "no parameter"),
+    ("address = 5", 'address = 5\n\n[axis.q]\nkind = "cia402"\nbus = "can0"\naddress = 5', 21,
+     "axis.q.address", "also axis 'z'"),
 ])
 def test_each_mistake_names_file_line_and_key(tmp_path, old, new, line, key, says):
     assert old in GOOD

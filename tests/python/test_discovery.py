@@ -11,13 +11,14 @@ import pytest
 from motorbus import Bench, _core, open_drive
 from motorbus.bus_server import BusServers
 from motorbus.discovery import discover
-from motorbus.drives import arcus, cia402, dmac, unitek
+from motorbus.drives import arcus, arcus_canopen, cia402, dmac, pmc007, unitek
 
 
 @pytest.fixture
 def wired():
     """Arcus 07 and 42 on one line (9 600 baud), DMAC 13 at 19 200 (not its 38 400) on another,
-    CiA 402 nodes 9 and 77 and a UNITEK servo on receive id 0x210 on a bus served over socketcand."""
+    CiA 402 nodes 9 and 77, a PMC007 on node 5, a DMX-CAN (CANopen persona) on node 3 and a
+    UNITEK servo on receive id 0x210 on a bus served over socketcand."""
     arcus_sims = [arcus.make_sim("07"), arcus.make_sim("42")]
     line1 = _core.PtyLineServer(arcus_sims, 9600)
     line1.enforce_baud = True
@@ -25,7 +26,8 @@ def wired():
     line2 = _core.PtyLineServer([dmac_sim], 19200)
     line2.enforce_baud = True
     servers = BusServers("virtual:discovery-test", socketcand=["127.0.0.1:0"], channel="can0")
-    nodes = [cia402.make_sim(n) for n in (9, 77)] + [unitek.make_sim("0x210")]
+    nodes = [cia402.make_sim(n) for n in (9, 77)] + [unitek.make_sim("0x210"), pmc007.make_sim(5),
+                                                     arcus_canopen.make_sim(3)]
     for n in nodes:
         n.attach(servers.endpoint())
     srv = servers.servers[0]
@@ -46,7 +48,8 @@ def test_finds_exactly_the_connected_drives_and_writes_a_working_bench(wired, tm
     assert got == {("arcus", "07", line1, 9600), ("arcus", "42", line1, 9600),
                    ("dmac", "13", line2, 19200),
                    ("cia402", "9", wired["bus"], None), ("cia402", "77", wired["bus"], None),
-                   ("unitek", "0x210", wired["bus"], None)}
+                   ("unitek", "0x210", wired["bus"], None), ("pmc007", "5", wired["bus"], None),
+                   ("arcus-canopen", "3", wired["bus"], None)}
     ids = {(f.kind, f.address): f.identity for f in result.found}
     assert ids[("arcus", "07")]["model"] == "DriveMax-CAN"
     assert ids[("dmac", "13")]["serial"] == "H142-10145"
@@ -59,7 +62,7 @@ def test_finds_exactly_the_connected_drives_and_writes_a_working_bench(wired, tm
     path = tmp_path / "found.toml"
     result.write(str(path))
     with Bench.load(path) as bench:
-        assert len(bench) == 6
+        assert len(bench) == 8
         for name, d in bench.axes.items():
             # The sweep's requests at the wrong rates reached the DMAC as garbage, which it
             # latches as a syntax error (#ERROR), as the real module would: acknowledge it.

@@ -69,6 +69,8 @@ def _arcus_canopen_setup(drive: Any) -> None:
     drive.params["0x6099:01"] = 20000  # home switch speed
     drive.params["0x6099:02"] = 2000   # zero position speed
     drive.params["0x609A"] = 20
+def _pmc007_setup(drive: Any) -> None:
+    drive.params["maximum_speed"] = 20000   # 6003h, pps: the run speed of position moves
 
 
 def _dmac_setup(drive: Any) -> None:
@@ -89,6 +91,8 @@ KINDS = {
                    unfault=lambda sim: sim.set_hardware_enable(True), param="ACC_RAMP", value=200, jog=50.0,
                    setup=lambda drive: drive.params.__setitem__("ACC_RAMP", 20),  # ms to N max
                    sim_options={"calibrated": True}),
+    "pmc007": Kind("pmc007", "5", 0.01, fault=lambda sim, drive: sim.inject_error(1),  # UVLO
+                   param="start_speed", value=500, jog=50.0, home="ext1", setup=_pmc007_setup),
 }
 
 

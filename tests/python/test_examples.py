@@ -84,7 +84,7 @@ def test_example_06_drive_api_python():
     out = run_example("06_drive_api.py")
     # The example lists the registry: every in-tree kind, and whatever else is installed.
     assert "kinds: " + ", ".join(sorted(motorbus.drive_kinds())) in out
-    assert {"arcus", "arcus-canopen", "cia402", "dmac", "unitek"} <= set(motorbus.drive_kinds())
+    assert {"arcus", "arcus-canopen", "cia402", "dmac", "pmc007", "unitek"} <= set(motorbus.drive_kinds())
     for kind in ("arcus", "dmac", "cia402"):
         assert f"{kind}: at 3.50 mm, enabled=True moving=False fault=False" in out, out
 
@@ -96,6 +96,8 @@ def test_example_08_arcus_canopen_python():
     assert "run current over CANopen (2004h:02): 1200 mA" in out
     assert "moved to 1000.0 counts, state OPERATION ENABLED" in out
     assert "homed at 0.0 StepNLoop IDLE" in out
+
+
 def test_example_09_unitek_python():
     out = run_example("09_unitek.py")
     assert "KERN_STATUS 0x0181" in out and "ACC_RAMP 1000 ms" in out
@@ -109,3 +111,16 @@ def test_example_09_unitek_cpp():
     assert "KERN_STATUS 0x0181" in out and "ACC_RAMP 1000 ms" in out
     assert "stream 0x30: 21 samples, last period 10.0 ms, lost 0, speed 3277 num" in out
     assert "position 65536 num, Tol 1" in out
+def test_example_07_pmc007_python():
+    out = run_example("07_pmc007.py")
+    assert "status: <ControllerStatus.BUSY: 8>" in out
+    assert "position 3200 busy False" in out
+    assert "program: 080003E8 03000000 010001F4 10100000 0B000000 12100003 0E000002 verified True" in out
+    assert "after the program: position 1700 counter 3 running False" in out
+
+
+def test_example_07_pmc007_cpp():
+    out = run_cpp_example("example_07_pmc007")
+    assert "6001h=0x08" in out
+    assert "position 3200 busy 0" in out
+    assert "after the program: position 1700 counter 3" in out

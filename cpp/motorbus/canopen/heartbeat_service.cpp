@@ -85,7 +85,7 @@ void HeartbeatService::lost(std::uint8_t n) {
     } catch (const Error&) {
     }
     // 0x1029:1 communication error behaviour (CiA 301 default 0: to PRE-OPERATIONAL).
-    std::uint64_t behaviour = 0;
+    std::uint64_t behaviour = options_.error_behaviour_without_1029;
     if (auto v = node_.od().find(0x1029, 1)) behaviour = v->get_u64();
     const NmtState s = node_.nmt_state();
     if (s == NmtState::Operational && behaviour == 0) node_.set_nmt_state(NmtState::PreOperational);

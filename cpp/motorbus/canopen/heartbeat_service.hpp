@@ -23,6 +23,10 @@ namespace motorbus::canopen {
 struct HeartbeatServiceOptions {
     unsigned consumer_entries = 4;  // 0x1016 sub-entries created when 0x1016 is absent
     std::uint16_t producer_ms = 0;  // 0x1017 default when absent
+    // The 0x1029:1 behaviour applied when the dictionary has no 0x1029 (0 = CiA 301's
+    // default: to PRE-OPERATIONAL; 1 = no state change; 2 = to STOPPED), for a
+    // device whose manual documents no reaction.
+    std::uint8_t error_behaviour_without_1029 = 0;
 };
 
 class HeartbeatService : public NodeService {

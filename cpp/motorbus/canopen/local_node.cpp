@@ -197,6 +197,7 @@ void LocalNode::apply_nmt(NmtCommand c) {
                         for (auto& [sub, var] : obj->subs) var->reset_to_default();
                 }
             }
+            if (options_.on_reset) options_.on_reset(c);
             if (options_.send_boot_up) send_boot_up();
             return transition(NmtState::PreOperational);
         }
@@ -242,6 +243,11 @@ void LocalNode::on_sdo_frame(const can::Frame& f) {
     if (state_.load() == NmtState::Stopped || state_.load() == NmtState::Initialising) {  // S17
         std::lock_guard lock(mutex_);
         ++sdo_stopped_;
+        return;
+    }
+    if (options_.sdo_require_dlc8 && f.len != 8) {
+        std::lock_guard lock(mutex_);
+        ++sdo_bad_dlc_;
         return;
     }
     {
@@ -324,6 +330,7 @@ LocalNodeCounters LocalNode::counters() const {
     c.nmt_commands = nmt_commands_;
     c.nmt_ignored = nmt_ignored_;
     c.sdo_while_stopped = sdo_stopped_;
+    c.sdo_bad_dlc = sdo_bad_dlc_;
     return c;
 }
 

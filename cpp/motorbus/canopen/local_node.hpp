@@ -83,6 +83,15 @@ struct LocalNodeOptions {
     // NMT reset node restores 0x2000-0x9FFF (and reset communication 0x1000-0x1FFF)
     // to their defaults before the new boot-up.
     bool reset_restores_defaults = true;
+    // Called on the bus thread after an NMT reset node / reset communication
+    // put the node in Initialising (and restored the defaults when asked), before
+    // the boot-up: a device whose reset differs from CiA 301 (e.g. one that keeps
+    // or reloads values from its own flash) applies it here.  Empty = nothing.
+    std::function<void(NmtCommand)> on_reset{};
+    // Ignore (and count in LocalNodeCounters::sdo_bad_dlc) SDO requests whose
+    // DLC is not 8, for a device whose manual says so.  false = the CiA 301
+    // lenience of SdoServerMachine (short frames parsed as far as they go).
+    bool sdo_require_dlc8 = false;
 };
 
 struct LocalNodeCounters {
@@ -90,6 +99,7 @@ struct LocalNodeCounters {
     std::uint64_t nmt_commands = 0;  // applied
     std::uint64_t nmt_ignored = 0;   // wrong DLC, other node, unknown command
     std::uint64_t sdo_while_stopped = 0;
+    std::uint64_t sdo_bad_dlc = 0;  // dropped by LocalNodeOptions::sdo_require_dlc8
 };
 
 class LocalNode {
@@ -152,7 +162,7 @@ private:
     std::optional<can::Frame> mailbox_;
     bool woken_ = false;
     bool stopping_ = false;
-    std::uint64_t dropped_ = 0, nmt_commands_ = 0, nmt_ignored_ = 0, sdo_stopped_ = 0;
+    std::uint64_t dropped_ = 0, nmt_commands_ = 0, nmt_ignored_ = 0, sdo_stopped_ = 0, sdo_bad_dlc_ = 0;
     struct ServiceSlot {
         std::shared_ptr<NodeService> service;
         Nanos deadline = 0;  // run once right after being added

@@ -91,6 +91,7 @@ Bytes Variable::get() const {
 
 std::uint32_t Variable::check_size_for_write(std::size_t n) const {
     const std::size_t fixed = type_size(spec_.type);
+    if (fixed && spec_.alt_size && n == spec_.alt_size) return 0;
     if (fixed) {
         if (n > fixed) return abort_code::kTooLong;
         if (n < fixed) return abort_code::kTooShort;
@@ -197,6 +198,15 @@ std::uint32_t Variable::remote_read(Bytes& out) const {
 
 std::uint32_t Variable::remote_write(std::span<const std::uint8_t> data) {
     if (!writable(spec_.access)) return abort_code::kReadOnly;
+    Bytes resized;
+    const std::size_t fixed = type_size(spec_.type);
+    if (fixed && spec_.alt_size && data.size() == spec_.alt_size && data.size() != fixed) {
+        for (std::size_t i = fixed; i < data.size(); ++i)
+            if (data[i] != 0) return abort_code::kValueTooHigh;
+        resized.assign(data.begin(), data.begin() + std::min(fixed, data.size()));
+        resized.resize(fixed, 0);
+        data = resized;
+    }
     if (auto c = validate(data)) return c;
     WriteHook hook;
     {

@@ -485,6 +485,9 @@ PLUGIN = DrivePlugin(
     sim_options=_SIM_OPTIONS,
     store_options=lambda store_dir, address: {"store_path": __import__("os").path.join(
         store_dir, f"arcus-canopen-{address}.store")},
+    # Discovery: profile 402 with the identity Table 10.1 gives (vendor 0, revision 112)
+    # beats the generic cia402 match; any other 402 node stays cia402.
+    canopen_match=lambda node: 5 if node.profile == 402 and not node.vendor_id and node.revision == 112 else 0,
 )
 
 

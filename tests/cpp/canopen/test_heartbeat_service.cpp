@@ -71,3 +71,24 @@ TEST(HeartbeatService, ProducesConsumesAndReactsToLoss_N10_N12_N13) {
     EXPECT_EQ(e->data[1], 0x81);
     node.close();
 }
+
+// error_behaviour_without_1029 = 1: a lost heartbeat sends EMCY 0x8130 and the
+// node stays OPERATIONAL (a device whose manual documents no reaction).
+TEST(HeartbeatService, NoStateChangeWhenAskedAndNo1029) {
+    auto dev_bus = can::open_virtual("svc-hbs-1");
+    auto host_bus = can::open_virtual("svc-hbs-1");
+    auto od = std::make_shared<ObjectDictionary>();
+    LocalNode node(*dev_bus, 5, od);
+    auto hb = HeartbeatService::attach(node, {.consumer_entries = 3, .error_behaviour_without_1029 = 1});
+    std::atomic<int> lost{0};
+    hb->on_lost = [&](std::uint8_t n) { lost += n == 1; };
+    BusSdoAccess sdo(*host_bus);
+    NmtMaster master(*host_bus);
+    master.start(5);
+    sdo.write_u32(5, 0x1016, 1, 0x00010032);
+    host_bus->send(encode_heartbeat(1, NodeState::Operational));
+    EXPECT_TRUE(eventually([&] { return lost.load() == 1; }));
+    std::this_thread::sleep_for(20ms);
+    EXPECT_EQ(node.nmt_state(), NmtState::Operational);
+    node.close();
+}

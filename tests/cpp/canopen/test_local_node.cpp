@@ -339,3 +339,31 @@ TEST(LocalNodeArgs, N14_InvalidNodeIdRefused) {
     EXPECT_THROW(LocalNode(*bus, 0, od), InvalidArgument);
     EXPECT_THROW(LocalNode(*bus, 128, od), InvalidArgument);
 }
+
+// LocalNodeOptions::on_reset is told which reset it was, after the defaults
+// were restored and before the boot-up; sdo_require_dlc8 drops short requests.
+TEST_F(NodeFixture, OnResetHookAndStrictDlc) {
+    std::atomic<int> last{0};
+    std::atomic<std::uint64_t> value_at_hook{0};
+    LocalNodeOptions o;
+    o.on_reset = [&](NmtCommand c) {
+        last = static_cast<int>(c);
+        value_at_hook = od->at(0x2003, 0)->get_u64();
+    };
+    o.sdo_require_dlc8 = true;
+    start(o);
+    sdo->write_u8(0x2003, 0, 7);
+    nmt(0x82);
+    ASSERT_TRUE(eventually([&] { return last == 0x82; }));
+    EXPECT_EQ(value_at_hook, 7u);  // reset communication leaves 0x2000+ alone
+    nmt(0x81);
+    ASSERT_TRUE(eventually([&] { return last == 0x81; }));
+    EXPECT_EQ(value_at_hook, 4u);  // reset node restored the default first
+    ASSERT_TRUE(eventually([&] { return node->nmt_state() == NmtState::PreOperational; }));
+    hub->clear();
+    std::uint8_t shortreq[4] = {0x40, 0x01, 0x60, 0x00};
+    host->send(can::Frame::make(0x605, std::span(shortreq, 4)));
+    ASSERT_TRUE(eventually([&] { return node->counters().sdo_bad_dlc == 1; }));
+    EXPECT_EQ(sdo->read_u8(0x6001, 0), 8);
+    for (const auto& f : hub->frames()) EXPECT_NE(f.id == 0x585u && f.payload()[0] == 0x80, true);
+}

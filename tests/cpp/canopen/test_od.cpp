@@ -175,3 +175,18 @@ TEST(ObjectDictionary, ConcurrentAccessIsSafe) {
         });
     for (auto& t : ts) t.join();
 }
+
+// VariableSpec::alt_size: a second size a remote write may carry, narrowed to the type.
+TEST(ObjectDictionary, AltSizeRemoteWrite) {
+    ObjectDictionary od;
+    auto v = od.add_variable({.index = 0x6020, .name = "Stop", .type = DataType::Unsigned8,
+                              .default_value = std::uint64_t{0}, .alt_size = 4});
+    std::uint8_t four[4] = {0x02, 0, 0, 0};
+    EXPECT_EQ(v->remote_write(std::span(four, 4)), 0u);
+    EXPECT_EQ(v->get(), (Bytes{0x02}));
+    std::uint8_t big[4] = {0x02, 0, 1, 0};
+    EXPECT_EQ(v->remote_write(std::span(big, 4)), abort_code::kValueTooHigh);
+    std::uint8_t two[2] = {1, 0};
+    EXPECT_EQ(v->remote_write(std::span(two, 2)), abort_code::kTooLong);  // only the one extra size
+    EXPECT_EQ(v->check_size_for_write(4), 0u);
+}

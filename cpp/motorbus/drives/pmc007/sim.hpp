@@ -1,0 +1,199 @@
+// The simulated PMC007 (003 manual): a CANopen node served on a Bus whose
+// dictionary is build_pmc007_od (the one table), with the device's behaviour
+// on the OD hooks:
+//   - SDO server / NMT / boot-up (LocalNode), heartbeat producer and consumer
+//     (HeartbeatService, 1016h/1017h), 4 TPDO + 4 RPDO (PdoService, mapping
+//     limited to the objects Appendix 1 marks mappable), EMCY on fault bits;
+//   - motion on a motion::MotorModel with the pmc007 profile (gears, start/stop
+//     speeds) on a Clock: step (6004h) and absolute (601Ch) commands, speed
+//     mode, immediate stop (6020h), enable (600Eh), with the busy / ignore /
+//     refuse rules of B-P07..B-P20;
+//   - RAM/ROM: 2007h=2 saves the ROM objects to "flash", reset node / power
+//     cycle reloads them (RAM objects return to their defaults), reset
+//     communication makes the RAM values of node-ID/baud/PDO/heartbeat active;
+//   - stall detection (jam the rotor with set_jammed), external stops with
+//     edge selection and debounce, GPIO with the inverted polarity;
+//   - the offline program (6018h/6019h), executed on the clock.
+// Time: the motion, debounce and program advance when poll() runs: on every
+// SDO access, from the node's timer (every 2 ms of real time) and when a test
+// calls it after advancing a SimClock.
+#pragma once
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "motorbus/can/bus.hpp"
+#include "motorbus/canopen/heartbeat_service.hpp"
+#include "motorbus/canopen/local_node.hpp"
+#include "motorbus/canopen/pdo_service.hpp"
+#include "motorbus/drives/pmc007/od_table.hpp"
+#include "motorbus/drives/pmc007/profile.hpp"
+#include "motorbus/drives/pmc007/program.hpp"
+#include "motorbus/motion/motor_model.hpp"
+#include "motorbus/runtime/clock.hpp"
+
+namespace motorbus::pmc007 {
+
+// 6000h bits.
+namespace err {
+constexpr std::uint8_t kUvlo = 1u << 0, kBerr = 1u << 1, kAerr = 1u << 2, kBoc = 1u << 3, kAoc = 1u << 4,
+                       kTsd = 1u << 5;
+}
+// 6001h bits (bit 4: EXT3 latch, the spec's reading).
+namespace st {
+constexpr std::uint8_t kExt1 = 1u << 0, kExt2 = 1u << 1, kStall = 1u << 2, kBusy = 1u << 3, kExt3 = 1u << 4;
+}
+// 6012h / 6011h:01 port bits.
+namespace port {
+constexpr int kGpio1 = 0, kExt1 = 7, kExt2 = 8, kEnc1 = 9, kEnc2 = 10;
+}
+
+inline constexpr std::uint32_t kAbortDeviceState = 0x08000022;
+inline constexpr std::uint32_t kAbortValueRange = 0x06090030;
+
+struct Pmc007SimOptions {
+    double steps_per_rev = 200;  // full steps of the motor (1.8 degree)
+    double pull_out_speed = 0;   // steps/s above which the rotor stalls (0 = never)
+    // A switch wired to EXT1 (pulls it low while lo <= position <= hi), e.g. the
+    // home/limit switch an external-stop homing runs into.  nullopt = none.
+    std::optional<std::pair<double, double>> ext1_switch{};
+    // Where the "flash" lives between runs (ROM objects saved by 2007h=2, the
+    // offline program saved by 6019h:03, the 602Ah position); "" = memory only.
+    std::string store_path{};
+};
+
+class Pmc007Sim {
+public:
+    Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions options = {});
+    ~Pmc007Sim();
+    Pmc007Sim(const Pmc007Sim&) = delete;
+    Pmc007Sim& operator=(const Pmc007Sim&) = delete;
+
+    // Serve on `bus` (boot-up sent); InvalidArgument if already attached.
+    void attach(can::Bus& bus);
+    void close();
+    bool attached() const;
+
+    // Power off and on again: flash reloaded, RAM defaults, position per 602Ah,
+    // offline program auto-run, boot-up (when attached).
+    void power_cycle();
+    // Advance motion, debounce, stall and the offline program to clock.now().
+    void poll();
+
+    // ---- what the device is doing ----
+    std::uint8_t node_id() const { return node_id_; }      // the active node-ID
+    std::uint8_t error_status();                            // 6000h
+    std::uint8_t controller_status();                       // 6001h (busy computed)
+    std::int32_t position();                                // 600Ch
+    double velocity();                                      // pps, signed
+    bool busy();
+    bool active();  // moving, running a program or debouncing an input
+    bool enabled();
+    std::uint16_t gpio_value();                             // 6012h (1 = low)
+    std::uint8_t active_baud_index() const { return baud_index_; }
+    canopen::ObjectDictionary& od() { return *od_; }
+    std::shared_ptr<canopen::ObjectDictionary> od_ptr() { return od_; }
+    canopen::LocalNode* node() { return node_.get(); }
+    std::vector<std::uint32_t> flash_program();
+    std::vector<std::uint32_t> ram_program();
+    bool program_running();
+    std::uint32_t program_pointer();
+    std::uint32_t program_counter_value();
+    std::uint64_t emcy_sent() const { return emcy_sent_; }
+    bool in_bootloader() const { return bootloader_; }
+
+    // ---- test hooks ----
+    // A load blocks the rotor: with stall detection configured (6017h threshold
+    // bits != 0) 6001h bit 2 latches; with 601Bh = 1 the motor stops.
+    void set_jammed(bool jammed);
+    // Drive the electrical level of an input port (6012h bit 0..10): high = true.
+    void set_input(int bit, bool high);
+    // The power stage detects an error (6000h bits): latched, EMCY sent.
+    void inject_error(std::uint8_t bits);
+
+private:
+    struct Pending {
+        Nanos t;
+        bool high;
+    };
+    std::uint32_t on_write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> d);
+    void on_reset(canopen::NmtCommand c);
+    // B-P27/B-P36: a node-ID written to 2002h takes effect at reset communication
+    // (or at power-up once saved): the node is served again under the new ID.
+    void schedule_node_id_switch();
+    void switch_node_id(std::uint8_t new_id);
+    struct Services {
+        std::shared_ptr<canopen::PdoService> pdo;
+        std::shared_ptr<canopen::HeartbeatService> hb;
+        std::shared_ptr<canopen::NodeService> ticker;
+    };
+    Services make_services(canopen::LocalNode& n);
+    canopen::LocalNodeOptions node_options();
+    void publish();
+    void load_power_up(bool cold);
+    void write_store_locked();
+    void read_store();
+    void update_locked();
+    std::uint32_t start_move_locked(std::int64_t delta);
+    bool refused_locked() const;
+    void stop_now_locked();
+    Pmc007ProfileParams params_locked(double speed) const;
+    void on_motor_event(const motion::MotorEvent& e);
+    void input_edge_locked(int bit, bool high, Nanos t);
+    void level_change_locked(int bit, bool high, Nanos t);
+    void emcy_locked(std::uint16_t code);
+    void run_program_locked(Nanos now);
+    bool exec_locked(std::uint32_t word, bool single);
+    std::int64_t u(std::uint16_t i, std::uint8_t s = 0) const;
+    void set(std::uint16_t i, std::uint8_t s, std::int64_t v);
+
+    std::atomic<std::uint8_t> node_id_;
+    std::atomic<std::uint8_t> baud_index_{4};
+    Clock& clock_;
+    Pmc007SimOptions opt_;
+    std::shared_ptr<canopen::ObjectDictionary> od_;
+    motion::MotorModel motor_;
+    mutable std::recursive_mutex m_;
+    can::Bus* bus_ = nullptr;
+    std::unique_ptr<canopen::LocalNode> node_;
+    std::shared_ptr<canopen::PdoService> pdo_;
+    std::shared_ptr<canopen::HeartbeatService> hb_;
+    std::shared_ptr<canopen::NodeService> ticker_;
+    bool attaching_ = false;
+    std::thread renode_;
+    std::atomic<bool> renode_done_{false};
+    std::vector<std::shared_ptr<void>> retired_;  // replaced nodes/services: their OD listeners stay valid
+
+    std::map<std::pair<std::uint16_t, std::uint8_t>, canopen::Bytes> flash_;
+    std::vector<std::uint32_t> flash_program_, ram_program_;
+    std::uint8_t errors_ = 0;   // 6000h
+    std::uint8_t latched_ = 0;  // 6001h bits 0-2, 4
+    bool speed_mode_running_ = false;
+    std::uint32_t last_step_ = 0;
+    std::int32_t last_abs_ = 0;
+    std::uint16_t levels_ = 0x7FF;  // electrical level of each port, 1 = high
+    std::array<std::optional<Pending>, 11> pending_{};
+    bool jammed_ = false;
+    std::atomic<bool> bootloader_{false};
+    bool bootloader_pending_ = false;
+    std::int32_t saved_position_ = 0;  // 6022h "EEPROM"
+    std::atomic<std::uint64_t> emcy_sent_{0};
+    Nanos last_emcy_ = -1;
+    std::uint8_t last_emcy_bits_ = 0;
+    bool publishing_ = false;
+    // Offline program execution.
+    bool running_ = false, paused_ = false, flag_ = false;
+    std::uint32_t pc_ = 0, counter_ = 0;
+    bool reset_en_ = false, pause_en_ = false;
+    std::uint32_t reset_target_ = 0;
+    bool program_fault_ = false;
+};
+
+}  // namespace motorbus::pmc007
