@@ -30,6 +30,7 @@ from .. import _core
 from ..canopen.cia402 import Cia402, Controlword, OpMode
 from ..drive import Capability, DriveStatus, ParamInfo, Params, Units
 from ..registry import DrivePlugin
+from . import arcus as _arcus
 from .cia402 import Cia402Drive
 
 __all__ = ["ArcusCanopen", "ArcusCanopenDrive", "ArcusCanopenSim", "ArcusHomingMethod", "BitRate",
@@ -80,22 +81,8 @@ class BitRate(enum.IntEnum):
     M1 = 9
 
 
-class SnlStatus(enum.IntEnum):
-    """2003h StepNLoop status (Table 8.14)."""
-    IDLE = 0
-    MOVING = 1
-    CORRECTING = 2
-    STOPPING = 3
-    ABORTING = 4
-    JOGGING = 5
-    HOMING = 6
-    Z_HOMING = 7
-    CORRECTION_RANGE_ERROR = 8
-    CORRECTION_ATTEMPT_ERROR = 9
-    STALL_ERROR = 10
-    LIMIT_ERROR = 11
-    NOT_AVAILABLE = 12
-    LIMIT_HOMING = 13
+# StepNLoop status: the same values on both personas (Tables 7.6 and 8.14), one enum.
+SnlStatus = _arcus.SnlStatus
 
 
 def _check_node(address: Union[str, int]) -> str:
