@@ -186,8 +186,6 @@ private:
     std::int32_t saved_position_ = 0;  // 6022h "EEPROM"
     std::atomic<std::uint64_t> emcy_sent_{0};
     Nanos last_emcy_ = -1;
-    std::uint8_t last_emcy_bits_ = 0;
-    bool publishing_ = false;
     // Offline program execution.
     bool running_ = false, paused_ = false, flag_ = false;
     std::uint32_t pc_ = 0, counter_ = 0;

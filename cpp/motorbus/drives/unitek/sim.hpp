@@ -147,7 +147,6 @@ private:
     std::optional<bool> limit_forced_[2];  // [0] minus, [1] plus
     Activity activity_ = Activity::Idle;
     std::uint32_t last_status_ = 0;
-    bool events_armed_ = false;
     SimCounters counters_;
 
     std::function<void(const can::Frame&)> out_;
