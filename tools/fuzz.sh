@@ -3,7 +3,7 @@
 # or built here), each on its own corpus fuzz/corpus-<target> plus fuzz/seeds/<target>.
 #   tools/fuzz.sh run SECONDS   each target for SECONDS        (make fuzz-smoke: 5)
 #   tools/fuzz.sh runs N        each target for N executions   (make fuzz: 10 000 000)
-# FUZZ_TARGETS="sdo_server slcan_decoder" runs only those targets (names without fuzz_);
+# FUZZ_TARGETS="sdo_server slcan_decoder" runs only those targets, in that order (names without fuzz_);
 # JOBS targets run at once (default: the number of cores).  FUZZ_BIN=DIR runs the
 # fuzz_* executables found in DIR instead (copies, so a long run survives rebuilds).  Prints libFuzzer's final
 # stats per target (`fuzz-stats NAME executions=N exec/s=R seconds=S`) and fails on
@@ -46,12 +46,16 @@ one() {  # one target; its whole output goes to $logs/<name>, the verdict to std
 }
 
 targets=()
-for f in "$BIN"/fuzz_*; do
-  [ -x "$f" ] || continue
-  name=$(basename "$f")
-  if [ -n "${FUZZ_TARGETS:-}" ] && ! [[ " $FUZZ_TARGETS " == *" ${name#fuzz_} "* ]]; then continue; fi
-  targets+=("$f")
-done
+if [ -n "${FUZZ_TARGETS:-}" ]; then   # in the order given (e.g. fastest first in a long run)
+  for t in $FUZZ_TARGETS; do
+    [ -x "$BIN/fuzz_$t" ] || { echo "fuzz: no target fuzz_$t in $BIN" >&2; exit 2; }
+    targets+=("$BIN/fuzz_$t")
+  done
+else
+  for f in "$BIN"/fuzz_*; do
+    [ -x "$f" ] && targets+=("$f")
+  done
+fi
 echo "fuzz: ${#targets[@]} targets, $MODE $AMOUNT each, $JOBS at once ($(date -u '+%F %H:%M') UTC)"
 failed=0
 running=0
