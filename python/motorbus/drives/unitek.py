@@ -620,7 +620,15 @@ class UnitekDrive(Drive):
         self._activity = "torque"
 
     def _stop(self) -> None:
-        self.native.write(Reg.SPEED_CMD, 0)
+        # Writes are never acknowledged: a stop is read back, so it has reached the drive
+        # before the call returns (a stop sent just before the link closes could
+        # otherwise be lost with it — seen when a bench closed under ASan).
+        for _ in range(2):
+            self.native.write(Reg.SPEED_CMD, 0)
+            if self.native.read(Reg.SPEED_CMD) == 0:
+                break
+        else:
+            raise _core.DriveFault("unitek stop: SPEED_CMD does not read back 0 after two writes")
         self._activity = "speed"
 
     def _quick_stop(self) -> None:
