@@ -42,6 +42,9 @@ struct Rig {
         client = std::make_unique<UnitekClient>(*host_bus, RegisterTable::builtin(), o);
     }
     ~Rig() {
+        // The spy's receive thread writes `seen`, a member destroyed before spy_bus:
+        // stop it first (TSan found the race).
+        spy_bus->close();
         client.reset();
         sim.reset();
     }
