@@ -17,6 +17,7 @@ import motorbus
 from motorbus import Bench, BenchFileError, registry
 
 from test_drive_api import KINDS  # per-kind address, parameters, homing method, sim options
+from test_hardening_bindings import sigint_default
 
 
 def _toml_value(v):
@@ -278,7 +279,8 @@ def test_ctrl_c_during_a_cli_move_stops_the_axis(tmp_path):
     p = tmp_path / "b.toml"
     p.write_text(GOOD)
     child = subprocess.Popen([sys.executable, "-m", "motorbus", "move", str(p), "x", "100", "--sim"],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             preexec_fn=sigint_default)   # a background test run ignores SIGINT
     time.sleep(1.5)   # the bench is up and the move (40 000 steps at 1 000 steps/s) under way
     assert child.poll() is None
     child.send_signal(signal.SIGINT)

@@ -69,11 +69,18 @@ BLOCKING = {
 }
 
 
+def sigint_default() -> None:
+    """In the child before exec: SIGINT back to its default.  A test run started in the
+    background (`make test &`, some CI runners) inherits SIGINT ignored, and Python then
+    installs no KeyboardInterrupt handler: every Ctrl-C case would fail for that reason."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _interrupt_child(code: str, *, settle: float = 0.3, limit: float = 5.0):
     """Runs `code` in a child, sends SIGINT `settle` s after it printed READY;
     returns (seconds from SIGINT to exit, returncode, stderr)."""
     child = subprocess.Popen([sys.executable, "-c", _PRELUDE + code], stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True)
+                             stderr=subprocess.PIPE, text=True, preexec_fn=sigint_default)
     try:
         line = child.stdout.readline()
         assert line.strip() == "READY", child.communicate(timeout=limit)
