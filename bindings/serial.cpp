@@ -11,6 +11,7 @@
 #include "motorbus/serial/line_device.hpp"
 #include "motorbus/serial/line_server.hpp"
 #include "motorbus/serial/port.hpp"
+#include "motorbus/serial/remote_port.hpp"
 
 namespace py = pybind11;
 using namespace motorbus;
@@ -250,8 +251,33 @@ void bind_serial(py::module_& m) {
             p.close();
         });
 
-    m.def("open_port", &open_port, py::arg("path"), py::arg("baud") = 0,
-          py::call_guard<py::gil_scoped_release>(), "Opens a serial device at `baud` (0 = keep the current speed).");
+    py::class_<TcpPort, Port, std::shared_ptr<TcpPort>>(m, "TcpPort", R"doc(A serial line behind a gateway, raw TCP: open_port("socket://host:port").
+
+    Bytes pass unchanged; the gateway (e.g. ser2net's `accepter: tcp,...`) owns the
+    line settings, so open_port's baud is ignored.  A dropped connection raises
+    LinkDown naming host:port; close() wakes a blocked read with ClosedError.
+)doc")
+        .def_property_readonly("peer", &TcpPort::peer, "'host:port'")
+        .def_property_readonly("is_open", &TcpPort::is_open);
+
+    py::class_<Rfc2217Port, TcpPort, std::shared_ptr<Rfc2217Port>>(m, "Rfc2217Port",
+                                                                  R"doc(A serial line behind an RFC 2217 (Telnet COM-PORT-OPTION) gateway: open_port("rfc2217://host:port", baud).
+
+    The baud and 8N1 are sent to the gateway (e.g. ser2net's `accepter:
+    telnet(rfc2217),tcp,...`), which sets them on its serial port; each is
+    waited for.  baud=0 asks the gateway for its current rate.  `.baud`
+    reads the rate the gateway acknowledged and sets a new one.
+)doc")
+        .def_property("baud", &Rfc2217Port::baud,
+                      [](Rfc2217Port& p, unsigned baud) {
+                          py::gil_scoped_release nogil;
+                          p.set_baud(baud);
+                      })
+        .def("set_baud", &Rfc2217Port::set_baud, py::arg("baud"), py::call_guard<py::gil_scoped_release>());
+
+    m.def("open_port", &open_port, py::arg("path"), py::arg("baud") = 0, py::call_guard<py::gil_scoped_release>(),
+          "Opens a serial device at `baud` (0 = keep the current speed), or a line behind a serial gateway:\n"
+          "'socket://host:port' (raw TCP, baud ignored) or 'rfc2217://host:port' (baud sent to the gateway).");
 
     py::class_<LineLink, std::shared_ptr<LineLink>>(m, "LineLink", R"doc(Request/reply line framing on a Port.
 

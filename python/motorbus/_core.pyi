@@ -34,7 +34,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -930,6 +930,39 @@ class PtyPair:
         ...
     @property
     def slave_path(self) -> str:
+        ...
+class TcpPort(Port):
+    """
+    A serial line behind a gateway, raw TCP: open_port("socket://host:port").
+    
+        Bytes pass unchanged; the gateway (e.g. ser2net's `accepter: tcp,...`) owns the
+        line settings, so open_port's baud is ignored.  A dropped connection raises
+        LinkDown naming host:port; close() wakes a blocked read with ClosedError.
+    """
+    @property
+    def is_open(self) -> bool:
+        ...
+    @property
+    def peer(self) -> str:
+        """
+        'host:port'
+        """
+class Rfc2217Port(TcpPort):
+    """
+    A serial line behind an RFC 2217 (Telnet COM-PORT-OPTION) gateway: open_port("rfc2217://host:port", baud).
+    
+        The baud and 8N1 are sent to the gateway (e.g. ser2net's `accepter:
+        telnet(rfc2217),tcp,...`), which sets them on its serial port; each is
+        waited for.  baud=0 asks the gateway for its current rate.  `.baud`
+        reads the rate the gateway acknowledged and sets a new one.
+    """
+    def set_baud(self, baud: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def baud(self) -> int:
+        ...
+    @baud.setter
+    def baud(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
 class LineLink:
     """
@@ -4588,7 +4621,8 @@ def nmt_encode(command: typing.SupportsInt | typing.SupportsIndex, node: typing.
     ...
 def open_port(path: str, baud: typing.SupportsInt | typing.SupportsIndex = 0) -> Port:
     """
-    Opens a serial device at `baud` (0 = keep the current speed).
+    Opens a serial device at `baud` (0 = keep the current speed), or a line behind a serial gateway:
+    'socket://host:port' (raw TCP, baud ignored) or 'rfc2217://host:port' (baud sent to the gateway).
     """
 def open_slcan(path: str, bitrate: typing.SupportsInt | typing.SupportsIndex = 500000, timestamps: bool = False, echo_suppression: bool = False, listen_only: bool = False, wait_for_acks: bool = True, tx_window: typing.SupportsInt | typing.SupportsIndex = 16, ack_timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0, open_timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0, status_poll: typing.SupportsFloat | typing.SupportsIndex = 0.0, tty_baud: typing.SupportsInt | typing.SupportsIndex = 115200, btr: typing.Any = None, receive_own: bool = False, rx_queue_size: typing.SupportsInt | typing.SupportsIndex = 65536, tx_coalesce: typing.SupportsFloat | typing.SupportsIndex = 2e-05) -> SlcanBus:
     """

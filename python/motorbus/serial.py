@@ -12,6 +12,11 @@ Example — a simulated device on a pty, talked to through the line link::
         link = LineLink(open_port(server.slave_path, 115200))
         assert link.transact("hello") == b"E:hello"
 
+A line behind a serial gateway (ser2net) opens the same way, by URL:
+``open_port("socket://host:port")`` (raw TCP, the gateway sets the line) or
+``open_port("rfc2217://host:port", 9600)`` (the baud is sent to the gateway);
+see docs/serial.md, "Remote lines".
+
 Everything that blocks releases the GIL.  Errors are the motorbus ones:
 ``TimeoutError`` (no complete reply in time), ``ReplyTooLong`` (a
 ``ProtocolError``; reply longer than ``max_line``), ``LinkDown`` (EOF/EIO, the
@@ -29,6 +34,8 @@ from ._core import (  # noqa: F401
     PtyLineServer,
     PtyPair,
     ReplyTooLong,
+    Rfc2217Port,
+    TcpPort,
     TtyPort,
     open_port,
 )
@@ -41,6 +48,8 @@ __all__ = [
     "PtyLineServer",
     "PtyPair",
     "ReplyTooLong",
+    "Rfc2217Port",
+    "TcpPort",
     "TtyPort",
     "open_port",
 ]

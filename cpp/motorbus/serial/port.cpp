@@ -21,6 +21,7 @@
 #include <shared_mutex>
 
 #include "motorbus/serial/baud_termios2.hpp"
+#include "motorbus/serial/remote_port.hpp"
 
 namespace motorbus::serial {
 
@@ -426,6 +427,8 @@ void PtyPair::close() {
 
 std::shared_ptr<Port> open_port(const std::string& path, unsigned baud) {
     if (path.empty()) throw InvalidArgument("open_port: empty path");
+    // socket://host:port and rfc2217://host:port: a line behind a serial gateway.
+    if (auto remote = parse_remote_url(path)) return open_remote_port(*remote, baud);
     return std::make_shared<TtyPort>(path, baud);
 }
 

@@ -109,7 +109,10 @@ private:
     int slave_fd_ = -1;
 };
 
-// Opens a serial device by path at `baud` (0 = keep the current speed).
+// Opens a serial device by path at `baud` (0 = keep the current speed), or a
+// line behind a serial gateway: socket://host:port (raw TCP; `baud` ignored,
+// the gateway sets the line) or rfc2217://host:port (`baud` sent to the gateway,
+// 0 = keep its rate).  See remote_port.hpp for the rules and errors.
 std::shared_ptr<Port> open_port(const std::string& path, unsigned baud);
 
 // The reply exceeded LineOptions::max_line; the excess was discarded up to the
