@@ -4,7 +4,7 @@
     motorbus bus dump SPEC [--count N] [--log FILE]
     motorbus bus play FILE SPEC [--speed X]
     motorbus sim serve [--pty] [--bus virtual:NAME] [--bitrate N] [--socketcand HOST:PORT]...
-                       [--slcan-pty]... --drive KIND:ADDR[,ADDR...]... [--baud N] [--store-dir DIR]
+                       [--slcan-pty]... --drive KIND:ADDR[,ADDR...]... [--baud N [--strict-baud]] [--store-dir DIR]
     motorbus drives
     motorbus demo
     motorbus status|move|home|stop|config ... BENCH [--sim]   (python/motorbus/cli_bench.py)
@@ -101,7 +101,7 @@ def cmd_sim_serve(args: argparse.Namespace) -> int:
 
     with SimBench(args.drive, bus=args.bus, bitrate=args.bitrate, socketcand=args.socketcand or (),
                   slcan_ptys=args.slcan_pty, channel=args.channel, baud=args.baud,
-                  store_dir=args.store_dir) as bench:
+                  strict_baud=args.strict_baud, store_dir=args.store_dir) as bench:
         for line in bench.announce():
             _say(line)
         report = (lambda: _report(bench.can)) if bench.can is not None else None
@@ -159,6 +159,9 @@ def build_parser() -> argparse.ArgumentParser:
                          "repeatable")
     ss.add_argument("--pty", action="store_true", help="serve serial lines on pseudo-terminals (the default)")
     ss.add_argument("--baud", type=int, default=0, help="pace serial replies at this baud rate (0 = unthrottled)")
+    ss.add_argument("--strict-baud", action="store_true",
+                    help="with --baud: requests sent at another baud rate arrive garbled and go unanswered, "
+                         "as on a real UART (to check that a client or gateway sets the rate)")
     ss.add_argument("--store-dir", default=None, help="where drives persist their stored settings")
     ss.add_argument("--bus", default=None, metavar="SPEC",
                     help="the CAN bus the CAN drives sit on (default: a new virtual bus)")

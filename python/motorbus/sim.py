@@ -58,22 +58,27 @@ class ServedLine:
 
 
 def serve_line(spec: str, baud: int = 0, clock: Any = None, store_dir: Optional[str] = None,
-               **options: Any) -> ServedLine:
-    """Starts one serial line (``KIND:ADDR[,ADDR...]`` of a serial kind) on a new pty."""
+               strict_baud: bool = False, **options: Any) -> ServedLine:
+    """Starts one serial line (``KIND:ADDR[,ADDR...]`` of a serial kind) on a new pty.
+
+    ``strict_baud`` (with ``baud``): requests sent at another rate arrive garbled and go
+    unanswered, as on a real UART, so a client (or a gateway) that sets the wrong baud
+    finds out."""
     plugin, addresses = registry.parse_drive_spec(spec)
     if plugin.transport != "serial":
         raise _core.InvalidArgument(f"drive spec {spec!r}: {plugin.kind} is a {plugin.transport} drive, not serial")
     drives = [make_sim(plugin.kind, a, clock=clock, store_dir=store_dir, **options) for a in addresses]
     server = _core.PtyLineServer(devices=drives, baud=baud)
+    server.enforce_baud = strict_baud
     return ServedLine(label=spec, server=server, drives=drives)
 
 
 def serve_lines(specs: Sequence[str], baud: int = 0, clock: Any = None,
-                store_dir: Optional[str] = None) -> list[ServedLine]:
+                store_dir: Optional[str] = None, strict_baud: bool = False) -> list[ServedLine]:
     lines: list[ServedLine] = []
     try:
         for spec in specs:
-            lines.append(serve_line(spec, baud=baud, clock=clock, store_dir=store_dir))
+            lines.append(serve_line(spec, baud=baud, clock=clock, store_dir=store_dir, strict_baud=strict_baud))
     except Exception:
         for line in lines:
             line.close()
@@ -93,7 +98,7 @@ class SimBench:
 
     def __init__(self, specs: Sequence[str], *, bus: Optional[str] = None, bitrate: Optional[int] = None,
                  socketcand: Sequence[str] = (), slcan_ptys: int = 0, channel: str = "can0", baud: int = 0,
-                 clock: Any = None, store_dir: Optional[str] = None,
+                 strict_baud: bool = False, clock: Any = None, store_dir: Optional[str] = None,
                  sim_options: Optional[dict] = None) -> None:
         self.lines: list[ServedLine] = []
         self.can: Optional[BusServers] = None
@@ -103,7 +108,7 @@ class SimBench:
         try:
             for spec, plugin, addresses in parsed:
                 if plugin.transport == "serial":
-                    line = serve_line(spec, baud=baud, clock=clock, store_dir=store_dir,
+                    line = serve_line(spec, baud=baud, clock=clock, store_dir=store_dir, strict_baud=strict_baud,
                                       **(sim_options or {}).get(plugin.kind, {}))
                     self.lines.append(line)
                     self.sims.update({(plugin.kind, a): d for a, d in zip(addresses, line.drives)})
