@@ -106,6 +106,11 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
         client on the same COB-IDs would take this one's responses)."""
         return self._sdo
 
+    @property
+    def node(self) -> int:
+        """The drive's CANopen node-ID."""
+        return self._node
+
     def set_mode(self, mode: int) -> None:  # accepts OpMode or int
         super().set_mode(int(mode))
 

@@ -17,20 +17,28 @@ The simulator (:class:`Cia402Sim`, ``make_sim``) is a CiA 402 node as the
 profile describes it, built from the core's pieces: a LocalNode (SDO server,
 NMT slave, boot-up), a HeartbeatService (producer 0x1017, consumer 0x1016), the
 device state machine (Cia402Device), profile position / profile velocity / homing
-on a motor model with home and limit switches.  ``motorbus sim serve --drive
-cia402:5`` serves it over socketcand or SLCAN.
+on a motor model with home and limit switches, and a PDO engine (RPDO/TPDO 1-4,
+SYNC; the motion objects are mappable).  ``motorbus sim serve --drive cia402:5``
+serves it over socketcand or SLCAN.
+
+Several CiA 402 axes on one bus start together on one SYNC (:func:`synchronised_start`,
+used by ``Bench.move_together``): each drive's set-point travels in a synchronous RPDO
+and every drive applies it on the same SYNC frame.
 """
 from __future__ import annotations
 
+import contextlib
+import struct
 import threading
-from typing import Any, Optional, Union
+from typing import Any, Iterator, Optional, Sequence, Union
 
 from .. import _core
 from ..canopen.cia402 import Cia402, Cia402Device, Controlword, OpMode
 from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params, Units
 from ..registry import DrivePlugin
 
-__all__ = ["Cia402Drive", "Cia402Sim", "PLUGIN", "make_sim", "open", "OBJECTS"]
+__all__ = ["Cia402Drive", "Cia402Sim", "PLUGIN", "SYNC_START_RPDO", "make_sim", "open", "OBJECTS",
+           "synchronised_start"]
 
 # Statusword bits the simulator drives itself (the state bits come from Cia402Device).
 _SW_REMOTE = 1 << 9
@@ -77,6 +85,8 @@ OBJECTS = [
     (0x6502, 0, "Supported drive modes", "U32", "ro", 0b100101, None, None, "", False, "PP, PV, HM"),
 ]
 _PERSISTENT = {(row[0], row[1]) for row in OBJECTS if row[9]}
+# What the simulator lets PDOs carry: the process data of PP/PV (CiA 402's usual mappings).
+_MAPPABLE = {0x6040, 0x6041, 0x6060, 0x6061, 0x6064, 0x606C, 0x607A, 0x60FF}
 _SIZES = {"U8": 1, "I8": 1, "U16": 2, "I16": 2, "U32": 4, "I32": 4}
 _SAVE = int.from_bytes(b"save", "little")  # CiA 301 0x1010 signature
 
@@ -133,6 +143,9 @@ class Cia402Sim:
         self.node: Optional[_core.LocalNode] = None
         self.heartbeat: Optional[_core.HeartbeatService] = None
         self.lost_master = threading.Event()
+        self.pdo: Optional[_core.PdoService] = None
+        #: clock time (ns) of the last profile-position set-point the drive accepted
+        self.last_setpoint_ns: Optional[int] = None
 
     # ---- serving ----------------------------------------------------------------------
     def attach(self, bus: _core.Bus) -> "Cia402Sim":
@@ -141,6 +154,7 @@ class Cia402Sim:
             raise _core.InvalidArgument(f"cia402 sim {self.node_id}: already attached")
         self.node = _core.LocalNode(bus, self.node_id, self.od)
         self.heartbeat = _core.HeartbeatService(self.node, consumer_entries=4, producer_ms=self._heartbeat_ms)
+        self.pdo = _core.PdoService(self.node, rpdos=4, tpdos=4)
         self.heartbeat.set_lost_callback(self._master_lost)
         return self
 
@@ -176,7 +190,7 @@ class Cia402Sim:
             od.add_record(index, name)
         for (index, sub, name, dtype, access, default, low, high, *_rest) in OBJECTS:
             self._values[(index, sub)] = default
-            kwargs = dict(access=access, default=default)
+            kwargs = dict(access=access, default=default, pdo_mappable=index in _MAPPABLE)
             if low is not None:
                 kwargs.update(low=low, high=high)
             if index in records:
@@ -187,9 +201,9 @@ class Cia402Sim:
                 var.set_read_hook(self._reader(index, sub, dtype))
                 if access != "ro":
                     var.set_write_hook(self._writer(index, sub, dtype))
-        cw = od.add_variable(0x6040, "Controlword", "U16", default=0)
+        cw = od.add_variable(0x6040, "Controlword", "U16", default=0, pdo_mappable=True)
         cw.set_write_hook(lambda var, data: self._controlword(int.from_bytes(data, "little")))
-        sw = od.add_variable(0x6041, "Statusword", "U16", access="ro", default=0)
+        sw = od.add_variable(0x6041, "Statusword", "U16", access="ro", default=0, pdo_mappable=True)
         sw.set_read_hook(lambda var, current: self._statusword().to_bytes(2, "little"))
         od.add_record(0x1010, "Store parameters", array=True)
         store = od.add_member(0x1010, 1, "Save all parameters", "U32", default=1)
@@ -302,6 +316,7 @@ class Cia402Sim:
         if self._pp is None or not self.motor.moving or self._activity != "pp":
             self._pp = _core.Cia402ProfilePosition(self._params(), self.motor.pulse_position)
             self._pp_t0 = self.clock.now()
+        self.last_setpoint_ns = self.clock.now()
         self._pp.new_setpoint(self._now_s(), target, relative=bool(cw & _CW_RELATIVE),
                               change_immediately=bool(cw & _CW_IMMEDIATE))
         self.motor.command(self._pp.profile, start_ns=self._pp_t0)
@@ -483,6 +498,11 @@ class Cia402Drive(Drive):
         super().__init__(host, units=units, on_error=on_error, on_exit=on_exit, close_native=close_native)
         self._sdo = host.sdo
         self._mode: Optional[int] = None
+        # A synchronised start in progress: the bus its SYNC comes on, and the controlword
+        # (without the set-point bit) of the move held in the RPDO until then.
+        self._sync_bus: Optional[_core.Bus] = None
+        self._held_cw: Optional[int] = None
+        self._sync_rpdo_cob: Optional[int] = None
 
     # ---- helpers ----
     def _u32(self, index: int, value: float) -> None:
@@ -514,6 +534,9 @@ class Cia402Drive(Drive):
         self._use_mode(OpMode.PROFILE_POSITION)
         if velocity is not None:
             self._u32(0x6081, velocity)  # stays the profile velocity for later moves too
+        if self._sync_bus is not None:
+            self._hold_set_point(int(round(target)), relative)
+            return
         try:
             self.native.move_to(int(round(target)), relative=relative)
         except _core.TimeoutError:
@@ -521,6 +544,45 @@ class Cia402Drive(Drive):
             # say that rather than "timeout" (checked only on failure: it costs an SDO read).
             self._refused("move")
             raise
+
+    # ---- SYNC-triggered start (see synchronised_start) ----
+    def _arm_sync_start(self, bus: _core.Bus) -> None:
+        """Maps RPDO SYNC_START_RPDO (once): synchronous (type 1), target position then
+        controlword — in that order, because the drive applies the entries in mapping order
+        and the set-point edge must find the new target already written.  Starts the node
+        (NMT): PDOs flow only in OPERATIONAL."""
+        node = self.native.node
+        if self._sync_rpdo_cob is None:
+            _core.pdo_write_config(self._sdo, node, False, SYNC_START_RPDO, transmission_type=1,
+                                   mapping=[(0x607A, 0, 32), (0x6040, 0, 16)])
+            self._sync_rpdo_cob = _core.pdo_read_config(self._sdo, node, False, SYNC_START_RPDO).cob_id
+        bus.send(_core.Frame(0x000, bytes([0x01, node])))   # NMT start remote node
+        self._sync_bus = bus
+
+    def _hold_set_point(self, target: int, relative: bool) -> None:
+        base = int(Controlword.ENABLE_OPERATION) | _CW_IMMEDIATE | (_CW_RELATIVE if relative else 0)
+        # As in an SDO move: the previous acknowledge must have dropped for the edge to count.
+        self.native.wait_statusword(_SW_BIT12, 0)
+        self._sync_bus.send(_core.Frame(self._sync_rpdo_cob, struct.pack("<iH", target, base | _CW_NEW_SETPOINT)))
+        self._held_cw = base
+
+    def _release_sync_start(self, started: bool) -> None:
+        """After the SYNC (``started``): completes the set-point handshake.  Without it (the
+        block failed): overwrites the held RPDO with one that carries no set-point edge, so a
+        later SYNC from anyone starts nothing."""
+        bus, base = self._sync_bus, self._held_cw
+        self._sync_bus = self._held_cw = None
+        if base is None:
+            return
+        if not started:
+            bus.send(_core.Frame(self._sync_rpdo_cob, struct.pack("<iH", self._read_i32(0x607A), base)))
+            return
+        try:
+            self.native.wait_statusword(_SW_BIT12, _SW_BIT12)
+        except _core.TimeoutError:
+            self._refused("move")
+            raise
+        self.native.write_controlword(base)
 
     def _refused(self, what: str) -> None:
         state = self.native.state
@@ -622,6 +684,33 @@ class Cia402Drive(Drive):
         self.native.start_watchdog(host_node, period, **kwargs)
 
 
+#: The RPDO a synchronised start maps on each drive (its previous mapping is replaced).
+SYNC_START_RPDO = 4
+
+
+@contextlib.contextmanager
+def synchronised_start(bus: _core.Bus, drives: Sequence[Cia402Drive]) -> Iterator[str]:
+    """Moves commanded inside the block start together on one CANopen SYNC.
+
+    Each drive gets its set-point (target position and the controlword with the
+    new-set-point bit) in a synchronous RPDO (type 1, RPDO ``SYNC_START_RPDO``), which a
+    CiA 301 device holds until the next SYNC; when the block exits one SYNC frame on
+    ``bus`` makes every drive apply it, so all start on the same frame.  The handshake is
+    then completed over SDO as for any move.  If the block fails, the held RPDOs are
+    overwritten with ones that start nothing.  Yields the method's name."""
+    for d in drives:
+        d._arm_sync_start(bus)
+    try:
+        yield "CANopen SYNC"
+    except BaseException:
+        for d in drives:
+            d._release_sync_start(started=False)
+        raise
+    bus.send(_core.Frame(0x080, b""))       # SYNC (COB-ID 0x080): every held RPDO applies now
+    for d in drives:
+        d._release_sync_start(started=True)
+
+
 def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Units] = None,
          timeout: float = 1.0, on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop",
          watchdog: Optional[dict] = None) -> Cia402Drive:  # noqa: A001 - the plugin's verb
@@ -655,4 +744,5 @@ PLUGIN = DrivePlugin(
     sim_options=("steps_per_rev", "home", "minus_limit", "plus_limit", "heartbeat_ms", "start_position"),
     # Any node whose device type (0x1000) names profile 402; vendor kinds score higher.
     canopen_match=lambda node: 1 if node.profile == 402 else 0,
+    synchronised_start=synchronised_start,
 )
