@@ -97,6 +97,9 @@ def cmd_move(args: argparse.Namespace) -> int:
         if not d.status.enabled:
             d.enable()
         move = d.move_by if args.by else d.move_to
+        # On stderr, so stdout stays the one result line scripts read.
+        print(f"{args.axis}: moving {'by' if args.by else 'to'} {_fmt(args.position)} {d.units.name} "
+              "(Ctrl-C stops the axis)", file=sys.stderr, flush=True)
         rc = _interruptible(d, lambda: move(args.position, velocity=args.velocity, timeout=args.timeout))
         _say(f"{args.axis}: {_fmt(d.position)} {d.units.name}")
         return rc

@@ -281,7 +281,9 @@ def test_ctrl_c_during_a_cli_move_stops_the_axis(tmp_path):
     child = subprocess.Popen([sys.executable, "-m", "motorbus", "move", str(p), "x", "100", "--sim"],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                              preexec_fn=sigint_default)   # a background test run ignores SIGINT
-    time.sleep(1.5)   # the bench is up and the move (40 000 steps at 1 000 steps/s) under way
+    # The bench is up and the move (40 000 steps at 1 000 steps/s) under way once it says so.
+    assert child.stderr.readline().startswith("x: moving to 100 mm")
+    time.sleep(0.3)
     assert child.poll() is None
     child.send_signal(signal.SIGINT)
     out, err = child.communicate(timeout=20)
