@@ -45,6 +45,12 @@ bool parse_double(std::string_view s, double& out) {
     return end == tmp.c_str() + tmp.size() && std::isfinite(out);
 }
 
+// A log time (seconds) this library reads: one whose "%.6f" form it can read back
+// (|t| < 1e18 s writes at most 26 characters; the reader takes 40).
+bool parse_log_time(std::string_view s, double& out) {
+    return parse_double(s, out) && std::fabs(out) < 1e18;
+}
+
 std::vector<std::string_view> split_ws(std::string_view line) {
     std::vector<std::string_view> parts;
     std::size_t i = 0;
@@ -148,7 +154,7 @@ std::optional<LogEntry> parse_candump_line(std::string_view line) {
     if (p.size() != 3 && p.size() != 4) return std::nullopt;
     LogEntry e;
     if (p[0].size() < 3 || p[0].front() != '(' || p[0].back() != ')') return std::nullopt;
-    if (!parse_double(p[0].substr(1, p[0].size() - 2), e.time)) return std::nullopt;
+    if (!parse_log_time(p[0].substr(1, p[0].size() - 2), e.time)) return std::nullopt;
     // An interface name is printable text: a control byte (NUL, ESC...) inside it
     // would not survive being written back (found by fuzz_can_log at 3.4 M runs).
     for (char c : p[1])
@@ -193,9 +199,21 @@ std::optional<LogEntry> parse_candump_line(std::string_view line) {
 }
 
 std::string format_candump_line(const LogEntry& e) {
-    char head[64];
-    std::snprintf(head, sizeof head, "(%.6f) %s ", e.time, e.channel.c_str());
-    std::string s = head;
+    // No fixed-size buffer: a long interface name or a huge time must be written whole
+    // (a 64-byte buffer cut both, and the line then read back as another frame —
+    // found by fuzz_can_log at 4.3 M runs).
+    char time[32];
+    const int n = std::snprintf(time, sizeof time, "(%.6f) ", e.time);
+    std::string s;
+    if (n >= 0 && static_cast<std::size_t>(n) < sizeof time) {
+        s = time;
+    } else {
+        s.resize(static_cast<std::size_t>(std::max(n, 0)) + 1);
+        std::snprintf(s.data(), s.size(), "(%.6f) ", e.time);
+        s.pop_back();  // the NUL snprintf wrote
+    }
+    s += e.channel;
+    s += ' ';
     s += e.frame.to_string();
     if (e.frame.rtr && e.frame.len == 0) s.pop_back();  // "123#R" not "123#R0"
     s += e.rx ? " R" : " T";

@@ -48,6 +48,26 @@ TEST(CandumpLog, ControlBytesInTheInterfaceNameAreRefused) {
     EXPECT_TRUE(parse_candump_line("(5) can0 123#00"s));
 }
 
+TEST(CandumpLog, LongInterfaceNamesAndHugeTimesAreWrittenWhole) {
+    // fuzz_can_log at 4.3 M runs: a 64-character interface name was cut by a fixed
+    // buffer, and the written line read back as another frame.
+    const std::string name(64, 'p');
+    for (double t : {0.0, 9.9e17}) {
+        LogEntry e{Frame::make(0x1EC, std::vector<std::uint8_t>{0xEC}), t, name, true};
+        auto line = format_candump_line(e);
+        EXPECT_NE(line.find(" " + name + " 1EC#EC R"), std::string::npos) << line;
+        auto back = parse_candump_line(line);
+        ASSERT_TRUE(back) << line;
+        EXPECT_EQ(back->channel, name);
+        EXPECT_EQ(back->time, t);
+        EXPECT_TRUE(back->frame.same_content(e.frame));
+    }
+    // Times beyond what a log can hold are refused when read (and still written whole).
+    EXPECT_FALSE(parse_candump_line("(1e300) can0 123#00"));
+    LogEntry huge{Frame::make(0x123, std::vector<std::uint8_t>{0}), 1e300, "can0", true};
+    EXPECT_NE(format_candump_line(huge).find(".000000) can0 123#00 R"), std::string::npos);
+}
+
 TEST(CandumpLog, FormatRoundTrip) {
     LogEntry e{Frame::make(0x7FF, std::vector<std::uint8_t>{1, 2}), 12.25, "can0", false};
     EXPECT_EQ(format_candump_line(e), "(12.250000) can0 7FF#0102 T");
