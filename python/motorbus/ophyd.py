@@ -30,6 +30,7 @@ from typing import Any, Mapping, Optional
 
 try:
     from ophyd_async.core import (
+        AsyncStatus,
         MovableLogic,
         StandardMovable,
         StandardReadable,
@@ -151,8 +152,8 @@ class MotorbusMotor(StandardReadable, StandardMovable[float]):
             return (await _call(lambda: drive.travel_limits))[1]
 
         with self.add_children_as_readables(StandardReadableFormat.HINTED_SIGNAL):
-            self.user_readback, self._publish_position = soft_signal_r_and_setter(float, units=units, precision=precision,
-                                                             getter=position, poll_period=POLL_PERIOD)
+            self.user_readback, self._publish_position = soft_signal_r_and_setter(
+                float, drive.position, units=units, precision=precision, getter=position, poll_period=POLL_PERIOD)
         with self.add_children_as_readables(StandardReadableFormat.CONFIG_SIGNAL):
             self.velocity = soft_signal_rw(float, float(velocity), units=f"{units}/s")
             self.low_limit_travel, _ = soft_signal_r_and_setter(float, units=units, getter=low)
@@ -162,6 +163,13 @@ class MotorbusMotor(StandardReadable, StandardMovable[float]):
         self.user_setpoint = soft_signal_rw(float, drive.position, units=units, precision=precision)
         self.actual_velocity, _ = soft_signal_r_and_setter(float, units=f"{units}/s", getter=speed)
         super().__init__(name=name)
+
+    @AsyncStatus.wrap
+    async def stage(self) -> None:
+        await super().stage()
+        # Staged, user_readback reads its monitor's cache, which starts from the last
+        # value seen: give it the position now, not the one of the last read.
+        self._publish_position(await _call(lambda: self.drive.position))
 
     @cached_property
     def movable_logic(self) -> _DriveMoveLogic:
