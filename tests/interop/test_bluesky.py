@@ -27,6 +27,7 @@ from ophyd_async.plan_stubs import ensure_connected  # noqa: E402
 
 import motorbus  # noqa: E402
 from motorbus import Bench, registry  # noqa: E402
+from motorbus.drives.arcus import ArcusMotorDisabled  # noqa: E402
 from motorbus.ophyd import MotorbusMotor, MoveLimitError, devices_from_bench  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
@@ -238,7 +239,7 @@ def test_stop_on_the_device_stops_the_axis(bench, motors):
         drive.params["0x6081"] = 20000
 
 
-@pytest.mark.parametrize("axis,error", [("arcus", motorbus.DriveFault), ("cia402", motorbus.DriveFault)])
+@pytest.mark.parametrize("axis,error", [("arcus", ArcusMotorDisabled), ("cia402", motorbus.DriveFault)])
 def test_a_move_the_drive_refuses_fails_the_status_with_its_error(bench, motors, RE, axis, error):
     m = motors[axis]
     RE(ensure_connected(m))
