@@ -266,6 +266,10 @@ class Drive(abc.ABC):
     def _is_idle(self) -> bool:
         return not self._status().moving
 
+    def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
+        """The soft travel limits the drive itself enforces now, native units (None: no limit that side)."""
+        return (None, None)
+
     def _make_params(self) -> Params:
         return Params(self)
 
@@ -388,6 +392,17 @@ class Drive(abc.ABC):
     @property
     def units(self) -> Units:
         return self._units
+
+    @property
+    def travel_limits(self) -> tuple[float, float]:
+        """``(low, high)`` in user units: the soft limits the drive enforces now, read from it;
+        ``-inf`` / ``inf`` on a side where it has none (most kinds have none at all)."""
+        self._check_open()
+        lo, hi = self._travel_limits()
+        sign = 1.0 if self._units.scale > 0 else -1.0   # a negative scale swaps the ends
+        a = -math.inf * sign if lo is None else self._units.to_user(lo)
+        b = math.inf * sign if hi is None else self._units.to_user(hi)
+        return (min(a, b), max(a, b))
 
     @property
     def params(self) -> Params:

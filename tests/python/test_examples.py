@@ -124,3 +124,12 @@ def test_example_07_pmc007_cpp():
     assert "6001h=0x08" in out
     assert "position 3200 busy 0" in out
     assert "after the program: position 1700 counter 3" in out
+
+
+def test_example_10_bluesky_scan_python():
+    import pytest
+    pytest.importorskip("ophyd_async")
+    pytest.importorskip("bluesky")
+    out = run_example("10_bluesky_scan.py")
+    assert out.splitlines() == [f"event {i + 1}: x={i:.2f} z=2.50" for i in range(5)] + \
+        ["run: success", "x stands at 4.00 mm"]

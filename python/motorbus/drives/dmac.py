@@ -540,6 +540,12 @@ class DmacDrive(Drive):
         # At rest, not merely at the target speed (BUSY ends there in velocity mode).
         return DmacStatus.MOVEMENT not in self.native.status
 
+    def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
+        # The soft end-stops bind only while SOFT_ENDS ON is in force (#STATUS bit 7).
+        if DmacStatus.SOFT_ENDS_ENABLED not in self.native.status:
+            return (None, None)
+        return (float(self.native.read("#NEGATIVE_END")), float(self.native.read("#POSITIVE_END")))
+
     def _status(self) -> DriveStatus:
         st = self.native.status
         err = DmacErrorWord(int(self.native.error)) if DmacStatus.ERROR in st else DmacErrorWord(0)
