@@ -28,7 +28,7 @@ from typing import Any, Optional, Union
 
 from .. import _core
 from ..canopen.cia402 import Cia402, Controlword, OpMode
-from ..drive import Capability, DriveStatus, ParamInfo, Params, Units
+from ..drive import Capability, ParamInfo, Params, Units
 from ..registry import DrivePlugin
 from . import arcus as _arcus
 from .cia402 import Cia402Drive
@@ -415,21 +415,12 @@ class ArcusCanopenDrive(Cia402Drive):
     def _store(self) -> None:
         self.native.store()
 
-    def _status(self) -> DriveStatus:
-        sw = self.native.statusword
-        state = _core.cia402_decode_statusword(sw)
-        inputs = self.native.read(0x60FD)
-        velocity = self._velocity()
-        mode = self._mode
-        fault = state in ("FAULT", "FAULT REACTION ACTIVE")
-        at_target = bool(sw & _SW_TARGET_REACHED)
-        homed = mode == OpMode.HOMING and bool(sw & _SW_BIT12)
-        self._homed = getattr(self, "_homed", False) or homed
-        text = (f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}, "
+    def _digital_inputs(self) -> int:
+        return int(self.native.read(0x60FD))
+
+    def _status_text(self, state: str, mode: Optional[int], sw: int, fault: bool) -> str:
+        return (f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}, "
                 f"StepNLoop {self._snl_text()}")
-        return DriveStatus(enabled=state == "OPERATION ENABLED", moving=velocity != 0 or not at_target,
-                           homed=self._homed, fault=fault, at_target=at_target,
-                           limit_positive=bool(inputs & 2), limit_negative=bool(inputs & 1), raw=sw, text=text)
 
     def _make_params(self) -> Params:
         return ArcusCanopenParams(self)

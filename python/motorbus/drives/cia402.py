@@ -651,19 +651,28 @@ class Cia402Drive(Drive):
     def _velocity(self) -> float:
         return float(self._read_i32(0x606C))
 
+    def _digital_inputs(self) -> int:
+        """60FDh (bit 0 negative limit, bit 1 positive limit)."""
+        return int.from_bytes(self._sdo.upload(0x60FD, 0), "little")
+
+    def _status_text(self, state: str, mode: Optional[int], sw: int, fault: bool) -> str:
+        """The status line; a vendor kind adds what its drive says beyond CiA 402."""
+        text = f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}"
+        if fault:
+            text += f", error 0x{self._read_u16(0x603F):04X}"
+        return text
+
     def _status(self) -> DriveStatus:
         sw = self.native.statusword
         state = _core.cia402_decode_statusword(sw)
-        inputs = int.from_bytes(self._sdo.upload(0x60FD, 0), "little")
+        inputs = self._digital_inputs()
         velocity = self._velocity()
         mode = self._mode
         fault = state in ("FAULT", "FAULT REACTION ACTIVE")
         at_target = bool(sw & _SW_TARGET_REACHED)
         homed = mode == OpMode.HOMING and bool(sw & _SW_BIT12)
         self._homed = getattr(self, "_homed", False) or homed
-        text = f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}"
-        if fault:
-            text += f", error 0x{self._read_u16(0x603F):04X}"
+        text = self._status_text(state, mode, sw, fault)
         return DriveStatus(enabled=state == "OPERATION ENABLED", moving=velocity != 0 or not at_target,
                            homed=self._homed, fault=fault, at_target=at_target,
                            limit_positive=bool(inputs & 2), limit_negative=bool(inputs & 1), raw=sw, text=text)
