@@ -11,25 +11,9 @@ python-can's virtual bus dominate both sides).
 from __future__ import annotations
 
 import argparse
-import time
 
+from helpers.timing import rate  # bench/helpers: shared by the benchmarks
 
-def _percentile(v, p):
-    v = sorted(v)
-    return v[min(len(v) - 1, int(len(v) * p))]
-
-
-def _rate(fn, seconds):
-    lat = []
-    t_end = time.perf_counter() + seconds
-    while True:
-        t = time.perf_counter()
-        fn()
-        t2 = time.perf_counter()
-        lat.append((t2 - t) * 1e6)
-        if t2 >= t_end:
-            break
-    return len(lat) / (sum(lat) / 1e6), _percentile(lat, 0.5), _percentile(lat, 0.99)
 
 
 def main() -> None:
@@ -51,7 +35,7 @@ def main() -> None:
     net.connect(interface="virtual", channel="bench-pmc007-sdo")
     remote = net.add_node(5, pmc007.EDS_PATH)
     assert remote.sdo.upload(0x6006, 0) == (400).to_bytes(2, "little")
-    ours = _rate(lambda: remote.sdo.upload(0x6005, 0), a.seconds)
+    ours = rate(lambda: remote.sdo.upload(0x6005, 0), a.seconds)
     net.disconnect()
     sim.close()
     bus.close()
@@ -63,7 +47,7 @@ def main() -> None:
     local = canopen.LocalNode(5, pmc007.EDS_PATH)
     server.add_node(local)
     remote = client.add_node(5, pmc007.EDS_PATH)
-    ref = _rate(lambda: remote.sdo.upload(0x6005, 0), a.seconds)
+    ref = rate(lambda: remote.sdo.upload(0x6005, 0), a.seconds)
     client.disconnect()
     server.disconnect()
 

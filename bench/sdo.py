@@ -13,28 +13,12 @@ import argparse
 import threading
 import time
 
+from helpers.timing import rate  # bench/helpers: shared by the benchmarks
+
 DOMAIN_MAX = 1 << 20
 NODES = 8              # expedited_rate_8_nodes: served nodes = client threads
 DEVICE_TYPE = 0x00020192
 
-
-def _percentile(v, p):
-    v = sorted(v)
-    return v[min(len(v) - 1, int(len(v) * p))]
-
-
-def _rate(fn, seconds):
-    """Calls fn until `seconds` passed; returns (calls/s, median us, p99 us)."""
-    lat = []
-    t_end = time.perf_counter() + seconds
-    while True:
-        t = time.perf_counter()
-        fn()
-        t2 = time.perf_counter()
-        lat.append((t2 - t) * 1e6)
-        if t2 >= t_end:
-            break
-    return len(lat) / sum(lat) * 1e6, _percentile(lat, 0.5), _percentile(lat, 0.99)
 
 
 def _throughput(fn, nbytes, seconds):
@@ -101,7 +85,7 @@ def ours(seconds):
     seg = bytes(range(256)) * 16        # 4 KiB
     blk = bytes(range(256)) * 256       # 64 KiB
     r = {}
-    r["expedited_rate"], r["expedited_median_us"], r["expedited_p99_us"] = _rate(lambda: sdo.read_u32(0x2000), seconds)
+    r["expedited_rate"], r["expedited_median_us"], r["expedited_p99_us"] = rate(lambda: sdo.read_u32(0x2000), seconds)
     od[0x2001].raw = seg
     r["segmented_upload_Bps"] = _throughput(lambda: sdo.upload(0x2001, 0), len(seg), seconds)
     r["segmented_download_Bps"] = _throughput(lambda: sdo.download(0x2001, 0, seg, segmented=True), len(seg), seconds)
@@ -166,7 +150,7 @@ def reference(seconds):
     seg = bytes(range(256)) * 16
     blk = bytes(range(256)) * 256
     r = {}
-    r["expedited_rate"], r["expedited_median_us"], r["expedited_p99_us"] = _rate(
+    r["expedited_rate"], r["expedited_median_us"], r["expedited_p99_us"] = rate(
         lambda: remote.sdo.upload(0x2000, 0), seconds)
     local.sdo.download(0x2001, 0, seg)
     r["segmented_upload_Bps"] = _throughput(lambda: remote.sdo.upload(0x2001, 0), len(seg), seconds)
