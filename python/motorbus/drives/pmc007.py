@@ -124,6 +124,11 @@ def _check_node(address: Union[str, int]) -> str:
     return str(node)
 
 
+def _object_property(name: str, doc: str) -> property:
+    """A read/write property over one integer object of the table (read and written by SDO)."""
+    return property(lambda self: int(self.read(name)), lambda self, value: self.write(name, value), doc=doc)
+
+
 class Pmc007:
     """The native client: named SDO access to every object of one PMC007 node.
 
@@ -222,38 +227,10 @@ class Pmc007:
         return bool(self.controller_status & ControllerStatus.BUSY)
 
     # ---- motion ----
-    @property
-    def position(self) -> int:
-        return int(self.read("motor_position"))
-
-    @position.setter
-    def position(self, steps: int) -> None:
-        self.write("motor_position", steps)
-
-    @property
-    def speed(self) -> int:
-        """6003h: signed run speed, pps (+ sets direction 1, - direction 0)."""
-        return int(self.read("maximum_speed"))
-
-    @speed.setter
-    def speed(self, pps: int) -> None:
-        self.write("maximum_speed", pps)
-
-    @property
-    def direction(self) -> int:
-        return int(self.read("rotation_direction"))
-
-    @direction.setter
-    def direction(self, d: int) -> None:
-        self.write("rotation_direction", d)
-
-    @property
-    def microstepping(self) -> int:
-        return int(self.read("microstepping"))
-
-    @microstepping.setter
-    def microstepping(self, m: int) -> None:
-        self.write("microstepping", m)
+    position = _object_property("motor_position", "600Ch: motor position, steps (writable: sets the counter)")
+    speed = _object_property("maximum_speed", "6003h: signed run speed, pps (+ sets direction 1, - direction 0)")
+    direction = _object_property("rotation_direction", "6002h: rotation direction, 0 or 1")
+    microstepping = _object_property("microstepping", "600Ah: microsteps per full step")
 
     @property
     def enabled(self) -> bool:
