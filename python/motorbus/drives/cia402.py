@@ -733,6 +733,14 @@ def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Uni
     return drive
 
 
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+SIM_FAULTS = {
+    # the drive detects a fault (an error code, default 0x5441 interlock): motor stops, state FAULT
+    "drive_fault": lambda sim, code=0x5441: sim.inject_fault(int(code)),
+    # the rotor jams: the motor model's position no longer follows the profile
+    "stall": lambda sim: sim.motor.set_jammed(True),
+}
+
 PLUGIN = DrivePlugin(
     kind="cia402",
     description="any CiA 402 drive on CANopen (profile position, profile velocity, homing); simulated generically",
@@ -745,4 +753,5 @@ PLUGIN = DrivePlugin(
     # Any node whose device type (0x1000) names profile 402; vendor kinds score higher.
     canopen_match=lambda node: 1 if node.profile == 402 else 0,
     synchronised_start=synchronised_start,
+    sim_faults=SIM_FAULTS,
 )
