@@ -737,8 +737,7 @@ def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Uni
 SIM_FAULTS = {
     # the drive detects a fault (an error code, default 0x5441 interlock): motor stops, state FAULT
     "drive_fault": lambda sim, code=0x5441: sim.inject_fault(int(code)),
-    # the rotor jams: the motor model's position no longer follows the profile
-    "stall": lambda sim: sim.motor.set_jammed(True),
+    # (no "stall": the generic simulator reports the commanded position, a jam would not show)
 }
 
 PLUGIN = DrivePlugin(

@@ -746,7 +746,7 @@ SIM_FAULTS = {
     "supply_drop": lambda sim: sim.inject_error(1),
     # any error-status bits (ErrorStatus), e.g. 0x20 = over-temperature shutdown
     "error": lambda sim, bits=1: sim.inject_error(int(bits)),
-    # the rotor jams while the pulses go out
+    # a load blocks the rotor: with stall detection set up (6017h) the drive reports it
     "stall": lambda sim: sim.set_jammed(True),
 }
 
