@@ -73,6 +73,7 @@ class BenchSession:
         self.explicit = bool(real or sim)
         self.bench: Any = None
         self.identities: dict[str, dict] = {}
+        self.open_error: Optional[BaseException] = None
         self.reopen = False            # a test spoilt the twin (sim_faults): the next test gets a fresh one
         self._lock = threading.Lock()
 
@@ -83,13 +84,21 @@ class BenchSession:
 
     def get(self) -> Any:
         with self._lock:
+            if self.open_error is not None:
+                # A bench that did not open once (a wrong file, hardware switched off)
+                # fails the tests that need it at once instead of timing out in each.
+                raise self.open_error
             if self.bench is None:
                 from .bench import Bench
 
-                if self.path is None:
-                    self.bench = Bench.from_dict(default_bench(), sim=True)
-                else:
-                    self.bench = Bench.load(self.path, sim=self.simulated)
+                try:
+                    if self.path is None:
+                        self.bench = Bench.from_dict(default_bench(), sim=True)
+                    else:
+                        self.bench = Bench.load(self.path, sim=self.simulated)
+                except Exception as e:
+                    self.open_error = e
+                    raise
                 self.reopen = False
                 self.identities = identify(self.bench)
             return self.bench
@@ -155,6 +164,7 @@ def identify(bench: Any) -> dict[str, dict]:
                     from .discovery import _node_identity
 
                     entry.update(_node_identity(found[0]))
+                    entry.update(_canopen_strings(bench.buses[cfg.bus], node))
                 else:
                     entry["identity"] = "no answer"
             elif plugin.probe is not None:
@@ -165,6 +175,30 @@ def identify(bench: Any) -> dict[str, dict]:
         except Exception as e:  # noqa: BLE001 - the report says why instead of failing the run
             entry["identity"] = f"unreadable: {type(e).__name__}: {e}"
         out[name] = {k: (v if isinstance(v, (str, int, float, bool)) else str(v)) for k, v in entry.items()}
+    return out
+
+
+_CANOPEN_STRINGS = ((0x1008, "model"), (0x1009, "hardware"), (0x100A, "firmware"))
+
+
+def _canopen_strings(bus: Any, node: int) -> dict:
+    """CiA 301's optional name and versions (0x1008/0x1009/0x100A), those the node has."""
+    from . import _core
+
+    out = {}
+    sdo = _core.SdoClient(bus, node, timeout=0.3)
+    try:
+        for index, key in _CANOPEN_STRINGS:
+            try:
+                text = sdo.read_string(index, 0).strip("\0 ")
+            except _core.MotorbusError:    # the object is optional: an abort says the node has none
+                continue
+            if text:
+                out[key] = text
+    finally:
+        close = getattr(sdo, "close", None)
+        if close is not None:
+            close()
     return out
 
 

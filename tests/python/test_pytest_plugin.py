@@ -151,6 +151,7 @@ def test_fixtures_on_every_kind_with_bench_sim(pytester, every_kind):
     assert json.loads(props["motorbus_axis_arcus"])["firmware"]          # the serial probes' firmware
     assert json.loads(props["motorbus_axis_dmac"])["firmware"]
     assert json.loads(props["motorbus_axis_cia402"])["device_type"] & 0xFFFF == 402   # CANopen 0x1000
+    assert json.loads(props["motorbus_axis_pmc007"])["firmware"]        # CANopen 0x100A, where the node has it
 
 
 @pytest.mark.subprocess
@@ -479,3 +480,13 @@ def test_ctrl_c_stops_every_axis(pytester, served):
             proc.communicate()
     assert proc.returncode == pytest.ExitCode.INTERRUPTED and "KeyboardInterrupt" in out, out
     assert served.moving() == []
+
+
+@pytest.mark.subprocess
+def test_a_bench_that_does_not_open_errors_each_test_with_the_reason(pytester, tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[axis.x]\nkind = "arcus"\nline = "nowhere"\naddress = 1\n')
+    pytester.makepyfile(test_bad="def test_a(bench): pass\ndef test_b(axis): pass\ndef test_c(): pass\n")
+    result = _run(pytester, "--bench-sim", str(bad))
+    result.assert_outcomes(passed=1, errors=2)
+    assert result.stdout.str().count("bad.toml:3: axis.x.line") >= 2, result.stdout.str()
