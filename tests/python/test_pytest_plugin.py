@@ -168,6 +168,13 @@ def test_default_bench_is_one_axis_of_every_registered_kind(pytester):
 
 
 @pytest.mark.subprocess
+def test_the_example_module_runs_on_the_default_twin(pytester):
+    example = Path(__file__).resolve().parents[2] / "examples" / "10_pytest_bench.py"
+    pytester.makepyfile(test_example=example.read_text())
+    _run(pytester, "--bench-sim", "-v").assert_outcomes(passed=8)
+
+
+@pytest.mark.subprocess
 def test_ini_option_names_the_default_bench(pytester, every_kind):
     path, axes = every_kind
     pytester.makeini(f"[pytest]\nmotorbus_bench = {path}\n")
