@@ -120,8 +120,13 @@ class BenchSession:
         if failed:
             for name, e in failed.items():
                 problems.append(f"{name}: stop: {type(e).__name__}: {e}")
-            for name, e in bench.stop_all("quick_stop"):
-                if name in failed:
+            for name in failed:        # the harder stop, for those axes only
+                drive = bench.axes[name]
+                if drive.closed:
+                    continue
+                try:
+                    drive.quick_stop()
+                except Exception as e:  # noqa: BLE001 - the others must still be tried
                     problems.append(f"{name}: quick_stop: {type(e).__name__}: {e}")
         return problems
 

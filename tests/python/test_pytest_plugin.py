@@ -497,3 +497,26 @@ def test_a_bench_that_does_not_open_errors_each_test_with_the_reason(pytester, t
     result = _run(pytester, "--bench-sim", str(bad))
     result.assert_outcomes(passed=1, errors=2)
     assert result.stdout.str().count("bad.toml:3: axis.x.line") >= 2, result.stdout.str()
+
+
+@pytest.mark.subprocess
+def test_an_axis_that_does_not_come_to_rest_gets_quick_stop_and_the_report_says_so(pytester, every_kind):
+    path, _ = every_kind
+    pytester.makepyfile(test_stuck="""
+        import motorbus
+
+        def test_stuck(monkeypatch, bench):   # bench torn down first: while the patches hold
+            d = bench["arcus"]
+            calls = []
+            def never_idle(timeout=None):
+                raise motorbus.TimeoutError("still moving (test)")
+            monkeypatch.setattr(d, "wait_idle", never_idle, raising=False)
+            monkeypatch.setattr(d, "quick_stop", lambda: calls.append("quick_stop"), raising=False)
+            d.__dict__["calls"] = calls
+
+        def test_quick_stop_was_used(bench):
+            assert bench["arcus"].__dict__["calls"] == ["quick_stop"]
+    """)
+    result = _run(pytester, "--bench-sim", path, "-rA", "--junitxml=report.xml")
+    result.assert_outcomes(passed=2)
+    assert "arcus: stop: TimeoutError: still moving (test)" in (pytester.path / "report.xml").read_text()
