@@ -360,15 +360,19 @@ def bus(request: pytest.FixtureRequest, bench: Any) -> Any:
 
 @pytest.fixture
 def poller(request: pytest.FixtureRequest, bench: Any, tmp_path: Path) -> Any:
-    """A running ``motorbus.Poller`` over the test's axes (the ``axes`` marker's, or
-    every axis) at the ini ``motorbus_poll_rate``; its samples are saved next to the
+    """A running ``motorbus.Poller`` over the test's axes (the ``axes`` marker's, else
+    the ``axis`` fixture's, else every axis) at the ini ``motorbus_poll_rate``; its samples are saved next to the
     test (``tmp_path / "motorbus-samples.npz"``) and named in the report."""
     import motorbus
 
     poller_cls = getattr(motorbus, "Poller", None)
     if poller_cls is None:
         pytest.skip("motorbus.Poller is not available in this motorbus (poller fixture)")
-    names = _wanted_axes(request) or tuple(bench.axes)
+    names = _wanted_axes(request)
+    if not names and "axis" in request.fixturenames:     # the test's one axis
+        drive = request.getfixturevalue("axis")
+        names = tuple(n for n, d in bench.axes.items() if d is drive)
+    names = names or tuple(bench.axes)
     rate = float(request.config.getini("motorbus_poll_rate"))
     with poller_cls({n: bench[n] for n in names}, rate_hz=rate) as p:
         try:

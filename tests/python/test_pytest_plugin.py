@@ -123,7 +123,9 @@ def test_fixtures_on_every_kind_with_bench_sim(pytester, every_kind):
         def test_unknown_axis_param(axis):
             raise AssertionError("must be skipped")
 
+        @pytest.mark.axes("arcus", "cia402")
         def test_poller(poller):
+            time.sleep(0.2)
             frame = poller.frame()
             assert frame
     """)
@@ -152,6 +154,10 @@ def test_fixtures_on_every_kind_with_bench_sim(pytester, every_kind):
     assert json.loads(props["motorbus_axis_dmac"])["firmware"]
     assert json.loads(props["motorbus_axis_cia402"])["device_type"] & 0xFFFF == 402   # CANopen 0x1000
     assert json.loads(props["motorbus_axis_pmc007"])["firmware"]        # CANopen 0x100A, where the node has it
+    if poller == "passed":      # the samples saved next to the test, named in its report
+        case = ET.fromstring(report).find(".//testcase[@name='test_poller']")
+        samples = {p.get("name"): p.get("value") for p in case.iter("property")}["motorbus_samples"]
+        assert Path(samples).stat().st_size > 0
 
 
 @pytest.mark.subprocess
