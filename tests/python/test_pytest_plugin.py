@@ -27,6 +27,11 @@ from test_hardening_bindings import sigint_default
 
 pytest_plugins = ["pytester"]
 
+# pytester puts sys.modules back as it found them after each test: a vendor module first
+# imported inside one would be imported again by a later test, its classes no longer the
+# ones the registry holds.  Load every kind now, before any snapshot.
+registry.drive_plugins()
+
 
 def _plugin_args() -> list[str]:
     """``-p motorbus.pytest_plugin`` unless the installed motorbus already declares it
