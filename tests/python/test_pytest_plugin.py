@@ -266,12 +266,20 @@ def test_sim_faults_vocabulary_per_kind_and_bench_faults(pytester, every_kind):
             with pytest.raises(motorbus.MotorbusError):
                 d.position
 
+        def test_cut_bus_loses_the_drives(bench, sim_faults):
+            d = bench["pmc007"]
+            d.position
+            sim_faults.cut_bus()
+            with pytest.raises(motorbus.MotorbusError):
+                for _ in range(3):
+                    d.position
+
         def test_unknown_line(sim_faults):
             with pytest.raises(motorbus.InvalidArgument, match="no simulated line 'rs232'"):
                 sim_faults.cut_line("rs232")
     """)
     result = _run(pytester, "--bench-sim", path, "-v")
-    result.assert_outcomes(passed=10)
+    result.assert_outcomes(passed=11)
 
 
 @pytest.mark.subprocess
