@@ -305,6 +305,10 @@ class Bench:
         self.lines: dict[str, Any] = {}
         self.sims: dict[str, Any] = {}          # axis name -> its simulator (sim=True)
         self._servers: list[Any] = []           # what serves the simulated transports
+        # sim=True: the pty server of each simulated line and the BusServers of each
+        # simulated bus, by name (fault injection cuts a line or spoils frames there)
+        self.served_lines: dict[str, Any] = {}
+        self.served_buses: dict[str, Any] = {}
         self._axes: dict[str, Drive] = {}
         self._closed = False
         try:
@@ -365,12 +369,14 @@ class Bench:
                 self.sims[a.name] = devices[-1]
             server = _core.PtyLineServer(devices=devices, baud=0)
             self._servers.append(server)
+            self.served_lines[line_name] = server
             cfg["port"] = server.slave_path
         for bus_name, cfg in self._bus_cfg.items():
             axes = [a for a in self.config.values() if a.bus == bus_name]
             served = BusServers(f"virtual:bench-sim-{os.getpid()}-{next(_sim_names)}",
                                 socketcand=["127.0.0.1:0"], channel="can0")
             self._servers.append(served)
+            self.served_buses[bus_name] = served
             for a in axes:
                 try:
                     sim = make_sim(a.kind, a.address, clock=clock, **a.sim)
@@ -566,6 +572,7 @@ class Bench:
             except Exception:  # noqa: BLE001
                 pass
         self._servers = []
+        self.served_lines, self.served_buses = {}, {}
 
     @property
     def closed(self) -> bool:

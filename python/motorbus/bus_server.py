@@ -91,6 +91,17 @@ class BusServers:
                            f"forwarded {st.forwarded}, dropped {st.forward_dropped}")
         return out
 
+    def set_faults(self, **faults: Any) -> None:
+        """Frame faults on the served bus (``VirtualBus.set_faults``: drop_every,
+        drop_probability, corrupt_probability, delay, seed) applied to every
+        endpoint this object opened, so frames in both directions suffer them:
+        requests from clients (through the servers' endpoints) and replies from
+        the simulated drives.  Only a served virtual bus can be made faulty."""
+        if self._shared is not None:
+            raise _core.InvalidArgument(f"bus {self.spec}: frame faults need a served virtual bus")
+        for b in self._buses:
+            b.set_faults(**faults)
+
     def close(self) -> None:
         for s in self.servers:
             s.close()

@@ -8,6 +8,7 @@
     motorbus drives
     motorbus demo
     motorbus status|move|home|stop|config ... BENCH [--sim]   (python/motorbus/cli_bench.py)
+    motorbus monitor BENCH [--rate HZ] [--axis NAME]... [--sim]   (python/motorbus/cli_monitor.py)
 """
 from __future__ import annotations
 
@@ -176,8 +177,9 @@ def build_parser() -> argparse.ArgumentParser:
     dl = sub.add_parser("drives", help="list the registered drive kinds")
     dl.set_defaults(func=cmd_drives)
 
-    from . import cli_bench
+    from . import cli_bench, cli_monitor
     cli_bench.add_commands(sub)
+    cli_monitor.add_commands(sub)
 
     dm = sub.add_parser("demo", help="run the simulated bench demo")
     dm.add_argument("--quick", action="store_true", help="shorter run (used by the tests)")

@@ -48,7 +48,7 @@ class DrivePlugin:
       ``canopen_match(node) -> int`` instead: a score for a node found by the
       CANopen scan (``NodeInfo``: device type, vendor id, product code...), 0 =
       not this kind; the highest score names the node's kind.
-    * ``synchronised_start(link, drives)``: see the field's comment.
+    * ``synchronised_start(link, drives)``, ``sim_faults``: see the fields' comments.
     """
 
     kind: str
@@ -72,6 +72,12 @@ class DrivePlugin:
     #: ``synchronised_start(link, drives)`` is a context manager; moves commanded
     #: inside it start together when it exits (``Bench.move_together`` uses it).
     synchronised_start: Optional[Callable[..., Any]] = None
+    #: Faults the kind's simulator can be given for robustness tests (the pytest
+    #: plugin's ``sim_faults`` fixture): ``{name: fault(sim, **options)}``, each
+    #: provoking what its name says on one simulated drive (a limit switch trips,
+    #: the rotor stalls, the supply drops...).  Names are the kind's own; the
+    #: fixture lists them when asked for one the kind does not have.
+    sim_faults: Optional[dict] = None
 
     def __post_init__(self) -> None:
         if self.transport not in ("serial", "can"):

@@ -593,6 +593,14 @@ def probe(line: "_core.LineLink", address: str) -> Optional[dict]:
         client.close()   # a shared LineLink stays open
 
 
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+SIM_FAULTS = {
+    # a limit switch closes (direction -1 or +1); the drive stops on it and latches the error
+    "trip_limit": lambda sim, direction=-1: sim.force_limit(int(direction), True),
+    # the rotor jams: pulses go out, the shaft stays (StepNLoop then reports the error)
+    "stall": lambda sim: sim.set_blocked(True),
+}
+
 PLUGIN = DrivePlugin(
     kind="arcus",
     description="Arcus DMX-CAN integrated stepper, ASCII over RS-232/RS-485 (StepNLoop closed loop)",
@@ -608,4 +616,5 @@ PLUGIN = DrivePlugin(
     probe=probe,
     probe_addresses=tuple(f"{a:02d}" for a in range(1, 100)),   # DN 01-99
     probe_bauds=(9600, 19200, 38400, 57600, 115200),              # the DB settings
+    sim_faults=SIM_FAULTS,
 )

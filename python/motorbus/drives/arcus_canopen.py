@@ -452,6 +452,12 @@ def open(*, line: Any = None, bus: Any = None, address: str = "1", units: Option
     return drive
 
 
+# The same drive as 'arcus' behind its CAN front end: the same faults.
+SIM_FAULTS = {
+    "trip_limit": lambda sim, direction=-1: sim.force_limit(int(direction), True),
+    "stall": lambda sim: sim.set_blocked(True),
+}
+
 PLUGIN = DrivePlugin(
     kind="arcus-canopen",
     description="Arcus DMX-CAN integrated stepper, CANopen CiA DSP-402 by SDO (the CAN persona of 'arcus')",
@@ -466,6 +472,7 @@ PLUGIN = DrivePlugin(
     # Discovery: profile 402 with the identity Table 10.1 gives (vendor 0, revision 112)
     # beats the generic cia402 match; any other 402 node stays cia402.
     canopen_match=lambda node: 5 if node.profile == 402 and not node.vendor_id and node.revision == 112 else 0,
+    sim_faults=SIM_FAULTS,
 )
 
 

@@ -742,6 +742,13 @@ def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Uni
     return drive
 
 
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+SIM_FAULTS = {
+    # the drive detects a fault (an error code, default 0x5441 interlock): motor stops, state FAULT
+    "drive_fault": lambda sim, code=0x5441: sim.inject_fault(int(code)),
+    # (no "stall": the generic simulator reports the commanded position, a jam would not show)
+}
+
 PLUGIN = DrivePlugin(
     kind="cia402",
     description="any CiA 402 drive on CANopen (profile position, profile velocity, homing); simulated generically",
@@ -754,4 +761,5 @@ PLUGIN = DrivePlugin(
     # Any node whose device type (0x1000) names profile 402; vendor kinds score higher.
     canopen_match=lambda node: 1 if node.profile == 402 else 0,
     synchronised_start=synchronised_start,
+    sim_faults=SIM_FAULTS,
 )

@@ -594,6 +594,14 @@ def probe(line: "_core.LineLink", address: str) -> Optional[dict]:
         client.close()
 
 
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+SIM_FAULTS = {
+    # the supply falls (mV): below the model's range the drive latches undervoltage and stops
+    "supply_drop": lambda sim, mv=11000: sim.set_supply_voltage(int(mv)),
+    # a sensor ("cpu", "driver" or "motor") heats (0.1 degC): past its threshold a thermal fault latches
+    "overheat": lambda sim, sensor="motor", tenths_c=900: sim.set_temperature(str(sensor), int(tenths_c)),
+}
+
 PLUGIN = DrivePlugin(
     kind="dmac",
     description="Midi Ingénierie DMAC17/23/34 brushless modules, ASCII protocol over RS-232/RS-485",
@@ -610,4 +618,5 @@ PLUGIN = DrivePlugin(
     probe=probe,
     probe_addresses=tuple(f"{a:02d}" for a in range(64)),   # 00-63
     probe_bauds=BAUDRATES,
+    sim_faults=SIM_FAULTS,
 )

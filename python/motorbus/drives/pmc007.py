@@ -717,6 +717,16 @@ def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Uni
     return drive
 
 
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+SIM_FAULTS = {
+    # the supply falls below the drive's threshold: the UVLO error bit (ErrorStatus bit 0)
+    "supply_drop": lambda sim: sim.inject_error(1),
+    # any error-status bits (ErrorStatus), e.g. 0x20 = over-temperature shutdown
+    "error": lambda sim, bits=1: sim.inject_error(int(bits)),
+    # a load blocks the rotor: with stall detection set up (6017h) the drive reports it
+    "stall": lambda sim: sim.set_jammed(True),
+}
+
 PLUGIN = DrivePlugin(
     kind="pmc007",
     description="CQPUSI PMC007 integrated stepper on CANopen (CiA 301)",
@@ -731,4 +741,5 @@ PLUGIN = DrivePlugin(
     # 1018h all 0), so a node reporting exactly that is taken for one; weak, but the
     # only mark the manual leaves.  A CiA 402 drive reports its profile instead.
     canopen_match=lambda node: 2 if node.device_type == 0 and not node.vendor_id and not node.product_code else 0,
+    sim_faults=SIM_FAULTS,
 )

@@ -721,6 +721,14 @@ def probe(bus: Any, address: str) -> Optional[dict]:
         client.close()
 
 
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+SIM_FAULTS = {
+    # a limit switch input goes active (direction -1 or +1)
+    "trip_limit": lambda sim, direction=-1: sim.force_limit(int(direction), True),
+    # the hardware enable (RUN) input drops: the power stage switches off
+    "enable_off": lambda sim: sim.set_hardware_enable(False),
+}
+
 PLUGIN = DrivePlugin(
     kind="unitek",
     description="UNITEK BAMOCAR/BAMOBIL/DS servo on its CAN register protocol (REGID, not CANopen)",
@@ -733,4 +741,5 @@ PLUGIN = DrivePlugin(
     store_options=lambda store_dir, address: {"store_path": str(Path(store_dir) / f"unitek-{address}.eeprom.json")},
     probe=probe,
     probe_addresses=tuple(f"0x{i:03X}" for i in range(0x201, 0x280)),   # the receive-id range
+    sim_faults=SIM_FAULTS,
 )
