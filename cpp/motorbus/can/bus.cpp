@@ -67,6 +67,7 @@ void Bus::link_lost(const std::string& reason) {
 bool Bus::wait_for_rx(std::unique_lock<std::mutex>& lock, Duration timeout) {
     if (!rx_queue_.empty()) return true;  // the common case under load: no clock read, no wait
     auto ready = [&] { return !rx_queue_.empty() || closed_.load() || link_lost_.load(); };
+    if (timeout.count() == 0 && !ready()) return false;  // a poll: no timed wait (a syscall)
     if (timeout.count() < 0) {
         rx_cv_.wait(lock, ready);
     } else if (!rx_cv_.wait_for(lock, timeout, ready)) {

@@ -119,11 +119,20 @@ void Variable::commit(std::span<const std::uint8_t> data) {
 }
 
 void Variable::notify() const {
+    // Called on every set: the usual single listener is copied without a vector.
+    ChangeListener one;
     std::vector<ChangeListener> ls;
     {
         std::lock_guard lock(mutex_);
         if (listeners_.empty()) return;
-        for (auto& [h, cb] : listeners_) ls.push_back(cb);
+        if (listeners_.size() == 1)
+            one = listeners_.front().second;
+        else
+            for (auto& [h, cb] : listeners_) ls.push_back(cb);
+    }
+    if (one) {
+        one(*this);
+        return;
     }
     for (auto& cb : ls) cb(*this);
 }

@@ -54,8 +54,32 @@ MotorModel::MotorModel(Clock& clock, MotorConfig cfg) : clock_(clock), cfg_(cfg)
         throw InvalidArgument("MotorModel: steps_per_rev and counts_per_rev must be positive");
     if (cfg_.tick_ns <= 0) throw InvalidArgument("MotorModel: tick_ns must be positive");
     if (!(cfg_.index_width_steps > 0)) cfg_.index_width_steps = cfg_.steps_per_rev / cfg_.counts_per_rev;
+    initial_cfg_ = cfg_;
     now_ = clock_.now();
     profile_start_ = now_;
+}
+
+void MotorModel::reset() {
+    if (in_dispatch_) throw InvalidArgument("MotorModel: reset from a listener");
+    cfg_ = initial_cfg_;
+    profile_ = Profile(State{0, 0, 0, 0});
+    now_ = clock_.now();
+    profile_start_ = now_;
+    profile_offset_ = 0;
+    running_ = false;
+    physical_ = 0;
+    slip_ = 0;
+    stalled_ = false;
+    jammed_ = false;
+    pulse_offset_ = 0;
+    encoder_offset_ = 0;
+    steps_per_unit_ = 1;
+    anchor_steps_ = 0;
+    anchor_units_ = 0;
+    for (auto& f : forced_) f.reset();
+    latch_ = LatchState::Off;
+    latched_pulse_ = 0;
+    latched_encoder_ = 0;
 }
 
 double MotorModel::profile_time(Nanos t) const { return static_cast<double>(t - profile_start_) * 1e-9; }

@@ -118,6 +118,11 @@ public:
     // Advance to clock.now() (or to t, never backwards), delivering events.
     void update();
     void advance_to(Nanos t);
+    // Back to the state just after construction: the configuration it was built
+    // with, at rest at position 0 (pulse, encoder, latch, switches not forced),
+    // with clock().now() as its time, which may be earlier than time().  The
+    // listeners stay.  For a harness that reuses one model (a fuzz target).
+    void reset();
     Nanos time() const { return now_; }
 
     // Listeners get every event in time order; returns an id for remove_listener.
@@ -178,6 +183,7 @@ public:
 private:
     Clock& clock_;
     MotorConfig cfg_;
+    MotorConfig initial_cfg_;  // cfg_ as built, for reset()
     Profile profile_;
     Nanos profile_start_ = 0;
     double profile_offset_ = 0;  // physical = profile position - profile_offset_

@@ -77,6 +77,8 @@ bool interruptible_wait_until(std::condition_variable& cv, std::unique_lock<std:
 template <class Rep, class Period, class Pred>
 bool interruptible_wait_for(std::condition_variable& cv, std::unique_lock<std::mutex>& lock,
                             std::chrono::duration<Rep, Period> timeout, Pred pred) {
+    // A poll (timeout 0) only checks: a timed wait that expires at once still costs a syscall.
+    if (timeout <= timeout.zero()) return pred();
     if (!interruptible()) return cv.wait_for(lock, timeout, pred);
     return interruptible_wait_until(cv, lock, std::chrono::steady_clock::now() +
                                                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(timeout),

@@ -55,12 +55,17 @@ Pmc007Sim::Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions option
           c.steps_per_rev = options.steps_per_rev;
           c.counts_per_rev = options.steps_per_rev;
           c.pull_out_speed = options.pull_out_speed;
+          c.tick_ns = options.tick_ns;
           if (options.ext1_switch) c.home = {true, options.ext1_switch->first, options.ext1_switch->second, true};
           return c;
       }()) {
     // Factory "flash": the defaults of every ROM object.
     for (const auto& r : pmc007_od_rows())
         if (r.storage == Storage::Rom) flash_[{r.index, r.sub}] = od_->at(r.index, r.sub)->default_bytes();
+    // What load_power_up() visits, looked up once (the keys of flash_ never change).
+    for (const auto& r : pmc007_od_rows())
+        power_up_.push_back({&r, od_->at(r.index, r.sub),
+                             r.storage == Storage::Rom ? &flash_.at({r.index, r.sub}) : nullptr});
     for (const auto& r : pmc007_od_rows()) {
         const bool pdo_area = r.index >= 0x1400 && r.index <= 0x1BFF;
         if (pdo_area || r.index == 0x1016 || r.index == 0x1017) continue;  // the generic services own them
@@ -364,12 +369,11 @@ void Pmc007Sim::load_power_up(bool cold) {
         ram_program_ = flash_program_;
     }
     t_publishing = true;  // values below are loaded, not "changed by the host"
-    for (const auto& r : pmc007_od_rows()) {
-        auto var = od_->at(r.index, r.sub);
-        if (r.storage == Storage::Rom && (r.index == 0x1016 || r.index == 0x1017) && r.sub != 0)
-            var->remote_write(flash_[{r.index, r.sub}]);  // through the heartbeat service's hooks
-        else if (r.storage == Storage::Rom)
-            var->try_set(flash_[{r.index, r.sub}]);
+    for (const auto& [r, var, flash] : power_up_) {
+        if (flash && (r->index == 0x1016 || r->index == 0x1017) && r->sub != 0)
+            var->remote_write(*flash);  // through the heartbeat service's hooks
+        else if (flash)
+            var->try_set(*flash);
         else
             var->reset_to_default();
     }
@@ -406,6 +410,28 @@ void Pmc007Sim::power_cycle() {
         }
         if (t.joinable()) t.join();
     }
+}
+
+void Pmc007Sim::reset_to_new() {
+    {
+        std::lock_guard lock(m_);
+        if (node_ || attaching_)
+            throw InvalidArgument("pmc007 sim " + std::to_string(node_id_.load()) + ": reset_to_new while attached");
+        // What the constructor starts from; load_power_up(true) then sets the rest.
+        for (const auto& [r, var, flash] : power_up_)
+            if (flash) *flash = var->default_bytes();
+        flash_program_.clear();
+        ram_program_.clear();
+        levels_ = 0x7FF;
+        saved_position_ = 0;
+        emcy_sent_ = 0;
+        last_emcy_ = -1;
+        reset_target_ = 0;
+        baud_index_ = 4;
+        motor_.reset();
+    }
+    read_store();
+    load_power_up(true);
 }
 
 void Pmc007Sim::on_reset(canopen::NmtCommand c) {

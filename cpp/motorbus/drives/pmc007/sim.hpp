@@ -64,6 +64,9 @@ struct Pmc007SimOptions {
     // A switch wired to EXT1 (pulls it low while lo <= position <= hi), e.g. the
     // home/limit switch an external-stop homing runs into.  nullopt = none.
     std::optional<std::pair<double, double>> ext1_switch{};
+    // The motor model's integration step (MotorConfig::tick_ns); switch edges
+    // and the end of a move are found at their own instant whatever the step.
+    Nanos tick_ns = 100'000;
     // Where the "flash" lives between runs (ROM objects saved by 2007h=2, the
     // offline program saved by 6019h:03, the 602Ah position); "" = memory only.
     std::string store_path{};
@@ -84,6 +87,12 @@ public:
     // Power off and on again: flash reloaded, RAM defaults, position per 602Ah,
     // offline program auto-run, boot-up (when attached).
     void power_cycle();
+    // Back to the state of a sim newly built with the same options (flash from
+    // the store file or factory values, programs empty, motor at rest at 0 with
+    // the clock's now() as its time), without rebuilding the dictionary, the
+    // costly part: for a harness that reuses one sim (the fuzz target).  Only
+    // while not attached (InvalidArgument otherwise).
+    void reset_to_new();
     // Advance motion, debounce, stall and the offline program to clock.now().
     void poll();
 
@@ -172,6 +181,12 @@ private:
     std::vector<std::shared_ptr<void>> retired_;  // replaced nodes/services: their OD listeners stay valid
 
     std::map<std::pair<std::uint16_t, std::uint8_t>, canopen::Bytes> flash_;
+    struct PowerUpRow {
+        const OdRow* row;
+        canopen::VariablePtr var;
+        canopen::Bytes* flash;  // its flash_ entry (ROM objects), else nullptr
+    };
+    std::vector<PowerUpRow> power_up_;  // every dictionary row, in table order
     std::vector<std::uint32_t> flash_program_, ram_program_;
     std::uint8_t errors_ = 0;   // 6000h
     std::uint8_t latched_ = 0;  // 6001h bits 0-2, 4

@@ -473,3 +473,37 @@ TEST(Pmc007Store, FlashSurvivesANewSimulator) {
     EXPECT_EQ(again.flash_program(), std::vector<std::uint32_t>{0x01000C80u});
     std::remove(path.c_str());
 }
+
+// reset_to_new() (the fuzz target reuses one sim): every object, the flash and
+// the state read as on a sim newly built at the same time.
+TEST(Pmc007SimReset, ResetToNewReadsAsAFreshSim) {
+    SimClock clock{1'000'000'000};
+    Pmc007Sim used(5, clock);
+    auto write = [&](std::uint16_t i, std::uint8_t s, std::vector<std::uint8_t> d) {
+        canopen::VariablePtr v;
+        ASSERT_EQ(used.od().lookup(i, s, v), 0);
+        ASSERT_EQ(v->remote_write(d), 0u) << std::hex << i;
+    };
+    write(0x601A, 0, {50, 0});        // a ROM object...
+    write(0x2007, 0, {2});            // ...saved to flash
+    write(0x600C, 0, {0xD2, 0x04, 0, 0});  // position 1234
+    used.inject_error(0x01);
+    used.set_input(3, false);
+    used.set_jammed(true);
+    clock.advance(300'000'000);
+    used.poll();
+    ASSERT_NE(used.error_status(), 0);
+    used.reset_to_new();
+    Pmc007Sim fresh(5, clock);
+    for (const auto& r : pmc007_od_rows())
+        EXPECT_EQ(used.od().at(r.index, r.sub)->get(), fresh.od().at(r.index, r.sub)->get())
+            << std::hex << r.index << ":" << int(r.sub);
+    EXPECT_EQ(used.error_status(), fresh.error_status());
+    EXPECT_EQ(used.controller_status(), fresh.controller_status());
+    EXPECT_EQ(used.position(), fresh.position());
+    EXPECT_EQ(used.gpio_value(), fresh.gpio_value());
+    EXPECT_EQ(used.flash_program(), fresh.flash_program());
+    // The flash is factory again: a power cycle does not bring back the saved 601Ah.
+    used.power_cycle();
+    EXPECT_EQ(used.od().at(0x601A, 0)->get(), fresh.od().at(0x601A, 0)->get());
+}
