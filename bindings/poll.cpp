@@ -45,17 +45,19 @@ void bind_poll(py::module_& m) {
     py::class_<poll::PollGroup>(m, "PollGroup",
                                 "One poll thread: reads its sources every period into a preallocated ring.")
         .def(py::init([](std::vector<std::shared_ptr<poll::Source>> sources, const py::object& period,
-                         std::size_t capacity, const py::object& spin, bool realtime, int priority) {
+                         std::size_t capacity, const py::object& spin, bool realtime, int priority,
+                         std::int64_t start_ns) {
                  poll::PollOptions o;
                  o.period_ns = duration_arg(period, "period").count();
                  o.spin_ns = duration_arg(spin, "spin").count();
                  o.capacity = capacity;
                  o.realtime = realtime;
                  o.priority = priority;
+                 o.start_ns = start_ns;
                  return std::make_unique<poll::PollGroup>(std::move(sources), o);
              }),
              py::arg("sources"), py::arg("period"), py::arg("capacity") = 1 << 16, py::arg("spin") = 0.0,
-             py::arg("realtime") = false, py::arg("priority") = 50,
+             py::arg("realtime") = false, py::arg("priority") = 50, py::arg("start_ns") = 0,
              // The sources hold references to native clients the Python objects own.
              py::keep_alive<1, 2>())
         .def("start", &poll::PollGroup::start)
@@ -67,15 +69,17 @@ void bind_poll(py::module_& m) {
         .def("take", [](poll::PollGroup& g) {
             auto& ring = g.ring();
             const std::size_t n = ring.available();  // more may arrive: take at most n
-            py::array_t<std::int64_t> t(static_cast<py::ssize_t>(n));
+            py::array_t<std::int64_t> k(static_cast<py::ssize_t>(n)), t(static_cast<py::ssize_t>(n));
             py::array_t<double> v({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(ring.columns())});
+            std::int64_t* kp = k.mutable_data();
             std::int64_t* tp = t.mutable_data();
             double* vp = v.mutable_data();
             std::size_t got;
             {
                 py::gil_scoped_release nogil;
-                got = ring.take(tp, vp, n);
+                got = ring.take(kp, tp, vp, n);
             }
-            return py::make_tuple(t, v, got);
-        }, "The rows written since the last take(): (t int64 ns[n], values float64[n, columns], n).");
+            return py::make_tuple(k, t, v, got);
+        }, "The rows written since the last take(): (deadline index int64[n], t int64 ns[n], "
+           "values float64[n, columns], m); only the first m rows are valid (m < n after an overflow).");
 }

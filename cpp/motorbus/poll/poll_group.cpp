@@ -57,8 +57,10 @@ void PollGroup::run() {
     }
     std::vector<double> row(ring_.columns());
     std::vector<double> nan_row(ring_.columns(), std::numeric_limits<double>::quiet_NaN());
-    // Start one period from now so the first wake-up is a scheduled one.
-    const Schedule schedule(monotonic_ns() + options_.period_ns, options_.period_ns);
+    // Deadline 0 at start_ns (groups of one Poller share it, so their rows of one
+    // index are one instant), or one period from now.
+    const Schedule schedule(options_.start_ns > 0 ? options_.start_ns : monotonic_ns() + options_.period_ns,
+                            options_.period_ns);
     std::uint64_t k = 0;
     Nanos previous_start = -1;
     std::uint64_t previous_index = 0;
@@ -71,9 +73,9 @@ void PollGroup::run() {
                 out += s->columns();
             }
             const Nanos end = monotonic_ns();
-            ring_.push(start, row.data());
+            ring_.push(static_cast<std::int64_t>(k), start, row.data());
             const auto next = schedule.after(k, end);
-            for (std::uint64_t j = k + 1; j < next.index; ++j) ring_.push(schedule.deadline(j), nan_row.data());
+            for (std::uint64_t j = k + 1; j < next.index; ++j) ring_.push(static_cast<std::int64_t>(j), schedule.deadline(j), nan_row.data());
             {
                 std::lock_guard lock(stats_mutex_);
                 ++samples_;

@@ -5,8 +5,8 @@
 //   PollGroup g({arcus1, arcus2}, {.period_ns = 1'000'000});
 //   g.start();  ...  g.take(...);  g.stats();  g.stop();
 //
-// Row layout: t (monotonic ns at the start of the sample's reads), then the
-// columns of each source in order.  A deadline that passed while a late sample
+// Row layout: the deadline's index k, t (monotonic ns at the start of the
+// sample's reads), then the columns of each source in order.  A deadline that passed while a late sample
 // ran gets a row of NaN with t = the deadline: missed samples show in the data.
 // A source that throws (LinkDown, TimeoutError...) ends the thread; stats()
 // holds the error's type and text.  stop() waits at most for the read in
@@ -32,6 +32,7 @@ struct PollOptions {
     Nanos spin_ns = 0;                 // busy-wait this long before each deadline
     bool realtime = false;             // try SCHED_FIFO
     int priority = 50;                 // its priority when granted
+    Nanos start_ns = 0;                // deadline 0 (monotonic ns); 0 = one period after start()
 };
 
 class PollGroup {

@@ -1,6 +1,7 @@
 // SampleRing: the preallocated store one poll thread writes and a reader
-// (Python, without the GIL) drains.  Each row is one sample: an int64
-// timestamp (monotonic ns) and `columns` float64 values.
+// (Python, without the GIL) drains.  Each row is one sample: the index k of
+// its deadline (t0 + k * period), an int64 timestamp (monotonic ns) and
+// `columns` float64 values.
 //
 // Single writer, single reader, guarded by a mutex held only for a memcpy of
 // the rows: the writer never allocates, never waits for Python.  When the
@@ -22,11 +23,11 @@ public:
     std::size_t columns() const { return columns_; }
 
     // Appends one row (values: columns() doubles).
-    void push(std::int64_t t_ns, const double* values);
+    void push(std::int64_t index, std::int64_t t_ns, const double* values);
 
-    // Copies the rows written since the last take() into t_out / v_out (sized
-    // by the caller from available()), oldest first; returns how many.
-    std::size_t take(std::int64_t* t_out, double* v_out, std::size_t max_rows);
+    // Copies the rows written since the last take() into index_out / t_out /
+    // v_out (sized by the caller from available()), oldest first; returns how many.
+    std::size_t take(std::int64_t* index_out, std::int64_t* t_out, double* v_out, std::size_t max_rows);
     std::size_t available() const;
     std::uint64_t written() const;     // rows pushed since construction
     std::uint64_t overflowed() const;  // rows overwritten before take() saw them
@@ -34,7 +35,7 @@ public:
 private:
     const std::size_t capacity_, columns_;
     mutable std::mutex mutex_;
-    std::vector<std::int64_t> t_;
+    std::vector<std::int64_t> index_, t_;
     std::vector<double> v_;
     std::uint64_t head_ = 0;  // rows ever written
     std::uint64_t tail_ = 0;  // rows ever taken or overwritten

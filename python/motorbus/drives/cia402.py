@@ -733,6 +733,13 @@ def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Uni
     return drive
 
 
+def poll_fields(drive: Cia402Drive, fields: Sequence[str]):
+    """motorbus.Poller: 6064h/606Ch/6041h by SDO through the drive's own client."""
+    from ..canopen.poll import CIA402_POLL_OBJECTS, sdo_poll_spec
+
+    return sdo_poll_spec(drive.kind, drive._sdo, drive.native._bus, fields, CIA402_POLL_OBJECTS)
+
+
 PLUGIN = DrivePlugin(
     kind="cia402",
     description="any CiA 402 drive on CANopen (profile position, profile velocity, homing); simulated generically",
@@ -745,4 +752,5 @@ PLUGIN = DrivePlugin(
     # Any node whose device type (0x1000) names profile 402; vendor kinds score higher.
     canopen_match=lambda node: 1 if node.profile == 402 else 0,
     synchronised_start=synchronised_start,
+    poll_fields=poll_fields,
 )

@@ -740,6 +740,20 @@ def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Uni
     return drive
 
 
+def poll_fields(drive: "Pmc007Drive", fields: Any):
+    """motorbus.Poller: 600Ch (position) and the controller status by SDO.  The
+    PMC007 has no actual-speed object (the Drive measures it over a window), so
+    "velocity" is refused: differentiate the polled position instead."""
+    from ..canopen.poll import sdo_poll_spec
+
+    objects = {}
+    for field, name in (("position", "motor_position"), ("status", "controller_status")):
+        row = OBJECTS[name]
+        objects[field] = (row["index"], row["sub"], row["type"].lower(), 1.0)
+    native = drive.native
+    return sdo_poll_spec(drive.kind, native.sdo, native.bus, fields, objects)
+
+
 PLUGIN = DrivePlugin(
     kind="pmc007",
     description="CQPUSI PMC007 integrated stepper on CANopen (CiA 301)",
@@ -754,4 +768,5 @@ PLUGIN = DrivePlugin(
     # 1018h all 0), so a node reporting exactly that is taken for one; weak, but the
     # only mark the manual leaves.  A CiA 402 drive reports its profile instead.
     canopen_match=lambda node: 2 if node.device_type == 0 and not node.vendor_id and not node.product_code else 0,
+    poll_fields=poll_fields,
 )

@@ -41,21 +41,22 @@ TEST(Schedule, RefusesANonPositivePeriod) { EXPECT_THROW(Schedule(0, 0), Invalid
 
 TEST(SampleRing, TakesRowsInOrderAcrossTheWrap) {
     SampleRing r(4, 2);
-    std::vector<std::int64_t> t(4);
+    std::vector<std::int64_t> k(4), t(4);
     std::vector<double> v(8);
     for (int i = 0; i < 3; ++i) {
         const double row[2] = {double(i), double(-i)};
-        r.push(i, row);
+        r.push(i, 100 + i, row);
     }
-    ASSERT_EQ(r.take(t.data(), v.data(), 4), 3u);
+    ASSERT_EQ(r.take(k.data(), t.data(), v.data(), 4), 3u);
     for (int i = 3; i < 7; ++i) {  // wraps: slots 3, 0, 1, 2
         const double row[2] = {double(i), double(-i)};
-        r.push(i, row);
+        r.push(i, 100 + i, row);
     }
     ASSERT_EQ(r.available(), 4u);
-    ASSERT_EQ(r.take(t.data(), v.data(), 4), 4u);
+    ASSERT_EQ(r.take(k.data(), t.data(), v.data(), 4), 4u);
     for (int i = 0; i < 4; ++i) {
-        EXPECT_EQ(t[i], 3 + i);
+        EXPECT_EQ(k[i], 3 + i);
+        EXPECT_EQ(t[i], 103 + i);
         EXPECT_EQ(v[2 * i], 3 + i);
         EXPECT_EQ(v[2 * i + 1], -(3 + i));
     }
@@ -67,13 +68,14 @@ TEST(SampleRing, CountsRowsOverwrittenBeforeTheyWereRead) {
     SampleRing r(3, 1);
     for (int i = 0; i < 5; ++i) {
         const double x = i;
-        r.push(i, &x);
+        r.push(i, 100 + i, &x);
     }
     EXPECT_EQ(r.overflowed(), 2u);
-    std::vector<std::int64_t> t(3);
+    std::vector<std::int64_t> k(3), t(3);
     std::vector<double> v(3);
-    ASSERT_EQ(r.take(t.data(), v.data(), 3), 3u);
-    EXPECT_EQ(t[0], 2);  // the two oldest rows are gone, the rest are intact
+    ASSERT_EQ(r.take(k.data(), t.data(), v.data(), 3), 3u);
+    EXPECT_EQ(k[0], 2);
+    EXPECT_EQ(t[0], 102);  // the two oldest rows are gone, the rest are intact
     EXPECT_EQ(v[2], 4.0);
     EXPECT_THROW(SampleRing(0, 1), InvalidArgument);
 }
@@ -114,16 +116,18 @@ private:
 };
 
 struct Taken {
-    std::vector<std::int64_t> t;
+    std::vector<std::int64_t> k, t;
     std::vector<double> v;
 };
 
 Taken take_all(PollGroup& g) {
     Taken out;
     const std::size_t n = g.ring().available();
+    out.k.resize(n);
     out.t.resize(n);
     out.v.resize(n * g.columns());
-    out.t.resize(g.ring().take(out.t.data(), out.v.data(), n));
+    out.t.resize(g.ring().take(out.k.data(), out.t.data(), out.v.data(), n));
+    out.k.resize(out.t.size());
     return out;
 }
 
@@ -145,6 +149,7 @@ TEST(PollGroup, WritesEverySourceColumnsWithIncreasingTimestamps) {
     for (std::size_t i = 0; i < got.t.size(); ++i) {
         if (i) {
             EXPECT_GT(got.t[i], got.t[i - 1]);
+            EXPECT_EQ(got.k[i], got.k[i - 1] + 1);  // one row per deadline, sampled or missed
         }
         if (std::isnan(got.v[3 * i])) continue;  // a missed deadline on a loaded machine
         EXPECT_EQ(got.v[3 * i + 1] - got.v[3 * i], 1.0);  // source a: its two columns of one read
