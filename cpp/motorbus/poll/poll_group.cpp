@@ -67,6 +67,16 @@ void PollGroup::run() {
     try {
         while (sleep_until(schedule.deadline(k), options_.spin_ns, stop_)) {
             const Nanos start = monotonic_ns();
+            // Woken after a later deadline (preempted): the ones in between are missed.
+            if (const auto woke = schedule.index_at(start); woke > k) {
+                for (std::uint64_t j = k; j < woke; ++j)
+                    ring_.push(static_cast<std::int64_t>(j), schedule.deadline(j), nan_row.data());
+                {
+                    std::lock_guard lock(stats_mutex_);
+                    missed_ += woke - k;
+                }
+                k = woke;
+            }
             double* out = row.data();
             for (auto& s : sources_) {
                 s->read(out);

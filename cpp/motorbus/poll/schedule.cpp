@@ -19,7 +19,7 @@ Schedule::Next Schedule::after(std::uint64_t k, Nanos now) const {
     const Nanos next = deadline(k + 1);
     if (now < next) return {k + 1, 0, false};
     // The latest deadline already passed: sample it now; the ones before it are gone.
-    const auto latest = static_cast<std::uint64_t>((now - t0_) / period_);
+    const auto latest = index_at(now);
     return {latest, latest - (k + 1), true};
 }
 

@@ -4,8 +4,12 @@
 //
 //   late:   a sample whose reads finished after the next deadline (the next
 //           sample then starts at once, behind time);
-//   missed: a deadline that passed entirely while a late sample ran: nothing
+//   missed: a deadline that passed entirely while a late sample ran, or while
+//           the thread woke up late (preempted past a whole period): nothing
 //           was read for it (the poll thread writes a NaN row, so it shows).
+//
+// So a sample of deadline k always starts in [deadline(k), deadline(k + 1)):
+// timestamps increase strictly across sampled and missed rows.
 #pragma once
 #include <atomic>
 #include <cstdint>
@@ -27,6 +31,10 @@ public:
         std::uint64_t skipped;  // deadlines between the finished one and `index`: missed
         bool late;              // the finished sample ran past deadline(k + 1)
     };
+    // The latest deadline at or before `now` (0 before t0).
+    std::uint64_t index_at(Nanos now) const {
+        return now < t0_ ? 0 : static_cast<std::uint64_t>((now - t0_) / period_);
+    }
     // Sample k finished at `now`: which deadline comes next.
     Next after(std::uint64_t k, Nanos now) const;
 

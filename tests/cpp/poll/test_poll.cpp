@@ -219,3 +219,11 @@ TEST(PollGroup, RefusesBadOptions) {
     g.start();
     EXPECT_THROW(g.start(), InvalidArgument);
 }
+
+TEST(Schedule, IndexAtIsTheLatestDeadlinePassed) {
+    Schedule s(1'000, 100);
+    EXPECT_EQ(s.index_at(500), 0u);
+    EXPECT_EQ(s.index_at(1'000), 0u);
+    EXPECT_EQ(s.index_at(1'099), 0u);
+    EXPECT_EQ(s.index_at(1'250), 2u);
+}
