@@ -1,5 +1,7 @@
 #include "motorbus/poll/poll_group.hpp"
 
+#include <sys/prctl.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -50,6 +52,9 @@ void PollGroup::fail(const char* type, const std::string& what) {
 }
 
 void PollGroup::run() {
+    // A normal thread's timed sleeps may end up to 50 µs late (the kernel's default
+    // timer slack, to batch wake-ups); a poller wants its deadline.
+    prctl(PR_SET_TIMERSLACK, 1000UL, 0UL, 0UL, 0UL);
     if (options_.realtime) {
         const bool rt = try_realtime(options_.priority);
         std::lock_guard lock(stats_mutex_);
