@@ -49,14 +49,18 @@ def figures(t_ns: np.ndarray, k: np.ndarray, period_ns: int, late: int) -> dict:
             "max": float(err.max()) if len(err) else float("nan")}
 
 
-def native_reads(drive):
-    """The same three reads the poller's source makes, as Python calls on the native client."""
+def native_reads(drive, fields):
+    """The same reads the poller's source makes, as Python calls on the native client."""
     if drive.kind == "arcus":
         c = drive.native
-        pos = "EX" if drive._snl else "PX"
-        return lambda: (c.query(pos), c.query("PS"), c.query("MST"))
-    sdo = drive._sdo
-    return lambda: (sdo.read_i32(0x6064), sdo.read_i32(0x606C), sdo.read_u16(0x6041))
+        names = {"position": "EX" if drive._snl else "PX", "velocity": "PS", "status": "MST"}
+        calls = [lambda n=names[f]: c.query(n) for f in fields]
+    else:
+        sdo = drive._sdo
+        objects = {"position": (sdo.read_i32, 0x6064), "velocity": (sdo.read_i32, 0x606C),
+                   "status": (sdo.read_u16, 0x6041)}
+        calls = [lambda r=objects[f]: r[0](r[1]) for f in fields]
+    return lambda: [c() for c in calls]
 
 
 def python_loop(groups: dict, seconds: float, period_ns: int) -> dict:
@@ -98,8 +102,8 @@ def python_loop(groups: dict, seconds: float, period_ns: int) -> dict:
     return {name: figures(ts, ks, period_ns, late) for name, (ks, ts, late) in results.items()}
 
 
-def poller_run(bench, seconds: float, rate: float, spin_us: float, realtime: bool) -> tuple[dict, dict]:
-    with Poller(bench.axes, rate_hz=rate, spin_us=spin_us, realtime=realtime) as poller:
+def poller_run(bench, fields, seconds: float, rate: float, spin_us: float, realtime: bool) -> tuple[dict, dict]:
+    with Poller(bench.axes, fields=fields, rate_hz=rate, spin_us=spin_us, realtime=realtime) as poller:
         end = time.monotonic() + seconds + 0.02
         while time.monotonic() < end:   # drain as a user would: the ring holds 10 s by default
             time.sleep(min(0.5, max(0.0, end - time.monotonic())))
@@ -133,21 +137,27 @@ def main() -> None:
     ap.add_argument("--rate", type=float, default=1000.0, help="Hz")
     ap.add_argument("--spin-us", type=float, default=0.0, help="Poller spin before each deadline (µs)")
     ap.add_argument("--realtime", action="store_true", help="Poller: try SCHED_FIFO")
+    ap.add_argument("--fields", default="position,velocity,status", help="comma-separated Poller fields")
+    ap.add_argument("--jog", type=float, default=20.0, help="jog every axis at this speed while polling (0: idle)")
     args = ap.parse_args()
     period_ns = int(round(1e9 / args.rate))
+    fields = tuple(f.strip() for f in args.fields.split(",") if f.strip())
     print(f"{time.strftime('%Y-%m-%d %H:%M:%S %Z')}  load {os.getloadavg()}  {os.cpu_count()} CPUs  "
-          f"{args.rate:g} Hz, {args.seconds:g} s each way, spin {args.spin_us:g} us")
+          f"{args.rate:g} Hz, {args.seconds:g} s each way, spin {args.spin_us:g} us, fields {','.join(fields)}, "
+          f"jog {args.jog:g}")
     with Bench.from_dict(BENCH, sim=True) as bench:
         for d in bench.axes.values():
             d.enable()
-            d.jog(20.0)   # slowly, so the readings change
-        cpp, stats = poller_run(bench, args.seconds, args.rate, args.spin_us, args.realtime)
+            if args.jog:
+                d.jog(args.jog)   # slowly, so the readings change
+        cpp, stats = poller_run(bench, fields, args.seconds, args.rate, args.spin_us, args.realtime)
         groups = {}
         for label, s in stats.items():
-            groups[label] = [native_reads(bench[a]) for a in s["axes"]]
+            groups[label] = [native_reads(bench[a], fields) for a in s["axes"]]
         py = python_loop(groups, args.seconds, period_ns)
         for d in bench.axes.values():
-            d.stop()
+            if args.jog:
+                d.stop()
     show("motorbus.Poller (C++ thread per transport):", cpp)
     for label, s in stats.items():
         print(f"    C++ histograms {label}: period error p50/p99/max {s['period_error_p50'] * 1e6:.0f}/"

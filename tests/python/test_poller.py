@@ -219,3 +219,29 @@ def test_bad_arguments_are_named():
         with pytest.raises(motorbus.InvalidArgument, match="already started"):
             p.start()
         p.stop()
+
+
+@pytest.mark.parametrize("kind,address,transport", [("dmac", "00", "line"), ("pmc007", "5", "bus"),
+                                                     ("arcus-canopen", "1", "bus")])
+def test_other_kinds_poll_their_own_objects(kind, address, transport):
+    link = {"line": "l1"} if transport == "line" else {"bus": "can0"}
+    bench = Bench.from_dict({"line": {"l1": {"port": "/dev/ttyUSB-poller-other"}},
+                             "bus": {"can0": {"spec": "socketcan:can0"}},
+                             "axis": {"q": {"kind": kind, "address": address, **link}}}, sim=True)
+    with bench:
+        q = bench["q"]
+        q.enable()
+        fields = ("position", "status") if kind == "pmc007" else ("position", "velocity", "status")
+        with Poller(bench.axes, fields=fields, rate_hz=20) as poller:
+            q.move_by(500)
+            q.wait_idle(timeout=20)
+            time.sleep(0.3)
+        frame = poller.frame()
+        assert poller.stats["q"]["error"] == ""
+        pos = _finite(frame["q.position"])
+        assert len(pos) >= 3
+        assert np.all(np.diff(pos) >= 0)
+        assert pos[-1] == pytest.approx(q.position)
+        if kind == "pmc007":
+            with pytest.raises(motorbus.InvalidArgument, match="velocity"):
+                Poller(bench.axes, fields=("velocity",))
