@@ -17,7 +17,7 @@ public:
     // numbers.  Called only from the poll thread, without the GIL.  A transport
     // failure throws (LinkDown, TimeoutError...): it ends the poll group.
     virtual void read(double* out) = 0;
-    // "cia402 node 5", "arcus 01": names the source in errors and stats.
+    // "SDO node 5": names the source in errors and stats.
     virtual std::string describe() const = 0;
 };
 
