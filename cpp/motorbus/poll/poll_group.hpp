@@ -2,7 +2,7 @@
 // or bus) on an absolute schedule and writes timestamped rows into a
 // SampleRing, without the GIL and without allocating per sample.
 //
-//   PollGroup g({arcus1, arcus2}, {.period_ns = 1'000'000});
+//   PollGroup g({source_a, source_b}, {.period_ns = 1'000'000});
 //   g.start();  ...  g.take(...);  g.stats();  g.stop();
 //
 // Row layout: the deadline's index k, t (monotonic ns at the start of the
