@@ -13,6 +13,7 @@
 #include "motorbus/canopen/local_node.hpp"
 #include "motorbus/canopen/od.hpp"
 #include "motorbus/canopen/sdo_client.hpp"
+#include "motorbus/canopen/sdo_poll_source.hpp"
 #include "motorbus/errors.hpp"
 
 namespace py = pybind11;
@@ -532,6 +533,17 @@ void bind_canopen(py::module_& m) {
         .def_property_readonly("request_id", &SdoClient::request_id)
         .def_property_readonly("response_id", &SdoClient::response_id)
         .def_property_readonly("counters", &SdoClient::counters);
+
+    // A PollSource reading objects by SDO through this client (motorbus.Poller).
+    m.def("sdo_poll_source",
+          [](SdoClient& sdo, const std::vector<std::tuple<std::uint16_t, std::uint8_t, std::string>>& objects)
+              -> std::shared_ptr<poll::Source> {
+              std::vector<SdoPollObject> v;
+              for (const auto& [index, sub, type] : objects) v.push_back({index, sub, type});
+              return std::make_shared<SdoPollSource>(sdo, std::move(v));
+          },
+          py::arg("sdo"), py::arg("objects"), py::keep_alive<0, 1>(),
+          "A PollSource uploading [(index, subindex, type)] each sample (type: 'i32', 'u16', ...).");
 
     // ---- LocalNode ---------------------------------------------------------------
     py::class_<LocalNode, LocalNodeHolder>(m, "LocalNode",

@@ -13,6 +13,7 @@ namespace py = pybind11;
 
 void bind_errors(py::module_& m);
 void bind_runtime(py::module_& m);
+void bind_poll(py::module_& m);
 void bind_can(py::module_& m);
 void bind_slcan(py::module_& m);
 void bind_socketcand(py::module_& m);
@@ -25,6 +26,7 @@ PYBIND11_MODULE(_core, m) {
     m.doc() = "motorbus C++ core";
     bind_errors(m);
     bind_runtime(m);
+    bind_poll(m);
     bind_can(m);
     bind_slcan(m);
     bind_socketcand(m);

@@ -10,6 +10,7 @@
 #include "motorbus/drives/arcus/codec.hpp"
 #include "motorbus/drives/arcus/sim.hpp"
 #include "motorbus/drives/arcus/homing.hpp"
+#include "motorbus/drives/arcus/poll_source.hpp"
 #include "motorbus/drives/arcus/profile.hpp"
 #include "motorbus/motion/motor_model.hpp"
 
@@ -445,4 +446,18 @@ void bind_arcus(py::module_& m) {
         .def_property("baud_code", get(&C::baud_code), put(&C::set_baud_code))
         .def_property("can_bit_rate_code", get(&C::can_bit_rate_code), put(&C::set_can_bit_rate_code))
         .def_property("node_id", get(&C::node_id), put(&C::set_node_id));
+
+    // A PollSource querying `names` (e.g. ["EX", "PS", "MST"]) each sample, with a
+    // client of its own on the drive's LineLink (motorbus.Poller).
+    m.def("arcus_poll_source",
+          [](std::shared_ptr<serial::LineLink> link, int address, std::vector<std::string> names,
+             const py::object& timeout, int query_retries) -> std::shared_ptr<poll::Source> {
+              py_helpers::not_none(link, "link");
+              ClientOptions o;
+              if (!timeout.is_none()) o.timeout = seconds_to_ns(timeout);
+              o.query_retries = query_retries;
+              return std::make_shared<PollSource>(std::move(link), address, std::move(names), o);
+          },
+          py::arg("link"), py::arg("address"), py::arg("names"), py::arg("timeout") = py::none(),
+          py::arg("query_retries") = 1);
 }

@@ -8,6 +8,7 @@
 #include "errors.hpp"
 #include "motorbus/drives/dmac/client.hpp"
 #include "motorbus/drives/dmac/codec.hpp"
+#include "motorbus/drives/dmac/poll_source.hpp"
 #include "motorbus/drives/dmac/sim.hpp"
 #include "motorbus/serial/line_device.hpp"
 #include "motorbus/serial/port.hpp"
@@ -452,4 +453,19 @@ void bind_dmac(py::module_& m) {
           py::arg("axes"), py::arg("segments"), py::arg("interpol_time_ms") = 100, py::arg("fifo_size") = 64,
           py::arg("sleep") = py::none(), py::arg("backoff") = py::none(),
           "Streams segments[k][axis] to every axis, starting them with SYNCHRO INTERPOL.");
+
+    // A PollSource reading `names` (e.g. ["POSITION", "SPEED", "STATUS"]) each sample,
+    // with a client of its own on the drive's LineLink (motorbus.Poller).
+    m.def("dmac_poll_source",
+          [](std::shared_ptr<serial::LineLink> link, int address, std::vector<std::string> names, int baud,
+             const py::object& timeout) -> std::shared_ptr<poll::Source> {
+              motorbus::py_helpers::not_none(link, "link");
+              ClientOptions o;
+              o.address = address;
+              o.baud = baud;
+              if (!timeout.is_none()) o.timeout = motorbus::py_helpers::seconds_to_ns(timeout);
+              return std::make_shared<PollSource>(std::move(link), std::move(o), std::move(names));
+          },
+          py::arg("link"), py::arg("address"), py::arg("names"), py::arg("baud") = 38400,
+          py::arg("timeout") = py::none());
 }

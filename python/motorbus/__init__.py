@@ -36,5 +36,6 @@ from . import registry  # noqa: E402,F401
 from .drive import Capability, Drive, DriveStatus, ParamInfo, Units, open_drive  # noqa: E402,F401
 from .registry import drive_kinds  # noqa: E402,F401
 from .bench import Bench, BenchFileError  # noqa: E402,F401
+from .poller import Poller, load_frame  # noqa: E402,F401
 
 __version__ = "0.1.0"

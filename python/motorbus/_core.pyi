@@ -34,7 +34,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'PollGroup', 'PollSource', 'PollStats', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_poll_source', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_poll_source', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'sdo_poll_source', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -58,6 +58,115 @@ class SimClock(Clock):
     def advance(self, dt_ns: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     def set(self, t_ns: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+class PollSource:
+    """
+    What one drive gives a PollGroup per sample (made by the drive kind's poll_fields).
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def columns(self) -> int:
+        ...
+class PollStats:
+    """
+    Counters and timing of one PollGroup (times in ns).
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def error(self) -> str:
+        """
+        why the group stopped on its own ('' if it did not)
+        """
+    @property
+    def error_type(self) -> str:
+        """
+        'LinkDown', 'TimeoutError'... ('' if none)
+        """
+    @property
+    def late(self) -> int:
+        """
+        samples whose reads ran past the next deadline
+        """
+    @property
+    def missed(self) -> int:
+        """
+        deadlines skipped entirely (NaN rows in the data)
+        """
+    @property
+    def overflowed(self) -> int:
+        """
+        rows lost because the reader fell a ring behind
+        """
+    @property
+    def period_error_max_ns(self) -> int:
+        ...
+    @property
+    def period_error_p50_ns(self) -> int:
+        ...
+    @property
+    def period_error_p99_ns(self) -> int:
+        ...
+    @property
+    def period_ns(self) -> int:
+        ...
+    @property
+    def read_time_max_ns(self) -> int:
+        ...
+    @property
+    def read_time_p50_ns(self) -> int:
+        ...
+    @property
+    def read_time_p99_ns(self) -> int:
+        ...
+    @property
+    def realtime(self) -> bool:
+        """
+        SCHED_FIFO asked for and granted
+        """
+    @property
+    def running(self) -> bool:
+        ...
+    @property
+    def samples(self) -> int:
+        """
+        samples read
+        """
+    @property
+    def wake_latency_max_ns(self) -> int:
+        ...
+    @property
+    def wake_latency_p50_ns(self) -> int:
+        ...
+    @property
+    def wake_latency_p99_ns(self) -> int:
+        ...
+class PollGroup:
+    """
+    One poll thread: reads its sources every period into a preallocated ring.
+    """
+    def __init__(self, sources: collections.abc.Sequence[PollSource], period: typing.Any, capacity: typing.SupportsInt | typing.SupportsIndex = 65536, spin: typing.Any = 0.0, realtime: bool = False, priority: typing.SupportsInt | typing.SupportsIndex = 50, start_ns: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
+        ...
+    def start(self) -> None:
+        ...
+    def stop(self) -> None:
+        ...
+    def take(self) -> tuple[numpy.typing.NDArray[numpy.int64], numpy.typing.NDArray[numpy.int64], numpy.typing.NDArray[numpy.float64], int]:
+        """
+        The rows written since the last take(): (deadline index int64[n], t int64 ns[n], values float64[n, columns], m); only the first m rows are valid (m < n after an overflow).
+        """
+    @property
+    def capacity(self) -> int:
+        ...
+    @property
+    def columns(self) -> int:
+        ...
+    @property
+    def running(self) -> bool:
+        ...
+    @property
+    def stats(self) -> PollStats:
         ...
 class Frame:
     """
@@ -4533,6 +4642,8 @@ def arcus_parse_reply(raw: typing.Any) -> tuple[typing.Any, str]:
     """
     (address or None, body) of one reply without its NUL; ProtocolError on bytes it never sends.
     """
+def arcus_poll_source(link: LineLink, address: typing.SupportsInt | typing.SupportsIndex, names: collections.abc.Sequence[str], timeout: typing.Any = None, query_retries: typing.SupportsInt | typing.SupportsIndex = 1) -> PollSource:
+    ...
 def arcus_speed_windows() -> list[ArcusSpeedWindow]:
     ...
 def arcus_window_for_hspd(hspd_pps: typing.SupportsFloat | typing.SupportsIndex) -> ArcusSpeedWindow:
@@ -4565,6 +4676,8 @@ def dmac_parse_read_reply(reply: bytes) -> DmacReadReply | None:
     """
     Parses 'aa#MNE[.bit]=value' strictly into a DmacReadReply; None when it breaks the grammar.
     """
+def dmac_poll_source(link: LineLink, address: typing.SupportsInt | typing.SupportsIndex, names: collections.abc.Sequence[str], baud: typing.SupportsInt | typing.SupportsIndex = 38400, timeout: typing.Any = None) -> PollSource:
+    ...
 def dmac_position_profile(start: MotionState, target: typing.SupportsFloat | typing.SupportsIndex, params: DmacProfileParams) -> Profile:
     ...
 def dmac_ramp_time(params: DmacProfileParams, v_from: typing.SupportsFloat | typing.SupportsIndex, v_to: typing.SupportsFloat | typing.SupportsIndex) -> float:
@@ -4708,6 +4821,10 @@ def read_log(path: str) -> tuple[list[LogEntry], int]:
     """
 def scan_network(bus: Bus, first: typing.SupportsInt | typing.SupportsIndex = 1, last: typing.SupportsInt | typing.SupportsIndex = 127, sdo_timeout: typing.SupportsFloat | typing.SupportsIndex = 0.2, listen: typing.SupportsFloat | typing.SupportsIndex = 0.0, probe_sdo: bool = True, identity: bool = True) -> list[NodeInfo]:
     ...
+def sdo_poll_source(sdo: SdoClient, objects: collections.abc.Sequence[tuple[typing.SupportsInt | typing.SupportsIndex, typing.SupportsInt | typing.SupportsIndex, str]]) -> PollSource:
+    """
+    A PollSource uploading [(index, subindex, type)] each sample (type: 'i32', 'u16', ...).
+    """
 def slcan_encode(frame: Frame, timestamp_ms: typing.Any = None) -> bytes:
     """
     The SLCAN line for `frame` (t/T/r/R, CR included).

@@ -18,11 +18,30 @@ from typing import Any, Callable, Optional
 
 from . import _core
 
-__all__ = ["DRIVE_GROUP", "BUS_GROUP", "DrivePlugin", "BusScheme", "drive_plugin", "drive_plugins",
+__all__ = ["DRIVE_GROUP", "BUS_GROUP", "DrivePlugin", "PollSpec", "BusScheme", "drive_plugin", "drive_plugins",
            "drive_kinds", "bus_scheme", "bus_schemes", "parse_drive_spec"]
 
 DRIVE_GROUP = "motorbus.drive"
 BUS_GROUP = "motorbus.bus"
+
+
+@dataclass(frozen=True)
+class PollSpec:
+    """What a drive kind's ``poll_fields(drive, fields)`` gives :class:`motorbus.Poller`.
+
+    * ``source``: a ``_core.PollSource`` (built on the kind's native C++ client)
+      that reads the fields, in the order asked, on the poll thread;
+    * ``scales``: per field, the factor from the source's reading to the Drive's
+      native units (the Poller then applies ``drive.units`` to position and velocity);
+    * ``transport``: the LineLink or Bus the source talks over: axes on one
+      transport share one poll thread (their requests take turns on it anyway);
+    * ``bus``: the CAN Bus (for ``candump=``), None on a serial line.
+    """
+
+    source: Any
+    scales: tuple
+    transport: Any
+    bus: Any = None
 
 
 @dataclass(frozen=True)
@@ -49,6 +68,7 @@ class DrivePlugin:
       CANopen scan (``NodeInfo``: device type, vendor id, product code...), 0 =
       not this kind; the highest score names the node's kind.
     * ``synchronised_start(link, drives)``, ``sim_faults``: see the fields' comments.
+    * ``poll_fields(drive, fields) -> PollSpec``: see the field's comment.
     """
 
     kind: str
@@ -78,6 +98,11 @@ class DrivePlugin:
     #: the rotor stalls, the supply drops...).  Names are the kind's own; the
     #: fixture lists them when asked for one the kind does not have.
     sim_faults: Optional[dict] = None
+    #: What ``motorbus.Poller`` reads from an open Drive of this kind on its C++
+    #: poll thread: ``poll_fields(drive, fields) -> PollSpec`` for a tuple of
+    #: field names among "position", "velocity", "status" (InvalidArgument for a
+    #: field the kind cannot give).  None: the kind cannot be polled.
+    poll_fields: Optional[Callable[..., "PollSpec"]] = None
 
     def __post_init__(self) -> None:
         if self.transport not in ("serial", "can"):

@@ -12,8 +12,10 @@ from motorbus import registry
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SHARED = ["CMakeLists.txt", "bindings/module.cpp", "python/motorbus/cli.py", "python/motorbus/sim.py",
           "python/motorbus/bus.py", "python/motorbus/__init__.py", "python/motorbus/drive.py",
-          "python/motorbus/registry.py", "python/motorbus/bus_server.py",
-          "python/motorbus/pytest_plugin.py", "python/motorbus/cli_monitor.py"]
+          "python/motorbus/registry.py", "python/motorbus/bus_server.py", "python/motorbus/poller.py",
+          "python/motorbus/pytest_plugin.py", "python/motorbus/cli_monitor.py",
+          "python/motorbus/canopen/poll.py", "bindings/poll.cpp"] + \
+    [str(p.relative_to(ROOT)) for p in sorted((ROOT / "cpp/motorbus/poll").iterdir())]
 
 
 def vendors() -> list[str]:

@@ -600,6 +600,22 @@ SIM_FAULTS = {
     # the rotor jams: pulses go out, the shaft stays (StepNLoop then reports the error)
     "stall": lambda sim: sim.set_blocked(True),
 }
+def poll_fields(drive: ArcusDrive, fields: Any) -> "PollSpec":
+    """motorbus.Poller: EX (PX with StepNLoop off), PS and MST queried by a client of
+    the poll thread's own on the drive's line.  PS is a speed (>= 0): the polled
+    velocity has no sign, unlike Drive.velocity (which adds the move's direction)."""
+    from ..registry import PollSpec
+
+    queries = {"position": "EX" if drive._snl else "PX", "velocity": "PS", "status": "MST"}
+    names = []
+    for f in fields:
+        if f not in queries:
+            raise _core.InvalidArgument(f"arcus poll field {f!r}: this kind gives {', '.join(queries)}")
+        names.append(queries[f])
+    link = drive.native.link
+    source = _core.arcus_poll_source(link, drive.native.address, names)
+    return PollSpec(source=source, scales=(1.0,) * len(names), transport=link)
+
 
 PLUGIN = DrivePlugin(
     kind="arcus",
@@ -617,4 +633,5 @@ PLUGIN = DrivePlugin(
     probe_addresses=tuple(f"{a:02d}" for a in range(1, 100)),   # DN 01-99
     probe_bauds=(9600, 19200, 38400, 57600, 115200),              # the DB settings
     sim_faults=SIM_FAULTS,
+    poll_fields=poll_fields,
 )

@@ -31,7 +31,7 @@ from ..canopen.cia402 import Cia402, Controlword, OpMode
 from ..drive import Capability, ParamInfo, Params, Units
 from ..registry import DrivePlugin
 from . import arcus as _arcus
-from .cia402 import Cia402Drive
+from .cia402 import Cia402Drive, poll_fields as _cia402_poll_fields
 
 __all__ = ["ArcusCanopen", "ArcusCanopenDrive", "ArcusCanopenSim", "ArcusHomingMethod", "BitRate",
            "CommType", "SnlStatus", "OBJECTS", "PLUGIN", "make_sim", "open"]
@@ -473,6 +473,8 @@ PLUGIN = DrivePlugin(
     # beats the generic cia402 match; any other 402 node stays cia402.
     canopen_match=lambda node: 5 if node.profile == 402 and not node.vendor_id and node.revision == 112 else 0,
     sim_faults=SIM_FAULTS,
+    # 6064h, 606Ch and 6041h by SDO, as for any CiA 402 drive.
+    poll_fields=_cia402_poll_fields,
 )
 
 

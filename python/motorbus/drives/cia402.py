@@ -748,6 +748,12 @@ SIM_FAULTS = {
     "drive_fault": lambda sim, code=0x5441: sim.inject_fault(int(code)),
     # (no "stall": the generic simulator reports the commanded position, a jam would not show)
 }
+def poll_fields(drive: Cia402Drive, fields: Sequence[str]):
+    """motorbus.Poller: 6064h/606Ch/6041h by SDO through the drive's own client."""
+    from ..canopen.poll import CIA402_POLL_OBJECTS, sdo_poll_spec
+
+    return sdo_poll_spec(drive.kind, drive._sdo, drive.native._bus, fields, CIA402_POLL_OBJECTS)
+
 
 PLUGIN = DrivePlugin(
     kind="cia402",
@@ -762,4 +768,5 @@ PLUGIN = DrivePlugin(
     canopen_match=lambda node: 1 if node.profile == 402 else 0,
     synchronised_start=synchronised_start,
     sim_faults=SIM_FAULTS,
+    poll_fields=poll_fields,
 )

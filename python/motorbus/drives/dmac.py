@@ -228,6 +228,9 @@ class DmacClient(_stop_at_exit.StopsMotor, _core.DmacClient):
             raise _core.InvalidArgument(f"DmacClient line: a path, a Port or a LineLink, not {type(line).__name__}")
         super().__init__(line, address=_parse_address(address), baud=baud, verify=verify, timeout=timeout,
                          sleep=sleep)
+        self.link = line          # what a poll source shares (motorbus.Poller)
+        self.baud = baud
+        self._timeout = timeout
         self.on_error = on_error
         self.on_exit = on_exit
         self._open = True
@@ -601,6 +604,21 @@ SIM_FAULTS = {
     # a sensor ("cpu", "driver" or "motor") heats (0.1 degC): past its threshold a thermal fault latches
     "overheat": lambda sim, sensor="motor", tenths_c=900: sim.set_temperature(str(sensor), int(tenths_c)),
 }
+def poll_fields(drive: "DmacDrive", fields: Any) -> "PollSpec":
+    """motorbus.Poller: #POSITION, #SPEED and #STATUS (hex) read by a client of the poll
+    thread's own on the drive's line.  Each READ waits the module's #LINE_DELAY (3 ms
+    from the factory): a DMAC line polls at tens of Hz."""
+    from ..registry import PollSpec
+
+    reads = {"position": ("POSITION", 1.0), "velocity": ("SPEED", 1.0 / _SPEED_PER_INC_S), "status": ("STATUS", 1.0)}
+    for f in fields:
+        if f not in reads:
+            raise _core.InvalidArgument(f"dmac poll field {f!r}: this kind gives {', '.join(reads)}")
+    n = drive.native
+    source = _core.dmac_poll_source(n.link, n.address, [reads[f][0] for f in fields], baud=n.baud,
+                                    timeout=n._timeout)
+    return PollSpec(source=source, scales=tuple(reads[f][1] for f in fields), transport=n.link)
+
 
 PLUGIN = DrivePlugin(
     kind="dmac",
@@ -619,4 +637,5 @@ PLUGIN = DrivePlugin(
     probe_addresses=tuple(f"{a:02d}" for a in range(64)),   # 00-63
     probe_bauds=BAUDRATES,
     sim_faults=SIM_FAULTS,
+    poll_fields=poll_fields,
 )

@@ -726,6 +726,19 @@ SIM_FAULTS = {
     # a load blocks the rotor: with stall detection set up (6017h) the drive reports it
     "stall": lambda sim: sim.set_jammed(True),
 }
+def poll_fields(drive: "Pmc007Drive", fields: Any):
+    """motorbus.Poller: 600Ch (position) and the controller status by SDO.  The
+    PMC007 has no actual-speed object (the Drive measures it over a window), so
+    "velocity" is refused: differentiate the polled position instead."""
+    from ..canopen.poll import sdo_poll_spec
+
+    objects = {}
+    for field, name in (("position", "motor_position"), ("status", "controller_status")):
+        row = OBJECTS[name]
+        objects[field] = (row["index"], row["sub"], row["type"].lower(), 1.0)
+    native = drive.native
+    return sdo_poll_spec(drive.kind, native.sdo, native.bus, fields, objects)
+
 
 PLUGIN = DrivePlugin(
     kind="pmc007",
@@ -742,4 +755,5 @@ PLUGIN = DrivePlugin(
     # only mark the manual leaves.  A CiA 402 drive reports its profile instead.
     canopen_match=lambda node: 2 if node.device_type == 0 and not node.vendor_id and not node.product_code else 0,
     sim_faults=SIM_FAULTS,
+    poll_fields=poll_fields,
 )

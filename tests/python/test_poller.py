@@ -1,0 +1,251 @@
+"""motorbus.Poller against simulated drives behind real transports (Arcus on a pty,
+CiA 402 over socketcand on 127.0.0.1): the frame follows the drives while they
+move, one row per deadline, late/missed samples counted and shown as NaN, a lost
+link ends only its group, overflow counted, .npz/.csv round trips, candump."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+import motorbus
+from motorbus import Bench, Poller, load_frame
+
+
+def _bench(**extra_axes):
+    axes = {
+        "x": {"kind": "arcus", "line": "rs485", "address": 1, "units": {"name": "mm", "scale": 0.0025}},
+        "y": {"kind": "arcus", "line": "rs485", "address": 2},
+        "z": {"kind": "cia402", "bus": "can0", "address": 5, "units": {"name": "deg", "scale": 0.1}},
+    }
+    axes.update(extra_axes)
+    return Bench.from_dict({"line": {"rs485": {"port": "/dev/ttyUSB-poller-test"}},
+                            "bus": {"can0": {"spec": "socketcan:can0"}}, "axis": axes}, sim=True)
+
+
+def _prepare(bench):
+    for name, d in bench.axes.items():
+        d.enable()
+        if d.kind == "arcus":
+            d.params["HSPD"] = 20000
+            d.params["ACC"] = 20
+        else:
+            d.params["0x6081"] = 20000
+            d.params["0x6083"] = 400000
+            d.params["0x6084"] = 400000
+
+
+def _finite(a):
+    return a[~np.isnan(a)]
+
+
+def test_frame_follows_moving_drives_in_user_units():
+    with _bench() as bench:
+        _prepare(bench)
+        x, z = bench["x"], bench["z"]
+        with Poller(bench.axes, rate_hz=200) as poller:
+            time.sleep(0.05)
+            x.move_to(10.0)            # 4000 counts at 20000 counts/s: ~0.2 s
+            z.move_to(300.0)           # 3000 increments
+            x.wait_idle(timeout=10)
+            z.wait_idle(timeout=10)
+            time.sleep(0.1)
+        frame = poller.frame()
+        assert set(frame) == set(poller.columns)
+        assert poller.columns[:5] == ["t", "x.t", "x.position", "x.velocity", "x.status"]
+        for axis, drive in (("x", x), ("z", z)):
+            pos = _finite(frame[f"{axis}.position"])
+            assert len(pos) > 20
+            assert np.all(np.diff(pos) >= 0), f"{axis}: position went back during a forward move"
+            assert pos[0] == pytest.approx(0.0, abs=1e-9)
+            assert pos[-1] == pytest.approx(drive.position, abs=1e-9)   # user units, the drive's own reading
+            inside = pos[(pos > 0) & (pos < drive.position)]
+            assert len(inside) >= 3, f"{axis}: no sample caught the move under way"
+        # Velocity in user units: x's PS of 20000 counts/s is 50 mm/s at full speed.
+        assert np.nanmax(frame["x.velocity"]) == pytest.approx(50.0, rel=0.05)
+        assert np.nanmax(frame["z.velocity"]) == pytest.approx(2000.0, rel=0.05)   # 20000 inc/s * 0.1
+        # Status: the raw words, unscaled: the last sample is what the drive says now.
+        assert frame["x.status"][~np.isnan(frame["x.status"])][-1] == x.native.query("MST")
+        assert frame["z.status"][~np.isnan(frame["z.status"])][-1] == z._sdo.read_u16(0x6041)
+        # One row per deadline, on the asked period; each group's own timestamps increase.
+        t = frame["t"]
+        assert np.all(np.diff(t) > 0)
+        assert np.allclose(np.diff(t), 0.005)
+        for axis in ("x", "y", "z"):
+            taken = ~np.isnan(frame[f"{axis}.t"])
+            ts, deadlines = frame[f"{axis}.t"][taken], t[taken]
+            assert np.all(np.diff(ts) > 0)
+            # Each sample starts inside its own period: never before its deadline, never a period late...
+            assert np.all(ts >= deadlines) and np.all(ts < deadlines + 0.005)
+            # ...so over the run the samples keep the asked period on average (no drift), misses or not.
+            assert (ts[-1] - ts[0]) / (deadlines[-1] - deadlines[0]) == pytest.approx(1.0, abs=0.05)
+        # Two groups: the line of x and y, the bus of z.
+        stats = poller.stats
+        assert sorted(stats) == ["x+y", "z"]
+        assert stats["x+y"]["transport"] == "serial" and stats["z"]["transport"] == "can"
+        for s in stats.values():
+            assert s["error"] == "" and not s["running"] and s["samples"] > 40
+            rows = s["samples"] + s["missed"]
+            assert rows == len(frame["t"]) or rows == len(frame["t"]) - 1 or rows == len(frame["t"]) + 1
+
+
+def test_read_returns_only_new_rows_and_frame_all_of_them():
+    with _bench() as bench:
+        with Poller({"x": bench["x"], "z": bench["z"]}, fields=("position",), rate_hz=500) as poller:
+            time.sleep(0.1)
+            first = poller.read()
+            time.sleep(0.1)
+            second = poller.read()
+        rest = poller.read()
+        frame = poller.frame()
+    assert list(first) == ["t", "x.t", "x.position", "z.t", "z.position"]
+    assert len(first["t"]) > 10 and len(second["t"]) > 10
+    joined = np.concatenate([first["t"], second["t"], rest["t"]])
+    assert np.all(np.diff(joined) > 0), "a deadline came twice across reads"
+    np.testing.assert_array_equal(frame["t"], joined)
+
+
+def test_a_rate_the_line_cannot_carry_counts_late_and_missed_samples_as_nan_rows():
+    # Six ASCII transactions on one pty line per sample cannot fit in 50 µs.
+    with _bench() as bench:
+        with Poller({"x": bench["x"], "y": bench["y"]}, rate_hz=20000) as poller:
+            time.sleep(0.3)
+        s = poller.stats["x+y"]
+        frame = poller.frame()
+    assert s["late"] > 10 and s["missed"] > 10
+    missed_rows = np.isnan(frame["x.position"])
+    assert int(missed_rows.sum()) == s["missed"]
+    assert np.all(np.isnan(frame["x.t"][missed_rows]))
+    assert s["read_time_p50"] > 50e-6
+    assert len(frame["t"]) == s["samples"] + s["missed"]
+
+
+@pytest.mark.parametrize("lose", ["line", "bus"])
+def test_a_lost_link_ends_its_group_with_the_error_and_the_other_goes_on(lose):
+    bench = _bench()
+    try:
+        with Poller(bench.axes, rate_hz=200) as poller:
+            time.sleep(0.1)
+            gone, other = ("x+y", "z") if lose == "line" else ("z", "x+y")
+            kind = motorbus._core.PtyLineServer if lose == "line" else motorbus.bus_server.BusServers
+            for srv in [s for s in bench._servers if isinstance(s, kind)]:
+                srv.close()
+            deadline = time.monotonic() + 5
+            while poller.stats[gone]["running"] and time.monotonic() < deadline:
+                time.sleep(0.01)
+            stats = poller.stats
+            assert not stats[gone]["running"]
+            assert stats[gone]["error_type"] in ("LinkDown", "TimeoutError"), stats[gone]
+            assert stats[gone]["error"]
+            before = stats[other]["samples"]
+            time.sleep(0.1)
+            assert poller.stats[other]["running"] and poller.stats[other]["samples"] > before
+            t0 = time.monotonic()
+        assert time.monotonic() - t0 < 2.0, "stop() took too long"
+        assert not poller.running
+    finally:
+        bench.close()
+
+
+def test_lost_serial_link_is_linkdown():
+    bench = _bench()
+    try:
+        with Poller({"x": bench["x"]}, rate_hz=200) as poller:
+            time.sleep(0.05)
+            for srv in [s for s in bench._servers if isinstance(s, motorbus._core.PtyLineServer)]:
+                srv.close()
+            deadline = time.monotonic() + 5
+            while poller.running and time.monotonic() < deadline:
+                time.sleep(0.01)
+        assert poller.stats["x"]["error_type"] == "LinkDown"
+    finally:
+        bench.close()
+
+
+def test_a_tiny_ring_counts_what_the_reader_lost():
+    with _bench() as bench:
+        with Poller({"z": bench["z"]}, fields=("position",), rate_hz=500, capacity=8) as poller:
+            time.sleep(0.2)
+        s = poller.stats["z"]
+        frame = poller.frame()
+    assert len(frame["t"]) == 8
+    assert s["overflowed"] == s["samples"] + s["missed"] - 8 > 0
+
+
+def test_save_npz_and_csv_round_trip(tmp_path):
+    with _bench() as bench:
+        with Poller(bench.axes, rate_hz=200) as poller:
+            time.sleep(0.1)
+        frame = poller.frame()
+        poller.save(tmp_path / "run.npz")
+        poller.save(tmp_path / "run.csv")
+    for name in ("run.npz", "run.csv"):
+        back = load_frame(tmp_path / name)
+        assert list(back) == list(frame)
+        for k in frame:
+            np.testing.assert_array_equal(back[k], frame[k], err_msg=f"{name}: {k}")
+    assert (tmp_path / "run.csv").read_text().splitlines()[0].startswith("t,x.t,x.position,")
+    with pytest.raises(motorbus.InvalidArgument, match=".npz or .csv"):
+        poller.save(tmp_path / "run.txt")
+
+
+def test_candump_records_the_sdo_traffic_of_the_poll(tmp_path):
+    log = tmp_path / "poll.log"
+    with _bench() as bench:
+        with Poller({"z": bench["z"]}, fields=("position", "status"), rate_hz=200, candump=log) as poller:
+            time.sleep(0.1)
+        samples = poller.stats["z"]["samples"]
+    entries, bad = motorbus.read_log(str(log))
+    assert bad == 0
+    responses = [bytes(e.frame.data) for e in entries if e.frame.id == 0x585]
+    # One expedited upload response per object per sample: 6064h (4 bytes) and 6041h (2 bytes).
+    position = [r for r in responses if r[:4] == bytes([0x43, 0x64, 0x60, 0x00])]
+    status = [r for r in responses if r[:4] == bytes([0x4B, 0x41, 0x60, 0x00])]
+    assert abs(len(position) - samples) <= 1 and abs(len(status) - samples) <= 1
+
+
+def test_bad_arguments_are_named():
+    with _bench() as bench:
+        for kwargs, says in [(dict(rate_hz=0), "rate_hz"), (dict(fields=("torque",)), "torque"),
+                             (dict(fields=()), "at least one"), (dict(capacity=0), "capacity"),
+                             (dict(spin_us=5000), "spin_us"), (dict(fields=("position", "position")), "once")]:
+            with pytest.raises(motorbus.InvalidArgument, match=says):
+                Poller(bench.axes, **kwargs)
+        with pytest.raises(motorbus.InvalidArgument, match="at least one axis"):
+            Poller([])
+        with pytest.raises(motorbus.InvalidArgument, match="twice"):
+            Poller([bench["x"], bench["x"]])
+        with pytest.raises(motorbus.InvalidArgument, match="a motorbus.Drive"):
+            Poller({"q": 5})
+        p = Poller(bench["z"], start=False)
+        p.start()
+        with pytest.raises(motorbus.InvalidArgument, match="already started"):
+            p.start()
+        p.stop()
+
+
+@pytest.mark.parametrize("kind,address,transport", [("dmac", "00", "line"), ("pmc007", "5", "bus"),
+                                                     ("arcus-canopen", "1", "bus")])
+def test_other_kinds_poll_their_own_objects(kind, address, transport):
+    link = {"line": "l1"} if transport == "line" else {"bus": "can0"}
+    bench = Bench.from_dict({"line": {"l1": {"port": "/dev/ttyUSB-poller-other"}},
+                             "bus": {"can0": {"spec": "socketcan:can0"}},
+                             "axis": {"q": {"kind": kind, "address": address, **link}}}, sim=True)
+    with bench:
+        q = bench["q"]
+        q.enable()
+        fields = ("position", "status") if kind == "pmc007" else ("position", "velocity", "status")
+        with Poller(bench.axes, fields=fields, rate_hz=20) as poller:
+            q.move_by(500)
+            q.wait_idle(timeout=20)
+            time.sleep(0.3)
+        frame = poller.frame()
+        assert poller.stats["q"]["error"] == ""
+        pos = _finite(frame["q.position"])
+        assert len(pos) >= 3
+        assert np.all(np.diff(pos) >= 0)
+        assert pos[-1] == pytest.approx(q.position)
+        if kind == "pmc007":
+            with pytest.raises(motorbus.InvalidArgument, match="velocity"):
+                Poller(bench.axes, fields=("velocity",))
