@@ -74,8 +74,10 @@ class Ser2net:
             f"  accepter: telnet(rfc2217),tcp,127.0.0.1,{self.rfc2217_port}\n"
             f"  connector: serialdev,{pty},9600n81,local\n")
         # -n: stay in the foreground; -u: no UUCP lock files (the pty is ours).
+        # Not under the sanitizer run's preloaded ASan runtime: ser2net is not ours to check.
+        env = {k: v for k, v in os.environ.items() if k not in ("LD_PRELOAD", "ASAN_OPTIONS", "UBSAN_OPTIONS")}
         self.proc = subprocess.Popen([SER2NET, "-n", "-u", "-c", str(config), "-P", str(tmp / "ser2net.pid")],
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
         deadline = time.monotonic() + 10
         for port in (self.raw_port, self.rfc2217_port):
             while True:

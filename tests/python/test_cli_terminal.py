@@ -28,19 +28,23 @@ units = { name = "mm", scale = 0.0025 }
 
 
 class Pane:
+    """A tmux session on a tmux server of its own (-L): a test never races another test's
+    server starting or exiting (a new session on a server that is exiting fails)."""
+
     def __init__(self, tmp_path):
         self.name = f"motorbus-{uuid.uuid4().hex[:8]}"
-        subprocess.run(["tmux", "new-session", "-d", "-s", self.name, "-x", "160", "-y", "40",
-                        "-c", str(tmp_path)], check=True)
+        self.tmux = ["tmux", "-L", self.name]
+        subprocess.run(self.tmux + ["new-session", "-d", "-s", self.name, "-x", "160", "-y", "40",
+                                    "-c", str(tmp_path)], check=True)
 
     def type(self, text: str, enter: bool = True) -> None:
-        subprocess.run(["tmux", "send-keys", "-t", self.name, text] + (["Enter"] if enter else []), check=True)
+        subprocess.run(self.tmux + ["send-keys", "-t", self.name, text] + (["Enter"] if enter else []), check=True)
 
     def ctrl_c(self) -> None:
-        subprocess.run(["tmux", "send-keys", "-t", self.name, "C-c"], check=True)
+        subprocess.run(self.tmux + ["send-keys", "-t", self.name, "C-c"], check=True)
 
     def text(self) -> str:
-        return subprocess.run(["tmux", "capture-pane", "-p", "-t", self.name, "-S", "-200"], check=True,
+        return subprocess.run(self.tmux + ["capture-pane", "-p", "-t", self.name, "-S", "-200"], check=True,
                               capture_output=True, text=True).stdout
 
     def wait_for(self, needle: str, timeout: float = 60.0) -> str:
@@ -53,7 +57,7 @@ class Pane:
         raise AssertionError(f"{needle!r} never appeared in the pane:\n{self.text()}")
 
     def close(self) -> None:
-        subprocess.run(["tmux", "kill-session", "-t", self.name], check=False)
+        subprocess.run(self.tmux + ["kill-server"], check=False)
 
 
 @pytest.fixture
