@@ -17,9 +17,11 @@ never imports this module.  The device follows ophyd-async's own motor
 (``ophyd_async.epics.motor.Motor``): ``user_readback`` (hinted, named as the
 device), ``user_setpoint``, ``velocity``, ``low_limit_travel`` /
 ``high_limit_travel``, ``motor_egu``; ``set(x)`` moves and waits for the drive to
-be at rest, ``stop()`` stops the axis.  Every signal reads the drive when read
-(no cached values), each drive call on a worker thread so the RunEngine's event
-loop never waits on a serial line or a CAN bus.
+be at rest, ``stop()`` stops the axis.  Every signal reads the drive when read,
+except ``user_readback`` while the device is staged (ophyd-async then reads its
+monitor, refreshed every ``POLL_PERIOD`` and at the end of each move); each drive
+call runs on a worker thread so the RunEngine's event loop never waits on a serial
+line or a CAN bus.
 """
 from __future__ import annotations
 

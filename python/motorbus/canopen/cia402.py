@@ -111,6 +111,11 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
         """The drive's CANopen node-ID."""
         return self._node
 
+    @property
+    def bus(self) -> Optional[_core.Bus]:
+        """The bus this drive object was opened on (None when given only an SDO client)."""
+        return self._bus
+
     def set_mode(self, mode: int) -> None:  # accepts OpMode or int
         super().set_mode(int(mode))
 

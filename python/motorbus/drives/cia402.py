@@ -752,7 +752,7 @@ def poll_fields(drive: Cia402Drive, fields: Sequence[str]):
     """motorbus.Poller: 6064h/606Ch/6041h by SDO through the drive's own client."""
     from ..canopen.poll import CIA402_POLL_OBJECTS, sdo_poll_spec
 
-    return sdo_poll_spec(drive.kind, drive._sdo, drive.native._bus, fields, CIA402_POLL_OBJECTS)
+    return sdo_poll_spec(drive.kind, drive._sdo, drive.native.bus, fields, CIA402_POLL_OBJECTS)
 
 
 PLUGIN = DrivePlugin(

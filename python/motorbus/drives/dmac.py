@@ -230,7 +230,7 @@ class DmacClient(_stop_at_exit.StopsMotor, _core.DmacClient):
                          sleep=sleep)
         self.link = line          # what a poll source shares (motorbus.Poller)
         self.baud = baud
-        self._timeout = timeout
+        self.timeout = timeout    # reply timeout (s), which a poll source reuses
         self.on_error = on_error
         self.on_exit = on_exit
         self._open = True
@@ -616,7 +616,7 @@ def poll_fields(drive: "DmacDrive", fields: Any) -> "PollSpec":
             raise _core.InvalidArgument(f"dmac poll field {f!r}: this kind gives {', '.join(reads)}")
     n = drive.native
     source = _core.dmac_poll_source(n.link, n.address, [reads[f][0] for f in fields], baud=n.baud,
-                                    timeout=n._timeout)
+                                    timeout=n.timeout)
     return PollSpec(source=source, scales=tuple(reads[f][1] for f in fields), transport=n.link)
 
 
