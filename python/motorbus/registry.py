@@ -103,6 +103,11 @@ class DrivePlugin:
     #: field names among "position", "velocity", "status" (InvalidArgument for a
     #: field the kind cannot give).  None: the kind cannot be polled.
     poll_fields: Optional[Callable[..., "PollSpec"]] = None
+    #: The kind's own profile model for a position move of an open Drive:
+    #: ``plan_move(drive, start, target) -> motion.Profile`` in native units,
+    #: t = 0 at the command, from the drive's current speed/ramp parameters
+    #: (``motorbus.plot.planned``, ``motorbus demo``).  None: no model.
+    plan_move: Optional[Callable[..., Any]] = None
 
     def __post_init__(self) -> None:
         if self.transport not in ("serial", "can"):
