@@ -312,6 +312,34 @@ def test_pmc007_end_to_end_on_local_node():
     node.close()
 
 
+def test_tpdo_carries_what_the_read_hook_answers():
+    """A TPDO reads its objects as an SDO upload does, through the read hook: a simulator
+    that computes 6064h when asked (the CiA 402 sim) sends its live position, not the
+    value the dictionary last stored (which stays 0 here)."""
+    from motorbus.canopen import LocalNode, ObjectDictionary, PdoService, SdoClient
+
+    dev, host = pair()
+    od = ObjectDictionary()
+    live = {"position": -1234}
+    var = od.add_variable(0x6064, "Position actual value", "I32", access="ro", pdo_mappable=True, default=0)
+    var.set_read_hook(lambda v, current: live["position"].to_bytes(4, "little", signed=True))
+    node = LocalNode(dev, 5, od)
+    PdoService(node)
+    configure_pdo(SdoClient(host, 5), 5, tpdo=1, transmission_type=1, mapping=[(0x6064, 0, 32, True)])
+    rx = PdoReceiver(host, 0x185, [(0x6064, 0, 32, True)])
+    NmtMaster(host).start(5)
+    seen = []
+    for position in (-1234, 5678):
+        live["position"] = position
+        after = rx.received
+        host.send(_core.Frame(0x080, b""))                   # SYNC: transmission type 1 sends TPDO 1
+        assert rx.wait_newer(after, timeout=2.0) is not None
+        seen.append(rx.value(0x6064))
+    assert [v - (1 << 32) if v >= 1 << 31 else v for v in seen] == [-1234, 5678]
+    assert od[0x6064, 0].raw == bytes(4)                    # nothing was stored: the hook answered
+    node.close()
+
+
 def test_heartbeat_service_on_local_node_applies_loss_of_master():
     from motorbus.canopen import HeartbeatService
     from motorbus.canopen import LocalNode, ObjectDictionary, SdoClient
