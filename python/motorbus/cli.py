@@ -122,9 +122,13 @@ def cmd_drives(args: argparse.Namespace) -> int:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    from . import demo
+    if args.tour:
+        from . import demo
 
-    return demo.main(quick=args.quick)
+        return demo.tour(quick=args.quick)
+    from . import bench_demo
+
+    return bench_demo.main(quick=args.quick, out=args.out, bench_file=args.bench)
 
 
 # ---------------------------------------------------------------------------
@@ -182,7 +186,12 @@ def build_parser() -> argparse.ArgumentParser:
     cli_monitor.add_commands(sub)
 
     dm = sub.add_parser("demo", help="run the simulated bench demo")
-    dm.add_argument("--quick", action="store_true", help="shorter run (used by the tests)")
+    dm.add_argument("--quick", action="store_true", help="shorter moves (used by the tests)")
+    dm.add_argument("--out", default=None, metavar="DIR",
+                    help="where to write the recording and plot (default: ./motorbus-demo)")
+    dm.add_argument("--bench", default=None, metavar="FILE",
+                    help="bench file to simulate (default: the demo bench shipped with motorbus)")
+    dm.add_argument("--tour", action="store_true", help="instead: the older tour of the transports one by one")
     dm.set_defaults(func=cmd_demo)
     return p
 

@@ -1,4 +1,6 @@
-"""``motorbus demo``: a whole simulated bench over real transports, no hardware.
+"""``motorbus demo --tour``: the transports one at a time, no hardware.
+
+(``motorbus demo`` itself is the bench demo in ``bench_demo.py``.)
 
 1. Serial: an RS-485 line (pty) with two Arcus DMX-CAN drives and an RS-232
    line with a Midi DMAC, served by ``motorbus sim serve`` in a child process
@@ -188,8 +190,9 @@ def canopen_bench(quick: bool, workdir: str) -> None:
             node.close()
 
 
-def main(quick: bool = False) -> int:
-    print("motorbus demo: a simulated bench over real transports (ptys, TCP on 127.0.0.1)")
+def tour(quick: bool = False) -> int:
+    """``motorbus demo --tour``: the transports one by one."""
+    print("motorbus demo --tour: the transports one by one (ptys, TCP on 127.0.0.1)")
     with tempfile.TemporaryDirectory(prefix="motorbus-demo-") as workdir:
         serial_bench(quick)
         can_bench(quick, workdir)

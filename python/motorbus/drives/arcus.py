@@ -617,6 +617,23 @@ def poll_fields(drive: ArcusDrive, fields: Any) -> "PollSpec":
     return PollSpec(source=source, scales=(1.0,) * len(names), transport=link)
 
 
+def plan_move(drive: ArcusDrive, start: float, target: float) -> Any:
+    """The move as the DMX-CAN makes it (its profile model, ``ArcusMotion``: jump to
+    LSPD, ramp in ACC ms, cruise at HSPD, DEC with EDEC, S-curve with SCV), in the
+    drive's position unit (encoder counts with StepNLoop on, pulses off)."""
+    from .. import motion
+
+    p = drive.params
+    hspd, lspd = float(p["HSPD"]), float(p["LSPD"])
+    params = motion.ArcusProfileParams(hspd=hspd, lspd=min(lspd, hspd), acc_ms=float(p["ACC"]),
+                                       dec_ms=float(p["DEC"]), edec=bool(p["EDEC"]), scv=bool(p["SCV"]),
+                                       snl_ratio=float(p["SLR"]) if drive._snl else 1.0)
+    model = motion.ArcusMotion(params)
+    error = model.move(float(start), float(target))
+    if error:
+        raise _core.InvalidArgument(f"arcus plan_move {start} -> {target}: the drive would answer {error}")
+    return model.profile
+
 PLUGIN = DrivePlugin(
     kind="arcus",
     description="Arcus DMX-CAN integrated stepper, ASCII over RS-232/RS-485 (StepNLoop closed loop)",
@@ -634,4 +651,5 @@ PLUGIN = DrivePlugin(
     probe_bauds=(9600, 19200, 38400, 57600, 115200),              # the DB settings
     sim_faults=SIM_FAULTS,
     poll_fields=poll_fields,
+    plan_move=plan_move,
 )

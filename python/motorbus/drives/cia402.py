@@ -755,6 +755,17 @@ def poll_fields(drive: Cia402Drive, fields: Sequence[str]):
     return sdo_poll_spec(drive.kind, drive._sdo, drive.native.bus, fields, CIA402_POLL_OBJECTS)
 
 
+def plan_move(drive: Cia402Drive, start: float, target: float) -> Any:
+    """Profile position mode as CiA 402 defines it: 6081h velocity, 6083h/6084h
+    accelerations, 6086h ramp shape (0 linear, 1 sin²), 607Fh cap; increments."""
+    from .. import motion
+
+    p = drive.params
+    params = motion.Cia402ProfileParams(profile_velocity=float(p["0x6081"]), profile_acceleration=float(p["0x6083"]),
+                                        profile_deceleration=float(p["0x6084"]),
+                                        motion_profile_type=int(p["0x6086"]), max_profile_velocity=float(p["0x607F"]) if "0x607F" in p else 0.0)
+    return motion.cia402_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
+
 PLUGIN = DrivePlugin(
     kind="cia402",
     description="any CiA 402 drive on CANopen (profile position, profile velocity, homing); simulated generically",
@@ -769,4 +780,5 @@ PLUGIN = DrivePlugin(
     synchronised_start=synchronised_start,
     sim_faults=SIM_FAULTS,
     poll_fields=poll_fields,
+    plan_move=plan_move,
 )

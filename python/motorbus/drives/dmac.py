@@ -620,6 +620,16 @@ def poll_fields(drive: "DmacDrive", fields: Any) -> "PollSpec":
     return PollSpec(source=source, scales=tuple(reads[f][1] for f in fields), transport=n.link)
 
 
+def plan_move(drive: "DmacDrive", start: float, target: float) -> Any:
+    """A DMAC position move (its profile model: #ACCEL_TIME/#DECEL_TIME to and from
+    #HIGH_SPEED, the closed-loop approach at #LOW_SPEED, S_CURVE), in increments."""
+    from .. import motion
+
+    p = drive.params
+    params = motion.DmacProfileParams(high_speed=int(p["#HIGH_SPEED"]), low_speed=int(p["#LOW_SPEED"]),
+                                      accel_time_ms=int(p["#ACCEL_TIME"]), decel_time_ms=int(p["#DECEL_TIME"]))
+    return motion.dmac_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
+
 PLUGIN = DrivePlugin(
     kind="dmac",
     description="Midi Ingénierie DMAC17/23/34 brushless modules, ASCII protocol over RS-232/RS-485",
@@ -638,4 +648,5 @@ PLUGIN = DrivePlugin(
     probe_bauds=BAUDRATES,
     sim_faults=SIM_FAULTS,
     poll_fields=poll_fields,
+    plan_move=plan_move,
 )
