@@ -1,17 +1,20 @@
 """The notebooks in notebooks/ run headless, top to bottom, in a real Jupyter kernel, and
 print what they say they show.
 
-Each notebook is executed by nbclient in a fresh kernel (ipykernel's own "python3" spec,
-which starts this interpreter, sys.executable) with notebooks/ as its working directory,
-the way `jupyter nbconvert --execute` would.  A cell that raises fails the test with the
+Each notebook is executed by nbclient in a fresh ipykernel kernel running this interpreter
+(sys.executable: a kernel spec of our own, under a name no user spec takes, so a "python3"
+spec in ~/.local/share/jupyter cannot send the notebook to another Python), with notebooks/
+as its working directory, the way `jupyter nbconvert --execute` would.  A cell that raises fails the test with the
 cell's traceback.  The checks read the notebook's outputs: the values it prints and the
 PNG its plot cell displays.
 """
 from __future__ import annotations
 
 import base64
+import json
 import pathlib
 import re
+import sys
 
 import nbformat
 import pytest
@@ -24,10 +27,26 @@ NOTEBOOKS = pathlib.Path(__file__).resolve().parents[2] / "notebooks"
 CELL_TIMEOUT = 60   # s; each notebook takes a few seconds
 
 
-def run(name: str) -> tuple[str, list[bytes]]:
+KERNEL = "motorbus-tests"
+
+
+@pytest.fixture
+def kernel(tmp_path, monkeypatch) -> str:
+    """A kernel spec that starts sys.executable, found through JUPYTER_PATH."""
+    spec = tmp_path / "kernels" / KERNEL
+    spec.mkdir(parents=True)
+    (spec / "kernel.json").write_text(json.dumps({
+        "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
+        "display_name": "motorbus tests", "language": "python"}))
+    monkeypatch.setenv("JUPYTER_PATH", str(tmp_path))
+    return KERNEL
+
+
+def run(name: str, kernel: str) -> tuple[str, list[bytes]]:
     """Execute notebooks/<name>; return its printed text and its PNG images."""
     nb = nbformat.read(NOTEBOOKS / name, as_version=4)
-    client = NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name="python3",
+    nb.cells.append(nbformat.v4.new_code_cell("import sys; print('kernel python', sys.executable)"))
+    client = NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name=kernel,
                             resources={"metadata": {"path": str(NOTEBOOKS)}})
     client.execute()
     text, pngs = [], []
@@ -37,7 +56,9 @@ def run(name: str) -> tuple[str, list[bytes]]:
                 text.append(out.text)
             elif out.output_type in ("display_data", "execute_result") and "image/png" in out.data:
                 pngs.append(base64.b64decode(out.data["image/png"]))
-    return "".join(text), pngs
+    out = "".join(text)
+    assert f"kernel python {sys.executable}" in out
+    return out, pngs
 
 
 def number(text: str, pattern: str) -> float:
@@ -55,8 +76,8 @@ def test_notebooks_are_committed_without_outputs():
                 assert not cell.outputs and cell.execution_count is None, f"{path.name}: clear its outputs"
 
 
-def test_01_bench_tour():
-    out, _ = run("01_bench_tour.ipynb")
+def test_01_bench_tour(kernel):
+    out, _ = run("01_bench_tour.ipynb", kernel)
     for name, kind in (("x", "arcus"), ("y", "dmac"), ("z", "cia402"), ("r", "arcus-canopen"), ("p", "pmc007"),
                        ("u", "unitek")):
         assert re.search(rf"^{name}: {kind} ", out, re.M), out
@@ -71,10 +92,11 @@ def test_01_bench_tour():
     assert "frame spacing at 250 kbit/s (us): [540.0, 540.0, 540.0]" in out
 
 
-def test_02_motion_preview_vs_measured():
-    out, pngs = run("02_motion_preview_vs_measured.ipynb")
+def test_02_motion_preview_vs_measured(kernel):
+    out, pngs = run("02_motion_preview_vs_measured.ipynb", kernel)
     duration = number(out, r"planned duration ([\d.]+) s")
     assert duration == pytest.approx(1.25)        # 50 mm at 50 mm/s, 200 mm/s² ramps: 0.25 + 0.75 + 0.25
+    assert number(out, r"motion.plan trapezoid ([\d.]+) s") == pytest.approx(duration, abs=1e-3)  # the kind's model
     assert number(out, r"final position ([-\d.]+) mm") == 50.0
     samples = number(out, r"samples during the move (\d+)")
     assert samples > 0.3 * duration * 1000        # a 1 kHz poll, of which a loaded machine misses some
@@ -89,8 +111,8 @@ def test_02_motion_preview_vs_measured():
     assert pngs and all(p.startswith(b"\x89PNG") for p in pngs)
 
 
-def test_03_streaming():
-    out, _ = run("03_streaming.ipynb")
+def test_03_streaming(kernel):
+    out, _ = run("03_streaming.ipynb", kernel)
     tpdos = number(out, r"TPDOs received (\d+)")
     assert tpdos >= 300                           # ~0.5 s of 1 ms SYNCs or more
     assert abs(tpdos - number(out, r"SYNCs sent (\d+)")) <= 1    # one TPDO per SYNC, none lost
