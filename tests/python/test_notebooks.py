@@ -84,12 +84,15 @@ def test_01_bench_tour(kernel):
         assert f"position {name}: 10.00 mm" in out
         assert re.search(rf"^status {name}: enabled=True moving=False fault=False", out, re.M), out
     assert "identity x: DriveMax-CAN" in out                       # the Arcus ID reply
+    assert "identity y: 00EV v1.7" in out                           # the DMAC's REQUEST_VERSION
     assert "identity z: motorbus CiA 402 sim" in out                # 1008h over SDO
+    assert "identity p: PMC007 (motorbus sim)" in out
+    assert "identity u: REGID drive receiving on 0x201, sending on 0x181" in out
     assert "diff after apply: []" in out
     assert "x encoder 1000" in out
     assert "moving: ['p', 'r', 'u', 'x', 'y', 'z']" in out         # every axis jogged...
     assert "stop failures: []" in out and "moving after stop: []" in out   # ...and stopped
-    assert "frame spacing at 250 kbit/s (us): [540.0, 540.0, 540.0]" in out
+    assert "frame spacing at 50 kbit/s (us): [2700.0]" in out      # every gap one 135-bit wire time
 
 
 def test_02_motion_preview_vs_measured(kernel):
