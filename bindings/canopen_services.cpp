@@ -777,10 +777,14 @@ void bind_canopen_services(py::module_& m) {
                  return PdoService::attach(node, o);
              }), py::arg("node"), py::arg("rpdos") = 4, py::arg("tpdos") = 4, py::arg("max_mapped") = 8,
              py::arg("strict") = true, py::arg("sync_window_us") = 0, py::keep_alive<1, 2>())
-        .def("mapping", [](PdoService& s, bool tpdo, unsigned n) { return entries_to(s.engine().mapping(tpdo, n)); },
-             py::arg("tpdo"), py::arg("number"))
+        // The engine holds its lock while a TPDO reads its objects, which may run a Python
+        // read hook (a simulator's live values): never wait for that lock holding the GIL.
+        .def("mapping", [](PdoService& s, bool tpdo, unsigned n) {
+                 auto entries = [&] { py::gil_scoped_release nogil; return s.engine().mapping(tpdo, n); }();
+                 return entries_to(entries);
+             }, py::arg("tpdo"), py::arg("number"))
         .def("cob_id", [](PdoService& s, bool tpdo, unsigned n) { return s.engine().cob_id(tpdo, n); },
-             py::arg("tpdo"), py::arg("number"))
+             py::arg("tpdo"), py::arg("number"), py::call_guard<py::gil_scoped_release>())
         .def("trigger_tpdo", [](PdoService& s, unsigned n) { py::gil_scoped_release nogil; s.engine().trigger_tpdo(n); })
         .def("notify_change", [](PdoService& s, std::uint16_t i, std::uint8_t sub) {
                  py::gil_scoped_release nogil;
@@ -791,7 +795,10 @@ void bind_canopen_services(py::module_& m) {
                  PyCallable call(cb.cast<py::function>());
                  s.engine().on_rpdo_timeout = [call](unsigned n) { call(n); };
              }, py::arg("callback"), "callback(rpdo_number) when an RPDO's event timer expires (P11).")
-        .def_property_readonly("counters", [](PdoService& s) { return s.engine().counters(); });
+        .def_property_readonly("counters", [](PdoService& s) {
+            py::gil_scoped_release nogil;
+            return s.engine().counters();
+        });
 
     py::class_<HeartbeatService, std::shared_ptr<HeartbeatService>>(m, "HeartbeatService",
         "Heartbeat producer (0x1017) and consumer (0x1016) of a LocalNode; EMCY 0x8130 and 0x1029 on loss.")
