@@ -102,6 +102,7 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
         t0 = time.monotonic()
         for name, d in bench.axes.items():
             d.home(timeout=30)
+        bench.apply()   # homing routines may leave their own search speeds behind
         _say(f"  {len(bench)} axes homed in {time.monotonic() - t0:.2f} s: "
              + ", ".join(f"{n}={d.position:g}" for n, d in bench.axes.items()))
 

@@ -79,8 +79,17 @@ def test_polled_axis_against_its_planned_profile(tmp_path):
     moving = (c["t"] > 0.02) & (c["t"] < 0.43)
     assert moving.sum() > 50
     assert c["measured"][-1] == pytest.approx(50.0)
-    # Measured follows the plan: within the command's latency (a few ms at 200 mm/s max).
-    assert np.max(np.abs(c["error"])) < 2.0
+    # Measured follows the plan once the command's latency (the SDO writes and the
+    # controlword handshake; tens of ms on a loaded machine) is taken out: the best lag
+    # is >= 0 (the drive cannot start before the command; a sample is stamped when its
+    # read starts, so up to one read time earlier) and leaves little error.
+    read_time = max(g["read_time_max"] for g in poller.stats.values())   # a sample's value comes this late
+    lags = np.arange(-0.02, 0.2, 0.0005)
+    worst = [np.max(np.abs(plot.compare(frame, "z", plan, t_cmd + lag)["error"])) for lag in lags]
+    best = int(np.argmin(worst))
+    assert lags[best] >= -(read_time + 0.001), (lags[best], read_time)
+    assert worst[best] < 1.0, (lags[best], worst[best])     # mm, on a 50 mm move at up to 200 mm/s
+    assert worst[0] > worst[best]                            # and the comparison does see timing
     ax_p, ax_v = plot.profile(frame, "z", plan, t0=t_cmd, velocity=True, units="mm")
     lines = ax_p.get_lines()
     assert [ln.get_label() for ln in lines] == ["z measured", "z planned"]
