@@ -88,7 +88,8 @@ def test_polled_axis_against_its_planned_profile(tmp_path):
     worst = [np.max(np.abs(plot.compare(frame, "z", plan, t_cmd + lag)["error"])) for lag in lags]
     best = int(np.argmin(worst))
     assert lags[best] >= -(read_time + 0.001), (lags[best], read_time)
-    assert worst[best] < 1.0, (lags[best], worst[best])     # mm, on a 50 mm move at up to 200 mm/s
+    # mm, on a 50 mm move at up to 200 mm/s: what one sample's read time allows at full speed
+    assert worst[best] < 200.0 * (read_time + 0.002) + 0.5, (lags[best], worst[best], read_time)
     assert worst[0] > worst[best]                            # and the comparison does see timing
     ax_p, ax_v = plot.profile(frame, "z", plan, t0=t_cmd, velocity=True, units="mm")
     lines = ax_p.get_lines()
