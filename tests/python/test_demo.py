@@ -32,6 +32,7 @@ def test_bench_demo_quick_discovers_homes_moves_polls_and_plots(tmp_path):
     axes = {"x": "arcus", "y": "arcus", "rot": "dmac", "z": "cia402", "tilt": "arcus-canopen", "feed": "pmc007",
             "spindle": "unitek"}
     assert "7/7 axes found as the file describes them" in text
+    assert "not in the file: nothing" in text
     assert "7 axes homed" in text
     for axis, kind in axes.items():   # one row per axis in the move's table, with its kind
         assert re.search(rf"\b{re.escape(axis)}\b\s*.\s*{re.escape(kind)}\b", text), (axis, text)
