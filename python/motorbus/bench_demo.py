@@ -32,30 +32,47 @@ DEFAULT_BENCH = os.path.join(os.path.dirname(__file__), "demo_bench.toml")
 #: Targets of the coordinated move, in each axis's user units (quick: shorter moves).
 TARGETS = {"x": 25.0, "y": -10.0, "rot": 720.0, "z": 100.0, "tilt": 20.0, "feed": 60.0, "spindle": 90.0}
 RATE_HZ = 1000.0
+#: The bit rate the bus load is computed for.  The twin's virtual buses carry frames
+#: without wire time, so this is the load the recorded traffic would put on a real
+#: 500 kbit/s bus (a common rate for these drives), not a property of the simulation.
+BUS_BITRATE = 500_000
 
 
 def _say(text: str = "") -> None:
     print(text, flush=True)
 
 
-def _discover(bench: Bench) -> list[tuple[str, str, str, str]]:
-    """(axis, kind in the file, address, what answered) for every axis."""
+def _served_spec(bench: Bench, bus: str) -> str:
+    """The open_bus spec of a simulated bus: its socketcand server on 127.0.0.1."""
+    srv = bench.served_buses[bus].servers[0]
+    return f"socketcand:{srv.host}:{srv.port}/can0"
+
+
+def _discover(bench: Bench) -> tuple[list[tuple[str, str, str, str]], list[str]]:
+    """(axis, kind in the file, address, what answered) for every axis, and what
+    answered on a bus that the file does not list."""
     from .discovery import discover
 
-    specs = [cfg["spec"] for cfg in bench._bus_cfg.values()]
-    found = discover(buses=specs, timeout=20.0).found
+    from concurrent.futures import ThreadPoolExecutor
+
+    specs = [_served_spec(bench, name) for name in bench.served_buses]
+    # One discovery per bus, side by side: each waits mostly on reply timeouts.
+    with ThreadPoolExecutor(max_workers=max(1, len(specs))) as pool:
+        found = [f for d in pool.map(lambda spec: discover(buses=[spec], timeout=20.0), specs) for f in d.found]
     on_can = {(f.bus, f.address): f for f in found}
     rows = []
     for name, cfg in bench.config.items():
         plugin = registry.drive_plugin(cfg.kind)
         if cfg.bus:
-            f = on_can.get((bench._bus_cfg[cfg.bus]["spec"], cfg.address))
+            f = on_can.get((_served_spec(bench, cfg.bus), cfg.address))
             got = f"{f.kind} {f.identity.get('model', '')}".strip() if f else "nothing"
         else:   # the line is the bench's own: ask this axis's address with the kind's identity probe
             ident = plugin.probe(bench.lines[cfg.line], cfg.address) if plugin.probe else None
             got = f"{cfg.kind} {ident.get('model', '')}".strip() if ident else "nothing"
         rows.append((name, cfg.kind, cfg.address, got))
-    return rows
+    listed = {(_served_spec(bench, c.bus), c.address) for c in bench.config.values() if c.bus}
+    extra = [f"{f.kind} {f.address} on {f.bus}" for f in found if (f.bus, f.address) not in listed]
+    return rows, extra
 
 
 def _table(title: str, header: list[str], rows: list[list[str]]) -> None:
@@ -85,15 +102,18 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
     with Bench.load(path, sim=True) as bench:
         for name, srv in bench.served_lines.items():
             _say(f"  line {name}: {srv.slave_path}")
-        for name, cfg in bench._bus_cfg.items():
-            _say(f"  bus {name}: {cfg['spec']}")
+        for name in bench.served_buses:
+            _say(f"  bus {name}: {_served_spec(bench, name)}")
 
         _say("\n== discovery over those transports")
-        rows = _discover(bench)
+        t0 = time.monotonic()
+        rows, extra = _discover(bench)
         _table("discovered vs the bench file", ["axis", "file", "address", "discovered"],
                [[a, k, addr, got] for a, k, addr, got in rows])
         matched = sum(1 for _, k, _, got in rows if got.split(" ")[0] == k)
-        _say(f"  {matched}/{len(rows)} axes found as the file describes them")
+        _say(f"  {matched}/{len(rows)} axes found as the file describes them ({time.monotonic() - t0:.1f} s: "
+             f"a CANopen scan of nodes 1-127 and the CAN probes per bus, an identity query per serial axis)")
+        _say("  not in the file: " + (", ".join(extra) if extra else "nothing"))
 
         _say("\n== enable, apply the file's parameters, home")
         bench.apply()
@@ -102,6 +122,7 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
         t0 = time.monotonic()
         for name, d in bench.axes.items():
             d.home(timeout=30)
+        bench.apply()   # homing routines may leave their own search speeds behind
         _say(f"  {len(bench)} axes homed in {time.monotonic() - t0:.2f} s: "
              + ", ".join(f"{n}={d.position:g}" for n, d in bench.axes.items()))
 
@@ -151,7 +172,11 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
                                         "samples", "missed"], table)
 
         png = os.path.join(out, "demo.png")
-        _draw(png, frame, plans, pollable, t_cmd, report.offsets, candump, bench, data)
+        load = _draw(png, frame, plans, pollable, t_cmd, report.offsets, candump, bench, data)
+        if load:
+            _say(f"  CAN bus load of the recording at {BUS_BITRATE / 1000:g} kbit/s (worst-case stuffing): "
+                 f"{load['count']} frames, mean {load['mean']:.1f} %, peak {load['peak']:.1f} % per "
+                 f"{load['window'] * 1000:g} ms")
         np.savez(os.path.join(out, "demo_plot.npz"), **data)
     _say(f"\n  recording: {frame_path}, {candump}")
     _say(f"  plot: {png} (its arrays: {os.path.join(out, 'demo_plot.npz')})")
@@ -160,22 +185,23 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
 
 
 def _draw(png: str, frame: dict, plans: dict, pollable: dict, t_cmd: float, offsets: dict, candump: str,
-          bench: Bench, data: dict) -> None:
+          bench: Bench, data: dict) -> Optional[dict]:
+    """Draws the PNG; returns the bus-load numbers of the first CAN recording (None without one)."""
     try:
         plt = plot._pyplot()
     except plot.MatplotlibMissing as e:
         _say(f"  no plot: {e}")
-        return
+        return None
     axes = [n for n in pollable]
     fig, grid = plt.subplots(len(axes) + 1, 1, figsize=(9, 2.2 * (len(axes) + 1)))
     for ax, n in zip(grid, axes):
         plot.profile(frame, n, plans.get(n), ax=ax, t0=t_cmd + offsets.get(n, 0.0), units=bench[n].units.name)
-    bitrate = 500_000   # the served virtual buses' nominal rate (the recording's frames do not carry it)
-    logs = [p for p in (candump, candump.replace(".log", "-2.log")) if os.path.exists(p)]
-    if logs:
-        _, numbers = plot.bus_load(logs[0], bitrate, window=0.05, ax=grid[-1])
+    numbers = None
+    if os.path.exists(candump) and os.path.getsize(candump):   # the first CAN group's traffic
+        _, numbers = plot.bus_load(candump, BUS_BITRATE, window=0.05, ax=grid[-1])
         for k in ("t", "load"):
             data[f"bus_load.{k}"] = numbers[k]
     fig.tight_layout()
     fig.savefig(png, dpi=90)
     plt.close(fig)
+    return numbers

@@ -56,10 +56,9 @@ def planned(drive: Any, start: float, target: float, n: int = 1000) -> dict[str,
     """The move ``start`` -> ``target`` (user units) as the drive's kind plans it,
     sampled: ``{"t", "p", "v"}`` in seconds and user units, t = 0 at the command.
 
-    The profile model is the kind's own (``DrivePlugin.plan_move``: an Arcus
-    plans with its HSPD/LSPD/ACC/DEC/SCV, a CiA 402 drive with 6081h-6086h...),
-    fed with the drive's current parameters; InvalidArgument for a kind that
-    has none."""
+    The profile model is the kind's own (``DrivePlugin.plan_move``, fed with
+    the drive's current speed and ramp parameters); InvalidArgument for a kind
+    that has none."""
     from .registry import drive_plugin
 
     plugin = drive_plugin(drive.kind)
@@ -108,7 +107,7 @@ def compare(frame: Mapping[str, np.ndarray], axis: str, plan: Any, t0: float,
     clock), ``measured``, ``planned`` (the plan at t, held at its end value after
     its end and at its start value before 0) and ``error`` = measured - planned.
     ``field`` "velocity" compares with the planned velocity (a kind that reports
-    an unsigned speed, e.g. Arcus PS, is compared by magnitude)."""
+    an unsigned speed is compared by magnitude)."""
     t, m = _measured(frame, axis, field)
     t = t - float(t0)
     pt, pp, pv = _planned_arrays(plan)

@@ -32,6 +32,7 @@ def test_bench_demo_quick_discovers_homes_moves_polls_and_plots(tmp_path):
     axes = {"x": "arcus", "y": "arcus", "rot": "dmac", "z": "cia402", "tilt": "arcus-canopen", "feed": "pmc007",
             "spindle": "unitek"}
     assert "7/7 axes found as the file describes them" in text
+    assert "not in the file: nothing" in text
     assert "7 axes homed" in text
     for axis, kind in axes.items():   # one row per axis in the move's table, with its kind
         assert re.search(rf"\b{re.escape(axis)}\b\s*.\s*{re.escape(kind)}\b", text), (axis, text)
@@ -39,7 +40,7 @@ def test_bench_demo_quick_discovers_homes_moves_polls_and_plots(tmp_path):
     assert png.exists() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
     assert (tmp_path / "demo_can.log").stat().st_size > 0
     data = np.load(tmp_path / "demo_plot.npz")
-    for axis in ("x", "y", "rot", "z"):   # the kinds with a profile model
+    for axis in ("x", "y", "rot", "z", "tilt", "feed"):   # every polled axis: each kind has a profile model
         measured, planned, target = data[f"{axis}.measured"], data[f"{axis}.planned"], float(data[f"{axis}.target"])
         assert len(measured) > 20
         assert measured[-1] == pytest.approx(target, abs=1e-6), axis     # reached the target

@@ -79,8 +79,18 @@ def test_polled_axis_against_its_planned_profile(tmp_path):
     moving = (c["t"] > 0.02) & (c["t"] < 0.43)
     assert moving.sum() > 50
     assert c["measured"][-1] == pytest.approx(50.0)
-    # Measured follows the plan: within the command's latency (a few ms at 200 mm/s max).
-    assert np.max(np.abs(c["error"])) < 2.0
+    # Measured follows the plan once the command's latency (the SDO writes and the
+    # controlword handshake; tens of ms on a loaded machine) is taken out: the best lag
+    # is >= 0 (the drive cannot start before the command; a sample is stamped when its
+    # read starts, so up to one read time earlier) and leaves little error.
+    read_time = max(g["read_time_max"] for g in poller.stats.values())   # a sample's value comes this late
+    lags = np.arange(-0.02, 0.2, 0.0005)
+    worst = [np.max(np.abs(plot.compare(frame, "z", plan, t_cmd + lag)["error"])) for lag in lags]
+    best = int(np.argmin(worst))
+    assert lags[best] >= -(read_time + 0.001), (lags[best], read_time)
+    # mm, on a 50 mm move at up to 200 mm/s: what one sample's read time allows at full speed
+    assert worst[best] < 200.0 * (read_time + 0.002) + 0.5, (lags[best], worst[best], read_time)
+    assert worst[0] > worst[best]                            # and the comparison does see timing
     ax_p, ax_v = plot.profile(frame, "z", plan, t0=t_cmd, velocity=True, units="mm")
     lines = ax_p.get_lines()
     assert [ln.get_label() for ln in lines] == ["z measured", "z planned"]
@@ -97,3 +107,53 @@ def test_missing_matplotlib_is_a_clear_error(monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib", None)
     with pytest.raises(plot.MatplotlibMissing, match=r"pip install 'motorbus\[plot\]'"):
         plot.profile({"t": np.zeros(1), "z.position": np.zeros(1)}, "z")
+
+
+def _demo_axis_bench(axis: str) -> Bench:
+    """One axis of the demo's bench file (python/motorbus/demo_bench.toml) as its simulated twin."""
+    import tomllib
+
+    from motorbus.bench_demo import DEFAULT_BENCH
+
+    with open(DEFAULT_BENCH, "rb") as f:
+        data = tomllib.load(f)
+    cfg = data["axis"][axis]
+    keep = {"axis": {axis: cfg}}
+    if "line" in cfg:
+        keep["line"] = {cfg["line"]: data["line"][cfg["line"]]}
+    else:
+        keep["bus"] = {cfg["bus"]: data["bus"][cfg["bus"]]}
+    return Bench.from_dict(keep, sim=True)
+
+
+@pytest.mark.parametrize("axis,target", [("x", 10.0), ("rot", 360.0), ("tilt", 10.0), ("feed", 20.0)])
+def test_each_kinds_plan_move_is_what_its_simulator_does(axis, target):
+    """plan_move of arcus, dmac, arcus-canopen and pmc007 (cia402: the test above) against
+    the kind's simulator over its real transport: once the command latency is taken out,
+    the measured position stays within what one sample's read time allows at full speed."""
+    with _demo_axis_bench(axis) as bench:
+        d = bench[axis]
+        d.enable()
+        bench.apply()
+        start = d.position
+        plan = plot.planned(d, start, target)
+        assert plan["p"][0] == pytest.approx(start) and plan["p"][-1] == pytest.approx(target)
+        with Poller(bench.axes, ("position",), rate_hz=1000) as poller:
+            time.sleep(0.05)
+            t_cmd = motorbus.monotonic_ns() / 1e9
+            d.move_to(target)
+            d.wait_idle(timeout=20)
+            time.sleep(0.05)
+        frame = poller.frame()
+        read_time = max(g["read_time_max"] for g in poller.stats.values())
+    vmax = np.max(np.abs(plan["v"]))
+    lags = np.arange(-0.03, 0.2, 0.0005)
+    worst = [np.max(np.abs(plot.compare(frame, axis, plan, t_cmd + lag)["error"])) for lag in lags]
+    best = int(np.argmin(worst))
+    c = plot.compare(frame, axis, plan, t_cmd + lags[best])
+    assert c["measured"][-1] == pytest.approx(target, abs=1e-6)
+    assert lags[best] >= -(read_time + 0.001), (lags[best], read_time)
+    # The plan's duration is the drive's: the move ends when the plan says (within the sampling).
+    ends = c["t"][np.argmax(np.abs(c["measured"] - target) < 1e-9)]
+    assert ends == pytest.approx(plan["t"][-1], abs=read_time + 0.01)
+    assert worst[best] < vmax * (read_time + 0.002) + 0.01 * abs(target - start), (axis, lags[best], worst[best])

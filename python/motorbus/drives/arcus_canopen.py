@@ -458,6 +458,27 @@ SIM_FAULTS = {
     "stall": lambda sim: sim.set_blocked(True),
 }
 
+def plan_move(drive: Any, start: float, target: float) -> Any:
+    """The move as this persona makes it: the DMX-CAN's own profile model
+    (``ArcusMotion``) loaded from the CiA 402 objects as the drive loads its ASCII
+    registers: 6081h = HSPD, 6082h = LSPD (at most 6081h), 6083h/6084h = ACC/DEC (ms),
+    6086h = 1 S-curve.  The StepNLoop ratio has no CANopen object: the factory
+    3200 pulses per 4000 counts (0.8) with 2001h:01 on."""
+    from .. import motion
+
+    native = drive.native
+    hspd = max(float(native.read(0x6081)), 1.0)
+    lspd = min(max(float(native.read(0x6082)), 1.0), hspd)
+    snl = bool(native.read(0x2001, 1))
+    params = motion.ArcusProfileParams(hspd=hspd, lspd=lspd, acc_ms=max(float(native.read(0x6083)), 1.0),
+                                       dec_ms=max(float(native.read(0x6084)), 1.0), edec=False,
+                                       scv=native.read(0x6086) == 1, snl_ratio=0.8 if snl else 1.0)
+    model = motion.ArcusMotion(params)
+    error = model.move(float(start), float(target))
+    if error:
+        raise _core.InvalidArgument(f"arcus-canopen plan_move {start} -> {target}: the model refuses: {error}")
+    return model.profile
+
 PLUGIN = DrivePlugin(
     kind="arcus-canopen",
     description="Arcus DMX-CAN integrated stepper, CANopen CiA DSP-402 by SDO (the CAN persona of 'arcus')",
@@ -475,6 +496,7 @@ PLUGIN = DrivePlugin(
     sim_faults=SIM_FAULTS,
     # 6064h, 606Ch and 6041h by SDO, as for any CiA 402 drive.
     poll_fields=_cia402_poll_fields,
+    plan_move=plan_move,
 )
 
 

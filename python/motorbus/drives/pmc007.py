@@ -740,6 +740,19 @@ def poll_fields(drive: "Pmc007Drive", fields: Any):
     return sdo_poll_spec(drive.kind, native.sdo, native.bus, fields, objects)
 
 
+def plan_move(drive: Any, start: float, target: float) -> Any:
+    """A PMC007 position move (its profile model): run speed |6003h| (the start
+    speed 6006h when 0), start/stop speeds 6006h/6007h, gears 6008h/6009h,
+    microstepping 600Ah; steps."""
+    from .. import motion
+
+    p = drive.params
+    speed = abs(float(p["0x6003"])) or float(p["0x6006"])
+    params = motion.Pmc007ProfileParams(speed=speed, start_speed=float(p["0x6006"]), stop_speed=float(p["0x6007"]),
+                                        accel_gear=int(p["0x6008"]), decel_gear=int(p["0x6009"]),
+                                        microstepping=int(p["0x600A"]))
+    return motion.pmc007_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
+
 PLUGIN = DrivePlugin(
     kind="pmc007",
     description="CQPUSI PMC007 integrated stepper on CANopen (CiA 301)",
@@ -756,4 +769,5 @@ PLUGIN = DrivePlugin(
     canopen_match=lambda node: 2 if node.device_type == 0 and not node.vendor_id and not node.product_code else 0,
     sim_faults=SIM_FAULTS,
     poll_fields=poll_fields,
+    plan_move=plan_move,
 )
