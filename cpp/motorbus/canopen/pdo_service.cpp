@@ -24,8 +24,9 @@ std::uint64_t OdPdoObjects::read_value(std::uint16_t index, std::uint8_t sub, st
     if (!v) return 0;
     // Through the remote path, as an SDO upload is: a read hook (a simulator's live
     // position, statusword...) is what the TPDO carries, not the last value stored.
+    // A hook that refuses leaves the stored value, as before hooks were asked.
     Bytes b;
-    if (v->remote_read(b) != 0) return 0;
+    if (v->remote_read(b) != 0) b = v->get();
     std::uint64_t raw = 0;
     for (std::size_t i = 0; i < b.size() && i < 8; ++i) raw |= std::uint64_t(b[i]) << (8 * i);
     return raw;

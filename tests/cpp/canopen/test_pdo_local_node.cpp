@@ -2,8 +2,10 @@
 // the whole PMC007 example end to end on the virtual bus.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/canopen/local_node.hpp"
@@ -163,5 +165,46 @@ TEST(PdoLocalNode, StrictNodeAbortsOverSdoAndCia301ProcedureWorks) {
         std::this_thread::sleep_for(2ms);
     }
     EXPECT_EQ(od->at(0x6040, 0)->get_u64(), 0x000Fu);
+    node.close();
+}
+
+// A TPDO reads its objects as an SDO upload does: through the read hook (a simulator's live
+// value), and the stored value where the hook refuses.
+TEST(PdoLocalNode, TpdoCarriesWhatTheReadHookAnswers) {
+    auto dev_bus = can::open_virtual("svc-hook");
+    auto host_bus = can::open_virtual("svc-hook");
+    auto sniff = can::open_virtual("svc-hook");
+    auto od = pmc007_od();
+    std::atomic<std::uint16_t> live{0x1234};
+    std::atomic<bool> refuse{false};
+    od->at(0x6012, 0)->set_read_hook([&](const Variable&, Bytes& value) -> std::uint32_t {
+        if (refuse) return abort_code::kGeneral;
+        const std::uint16_t v = live;
+        value = {static_cast<std::uint8_t>(v & 0xFF), static_cast<std::uint8_t>(v >> 8)};
+        return 0;
+    });
+    LocalNode node(*dev_bus, 5, od);
+    auto pdo = PdoService::attach(node);
+    BusSdoAccess sdo(*host_bus);
+    PdoConfig c;
+    c.transmission_type = 1;  // on every SYNC
+    c.mapping = std::vector<PdoMapEntry>{{0x6012, 0, 16}};
+    write_pdo(sdo, 5, c, PdoProcedure::Cia301);
+    NmtMaster nmt(*host_bus);
+    nmt.start(5);
+    std::this_thread::sleep_for(20ms);
+    can::Frame sync;
+    sync.id = 0x080;
+    sync.len = 0;
+    auto tpdo_after_sync = [&] {
+        host_bus->send(sync);
+        auto got = collect(*sniff, 0x185, 1, 2000ms);
+        return got.empty() ? Bytes{} : payload(got[0]);
+    };
+    EXPECT_EQ(tpdo_after_sync(), (Bytes{0x34, 0x12}));
+    live = 0xBEEF;
+    EXPECT_EQ(tpdo_after_sync(), (Bytes{0xEF, 0xBE}));
+    refuse = true;
+    EXPECT_EQ(tpdo_after_sync(), (Bytes{0x03, 0x00}));  // the stored default
     node.close();
 }
