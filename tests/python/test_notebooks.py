@@ -111,7 +111,12 @@ def test_02_motion_preview_vs_measured(kernel):
     read_time_max = number(out, r"read time max ([\d.]+) ms") / 1e3
     assert number(out, r"following error max ([\d.]+) mm") <= 50.0 * read_time_max + 0.011
     assert number(out, r"following error p50 ([\d.]+) mm") < 0.25     # half the samples within 5 ms
-    assert pngs and all(p.startswith(b"\x89PNG") for p in pngs)
+    assert len(pngs) == 2 and all(p.startswith(b"\x89PNG") for p in pngs)   # profile + bus load
+    # The candump holds the drive's SDO responses: two per sample (position, velocity), plus
+    # the move's own handshake.
+    polled = number(out, r"poller: (\d+) samples")
+    assert number(out, r"frames recorded (\d+)") >= 2 * polled
+    assert 0 < number(out, r"bus load at 500 kbit/s: mean ([\d.]+) %") <= 100
 
 
 def test_03_streaming(kernel):
