@@ -22,7 +22,12 @@ std::uint32_t OdPdoObjects::check_mapping(std::uint16_t index, std::uint8_t sub,
 std::uint64_t OdPdoObjects::read_value(std::uint16_t index, std::uint8_t sub, std::uint8_t) {
     auto v = od_.find(index, sub);
     if (!v) return 0;
-    const Bytes b = v->get();
+    // Through the remote path, as an SDO upload: an object whose value the
+    // application computes on read (a read hook: position actual value,
+    // statusword...) is sent as it is now, not as last stored (CiA 301: a TPDO
+    // carries the object's current value).
+    Bytes b;
+    if (v->remote_read(b) != 0) b = v->get();
     std::uint64_t raw = 0;
     for (std::size_t i = 0; i < b.size() && i < 8; ++i) raw |= std::uint64_t(b[i]) << (8 * i);
     return raw;

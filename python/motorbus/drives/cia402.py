@@ -755,6 +755,17 @@ def poll_fields(drive: Cia402Drive, fields: Sequence[str]):
     return sdo_poll_spec(drive.kind, drive._sdo, drive.native.bus, fields, CIA402_POLL_OBJECTS)
 
 
+def capture_fields(drive: Cia402Drive, fields: Sequence[str], period: float):
+    """motorbus.Poller, capturing: 6064h/606Ch/6041h mapped into TPDO 1 (and 2 when
+    they pass 64 bits), sent on the event timer every period (whole ms, >= 1)."""
+    from ..canopen.poll import CIA402_POLL_OBJECTS, tpdo_capture_spec
+
+    if drive.native.bus is None:
+        raise _core.InvalidArgument(f"{drive.kind} capture: the drive's SDO client has no bus to listen on")
+    return tpdo_capture_spec(drive.kind, drive._sdo, drive.native.bus, drive.native.node, fields,
+                             CIA402_POLL_OBJECTS, period)
+
+
 PLUGIN = DrivePlugin(
     kind="cia402",
     description="any CiA 402 drive on CANopen (profile position, profile velocity, homing); simulated generically",
@@ -769,4 +780,5 @@ PLUGIN = DrivePlugin(
     synchronised_start=synchronised_start,
     sim_faults=SIM_FAULTS,
     poll_fields=poll_fields,
+    capture_fields=capture_fields,
 )
