@@ -15,8 +15,9 @@ what to read through its plugin's ``poll_fields`` (registry.PollSpec); this
 module converts the native readings to the axis's user units (``drive.units``)
 with numpy, never per sample in Python.
 
-Where a drive pushes its data (CANopen TPDOs of a cia402 drive, cyclic
-registers of a unitek drive), the poller captures instead of asking
+Where a drive pushes its data (CANopen TPDOs, a register protocol's cyclic
+transmissions: the kinds whose plugin has ``capture_fields``, listed in
+docs/poller.md), the poller captures instead of asking
 (``mode="auto"``, the default): the drive kind sets the drive to transmit the
 fields about every period, the bus receive thread keeps the latest values, and
 each sample takes them — nothing is sent per sample.  ``mode="ask"`` always
@@ -88,8 +89,8 @@ class Poller:
     * ``candump``: a path; the CAN traffic of CAN groups is recorded there as a
       candump log while polling (``name.log`` -> ``name-2.log`` for a second bus);
     * ``mode``: ``"auto"`` (default: capture what the drive pushes where its
-      kind can push — cia402 by TPDOs on the event timer, unitek by cyclic
-      registers — and ask the others), ``"capture"`` (every axis captured; an
+      kind can push, i.e. its plugin has ``capture_fields`` — TPDOs on the
+      event timer, cyclic registers — and ask the others), ``"capture"`` (every axis captured; an
       axis whose kind cannot push is an InvalidArgument) or ``"ask"`` (always
       ask, one request per field per sample).  ``modes`` says per axis.
     """

@@ -1,5 +1,5 @@
 // What capture sources share (sources whose drive pushes its data: CANopen
-// TPDOs, UNITEK cyclic registers): the latest pushed values, written by the
+// TPDOs, a register protocol's cyclic transmissions): the latest pushed values, written by the
 // bus receive thread and taken by the poll thread under a short lock, and the
 // row a capture source writes:
 //
