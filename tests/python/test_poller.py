@@ -248,6 +248,8 @@ def test_other_kinds_poll_their_own_objects(kind, address, transport):
             time.sleep(0.3)
         frame = poller.frame()
         assert poller.stats["q"]["error"] == ""
+        # The PMC007 maps 600Ch and 6001h into TPDOs: captured; the DMX-CAN has no PDOs, DMAC is ASCII.
+        assert poller.modes == {"q": "capture" if kind == "pmc007" else "ask"}
         pos = _finite(frame["q.position"])
         assert len(pos) >= 3
         assert np.all(np.diff(pos) >= 0)

@@ -48,13 +48,16 @@ _BITS = {"i8": (8, True), "i16": (16, True), "i32": (32, True), "u8": (8, False)
 
 
 def tpdo_capture_spec(kind: str, sdo: Any, bus: Any, node: int, fields: Sequence[str],
-                      objects: Mapping[str, tuple], period: float, first_tpdo: int = 1) -> PollSpec:
+                      objects: Mapping[str, tuple], period: float, first_tpdo: int = 1,
+                      procedure: str = "cia301") -> PollSpec:
     """A PollSpec capturing ``objects[field]`` from TPDOs the drive sends on its event timer.
 
     Maps the fields, in order, into TPDO ``first_tpdo``, ``first_tpdo + 1``... (a new
     one when the next object would pass 64 bits), transmission type 254 with the
     event timer at the period in whole ms (at least 1), then starts the node (NMT:
     PDOs flow only in OPERATIONAL).  The returned ``close`` disables those TPDOs.
+    ``procedure``: how the TPDOs are written (``"cia301"``, or ``"direct"`` for drives
+    that document changing a PDO in place, as the PMC007 does).
     Data older than 3 timer periods + 2 ms counts as stale."""
     rows = []
     for f in fields:
@@ -77,9 +80,10 @@ def tpdo_capture_spec(kind: str, sdo: Any, bus: Any, node: int, fields: Sequence
     numbers = list(range(first_tpdo, first_tpdo + len(pdos)))
     tpdos = []
     for number, mapping in zip(numbers, pdos):
-        _core.pdo_write_config(sdo, node, True, number, transmission_type=254, inhibit_100us=0,
-                               event_timer_ms=timer_ms, mapping=mapping)
-        tpdos.append((_core.pdo_read_config(sdo, node, True, number).cob_id & 0x7FF, mapping))
+        cob = 0x180 + 0x100 * (number - 1) + node   # the predefined connection set's COB-ID
+        _core.pdo_write_config(sdo, node, True, number, cob_id=cob, transmission_type=254, inhibit_100us=0,
+                               event_timer_ms=timer_ms, mapping=mapping, procedure=procedure)
+        tpdos.append((cob, mapping))
     source = _core.PdoCaptureSource(bus, node, tpdos, columns, max_age=(3 * timer_ms + 2) / 1000)
     bus.send(_core.Frame(0x000, bytes([0x01, node])))   # NMT start remote node
 
@@ -87,6 +91,7 @@ def tpdo_capture_spec(kind: str, sdo: Any, bus: Any, node: int, fields: Sequence
         source.close()
         for number, (cob, _) in zip(numbers, tpdos):
             _core.pdo_write_config(sdo, node, True, number, cob_id=cob, enabled=False, procedure="direct")
+
 
     return PollSpec(source=source, scales=tuple(r[4] for r in rows), transport=bus, bus=bus,
                     stamped=True, close=close)
