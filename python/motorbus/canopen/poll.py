@@ -57,7 +57,7 @@ def tpdo_capture_spec(kind: str, sdo: Any, bus: Any, node: int, fields: Sequence
     event timer at the period in whole ms (at least 1), then starts the node (NMT:
     PDOs flow only in OPERATIONAL).  The returned ``close`` disables those TPDOs.
     ``procedure``: how the TPDOs are written (``"cia301"``, or ``"direct"`` for drives
-    that document changing a PDO in place, as the PMC007 does).
+    that document changing a PDO in place instead of the CiA 301 procedure).
     Data older than 3 timer periods + 2 ms counts as stale."""
     rows = []
     for f in fields:
