@@ -138,6 +138,8 @@ def test_a_lost_link_ends_its_group_with_the_error_and_the_other_goes_on(lose):
             stats = poller.stats
             assert not stats[gone]["running"]
             assert stats[gone]["error_type"] in ("LinkDown", "TimeoutError"), stats[gone]
+            if lose == "bus":   # z is captured (it sends nothing per sample): its source checks the bus
+                assert stats[gone]["captured"] == ["z"] and stats[gone]["error_type"] == "LinkDown", stats[gone]
             assert stats[gone]["error"]
             before = stats[other]["samples"]
             time.sleep(0.1)
@@ -386,3 +388,23 @@ def test_mode_ask_reads_unitek_registers_each_sample(tmp_path):
         assert pos[-1] == pytest.approx(u.position)
         assert _finite(frame["u.status"])[-1] == u.status.raw
         assert not u.native.cyclic
+
+
+def test_a_lost_link_ends_a_captured_unitek_group_with_linkdown():
+    bench = _can_bench()
+    try:
+        bench["u"].enable()
+        with Poller({"u": bench["u"]}, rate_hz=200) as poller:
+            time.sleep(0.1)
+            assert poller.stats["u"]["running"] and poller.stats["u"]["captured"] == ["u"]
+            for srv in [s for s in bench._servers if isinstance(s, motorbus.bus_server.BusServers)]:
+                srv.close()
+            deadline = time.monotonic() + 5
+            while poller.running and time.monotonic() < deadline:
+                time.sleep(0.01)
+            t0 = time.monotonic()
+        assert time.monotonic() - t0 < 2.0, "stop() took too long"
+        s = poller.stats["u"]
+        assert not s["running"] and s["error_type"] == "LinkDown" and "down" in s["error"], s
+    finally:
+        bench.close()
