@@ -18,6 +18,8 @@ void bind_poll(py::module_& m) {
     py::class_<poll::Source, std::shared_ptr<poll::Source>>(
         m, "PollSource", "What one drive gives a PollGroup per sample (made by the drive kind's poll_fields).")
         .def_property_readonly("columns", &poll::Source::columns)
+        .def_property_readonly("stale", &poll::Source::stale,
+                               "reads that found pushed data too old or missing (0 for sources that ask)")
         .def("__repr__", [](const poll::Source& s) {
             return "<PollSource " + s.describe() + ", " + std::to_string(s.columns()) + " columns>";
         });
@@ -27,6 +29,8 @@ void bind_poll(py::module_& m) {
         .field("missed", &poll::PollStats::missed, "deadlines skipped entirely (NaN rows in the data)")
         .field("late", &poll::PollStats::late, "samples whose reads ran past the next deadline")
         .field("overflowed", &poll::PollStats::overflowed, "rows lost because the reader fell a ring behind")
+        .field("stale", &poll::PollStats::stale,
+               "capture sources' reads that found pushed data older than its period allows (or none yet)")
         .field("period_ns", &poll::PollStats::period_ns)
         .field("period_error_p50_ns", &poll::PollStats::period_error_p50)
         .field("period_error_p99_ns", &poll::PollStats::period_error_p99)

@@ -9,6 +9,7 @@
 #include "../errors.hpp"
 #include "motorbus/drives/unitek/client.hpp"
 #include "motorbus/drives/unitek/codec.hpp"
+#include "motorbus/drives/unitek/poll_source.hpp"
 #include "motorbus/drives/unitek/profile.hpp"
 #include "motorbus/drives/unitek/sim.hpp"
 
@@ -498,4 +499,31 @@ void bind_unitek(py::module_& m) {
             py::gil_scoped_release nogil;
             h.sim->load_eeprom(in);
         }, py::arg("values"));
+
+    // Poll sources (motorbus.Poller) on this client: asking, or capturing cyclic transmissions.
+    m.def("unitek_poll_source", [](ClientHolder& h, const std::vector<std::int64_t>& regids) -> std::shared_ptr<poll::Source> {
+              std::vector<std::uint8_t> r;
+              for (auto id : regids) r.push_back(regid_arg(id));
+              return std::make_shared<PollSource>(*h.client, std::move(r));
+          }, py::arg("client"), py::arg("regids"), py::keep_alive<0, 1>(),
+          "A PollSource reading each register (3D REGID 00) every sample.");
+    py::class_<CaptureSource, poll::Source, std::shared_ptr<CaptureSource>>(
+        m, "UnitekCaptureSource",
+        "A PollSource taking the latest cyclic transmission of each register (columns: arrival ns, values).")
+        .def_property_readonly("interval_ms", &CaptureSource::interval_ms)
+        .def_property_readonly("max_age", [](const CaptureSource& s) { return s.max_age_ns() / 1e9; })
+        .def("close", &CaptureSource::close, py::call_guard<py::gil_scoped_release>(),
+             "Stops the cyclic transmissions this source started (idempotent).");
+    m.def("unitek_capture_source", [](ClientHolder& h, const std::vector<std::int64_t>& regids, int interval_ms,
+                                      const py::object& max_age) {
+              std::vector<std::uint8_t> r;
+              for (auto id : regids) r.push_back(regid_arg(id));
+              const Nanos age = max_age.is_none() ? 0 : duration_arg(max_age, "max_age").count();
+              auto* bus = h.bus.get();
+              py::gil_scoped_release nogil;
+              return std::make_shared<CaptureSource>(*h.client, *bus, std::move(r), interval_ms, age);
+          }, py::arg("client"), py::arg("regids"), py::arg("interval_ms"), py::arg("max_age") = py::none(),
+          py::keep_alive<0, 1>(),
+          "Subscribes each register every interval_ms (unless it already transmits) and captures it; "
+          "max_age (s, default 3 intervals + 2 ms): older data counts as stale.");
 }

@@ -34,7 +34,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'PollGroup', 'PollSource', 'PollStats', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_poll_source', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_poll_source', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'sdo_poll_source', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoCaptureSource', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'PollGroup', 'PollSource', 'PollStats', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekCaptureSource', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_poll_source', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_poll_source', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'sdo_poll_source', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_capture_source', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_poll_source', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -68,6 +68,11 @@ class PollSource:
     @property
     def columns(self) -> int:
         ...
+    @property
+    def stale(self) -> int:
+        """
+        reads that found pushed data too old or missing (0 for sources that ask)
+        """
 class PollStats:
     """
     Counters and timing of one PollGroup (times in ns).
@@ -132,6 +137,11 @@ class PollStats:
     def samples(self) -> int:
         """
         samples read
+        """
+    @property
+    def stale(self) -> int:
+        """
+        capture sources' reads that found pushed data older than its period allows (or none yet)
         """
     @property
     def wake_latency_max_ns(self) -> int:
@@ -2238,6 +2248,24 @@ class HeartbeatService:
         """
     @property
     def heartbeats_sent(self) -> int:
+        ...
+class PdoCaptureSource(PollSource):
+    """
+    A PollSource taking the latest values of TPDOs (columns: arrival ns, values).
+    """
+    def __init__(self, bus: Bus, node: typing.SupportsInt | typing.SupportsIndex, tpdos: collections.abc.Sequence[tuple[typing.SupportsInt | typing.SupportsIndex, collections.abc.Iterable]], columns: collections.abc.Sequence[tuple[typing.SupportsInt | typing.SupportsIndex, typing.SupportsInt | typing.SupportsIndex]], max_age: typing.Any) -> None:
+        """
+        tpdos: [(cob_id, [(index, sub, bits, signed)])]; columns: [(tpdo i, entry j)] in row order; max_age (s): older data counts as stale.
+        """
+    def close(self) -> None:
+        """
+        Stops listening.
+        """
+    @property
+    def received(self) -> int:
+        ...
+    @property
+    def short_frames(self) -> int:
         ...
 class MotionState:
     def __init__(self, p: typing.SupportsFloat | typing.SupportsIndex = 0.0, v: typing.SupportsFloat | typing.SupportsIndex = 0.0, a: typing.SupportsFloat | typing.SupportsIndex = 0.0, j: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
@@ -4610,6 +4638,20 @@ class UnitekSim:
     @property
     def tx_id(self) -> int:
         ...
+class UnitekCaptureSource(PollSource):
+    """
+    A PollSource taking the latest cyclic transmission of each register (columns: arrival ns, values).
+    """
+    def close(self) -> None:
+        """
+        Stops the cyclic transmissions this source started (idempotent).
+        """
+    @property
+    def interval_ms(self) -> int:
+        ...
+    @property
+    def max_age(self) -> float:
+        ...
 def abort_text(code: typing.SupportsInt | typing.SupportsIndex) -> typing.Any:
     """
     CiA 301 text for an SDO abort code (None if unknown).
@@ -4847,6 +4889,10 @@ def time_decode(frame: Frame) -> typing.Any:
     """
 def time_encode(unix_ms: typing.SupportsInt | typing.SupportsIndex) -> Frame:
     ...
+def unitek_capture_source(client: UnitekClient, regids: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], interval_ms: typing.SupportsInt | typing.SupportsIndex, max_age: typing.Any = None) -> UnitekCaptureSource:
+    """
+    Subscribes each register every interval_ms (unless it already transmits) and captures it; max_age (s, default 3 intervals + 2 ms): older data counts as stale.
+    """
 def unitek_continuous_current_num(device: str, amps: typing.SupportsFloat | typing.SupportsIndex) -> int:
     ...
 def unitek_decode_from_drive(data: typing.Any) -> tuple[int, int, int]:
@@ -4867,6 +4913,10 @@ def unitek_encode_write(regid: typing.SupportsInt | typing.SupportsIndex, value:
     ...
 def unitek_event_status_mask(mask: typing.SupportsInt | typing.SupportsIndex) -> int:
     ...
+def unitek_poll_source(client: UnitekClient, regids: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]) -> PollSource:
+    """
+    A PollSource reading each register (3D REGID 00) every sample.
+    """
 def unitek_sim_default_table() -> UnitekRegisterTable:
     ...
 def unitek_speed_profile(start: MotionState, speed_num: typing.SupportsFloat | typing.SupportsIndex, params: UnitekRampParams, hold: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> Profile:

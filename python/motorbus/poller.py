@@ -15,9 +15,21 @@ what to read through its plugin's ``poll_fields`` (registry.PollSpec); this
 module converts the native readings to the axis's user units (``drive.units``)
 with numpy, never per sample in Python.
 
+Where a drive pushes its data (CANopen TPDOs, a register protocol's cyclic
+transmissions: the kinds whose plugin has ``capture_fields``, listed in
+docs/poller.md), the poller captures instead of asking
+(``mode="auto"``, the default): the drive kind sets the drive to transmit the
+fields about every period, the bus receive thread keeps the latest values, and
+each sample takes them — nothing is sent per sample.  ``mode="ask"`` always
+asks (SDO reads, register reads, ASCII queries); ``mode="capture"`` refuses an
+axis whose kind cannot push.  ``poller.modes`` says what each axis does.
+
 A frame has one row per deadline index: ``t`` (s, the deadline, on the
-monotonic clock of ``motorbus.monotonic_ns``), and per axis ``<axis>.t`` (s,
-when that axis's group started the sample) and ``<axis>.<field>``.  A deadline
+monotonic clock of ``motorbus.monotonic_ns``), and per axis ``<axis>.t`` (s:
+when that axis's group started the sample; for a captured axis when the oldest
+of its values arrived, so the data's age shows) and ``<axis>.<field>``.  A
+captured value that never arrived is NaN; a push that stopped arriving keeps
+its old ``<axis>.t`` and each such sample counts in ``stats[...]["stale"]``.  A deadline
 a group missed (its previous sample ran past a whole period) is a row of NaN
 for its axes, and is counted in ``stats``: never hidden.  A group whose link
 fails stops (its error is in ``stats``); the others go on.
@@ -41,6 +53,7 @@ __all__ = ["Poller", "FIELDS", "load_frame"]
 FIELDS = ("position", "velocity", "status")
 _SCALED = ("position", "velocity")   # converted to user units; status stays the raw word
 _START_DELAY_NS = 20_000_000         # deadline 0: after every thread is up
+MODES = ("auto", "capture", "ask")
 
 
 class _Group:
@@ -50,9 +63,10 @@ class _Group:
         self.label = label
         self.transport = transport
         self.bus = bus
-        self.axes: list[tuple[str, list[str]]] = []   # (axis name, fields) in column order
+        self.axes: list[tuple[str, list[str], bool]] = []   # (axis name, fields, stamped) in column order
         self.sources: list[Any] = []
         self.scales: list[float] = []
+        self.closers: list[Any] = []   # PollSpec.close of capture sources
         self.core: Optional[Any] = None
         self.recorder: Optional[Any] = None
         self.last_k = -1
@@ -73,12 +87,18 @@ class Poller:
     * ``realtime``: try SCHED_FIFO (``stats[...]["realtime"]`` says whether it
       was granted);
     * ``candump``: a path; the CAN traffic of CAN groups is recorded there as a
-      candump log while polling (``name.log`` -> ``name-2.log`` for a second bus).
+      candump log while polling (``name.log`` -> ``name-2.log`` for a second bus);
+    * ``mode``: ``"auto"`` (default: capture what the drive pushes where its
+      kind can push, i.e. its plugin has ``capture_fields`` — TPDOs on the
+      event timer, cyclic registers — and ask the others), ``"capture"`` (every axis captured; an
+      axis whose kind cannot push is an InvalidArgument) or ``"ask"`` (always
+      ask, one request per field per sample).  ``modes`` says per axis.
     """
 
     def __init__(self, axes: Any, fields: Iterable[str] = FIELDS, rate_hz: float = 1000.0, *,
                  capacity: Optional[int] = None, spin_us: float = 0.0, realtime: bool = False,
-                 candump: Optional[Union[str, "os.PathLike[str]"]] = None, start: bool = True) -> None:
+                 candump: Optional[Union[str, "os.PathLike[str]"]] = None, mode: str = "auto",
+                 start: bool = True) -> None:
         named = _named_axes(axes)
         fields = _check_fields(fields)
         if isinstance(rate_hz, bool) or not isinstance(rate_hz, (int, float)) or not math.isfinite(rate_hz) \
@@ -94,27 +114,37 @@ class Poller:
         if not isinstance(spin_us, (int, float)) or not 0 <= spin_us <= self.period_ns / 1000:
             raise _core.InvalidArgument(f"Poller spin_us: between 0 and the period ({self.period_ns / 1000:g} µs), "
                                         f"not {spin_us!r}")
+        if mode not in MODES:
+            raise _core.InvalidArgument(f"Poller mode: one of {', '.join(repr(m) for m in MODES)}, not {mode!r}")
         self.fields = fields
         self.rate_hz = float(rate_hz)
+        self.mode = mode
         self.axes = dict(named)
+        #: per axis: "capture" (takes what the drive pushes) or "ask"
+        self.modes: dict[str, str] = {}
         self._groups: list[_Group] = []
         by_transport: dict[int, _Group] = {}
-        for name, drive in named:
-            plugin = drive_plugin(drive.kind)
-            if plugin.poll_fields is None:
-                raise _core.InvalidArgument(f"Poller: axis {name!r} ({drive.kind}): this drive kind cannot be polled")
-            spec = plugin.poll_fields(drive, fields)
-            group = by_transport.get(id(spec.transport))
-            if group is None:
-                group = _Group(f"group{len(self._groups)}", spec.transport, spec.bus)
-                by_transport[id(spec.transport)] = group
-                self._groups.append(group)
-            group.axes.append((name, list(fields)))
-            group.sources.append(spec.source)
-            unit_scale = float(drive.units.scale)
-            group.scales.extend(s * (unit_scale if f in _SCALED else 1.0) for f, s in zip(fields, spec.scales))
+        try:
+            for name, drive in named:
+                spec = self._spec(name, drive, fields, mode)
+                group = by_transport.get(id(spec.transport))
+                if group is None:
+                    group = _Group(f"group{len(self._groups)}", spec.transport, spec.bus)
+                    by_transport[id(spec.transport)] = group
+                    self._groups.append(group)
+                if spec.close is not None:
+                    group.closers.append(spec.close)
+                group.axes.append((name, list(fields), bool(spec.stamped)))
+                group.sources.append(spec.source)
+                unit_scale = float(drive.units.scale)
+                if spec.stamped:
+                    group.scales.append(1.0)   # the arrival time (ns), handled in _merge
+                group.scales.extend(s * (unit_scale if f in _SCALED else 1.0) for f, s in zip(fields, spec.scales))
+        except BaseException:
+            self._close_sources()
+            raise
         for g in self._groups:   # a readable label: the axes it holds
-            g.label = "+".join(a for a, _ in g.axes)
+            g.label = "+".join(a for a, _, _ in g.axes)
         self._capacity = capacity
         self._spin_ns = int(spin_us * 1000)
         self._realtime = bool(realtime)
@@ -125,6 +155,29 @@ class Poller:
         self._stopped = False
         if start:
             self.start()
+
+    def _spec(self, name: str, drive: Any, fields: tuple, mode: str) -> Any:
+        plugin = drive_plugin(drive.kind)
+        can_capture = plugin.capture_fields is not None
+        if mode == "capture" and not can_capture:
+            raise _core.InvalidArgument(f"Poller mode 'capture': axis {name!r} ({drive.kind}) cannot push its data; "
+                                        f"use mode='auto' to ask it instead")
+        if mode != "ask" and can_capture:
+            self.modes[name] = "capture"
+            return plugin.capture_fields(drive, fields, self.period_ns / 1e9)
+        if plugin.poll_fields is None:
+            raise _core.InvalidArgument(f"Poller: axis {name!r} ({drive.kind}): this drive kind cannot be polled")
+        self.modes[name] = "ask"
+        return plugin.poll_fields(drive, fields)
+
+    def _close_sources(self) -> None:
+        for g in self._groups:
+            closers, g.closers = g.closers, []
+            for close in closers:
+                try:
+                    close()
+                except _core.MotorbusError:
+                    pass   # best effort: the link may be gone (the drive then stops transmitting with it)
 
     # ---- lifecycle ----
     def start(self) -> "Poller":
@@ -154,6 +207,7 @@ class Poller:
                 g.core.stop()
             if g.recorder is not None:
                 g.recorder.stop()
+        self._close_sources()
 
     def __enter__(self) -> "Poller":
         return self
@@ -171,7 +225,7 @@ class Poller:
         """The frame's keys, in order."""
         out = ["t"]
         for g in self._groups:
-            for axis, fields in g.axes:
+            for axis, fields, _ in g.axes:
                 out.append(f"{axis}.t")
                 out.extend(f"{axis}.{f}" for f in fields)
         return out
@@ -227,9 +281,13 @@ class Poller:
             missed = np.isnan(v).all(axis=1) if v.shape[1] else np.zeros(len(k), bool)
             when = np.where(missed, np.nan, t / 1e9)
             col = 0
-            for axis, fields in g.axes:
+            for axis, fields, stamped in g.axes:
                 tcol = np.full(n, np.nan)
-                tcol[rows] = when
+                if stamped:   # the source's arrival time column (ns; NaN before anything arrived)
+                    tcol[rows] = v[:, col] / 1e9
+                    col += 1
+                else:
+                    tcol[rows] = when
                 out[f"{axis}.t"] = tcol
                 for f in fields:
                     c = np.full(n, np.nan)
@@ -241,17 +299,20 @@ class Poller:
     # ---- figures ----
     @property
     def stats(self) -> dict[str, dict[str, Any]]:
-        """Per group (keyed by its axes, "x+y"): transport, samples, missed, late,
-        overflowed, period error / wake latency / read time p50, p99, max (s),
+        """Per group (keyed by its axes, "x+y"): transport, captured (its axes
+        that capture), samples, missed, late, overflowed, stale (samples whose
+        captured data was older than the push period allows, or had not
+        arrived yet: summed over the group's captured axes), period error / wake latency / read time p50, p99, max (s),
         realtime, running, error_type and error ("" unless the group stopped on
         its own, e.g. "LinkDown")."""
         out = {}
         for g in self._groups:
-            entry: dict[str, Any] = {"axes": [a for a, _ in g.axes], "transport": "can" if g.bus is not None
-                                     else "serial", "period": self.period_ns / 1e9}
+            entry: dict[str, Any] = {"axes": [a for a, _, _ in g.axes], "transport": "can" if g.bus is not None
+                                     else "serial", "period": self.period_ns / 1e9,
+                                     "captured": [a for a, _, stamped in g.axes if stamped]}
             if g.core is not None:
                 s = g.core.stats
-                entry.update(samples=s.samples, missed=s.missed, late=s.late, overflowed=s.overflowed,
+                entry.update(samples=s.samples, missed=s.missed, late=s.late, overflowed=s.overflowed, stale=s.stale,
                              realtime=s.realtime, running=s.running, error_type=s.error_type, error=s.error)
                 for what in ("period_error", "wake_latency", "read_time"):
                     for q in ("p50", "p99", "max"):

@@ -35,13 +35,21 @@ class PollSpec:
       native units (the Poller then applies ``drive.units`` to position and velocity);
     * ``transport``: the LineLink or Bus the source talks over: axes on one
       transport share one poll thread (their requests take turns on it anyway);
-    * ``bus``: the CAN Bus (for ``candump=``), None on a serial line.
+    * ``bus``: the CAN Bus (for ``candump=``), None on a serial line;
+    * ``stamped``: True for a capture source (the drive pushes, the source takes
+      the latest pushed values): its first column is when the data arrived
+      (monotonic ns, NaN until it did), before the fields — the Poller shows it
+      as ``<axis>.t``;
+    * ``close``: called once when the Poller stops (a capture source stops the
+      transmissions it started), or None.
     """
 
     source: Any
     scales: tuple
     transport: Any
     bus: Any = None
+    stamped: bool = False
+    close: Optional[Callable[[], None]] = None
 
 
 @dataclass(frozen=True)
@@ -108,6 +116,12 @@ class DrivePlugin:
     #: t = 0 at the command, from the drive's current speed/ramp parameters
     #: (``motorbus.plot.planned``, ``motorbus demo``).  None: no model.
     plan_move: Optional[Callable[..., Any]] = None
+    #: For kinds whose drive can push its data (CANopen TPDOs, cyclic registers):
+    #: ``capture_fields(drive, fields, period) -> PollSpec`` (period in s) sets the
+    #: drive to transmit the fields about every period and returns a capture
+    #: source (``stamped=True``) that takes what arrives instead of asking.
+    #: None: the kind can only be asked (``poll_fields``).
+    capture_fields: Optional[Callable[..., "PollSpec"]] = None
 
     def __post_init__(self) -> None:
         if self.transport not in ("serial", "can"):

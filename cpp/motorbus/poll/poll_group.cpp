@@ -126,6 +126,7 @@ PollStats PollGroup::stats() const {
     s.overflowed = ring_.overflowed();
     s.period_ns = options_.period_ns;
     s.running = running_.load();
+    for (const auto& src : sources_) s.stale += src->stale();
     std::lock_guard lock(stats_mutex_);
     s.samples = samples_;
     s.missed = missed_;

@@ -4,6 +4,7 @@
 // source beside the CANopen code, an ASCII query source in a vendor folder...).
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 namespace motorbus::poll {
@@ -19,6 +20,11 @@ public:
     virtual void read(double* out) = 0;
     // "SDO node 5": names the source in errors and stats.
     virtual std::string describe() const = 0;
+    // Capture sources (the drive pushes, read() takes the latest pushed values):
+    // how many read() calls found data older than the push period allows (or
+    // none yet).  A push that stopped shows here, never as silent repetition.
+    // Sources that ask return 0.  Read from any thread.
+    virtual std::uint64_t stale() const { return 0; }
 };
 
 }  // namespace motorbus::poll

@@ -36,6 +36,7 @@ struct PollStats {
     std::uint64_t missed = 0;    // deadlines skipped entirely (NaN rows)
     std::uint64_t late = 0;      // samples whose reads ran past the next deadline
     std::uint64_t overflowed = 0;  // rows the reader lost to a full ring
+    std::uint64_t stale = 0;     // capture sources' reads that found old or no pushed data (Source::stale)
     Nanos period_ns = 0;
     Nanos period_error_p50 = 0, period_error_p99 = 0, period_error_max = 0;
     Nanos wake_latency_p50 = 0, wake_latency_p99 = 0, wake_latency_max = 0;

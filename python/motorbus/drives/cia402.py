@@ -765,6 +765,16 @@ def plan_move(drive: Cia402Drive, start: float, target: float) -> Any:
                                         profile_deceleration=float(p["0x6084"]),
                                         motion_profile_type=int(p["0x6086"]), max_profile_velocity=float(p["0x607F"]) if "0x607F" in p else 0.0)
     return motion.cia402_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
+def capture_fields(drive: Cia402Drive, fields: Sequence[str], period: float):
+    """motorbus.Poller, capturing: 6064h/606Ch/6041h mapped into TPDO 1 (and 2 when
+    they pass 64 bits), sent on the event timer every period (whole ms, >= 1)."""
+    from ..canopen.poll import CIA402_POLL_OBJECTS, tpdo_capture_spec
+
+    if drive.native.bus is None:
+        raise _core.InvalidArgument(f"{drive.kind} capture: the drive's SDO client has no bus to listen on")
+    return tpdo_capture_spec(drive.kind, drive._sdo, drive.native.bus, drive.native.node, fields,
+                             CIA402_POLL_OBJECTS, period)
+
 
 PLUGIN = DrivePlugin(
     kind="cia402",
@@ -781,4 +791,5 @@ PLUGIN = DrivePlugin(
     sim_faults=SIM_FAULTS,
     poll_fields=poll_fields,
     plan_move=plan_move,
+    capture_fields=capture_fields,
 )

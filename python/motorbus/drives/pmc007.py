@@ -732,12 +732,29 @@ def poll_fields(drive: "Pmc007Drive", fields: Any):
     "velocity" is refused: differentiate the polled position instead."""
     from ..canopen.poll import sdo_poll_spec
 
+    native = drive.native
+    return sdo_poll_spec(drive.kind, native.sdo, native.bus, fields, _poll_objects())
+
+
+def _poll_objects() -> dict:
     objects = {}
     for field, name in (("position", "motor_position"), ("status", "controller_status")):
         row = OBJECTS[name]
         objects[field] = (row["index"], row["sub"], row["type"].lower(), 1.0)
+    return objects
+
+
+def capture_fields(drive: "Pmc007Drive", fields: Any, period: float):
+    """motorbus.Poller, capturing: 600Ch and the controller status (6001h), both
+    PDO-mappable, in TPDO 1 on the event timer, written with the manual's sequence
+    (App.3 §11.2: the PDO changed in place)."""
+    from ..canopen.poll import tpdo_capture_spec
+
     native = drive.native
-    return sdo_poll_spec(drive.kind, native.sdo, native.bus, fields, objects)
+    if native.bus is None:
+        raise _core.InvalidArgument("pmc007 capture: the drive's SDO client has no bus to listen on")
+    return tpdo_capture_spec(drive.kind, native.sdo, native.bus, native.node, fields, _poll_objects(), period,
+                             procedure="direct")
 
 
 def plan_move(drive: Any, start: float, target: float) -> Any:
@@ -770,4 +787,5 @@ PLUGIN = DrivePlugin(
     sim_faults=SIM_FAULTS,
     poll_fields=poll_fields,
     plan_move=plan_move,
+    capture_fields=capture_fields,
 )

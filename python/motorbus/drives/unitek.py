@@ -52,7 +52,7 @@ from typing import Any, Callable, Optional, Sequence, Union
 
 from .. import _core
 from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params, Units
-from ..registry import DrivePlugin
+from ..registry import DrivePlugin, PollSpec
 
 __all__ = ["FrameError", "UnknownRegister", "CyclicLimit", "Reg", "Status", "ModeBit", "Unitek", "UnitekDrive", "UnitekSim", "Stream", "PLUGIN", "make_sim",
            "open", "builtin_registers", "load_registers", "ndrive_registers", "REVOLUTIONS"]
@@ -270,6 +270,8 @@ class Unitek:
         else:
             table = registers
         rx = int(check_address(rx_id), 16)
+        #: the CAN bus the drive is on (the Poller groups axes by it)
+        self.bus = bus
         self._core = _core.UnitekClient(bus, rx_id=rx, tx_id=_tx_for(rx) if tx_id is None else tx_id,
                                         timeout=timeout, table=table, clock=clock)
         self.on_error = on_error
@@ -721,6 +723,42 @@ def probe(bus: Any, address: str) -> Optional[dict]:
         client.close()
 
 
+# ---- motorbus.Poller ---------------------------------------------------------------
+#: The registers of the Drive's readings: (REGID, factor from the register's number to
+#: the Drive's native units — velocity: SPEED_IST's number to counts/s, set per drive).
+_POLL_REGISTERS = {"position": Reg.POS_IST, "velocity": Reg.SPEED_IST, "status": Reg.KERN_STATUS}
+
+
+def _poll_rows(drive: UnitekDrive, fields: Sequence[str]) -> tuple[list[int], tuple]:
+    regids, scales = [], []
+    for f in fields:
+        if f not in _POLL_REGISTERS:
+            raise _core.InvalidArgument(f"unitek poll field {f!r}: this kind gives {', '.join(_POLL_REGISTERS)}")
+        regids.append(int(_POLL_REGISTERS[f]))
+        scales.append(drive._counts_per_s_per_num if f == "velocity" else 1.0)
+    return regids, tuple(scales)
+
+
+def poll_fields(drive: UnitekDrive, fields: Sequence[str]) -> PollSpec:
+    """motorbus.Poller, asking: POS_IST/SPEED_IST/KERN_STATUS read (3D REGID 00) each sample."""
+    regids, scales = _poll_rows(drive, fields)
+    source = _core.unitek_poll_source(drive.native._core, regids)
+    return PollSpec(source=source, scales=scales, transport=drive.native.bus, bus=drive.native.bus)
+
+
+def capture_fields(drive: UnitekDrive, fields: Sequence[str], period: float) -> PollSpec:
+    """motorbus.Poller, capturing: the drive transmits each register cyclically
+    (``3D REGID t``, t = the poll period in whole ms, 1..254) and each sample takes
+    the latest value.  A register the user already streams keeps its interval; the
+    transmissions started here stop when the Poller stops.  At most 8 registers
+    transmit cyclically per drive (CyclicLimit beyond)."""
+    regids, scales = _poll_rows(drive, fields)
+    interval_ms = min(254, max(1, int(round(period * 1000))))
+    source = _core.unitek_capture_source(drive.native._core, regids, interval_ms)
+    return PollSpec(source=source, scales=scales, transport=drive.native.bus, bus=drive.native.bus,
+                    stamped=True, close=source.close)
+
+
 # Faults the simulator can be given (the pytest plugin's sim_faults fixture).
 SIM_FAULTS = {
     # a limit switch input goes active (direction -1 or +1)
@@ -742,4 +780,6 @@ PLUGIN = DrivePlugin(
     probe=probe,
     probe_addresses=tuple(f"0x{i:03X}" for i in range(0x201, 0x280)),   # the receive-id range
     sim_faults=SIM_FAULTS,
+    poll_fields=poll_fields,
+    capture_fields=capture_fields,
 )

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "motorbus/errors.hpp"
+#include "motorbus/poll/capture.hpp"
 #include "motorbus/poll/poll_group.hpp"
 
 using namespace motorbus;
@@ -226,4 +227,72 @@ TEST(Schedule, IndexAtIsTheLatestDeadlinePassed) {
     EXPECT_EQ(s.index_at(1'000), 0u);
     EXPECT_EQ(s.index_at(1'099), 0u);
     EXPECT_EQ(s.index_at(1'250), 2u);
+}
+
+// ---- capture sources' shared part --------------------------------------------------
+
+TEST(CaptureSlots, NothingArrivedIsNanAndStale) {
+    CaptureSlots slots(2, 3'000'000);
+    double row[3];
+    slots.read(row, 10'000'000);
+    EXPECT_TRUE(std::isnan(row[0]) && std::isnan(row[1]) && std::isnan(row[2]));
+    EXPECT_EQ(slots.stale(), 1u);
+}
+
+TEST(CaptureSlots, RowIsOldestArrivalThenValuesAndAgeCountsStale) {
+    CaptureSlots slots(3, 3'000'000);
+    const double a[2] = {1.5, -2.0};
+    const double b = 7.0;
+    slots.set(0, a, 2, 10'000'000);
+    double row[4];
+    slots.read(row, 11'000'000);  // the third value never came
+    EXPECT_TRUE(std::isnan(row[0]));
+    EXPECT_EQ(row[1], 1.5);
+    EXPECT_EQ(row[2], -2.0);
+    EXPECT_TRUE(std::isnan(row[3]));
+    EXPECT_EQ(slots.stale(), 1u);
+    slots.set(2, &b, 1, 12'000'000);
+    slots.read(row, 12'500'000);  // fresh: the oldest (10 ms) is 2.5 ms old <= 3 ms
+    EXPECT_EQ(row[0], 10'000'000.0);
+    EXPECT_EQ(row[3], 7.0);
+    EXPECT_EQ(slots.stale(), 1u);
+    slots.read(row, 13'000'001);  // the push of values 0-1 stopped: 3 ms + 1 ns old
+    EXPECT_EQ(row[0], 10'000'000.0);
+    EXPECT_EQ(row[1], 1.5);       // the last word is still given, its age shows in row[0]
+    EXPECT_EQ(slots.stale(), 2u);
+}
+
+TEST(CaptureSlots, RefusesNoValuesOrNoAge) {
+    EXPECT_THROW(CaptureSlots(0, 1), InvalidArgument);
+    EXPECT_THROW(CaptureSlots(1, 0), InvalidArgument);
+}
+
+namespace {
+// A capture-like source: reports stale reads, which the group sums into its stats.
+class StaleSource final : public Source {
+public:
+    std::size_t columns() const override { return 1; }
+    void read(double* out) override {
+        out[0] = 1.0;
+        stale_.fetch_add(1);
+    }
+    std::string describe() const override { return "stale"; }
+    std::uint64_t stale() const override { return stale_.load(); }
+
+private:
+    std::atomic<std::uint64_t> stale_{0};
+};
+}  // namespace
+
+TEST(PollGroup, StatsSumTheSourcesStaleReads) {
+    auto a = std::make_shared<StaleSource>();
+    auto b = std::make_shared<StaleSource>();
+    PollGroup g({a, b}, {.period_ns = 2'000'000, .capacity = 64});
+    g.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    g.stop();
+    const auto s = g.stats();
+    EXPECT_GT(s.samples, 3u);
+    EXPECT_EQ(s.stale, a->stale() + b->stale());
+    EXPECT_EQ(s.stale, 2 * s.samples);
 }
