@@ -19,6 +19,7 @@
 #include "motorbus/canopen/heartbeat_service.hpp"
 #include "motorbus/canopen/nmt.hpp"
 #include "motorbus/canopen/pdo.hpp"
+#include "motorbus/canopen/pdo_capture_source.hpp"
 #include "motorbus/canopen/pdo_engine.hpp"
 #include "motorbus/canopen/pdo_service.hpp"
 #include "motorbus/canopen/sdo_client.hpp"
@@ -777,14 +778,22 @@ void bind_canopen_services(py::module_& m) {
                  return PdoService::attach(node, o);
              }), py::arg("node"), py::arg("rpdos") = 4, py::arg("tpdos") = 4, py::arg("max_mapped") = 8,
              py::arg("strict") = true, py::arg("sync_window_us") = 0, py::keep_alive<1, 2>())
-        // The engine holds its lock while a TPDO reads its objects, which may run a Python
-        // read hook (a simulator's live values): never wait for that lock holding the GIL.
+        // The engine's lock is held while a TPDO reads its objects, whose read hooks may
+        // take the GIL: never wait for that lock holding the GIL.
         .def("mapping", [](PdoService& s, bool tpdo, unsigned n) {
-                 auto entries = [&] { py::gil_scoped_release nogil; return s.engine().mapping(tpdo, n); }();
-                 return entries_to(entries);
-             }, py::arg("tpdo"), py::arg("number"))
-        .def("cob_id", [](PdoService& s, bool tpdo, unsigned n) { return s.engine().cob_id(tpdo, n); },
-             py::arg("tpdo"), py::arg("number"), py::call_guard<py::gil_scoped_release>())
+                 std::vector<PdoMapEntry> v;
+                 {
+                     py::gil_scoped_release nogil;
+                     v = s.engine().mapping(tpdo, n);
+                 }
+                 return entries_to(v);
+             },
+             py::arg("tpdo"), py::arg("number"))
+        .def("cob_id", [](PdoService& s, bool tpdo, unsigned n) {
+                 py::gil_scoped_release nogil;
+                 return s.engine().cob_id(tpdo, n);
+             },
+             py::arg("tpdo"), py::arg("number"))
         .def("trigger_tpdo", [](PdoService& s, unsigned n) { py::gil_scoped_release nogil; s.engine().trigger_tpdo(n); })
         .def("notify_change", [](PdoService& s, std::uint16_t i, std::uint8_t sub) {
                  py::gil_scoped_release nogil;
@@ -835,4 +844,23 @@ void bind_canopen_services(py::module_& m) {
               return res;
           }, py::arg("bus"), py::arg("first") = 1, py::arg("last") = 127, py::arg("sdo_timeout") = 0.2,
           py::arg("listen") = 0.0, py::arg("probe_sdo") = true, py::arg("identity") = true);
+
+    // A PollSource capturing TPDOs (motorbus.Poller mode "capture"); the drive kind configures them.
+    py::class_<PdoCaptureSource, poll::Source, std::shared_ptr<PdoCaptureSource>>(
+        m, "PdoCaptureSource", "A PollSource taking the latest values of TPDOs (columns: arrival ns, values).")
+        .def(py::init([](BusPtr bus, int node, const std::vector<std::pair<std::uint32_t, py::iterable>>& tpdos,
+                         const std::vector<std::pair<std::size_t, std::size_t>>& columns, const py::object& max_age) {
+                 not_none(bus, "bus");
+                 std::vector<CapturedPdo> pdos;
+                 for (const auto& [cob, entries] : tpdos) pdos.push_back({cob, entries_from(entries)});
+                 const Nanos age = duration_arg(max_age, "max_age").count();
+                 return make_service<PdoCaptureSource>(bus, *bus, static_cast<std::uint8_t>(node), std::move(pdos),
+                                                       columns, age);
+             }),
+             py::arg("bus"), py::arg("node"), py::arg("tpdos"), py::arg("columns"), py::arg("max_age"),
+             "tpdos: [(cob_id, [(index, sub, bits, signed)])]; columns: [(tpdo i, entry j)] in row order; "
+             "max_age (s): older data counts as stale.")
+        .def_property_readonly("received", &PdoCaptureSource::received)
+        .def_property_readonly("short_frames", &PdoCaptureSource::short_frames)
+        .def("close", &PdoCaptureSource::close, py::call_guard<py::gil_scoped_release>(), "Stops listening.");
 }

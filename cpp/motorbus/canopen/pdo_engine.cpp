@@ -360,16 +360,14 @@ bool PdoEngine::operational() const {
 
 void PdoEngine::send_tpdo(Pdo& p, Nanos now, Out& out) {
     if (!p.valid() || !p.complete) return;
-    std::uint64_t values[PdoLayout::kMaxEntries];
-    for (std::size_t i = 0; i < p.layout.size(); ++i) {
-        const auto& e = p.layout.entry(i);
-        values[i] = objects_.read_value(e.index, e.sub, e.bits);
-    }
+    // The mapped objects are read later, outside the lock (flush): reading one may
+    // run its read hook (a simulator's live position), and a hook that sets an
+    // object notifies this engine (notify_change) — under the lock that would
+    // deadlock on the engine's own mutex.
     can::Frame f;
     f.id = p.can_id();
     f.extended = p.extended();
-    f.len = static_cast<std::uint8_t>(p.layout.pack(values, f.data.data()));
-    out.frames.push_back(f);
+    out.tpdos.push_back({p.layout, f});
     p.pending = false;
     p.last_sent = now;
     p.timer_due = p.event_timer ? now + Nanos(p.event_timer) * 1'000'000 : -1;
@@ -502,7 +500,16 @@ bool PdoEngine::on_frame(const can::Frame& f) {
     return used;
 }
 
+namespace {
+// The engine whose TPDO objects this thread is reading (flush), if any.
+thread_local const PdoEngine* reading_tpdo_objects = nullptr;
+}  // namespace
+
 void PdoEngine::notify_change(std::uint16_t index, std::uint8_t sub) {
+    // A read hook may set the object it answers for (a simulator publishing its
+    // state as it is read): that is what the TPDO being built carries, not a new
+    // event — sending again would read again, for ever.
+    if (reading_tpdo_objects == this) return;
     {
         std::lock_guard l(m_);
         for (auto& p : tpdos_) {
@@ -563,9 +570,22 @@ Nanos PdoEngine::process(Nanos now) {
 }
 
 void PdoEngine::flush(Out& out) {
-    // Outside the lock: writing an object may notify listeners that call back in.
+    // Outside the lock: writing or reading an object may run hooks that call back in.
     for (auto& w : out.writes) objects_.write_value(w.index, w.sub, w.bits, w.raw);
-    for (auto& f : out.frames) send_(f);
+    for (auto& t : out.tpdos) {
+        struct ReadingGuard {  // marks this thread as reading this engine's TPDO objects
+            const PdoEngine* outer = reading_tpdo_objects;
+            explicit ReadingGuard(const PdoEngine* e) { reading_tpdo_objects = e; }
+            ~ReadingGuard() { reading_tpdo_objects = outer; }
+        } guard(this);
+        std::uint64_t values[PdoLayout::kMaxEntries];
+        for (std::size_t i = 0; i < t.layout.size(); ++i) {
+            const auto& e = t.layout.entry(i);
+            values[i] = objects_.read_value(e.index, e.sub, e.bits);
+        }
+        t.frame.len = static_cast<std::uint8_t>(t.layout.pack(values, t.frame.data.data()));
+        send_(t.frame);
+    }
     if (emcy_)
         for (auto& [code, active] : out.emcy) emcy_(code, active);
     if (on_rpdo)

@@ -181,7 +181,13 @@ private:
     };
     struct Out {
         std::vector<Write> writes;
-        std::vector<can::Frame> frames;
+        // TPDOs due: their mapping as it was when they fell due, and the frame's
+        // id; the objects are read (and the frames packed and sent) in flush().
+        struct Tpdo {
+            PdoLayout layout;
+            can::Frame frame;
+        };
+        std::vector<Tpdo> tpdos;
         std::vector<std::pair<std::uint16_t, bool>> emcy;
         std::vector<unsigned> rpdo_applied, rpdo_timeout;
     };

@@ -208,3 +208,39 @@ TEST(PdoLocalNode, TpdoCarriesWhatTheReadHookAnswers) {
     EXPECT_EQ(tpdo_after_sync(), (Bytes{0x03, 0x00}));  // the stored default
     node.close();
 }
+
+// A read hook that sets a mapped object as it answers (the PMC007 simulator
+// publishes its whole state on each read) once deadlocked the engine on its own
+// mutex (the TPDO was built under it), and without the re-entry guard an
+// event-driven TPDO would fire again for the value its own reading set, for ever.
+TEST(PdoLocalNode, AReadHookThatSetsAMappedObjectSendsEachEventTpdoOnce) {
+    auto dev_bus = can::open_virtual("svc-hook-set");
+    auto host_bus = can::open_virtual("svc-hook-set");
+    auto sniff = can::open_virtual("svc-hook-set");
+    auto od = pmc007_od();
+    auto other = od->at(0x6040, 0);
+    std::atomic<int> reads{0};
+    od->at(0x6012, 0)->set_read_hook([&](const Variable&, Bytes& value) -> std::uint32_t {
+        const int n = ++reads;
+        const std::uint8_t b[2] = {static_cast<std::uint8_t>(n), 0};
+        other->set(std::span<const std::uint8_t>(b, 2));  // notifies the PDO engine
+        value = {b[0], 0};
+        return 0;
+    });
+    LocalNode node(*dev_bus, 5, od);
+    auto pdo = PdoService::attach(node);
+    BusSdoAccess sdo(*host_bus);
+    PdoConfig c;
+    c.transmission_type = 254;  // event-driven: a change of a mapped object is an event
+    c.event_timer_ms = 20;
+    c.mapping = std::vector<PdoMapEntry>{{0x6012, 0, 16}, {0x6040, 0, 16}};
+    write_pdo(sdo, 5, c, PdoProcedure::Cia301);
+    NmtMaster nmt(*host_bus);
+    nmt.start(5);
+    auto got = collect(*sniff, 0x185, 100, 300ms);
+    // About one per 20 ms timer tick: never a storm, never none.
+    EXPECT_GE(got.size(), 5u);
+    EXPECT_LE(got.size(), 25u);
+    EXPECT_LE(reads.load(), static_cast<int>(got.size()) + 1);
+    node.close();
+}
