@@ -194,6 +194,18 @@ def show(title: str, figs: dict) -> None:
               f"period error p50 {f['p50']:8.1f} us  p99 {f['p99']:8.1f} us  max {f['max']:9.1f} us{extra}")
 
 
+FLOOR_EXE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "dev", "bench_timer_floor")
+
+
+def timer_floor(seconds: float, rate: float) -> str:
+    """A bare 1 kHz sleep-to-deadline loop in C++ on this idle machine (bench/cpp/timer_floor.cpp):
+    no poller can wake more punctually than that."""
+    if not os.path.exists(FLOOR_EXE):
+        return "not measured (build/dev/bench_timer_floor is built by make build, MOTORBUS_BENCH=ON)"
+    out = subprocess.run([FLOOR_EXE, f"{seconds:g}", f"{rate:g}"], capture_output=True, text=True, check=True)
+    return out.stdout.strip().removeprefix("timer floor: ")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=60.0, help="seconds of polling, each way")
@@ -210,6 +222,7 @@ def main() -> None:
     print(f"{time.strftime('%Y-%m-%d %H:%M:%S %Z')}  load {os.getloadavg()}  {os.cpu_count()} CPUs  "
           f"{args.rate:g} Hz, {args.seconds:g} s each way, spin {args.spin_us:g} us, fields {','.join(fields)}, "
           f"jog {args.jog:g}, mode {args.mode}")
+    floor = timer_floor(args.seconds, args.rate)
     child, spec = serve_sims()
     try:
         with Bench.from_dict(spec) as bench:
@@ -237,6 +250,7 @@ def main() -> None:
               f"{s['wake_latency_p99'] * 1e6:.0f} us, reads p50 {s['read_time_p50'] * 1e6:.0f} us, "
               f"realtime {s['realtime']}")
     show("Python threading loop, same reads on the native clients:", py)
+    print(f"this machine's floor, measured before the sims started ({os.path.basename(FLOOR_EXE)}): {floor}")
     for label in cpp:
         c, p = cpp[label], py[label]
         print(f"  ratio {label}: p99 period error Python / Poller {p['p99'] / max(c['p99'], 1e-9):.1f}x, "
