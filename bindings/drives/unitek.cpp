@@ -501,9 +501,13 @@ void bind_unitek(py::module_& m) {
         }, py::arg("values"));
 
     // Poll sources (motorbus.Poller) on this client: asking, or capturing cyclic transmissions.
-    m.def("unitek_poll_source", [](ClientHolder& h, const std::vector<std::int64_t>& regids) -> std::shared_ptr<poll::Source> {
-              std::vector<std::uint8_t> r;
-              for (auto id : regids) r.push_back(regid_arg(id));
+    auto regids_arg = [](const std::vector<std::int64_t>& ids) {
+        std::vector<std::uint8_t> r;
+        for (auto id : ids) r.push_back(regid_arg(id));
+        return r;
+    };
+    m.def("unitek_poll_source", [regids_arg](ClientHolder& h, const std::vector<std::int64_t>& regids) -> std::shared_ptr<poll::Source> {
+              auto r = regids_arg(regids);
               return std::make_shared<PollSource>(*h.client, std::move(r));
           }, py::arg("client"), py::arg("regids"), py::keep_alive<0, 1>(),
           "A PollSource reading each register (3D REGID 00) every sample.");
@@ -514,10 +518,9 @@ void bind_unitek(py::module_& m) {
         .def_property_readonly("max_age", [](const CaptureSource& s) { return s.max_age_ns() / 1e9; })
         .def("close", &CaptureSource::close, py::call_guard<py::gil_scoped_release>(),
              "Stops the cyclic transmissions this source started (idempotent).");
-    m.def("unitek_capture_source", [](ClientHolder& h, const std::vector<std::int64_t>& regids, int interval_ms,
-                                      const py::object& max_age) {
-              std::vector<std::uint8_t> r;
-              for (auto id : regids) r.push_back(regid_arg(id));
+    m.def("unitek_capture_source", [regids_arg](ClientHolder& h, const std::vector<std::int64_t>& regids,
+                                                int interval_ms, const py::object& max_age) {
+              auto r = regids_arg(regids);
               const Nanos age = max_age.is_none() ? 0 : duration_arg(max_age, "max_age").count();
               auto* bus = h.bus.get();
               py::gil_scoped_release nogil;

@@ -85,7 +85,7 @@ def tpdo_capture_spec(kind: str, sdo: Any, bus: Any, node: int, fields: Sequence
                                event_timer_ms=timer_ms, mapping=mapping, procedure=procedure)
         tpdos.append((cob, mapping))
     source = _core.PdoCaptureSource(bus, node, tpdos, columns, max_age=(3 * timer_ms + 2) / 1000)
-    bus.send(_core.Frame(0x000, bytes([0x01, node])))   # NMT start remote node
+    bus.send(_core.nmt_encode(_core.NmtCommand.START, node))   # PDOs flow only in OPERATIONAL
 
     def close() -> None:
         source.close()

@@ -556,7 +556,7 @@ class Cia402Drive(Drive):
             _core.pdo_write_config(self._sdo, node, False, SYNC_START_RPDO, transmission_type=1,
                                    mapping=[(0x607A, 0, 32), (0x6040, 0, 16)])
             self._sync_rpdo_cob = _core.pdo_read_config(self._sdo, node, False, SYNC_START_RPDO).cob_id
-        bus.send(_core.Frame(0x000, bytes([0x01, node])))   # NMT start remote node
+        bus.send(_core.nmt_encode(_core.NmtCommand.START, node))   # PDOs flow only in OPERATIONAL
         self._sync_bus = bus
 
     def _hold_set_point(self, target: int, relative: bool) -> None:

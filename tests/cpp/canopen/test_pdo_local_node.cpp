@@ -168,12 +168,27 @@ TEST(PdoLocalNode, StrictNodeAbortsOverSdoAndCia301ProcedureWorks) {
     node.close();
 }
 
+// Node 5 serving `od` on a virtual bus, its TPDO 1 written to `c` by SDO and the node
+// started; a host endpoint and a sniffer on the same bus.
+struct StartedNode {
+    std::shared_ptr<can::VirtualBus> dev_bus, host_bus, sniff;
+    std::unique_ptr<LocalNode> node;
+    std::shared_ptr<PdoService> pdo;
+    StartedNode(const char* bus_name, std::shared_ptr<ObjectDictionary> od, const PdoConfig& c)
+        : dev_bus(can::open_virtual(bus_name)), host_bus(can::open_virtual(bus_name)),
+          sniff(can::open_virtual(bus_name)), node(std::make_unique<LocalNode>(*dev_bus, 5, std::move(od))),
+          pdo(PdoService::attach(*node)) {
+        BusSdoAccess sdo(*host_bus);
+        write_pdo(sdo, 5, c, PdoProcedure::Cia301);
+        NmtMaster nmt(*host_bus);
+        nmt.start(5);
+    }
+    ~StartedNode() { node->close(); }
+};
+
 // A TPDO reads its objects as an SDO upload does: through the read hook (a simulator's live
 // value), and the stored value where the hook refuses.
 TEST(PdoLocalNode, TpdoCarriesWhatTheReadHookAnswers) {
-    auto dev_bus = can::open_virtual("svc-hook");
-    auto host_bus = can::open_virtual("svc-hook");
-    auto sniff = can::open_virtual("svc-hook");
     auto od = pmc007_od();
     std::atomic<std::uint16_t> live{0x1234};
     std::atomic<bool> refuse{false};
@@ -183,22 +198,17 @@ TEST(PdoLocalNode, TpdoCarriesWhatTheReadHookAnswers) {
         value = {static_cast<std::uint8_t>(v & 0xFF), static_cast<std::uint8_t>(v >> 8)};
         return 0;
     });
-    LocalNode node(*dev_bus, 5, od);
-    auto pdo = PdoService::attach(node);
-    BusSdoAccess sdo(*host_bus);
     PdoConfig c;
     c.transmission_type = 1;  // on every SYNC
     c.mapping = std::vector<PdoMapEntry>{{0x6012, 0, 16}};
-    write_pdo(sdo, 5, c, PdoProcedure::Cia301);
-    NmtMaster nmt(*host_bus);
-    nmt.start(5);
+    StartedNode n("svc-hook", od, c);
     std::this_thread::sleep_for(20ms);
     can::Frame sync;
     sync.id = 0x080;
     sync.len = 0;
     auto tpdo_after_sync = [&] {
-        host_bus->send(sync);
-        auto got = collect(*sniff, 0x185, 1, 2000ms);
+        n.host_bus->send(sync);
+        auto got = collect(*n.sniff, 0x185, 1, 2000ms);
         return got.empty() ? Bytes{} : payload(got[0]);
     };
     EXPECT_EQ(tpdo_after_sync(), (Bytes{0x34, 0x12}));
@@ -206,7 +216,6 @@ TEST(PdoLocalNode, TpdoCarriesWhatTheReadHookAnswers) {
     EXPECT_EQ(tpdo_after_sync(), (Bytes{0xEF, 0xBE}));
     refuse = true;
     EXPECT_EQ(tpdo_after_sync(), (Bytes{0x03, 0x00}));  // the stored default
-    node.close();
 }
 
 // A read hook that sets a mapped object as it answers (the PMC007 simulator
@@ -214,9 +223,6 @@ TEST(PdoLocalNode, TpdoCarriesWhatTheReadHookAnswers) {
 // mutex (the TPDO was built under it), and without the re-entry guard an
 // event-driven TPDO would fire again for the value its own reading set, for ever.
 TEST(PdoLocalNode, AReadHookThatSetsAMappedObjectSendsEachEventTpdoOnce) {
-    auto dev_bus = can::open_virtual("svc-hook-set");
-    auto host_bus = can::open_virtual("svc-hook-set");
-    auto sniff = can::open_virtual("svc-hook-set");
     auto od = pmc007_od();
     auto other = od->at(0x6040, 0);
     std::atomic<int> reads{0};
@@ -227,20 +233,14 @@ TEST(PdoLocalNode, AReadHookThatSetsAMappedObjectSendsEachEventTpdoOnce) {
         value = {b[0], 0};
         return 0;
     });
-    LocalNode node(*dev_bus, 5, od);
-    auto pdo = PdoService::attach(node);
-    BusSdoAccess sdo(*host_bus);
     PdoConfig c;
     c.transmission_type = 254;  // event-driven: a change of a mapped object is an event
     c.event_timer_ms = 20;
     c.mapping = std::vector<PdoMapEntry>{{0x6012, 0, 16}, {0x6040, 0, 16}};
-    write_pdo(sdo, 5, c, PdoProcedure::Cia301);
-    NmtMaster nmt(*host_bus);
-    nmt.start(5);
-    auto got = collect(*sniff, 0x185, 100, 300ms);
+    StartedNode n("svc-hook-set", od, c);
+    auto got = collect(*n.sniff, 0x185, 100, 300ms);
     // About one per 20 ms timer tick: never a storm, never none.
     EXPECT_GE(got.size(), 5u);
     EXPECT_LE(got.size(), 25u);
     EXPECT_LE(reads.load(), static_cast<int>(got.size()) + 1);
-    node.close();
 }
