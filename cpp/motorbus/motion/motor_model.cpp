@@ -262,25 +262,46 @@ void MotorModel::emit(MotorEvent::Kind k, Nanos t) {
 
 void MotorModel::update() { advance_to(clock_.now()); }
 
+// True when the rotor follows the command without a stall anywhere in the
+// piece [from_s, to_s] (profile times) of the constant-acceleration segment
+// `seg`: no velocity sign change, and neither load limit exceeded at either end
+// (the extremes of a linear velocity).  The ends are taken from the segment
+// itself: at its last instant the profile may already read the next segment.
+bool MotorModel::whole_piece_is_steady(const Segment& seg, double from_s, double to_s) const {
+    const State a = seg.at(from_s - seg.t0), b = seg.at(to_s - seg.t0);
+    if (a.v * b.v < 0) return false;
+    const double k = std::fabs(steps_per_unit_);
+    const auto over = [&](const State& s) {
+        return (cfg_.pull_out_speed > 0 && std::fabs(s.v) * k > cfg_.pull_out_speed) ||
+               (cfg_.max_acceleration > 0 && std::fabs(s.a) * k > cfg_.max_acceleration);
+    };
+    return !over(a) && !over(b);
+}
+
 void MotorModel::advance_to(Nanos t) {
     if (in_dispatch_) return;  // a listener's query must not re-enter the integration
     while (now_ < t) {
         Nanos next = std::min<Nanos>(t, now_ + cfg_.tick_ns);
         // Idle and held by the jam: nothing can change until the next command.
         if (!running_ && stalled_ && jammed_) next = t;
-        // Cruising at constant velocity nothing can change between events, and
-        // every event is found exactly (the motion is monotone): take the whole
-        // cruise in one step, so a long jog on a simulated clock costs O(events).
+        // Along a constant-acceleration piece of the profile (a cruise, or a ramp
+        // whose velocity keeps its sign) the motion is monotone, so every switch
+        // and index edge is found exactly by bisection over any span; if the load
+        // limits hold at both ends they hold all along (velocity is linear in
+        // time, acceleration constant), so no stall can start inside either.
+        // Take the whole piece in one step: a long move on a simulated clock then
+        // costs O(segments + events), not one step per tick.
         if (running_ && !stalled_ && !jammed_) {
             const double pt = profile_time(now_);
             const std::size_t k = profile_.segment_index(pt);
             if (k < profile_.segments().size()) {
                 const Segment& seg = profile_.segments()[k];
-                if (seg.kind == Segment::Kind::Cubic && seg.start.a == 0 && seg.start.j == 0) {
+                if (seg.kind == Segment::Kind::Cubic && seg.start.j == 0) {
                     const double end_s = seg.t0 + seg.duration;
                     const double span = std::min(end_s - pt, 1e6);  // stay well inside Nanos
-                    const Nanos seg_end = now_ + static_cast<Nanos>(span * 1e9);
-                    if (seg_end > next) next = std::min<Nanos>(t, seg_end);
+                    const Nanos seg_end = std::min<Nanos>(t, now_ + static_cast<Nanos>(span * 1e9));
+                    if (seg_end > next && whole_piece_is_steady(seg, pt, pt + (seg_end - now_) * 1e-9))
+                        next = seg_end;
                 }
             }
         }

@@ -20,7 +20,10 @@
 // Time: Nanos on a motorbus::Clock.  update() advances the model to
 // clock.now() in ticks of MotorConfig::tick_ns; edges of switches, index and
 // latch found inside a tick are refined to ~1 ns by bisection on the profile,
-// and listeners see them in time order with the exact time.  A listener may
+// and listeners see them in time order with the exact time.  A constant-
+// acceleration piece of the profile that cannot stall the rotor (a cruise, a
+// ramp keeping its direction, within the load limits) is taken in one step:
+// its motion is monotone, so bisection finds its edges as exactly.  A listener may
 // command a new profile from inside the callback; it takes effect at the
 // event's time, so homing stops happen where a real drive would stop.
 #pragma once
@@ -63,7 +66,7 @@ struct MotorConfig {
     // while the test jams it (set_jammed).
     double pull_out_speed = 0;    // steps/s
     double max_acceleration = 0;  // steps/s^2
-    Nanos tick_ns = 100'000;      // integration step (100 us)
+    Nanos tick_ns = 100'000;      // integration step (100 us) where the motion may stall or reverse
 };
 
 struct MotorEvent {
@@ -212,6 +215,7 @@ private:
     SwitchConfig& switch_config(Switch w);
     bool switch_level(Switch w, double physical) const;  // what the controller reads
     void step_to(Nanos t);
+    bool whole_piece_is_steady(const Segment& seg, double from_s, double to_s) const;
     void emit(MotorEvent::Kind k, Nanos t);
     void emit_switch(Switch w, bool on);
     MotorEvent make_event(MotorEvent::Kind k, Nanos t) const;

@@ -194,6 +194,74 @@ TEST(MotorModel, JamAndLatch) {
     EXPECT_EQ(m.latched_encoder(), m.encoder());
 }
 
+// A constant-acceleration piece is taken in one step when it cannot stall or
+// reverse (the model's speed-up for long simulated moves); these pin down that
+// nothing is lost by it.
+namespace {
+std::vector<MotorEvent> play(MotorModel& m, SimClock& clk, const Profile& p, Nanos for_ns) {
+    std::vector<MotorEvent> ev;
+    m.add_listener([&](const MotorEvent& e) { ev.push_back(e); });
+    m.command(p);
+    clk.advance(for_ns);
+    m.update();
+    return ev;
+}
+Nanos first(const std::vector<MotorEvent>& ev, MotorEvent::Kind k, int nth = 0) {
+    for (const auto& e : ev)
+        if (e.kind == k && nth-- == 0) return e.t;
+    return -1;
+}
+}  // namespace
+
+TEST(MotorModel, LongRampsTakenWholeStillFindEveryEdgeExactly) {
+    SimClock clk;
+    MotorConfig cfg;
+    cfg.index_position = 100;
+    cfg.home = SwitchConfig{true, 1000, 1200, true};
+    MotorModel m(clk, cfg);
+    const Profile p = move_profile(0, 3 * 3200 + 50, 3200, 320);  // 10 s ramps, no cruise
+    const auto ev = play(m, clk, p, 60 * kSec);
+    EXPECT_NEAR(static_cast<double>(first(ev, MotorEvent::Kind::HomeOn)), p.first_crossing(1000) * 1e9, 2.0);
+    EXPECT_NEAR(static_cast<double>(first(ev, MotorEvent::Kind::HomeOff)), p.first_crossing(1200) * 1e9, 2.0);
+    for (int k = 0; k < 3; ++k)  // 100, 3300, 6500: one in the first ramp, two in the second
+        EXPECT_NEAR(static_cast<double>(first(ev, MotorEvent::Kind::IndexPulse, k)),
+                    p.first_crossing(100 + 3200.0 * k) * 1e9, 2.0) << k;
+    EXPECT_EQ(first(ev, MotorEvent::Kind::IndexPulse, 3), -1);
+    EXPECT_EQ(ev.back().kind, MotorEvent::Kind::ProfileDone);
+    EXPECT_EQ(m.pulse_count(), 3 * 3200 + 50);
+}
+
+TEST(MotorModel, ARampThatReversesFindsTheWayOutAndBack) {
+    // v goes 1000 -> -1000 steps/s in one 2 s piece: p(t) = 1000 t - 500 t^2 goes
+    // out to 500 and back to 0, through the home window [300, 400] twice.  Its
+    // two ends are at the same position, so only stepping finds the four edges.
+    SimClock clk;
+    MotorConfig cfg;
+    cfg.home = SwitchConfig{true, 300, 400, true};
+    MotorModel m(clk, cfg);
+    Profile q(State{0, 0, 0, 0});
+    q.append_jump(2.0, 1000, -1000, 0).finish(0, 0);
+    const auto ev = play(m, clk, q, 3 * kSec);
+    const double r300 = std::sqrt(0.4), r400 = std::sqrt(0.2);  // p = 300, 400 at t = 1 -/+ r
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOn) / 1e9, 1 - r300, 1e-8);
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOff) / 1e9, 1 - r400, 1e-8);
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOn, 1) / 1e9, 1 + r400, 1e-8);
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOff, 1) / 1e9, 1 + r300, 1e-8);
+}
+
+TEST(MotorModel, AStallInsideALongRampStartsWithinATickOfThePullOutSpeed) {
+    SimClock clk;
+    MotorConfig cfg;
+    cfg.pull_out_speed = 5000;  // reached 5 s into a 10 s ramp to 10 000 steps/s
+    MotorModel m(clk, cfg);
+    Profile q(State{0, 0, 0, 0});
+    q.append_jump(10.0, 0, 1000, 0).finish(50'000, 0);
+    const auto ev = play(m, clk, q, 20 * kSec);
+    const Nanos stalled = first(ev, MotorEvent::Kind::Stalled);
+    EXPECT_GE(stalled, 5 * kSec);
+    EXPECT_LE(stalled, 5 * kSec + cfg.tick_ns);
+}
+
 // ---- Homing ----------------------------------------------------------------------
 
 namespace {
