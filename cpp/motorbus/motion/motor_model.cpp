@@ -282,8 +282,9 @@ void MotorModel::advance_to(Nanos t) {
     if (in_dispatch_) return;  // a listener's query must not re-enter the integration
     while (now_ < t) {
         Nanos next = std::min<Nanos>(t, now_ + cfg_.tick_ns);
-        // Idle and held by the jam: nothing can change until the next command.
-        if (!running_ && stalled_ && jammed_) next = t;
+        // At rest, or idle and held by the jam: nothing can change until the next
+        // command (step_to skips the interval), so skip it all at once.
+        if (!running_ && (!stalled_ || jammed_)) next = t;
         // Along a constant-acceleration piece of the profile (a cruise, or a ramp
         // whose velocity keeps its sign) the motion is monotone, so every switch
         // and index edge is found exactly by bisection over any span; if the load
