@@ -115,6 +115,23 @@ TEST(StepNLoop, IdleDisturbanceAndLimitAndDisabled) {
 
 using motorbus::test::move_profile;
 
+// Commands p, runs the clock for_ns, returns the events seen.
+namespace {
+std::vector<MotorEvent> play(MotorModel& m, SimClock& clk, const Profile& p, Nanos for_ns) {
+    std::vector<MotorEvent> ev;
+    m.add_listener([&](const MotorEvent& e) { ev.push_back(e); });
+    m.command(p);
+    clk.advance(for_ns);
+    m.update();
+    return ev;
+}
+Nanos first(const std::vector<MotorEvent>& ev, MotorEvent::Kind k, int nth = 0) {
+    for (const auto& e : ev)
+        if (e.kind == k && nth-- == 0) return e.t;
+    return -1;
+}
+}  // namespace
+
 TEST(MotorModel, FollowsProfileAndEncoderRatio) {
     SimClock clk;
     MotorModel m(clk);
@@ -133,29 +150,27 @@ TEST(MotorModel, FollowsProfileAndEncoderRatio) {
 }
 
 TEST(MotorModel, IndexOncePerRevAndExactEdgeTimes) {
-    SimClock clk;
-    MotorConfig cfg;
-    cfg.index_position = 100;
-    cfg.home = SwitchConfig{true, 1000, 1200, true};
-    MotorModel m(clk, cfg);
-    std::vector<MotorEvent> ev;
-    m.add_listener([&](const MotorEvent& e) { ev.push_back(e); });
-    const Profile p = move_profile(0, 3 * 3200 + 50);
-    m.command(p);
-    clk.advance(10 * kSec);
-    m.update();
-    int index = 0;
-    Nanos home_on = -1, home_off = -1;
-    for (const auto& e : ev) {
-        if (e.kind == MotorEvent::Kind::IndexPulse) ++index;
-        if (e.kind == MotorEvent::Kind::HomeOn) home_on = e.t;
-        if (e.kind == MotorEvent::Kind::HomeOff) home_off = e.t;
+    // Short ramps (0.1 s), and 10 s ramps with no cruise: a ramp that cannot
+    // stall or reverse is taken in one step, and its edges must stay as exact.
+    for (const double accel : {32000.0, 320.0}) {
+        SCOPED_TRACE(accel);
+        SimClock clk;
+        MotorConfig cfg;
+        cfg.index_position = 100;
+        cfg.home = SwitchConfig{true, 1000, 1200, true};
+        MotorModel m(clk, cfg);
+        const Profile p = move_profile(0, 3 * 3200 + 50, 3200, accel);
+        const auto ev = play(m, clk, p, 60 * kSec);
+        EXPECT_NEAR(static_cast<double>(first(ev, MotorEvent::Kind::HomeOn)), p.first_crossing(1000) * 1e9, 2.0);
+        EXPECT_NEAR(static_cast<double>(first(ev, MotorEvent::Kind::HomeOff)), p.first_crossing(1200) * 1e9, 2.0);
+        for (int k = 0; k < 3; ++k)  // 100, 3300, 6500 (9700 is past 9650)
+            EXPECT_NEAR(static_cast<double>(first(ev, MotorEvent::Kind::IndexPulse, k)),
+                        p.first_crossing(100 + 3200.0 * k) * 1e9, 2.0) << k;
+        EXPECT_EQ(first(ev, MotorEvent::Kind::IndexPulse, 3), -1);
+        EXPECT_EQ(ev.back().kind, MotorEvent::Kind::ProfileDone);
+        EXPECT_EQ(m.pulse_count(), 3 * 3200 + 50);
+        EXPECT_TRUE(m.home_input());  // active low: idle high off the switch
     }
-    EXPECT_EQ(index, 3);  // 100, 3300, 6500 (9700 is past 9650)
-    EXPECT_NEAR(static_cast<double>(home_on), p.first_crossing(1000) * 1e9, 2.0);
-    EXPECT_NEAR(static_cast<double>(home_off), p.first_crossing(1200) * 1e9, 2.0);
-    EXPECT_EQ(ev.back().kind, MotorEvent::Kind::ProfileDone);
-    EXPECT_TRUE(m.home_input());  // active low: idle high off the switch
 }
 
 TEST(MotorModel, StallLosesStepsEncoderShowsIt) {
@@ -196,40 +211,7 @@ TEST(MotorModel, JamAndLatch) {
 
 // A constant-acceleration piece is taken in one step when it cannot stall or
 // reverse (the model's speed-up for long simulated moves); these pin down that
-// nothing is lost by it.
-namespace {
-std::vector<MotorEvent> play(MotorModel& m, SimClock& clk, const Profile& p, Nanos for_ns) {
-    std::vector<MotorEvent> ev;
-    m.add_listener([&](const MotorEvent& e) { ev.push_back(e); });
-    m.command(p);
-    clk.advance(for_ns);
-    m.update();
-    return ev;
-}
-Nanos first(const std::vector<MotorEvent>& ev, MotorEvent::Kind k, int nth = 0) {
-    for (const auto& e : ev)
-        if (e.kind == k && nth-- == 0) return e.t;
-    return -1;
-}
-}  // namespace
-
-TEST(MotorModel, LongRampsTakenWholeStillFindEveryEdgeExactly) {
-    SimClock clk;
-    MotorConfig cfg;
-    cfg.index_position = 100;
-    cfg.home = SwitchConfig{true, 1000, 1200, true};
-    MotorModel m(clk, cfg);
-    const Profile p = move_profile(0, 3 * 3200 + 50, 3200, 320);  // 10 s ramps, no cruise
-    const auto ev = play(m, clk, p, 60 * kSec);
-    EXPECT_NEAR(static_cast<double>(first(ev, MotorEvent::Kind::HomeOn)), p.first_crossing(1000) * 1e9, 2.0);
-    EXPECT_NEAR(static_cast<double>(first(ev, MotorEvent::Kind::HomeOff)), p.first_crossing(1200) * 1e9, 2.0);
-    for (int k = 0; k < 3; ++k)  // 100, 3300, 6500: one in the first ramp, two in the second
-        EXPECT_NEAR(static_cast<double>(first(ev, MotorEvent::Kind::IndexPulse, k)),
-                    p.first_crossing(100 + 3200.0 * k) * 1e9, 2.0) << k;
-    EXPECT_EQ(first(ev, MotorEvent::Kind::IndexPulse, 3), -1);
-    EXPECT_EQ(ev.back().kind, MotorEvent::Kind::ProfileDone);
-    EXPECT_EQ(m.pulse_count(), 3 * 3200 + 50);
-}
+// nothing is lost by it where it must not be taken whole.
 
 TEST(MotorModel, ARampThatReversesFindsTheWayOutAndBack) {
     // v goes 1000 -> -1000 steps/s in one 2 s piece: p(t) = 1000 t - 500 t^2 goes
