@@ -262,20 +262,34 @@ void MotorModel::emit(MotorEvent::Kind k, Nanos t) {
 
 void MotorModel::update() { advance_to(clock_.now()); }
 
+// Load: the rotor cannot follow a command faster than the pull-out speed or
+// harder than the maximum acceleration (both in steps, a limit of 0 = none).
+bool MotorModel::load_exceeded(double v_steps, double a_steps) const {
+    return (cfg_.pull_out_speed > 0 && std::fabs(v_steps) > cfg_.pull_out_speed) ||
+           (cfg_.max_acceleration > 0 && std::fabs(a_steps) > cfg_.max_acceleration);
+}
+
 // True when the rotor follows the command without a stall anywhere in the
-// piece [from_s, to_s] (profile times) of the constant-acceleration segment
-// `seg`: no velocity sign change, and neither load limit exceeded at either end
-// (the extremes of a linear velocity).  The ends are taken from the segment
-// itself: at its last instant the profile may already read the next segment.
+// piece [from_s, to_s] (profile times) of the cubic segment `seg`, moving one
+// way only.  Velocity is quadratic in time (linear when the jerk is 0), so its
+// extremes are at the ends of the piece and where the acceleration crosses
+// zero inside it; the acceleration is linear, so its extremes are at the
+// ends.  The ends are taken from the segment itself: at its last instant the
+// profile may already read the next segment.
 bool MotorModel::whole_piece_is_steady(const Segment& seg, double from_s, double to_s) const {
     const State a = seg.at(from_s - seg.t0), b = seg.at(to_s - seg.t0);
-    if (a.v * b.v < 0) return false;
+    double v_lo = std::min(a.v, b.v), v_hi = std::max(a.v, b.v);
+    if (seg.start.j != 0) {
+        const double t_flat = -seg.start.a / seg.start.j;  // segment time where a = 0
+        if (t_flat > from_s - seg.t0 && t_flat < to_s - seg.t0) {
+            const double v = seg.at(t_flat).v;
+            v_lo = std::min(v_lo, v);
+            v_hi = std::max(v_hi, v);
+        }
+    }
+    if (v_lo < 0 && v_hi > 0) return false;  // reverses inside: not monotone
     const double k = std::fabs(steps_per_unit_);
-    const auto over = [&](const State& s) {
-        return (cfg_.pull_out_speed > 0 && std::fabs(s.v) * k > cfg_.pull_out_speed) ||
-               (cfg_.max_acceleration > 0 && std::fabs(s.a) * k > cfg_.max_acceleration);
-    };
-    return !over(a) && !over(b);
+    return !load_exceeded(std::max(-v_lo, v_hi) * k, std::max(std::fabs(a.a), std::fabs(b.a)) * k);
 }
 
 void MotorModel::advance_to(Nanos t) {
@@ -285,19 +299,19 @@ void MotorModel::advance_to(Nanos t) {
         // At rest, or idle and held by the jam: nothing can change until the next
         // command (step_to skips the interval), so skip it all at once.
         if (!running_ && (!stalled_ || jammed_)) next = t;
-        // Along a constant-acceleration piece of the profile (a cruise, or a ramp
-        // whose velocity keeps its sign) the motion is monotone, so every switch
-        // and index edge is found exactly by bisection over any span; if the load
-        // limits hold at both ends they hold all along (velocity is linear in
-        // time, acceleration constant), so no stall can start inside either.
-        // Take the whole piece in one step: a long move on a simulated clock then
-        // costs O(segments + events), not one step per tick.
+        // Along a cubic piece of the profile (a cruise, a ramp, an S-curve's
+        // jerk phase) whose velocity keeps its sign the motion is monotone, so
+        // every switch and index edge is found exactly by bisection over any
+        // span; if the load limits hold at the piece's velocity and acceleration
+        // extremes no stall can start inside it either.  Take the whole piece in
+        // one step: a long move on a simulated clock then costs
+        // O(segments + events), not one step per tick.
         if (running_ && !stalled_ && !jammed_) {
             const double pt = profile_time(now_);
             const std::size_t k = profile_.segment_index(pt);
             if (k < profile_.segments().size()) {
                 const Segment& seg = profile_.segments()[k];
-                if (seg.kind == Segment::Kind::Cubic && seg.start.j == 0) {
+                if (seg.kind == Segment::Kind::Cubic) {
                     const double end_s = seg.t0 + seg.duration;
                     const double span = std::min(end_s - pt, 1e6);  // stay well inside Nanos
                     const Nanos seg_end = std::min<Nanos>(t, now_ + static_cast<Nanos>(span * 1e9));
@@ -323,10 +337,9 @@ void MotorModel::step_to(Nanos t_end) {
     }
     const State cs = command_state(t_end);
     // Load: does the rotor keep up over this tick?
-    const bool over_speed = cfg_.pull_out_speed > 0 && std::fabs(cs.v) > cfg_.pull_out_speed;
-    const bool over_accel = cfg_.max_acceleration > 0 && std::fabs(cs.a) > cfg_.max_acceleration;
+    const bool overloaded = load_exceeded(cs.v, cs.a);
     const bool commanded_motion = running_ && cs.v != 0;
-    if (!stalled_ && commanded_motion && (jammed_ || over_speed || over_accel)) {
+    if (!stalled_ && commanded_motion && (jammed_ || overloaded)) {
         stalled_ = true;
         slip_ = cs.p - physical_;
         now_ = t_end;
@@ -334,7 +347,7 @@ void MotorModel::step_to(Nanos t_end) {
         return;
     }
     if (stalled_) {
-        if (!jammed_ && !over_speed && !over_accel) {
+        if (!jammed_ && !overloaded) {
             stalled_ = false;
             slip_ = cs.p - physical_;
             now_ = t_end;

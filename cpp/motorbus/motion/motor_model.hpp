@@ -215,6 +215,7 @@ private:
     SwitchConfig& switch_config(Switch w);
     bool switch_level(Switch w, double physical) const;  // what the controller reads
     void step_to(Nanos t);
+    bool load_exceeded(double v_steps, double a_steps) const;
     bool whole_piece_is_steady(const Segment& seg, double from_s, double to_s) const;
     void emit(MotorEvent::Kind k, Nanos t);
     void emit_switch(Switch w, bool on);

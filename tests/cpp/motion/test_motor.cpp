@@ -209,9 +209,9 @@ TEST(MotorModel, JamAndLatch) {
     EXPECT_EQ(m.latched_encoder(), m.encoder());
 }
 
-// A constant-acceleration piece is taken in one step when it cannot stall or
-// reverse (the model's speed-up for long simulated moves); these pin down that
-// nothing is lost by it where it must not be taken whole.
+// A cubic piece is taken in one step when it cannot stall or reverse (the
+// model's speed-up for long simulated moves); these pin down that nothing is
+// lost by it, and that it is not taken whole where it must not be.
 
 TEST(MotorModel, ARampThatReversesFindsTheWayOutAndBack) {
     // v goes 1000 -> -1000 steps/s in one 2 s piece: p(t) = 1000 t - 500 t^2 goes
@@ -229,6 +229,53 @@ TEST(MotorModel, ARampThatReversesFindsTheWayOutAndBack) {
     EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOff) / 1e9, 1 - r400, 1e-8);
     EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOn, 1) / 1e9, 1 + r400, 1e-8);
     EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOff, 1) / 1e9, 1 + r300, 1e-8);
+}
+
+TEST(MotorModel, AJerkPieceIsTakenWholeWithExactEdges) {
+    // One 2 s jerk piece from rest: p(t) = 1000 t^3 / 6, monotone, so it is
+    // taken in one step; the index (at 100) and home window [300, 400] edges
+    // must still come out at their exact times.
+    SimClock clk;
+    MotorConfig cfg;
+    cfg.index_position = 100;
+    cfg.home = SwitchConfig{true, 300, 400, true};
+    MotorModel m(clk, cfg);
+    Profile q(State{0, 0, 0, 0});
+    q.append_jump(2.0, 0, 0, 1000).finish(1000.0 * 8 / 6, 0);
+    const auto ev = play(m, clk, q, 3 * kSec);
+    const auto at = [](double p) { return std::cbrt(6 * p / 1000); };
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::IndexPulse) / 1e9, at(100), 1e-8);
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOn) / 1e9, at(300), 1e-8);
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOff) / 1e9, at(400), 1e-8);
+}
+
+TEST(MotorModel, AJerkPieceThatReversesInsideIsStepped) {
+    // v(t) = 1000 - 4000 t + 2000 t^2: +1000 at both ends of the 2 s piece but
+    // -1000 at t = 1, so p goes out to 138, back to -805 and ends at -667.
+    // Both ends (and the middle) are outside the home window [50, 100]: only
+    // the velocity's interior extreme says the piece is not monotone, and
+    // only stepping it finds the four edges.
+    SimClock clk;
+    MotorConfig cfg;
+    cfg.home = SwitchConfig{true, 50, 100, true};
+    MotorModel m(clk, cfg);
+    Profile q(State{0, 0, 0, 0});
+    q.append_jump(2.0, 1000, -4000, 4000).finish(-2000.0 / 3, 0);
+    const auto ev = play(m, clk, q, 3 * kSec);
+    const auto p = [](double t) { return 1000 * t - 2000 * t * t + 4000 * t * t * t / 6; };
+    const auto crossing = [&](double level, double lo, double hi) {  // p - level changes sign once in [lo, hi]
+        const bool up = p(lo) < level;
+        for (int i = 0; i < 100; ++i) {
+            const double mid = (lo + hi) / 2;
+            ((p(mid) < level) == up ? lo : hi) = mid;
+        }
+        return lo;
+    };
+    const double t_out = 1 - std::sqrt(0.5);  // where v = 0 the first time: p = 138
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOn) / 1e9, crossing(50, 0, t_out), 1e-8);
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOff) / 1e9, crossing(100, 0, t_out), 1e-8);
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOn, 1) / 1e9, crossing(100, t_out, 1), 1e-8);
+    EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOff, 1) / 1e9, crossing(50, t_out, 1), 1e-8);
 }
 
 TEST(MotorModel, AStallInsideALongRampStartsWithinATickOfThePullOutSpeed) {
