@@ -11,6 +11,12 @@
 using namespace motorbus;
 using namespace motorbus::canopen;
 
+namespace {
+// Frames and ticks looked at per input: a longer input only runs more
+// transfers one after another, each from a fresh start.
+constexpr std::size_t kMaxSteps = 256;
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     if (size < 2) return 0;
     SdoClientConfig cfg;
@@ -32,7 +38,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     };
     start(data[1]);
     std::size_t i = 2;
-    while (i < size) {
+    std::size_t steps = 0;
+    while (i < size && steps++ < kMaxSteps) {
         const std::uint8_t hdr = data[i++];
         if (!cli.busy()) {
             if (cli.status() == SdoClientMachine::Status::Failed && !cli.error()) std::abort();

@@ -78,6 +78,7 @@ void HeartbeatConsumer::monitor(std::uint8_t node, std::chrono::nanoseconds time
     if (timeout.count() <= 0) throw InvalidArgument("heartbeat consumer: timeout must be > 0");
     std::lock_guard l(mutex_);
     auto& n = nodes_[node];
+    if (!n.monitored) watched_.push_back(node);
     n.monitored = true;
     n.timeout = timeout.count();
     if (n.h.alive) n.deadline = n.h.last_seen + n.timeout;
@@ -87,6 +88,7 @@ void HeartbeatConsumer::monitor(std::uint8_t node, std::chrono::nanoseconds time
 void HeartbeatConsumer::forget(std::uint8_t node) {
     if (node == 0 || node > kMaxNodeId) return;
     std::lock_guard l(mutex_);
+    if (nodes_[node].monitored) watched_.erase(std::find(watched_.begin(), watched_.end(), node));
     nodes_[node] = Node{};
     nodes_[node].h.node_id = node;
 }
@@ -143,15 +145,15 @@ Nanos HeartbeatConsumer::process(Nanos now) {
     Nanos next = -1;
     {
         std::lock_guard l(mutex_);
-        for (std::size_t i = 1; i < nodes_.size(); ++i) {
+        for (const std::uint8_t i : watched_) {
             auto& n = nodes_[i];
-            if (!n.monitored || n.deadline < 0) continue;
+            if (n.deadline < 0) continue;
             if (now >= n.deadline) {
                 n.deadline = -1;  // re-armed by the next heartbeat
                 n.h.alive = false;
                 n.h.lost = true;
                 ++n.h.timeouts;
-                lost.emplace_back(static_cast<std::uint8_t>(i), n.h.state);
+                lost.emplace_back(i, n.h.state);
             } else if (next < 0 || n.deadline < next) {
                 next = n.deadline;
             }

@@ -106,6 +106,8 @@ private:
     Clock& clock_;
     mutable std::mutex mutex_;
     std::array<Node, 128> nodes_{};
+    // The monitored node ids, so a deadline check visits those, not all 127.
+    std::vector<std::uint8_t> watched_;
     std::atomic<std::uint64_t> ignored_{0};
     can::SubscriptionId sub_ = 0;
     TimerThread timer_;

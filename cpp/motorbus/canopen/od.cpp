@@ -1,9 +1,9 @@
 #include "motorbus/canopen/od.hpp"
 
-#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cstdio>
+#include <cstring>
 
 #include "motorbus/errors.hpp"
 
@@ -87,6 +87,11 @@ Variable::Variable(VariableSpec spec, std::size_t dictionary_max_size) : spec_(s
 Bytes Variable::get() const {
     std::lock_guard lock(mutex_);
     return value_;
+}
+
+bool Variable::holds(std::span<const std::uint8_t> data) const {
+    std::lock_guard lock(mutex_);
+    return value_.size() == data.size() && (data.empty() || std::memcmp(value_.data(), data.data(), data.size()) == 0);
 }
 
 std::uint32_t Variable::check_size_for_write(std::size_t n) const {

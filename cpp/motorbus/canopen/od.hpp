@@ -113,6 +113,8 @@ public:
 
     // --- local access (the device/application itself; no access check, no hooks) ---
     Bytes get() const;
+    // True when the stored value is exactly `data` (compared in place, no copy).
+    bool holds(std::span<const std::uint8_t> data) const;
     // Replaces the value after checking size and limits; throws InvalidArgument
     // with the CiA reason otherwise.  Tells the change listeners.
     void set(std::span<const std::uint8_t> data);

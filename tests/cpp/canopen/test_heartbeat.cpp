@@ -111,6 +111,34 @@ TEST_F(ConsumerFixture, N10_LostWithinConsumerTimePlusOneTick_ThenBack) {
     EXPECT_EQ(hc.health(5).boot_ups, 1u);
 }
 
+TEST_F(ConsumerFixture, OnlyMonitoredNodesAreCheckedAndForgetStopsIt) {
+    // Three nodes beat; 5 and 127 are monitored (twice: a second monitor() only
+    // changes the time), then 5 is forgotten and monitored again.
+    hc.monitor(5, 100ms);
+    hc.monitor(127, 300ms);
+    hc.monitor(127, 200ms);
+    for (std::uint8_t n : {5, 9, 127}) beat(n, 0x05);
+    const Nanos t0 = clock.now();
+    EXPECT_EQ(hc.process(t0), t0 + 100'000'000);  // the earliest deadline: node 5's
+    hc.forget(5);
+    EXPECT_EQ(hc.process(t0), t0 + 200'000'000);  // only 127 left
+    clock.advance(250'000'000);
+    events.clear();
+    EXPECT_EQ(hc.process(clock.now()), -1);
+    ASSERT_EQ(events.size(), 1u);  // 127 lost; 9 never monitored, 5 forgotten
+    EXPECT_EQ(events[0], std::make_pair(127, HeartbeatEvent::Lost));
+    hc.monitor(5, 100ms);
+    beat(5, 0x05);
+    EXPECT_EQ(hc.process(clock.now()), clock.now() + 100'000'000);
+    hc.forget(127);
+    hc.forget(9);  // not monitored: nothing to stop
+    clock.advance(100'000'000);
+    events.clear();
+    EXPECT_EQ(hc.process(clock.now()), -1);
+    ASSERT_EQ(events.size(), 1u);
+    EXPECT_EQ(events[0], std::make_pair(5, HeartbeatEvent::Lost));
+}
+
 TEST_F(ConsumerFixture, N6_BadDlcCountedAndNextValidWorks) {
     hc.monitor(5, 100ms);
     dev->send(frame(0x705, {}));

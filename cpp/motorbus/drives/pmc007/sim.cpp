@@ -78,6 +78,8 @@ Pmc007Sim::Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions option
             });
         var->add_change_listener([this](const canopen::Variable&) { publish(); });
     }
+    for (std::size_t k = 0; k < published_.size(); ++k)
+        published_[k] = od_->at(kPublished[k].first, kPublished[k].second);
     for (auto [i, s] : kLive)
         od_->at(i, s)->set_read_hook([this](const canopen::Variable& v, Bytes& out) -> std::uint32_t {
             poll();
@@ -239,18 +241,20 @@ std::int64_t Pmc007Sim::u(std::uint16_t i, std::uint8_t s) const {
     return decode_le(b, v->type() == canopen::DataType::Integer32);
 }
 
-void Pmc007Sim::set(std::uint16_t i, std::uint8_t s, std::int64_t value) {
-    auto v = od_->at(i, s);
-    const std::size_t n = v->size();
-    Bytes b(n);
+void Pmc007Sim::set(std::uint16_t i, std::uint8_t s, std::int64_t value) { set(od_->at(i, s), value); }
+
+void Pmc007Sim::set(const canopen::VariablePtr& v, std::int64_t value) {
+    std::uint8_t b[8];  // every object set here is a number of at most 8 bytes
+    const std::size_t n = std::min(v->size(), sizeof b);
     for (std::size_t k = 0; k < n; ++k) b[k] = static_cast<std::uint8_t>(std::uint64_t(value) >> (8 * k));
-    if (v->get() != b) v->try_set(b);
+    // Only a change is stored: listeners (publish, PDO events) hear changes.
+    if (!v->holds({b, n})) v->try_set({b, n});
 }
 
 void Pmc007Sim::publish() {
     if (t_publishing) return;
     t_publishing = true;
-    std::vector<std::pair<std::pair<std::uint16_t, std::uint8_t>, std::int64_t>> out;
+    std::array<std::int64_t, std::size(kPublished)> values;  // in kPublished order
     {
         std::lock_guard lock(m_);
         const std::uint8_t status = controller_status();
@@ -259,24 +263,24 @@ void Pmc007Sim::publish() {
         if (errors_ & (err::kAoc | err::kBoc)) er |= 0x02;
         if (errors_ & err::kUvlo) er |= 0x04;
         if (errors_ & err::kTsd) er |= 0x08;
-        out.push_back({{0x1001, 0}, er});
-        out.push_back({{0x1002, 0}, std::int64_t(errors_) * 256 + status});
-        out.push_back({{0x2007, 0}, 0});
-        out.push_back({{0x6000, 0}, errors_});
-        out.push_back({{0x6001, 0}, status});
-        out.push_back({{0x600C, 0}, position()});
-        out.push_back({{0x6012, 0}, gpio_value()});
-        out.push_back({{0x6022, 0}, saved_position_});
-        out.push_back({{0x6004, 0}, last_step_});
-        out.push_back({{0x601C, 0}, last_abs_});
-        out.push_back({{0x6020, 0}, 0});
-        out.push_back({{0x6019, 3}, 0});
-        out.push_back({{0x6019, 5}, 0});
-        out.push_back({{0x6011, 1}, u(0x6011, 1) & 0x7F});  // B-P24: bits 7-10 are fixed inputs
         const auto ptr = static_cast<std::size_t>(u(0x6019, 1));
-        out.push_back({{0x6019, 2}, ptr < ram_program_.size() ? ram_program_[ptr] : 0});
+        values = {er,                                   // 1001h
+                  std::int64_t(errors_) * 256 + status,  // 1002h
+                  0,                                    // 2007h
+                  errors_,                              // 6000h
+                  status,                               // 6001h
+                  position(),                           // 600Ch
+                  gpio_value(),                         // 6012h
+                  saved_position_,                      // 6022h
+                  last_step_,                           // 6004h
+                  last_abs_,                            // 601Ch
+                  0,                                    // 6020h
+                  0,                                    // 6019h:03
+                  0,                                    // 6019h:05
+                  u(0x6011, 1) & 0x7F,                  // 6011h:01, B-P24: bits 7-10 are fixed inputs
+                  ptr < ram_program_.size() ? ram_program_[ptr] : 0};  // 6019h:02
     }
-    for (auto& [k, v] : out) set(k.first, k.second, v);
+    for (std::size_t k = 0; k < values.size(); ++k) set(published_[k], values[k]);
     t_publishing = false;
 }
 
@@ -372,9 +376,9 @@ void Pmc007Sim::load_power_up(bool cold) {
     for (const auto& [r, var, flash] : power_up_) {
         if (flash && (r->index == 0x1016 || r->index == 0x1017) && r->sub != 0)
             var->remote_write(*flash);  // through the heartbeat service's hooks
-        else if (flash)
+        else if (flash && !var->holds(*flash))  // only a change is stored (and heard)
             var->try_set(*flash);
-        else
+        else if (!flash && !var->holds(var->default_bytes()))
             var->reset_to_default();
     }
     t_publishing = false;

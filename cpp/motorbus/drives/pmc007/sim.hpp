@@ -21,12 +21,14 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
@@ -162,6 +164,7 @@ private:
     bool exec_locked(std::uint32_t word, bool single);
     std::int64_t u(std::uint16_t i, std::uint8_t s = 0) const;
     void set(std::uint16_t i, std::uint8_t s, std::int64_t v);
+    void set(const canopen::VariablePtr& var, std::int64_t v);
 
     std::atomic<std::uint8_t> node_id_;
     std::atomic<std::uint8_t> baud_index_{4};
@@ -187,6 +190,11 @@ private:
         canopen::Bytes* flash;  // its flash_ entry (ROM objects), else nullptr
     };
     std::vector<PowerUpRow> power_up_;  // every dictionary row, in table order
+    // The objects publish() keeps up to date, looked up once (it runs on every poll).
+    static constexpr std::pair<std::uint16_t, std::uint8_t> kPublished[] = {
+        {0x1001, 0}, {0x1002, 0}, {0x2007, 0}, {0x6000, 0}, {0x6001, 0}, {0x600C, 0}, {0x6012, 0}, {0x6022, 0},
+        {0x6004, 0}, {0x601C, 0}, {0x6020, 0}, {0x6019, 3}, {0x6019, 5}, {0x6011, 1}, {0x6019, 2}};
+    std::array<canopen::VariablePtr, std::size(kPublished)> published_;
     std::vector<std::uint32_t> flash_program_, ram_program_;
     std::uint8_t errors_ = 0;   // 6000h
     std::uint8_t latched_ = 0;  // 6001h bits 0-2, 4
