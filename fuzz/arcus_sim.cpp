@@ -10,6 +10,13 @@
 
 using namespace motorbus;
 
+namespace {
+// Time between two lines: 0-255 units.  While a StepNLoop or sync move is
+// armed the simulator samples every 1 ms tick, so this bounds one line's cost
+// (0-1.275 s: long enough for moves to end and limits to be hit).
+constexpr Nanos kTimeUnit = 5'000'000;
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     SimClock clock;
     arcus::SimOptions o;
@@ -28,7 +35,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (!reply.empty() && (reply.back() != '\0' || reply.find('\0') != reply.size() - 1)) __builtin_trap();
         if (cr == std::string_view::npos) break;
         start = cr + 1;
-        if (start < in.size()) clock.advance(static_cast<Nanos>(static_cast<std::uint8_t>(in[start])) * 20'000'000);
+        if (start < in.size()) clock.advance(static_cast<Nanos>(static_cast<std::uint8_t>(in[start])) * kTimeUnit);
     }
     (void)sim.motor_status();
     (void)sim.snl_status();
