@@ -14,6 +14,12 @@
 using namespace motorbus;
 using namespace motorbus::unitek;
 
+namespace {
+// Frames looked at per input: with up to 64 ms between frames a longer input
+// adds cyclic transmissions and motion, not new states.
+constexpr std::size_t kMaxFrames = 64;
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     // The register table is built once: building it per input (a few hundred
     // named registers) was a fifth of the run time.  The sim gets a copy.
@@ -28,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     });
     std::size_t i = 0;
     std::size_t frames = 0;
-    while (i + 2 <= size && frames < 256) {
+    while (i + 2 <= size && frames < kMaxFrames) {
         const std::uint8_t sel = data[i++];
         const std::size_t dlc = data[i++] % 9;
         if (i + dlc > size) break;
