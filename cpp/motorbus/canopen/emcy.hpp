@@ -16,6 +16,7 @@
 
 #include "motorbus/can/bus.hpp"
 #include "motorbus/canopen/timer_thread.hpp"
+#include "motorbus/runtime/callback_slot.hpp"
 #include "motorbus/runtime/clock.hpp"
 
 namespace motorbus::canopen {
@@ -59,7 +60,7 @@ public:
     // in a bounded queue (256, oldest dropped), so report-then-wait never races.
     std::optional<EmcyMessage> wait(std::uint8_t node, std::chrono::nanoseconds timeout);
 
-    std::function<void(const EmcyMessage&)> on_emcy;
+    CallbackSlot<void(const EmcyMessage&)> on_emcy;
     std::uint64_t ignored_frames() const { return ignored_.load(); }
     std::uint64_t received() const { return received_.load(); }
 

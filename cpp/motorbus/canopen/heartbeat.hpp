@@ -15,6 +15,7 @@
 #include "motorbus/can/bus.hpp"
 #include "motorbus/canopen/nmt.hpp"
 #include "motorbus/canopen/timer_thread.hpp"
+#include "motorbus/runtime/callback_slot.hpp"
 #include "motorbus/runtime/clock.hpp"
 
 namespace motorbus::canopen {
@@ -90,7 +91,7 @@ public:
     void stop();
 
     // Called on the bus thread (events from frames) or the timer thread (Lost).
-    std::function<void(std::uint8_t node, HeartbeatEvent ev, NodeState state)> on_event;
+    CallbackSlot<void(std::uint8_t node, HeartbeatEvent ev, NodeState state)> on_event;
 
     std::uint64_t ignored_frames() const { return ignored_.load(); }
 

@@ -17,6 +17,7 @@
 
 #include "motorbus/canopen/heartbeat.hpp"
 #include "motorbus/canopen/local_node.hpp"
+#include "motorbus/runtime/callback_slot.hpp"
 
 namespace motorbus::canopen {
 
@@ -35,7 +36,7 @@ public:
     ~HeartbeatService() override;
 
     // Called on the node's worker thread (Lost) or the bus thread (others).
-    std::function<void(std::uint8_t node)> on_lost;
+    CallbackSlot<void(std::uint8_t node)> on_lost;
     std::function<void(std::uint8_t node, HeartbeatEvent ev, NodeState state)> on_event;
     NodeHealth health(std::uint8_t node) const { return consumer_.health(node); }
     std::uint64_t heartbeats_sent() const;

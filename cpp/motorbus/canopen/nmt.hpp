@@ -17,6 +17,7 @@
 #include "motorbus/can/frame.hpp"
 // NmtCommand and the LocalNode's NmtState (without UNKNOWN) come from here.
 #include "motorbus/canopen/local_node.hpp"
+#include "motorbus/runtime/callback_slot.hpp"
 
 namespace motorbus::canopen {
 
@@ -118,7 +119,7 @@ public:
 
     // Called on the bus thread when a node's reported state changes, and for
     // every boot-up message (old state may equal new state then).
-    std::function<void(std::uint8_t node, NodeState old_state, NodeState new_state)> on_state_change;
+    CallbackSlot<void(std::uint8_t node, NodeState old_state, NodeState new_state)> on_state_change;
 
     std::uint64_t foreign_commands_ignored() const { return foreign_ignored_.load(); }
 

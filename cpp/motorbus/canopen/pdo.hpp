@@ -19,6 +19,7 @@
 
 #include "motorbus/can/bus.hpp"
 #include "motorbus/canopen/sdo_access.hpp"
+#include "motorbus/runtime/callback_slot.hpp"
 
 namespace motorbus::canopen {
 
@@ -176,7 +177,7 @@ public:
     // Asks the device for the PDO with an RTR frame.
     void request();
 
-    std::function<void(const std::vector<std::uint64_t>&, Nanos timestamp)> on_receive;
+    CallbackSlot<void(const std::vector<std::uint64_t>&, Nanos timestamp)> on_receive;
 
 private:
     void on_frame(const can::Frame& f);

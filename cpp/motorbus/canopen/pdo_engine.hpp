@@ -19,6 +19,7 @@
 
 #include "motorbus/can/frame.hpp"
 #include "motorbus/canopen/pdo.hpp"
+#include "motorbus/runtime/callback_slot.hpp"
 #include "motorbus/runtime/clock.hpp"
 
 namespace motorbus::canopen {
@@ -134,7 +135,7 @@ public:
 
     // RPDO n applied / timed out (P11: the simulator's loss-of-command reaction).
     std::function<void(unsigned n)> on_rpdo;
-    std::function<void(unsigned n)> on_rpdo_timeout;
+    CallbackSlot<void(unsigned n)> on_rpdo_timeout;
 
     struct Counters {
         std::uint64_t tpdo_sent = 0, rpdo_applied = 0, rpdo_ignored = 0, rpdo_length_errors = 0,

@@ -1,11 +1,15 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <future>
+#include <memory>
 #include <thread>
 
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/canopen/emcy.hpp"
 #include "motorbus/canopen/heartbeat.hpp"
 #include "motorbus/errors.hpp"
+#include "motorbus/runtime/callback_slot.hpp"
 #include "test_nmt_support.hpp"
 
 using namespace motorbus;
@@ -137,6 +141,51 @@ TEST_F(ConsumerFixture, OnlyMonitoredNodesAreCheckedAndForgetStopsIt) {
     EXPECT_EQ(hc.process(clock.now()), -1);
     ASSERT_EQ(events.size(), 1u);
     EXPECT_EQ(events[0], std::make_pair(5, HeartbeatEvent::Lost));
+}
+
+// Python's set_callback(None) on a running consumer replaced on_event while
+// the consumer's threads called it (an abort under ASan in the sanitizer
+// suite, a data race under TSan).  Replacing it while events fire is now safe.
+TEST_F(ConsumerFixture, CallbackReplacedWhileEventsFire) {
+    hc.monitor(5, 100ms);
+    std::atomic<bool> stop{false};
+    std::atomic<int> calls{0};
+    std::thread beats([&] {
+        for (int i = 0; !stop; ++i) beat(5, i % 2 ? 0x05 : 0x7F);  // every beat is a state change
+    });
+    // Until events have fired into many replaced callables (bounded: a broken feed fails below).
+    for (int i = 0; (i < 3000 || calls.load() < 200) && i < 10'000'000; ++i) {
+        auto token = std::make_shared<int>(i);  // heap state a destroyed callable would free
+        if (i % 3 == 0)
+            hc.on_event = nullptr;
+        else
+            hc.on_event = [token, &calls](std::uint8_t, HeartbeatEvent, NodeState) { calls += *token >= 0; };
+    }
+    stop = true;
+    beats.join();
+    EXPECT_GE(calls.load(), 200);
+}
+
+TEST(CallbackSlot, AReplacedCallableLivesUntilItsCallReturns) {
+    CallbackSlot<void(int)> slot;
+    auto held = std::make_shared<int>(1);
+    const std::weak_ptr<int> watch = held;
+    std::promise<void> entered, release;
+    auto entered_f = entered.get_future();
+    auto release_f = release.get_future().share();
+    slot = [held = std::move(held), &entered, release_f](int) {
+        entered.set_value();
+        release_f.wait();
+    };
+    std::thread caller([&] { slot(1); });
+    entered_f.wait();
+    slot = nullptr;  // replaced while its call runs
+    EXPECT_FALSE(static_cast<bool>(slot));
+    EXPECT_FALSE(watch.expired());  // the call in progress still holds it
+    release.set_value();
+    caller.join();
+    EXPECT_TRUE(watch.expired());  // released when that call returned
+    slot(2);                       // cleared: nothing to call
 }
 
 TEST_F(ConsumerFixture, N6_BadDlcCountedAndNextValidWorks) {
