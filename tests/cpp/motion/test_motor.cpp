@@ -213,17 +213,27 @@ TEST(MotorModel, JamAndLatch) {
 // model's speed-up for long simulated moves); these pin down that nothing is
 // lost by it, and that it is not taken whole where it must not be.
 
+namespace {
+// One profile piece from rest at 0: velocity v, acceleration a and jerk j at
+// its start, held for `duration` s, then finished at `end_p`; the events a
+// model with `cfg` reports in the next `for_ns`.
+std::vector<MotorEvent> play_piece(const MotorConfig& cfg, double duration, double v, double a, double j,
+                                   double end_p, Nanos for_ns) {
+    SimClock clk;
+    MotorModel m(clk, cfg);
+    Profile q(State{0, 0, 0, 0});
+    q.append_jump(duration, v, a, j).finish(end_p, 0);
+    return play(m, clk, q, for_ns);
+}
+}  // namespace
+
 TEST(MotorModel, ARampThatReversesFindsTheWayOutAndBack) {
     // v goes 1000 -> -1000 steps/s in one 2 s piece: p(t) = 1000 t - 500 t^2 goes
     // out to 500 and back to 0, through the home window [300, 400] twice.  Its
     // two ends are at the same position, so only stepping finds the four edges.
-    SimClock clk;
     MotorConfig cfg;
     cfg.home = SwitchConfig{true, 300, 400, true};
-    MotorModel m(clk, cfg);
-    Profile q(State{0, 0, 0, 0});
-    q.append_jump(2.0, 1000, -1000, 0).finish(0, 0);
-    const auto ev = play(m, clk, q, 3 * kSec);
+    const auto ev = play_piece(cfg, 2.0, 1000, -1000, 0, 0, 3 * kSec);
     const double r300 = std::sqrt(0.4), r400 = std::sqrt(0.2);  // p = 300, 400 at t = 1 -/+ r
     EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOn) / 1e9, 1 - r300, 1e-8);
     EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOff) / 1e9, 1 - r400, 1e-8);
@@ -235,14 +245,10 @@ TEST(MotorModel, AJerkPieceIsTakenWholeWithExactEdges) {
     // One 2 s jerk piece from rest: p(t) = 1000 t^3 / 6, monotone, so it is
     // taken in one step; the index (at 100) and home window [300, 400] edges
     // must still come out at their exact times.
-    SimClock clk;
     MotorConfig cfg;
     cfg.index_position = 100;
     cfg.home = SwitchConfig{true, 300, 400, true};
-    MotorModel m(clk, cfg);
-    Profile q(State{0, 0, 0, 0});
-    q.append_jump(2.0, 0, 0, 1000).finish(1000.0 * 8 / 6, 0);
-    const auto ev = play(m, clk, q, 3 * kSec);
+    const auto ev = play_piece(cfg, 2.0, 0, 0, 1000, 1000.0 * 8 / 6, 3 * kSec);
     const auto at = [](double p) { return std::cbrt(6 * p / 1000); };
     EXPECT_NEAR(first(ev, MotorEvent::Kind::IndexPulse) / 1e9, at(100), 1e-8);
     EXPECT_NEAR(first(ev, MotorEvent::Kind::HomeOn) / 1e9, at(300), 1e-8);
@@ -255,13 +261,9 @@ TEST(MotorModel, AJerkPieceThatReversesInsideIsStepped) {
     // Both ends (and the middle) are outside the home window [50, 100]: only
     // the velocity's interior extreme says the piece is not monotone, and
     // only stepping it finds the four edges.
-    SimClock clk;
     MotorConfig cfg;
     cfg.home = SwitchConfig{true, 50, 100, true};
-    MotorModel m(clk, cfg);
-    Profile q(State{0, 0, 0, 0});
-    q.append_jump(2.0, 1000, -4000, 4000).finish(-2000.0 / 3, 0);
-    const auto ev = play(m, clk, q, 3 * kSec);
+    const auto ev = play_piece(cfg, 2.0, 1000, -4000, 4000, -2000.0 / 3, 3 * kSec);
     const auto p = [](double t) { return 1000 * t - 2000 * t * t + 4000 * t * t * t / 6; };
     const auto crossing = [&](double level, double lo, double hi) {  // p - level changes sign once in [lo, hi]
         const bool up = p(lo) < level;
@@ -279,13 +281,9 @@ TEST(MotorModel, AJerkPieceThatReversesInsideIsStepped) {
 }
 
 TEST(MotorModel, AStallInsideALongRampStartsWithinATickOfThePullOutSpeed) {
-    SimClock clk;
     MotorConfig cfg;
     cfg.pull_out_speed = 5000;  // reached 5 s into a 10 s ramp to 10 000 steps/s
-    MotorModel m(clk, cfg);
-    Profile q(State{0, 0, 0, 0});
-    q.append_jump(10.0, 0, 1000, 0).finish(50'000, 0);
-    const auto ev = play(m, clk, q, 20 * kSec);
+    const auto ev = play_piece(cfg, 10.0, 0, 1000, 0, 50'000, 20 * kSec);
     const Nanos stalled = first(ev, MotorEvent::Kind::Stalled);
     EXPECT_GE(stalled, 5 * kSec);
     EXPECT_LE(stalled, 5 * kSec + cfg.tick_ns);
