@@ -124,12 +124,17 @@ def test_03_streaming(kernel):
     tpdos = number(out, r"TPDOs received (\d+)")
     assert tpdos >= 300                           # ~0.5 s of 1 ms SYNCs or more
     assert abs(tpdos - number(out, r"SYNCs sent (\d+)")) <= 1    # one TPDO per SYNC, none lost
-    assert number(out, r"TPDO median period ([\d.]+) ms") == pytest.approx(1.0, abs=0.2)
+    # Over the span, not gap by gap: a reader thread the host runs late takes several frames
+    # at once (gaps of ~0), which says nothing of the drive.  The SYNC producer keeps a 1 ms
+    # grid and skips slots it missed, so the period is 1 ms or longer, never shorter.
+    assert 0.95 <= number(out, r"TPDO mean period ([\d.]+) ms") <= 1.5
     assert number(out, r"TPDO last position (-?\d+)") == 2000     # 20 mm at 0.01 mm per increment
     assert number(out, r"TPDO positions rising (\d+)") > 10       # the move seen while it happened
     samples = number(out, r"SPEED_IST samples (\d+)")
     assert number(out, r"POS_IST samples (\d+)") >= 75     # the second register, every 2 ms
     assert samples >= 150
-    assert number(out, r"SPEED_IST median period ([\d.]+) ms") == pytest.approx(1.0, abs=0.2)
+    # The drive keeps its 1 ms cadence on its own clock (a late timer sends what was due, each
+    # with the value of its instant), so the span holds one sample per millisecond.
+    assert number(out, r"SPEED_IST mean period ([\d.]+) ms") == pytest.approx(1.0, abs=0.1)
     assert number(out, r"SPEED_IST samples \d+, lost (\d+)") == 0
     assert number(out, r"SPEED_IST peak ([\d.]+) rpm") > 0
