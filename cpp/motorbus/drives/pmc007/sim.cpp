@@ -78,8 +78,21 @@ Pmc007Sim::Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions option
             });
         var->add_change_listener([this](const canopen::Variable&) { publish(); });
     }
-    for (std::size_t k = 0; k < published_.size(); ++k)
-        published_[k] = od_->at(kPublished[k].first, kPublished[k].second);
+    published_ = {.error_register = od_->at(0x1001, 0),
+                  .manufacturer_status = od_->at(0x1002, 0),
+                  .system_control = od_->at(0x2007, 0),
+                  .error_status = od_->at(0x6000, 0),
+                  .controller_status = od_->at(0x6001, 0),
+                  .motor_position = od_->at(0x600C, 0),
+                  .gpio_value = od_->at(0x6012, 0),
+                  .saved_position = od_->at(0x6022, 0),
+                  .step_command = od_->at(0x6004, 0),
+                  .absolute_command = od_->at(0x601C, 0),
+                  .stop_command = od_->at(0x6020, 0),
+                  .save_program = od_->at(0x6019, 3),
+                  .run_instruction = od_->at(0x6019, 5),
+                  .gpio_direction = od_->at(0x6011, 1),
+                  .program_word = od_->at(0x6019, 2)};
     for (auto [i, s] : kLive)
         od_->at(i, s)->set_read_hook([this](const canopen::Variable& v, Bytes& out) -> std::uint32_t {
             poll();
@@ -254,33 +267,42 @@ void Pmc007Sim::set(const canopen::VariablePtr& v, std::int64_t value) {
 void Pmc007Sim::publish() {
     if (t_publishing) return;
     t_publishing = true;
-    std::array<std::int64_t, std::size(kPublished)> values;  // in kPublished order
+    // Computed under the lock, stored after it: a store runs the objects' listeners.
+    std::int64_t er = 0, status = 0, errors = 0, position_now = 0, saved = 0, step = 0, absolute = 0;
+    std::int64_t gpio = 0, direction = 0, word = 0;
     {
         std::lock_guard lock(m_);
-        const std::uint8_t status = controller_status();
-        std::uint8_t er = 0;
+        status = controller_status();
+        errors = errors_;
         if (errors_) er |= 0x01;
         if (errors_ & (err::kAoc | err::kBoc)) er |= 0x02;
         if (errors_ & err::kUvlo) er |= 0x04;
         if (errors_ & err::kTsd) er |= 0x08;
+        position_now = position();
+        gpio = gpio_value();
+        saved = saved_position_;
+        step = last_step_;
+        absolute = last_abs_;
+        direction = u(0x6011, 1) & 0x7F;  // B-P24: bits 7-10 are fixed inputs
         const auto ptr = static_cast<std::size_t>(u(0x6019, 1));
-        values = {er,                                   // 1001h
-                  std::int64_t(errors_) * 256 + status,  // 1002h
-                  0,                                    // 2007h
-                  errors_,                              // 6000h
-                  status,                               // 6001h
-                  position(),                           // 600Ch
-                  gpio_value(),                         // 6012h
-                  saved_position_,                      // 6022h
-                  last_step_,                           // 6004h
-                  last_abs_,                            // 601Ch
-                  0,                                    // 6020h
-                  0,                                    // 6019h:03
-                  0,                                    // 6019h:05
-                  u(0x6011, 1) & 0x7F,                  // 6011h:01, B-P24: bits 7-10 are fixed inputs
-                  ptr < ram_program_.size() ? ram_program_[ptr] : 0};  // 6019h:02
+        word = ptr < ram_program_.size() ? ram_program_[ptr] : 0;
     }
-    for (std::size_t k = 0; k < values.size(); ++k) set(published_[k], values[k]);
+    const Published& p = published_;
+    set(p.error_register, er);
+    set(p.manufacturer_status, errors * 256 + status);
+    set(p.system_control, 0);
+    set(p.error_status, errors);
+    set(p.controller_status, status);
+    set(p.motor_position, position_now);
+    set(p.gpio_value, gpio);
+    set(p.saved_position, saved);
+    set(p.step_command, step);
+    set(p.absolute_command, absolute);
+    set(p.stop_command, 0);
+    set(p.save_program, 0);
+    set(p.run_instruction, 0);
+    set(p.gpio_direction, direction);
+    set(p.program_word, word);
     t_publishing = false;
 }
 

@@ -190,11 +190,26 @@ private:
         canopen::Bytes* flash;  // its flash_ entry (ROM objects), else nullptr
     };
     std::vector<PowerUpRow> power_up_;  // every dictionary row, in table order
-    // The objects publish() keeps up to date, looked up once (it runs on every poll).
-    static constexpr std::pair<std::uint16_t, std::uint8_t> kPublished[] = {
-        {0x1001, 0}, {0x1002, 0}, {0x2007, 0}, {0x6000, 0}, {0x6001, 0}, {0x600C, 0}, {0x6012, 0}, {0x6022, 0},
-        {0x6004, 0}, {0x601C, 0}, {0x6020, 0}, {0x6019, 3}, {0x6019, 5}, {0x6011, 1}, {0x6019, 2}};
-    std::array<canopen::VariablePtr, std::size(kPublished)> published_;
+    // The objects publish() keeps up to date, looked up once (it runs on every poll) and
+    // named, so a value is set on its object by name, never by position in a list.
+    struct Published {
+        canopen::VariablePtr error_register;       // 1001h
+        canopen::VariablePtr manufacturer_status;  // 1002h
+        canopen::VariablePtr system_control;       // 2007h: reads back 0, an action
+        canopen::VariablePtr error_status;         // 6000h
+        canopen::VariablePtr controller_status;    // 6001h
+        canopen::VariablePtr motor_position;       // 600Ch
+        canopen::VariablePtr gpio_value;           // 6012h
+        canopen::VariablePtr saved_position;       // 6022h
+        canopen::VariablePtr step_command;         // 6004h
+        canopen::VariablePtr absolute_command;     // 601Ch
+        canopen::VariablePtr stop_command;         // 6020h: reads back 0, an action
+        canopen::VariablePtr save_program;         // 6019h:03: reads back 0, an action
+        canopen::VariablePtr run_instruction;      // 6019h:05: reads back 0, an action
+        canopen::VariablePtr gpio_direction;       // 6011h:01
+        canopen::VariablePtr program_word;         // 6019h:02: the word at the pointer
+    };
+    Published published_;
     std::vector<std::uint32_t> flash_program_, ram_program_;
     std::uint8_t errors_ = 0;   // 6000h
     std::uint8_t latched_ = 0;  // 6001h bits 0-2, 4
