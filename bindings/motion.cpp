@@ -230,6 +230,7 @@ void bind_motion(py::module_& m) {
         .def_readwrite("counts_per_rev", &MotorConfig::counts_per_rev)
         .def_readwrite("index_position", &MotorConfig::index_position)
         .def_readwrite("index_width_steps", &MotorConfig::index_width_steps)
+        .def_readwrite("index_channel", &MotorConfig::index_channel)
         .def_readwrite("home", &MotorConfig::home)
         .def_readwrite("minus_limit", &MotorConfig::minus_limit)
         .def_readwrite("plus_limit", &MotorConfig::plus_limit)

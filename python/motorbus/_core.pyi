@@ -2625,6 +2625,7 @@ class SwitchConfig:
         ...
 class MotorConfig:
     home: SwitchConfig
+    index_channel: bool
     minus_limit: SwitchConfig
     plus_limit: SwitchConfig
     def __init__(self) -> None:

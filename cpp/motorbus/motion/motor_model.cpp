@@ -210,6 +210,7 @@ bool MotorModel::plus_limit_input() const {
     return cfg_.plus_limit.active_low ? !plus_limit_active() : plus_limit_active();
 }
 bool MotorModel::index_active() const {
+    if (!cfg_.index_channel) return false;
     const double rel = physical_ - cfg_.index_position;
     const double m = rel - std::floor(rel / cfg_.steps_per_rev) * cfg_.steps_per_rev;
     return m >= 0 && m < cfg_.index_width_steps;
@@ -292,6 +293,10 @@ bool MotorModel::whole_piece_is_steady(const Segment& seg, double from_s, double
     return !load_exceeded(std::max(-v_lo, v_hi) * k, std::max(std::fabs(a.a), std::fabs(b.a)) * k);
 }
 
+Nanos MotorModel::profile_end() const {
+    return profile_start_ + static_cast<Nanos>(std::ceil(profile_.duration() * 1e9));
+}
+
 void MotorModel::advance_to(Nanos t) {
     if (in_dispatch_) return;  // a listener's query must not re-enter the integration
     while (now_ < t) {
@@ -299,6 +304,16 @@ void MotorModel::advance_to(Nanos t) {
         // At rest, or idle and held by the jam: nothing can change until the next
         // command (step_to skips the interval), so skip it all at once.
         if (!running_ && (!stalled_ || jammed_)) next = t;
+        // Stalled by a jam through a move: the rotor stays where it is and only the
+        // slip grows, which each step recomputes from its end, so every step before
+        // the one that reaches the profile's end changes nothing.  Take them in one:
+        // to that step's end, on the same tick grid, so the move ends at the instant
+        // it does tick by tick.
+        if (running_ && stalled_ && jammed_) {
+            const Nanos left = profile_end() - now_;
+            const Nanos ticks = left > cfg_.tick_ns ? (left + cfg_.tick_ns - 1) / cfg_.tick_ns : 1;
+            next = ticks > (t - now_) / cfg_.tick_ns ? t : now_ + ticks * cfg_.tick_ns;
+        }
         // Along a cubic piece of the profile (a cruise, a ramp, an S-curve's
         // jerk phase) whose velocity keeps its sign the motion is monotone, so
         // every switch and index edge is found exactly by bisection over any
@@ -328,8 +343,7 @@ void MotorModel::advance_to(Nanos t) {
 // (whose listeners then run with now_ at the event's time).
 void MotorModel::step_to(Nanos t_end) {
     const Nanos t0 = now_;
-    const Nanos profile_end =
-        profile_start_ + static_cast<Nanos>(std::ceil(profile_.duration() * 1e9));
+    const Nanos profile_end = this->profile_end();
     if (!running_ && !stalled_) {
         // At rest nothing changes: skip the interval.
         now_ = t_end;
@@ -418,7 +432,7 @@ void MotorModel::step_to(Nanos t_end) {
     consider_switch(Switch::MinusLimit, MotorEvent::Kind::MinusLimitOn, MotorEvent::Kind::MinusLimitOff);
     consider_switch(Switch::PlusLimit, MotorEvent::Kind::PlusLimitOn, MotorEvent::Kind::PlusLimitOff);
     // Z index rising edges: entering [idx + k*rev, idx + k*rev + width).
-    if (p_new != p_prev) {
+    if (cfg_.index_channel && p_new != p_prev) {
         const double spr = cfg_.steps_per_rev;
         const bool up = p_new > p_prev;
         const double edge0 = cfg_.index_position + (up ? 0.0 : cfg_.index_width_steps);

@@ -58,6 +58,10 @@ struct MotorConfig {
     double counts_per_rev = 4000;  // DMX-CAN: 1000 lines, quadrature
     double index_position = 0;     // physical steps of one Z index (repeats each rev)
     double index_width_steps = 0.8;  // Z is high within [index, index + width)
+    // The motor has a Z index channel.  A drive that reads none (PMC007) says
+    // false: no IndexPulse events, whose search would otherwise end a step of the
+    // integration at every revolution of a long move.
+    bool index_channel = true;
     SwitchConfig home;
     SwitchConfig minus_limit;
     SwitchConfig plus_limit;
@@ -115,6 +119,7 @@ public:
     bool moving() const;                 // a commanded profile is still running
     const Profile& profile() const { return profile_; }
     Nanos profile_start() const { return profile_start_; }
+    Nanos profile_end() const;           // when the current profile ends (its start + duration, rounded up)
     // Time within the current profile (s) at time t.
     double profile_time(Nanos t) const;
 

@@ -227,6 +227,81 @@ std::vector<MotorEvent> play_piece(const MotorConfig& cfg, double duration, doub
 }
 }  // namespace
 
+TEST(MotorModel, AJammedMoveEndsWhereItDoesTickByTick) {
+    // Held by a jam, the rest of a move is taken in one step (only the slip
+    // grows); the move must still end on the same tick, with the same slip, as
+    // when the clock is walked one tick at a time.
+    MotorConfig cfg;
+    cfg.tick_ns = kMs;
+    const Profile p = move_profile(0, 5000, 3200, 32000);
+    struct Run {
+        std::vector<MotorEvent> ev;
+        double slip, pulse, physical;
+    };
+    auto run = [&](Nanos step) {
+        SimClock clk;
+        MotorModel m(clk, cfg);
+        Run r;
+        m.add_listener([&](const MotorEvent& e) { r.ev.push_back(e); });
+        m.set_jammed(true);
+        m.command(p);
+        for (Nanos t = 0; t < 3 * kSec; t += step) {
+            clk.advance(step);
+            m.update();
+        }
+        r.slip = m.slip(), r.pulse = m.pulse_position(), r.physical = m.physical_position();
+        return r;
+    };
+    const Run whole = run(3 * kSec), ticks = run(kMs);
+    ASSERT_EQ(whole.ev.size(), 2u);
+    EXPECT_EQ(whole.ev[0].kind, MotorEvent::Kind::Stalled);
+    EXPECT_EQ(whole.ev[1].kind, MotorEvent::Kind::ProfileDone);
+    ASSERT_EQ(ticks.ev.size(), 2u);
+    EXPECT_EQ(whole.ev[0].t, ticks.ev[0].t);
+    EXPECT_EQ(whole.ev[1].t, ticks.ev[1].t);
+    // The first tick at or after the profile's end (not the end itself).
+    const Nanos end = static_cast<Nanos>(std::ceil(p.duration() * 1e9));
+    EXPECT_GE(whole.ev[1].t, end);
+    EXPECT_LT(whole.ev[1].t, end + kMs);
+    EXPECT_EQ(whole.ev[1].t % kMs, 0);
+    EXPECT_EQ(whole.slip, ticks.slip);
+    EXPECT_EQ(whole.pulse, 5000);
+    EXPECT_EQ(whole.physical, ticks.physical);
+    EXPECT_DOUBLE_EQ(whole.slip, 5000 - whole.physical);
+}
+
+TEST(MotorModel, WithoutAnIndexChannelNoIndexPulses) {
+    // A drive that reads no Z index (PMC007): the same move reports its switch
+    // edges and end at the same instants, with no IndexPulse between them.
+    MotorConfig with;
+    with.index_position = 100;
+    with.home = SwitchConfig{true, 1000, 1200, true};
+    MotorConfig without = with;
+    without.index_channel = false;
+    const Profile p = move_profile(0, 3 * 3200 + 50, 3200, 32000);
+    SimClock c1, c2;
+    MotorModel m1(c1, with), m2(c2, without);
+    const auto e1 = play(m1, c1, p, 10 * kSec), e2 = play(m2, c2, p, 10 * kSec);
+    std::vector<MotorEvent> e1_no_index;
+    for (const auto& e : e1)
+        if (e.kind != MotorEvent::Kind::IndexPulse) e1_no_index.push_back(e);
+    EXPECT_EQ(e1.size() - e1_no_index.size(), 3u);
+    ASSERT_EQ(e2.size(), e1_no_index.size());
+    for (std::size_t i = 0; i < e2.size(); ++i) {
+        EXPECT_EQ(e2[i].kind, e1_no_index[i].kind) << i;
+        EXPECT_EQ(e2[i].t, e1_no_index[i].t) << i;
+    }
+    // Both back onto the index position: only the model with the channel sees Z high.
+    for (auto [m, c] : {std::pair{&m1, &c1}, std::pair{&m2, &c2}}) {
+        m->command(move_profile(m->pulse_position(), 100));
+        c->advance(10 * kSec);
+        m->update();
+        EXPECT_EQ(m->pulse_count(), 100);
+    }
+    EXPECT_TRUE(m1.index_active());
+    EXPECT_FALSE(m2.index_active());
+}
+
 TEST(MotorModel, ARampThatReversesFindsTheWayOutAndBack) {
     // v goes 1000 -> -1000 steps/s in one 2 s piece: p(t) = 1000 t - 500 t^2 goes
     // out to 500 and back to 0, through the home window [300, 400] twice.  Its

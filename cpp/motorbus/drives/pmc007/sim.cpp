@@ -54,6 +54,7 @@ Pmc007Sim::Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions option
           motion::MotorConfig c;
           c.steps_per_rev = options.steps_per_rev;
           c.counts_per_rev = options.steps_per_rev;
+          c.index_channel = false;  // the PMC007 reads no encoder index from the motor
           c.pull_out_speed = options.pull_out_speed;
           c.tick_ns = options.tick_ns;
           if (options.ext1_switch) c.home = {true, options.ext1_switch->first, options.ext1_switch->second, true};
