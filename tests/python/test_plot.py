@@ -68,7 +68,7 @@ def test_polled_axis_against_its_planned_profile(tmp_path):
         z.params["0x6084"] = 100000
         plan = plot.planned(z, 0.0, 50.0)          # 5000 increments: 0.2 s ramp up, 0.05 s cruise, 0.2 s down
         assert plan["p"][-1] == pytest.approx(50.0) and plan["t"][-1] == pytest.approx(0.45, abs=1e-6)
-        with Poller(bench.axes, rate_hz=500) as poller:
+        with Poller(bench.axes, rate_hz=500, mode="ask") as poller:   # asked: read-time bound (see below)
             time.sleep(0.05)
             t_cmd = motorbus.monotonic_ns() / 1e9
             z.move_to(50.0)
