@@ -161,7 +161,9 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
                 samples = str(int(np.count_nonzero(~np.isnan(frame[f"{n}.position"]))))
             if n in plans and n in pollable:
                 c = plot.compare(frame, n, plans[n], t_cmd + report.offsets.get(n, 0.0))
-                err = f"{np.max(np.abs(c['error'])):.3g}"
+                # A poll group that stopped early (its error is printed below the table) may
+                # have no sample of the move: say so rather than take the max of nothing.
+                err = f"{np.max(np.abs(c['error'])):.3g}" if len(c["error"]) else "no samples"
                 for k, v in c.items():
                     data[f"{n}.{k}"] = v
                 data[f"{n}.plan_t"], data[f"{n}.plan_p"] = plans[n]["t"], plans[n]["p"]
@@ -170,6 +172,9 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
                           str(missed.get(n, "—"))])
         _table("the coordinated move", ["axis", "kind", "target", "reached", "max |error| vs plan",
                                         "samples", "missed"], table)
+        for group, s in stats.items():
+            if s.get("error"):
+                _say(f"  poll group {group} stopped early: {s.get('error_type')}: {s['error']}")
 
         png = os.path.join(out, "demo.png")
         load = _draw(png, frame, plans, pollable, t_cmd, report.offsets, candump, bench, data)

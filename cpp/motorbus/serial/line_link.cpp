@@ -4,6 +4,7 @@
 #include <mutex>
 #include <thread>
 
+#include "motorbus/runtime/fifo_mutex.hpp"
 #include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/serial/line_framer.hpp"
 #include "motorbus/serial/port.hpp"
@@ -39,7 +40,7 @@ struct LineLink::Impl {
     std::shared_ptr<Port> port;
     LineOptions options;
     LineFramer framer;
-    std::mutex mutex;  // one transaction at a time
+    FifoMutex mutex;  // one transaction at a time, in the order they were asked for
     std::vector<std::uint8_t> pending;  // read but not yet framed
     std::string echo;                   // bytes we expect back from an echoing adapter
     std::size_t echo_pos = 0;

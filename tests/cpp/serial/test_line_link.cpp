@@ -2,6 +2,7 @@
 // Hostile rows covered at the link level: A1, A3, A8, A10, A11.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <functional>
@@ -315,6 +316,36 @@ TEST(LineLink, ConcurrentTransactionsAreSerialized) {
     for (auto& t : ts) t.join();
     EXPECT_EQ(bad.load(), 0);
     EXPECT_EQ(link.counters().replies, 80u);
+}
+
+TEST(LineLink, AWaitingTransactionIsServedNextNotStarvedByALoop) {
+    // A poller that reads a slow line back to back (always behind its deadlines)
+    // must not keep another thread's command out: the command waits for the
+    // transaction in progress, then goes.  Each reply takes 2 ms.
+    PtyPair pty;
+    std::atomic<int> served{0};
+    ScriptedPeer peer(pty, [&](const std::string& req) {
+        ++served;
+        return std::vector<Chunk>{{req + "\r\n", 2ms}};
+    });
+    LineLink link(pty.port(), opts({"\r\n"}, 64, 2s));
+    std::atomic<bool> stop{false};
+    std::thread poller([&] {
+        while (!stop) link.transact("poll");
+    });
+    while (served.load() < 5) std::this_thread::sleep_for(1ms);
+    int worst = 0;
+    for (int i = 0; i < 20; ++i) {
+        const int before = served.load();
+        EXPECT_EQ(link.transact("cmd" + std::to_string(i)), "cmd" + std::to_string(i));
+        // Served between asking and the reply: the poll in progress (and one that
+        // may have started just before the command took its turn), then the command.
+        worst = std::max(worst, served.load() - before - 1);
+        std::this_thread::sleep_for(1ms);
+    }
+    stop = true;
+    poller.join();
+    EXPECT_LE(worst, 2) << "polls served while a command waited for the line";
 }
 
 TEST(LineLink, LinkDownWhenPeerVanishes) {
