@@ -33,7 +33,10 @@ from .socketcand import (  # noqa: E402,F401
 from . import canopen  # noqa: E402,F401
 from ._core import SdoAbortError, SdoProtocolError, SdoTimeout  # noqa: E402,F401
 from . import registry  # noqa: E402,F401
-from .drive import Capability, Drive, DriveStatus, ParamInfo, Units, open_drive  # noqa: E402,F401
+from .drive import (  # noqa: E402,F401
+    Capability, Drive, DriveStatus, LimitReached, MoveFailed, MoveFaulted, MoveInterrupted, MoveOutcome, MoveStalled,
+    MoveTimedOut, ParamInfo, Units, open_drive,
+)
 from .registry import drive_kinds  # noqa: E402,F401
 from .bench import Bench, BenchFileError  # noqa: E402,F401
 from .poller import Poller, load_frame  # noqa: E402,F401

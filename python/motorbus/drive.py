@@ -27,6 +27,7 @@ every vendor.  The vocabulary:
 from __future__ import annotations
 
 import abc
+import dataclasses
 import enum
 import math
 import time
@@ -36,7 +37,9 @@ from typing import Any, Callable, Optional, Union
 
 from . import _core, _stop_at_exit, registry
 
-__all__ = ["open_drive", "Capability", "Drive", "DriveStatus", "ParamInfo", "Params", "StopHow", "Units", "STOP_WAYS"]
+__all__ = ["open_drive", "Capability", "Drive", "DriveStatus", "ParamInfo", "Params", "StopHow", "Units", "STOP_WAYS",
+           "MoveFailed", "MoveInterrupted", "LimitReached", "MoveFaulted", "MoveStalled", "MoveTimedOut",
+           "MoveOutcome", "StopReason"]
 
 #: The one safety vocabulary (on_error, on_exit).
 STOP_WAYS = ("stop", "quick_stop", "disable", None)
@@ -76,6 +79,102 @@ class Units:
         return value * self.scale
 
 
+class MoveFailed(_core.DriveFault):
+    """A move, jog or homing that did not end at rest where it was sent.
+
+    The one outcome error of every kind (a ``DriveFault``, so ``except DriveFault``
+    still catches it); the subclass says why.  Attributes: ``axis`` (the kind, or the
+    bench's axis name), ``target`` and ``position`` in user units (``target`` None for
+    a jog or a homing), ``reason`` (one line, the drive's own words where it has
+    them), ``code`` (the drive's fault or error code, or None), ``status`` (the
+    drive's native status, ``DriveStatus.raw``) and ``units`` (their name)."""
+
+    __module__ = "motorbus"
+    #: A word for the kind of failure: exit codes and JSON carry it.
+    outcome = "failed"
+
+    def __init__(self, message: str, *, axis: str = "", target: Optional[float] = None,
+                 position: Optional[float] = None, reason: str = "", code: Optional[int] = None,
+                 status: Any = None, units: str = "") -> None:
+        super().__init__(message)
+        self.axis, self.target, self.position = axis, target, position
+        self.reason, self.code, self.status, self.units = reason, code, status, units
+
+
+class MoveInterrupted(MoveFailed):
+    """Stopped before the target: a stop or quick stop from this program, another
+    program, or a stop input of the drive."""
+
+    __module__ = "motorbus"
+
+    outcome = "interrupted"
+
+
+class LimitReached(MoveFailed):
+    """Stopped by a hard limit switch or a soft travel limit (``side``: +1 or -1, 0 if
+    the drive does not say which)."""
+
+    __module__ = "motorbus"
+
+    outcome = "limit"
+
+    def __init__(self, message: str, *, side: int = 0, **kw: Any) -> None:
+        super().__init__(message, **kw)
+        self.side = side
+
+
+class MoveFaulted(MoveFailed):
+    """The drive faulted during the move (``code`` and ``reason`` are the drive's)."""
+
+    __module__ = "motorbus"
+
+    outcome = "fault"
+
+
+class MoveStalled(MoveFailed):
+    """The rotor stalled or the following error grew too large (PMC007 stall detection,
+    Arcus StepNLoop)."""
+
+    __module__ = "motorbus"
+
+    outcome = "stall"
+
+
+class MoveTimedOut(MoveFailed, _core.TimeoutError):
+    """Not at rest within the timeout (also a ``motorbus.TimeoutError``); the motor may
+    still be moving: ``position`` is where it was then."""
+
+    __module__ = "motorbus"
+
+    outcome = "timeout"
+
+
+@dataclass(frozen=True)
+class StopReason:
+    """What a kind can see of why its drive stopped (``Drive._stop_reason``)."""
+
+    error: type                 # a MoveFailed subclass
+    text: str                   # the drive's own words: "+limit switch", "0x7500 overcurrent"...
+    code: Optional[int] = None
+    side: int = 0               # LimitReached: +1 / -1
+
+
+@dataclass(frozen=True)
+class MoveOutcome:
+    """The last move's outcome (``DriveStatus.last_move``): what was asked, where it ended."""
+
+    what: str                   # "move", "jog" or "home"
+    target: Optional[float]     # user units (None: jog, home)
+    position: Optional[float]   # user units, where it came to rest (None while running)
+    state: str                  # "running", "done" or the failure's outcome word
+    reason: str = ""
+    error: Optional[MoveFailed] = None
+
+    @property
+    def ok(self) -> bool:
+        return self.state == "done"
+
+
 @dataclass(frozen=True)
 class DriveStatus:
     """What every drive can say about itself; ``raw`` is the vendor's own status."""
@@ -89,6 +188,8 @@ class DriveStatus:
     limit_negative: bool
     raw: Any = None
     text: str = ""
+    #: The last move, jog or homing of this Drive and how it ended (None: none yet).
+    last_move: Optional[MoveOutcome] = None
 
 
 @dataclass(frozen=True)
@@ -186,6 +287,20 @@ class UnknownParameter(_core.InvalidArgument, KeyError):
         return str(self.args[0]) if self.args else ""
 
 
+class _Move:
+    """The move, jog or homing in progress: what was asked, in native units, and what
+    must be put back when it ends (settings a ``velocity=`` changed for this move)."""
+
+    __slots__ = ("what", "target", "stopped_by", "restore", "judged")
+
+    def __init__(self, what: str, target: Optional[float]) -> None:
+        self.what = what
+        self.target = target
+        self.stopped_by: Optional[str] = None      # "stop()" / "quick_stop()" of this program
+        self.restore: list[Callable[[], None]] = []
+        self.judged = False
+
+
 class Drive(abc.ABC):
     """One motor axis, whatever its vendor.  See the module doc.
 
@@ -200,6 +315,9 @@ class Drive(abc.ABC):
     default_timeout: float = 60.0
     #: Poll period of the generic wait_idle.
     poll_interval: float = 0.005
+    #: How far from its target (native units) a move may come to rest and still count as
+    #: arrived, when the kind does not read it from the drive (``_in_position_window``).
+    in_position_window: float = 0.0
 
     def __init__(self, native: Any, *, units: Optional[Units] = None, on_error: StopHow = "stop",
                  on_exit: StopHow = "stop", close_native: Optional[Callable[[], None]] = None) -> None:
@@ -217,6 +335,10 @@ class Drive(abc.ABC):
         self._close_native = close_native
         self._closed = False
         self._params: Optional[Params] = None
+        self._move: Optional[_Move] = None
+        self._last_move: Optional[MoveOutcome] = None
+        #: The name errors give this axis (a bench sets its axis name).
+        self.name = self.kind
         _stop_at_exit.track(self)
 
     # ---- vendor side (native units) -------------------------------------------------
@@ -264,7 +386,35 @@ class Drive(abc.ABC):
     def _status(self) -> DriveStatus: ...
 
     def _is_idle(self) -> bool:
+        """True once the motor is at rest, whatever the reason (target, limit, fault,
+        stop): the outcome is judged afterwards from ``_stop_reason`` and the position."""
         return not self._status().moving
+
+    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+        """Why the drive stopped, as far as it says (a fault, a limit, a stall, a stop
+        input), or None when it shows no reason.  Called once the motor is at rest after
+        a move that did not reach its target (and for a jog or a homing), and after a
+        move that did, where a fault or stall still fails it.  Kinds override this
+        to map their own status words and error registers; the default reads the
+        common fields of ``status``."""
+        if status.fault:
+            return StopReason(MoveFaulted, status.text)
+        if status.limit_positive or status.limit_negative:
+            side = 1 if status.limit_positive else -1
+            return StopReason(LimitReached, f"the {'+' if side > 0 else '-'}limit switch", side=side)
+        return None
+
+    def _in_position_window(self) -> float:
+        """How far from its target (native units) a move may end and count as arrived."""
+        return self.in_position_window
+
+    def _for_this_move(self, read: Callable[[], Any], write: Callable[[Any], None], value: Any) -> None:
+        """For a vendor's ``_move_to``: sets a drive setting (a speed) for the move being
+        started and puts the old value back once it has ended, however it ended."""
+        old = read()
+        write(value)
+        if self._move is not None:
+            self._move.restore.append(lambda: write(old))
 
     def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         """The soft travel limits the drive itself enforces now, native units (None: no limit that side)."""
@@ -296,7 +446,8 @@ class Drive(abc.ABC):
         """Absolute move in user units; ``velocity`` (user units/s) for this move, else the drive's own."""
         self._check_open()
         target = self._units.to_native(self._number("position", position))
-        self._move_to(target, self._speed_arg(velocity))
+        speed = self._speed_arg(velocity)
+        self._start("move", target, lambda: self._move_to(target, speed))
         if wait:
             self.wait_idle(timeout)
 
@@ -304,7 +455,11 @@ class Drive(abc.ABC):
                 timeout: Optional[float] = None) -> None:
         """Relative move in user units."""
         self._check_open()
-        self._move_by(self._units.to_native(self._number("distance", distance)), self._speed_arg(velocity))
+        distance = self._units.to_native(self._number("distance", distance))
+        speed = self._speed_arg(velocity)
+        self._settle()
+        target = self._position() + distance
+        self._start("move", target, lambda: self._move_by(distance, speed))
         if wait:
             self.wait_idle(timeout)
 
@@ -313,31 +468,160 @@ class Drive(abc.ABC):
         self._check_open()
         v = self._units.to_native(self._number("velocity", velocity))
         if v == 0:
-            self._stop()
+            self.stop()
             return
-        self._jog(v)
+        self._start("jog", None, lambda: self._jog(v))
 
     def stop(self) -> None:
-        """Decelerate to a stop with the drive's deceleration."""
+        """Decelerate to a stop with the drive's deceleration.  A move this stops ends in
+        ``MoveInterrupted`` (from its ``wait_idle``); a jog ends normally."""
         self._check_open()
+        if self._move is not None and self._move.stopped_by is None:
+            self._move.stopped_by = "stop()"
         self._stop()
 
     def quick_stop(self) -> None:
         """The fastest stop the drive has (an abort or the quick-stop ramp)."""
         self._check_open()
+        if self._move is not None and self._move.stopped_by is None:
+            self._move.stopped_by = "quick_stop()"
         self._quick_stop()
 
     def home(self, method: Any = None, *, wait: bool = True, timeout: Optional[float] = None) -> None:
-        """Run the drive's homing (``method``: the vendor's own, None = its default)."""
+        """Run the drive's homing (``method``: the vendor's own, None = its default);
+        returns once it has finished, else raises a :class:`MoveFailed`."""
         self._check_open()
-        self._home(method)
+        self._start("home", None, lambda: self._home(method))
         if wait:
-            self._wait(self._homing_done, timeout, "homing")
+            self.wait_idle(timeout)
 
     def wait_idle(self, timeout: Optional[float] = None) -> None:
-        """Return when the motor is at rest (TimeoutError after ``timeout`` s, None = default_timeout)."""
+        """Return when the motor is at rest.  After a move, jog or homing of this Drive,
+        return only if it ended where it was sent (a jog: by this program's ``stop()``);
+        otherwise raise the :class:`MoveFailed` subclass that says why, once
+        (``status.last_move`` keeps it).  ``MoveTimedOut`` (a ``TimeoutError``) after
+        ``timeout`` s (None = ``default_timeout``)."""
         self._check_open()
-        self._wait(self._is_idle, timeout, "motion")
+        move = self._move
+        if move is None or move.judged:
+            self._wait(self._is_idle, timeout, "motion")
+            return
+        done = self._homing_done if move.what == "home" else self._is_idle
+        limit = self.default_timeout if timeout is None else self._number("timeout", timeout)
+        try:
+            self._wait(done, limit, "homing" if move.what == "home" else move.what)
+        except MoveFailed as e:
+            self._finish(move, e)
+            raise
+        except _core.TimeoutError:
+            raise self._failure(move, StopReason(MoveTimedOut, f"the timeout ({limit:g} s)"),
+                                at_rest=False) from None
+        except _core.DriveFault as e:       # a kind's own error while waiting: a fault
+            raise self._failure(move, StopReason(MoveFaulted, str(e))) from e
+        self._judge(move, raise_error=True)
+
+    # ---- the outcome of a move ----------------------------------------------------
+    def _start(self, what: str, target: Optional[float], command: Callable[[], None]) -> None:
+        """Begins a move, jog or homing: the previous one's settings are put back first."""
+        self._settle()
+        move = _Move(what, target)
+        self._move = move
+        self._last_move = MoveOutcome(what, None if target is None else self._units.to_user(target), None, "running")
+        try:
+            command()
+        except BaseException:
+            self._restore(move)
+            self._move, self._last_move = None, None
+            raise
+
+    def _settle(self) -> None:
+        """Judges an earlier move nobody waited for, if it has ended (its outcome goes to
+        ``status.last_move``, not raised), and puts its settings back."""
+        move = self._move
+        if move is not None and not move.judged:
+            try:
+                if move.what == "home" or not self._is_idle():
+                    self._restore(move)     # superseded; a homing is not judged by rest alone
+                    move.judged = True
+                    return
+                self._judge(move, raise_error=False)
+            except MoveFailed:
+                pass
+
+    def _judge(self, move: _Move, *, raise_error: bool) -> None:
+        """The motor is at rest after ``move``: done, or the MoveFailed that says why."""
+        status = self._status()
+        reason = self._stop_reason(status)
+        position = self._position()
+        arrived = move.target is None or abs(position - move.target) <= self._in_position_window()
+        if move.what == "home":
+            failed = (reason is not None and reason.error is not LimitReached) or move.stopped_by is not None \
+                or not status.homed
+        elif move.what == "jog":
+            failed = reason is not None or move.stopped_by is None
+        else:
+            failed = not arrived or (reason is not None and reason.error in (MoveFaulted, MoveStalled))
+        if not failed:
+            self._finish(move, None, position)
+            return
+        if reason is None:
+            if move.stopped_by is not None:
+                reason = StopReason(MoveInterrupted, f"{move.stopped_by} of this program")
+            elif move.what == "home":
+                reason = StopReason(MoveInterrupted, "an end of the homing before the drive was homed (a stop "
+                                                     "from another program or a stop input?)")
+            else:
+                reason = StopReason(MoveInterrupted, "a stop from another program or a stop input (the drive "
+                                                     "shows no fault or limit)")
+        error = self._failure(move, reason, status=status, position=position)
+        if raise_error:
+            raise error
+
+    def _failure(self, move: _Move, reason: StopReason, *, status: Optional[DriveStatus] = None,
+                 position: Optional[float] = None, at_rest: bool = True) -> MoveFailed:
+        """Builds the error for ``move`` (and records it as the last outcome)."""
+        if position is None:
+            try:
+                position = self._position()
+            except Exception:  # noqa: BLE001 - the error must still be raised
+                position = math.nan
+        if status is None:
+            try:
+                status = self._status()
+            except Exception:  # noqa: BLE001
+                status = None
+        u = self._units
+        where, goal = u.to_user(position), None if move.target is None else u.to_user(move.target)
+        place = "still moving at" if not at_rest else "stopped at"
+        what = {"move": f"target {goal:g} {u.name}" if goal is not None else "move",
+                "jog": "a jog", "home": "homing"}[move.what]
+        kw = dict(axis=self.name, target=goal, position=where, reason=reason.text, code=reason.code,
+                  status=None if status is None else status.raw, units=u.name)
+        message = f"{self.name}: {place} {where:g} {u.name} by {reason.text}, {what}"
+        error = (reason.error(message, side=reason.side, **kw) if issubclass(reason.error, LimitReached)
+                 else reason.error(message, **kw))
+        self._finish(move, error, position)
+        return error
+
+    def _finish(self, move: _Move, error: Optional[MoveFailed], position: Optional[float] = None) -> None:
+        move.judged = True
+        self._restore(move)
+        u = self._units
+        if position is None and error is not None:
+            where = error.position
+        else:
+            where = None if position is None else u.to_user(position)
+        self._last_move = MoveOutcome(move.what, None if move.target is None else u.to_user(move.target), where,
+                                      "done" if error is None else error.outcome,
+                                      "" if error is None else error.reason, error)
+
+    def _restore(self, move: _Move) -> None:
+        steps, move.restore = move.restore, []
+        for put_back in steps:
+            try:
+                put_back()
+            except Exception:  # noqa: BLE001 - a lost link must not hide the move's outcome
+                pass
 
     def clear_faults(self) -> None:
         """Clear latched faults (limit errors, drive faults) so it accepts motion again."""
@@ -386,8 +670,24 @@ class Drive(abc.ABC):
 
     @property
     def status(self) -> DriveStatus:
+        """The drive's status now, with ``last_move``: how the last move, jog or homing
+        ended (judged here if it ended while nobody waited)."""
         self._check_open()
-        return self._status()
+        self._settle_if_at_rest()
+        st = self._status()
+        last = self._last_move
+        if last is not None and last.what == "move" and last.state != "done" and st.at_target:
+            st = dataclasses.replace(st, at_target=False)     # halted short: not "at target"
+        return dataclasses.replace(st, last_move=last)
+
+    def _settle_if_at_rest(self) -> None:
+        move = self._move
+        if move is not None and not move.judged and move.what != "home":
+            try:
+                if self._is_idle():
+                    self._judge(move, raise_error=False)
+            except _core.DriveFault:    # judged and recorded in last_move
+                pass
 
     @property
     def units(self) -> Units:
@@ -452,10 +752,12 @@ class Drive(abc.ABC):
 
     def _wait(self, done: Callable[[], bool], timeout: Optional[float], what: str) -> None:
         limit = self.default_timeout if timeout is None else self._number("timeout", timeout)
+        if limit < 0:
+            raise _core.InvalidArgument(f"{self.name}: timeout must be >= 0, not {limit!r}")
         deadline = time.monotonic() + limit
         while not done():
             if time.monotonic() >= deadline:
-                raise _core.TimeoutError(f"{self.kind}: {what} not finished after {limit:g} s")
+                raise _core.TimeoutError(f"{self.name}: {what} not finished after {limit:g} s")
             time.sleep(self.poll_interval)
 
     def __repr__(self) -> str:
