@@ -41,7 +41,7 @@ from typing import Any, Iterator, Mapping, Optional, Sequence
 
 from . import _core, registry
 from .bus import open_bus
-from .drive import Drive, DriveStatus, Units
+from .drive import Drive, DriveStatus, MoveFailed, Units
 
 __all__ = ["Bench", "BenchFileError", "AxisConfig", "ParamDiff", "StartReport"]
 
@@ -418,6 +418,7 @@ class Bench:
             raise self._fail(f"{cfg.kind} does not take this option set: {e}", "axis", cfg.name, "options") from None
         except _core.InvalidArgument as e:
             raise self._fail(str(e), "axis", cfg.name, "options") from None
+        drive.name = cfg.name      # errors (MoveFailed...) name the bench's axis
         for pname in cfg.params:
             if pname not in drive.params:
                 drive.close()
@@ -495,10 +496,27 @@ class Bench:
                 offsets[n] = now - t0
             methods.append("software")
         if wait:
-            for d in drives.values():
-                d.wait_idle(timeout)
+            self._wait_all(drives, timeout)
         method = methods[0] if len(set(methods)) == 1 else " + ".join(dict.fromkeys(methods))
         return StartReport(method, offsets, max(offsets.values()))
+
+    @staticmethod
+    def _wait_all(drives: Mapping[str, Drive], timeout: Optional[float]) -> None:
+        """Waits for every axis, even after one failed (each outcome is judged and kept in
+        its ``status.last_move``); then raises the first axis's :class:`MoveFailed`, with
+        ``failures`` = every failed axis's error by name."""
+        failures: dict[str, MoveFailed] = {}
+        for name, d in drives.items():
+            try:
+                d.wait_idle(timeout)
+            except MoveFailed as e:
+                failures[name] = e
+        if failures:
+            first = next(iter(failures.values()))
+            first.failures = failures
+            if len(failures) > 1:
+                first.add_note("also: " + "; ".join(str(e) for e in list(failures.values())[1:]))
+            raise first
 
     def status(self) -> dict[str, DriveStatus]:
         return {name: d.status for name, d in self._axes.items()}

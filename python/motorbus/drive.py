@@ -778,7 +778,10 @@ def open_drive(kind: str, *, line: Any = None, bus: Any = None, address: Union[s
     * ``options``: the vendor's (``on_error``, ``on_exit``, timeouts...).
     """
     plugin = registry.drive_plugin(kind)
-    canonical = plugin.check_address(str(address).strip())
+    # An integer means that integer for every kind (a UNITEK id 0x201 is 513, not "513"
+    # read as hex text); text is the vendor's own notation.
+    is_int = isinstance(address, int) and not isinstance(address, bool)
+    canonical = plugin.check_address(address if is_int else str(address).strip())
     if plugin.transport == "serial":
         if line is None or bus is not None:
             raise _core.InvalidArgument(f"open_drive({kind!r}): a serial drive takes line=, not bus=")

@@ -92,15 +92,18 @@ class _DriveMoveLogic(MovableLogic[float]):
         speed = await self._motor.velocity.get_value()
         await self.setpoint.set(new_position)
         # Start, then wait on the drive: a refusal (disabled, fault, limit) raises the
-        # drive's own typed error here and fails the move's status with it.
+        # drive's own typed error here, and a move that ends short raises the Drive API's
+        # MoveFailed (limit, fault, stall, interrupted, timeout); either fails the status.
         await _call(drive.move_to, float(new_position), velocity=speed or None, wait=False)
-        await _call(drive.wait_idle, timeout())
-        status, position = await _call(lambda: (drive.status, drive.position))
-        # A staged signal reads its monitor's cache (ophyd-async), refreshed every
-        # POLL_PERIOD: hand it the position at rest so the reading after the move is it.
-        self._motor._publish_position(position)
-        if status.fault:
-            raise _core.DriveFault(f"{self._motor.name}: move to {new_position:g} ended in a fault: {status.text}")
+        try:
+            await _call(drive.wait_idle, timeout())
+        finally:
+            # A staged signal reads its monitor's cache (ophyd-async), refreshed every
+            # POLL_PERIOD: hand it the position at rest so the reading after the move is it.
+            try:
+                self._motor._publish_position(await _call(lambda: drive.position))
+            except _core.MotorbusError:
+                pass
 
     async def stop(self) -> None:
         await _call(self._motor.drive.stop)

@@ -346,6 +346,8 @@ SIM_OPTIONS = ("model", "supply_voltage", "baudrate", "request_terminator", "rep
 
 def check_address(text: str) -> str:
     """The canonical two-digit address ("00".."63"), or InvalidArgument naming the problem."""
+    if isinstance(text, int) and not isinstance(text, bool):
+        text = str(text)             # an integer means that integer
     if not isinstance(text, str) or not text.strip().isdigit():
         raise _core.InvalidArgument(f"DMAC address: {text!r} is not a number 00..63")
     return f"{_parse_address(text.strip()):02d}"
