@@ -108,6 +108,8 @@ class BenchSession:
         bench = self.bench
         if bench is None or bench.closed:
             return []
+        from .drive import MoveFailed, MoveTimedOut
+
         problems = []
         failed = dict(bench.stop_all("stop"))
         for name, drive in bench.axes.items():
@@ -115,6 +117,11 @@ class BenchSession:
                 continue
             try:
                 drive.wait_idle(timeout=_STOP_WAIT)
+            except MoveFailed as e:
+                # The move this stop cut short (or that had already failed) is the test's
+                # business; only an axis still moving needs the harder stop.
+                if isinstance(e, MoveTimedOut):
+                    failed[name] = e
             except Exception as e:  # noqa: BLE001 - then the harder stop
                 failed[name] = e
         if failed:
