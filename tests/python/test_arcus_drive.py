@@ -75,11 +75,12 @@ def test_move_in_user_units_reads_back_within_one_count(served):
         assert abs(d.position - 10.0) <= 0.01
 
 
-def test_velocity_of_a_move_sets_hspd_which_stays(served):
+def test_velocity_of_a_move_is_for_that_move_only(served):
     with served.open() as d:
         d.enable()
-        d.move_to(5, velocity=150.0)          # 15000 counts/s
-        assert d.params["HSPD"] == 15000
+        d.move_to(5, velocity=150.0)          # 15000 counts/s for this move
+        assert abs(d.position - 5) <= 0.2     # within SLT (20 counts)
+        assert d.params["HSPD"] == 20000      # the drive's own speed is back
 
 
 def test_open_loop_positions_are_pulses(served):
@@ -136,8 +137,11 @@ def test_home_into_a_limit_raises_the_homing_error():
     try:
         with s.open() as d:
             d.enable()
-            with pytest.raises(ArcusHomingError, match="homing failed"):
+            with pytest.raises(ArcusHomingError, match="homing failed") as failed:
                 d.home("H+")                  # the limit comes first
+            e = failed.value                  # a MoveFailed whose class says why
+            assert isinstance(e, motorbus.LimitReached) and e.side == 1 and e.outcome == "limit"
+            assert "MST bit 7" in e.reason and d.status.last_move.state == "limit"
             assert not d.status.homed and d.status.fault and d.status.limit_positive
             d.clear_faults()
             assert not d.status.fault
@@ -150,7 +154,9 @@ def test_fault_then_clear_faults(served):
         d.enable()
         served.sim.force_limit(-1, True)     # the minus limit switch is hit
         d.jog(-10)
-        d.wait_idle(timeout=5)
+        with pytest.raises(motorbus.LimitReached) as failed:
+            d.wait_idle(timeout=5)           # a jog a limit ended
+        assert failed.value.side == -1
         st = d.status
         assert st.fault and st.limit_negative
         assert st.raw == (MotorStatus.MINUS_LIMIT | MotorStatus.MINUS_LIMIT_ERROR, SnlStatus.LIMIT_ERROR)
@@ -167,7 +173,9 @@ def test_stall_is_a_fault_cleared_by_clear_faults(served):
     with served.open() as d:
         d.enable()
         served.sim.set_blocked(True)
-        d.move_to(50)
+        with pytest.raises(motorbus.MoveStalled, match="SLS 10") as failed:
+            d.move_to(50)
+        assert failed.value.code == 10 and failed.value.position < 50
         assert d.status.fault and d.status.raw[1] is SnlStatus.STALL_ERROR
         served.sim.set_blocked(False)
         d.clear_faults()

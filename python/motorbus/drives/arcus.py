@@ -38,6 +38,8 @@ __all__ = [
     "ArcusDrive",
     "ArcusParams",
     "ArcusHomingError",
+    "ArcusHomingLimit",
+    "ArcusHomingStalled",
     "ArcusMotorDisabled",
     "HOME_METHODS",
     "DEFAULT_HOME_METHOD",
@@ -302,8 +304,24 @@ HOME_METHODS = ("H+", "H-", "HL+", "HL-", "L+", "L-", "Z+", "Z-", "ZH+", "ZH-")
 DEFAULT_HOME_METHOD = "H+"
 
 
-class ArcusHomingError(_core.DriveFault):
-    """home() ended in a limit error or a StepNLoop error instead of at the switch."""
+class ArcusHomingError(_drive.MoveFailed):
+    """home() ended in a limit error or a StepNLoop error instead of at the switch.
+
+    A :class:`motorbus.MoveFailed`: the error raised is one of its subclasses,
+    which is also the outcome class of the reason (:class:`ArcusHomingLimit` is a
+    ``LimitReached``, :class:`ArcusHomingStalled` a ``MoveStalled``)."""
+
+    __module__ = "motorbus.drives.arcus"
+
+
+class ArcusHomingLimit(ArcusHomingError, _drive.LimitReached):
+    """The homing ran into a limit switch (MST bit 6/7): ``side`` says which."""
+
+    __module__ = "motorbus.drives.arcus"
+
+
+class ArcusHomingStalled(ArcusHomingError, _drive.MoveStalled):
+    """A StepNLoop error (SLS 8..10) ended the homing."""
 
     __module__ = "motorbus.drives.arcus"
 
@@ -398,6 +416,20 @@ class ArcusParams(_drive.Params):
             self._drive._read_loop_settings()
 
 
+#: SLS error values and the manual's words for them (Table 7.6, Table 7.7, §8 object 2003h).
+_SNL_ERRORS = {
+    SnlStatus.CORRECTION_RANGE_ERROR: "StepNLoop correction range error: the delta exceeded the error range "
+                                      "(SLE) while the motor was idle (SLS 8)",
+    SnlStatus.CORRECTION_ATTEMPT_ERROR: "StepNLoop correction attempt error: the position was not reached in the "
+                                        "maximum number of correction attempts (SLA) (SLS 9)",
+    SnlStatus.STALL_ERROR: "StepNLoop stall error: the delta (DX) exceeded the error range (SLE) while the "
+                           "motor was moving (SLS 10)",
+}
+#: SLS values of a motor still busy (moving, correcting, stopping, homing): not at rest yet.
+_SNL_BUSY = frozenset({SnlStatus.MOVING, SnlStatus.CORRECTING, SnlStatus.STOPPING, SnlStatus.ABORTING,
+                       SnlStatus.JOGGING, SnlStatus.HOMING, SnlStatus.Z_HOMING, SnlStatus.LIMIT_HOMING})
+
+
 class ArcusDrive(_drive.Drive):
     """A DMX-CAN behind :class:`motorbus.Drive`.
 
@@ -405,8 +437,13 @@ class ArcusDrive(_drive.Drive):
     setting) positions, targets and velocities are encoder counts and
     counts/s (4000 per rev) and ``position`` is EX; with SL=0 they are pulses
     and pulses/s (3200 per rev) and ``position`` is PX.  ``velocity=`` of a
-    move sets HSPD, which stays set afterwards.  No watchdog: on link loss the
-    motor keeps doing what it was last told and the next call raises LinkDown.
+    move (and a jog's velocity) sets HSPD for that move only: the old HSPD is
+    written back once it has ended, however it ended.  A move has arrived when
+    it is at rest within the StepNLoop tolerance SLT of its target (SL=1), or
+    exactly on it (SL=0: the pulse counter); otherwise it raises the
+    ``motorbus.MoveFailed`` that says why (docs/drives/arcus.md, "How a move
+    ends").  No watchdog: on link loss the motor keeps doing what it was last
+    told and the next call raises LinkDown.
     """
 
     kind = "arcus"
@@ -425,7 +462,6 @@ class ArcusDrive(_drive.Drive):
         # a script that changes them through drive.native should reopen the Drive).
         self._enabled = self.native.enabled
         self._incremental: Optional[bool] = None
-        self._relative_move = False
         self._read_loop_settings()
 
     def _read_loop_settings(self) -> None:
@@ -436,6 +472,19 @@ class ArcusDrive(_drive.Drive):
         if not self._enabled:
             raise ArcusMotorDisabled(f"arcus {self.native.address:02d}: the motor is disabled (EO=0); "
                                      "call enable() first")
+
+    def _speed_for_this_move(self, velocity: Optional[float]) -> None:
+        # HSPD for this move only (Drive writes the old value back when it ends);
+        # nothing is written when the move runs at the drive's own speed.
+        if velocity is None:
+            return
+        speed = max(1, int(round(abs(velocity))))
+        old = self.native.high_speed
+        if old != speed:
+            self._for_this_move(lambda: old, self._set_high_speed, speed)
+
+    def _set_high_speed(self, value: int) -> None:
+        self.native.high_speed = value
 
     # ---- motion ----
     def _enable(self) -> None:
@@ -454,28 +503,25 @@ class ArcusDrive(_drive.Drive):
     def _move_to(self, target: float, velocity: Optional[float]) -> None:
         self._require_enabled()
         goal = int(round(target))
-        if velocity is not None:
-            self.native.high_speed = max(1, int(round(velocity)))
+        self._speed_for_this_move(velocity)
         self._use_mode(False)
         self._target, self._direction = goal, 0   # direction: worked out when velocity is read
-        self._relative_move = False
         self.native.move(goal)
 
     def _move_by(self, distance: float, velocity: Optional[float]) -> None:
-        self._require_enabled()
-        step = int(round(distance))
-        if velocity is not None:
-            self.native.high_speed = max(1, int(round(velocity)))
-        self._use_mode(True)
-        self._target, self._direction = None, 1 if step >= 0 else -1
-        self._relative_move = True                # at target once it stops without a fault
-        self.native.move(step)                    # X in INC mode: relative
+        # An absolute X to the target Drive judges the move by (where the axis was read
+        # plus the distance).  An X in INC mode would count from PX, the commanded
+        # position, which StepNLoop leaves up to SLT away from EX: the move would end
+        # within SLT of a target that is itself up to SLT off the one judged.
+        move = self._move
+        target = move.target if move is not None and move.target is not None else self._position() + distance
+        self._move_to(target, velocity)
 
     def _jog(self, velocity: float) -> None:
         self._require_enabled()
-        self.native.high_speed = max(1, int(round(abs(velocity))))
+        self._speed_for_this_move(velocity)
         self._direction = 1 if velocity > 0 else -1
-        self._target, self._relative_move = None, False
+        self._target = None
         self.native.jog(self._direction)
 
     def _stop(self) -> None:
@@ -493,19 +539,26 @@ class ArcusDrive(_drive.Drive):
         self._require_enabled()
         self._homed = False
         self._homing = True
-        self._target, self._relative_move = None, False
+        self._target = None
         self._direction = 1 if method.endswith("+") else -1
         self.native.action(method)
 
     def _homing_done(self) -> bool:
-        st = self.native.status
-        if st.moving:
+        if not self._is_idle():
             return False
         self._homing = False
-        snl = self.native.snl_status if self._snl else SnlStatus.DISABLED
-        if st.limit_error or snl.is_error:
-            raise ArcusHomingError(f"arcus {self.native.address:02d}: homing failed: MST {st!r}, SLS {snl.name}")
-        self._homed = True
+        status = self._status()
+        reason = self._stop_reason(status)
+        if reason is not None and reason.error in (_drive.LimitReached, _drive.MoveStalled):
+            error = ArcusHomingLimit if reason.error is _drive.LimitReached else ArcusHomingStalled
+            move = self._move
+            if move is not None:
+                raise self._failure(move, _drive.StopReason(error, f"{reason.text}: homing failed", reason.code,
+                                                            reason.side), status=status)
+            raise error(f"arcus {self.native.address:02d}: homing failed: {reason.text}")
+        # Nothing the drive shows tells a homing that found its switch from one a STOP
+        # of another client on the line ended (docs/drives/arcus.md): it counts as homed.
+        self._homed = reason is None
         return True
 
     def _clear_faults(self) -> None:
@@ -526,7 +579,35 @@ class ArcusDrive(_drive.Drive):
         return float(self.native.speed * (self._direction or 1))
 
     def _is_idle(self) -> bool:
-        return not self.native.status.moving
+        # At rest: no pulses (MST bits 0..2) and, under StepNLoop, no correction on
+        # its way either (SLS 1..7, 13).  An error state (SLS 8..11) is at rest.
+        if self.native.status.moving:
+            return False
+        return not self._snl or self.native.snl_status not in _SNL_BUSY
+
+    def _in_position_window(self) -> float:
+        # StepNLoop calls a move "in position" within SLT encoder counts (Table 7.5);
+        # without it the drive counts pulses and stops on the target exactly.
+        return float(self._tolerance)
+
+    def _stop_reason(self, status: _drive.DriveStatus) -> Optional[_drive.StopReason]:
+        mst, snl = status.raw
+        # MST bits 6/7 latch when a limit switch stops a motion in its direction
+        # (Table 7.3); the DMX-CAN has hard limit inputs only, no soft limits.
+        if mst & MotorStatus.PLUS_LIMIT_ERROR:
+            return _drive.StopReason(_drive.LimitReached, "the +limit switch (MST bit 7, plus limit error)",
+                                     side=1)
+        if mst & MotorStatus.MINUS_LIMIT_ERROR:
+            return _drive.StopReason(_drive.LimitReached, "the -limit switch (MST bit 6, minus limit error)",
+                                     side=-1)
+        if snl in _SNL_ERRORS:
+            return _drive.StopReason(_drive.MoveStalled, _SNL_ERRORS[snl], code=int(snl))
+        if snl is SnlStatus.LIMIT_ERROR:     # MST's latch cleared by hand, SLS's not
+            return _drive.StopReason(_drive.LimitReached, "a limit switch (StepNLoop limit error, SLS 11)")
+        if not status.enabled:
+            return _drive.StopReason(_drive.MoveInterrupted, "the motor power switched off (EO=0)")
+        # A STOP or an ABORT leaves no trace in MST or SLS once the motor is at rest.
+        return None
 
     def _status(self) -> _drive.DriveStatus:
         c = self.native
@@ -536,8 +617,8 @@ class ArcusDrive(_drive.Drive):
         moving = st.moving
         fault = st.limit_error or snl.is_error
         pos = self._position()
-        at_target = not moving and not fault and (
-            self._relative_move or (self._target is not None and abs(pos - self._target) <= self._tolerance))
+        at_target = not moving and not fault and (self._target is not None and abs(pos - self._target)
+                                                  <= self._tolerance)
         flags = "|".join(f.name for f in MotorStatus if f in st) or "idle"
         text = (f"arcus {c.address:02d}: {'enabled' if enabled else 'disabled'}, MST {flags}, SLS {snl.name}, "
                 f"{'EX' if self._snl else 'PX'}={int(pos)}")
@@ -593,13 +674,27 @@ def probe(line: "_core.LineLink", address: str) -> Optional[dict]:
         client.close()   # a shared LineLink stays open
 
 
-# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+def _limit_fault(sim: ArcusSim, direction: Any = 1) -> None:
+    if isinstance(direction, bool) or str(direction).strip() not in ("1", "+1", "-1"):
+        raise _core.InvalidArgument(f"arcus sim fault 'limit': direction +1 or -1, not {direction!r}")
+    sim.force_limit(int(str(direction).strip()), True)
+
+
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture), under
+# the standard names of docs/drives/arcus.md ("How a move ends").  The DMX-CAN has
+# no drive fault register and no stop input in ASCII mode: no "fault", no "stop_input".
 SIM_FAULTS = {
-    # a limit switch closes (direction -1 or +1); the drive stops on it and latches the error
-    "trip_limit": lambda sim, direction=-1: sim.force_limit(int(direction), True),
-    # the rotor jams: pulses go out, the shaft stays (StepNLoop then reports the error)
+    # a limit switch closes (direction +1 or -1, forced until the sim is replaced): a
+    # motion that way stops at once and latches the limit error (MST bit 6/7, SLS 11)
+    "limit": _limit_fault,
+    # the rotor jams: pulses go out, the shaft stays; StepNLoop stops the motor when
+    # the delta passes SLE (SLS 10, stall error; with SL=0 nothing notices)
     "stall": lambda sim: sim.set_blocked(True),
+    # the names of earlier releases
+    "trip_limit": lambda sim, direction=-1: _limit_fault(sim, direction),
 }
+
+
 def poll_fields(drive: ArcusDrive, fields: Any) -> "PollSpec":
     """motorbus.Poller: EX (PX with StepNLoop off), PS and MST queried by a client of
     the poll thread's own on the drive's line.  PS is a speed (>= 0): the polled
