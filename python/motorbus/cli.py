@@ -5,6 +5,7 @@
     motorbus bus play FILE SPEC [--speed X]
     motorbus sim serve [--pty] [--bus virtual:NAME] [--bitrate N] [--socketcand HOST:PORT]...
                        [--slcan-pty]... --drive KIND:ADDR[,ADDR...]... [--baud N [--strict-baud]] [--store-dir DIR]
+    motorbus sim serve --bench FILE [--write FILE] [--link-dir DIR] [--port PORT|BUS=PORT]... [--control]
     motorbus drives
     motorbus demo
     motorbus status|move|home|stop|config ... BENCH [--sim]   (python/motorbus/cli_bench.py)
@@ -97,9 +98,17 @@ def cmd_bus_play(args: argparse.Namespace) -> int:
 
 # ---------------------------------------------------------------------------
 def cmd_sim_serve(args: argparse.Namespace) -> int:
-    """Serial kinds on ptys, CAN kinds as nodes on one served bus (see motorbus.sim)."""
+    """Serial kinds on ptys, CAN kinds as nodes on one served bus (see motorbus.sim);
+    with --bench, every axis of a bench file on stable paths (motorbus.sim.BenchTwin)."""
     from .sim import SimBench
 
+    if args.bench:
+        return _sim_serve_bench(args)
+    if not args.drive:
+        raise _core.InvalidArgument("sim serve: what to serve? --drive KIND:ADDR[,ADDR...] or --bench FILE")
+    for flag in ("write", "link_dir", "port", "control"):
+        if getattr(args, flag):
+            raise _core.InvalidArgument(f"sim serve: --{flag.replace('_', '-')} goes with --bench FILE")
     with SimBench(args.drive, bus=args.bus, bitrate=args.bitrate, socketcand=args.socketcand or (),
                   slcan_ptys=args.slcan_pty, channel=args.channel, baud=args.baud,
                   strict_baud=args.strict_baud, store_dir=args.store_dir) as bench:
@@ -109,6 +118,76 @@ def cmd_sim_serve(args: argparse.Namespace) -> int:
         _wait_for_signal(on_usr1=report)
         if report is not None:
             report()
+    return 0
+
+
+def _sim_serve_bench(args: argparse.Namespace) -> int:
+    """``sim serve --bench FILE``: the file's twin, until SIGINT/SIGTERM (or, with
+    --control, the end of stdin: a test that dies leaves no twin behind)."""
+    from .sim import BenchTwin, TwinBusy
+
+    for flag, given in (("--drive", args.drive), ("--bus", args.bus), ("--socketcand", args.socketcand),
+                        ("--slcan-pty", args.slcan_pty)):
+        if given:
+            raise _core.InvalidArgument(f"sim serve --bench: {flag} does not apply (the file names the axes, "
+                                        f"lines and buses; --port fixes the socketcand ports)")
+    ports: Any = None
+    for text in args.port or ():
+        name, eq, number = text.rpartition("=")
+        try:
+            port = int(number)
+        except ValueError:
+            raise _core.InvalidArgument(f"--port {text!r}: expected PORT or BUS=PORT") from None
+        if not eq and ports is None:
+            ports = port
+        elif eq and (ports is None or isinstance(ports, dict)):
+            ports = {**(ports or {}), name: port}
+        else:
+            raise _core.InvalidArgument(f"--port {text!r}: give one PORT (buses in file order take PORT, "
+                                        f"PORT+1...) or BUS=PORT for each bus, not both")
+    try:
+        twin = BenchTwin(args.bench, link_dir=args.link_dir, ports=ports, channel=args.channel, baud=args.baud,
+                         strict_baud=args.strict_baud, bitrate=args.bitrate, store_dir=args.store_dir)
+    except TwinBusy as e:
+        print(f"motorbus: {e}", file=sys.stderr)
+        return 1
+    stop, usr1 = threading.Event(), threading.Event()
+
+    def on_signal(signum: int, frame: Any) -> None:
+        (usr1 if signum == signal.SIGUSR1 else stop).set()
+
+    def report() -> None:
+        for r in twin.report():
+            print(r, file=sys.stderr, flush=True)
+
+    # Handlers first: the end of --control input stops serving through the same event.
+    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGUSR1)}
+    try:
+        with twin:
+            for line in twin.announce():
+                _say(line)
+            if args.write:
+                _say(f"bench {twin.write(args.write)}")   # last: a reader waiting for it finds the twin up
+            if args.control:
+                lock = threading.Lock()
+
+                def answer(text: str) -> None:
+                    with lock:
+                        _say(text)
+
+                def control() -> None:
+                    twin.serve_control(sys.stdin, answer)
+                    stop.set()     # end of input: a test that died leaves no twin behind
+
+                threading.Thread(target=control, name="sim serve control", daemon=True).start()
+            while not stop.wait(0.2):
+                if usr1.is_set():
+                    usr1.clear()
+                    report()
+            report()
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
     return 0
 
 
@@ -157,11 +236,42 @@ def build_parser() -> argparse.ArgumentParser:
     pl.set_defaults(func=cmd_bus_play)
 
     sim = sub.add_parser("sim", help="simulated drives").add_subparsers(dest="sim_cmd", required=True)
-    ss = sim.add_parser("serve", help="serve simulated drives: serial kinds on ptys, CAN kinds on a served bus")
-    ss.add_argument("--drive", action="append", required=True, metavar="KIND:ADDR[,ADDR...]",
+    ss = sim.add_parser(
+        "serve", help="serve simulated drives: serial kinds on ptys, CAN kinds on a served bus",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Serve simulated drives to other processes until SIGINT/SIGTERM.\n\n"
+                    "--drive KIND:ADDR...: drives of any kinds; prints `<spec> <pty>` per serial line and the CAN "
+                    "servers.\n\n"
+                    "--bench FILE: every axis of a bench file, with its `sim` options, as ONE twin that lasts. "
+                    "`--sim` on status/move/home/monitor/... makes a fresh twin for that one command (its "
+                    "positions and faults end with it); serve the twin here instead and point those commands, "
+                    "notebooks and `pytest --bench` at the file --write writes:\n"
+                    "  motorbus sim serve --bench bench.toml --write twin.toml &\n"
+                    "  motorbus move twin.toml x 10; motorbus status twin.toml\n"
+                    "Each serial line is the symlink LINK_DIR/<line name> to its pty (default LINK_DIR: "
+                    "$TMPDIR or /tmp, then motorbus-sim-<uid>/<bench file name without .toml>); each bus a "
+                    "socketcand server on 127.0.0.1 (--port fixes the port). Prints `line NAME LINK -> PTY`, "
+                    "`bus NAME SPEC`, then `bench FILE` once written. Exit 1 if another twin serves LINK_DIR.\n\n"
+                    "--control: commands on stdin, one per line, each answered by one line `ok ...` or "
+                    "`error: ...`: `fault AXIS NAME [key=value ...]` (the kind's sim_faults, values read as "
+                    "true/false, int, float or text), `faults AXIS` (the names), `axes`. End of stdin stops "
+                    "serving. motorbus.sim.ServedBench runs all this from a test.")
+    ss.add_argument("--drive", action="append", metavar="KIND:ADDR[,ADDR...]",
                     help="drives of one registered kind (`motorbus drives` lists them): a serial line with one "
                          "or more drives of a serial kind (KIND:01,02 = RS-485 multi-drop), or CAN nodes (cia402:5,6); "
                          "repeatable")
+    ss.add_argument("--bench", default=None, metavar="FILE",
+                    help="serve every axis of this bench file (with its sim options) instead of --drive")
+    ss.add_argument("--write", default=None, metavar="FILE",
+                    help="with --bench: write the bench file of what is served (same axes, units, params; "
+                         "ports = the line symlinks, specs = the socketcand servers)")
+    ss.add_argument("--link-dir", default=None, metavar="DIR",
+                    help="with --bench: where the line symlinks DIR/<line name> go (default: see above)")
+    ss.add_argument("--port", action="append", metavar="PORT|BUS=PORT",
+                    help="with --bench: the socketcand port of the first bus (the next bus in the file gets "
+                         "PORT+1...), or of the named bus (repeatable); default: free ports")
+    ss.add_argument("--control", action="store_true",
+                    help="with --bench: read fault-injection commands on stdin (see above)")
     ss.add_argument("--pty", action="store_true", help="serve serial lines on pseudo-terminals (the default)")
     ss.add_argument("--baud", type=int, default=0, help="pace serial replies at this baud rate (0 = unthrottled)")
     ss.add_argument("--strict-baud", action="store_true",
