@@ -40,5 +40,8 @@ from .drive import (  # noqa: E402,F401
 from .registry import drive_kinds  # noqa: E402,F401
 from .bench import Bench, BenchFileError  # noqa: E402,F401
 from .poller import Poller, load_frame  # noqa: E402,F401
+from ._stop_at_exit import (  # noqa: E402,F401 - SIGTERM/SIGHUP stop the drives (docs/reliability.md)
+    TerminatedBySignal, handle_signal as stop_on_signal, stop_all as stop_all_drives,
+)
 
 __version__ = "0.1.0"
