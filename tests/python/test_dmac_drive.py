@@ -28,7 +28,7 @@ def test_enable_move_and_status(rig):
     assert d.status.enabled and not d.status.fault
     d.move_to(50.0, velocity=500.0)           # 5000 increments at 50000 inc/s
     assert d.position == 50.0
-    assert d.params["#HIGH_SPEED"] == 30000    # the move's speed stays set
+    assert d.params["#HIGH_SPEED"] == 60000    # the move's 30000 was for that move only
     d.move_by(-20.0)
     assert d.position == 30.0
     st = d.status
@@ -73,8 +73,11 @@ def test_home_without_a_switch_fails_typed():
             d.enable()
             d.native.hard_ends("ALL")
             d.params["#LOW_SPEED"] = 60000
-            with pytest.raises(HomingFailed):
-                d.home(timeout=5)
+            with pytest.raises(HomingFailed) as failed:
+                d.home(timeout=5)             # the end-stop at 2000 comes before IN5 at 3000
+            e = failed.value
+            assert isinstance(e, motorbus.LimitReached) and e.side == 1 and "IN5 reference edge" in e.reason
+            assert 2000 <= e.position < 3000 and not d.status.homed
 
 
 def test_fault_then_clear(rig):
@@ -83,8 +86,10 @@ def test_fault_then_clear(rig):
     sim.set_supply_voltage(11000)             # undervoltage on a DMAC34
     st = d.status
     assert st.fault and not st.enabled and DmacErrorWord.UNDERVOLTAGE in st.raw[1]
-    with pytest.raises(motorbus.DriveFault):
+    with pytest.raises(motorbus.DriveFault, match=r"cause is still present .*SUPPLY_VOLTAGE 11 V.*clear_faults\(\)"):
         d.move_to(1.0)
+    with pytest.raises(motorbus.DriveFault, match="latched again at once.*undervoltage.*still present"):
+        d.clear_faults()
     sim.set_supply_voltage(32000)
     d.clear_faults()
     assert not d.status.fault

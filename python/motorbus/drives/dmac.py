@@ -27,7 +27,8 @@ import contextlib
 from typing import Any, Iterable, Iterator, Optional, Sequence
 
 from .. import _core, _stop_at_exit
-from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params
+from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFailed, MoveFaulted, MoveInterrupted,
+                     MoveTimedOut, ParamInfo, Params, StopReason)
 from ..registry import DrivePlugin
 
 DmacSim = _core.DmacSim
@@ -132,8 +133,43 @@ class DmacErrorWord(enum.IntFlag):
 FAULTS = DmacErrorWord.THERMAL | DmacErrorWord.SHORT_CIRCUIT | DmacErrorWord.UNDERVOLTAGE | DmacErrorWord.OVERVOLTAGE
 
 
-class HomingFailed(_core.DriveFault):
-    """A DMAC reference run stopped before IN5 re-homed the axis (an end-stop, a fault, a STOP)."""
+class HomingFailed(MoveFailed):
+    """A DMAC reference run that did not end homed: a :class:`motorbus.MoveFailed`.  The
+    error raised is one of its subclasses, also the outcome class of the reason: an
+    end-stop (:class:`HomingLimitReached`, a ``LimitReached``), a fault
+    (:class:`HomingFaulted`), a stop (:class:`HomingInterrupted`) or no IN5 reference
+    edge within the timeout (:class:`HomingTimedOut`, a ``MoveTimedOut``)."""
+
+
+class HomingLimitReached(HomingFailed, LimitReached):
+    """An end-stop stopped the reference run before IN5 rose."""
+
+
+class HomingFaulted(HomingFailed, MoveFaulted):
+    """A hardware fault (#ERROR bits 2..5) stopped the reference run."""
+
+
+class HomingInterrupted(HomingFailed, MoveInterrupted):
+    """A STOP, HALT, POWER OFF or BRAKE ON (this program, another client on the line) ended the run."""
+
+
+class HomingTimedOut(HomingFailed, MoveTimedOut):
+    """No IN5 reference edge within the timeout (the search is stopped)."""
+
+
+#: Where make_sim's IN5 reference switch turns on (1/10000 rev, stays on beyond it): the
+#: default homing finds it from anywhere (it backs off first when IN5 is already on).
+DEFAULT_REFERENCE_SWITCH = 3000.0
+
+#: The manual's words for the #ERROR fault bits (2.1, 3.5.4, 5.5).
+_FAULT_TEXT = {
+    2: "thermal disjunction (#ERROR bit 2): the motor or the electronics above 85 degC, or the CPU above "
+       "120 degC; the motor power is cut",
+    3: "short-circuit (#ERROR bit 3): a motor overcurrent disjunction; the motor power is cut",
+    4: "undervoltage (#ERROR bit 4): the supply dropped below {under} V; motion is stopped and the module is "
+       "in undervoltage lockout",
+    5: "overvoltage (#ERROR bit 5): the supply rose above {over} V; the motor power is disabled",
+}
 
 
 __all__ = [
@@ -155,6 +191,11 @@ __all__ = [
     "DmacVersionInfo",
     "FAULTS",
     "HomingFailed",
+    "HomingFaulted",
+    "HomingInterrupted",
+    "HomingLimitReached",
+    "HomingTimedOut",
+    "DEFAULT_REFERENCE_SWITCH",
     "LINE_SETTINGS",
     "PLUGIN",
     "UnknownCommand",
@@ -286,7 +327,9 @@ def make_sim(address: Any = "00", clock: Any = None, **options: Any) -> DmacSim:
     ``positive_end_switch`` / ``negative_end_switch`` (position in 1/10000 rev
     where a mechanical end-stop switch on IN1/IN2 or IN9/IN10 closes) and
     ``end_switch_active_low``, ``reference_switch`` (position where a switch
-    on IN5 turns on and stays on beyond: REFERENCE homing and #CAPTURE).
+    on IN5 turns on and stays on beyond: REFERENCE homing and #CAPTURE;
+    default ``DEFAULT_REFERENCE_SWITCH``, 3000 = 0.3 rev, so the Drive's default
+    homing works on a served twin; None = no switch).
     ``clock`` is a motorbus Clock (SimClock for tests); None = real time.
     """
     allowed = {"model", "supply_voltage", "baudrate", "request_terminator", "reply_terminator",
@@ -301,6 +344,7 @@ def make_sim(address: Any = "00", clock: Any = None, **options: Any) -> DmacSim:
         options["supply_voltage"] = int(options["supply_voltage"])
     if "baudrate" in options:
         options["baudrate"] = int(options["baudrate"])
+    options.setdefault("reference_switch", DEFAULT_REFERENCE_SWITCH)
     return DmacSim(clock, address=_parse_address(address), **options)
 
 
@@ -417,12 +461,21 @@ class DmacDrive(Drive):
 
     * ``enable()``: BRAKE OFF (DMAC34) and POWER ON; ``disable()``: POWER OFF.
     * ``stop()``: STOP (#DECEL_TIME ramp); ``quick_stop()``: HALT (no ramp).
-    * ``move_to(..., velocity=v)``: writes #HIGH_SPEED for the move; it stays set.
-    * ``home(method)``: ``"reference"`` (default): REFERENCE ON and MOVE_SPEED
-      at #LOW_SPEED clockwise until IN5 rises (the module re-homes there), then
-      back to 0; ``"here"``: #POSITION:=0 where the axis stands.
-    * ``clear_faults()``: #ERROR:=0; ``store()``: nothing to send — the DMAC
-      writes its stored variables to non-volatile memory as they are written.
+    * ``move_to(..., velocity=v)``: #HIGH_SPEED for that move only; the old value is
+      written back when the move ends, however it ends (both writes go to the
+      module's non-volatile memory: set ``params["#HIGH_SPEED"]`` once for many moves).
+    * A move has arrived when it is at rest within 1 increment of its target (the
+      position loop's precision, manual 1.2.1: the DMAC has no window setting);
+      otherwise it raises the ``motorbus.MoveFailed`` that says why, from #STATUS
+      and #ERROR (docs/drives/dmac.md, "How a move ends").
+    * ``home(method)``: ``"reference"`` (default): off the IN5 switch first if it is
+      already on, then REFERENCE ON and MOVE_SPEED at #LOW_SPEED clockwise until IN5
+      rises (the module re-homes there), then back to 0; ``"here"``: #POSITION:=0
+      where the axis stands.  A run that fails raises a :class:`HomingFailed`.
+    * ``clear_faults()``: #ERROR:=0; raises if the fault latches again at once (its
+      cause, a supply or a temperature out of range, is still present).
+      ``store()``: nothing to send — the DMAC writes its stored variables to
+      non-volatile memory as they are written.
     * No watchdog: on link loss the module keeps doing what it was last told.
     """
 
@@ -431,11 +484,14 @@ class DmacDrive(Drive):
                               Capability.INTERPOLATION, Capability.ENCODER, Capability.STORE})
     has_watchdog = False
     HOME_METHODS = ("reference", "here")
+    #: The position loop reaches its target "with a precision of 1/10000 rev" (manual
+    #: 1.2.1): one increment, the module having no in-position window to read.
+    in_position_window = 1.0
 
     def __init__(self, native: DmacClient, **kwargs: Any) -> None:
         super().__init__(native, **kwargs)
         self._homed = False
-        self._homing: Optional[str] = None
+        self._homing: Optional[str] = None      # "backoff", "search", "return" or None
 
     def _make_params(self) -> Params:
         return DmacParams(self)
@@ -449,30 +505,84 @@ class DmacDrive(Drive):
         self.native.command(line)
         return "OK"
 
+    # ---- faults in the Drive's words ----
+    def _fault_cause(self, err: DmacErrorWord) -> str:
+        """Whether the cause of the latched faults in ``err`` is still there, read from the module."""
+        n = self.native
+        under, over = (20, 170) if n.is_dmac34 else (12, 49)
+        present = []
+        if err & (DmacErrorWord.UNDERVOLTAGE | DmacErrorWord.OVERVOLTAGE):
+            mv = n.supply_voltage
+            if mv < under * 1000 or mv > over * 1000:
+                present.append(f"#SUPPLY_VOLTAGE {mv / 1000:g} V, outside {under}..{over} V")
+        if err & DmacErrorWord.THERMAL:
+            temps = [("#CPU_TEMPERATURE", n.cpu_temperature, 1200)]
+            if n.is_dmac34:
+                temps += [("#DRIVER_TEMPERATURE", n.driver_temperature, 850),
+                          ("#MOTOR_TEMPERATURE", n.motor_temperature, 850)]
+            present += [f"{name} {t / 10:g} degC, above {limit / 10:g}" for name, t, limit in temps if t > limit]
+        return "; ".join(present)
+
+    def _fault_text(self, err: DmacErrorWord) -> str:
+        under, over = (20, 170) if self.native.is_dmac34 else (12, 49)
+        words = [_FAULT_TEXT[b].format(under=under, over=over) for b in (2, 3, 4, 5) if err.bit(b)]
+        return "; ".join(words) or f"#ERROR {', '.join(err.names)}"
+
+    @contextlib.contextmanager
+    def _refused_in_drive_words(self, what: str) -> Iterator[None]:
+        """A command the client refuses because a fault is latched: say so in the Drive's
+        words (clear_faults(), and whether the cause is still there)."""
+        try:
+            yield
+        except CommandRejected as e:
+            err = DmacErrorWord(int(getattr(e, "error", 0) or 0)) & FAULTS
+            if not err:
+                raise
+            cause = self._fault_cause(err)
+            then = (f"its cause is still present ({cause}): remove it, then call clear_faults()" if cause else
+                    "clear_faults() acknowledges it")
+            error = CommandRejected(f"dmac {self.native.address:02d}: {what} refused: a fault is latched "
+                                    f"({self._fault_text(err)}); {then}")
+            error.error = int(err)
+            raise error from None
+
+    # ---- motion ----
     def _enable(self) -> None:
         if self.native.is_dmac34:
             self.native.brake(False)
-        self.native.power("ON")
+        with self._refused_in_drive_words("enable()"):
+            self.native.power("ON")
 
     def _disable(self) -> None:
         self.native.power("OFF")
 
-    def _set_speed(self, velocity: Optional[float]) -> None:
+    def _speed_for_this_move(self, velocity: Optional[float]) -> None:
         if velocity is None:
             return
         speed = int(round(velocity * _SPEED_PER_INC_S))
         if not 1 <= speed <= 400000:
             raise _core.InvalidArgument(f"dmac: velocity {velocity:g} increments/s is outside "
                                         f"1..400000 (0.01 rpm, #HIGH_SPEED)")
-        self.native.high_speed = speed
+        old = self.native.high_speed
+        if old != speed:       # a stored variable: no flash write when it would not change
+            self._for_this_move(lambda: old, self._set_high_speed, speed)
+
+    def _set_high_speed(self, value: int) -> None:
+        self.native.high_speed = value
 
     def _move_to(self, target: float, velocity: Optional[float]) -> None:
-        self._set_speed(velocity)
-        self.native.move_to(self._increments(target))
+        goal = self._increments(target)
+        self._speed_for_this_move(velocity)
+        with self._refused_in_drive_words(f"move_to (MOVE_TO {goal})"):
+            self.native.move_to(goal)
 
     def _move_by(self, distance: float, velocity: Optional[float]) -> None:
-        self._set_speed(velocity)
-        self.native.move_on(self._increments(distance))
+        # MOVE_ON counts from where the axis is at rest (the sim and the manual: from the
+        # target of a move in progress), which is where Drive read the start it judges by.
+        step = self._increments(distance)
+        self._speed_for_this_move(velocity)
+        with self._refused_in_drive_words(f"move_by (MOVE_ON {step})"):
+            self.native.move_on(step)
 
     def _jog(self, velocity: float) -> None:
         speed = int(round(velocity * _SPEED_PER_INC_S))
@@ -481,53 +591,125 @@ class DmacDrive(Drive):
         if speed == 0:
             self.native.stop()
             return
-        self.native.move_speed(speed)  # the module limits |speed| to #HIGH_SPEED
+        with self._refused_in_drive_words(f"jog (MOVE_SPEED {speed})"):
+            self.native.move_speed(speed)  # the module limits |speed| to #HIGH_SPEED
 
     def _stop(self) -> None:
-        self._homing = None
         self.native.stop()
 
     def _quick_stop(self) -> None:
-        self._homing = None
         self.native.halt()
+
+    # ---- homing ----
+    def _in5(self) -> bool:
+        return bool(self.native.inputs & (1 << 4))
 
     def _home(self, method: Any) -> None:
         method = "reference" if method is None else method
         if method not in self.HOME_METHODS:
             raise _core.InvalidArgument(f"dmac: home method {method!r} is not one of {self.HOME_METHODS}")
         self._homed = False
+        self._homing = None
         if method == "here":
             self.native.position = 0
             self._homed = True
-            self._homing = None
             return
+        with self._refused_in_drive_words("home()"):
+            if self._in5():
+                # REFERENCE needs a rising edge: leave the switch (counter-clockwise) first.
+                self.native.move_speed(-max(1, self.native.high_speed))
+                self._homing = "backoff"
+            else:
+                self._start_search()
+
+    def _start_search(self) -> None:
         self.native.reference(True)
         self.native.move_speed(max(1, self.native.low_speed))
         self._homing = "search"
 
+    def _homing_failed(self, st: DmacStatus, waiting_for: str) -> None:
+        """The run stopped early: raise the HomingFailed subclass of the reason the module shows."""
+        self._homing = None
+        try:
+            self.native.reference(False)
+        except _core.MotorbusError:
+            pass
+        status = self._status()
+        reason = self._stop_reason(status)
+        move = self._move
+        if reason is None:
+            by = move.stopped_by if move is not None else None
+            reason = StopReason(MoveInterrupted, f"{by} of this program" if by else
+                                "a STOP or HALT from another client on the line")
+        error = {LimitReached: HomingLimitReached, MoveFaulted: HomingFaulted}.get(reason.error, HomingInterrupted)
+        text = f"{reason.text}, while waiting for {waiting_for}"
+        if move is not None:
+            raise self._failure(move, StopReason(error, text, reason.code, reason.side), status=status)
+        raise error(f"dmac {self.native.address:02d}: homing failed: {text}")
+
     def _homing_done(self) -> bool:
-        if self._homing is None:
+        phase = self._homing
+        if phase is None:          # "here": done when it was asked
             return True
         st = self.native.status
-        if self._homing == "search":
-            if DmacStatus.REFERENCE not in st:          # IN5 rose: the module re-homed
-                self.native.move_to(0)                 # back onto the reference point
+        moving = DmacStatus.MOVEMENT in st
+        if phase == "backoff":
+            if not self._in5():
+                self.native.stop()
+                self._homing = "backoff_stop"
+            elif not moving or DmacStatus.ABNORMAL_STOP in st:
+                self._homing_failed(st, "IN5 to turn off (backing off the reference switch, counter-clockwise)")
+            return False
+        if phase == "backoff_stop":
+            if not moving:
+                self._start_search()
+            return False
+        if phase == "search":
+            if DmacStatus.REFERENCE not in st:         # IN5 rose: the module re-homed
+                self.native.move_to(0)                # back onto the reference point
                 self._homing = "return"
                 return False
-            if DmacStatus.MOVEMENT not in st or DmacStatus.ABNORMAL_STOP in st:
-                self._homing = None
-                self.native.reference(False)
-                raise HomingFailed(f"dmac {self.native.address:02d}: the reference run stopped before IN5 "
-                                   f"rose (#STATUS {st.names})")
+            if not moving or DmacStatus.ABNORMAL_STOP in st:
+                self._homing_failed(st, "the IN5 reference edge (REFERENCE ON, clockwise at #LOW_SPEED)")
             return False
-        if DmacStatus.MOVEMENT in st:
+        if moving:
             return False
         self._homing = None
-        self._homed = True
+        self._homed = abs(self.native.position) <= self.in_position_window
         return True
+
+    def wait_idle(self, timeout: Optional[float] = None) -> None:
+        move = self._move
+        phase = self._homing
+        try:
+            super().wait_idle(timeout)
+        except MoveTimedOut as e:
+            phase = self._homing or phase
+            if move is None or move.what != "home" or phase is None:
+                raise
+            # A reference search turns until IN5 rises: stop it, and say what it waited for.
+            self._homing = None
+            try:
+                self.native.stop()
+                self.native.reference(False)
+            except _core.MotorbusError:
+                pass
+            waited = {"backoff": "IN5 to turn off (backing off the reference switch, counter-clockwise)",
+                      "backoff_stop": "the axis to stop after backing off the reference switch",
+                      "search": "the IN5 reference edge (REFERENCE ON, clockwise at #LOW_SPEED); "
+                                "is a reference switch wired on IN5? the search was stopped",
+                      "return": "the return to 0 after the IN5 edge"}[phase]
+            raise self._failure(move, StopReason(HomingTimedOut, f"{e.reason} waiting for {waited}"),
+                                status=None, position=None, at_rest=False) from None
 
     def _clear_faults(self) -> None:
         self.native.clear_error()
+        err = DmacErrorWord(int(self.native.error)) & FAULTS
+        if err:
+            cause = self._fault_cause(err)
+            raise _core.DriveFault(
+                f"dmac {self.native.address:02d}: clear_faults(): the fault latched again at once "
+                f"({self._fault_text(err)}): its cause is still present" + (f" ({cause})" if cause else ""))
 
     def _store(self) -> None:
         # Stored variables go to non-volatile memory when written (manual 5.x,
@@ -535,6 +717,7 @@ class DmacDrive(Drive):
         # OPTIMIZED_CURRENT at shut-down.  There is no save command to send.
         pass
 
+    # ---- readings ----
     def _position(self) -> float:
         return float(self.native.position)
 
@@ -544,6 +727,30 @@ class DmacDrive(Drive):
     def _is_idle(self) -> bool:
         # At rest, not merely at the target speed (BUSY ends there in velocity mode).
         return DmacStatus.MOVEMENT not in self.native.status
+
+    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+        st, err = status.raw
+        faults = err & FAULTS
+        if faults:
+            return StopReason(MoveFaulted, self._fault_text(faults), code=int(faults))
+        # An end-stop stops the motion with "movement stopped abnormally" (#STATUS bit 32);
+        # the end-stop bits alone only say the axis sits on one (a move away may follow).
+        if DmacStatus.ABNORMAL_STOP in st:
+            for bit, side, text in ((DmacStatus.HARD_POSITIVE_END, 1, "the hard positive end-stop (#STATUS bit 17)"),
+                                    (DmacStatus.HARD_NEGATIVE_END, -1, "the hard negative end-stop (#STATUS bit 18)"),
+                                    (DmacStatus.SOFT_POSITIVE_END, 1,
+                                     "the soft positive end-stop #POSITIVE_END (#STATUS bit 19)"),
+                                    (DmacStatus.SOFT_NEGATIVE_END, -1,
+                                     "the soft negative end-stop #NEGATIVE_END (#STATUS bit 20)")):
+                if bit in st:
+                    return StopReason(LimitReached, text, side=side)
+            return StopReason(MoveInterrupted, "an abnormal stop with no end-stop or fault shown (#STATUS bit 32)")
+        if DmacStatus.POWER_ON not in st:
+            return StopReason(MoveInterrupted, "POWER OFF (#STATUS bit 25 clear)")
+        if DmacStatus.BRAKE in st:
+            return StopReason(MoveInterrupted, "BRAKE ON (#STATUS bit 21)")
+        # STOP and HALT leave no trace in #STATUS once the axis is at rest.
+        return None
 
     def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         # The soft end-stops bind only while SOFT_ENDS ON is in force (#STATUS bit 7).
@@ -599,13 +806,49 @@ def probe(line: "_core.LineLink", address: str) -> Optional[dict]:
         client.close()
 
 
-# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+def _sim_model_is_dmac34(sim: DmacSim) -> bool:
+    # REQUEST_VERSION names the model; it reads only.
+    return b"DMAC34" in sim.on_line(f"{sim.address:02d}REQUEST_VERSION".encode())
+
+
+def _limit_fault(sim: DmacSim, direction: Any = 1) -> None:
+    """The end-stop switch of one side closes, that side's hard end-stop enabled (as on a
+    bench whose switches are wired and HARD_ENDS set): a motion that way stops."""
+    if isinstance(direction, bool) or str(direction).strip() not in ("1", "+1", "-1"):
+        raise _core.InvalidArgument(f"dmac sim fault 'limit': direction +1 or -1, not {direction!r}")
+    side = int(str(direction).strip())
+    status = DmacStatus(sim.read("#STATUS"))
+    positive = DmacStatus.HARD_POSITIVE_END_ENABLED in status or side > 0
+    negative = DmacStatus.HARD_NEGATIVE_END_ENABLED in status or side < 0
+    word = "ALL" if positive and negative else "POS" if positive else "NEG"
+    sim.on_line(f"{sim.address:02d}HARD_ENDS {word}".encode())
+    dmac34 = _sim_model_is_dmac34(sim)
+    sim.set_input((9 if side > 0 else 10) if dmac34 else (1 if side > 0 else 2), True)
+
+
+def _fault(sim: DmacSim, bit: Any = 4) -> None:
+    """A hardware fault (#ERROR bit 2 thermal, 3 short-circuit, 4 undervoltage, 5 overvoltage)."""
+    if isinstance(bit, bool) or str(bit).strip() not in ("2", "3", "4", "5"):
+        raise _core.InvalidArgument(f"dmac sim fault 'fault': bit 2, 3, 4 or 5 (#ERROR), not {bit!r}")
+    sim.inject_error(int(str(bit).strip()))
+
+
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture), under the
+# standard names of docs/drives/dmac.md ("How a move ends").  A DMAC has no stall (its
+# self-switched motor "guarantees the motor position") and no stop input: no "stall",
+# no "stop_input".
 SIM_FAULTS = {
+    # an end-stop switch closes (direction +1 or -1): the module stops, ABNORMAL_STOP
+    "limit": _limit_fault,
+    # a hardware fault latches (bit=, default 4 undervoltage): the module stops
+    "fault": _fault,
     # the supply falls (mV): below the model's range the drive latches undervoltage and stops
     "supply_drop": lambda sim, mv=11000: sim.set_supply_voltage(int(mv)),
     # a sensor ("cpu", "driver" or "motor") heats (0.1 degC): past its threshold a thermal fault latches
     "overheat": lambda sim, sensor="motor", tenths_c=900: sim.set_temperature(str(sensor), int(tenths_c)),
 }
+
+
 def poll_fields(drive: "DmacDrive", fields: Any) -> "PollSpec":
     """motorbus.Poller: #POSITION, #SPEED and #STATUS (hex) read by a client of the poll
     thread's own on the drive's line.  Each READ waits the module's #LINE_DELAY (3 ms
