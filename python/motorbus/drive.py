@@ -29,6 +29,7 @@ from __future__ import annotations
 import abc
 import dataclasses
 import enum
+import logging
 import math
 import time
 from collections.abc import Iterator, MutableMapping
@@ -36,6 +37,9 @@ from dataclasses import dataclass
 from typing import Any, Callable, Optional, Union
 
 from . import _core, _stop_at_exit, registry
+
+#: A DEBUG line per command (``motorbus -vv``); the protocol itself: ``motorbus.trace``.
+log = logging.getLogger(__name__)
 
 __all__ = ["open_drive", "Capability", "Drive", "DriveStatus", "ParamInfo", "Params", "StopHow", "Units", "STOP_WAYS",
            "MoveFailed", "MoveInterrupted", "LimitReached", "MoveFaulted", "MoveStalled", "MoveTimedOut",
@@ -434,17 +438,20 @@ class Drive(abc.ABC):
     def enable(self) -> None:
         """Power the motor (the drive holds position)."""
         self._check_open()
+        log.debug("%s: enable", self.name)
         self._enable()
 
     def disable(self) -> None:
         """Power stage off: the motor no longer holds position."""
         self._check_open()
+        log.debug("%s: disable", self.name)
         self._disable()
 
     def move_to(self, position: float, *, velocity: Optional[float] = None, wait: bool = True,
                 timeout: Optional[float] = None) -> None:
         """Absolute move in user units; ``velocity`` (user units/s) for this move, else the drive's own."""
         self._check_open()
+        log.debug("%s: move_to %r %s (velocity %r, wait %s)", self.name, position, self._units.name, velocity, wait)
         target = self._units.to_native(self._number("position", position))
         speed = self._speed_arg(velocity)
         self._start("move", target, lambda: self._move_to(target, speed))
@@ -455,6 +462,7 @@ class Drive(abc.ABC):
                 timeout: Optional[float] = None) -> None:
         """Relative move in user units."""
         self._check_open()
+        log.debug("%s: move_by %r %s (velocity %r, wait %s)", self.name, distance, self._units.name, velocity, wait)
         distance = self._units.to_native(self._number("distance", distance))
         speed = self._speed_arg(velocity)
         self._settle()
@@ -466,6 +474,7 @@ class Drive(abc.ABC):
     def jog(self, velocity: float) -> None:
         """Run at ``velocity`` (user units/s, the sign is the direction) until stop()."""
         self._check_open()
+        log.debug("%s: jog %r %s/s", self.name, velocity, self._units.name)
         v = self._units.to_native(self._number("velocity", velocity))
         if v == 0:
             self.stop()
@@ -476,6 +485,7 @@ class Drive(abc.ABC):
         """Decelerate to a stop with the drive's deceleration.  A move this stops ends in
         ``MoveInterrupted`` (from its ``wait_idle``); a jog ends normally."""
         self._check_open()
+        log.debug("%s: stop", self.name)
         if self._move is not None and self._move.stopped_by is None:
             self._move.stopped_by = "stop()"
         self._stop()
@@ -483,6 +493,7 @@ class Drive(abc.ABC):
     def quick_stop(self) -> None:
         """The fastest stop the drive has (an abort or the quick-stop ramp)."""
         self._check_open()
+        log.debug("%s: quick_stop", self.name)
         if self._move is not None and self._move.stopped_by is None:
             self._move.stopped_by = "quick_stop()"
         self._quick_stop()
@@ -491,6 +502,7 @@ class Drive(abc.ABC):
         """Run the drive's homing (``method``: the vendor's own, None = its default);
         returns once it has finished, else raises a :class:`MoveFailed`."""
         self._check_open()
+        log.debug("%s: home (method %r, wait %s)", self.name, method, wait)
         self._start("home", None, lambda: self._home(method))
         if wait:
             self.wait_idle(timeout)
@@ -604,6 +616,7 @@ class Drive(abc.ABC):
         return error
 
     def _finish(self, move: _Move, error: Optional[MoveFailed], position: Optional[float] = None) -> None:
+        log.debug("%s: %s ended: %s", self.name, move.what, "done" if error is None else error)
         move.judged = True
         self._restore(move)
         u = self._units
@@ -626,6 +639,7 @@ class Drive(abc.ABC):
     def clear_faults(self) -> None:
         """Clear latched faults (limit errors, drive faults) so it accepts motion again."""
         self._check_open()
+        log.debug("%s: clear_faults", self.name)
         self._clear_faults()
 
     def console(self, line: str) -> str:
@@ -641,6 +655,7 @@ class Drive(abc.ABC):
     def store(self) -> None:
         """Persist the parameters in the drive's non-volatile memory."""
         self._check_open()
+        log.debug("%s: store", self.name)
         self._store()
 
     def close(self) -> None:
