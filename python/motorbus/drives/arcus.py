@@ -606,7 +606,13 @@ class ArcusDrive(_drive.Drive):
             return _drive.StopReason(_drive.LimitReached, "a limit switch (StepNLoop limit error, SLS 11)")
         if not status.enabled:
             return _drive.StopReason(_drive.MoveInterrupted, "the motor power switched off (EO=0)")
-        # A STOP or an ABORT leaves no trace in MST or SLS once the motor is at rest.
+        # A STOP or an ABORT leaves no trace in MST or SLS once the motor is at rest.  A
+        # line is one process's: a move this program did not stop was stopped by
+        # another client on the same line (the DMX-CAN has no stop input).
+        move = self._move
+        if move is not None and move.what == "move" and move.stopped_by is None:
+            return _drive.StopReason(_drive.MoveInterrupted, "a command from another client on the line (STOP, "
+                                     "ABORT or a new target: the DMX-CAN keeps no trace of it at rest)")
         return None
 
     def _status(self) -> _drive.DriveStatus:

@@ -749,7 +749,13 @@ class DmacDrive(Drive):
             return StopReason(MoveInterrupted, "POWER OFF (#STATUS bit 25 clear)")
         if DmacStatus.BRAKE in st:
             return StopReason(MoveInterrupted, "BRAKE ON (#STATUS bit 21)")
-        # STOP and HALT leave no trace in #STATUS once the axis is at rest.
+        # STOP and HALT leave no trace in #STATUS once the axis is at rest.  A line is one
+        # process's: a move this program did not stop was stopped by another client on
+        # the same line (the DMAC has no stop input).
+        move = self._move
+        if move is not None and move.what == "move" and move.stopped_by is None:
+            return StopReason(MoveInterrupted, "a command from another client on the line (STOP, HALT or a new "
+                                               "target: the DMAC keeps no trace of it at rest)")
         return None
 
     def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
