@@ -8,12 +8,16 @@
     motorbus sim serve --bench FILE [--write FILE] [--link-dir DIR] [--port PORT|BUS=PORT]... [--control]
     motorbus drives
     motorbus demo
-    motorbus status|move|home|stop|config ... BENCH [--sim]   (python/motorbus/cli_bench.py)
-    motorbus monitor BENCH [--rate HZ] [--axis NAME]... [--sim]   (python/motorbus/cli_monitor.py)
+    motorbus status|move|home|stop|enable|disable|clear|config ... BENCH [--json] [--sim]   (cli_bench.py)
+    motorbus monitor BENCH [--rate HZ] [--axis NAME]... [--ask] [--sim]   (python/motorbus/cli_monitor.py)
+    motorbus --version;  motorbus -v|-vv|--trace COMMAND ...   (logging to stderr; --trace: frames and lines)
+
+The exit codes are one table (cli_bench.EXIT_CODES), printed at the end of ``motorbus --help``.
 """
 from __future__ import annotations
 
 import argparse
+import logging
 import signal
 import sys
 import threading
@@ -21,6 +25,8 @@ from typing import Any, Optional, Sequence
 
 from . import _core
 from .bus import open_bus
+
+log = logging.getLogger(__name__)
 
 
 def _wait_for_signal(on_usr1: Optional[Any] = None) -> None:
@@ -195,8 +201,10 @@ def cmd_drives(args: argparse.Namespace) -> int:
     """Lists the registered drive kinds."""
     from .registry import drive_plugins
 
-    for kind, plugin in drive_plugins().items():
-        _say(f"{kind:10s} {plugin.transport:6s} {plugin.description}")
+    from .cli_bench import table
+
+    rows = [(kind, plugin.transport, plugin.description) for kind, plugin in drive_plugins().items()]
+    _say(table(rows, ("kind", "link", "description")))
     return 0
 
 
@@ -211,9 +219,54 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------------
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("motorbus")
+    except PackageNotFoundError:  # pragma: no cover - run from a source tree without metadata
+        return "unknown (not installed)"
+
+
+def _log_options(p: argparse.ArgumentParser, default: Any) -> None:
+    """-v / --trace, on the top-level parser and after every command (``motorbus move ... -v``)."""
+    p.add_argument("-v", "--verbose", action="count", default=default,
+                   help="log what motorbus does to stderr (-v: opening links and drives; -vv: every drive command)")
+    p.add_argument("--trace", action="store_true", default=default,
+                   help="-vv and a protocol trace: every CAN frame on the bench's buses and every line on its "
+                        "serial lines")
+
+
+def setup_logging(verbose: int, trace: bool) -> None:
+    """Python logging to stderr for the ``motorbus`` loggers (the library never configures
+    logging itself; a program using it does, as here)."""
+    from . import trace as protocol_trace
+
+    if not verbose and not trace:
+        return
+    level = logging.DEBUG if trace or verbose >= 2 else logging.INFO
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(relativeCreated)9.1f ms %(name)s: %(message)s"))
+    root = logging.getLogger("motorbus")
+    root.addHandler(handler)
+    root.setLevel(level)
+    if trace:
+        protocol_trace.enable()
+    else:
+        logging.getLogger("motorbus.trace").setLevel(logging.WARNING)
+
+
 def build_parser() -> argparse.ArgumentParser:
+    from .cli_bench import exit_codes_text
+
     p = argparse.ArgumentParser(prog="motorbus", description="Drive integrated motor controllers over CAN, "
-                                "CANopen and serial lines; serve buses and simulated drives.")
+                                "CANopen and serial lines; serve buses and simulated drives.",
+                                epilog=exit_codes_text(), formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"motorbus {_version()}")
+    _log_options(p, 0)
+    # The same options after a command; SUPPRESS keeps the top-level value when not given there.
+    common = argparse.ArgumentParser(add_help=False)
+    _log_options(common, argparse.SUPPRESS)
     sub = p.add_subparsers(dest="command", required=True)
 
     bus = sub.add_parser("bus", help="serve, dump or replay a CAN bus").add_subparsers(dest="bus_cmd", required=True)
@@ -288,12 +341,12 @@ def build_parser() -> argparse.ArgumentParser:
     ss.add_argument("--channel", default="can0", help="channel name announced to socketcand clients")
     ss.set_defaults(func=cmd_sim_serve)
 
-    dl = sub.add_parser("drives", help="list the registered drive kinds")
+    dl = sub.add_parser("drives", help="list the registered drive kinds", parents=[common])
     dl.set_defaults(func=cmd_drives)
 
     from . import cli_bench, cli_monitor
-    cli_bench.add_commands(sub)
-    cli_monitor.add_commands(sub)
+    cli_bench.add_commands(sub, common)
+    cli_monitor.add_commands(sub, common)
 
     dm = sub.add_parser("demo", help="run the simulated bench demo")
     dm.add_argument("--quick", action="store_true", help="shorter moves (used by the tests)")
@@ -307,12 +360,20 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
+    from .cli_bench import EXIT_INTERRUPTED, error_text, exit_code
+
     args = build_parser().parse_args(argv)
+    setup_logging(getattr(args, "verbose", 0) or 0, bool(getattr(args, "trace", False)))
     try:
         return int(args.func(args) or 0)
     except _core.MotorbusError as e:
-        print(f"motorbus: {e}", file=sys.stderr)
-        return 2
+        # The exit code says what kind of failure (cli_bench.EXIT_CODES): a port held by
+        # another process is not a mistake in the command line.
+        print(error_text(e), file=sys.stderr)
+        return exit_code(e)
+    except KeyboardInterrupt:
+        print("motorbus: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

@@ -1,30 +1,109 @@
-"""``motorbus status|move|home|stop|config`` — work a bench described in a TOML file.
+"""``motorbus status|move|home|stop|enable|disable|clear|config|scan|terminal`` — work a bench
+described in a TOML file.
 
-    motorbus status BENCH [--sim]
-    motorbus move BENCH AXIS POSITION [--by] [--velocity V] [--timeout S] [--sim]
-    motorbus home BENCH AXIS [--method M] [--timeout S] [--sim]
+    motorbus status BENCH [--json] [--sim]
+    motorbus move BENCH AXIS POSITION [--by] [--velocity V] [--timeout S] [--json] [--sim]
+    motorbus home BENCH AXIS [--method M] [--timeout S] [--json] [--sim]
     motorbus stop BENCH [AXIS...] [--quick] [--sim]
-    motorbus config read|diff|apply|store BENCH [--axis NAME]... [--all] [--sim]
-    motorbus scan [--serial PORT]... [--can SPEC]... [--kind KIND]... [--write BENCH] [--timeout S]
+    motorbus enable|disable|clear BENCH AXIS [--sim]
+    motorbus config read|diff|apply|store BENCH [--axis NAME]... [--all] [--json] [--sim]
+    motorbus scan [--serial PORT]... [--can SPEC]... [--kind KIND]... [--write BENCH] [--timeout S] [--json]
     motorbus terminal BENCH AXIS [--sim]     (the drive's own protocol, line by line, with history)
 
-Exit codes: 0 done; 1 a drive refused or failed (the message says which axis
-and why); 2 the command line or the bench file is wrong (``file:line: key:
-...``); 3 ``config diff`` found differences; 130 interrupted (Ctrl-C during a
-move or homing stops that axis first).  ``--sim`` runs the command against the
-bench's simulated twin (every axis replaced by its simulator).
+The exit codes are one table, :data:`EXIT_CODES` (``motorbus --help`` prints it).
+``status``, ``config read`` and ``config diff`` only read: they send nothing that
+changes a drive and stop nothing when they leave (another program may be moving the
+bench).  A command naming axes opens only the lines and buses those axes are on.
+``--sim`` runs the command against the bench's simulated twin: a fresh one per
+command (every axis replaced by its simulator, at its power-on state).
 """
 from __future__ import annotations
 
 import argparse
+import json
+import logging
+import math
 import os
 import sys
+import time
 from typing import Any, Callable, Optional, Sequence
 
 from . import _core
 from .bench import Bench, BenchFileError
+from .drive import MoveFailed
 
-EXIT_OK, EXIT_DRIVE, EXIT_USAGE, EXIT_DIFFERENT, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+log = logging.getLogger(__name__)
+
+# ---- exit codes: one table, printed by `motorbus --help` and docs/bench-files.md -----------------
+EXIT_OK = 0
+EXIT_DRIVE = 1          # a drive refused a command or failed (not a move outcome below)
+EXIT_USAGE = 2          # the command line or the bench file is wrong
+EXIT_DIFFERENT = 3      # config diff: the drives differ from the file
+EXIT_BUSY = 4           # a serial port is held by another process
+EXIT_LINK = 5           # a line or bus cannot be reached, or a drive does not answer
+EXIT_MOVE_INTERRUPTED = 10   # a move stopped short: a stop from another program or a stop input
+EXIT_MOVE_LIMIT = 11         # a move stopped at a hard or soft limit
+EXIT_MOVE_FAULT = 12         # the drive faulted during the move
+EXIT_MOVE_STALL = 13         # stall or following error
+EXIT_MOVE_TIMEOUT = 14       # not at rest within --timeout (the axis was stopped)
+EXIT_MOVE_FAILED = 15        # a move failed another way
+EXIT_INTERRUPTED = 130       # Ctrl-C (a move or homing is stopped first)
+
+EXIT_CODES: tuple[tuple[int, str], ...] = (
+    (EXIT_OK, "done (a move or homing ended where it was sent)"),
+    (EXIT_DRIVE, "a drive refused a command or failed (the message says which axis and why)"),
+    (EXIT_USAGE, "the command line or the bench file is wrong (file:line: key, or the argument)"),
+    (EXIT_DIFFERENT, "config diff found differences"),
+    (EXIT_BUSY, "busy: a serial port is held by another process (the message names it)"),
+    (EXIT_LINK, "a line or bus cannot be reached, or a drive did not answer"),
+    (EXIT_MOVE_INTERRUPTED, "move/home stopped short by a stop from another program or a drive stop input"),
+    (EXIT_MOVE_LIMIT, "move/home stopped by a limit switch or soft limit"),
+    (EXIT_MOVE_FAULT, "move/home ended by a drive fault (its code and text)"),
+    (EXIT_MOVE_STALL, "move/home ended by a stall or following error"),
+    (EXIT_MOVE_TIMEOUT, "move/home not finished within --timeout (the axis is stopped)"),
+    (EXIT_MOVE_FAILED, "move/home failed another way"),
+    (EXIT_INTERRUPTED, "Ctrl-C (a move or homing is stopped, and waited for, first)"),
+)
+
+#: MoveFailed.outcome -> exit code.
+OUTCOME_EXIT = {"interrupted": EXIT_MOVE_INTERRUPTED, "limit": EXIT_MOVE_LIMIT, "fault": EXIT_MOVE_FAULT,
+                "stall": EXIT_MOVE_STALL, "timeout": EXIT_MOVE_TIMEOUT, "failed": EXIT_MOVE_FAILED}
+
+
+def exit_codes_text() -> str:
+    """The exit-code table as ``motorbus --help`` prints it."""
+    return "exit codes:\n" + "\n".join(f"  {code:<4d} {meaning}" for code, meaning in EXIT_CODES)
+
+
+#: The largest position or speed, in native units, a command line may ask for: every
+#: kind's position and speed registers are 32-bit (CiA 402 0x607A/0x6081, Arcus, DMAC,
+#: PMC007, UNITEK), so a larger value cannot be what was meant.
+NATIVE_MAX = 2 ** 31 - 1
+
+
+def is_busy(e: BaseException) -> bool:
+    """A port held by another process (the C++ PortBusy, raised as a LinkDown)."""
+    return isinstance(e, _core.LinkDown) and " is busy: " in str(e)
+
+
+def exit_code(e: BaseException) -> int:
+    """The exit code for an error that ended a command (see EXIT_CODES)."""
+    if isinstance(e, MoveFailed):
+        return OUTCOME_EXIT.get(e.outcome, EXIT_MOVE_FAILED)
+    if isinstance(e, _core.InvalidArgument):       # BenchFileError too
+        return EXIT_USAGE
+    if is_busy(e):
+        return EXIT_BUSY
+    if isinstance(e, (_core.LinkDown, _core.TimeoutError)):
+        return EXIT_LINK
+    return EXIT_DRIVE
+
+
+def error_text(e: BaseException) -> str:
+    """One line for stderr: the error in its own words (the class name where it adds to them)."""
+    if isinstance(e, (MoveFailed, _core.InvalidArgument)) or is_busy(e):
+        return f"motorbus: {e}"
+    return f"motorbus: {type(e).__name__}: {e}"
 
 
 def table(rows: Sequence[Sequence[Any]], header: Sequence[str]) -> str:
@@ -40,112 +119,364 @@ def _say(text: str) -> None:
     print(text, flush=True)
 
 
-def _with_bench(args: argparse.Namespace, work: Callable[[Bench], int]) -> int:
-    """Opens the bench, runs `work`, maps errors to exit codes; every axis is
-    stopped on the way out (the Bench's `with`)."""
+def _err(text: str) -> None:
+    print(text, file=sys.stderr, flush=True)
+
+
+def _json(obj: Any) -> None:
+    print(json.dumps(obj, indent=2, default=_json_default), flush=True)
+
+
+def _json_default(v: Any) -> Any:
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if isinstance(v, (bytes, bytearray)):
+        return v.hex()
+    if isinstance(v, (tuple, list)):
+        return list(v)
+    return str(v)
+
+
+def _num(v: Any) -> Any:
+    """JSON has no inf/nan: None instead."""
+    return None if isinstance(v, float) and not math.isfinite(v) else v
+
+
+# ---- opening a bench ------------------------------------------------------------------------------
+class NotOpened:
+    """An axis ``load_bench`` was told not to open (``open_axis`` said no): its place in
+    the bench, with what the file says of it (``config``), and no Drive."""
+
+    closed = True
+
+    def __init__(self, config: Any) -> None:
+        self.config, self.kind, self.name = config, config.kind, config.name
+
+    def close(self) -> None:
+        pass
+
+
+def load_bench(path: str, *, sim: bool, axes: Optional[Sequence[str]] = None,
+               open_axis: Optional[Callable[[Any], bool]] = None) -> Bench:
+    """Opens the bench file; with ``axes``, only those axes and the lines and buses they
+    are on (``stop BENCH z`` must not open, or need, the serial line of another axis).
+    An axis name the file does not have is an InvalidArgument listing its axes.  With
+    the protocol trace on (``--trace``), the bench's transports are traced from before
+    its axes are opened.  ``open_axis(AxisConfig)`` False: that axis's links are opened
+    but not the axis itself (``NotOpened`` in its place: nothing is sent to it)."""
+    from . import trace
+
+    wanted = list(dict.fromkeys(axes)) if axes else None
+    tracer = trace.Tracer() if trace.enabled() else None
+
+    class CliBench(Bench):
+        # Bench.load reads and checks the file, then builds cls(data, ...): the data is
+        # narrowed here, before anything is opened (the text keeps its line numbers).
+        def __init__(self, data: Any, **kw: Any) -> None:
+            super().__init__(data if wanted is None else _only_axes(data, wanted, path), **kw)
+
+        def _open_links(self) -> None:
+            shared: set = set()
+            if tracer is not None:
+                for name, cfg in self._bus_cfg.items():
+                    if tracer.watch_spec(name, cfg["spec"]):
+                        shared.add(name)
+            super()._open_links()
+            if tracer is not None:
+                for name, bus in self.buses.items():
+                    if name not in shared:
+                        tracer.watch_bus(name, bus)
+                for name, link in self.lines.items():
+                    tracer.watch_line(name, link)
+
+        def _open_axis(self, cfg: Any) -> Any:
+            if open_axis is not None and not open_axis(cfg):
+                return NotOpened(cfg)
+            return super()._open_axis(cfg)
+
+        def close(self) -> None:
+            try:
+                super().close()
+            finally:
+                if tracer is not None:
+                    tracer.close()
+
+    if wanted is None and tracer is None and open_axis is None:
+        return Bench.load(path, sim=sim)
+    return CliBench.load(path, sim=sim)
+
+
+def _only_axes(data: Any, wanted: Sequence[str], source: str) -> Any:
+    if not isinstance(data, dict) or not isinstance(data.get("axis"), dict):
+        return data                      # malformed: the checker says how
+    table_ = data["axis"]
+    missing = [n for n in wanted if n not in table_]
+    if missing:
+        raise _core.InvalidArgument(f"bench {source}: no axis {missing[0]!r} (axes: {', '.join(table_)})")
+    kept = {n: table_[n] for n in wanted}
+    out = dict(data)
+    out["axis"] = kept
+    for section, key in (("bus", "bus"), ("line", "line")):
+        links = data.get(section)
+        if isinstance(links, dict):
+            used = {t.get(key) for t in kept.values() if isinstance(t, dict)}
+            out[section] = {name: t for name, t in links.items() if name in used}
+            if not out[section]:
+                del out[section]
+    return out
+
+
+def _run(args: argparse.Namespace, work: Callable[[Bench], int], *, axes: Optional[Sequence[str]] = None,
+         stop_on_exit: bool = True) -> int:
+    """Opens the bench (only ``axes`` when given), runs ``work``, maps errors to exit
+    codes.  ``stop_on_exit``: every opened axis is stopped on the way out, as the Bench's
+    ``with`` does; a command that only reads passes False and just closes (it must not
+    stop what another program is moving)."""
     try:
-        bench = Bench.load(args.bench, sim=args.sim)
-    except BenchFileError as e:
-        print(f"motorbus: {e}", file=sys.stderr)
-        return EXIT_USAGE
-    with bench:
+        bench = load_bench(args.bench, sim=args.sim, axes=axes)
+    except _core.MotorbusError as e:
+        _err(error_text(e))
+        return exit_code(e)
+    try:
         try:
             return work(bench)
-        except BenchFileError as e:
-            print(f"motorbus: {e}", file=sys.stderr)
-            return EXIT_USAGE
-        except _core.InvalidArgument as e:
-            print(f"motorbus: {e}", file=sys.stderr)
-            return EXIT_USAGE
         except _core.MotorbusError as e:
-            print(f"motorbus: {type(e).__name__}: {e}", file=sys.stderr)
-            return EXIT_DRIVE
+            _err(error_text(e))
+            return exit_code(e)
+        finally:
+            if stop_on_exit:
+                for name, e in bench.stop_all():
+                    _err(f"motorbus: {name}: could not stop: {type(e).__name__}: {e}")
+    finally:
+        bench.close()
 
 
-def _fmt(v: float) -> str:
-    return f"{v:.6g}"
+def _fmt(v: Any) -> str:
+    return f"{v:.6g}" if isinstance(v, (int, float)) else str(v)
+
+
+# ---- argument types: a typed error naming the argument, exit 2 ---------------------------------------
+def finite_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a number, not {text!r}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"a finite number, not {text!r}")
+    if abs(v) > 1e15:
+        # No bench moves that far in any unit; such a number is a typo.
+        raise argparse.ArgumentTypeError(f"{text} is beyond any drive's range")
+    return v
+
+
+def positive_float(text: str) -> float:
+    v = finite_float(text)
+    if v <= 0:
+        raise argparse.ArgumentTypeError(f"a number above 0, not {text}")
+    return v
+
+
+def seconds(text: str) -> float:
+    v = finite_float(text)
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"seconds >= 0, not {text}")
+    return v
+
+
+def homing_method(text: str) -> Any:
+    """A CiA 402 method number (an INTEGER8 in 0x6098) or the kind's method name."""
+    t = text.strip()
+    if t.lstrip("+-").isdigit():
+        if len(t) > 5 or not -128 <= int(t) <= 127:
+            raise argparse.ArgumentTypeError(f"a homing method number is -128..127 (CiA 402 0x6098, an "
+                                             f"INTEGER8), not {t}")
+        return int(t)
+    if not t:
+        raise argparse.ArgumentTypeError("a method number or name, not an empty string")
+    return t
+
+
+def _check_native(d: Any, name: str, value: float) -> None:
+    """Refuses, before anything is sent, a value the drive's 32-bit registers cannot hold."""
+    native = abs(d.units.to_native(value))
+    if not math.isfinite(native) or native > NATIVE_MAX:
+        raise _core.InvalidArgument(f"argument {name}: {value:g} {d.units.name} is {native:.3g} native units, "
+                                    f"beyond the drive's range (±{NATIVE_MAX})")
+
+
+# ---- the commands -----------------------------------------------------------------------------------
+def _flags(st: Any) -> list[str]:
+    return [w for w, on in (("enabled", st.enabled), ("moving", st.moving), ("homed", st.homed),
+                            ("FAULT", st.fault), ("+limit", st.limit_positive),
+                            ("-limit", st.limit_negative)) if on]
+
+
+def _outcome_json(last: Any) -> Any:
+    if last is None:
+        return None
+    e = last.error
+    return {"what": last.what, "target": _num(last.target), "position": _num(last.position), "outcome": last.state,
+            "reason": last.reason, "code": getattr(e, "code", None)}
 
 
 def cmd_status(args: argparse.Namespace) -> int:
     def work(bench: Bench) -> int:
-        rows = []
+        rows, out = [], {}
         for name, d in bench.axes.items():
             st = d.status
-            flags = [w for w, on in (("enabled", st.enabled), ("moving", st.moving), ("homed", st.homed),
-                                     ("FAULT", st.fault), ("+limit", st.limit_positive),
-                                     ("-limit", st.limit_negative)) if on]
-            rows.append((name, d.kind, _fmt(d.position), d.units.name, " ".join(flags) or "-", st.text))
-        _say(table(rows, ("axis", "kind", "position", "units", "state", "drive says")))
+            pos = d.position
+            rows.append((name, d.kind, _fmt(pos), d.units.name, " ".join(_flags(st)) or "-", st.text))
+            out[name] = {"kind": d.kind, "position": _num(pos), "units": d.units.name, "enabled": st.enabled,
+                         "moving": st.moving, "homed": st.homed, "fault": st.fault, "at_target": st.at_target,
+                         "limit_positive": st.limit_positive, "limit_negative": st.limit_negative,
+                         "text": st.text, "last_move": _outcome_json(st.last_move)}
+        if args.json:
+            _json({"bench": bench.source, "simulated": bench.simulated, "axes": out})
+        else:
+            _say(table(rows, ("axis", "kind", "position", "units", "state", "drive says")))
         return EXIT_OK
-    return _with_bench(args, work)
+    # Reads only: nothing is stopped on the way out (another program may be moving the bench).
+    return _run(args, work, stop_on_exit=False)
 
 
-def _interruptible(drive: Any, action: Callable[[], None]) -> int:
-    """Runs a move/homing; Ctrl-C stops the axis (decelerating) and exits 130."""
+def _stop_and_settle(d: Any, limit: float = 5.0) -> Optional[MoveFailed]:
+    """Ctrl-C: stops the axis and waits (up to ``limit`` s) until it is at rest, so the
+    position said afterwards is where it stopped, not where it was braking.  Returns the
+    move's outcome error (None if it had ended anyway)."""
     try:
-        action()
+        d.stop()
+    except _core.MotorbusError as e:
+        log.warning("%s: stop after Ctrl-C failed: %s", d.name, e)
+        return None
+    try:
+        d.wait_idle(timeout=limit)
+    except MoveFailed as e:
+        return e
+    except _core.MotorbusError as e:
+        log.warning("%s: waiting for rest after Ctrl-C: %s", d.name, e)
+    return None
+
+
+def _motion(args: argparse.Namespace, bench: Bench, what: str, action: Callable[[Any], None],
+            target: Optional[float]) -> int:
+    """Runs a move or homing on ``args.axis`` and reports how it ended: the position on
+    stdout (or the JSON result), why it ended short on stderr, the outcome's exit code."""
+    d = bench[args.axis]
+    error: Optional[MoveFailed] = None
+    interrupted = False
+    try:
+        if not d.status.enabled:
+            d.enable()
+        action(d)
+    except MoveFailed as e:
+        error = e
     except KeyboardInterrupt:
-        drive.stop()
-        print("motorbus: interrupted: axis stopped", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    return EXIT_OK
+        interrupted = True
+        try:
+            error = _stop_and_settle(d)
+        except KeyboardInterrupt:      # a second Ctrl-C: the fastest stop, no more waiting
+            d.quick_stop()
+    if isinstance(error, MoveFailed) and error.outcome == "timeout":
+        d.stop()                          # do not leave it running past the time it was given
+    position = d.position
+    if interrupted:
+        rest = "at rest" if not d.status.moving else "still braking"
+        goal = f", target {_fmt(target)} {d.units.name}" if target is not None else ""
+        _err(f"{args.axis}: interrupted: axis stopped at {_fmt(position)} {d.units.name} by Ctrl-C ({rest}){goal}")
+        code = EXIT_INTERRUPTED
+    elif error is not None:
+        _err(error_text(error))
+        code = exit_code(error)
+    else:
+        code = EXIT_OK
+    if args.json:
+        _json({"axis": args.axis, "kind": d.kind, "what": what, "target": _num(target), "position": _num(position),
+               "units": d.units.name,
+               "outcome": "ctrl-c" if interrupted else (error.outcome if error else "done"),
+               "reason": "Ctrl-C" if interrupted else (error.reason if error else ""),
+               "code": getattr(error, "code", None), "exit_code": code})
+    elif what == "home" and code == EXIT_OK:
+        _say(f"{args.axis}: homed at {_fmt(position)} {d.units.name}")
+    else:
+        _say(f"{args.axis}: {_fmt(position)} {d.units.name}")
+    return code
 
 
 def cmd_move(args: argparse.Namespace) -> int:
     def work(bench: Bench) -> int:
         d = bench[args.axis]
-        if not d.status.enabled:
-            d.enable()
-        move = d.move_by if args.by else d.move_to
+        _check_native(d, "POSITION", args.position)
+        if args.velocity is not None:
+            _check_native(d, "--velocity", args.velocity)
+        target = args.position
+        if args.by:
+            target = d.position + args.position
         # On stderr, so stdout stays the one result line scripts read.
-        print(f"{args.axis}: moving {'by' if args.by else 'to'} {_fmt(args.position)} {d.units.name} "
-              "(Ctrl-C stops the axis)", file=sys.stderr, flush=True)
-        rc = _interruptible(d, lambda: move(args.position, velocity=args.velocity, timeout=args.timeout))
-        _say(f"{args.axis}: {_fmt(d.position)} {d.units.name}")
-        return rc
-    return _with_bench(args, work)
+        _err(f"{args.axis}: moving {'by' if args.by else 'to'} {_fmt(args.position)} {d.units.name} "
+             "(Ctrl-C stops the axis)")
+        move = d.move_by if args.by else d.move_to
+        return _motion(args, bench, "move",
+                       lambda d: move(args.position, velocity=args.velocity, timeout=args.timeout), target)
+    return _run(args, work, axes=[args.axis])
 
 
 def cmd_home(args: argparse.Namespace) -> int:
     def work(bench: Bench) -> int:
-        d = bench[args.axis]
-        if not d.status.enabled:
-            d.enable()
-        method: Any = args.method
-        if method is not None and method.lstrip("-").isdigit():
-            method = int(method)  # CiA 402 methods are numbers
-        rc = _interruptible(d, lambda: d.home(method, timeout=args.timeout))
-        _say(f"{args.axis}: homed at {_fmt(d.position)} {d.units.name}")
-        return rc
-    return _with_bench(args, work)
+        return _motion(args, bench, "home", lambda d: d.home(args.method, timeout=args.timeout), None)
+    return _run(args, work, axes=[args.axis])
 
 
 def cmd_stop(args: argparse.Namespace) -> int:
     def work(bench: Bench) -> int:
         how = "quick_stop" if args.quick else "stop"
         failed = []
-        for name, d in bench.select(args.axes).items():
+        for name, d in bench.axes.items():
             try:
                 getattr(d, how)()
                 _say(f"{name}: stopped")
             except _core.MotorbusError as e:
-                failed.append(name)
-                print(f"motorbus: {name}: {type(e).__name__}: {e}", file=sys.stderr)
-        return EXIT_DRIVE if failed else EXIT_OK
-    return _with_bench(args, work)
+                failed.append(exit_code(e))
+                _err(f"motorbus: {name}: {type(e).__name__}: {e}")
+        return max(failed) if failed else EXIT_OK
+    # Only the named axes' lines and buses are opened; the stop itself is the command.
+    return _run(args, work, axes=args.axes or None, stop_on_exit=False)
+
+
+def _one_axis_command(verb: str, say: str) -> Callable[[argparse.Namespace], int]:
+    def cmd(args: argparse.Namespace) -> int:
+        def work(bench: Bench) -> int:
+            d = bench[args.axis]
+            getattr(d, verb)()
+            st = d.status
+            _say(f"{args.axis}: {say}; {' '.join(_flags(st)) or '-'}; {st.text}")
+            return EXIT_OK
+        # enable/disable/clear leave the axis as they made it: nothing stopped on the way out.
+        return _run(args, work, axes=[args.axis], stop_on_exit=False)
+    return cmd
+
+
+cmd_enable = _one_axis_command("enable", "enabled")
+cmd_disable = _one_axis_command("disable", "disabled")
+cmd_clear = _one_axis_command("clear_faults", "faults cleared")
 
 
 def cmd_config(args: argparse.Namespace) -> int:
     def work(bench: Bench) -> int:
         axes = args.axis or None
         if args.action == "read":
-            rows = [(axis, p, v) for axis, params in bench.read_params(axes, all_params=args.all).items()
-                    for p, v in params.items()]
-            _say(table(rows, ("axis", "parameter", "drive value")))
+            params = bench.read_params(axes, all_params=args.all)
+            if args.json:
+                _json(params)
+            else:
+                _say(table([(axis, p, v) for axis, ps in params.items() for p, v in ps.items()],
+                           ("axis", "parameter", "drive value")))
             return EXIT_OK
         if args.action == "diff":
             diffs = bench.diff(axes)
-            if diffs:
+            if args.json:
+                _json([{"axis": c.axis, "parameter": c.name, "file": c.file_value, "drive": c.drive_value}
+                       for c in diffs])
+            elif diffs:
                 _say(table([(c.axis, c.name, c.file_value, c.drive_value) for c in diffs],
                            ("axis", "parameter", "file", "drive")))
             else:
@@ -153,36 +484,90 @@ def cmd_config(args: argparse.Namespace) -> int:
             return EXIT_DIFFERENT if diffs else EXIT_OK
         if args.action == "apply":
             changed = bench.apply(axes)
-            for c in changed:
-                _say(f"{c.axis}.{c.name}: {c.drive_value} -> {c.file_value}")
-            _say(f"{len(changed)} parameter(s) written")
+            if args.json:
+                _json([{"axis": c.axis, "parameter": c.name, "was": c.drive_value, "now": c.file_value}
+                       for c in changed])
+            else:
+                for c in changed:
+                    _say(f"{c.axis}.{c.name}: {c.drive_value} -> {c.file_value}")
+                _say(f"{len(changed)} parameter(s) written")
             return EXIT_OK
         bench.store(axes)
-        _say(f"stored on {', '.join(bench.select(axes))}")
+        if args.json:
+            _json({"stored": list(bench.select(axes))})
+        else:
+            _say(f"stored on {', '.join(bench.select(axes))}")
         return EXIT_OK
-    return _with_bench(args, work)
+    # read and diff only read: nothing is stopped on the way out.  apply and store write
+    # parameters; the axes are stopped on the way out as after any changing command.
+    return _run(args, work, axes=args.axis or None, stop_on_exit=args.action in ("apply", "store"))
+
+
+#: Identity fields that are codes, shown in hex as the manuals print them.
+_HEX_IDENTITY = {"device_type", "vendor_id", "product_code", "revision", "serial"}
+
+
+def _identity_text(identity: dict) -> str:
+    return ", ".join(f"{k}=0x{v:08X}" if k in _HEX_IDENTITY and isinstance(v, int) and not isinstance(v, bool)
+                     else f"{k}={v}" for k, v in identity.items())
+
+
+def _check_writable(path: str) -> Optional[str]:
+    """Why ``path`` cannot be written (None: it can), checked before a long scan."""
+    full = os.path.abspath(path)
+    parent = os.path.dirname(full) or "."
+    if os.path.isdir(full):
+        return f"{path} is a directory"
+    if not os.path.isdir(parent):
+        return f"no directory {parent}"
+    if os.path.exists(full):
+        if not os.path.isfile(full):
+            return f"{path} is not a regular file"
+        if not os.access(full, os.W_OK):
+            return f"{path} is not writable"
+    elif not os.access(parent, os.W_OK | os.X_OK):
+        return f"cannot create files in {parent}"
+    return None
 
 
 def cmd_scan(args: argparse.Namespace) -> int:
+    from . import trace
     from .discovery import discover
 
     if not args.serial and not args.can:
-        print("motorbus scan: give --serial PORT and/or --can SPEC", file=sys.stderr)
+        _err("motorbus scan: give --serial PORT and/or --can SPEC")
         return EXIT_USAGE
+    if args.write:
+        why = _check_writable(args.write)
+        if why is not None:
+            _err(f"motorbus scan: argument --write: {why}")
+            return EXIT_USAGE
+    if trace.enabled():
+        log.info("scan: the protocol trace covers the opened benches, not the scan's probes")
     try:
         result = discover(args.serial or (), args.can or (), kinds=args.kind, timeout=args.timeout,
-                          reply_timeout=args.reply_timeout, progress=not args.quiet)
-    except _core.InvalidArgument as e:
-        print(f"motorbus: {e}", file=sys.stderr)
-        return EXIT_USAGE
-    rows = [(f.kind, f.address, f.line or f.bus, f.baud or "", ", ".join(f"{k}={v}" for k, v in f.identity.items()))
-            for f in result.found]
-    _say(table(rows, ("kind", "address", "where", "baud", "identity")) if rows else "no drive answered")
+                          reply_timeout=args.reply_timeout, progress=not args.quiet and not args.json)
+    except _core.MotorbusError as e:
+        _err(error_text(e))
+        return exit_code(e)
+    if args.json:
+        _json({"found": [{"kind": f.kind, "address": f.address, "line": f.line, "bus": f.bus, "baud": f.baud,
+                          "identity": f.identity} for f in result.found],
+               "skipped": [str(s) for s in result.skipped], "wrote": args.write})
+    else:
+        rows = [(f.kind, f.address, f.line or f.bus, f.baud or "", _identity_text(f.identity))
+                for f in result.found]
+        _say(table(rows, ("kind", "address", "where", "baud", "identity")) if rows else "no drive answered")
     for s in result.skipped:
-        print(f"motorbus: not probed (time budget or port): {s}", file=sys.stderr)
+        _err(f"motorbus: not probed (time budget or port): {s}")
     if args.write:
-        result.write(args.write)
-        _say(f"wrote {args.write}")
+        try:
+            result.write(args.write)
+        except OSError as e:
+            _err(f"motorbus scan: argument --write: {args.write}: {e.strerror}")
+            return EXIT_USAGE
+        if not args.json:
+            _say(f"wrote {args.write}")
     return EXIT_OK
 
 
@@ -192,6 +577,7 @@ def cmd_terminal(args: argparse.Namespace) -> int:
     console goes on.  `quit`, `exit` or end of input leave (the axis is stopped)."""
     interactive = sys.stdin.isatty()
     history = os.path.expanduser("~/.motorbus_history")
+    readline: Any = None
     if interactive:
         try:
             import readline
@@ -200,7 +586,7 @@ def cmd_terminal(args: argparse.Namespace) -> int:
             except OSError:
                 pass
         except ImportError:  # pragma: no cover - readline is in every CPython on Linux
-            readline = None  # type: ignore[assignment]
+            readline = None
 
     def work(bench: Bench) -> int:
         d = bench[args.axis]
@@ -228,53 +614,75 @@ def cmd_terminal(args: argparse.Namespace) -> int:
             except OSError:
                 pass
         return EXIT_OK
-    return _with_bench(args, work)
+    return _run(args, work, axes=[args.axis])
 
 
-def add_commands(sub: Any) -> None:
-    """Adds the bench commands to the top-level parser's subparsers."""
+def add_commands(sub: Any, common: Any = None) -> None:
+    """Adds the bench commands to the top-level parser's subparsers (``common``: a parent
+    parser with the options every command takes, -v/--trace)."""
+    parents = [common] if common is not None else []
+
     def bench_parser(name: str, help: str) -> argparse.ArgumentParser:
-        p = sub.add_parser(name, help=help)
+        p = sub.add_parser(name, help=help, parents=parents)
         p.add_argument("bench", metavar="BENCH", help="the bench file (TOML)")
-        p.add_argument("--sim", action="store_true", help="run against the bench's simulated twin")
+        p.add_argument("--sim", action="store_true",
+                       help="run against the bench's simulated twin (a fresh twin for this command only)")
         return p
 
-    p = bench_parser("status", "a table of every axis: position, state, what the drive says")
+    def with_json(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
+
+    p = bench_parser("status", "a table of every axis: position, state, what the drive says (reads only)")
+    with_json(p)
     p.set_defaults(func=cmd_status)
     p = bench_parser("move", "move an axis (in the bench's units); Ctrl-C stops it")
-    p.add_argument("axis")
-    p.add_argument("position", type=float)
+    p.add_argument("axis", metavar="AXIS")
+    p.add_argument("position", metavar="POSITION", type=finite_float)
     p.add_argument("--by", action="store_true", help="relative move")
-    p.add_argument("--velocity", type=float, default=None, help="speed for this move (user units/s)")
-    p.add_argument("--timeout", type=float, default=None, help="seconds to wait for the end of the move")
+    p.add_argument("--velocity", type=positive_float, default=None,
+                   help="speed for this move only (user units/s); the drive's own setting is put back")
+    p.add_argument("--timeout", type=seconds, default=None, help="seconds to wait for the end of the move")
+    with_json(p)
     p.set_defaults(func=cmd_move)
     p = bench_parser("home", "home an axis; Ctrl-C stops it")
-    p.add_argument("axis")
-    p.add_argument("--method", default=None, help="the drive's own homing method (default: the kind's)")
-    p.add_argument("--timeout", type=float, default=None)
+    p.add_argument("axis", metavar="AXIS")
+    p.add_argument("--method", type=homing_method, default=None,
+                   help="the drive's own homing method: a CiA 402 number or the kind's name (default: the kind's)")
+    p.add_argument("--timeout", type=seconds, default=None)
+    with_json(p)
     p.set_defaults(func=cmd_home)
-    p = bench_parser("stop", "stop axes (all when none is named)")
+    p = bench_parser("stop", "stop axes (all when none is named; opens only the named axes' links)")
     p.add_argument("axes", nargs="*", metavar="AXIS")
     p.add_argument("--quick", action="store_true", help="the fastest stop the drive has")
     p.set_defaults(func=cmd_stop)
-    p = sub.add_parser("scan", help="find the drives on serial lines and CAN buses (reads only)")
+    for verb, func, text in (("enable", cmd_enable, "power an axis (it holds position)"),
+                             ("disable", cmd_disable, "power stage off: the axis no longer holds position"),
+                             ("clear", cmd_clear, "clear an axis's latched faults (limit errors, drive faults)")):
+        p = bench_parser(verb, text)
+        p.add_argument("axis", metavar="AXIS")
+        p.set_defaults(func=func)
+    p = sub.add_parser("scan", help="find the drives on serial lines and CAN buses (reads only)", parents=parents)
     p.add_argument("--serial", action="append", metavar="PORT", help="a serial port to sweep; repeatable")
     p.add_argument("--can", action="append", metavar="SPEC", help="an open_bus spec to scan; repeatable")
     p.add_argument("--kind", action="append", help="only these kinds (default: every registered kind)")
-    p.add_argument("--write", metavar="BENCH", help="write a bench file for what was found")
-    p.add_argument("--timeout", type=float, default=300.0, help="time budget for the whole scan (s)")
-    p.add_argument("--reply-timeout", type=float, default=0.05, help="wait per serial address (s)")
+    p.add_argument("--write", metavar="BENCH", help="write a bench file for what was found (checked before the scan)")
+    p.add_argument("--timeout", type=positive_float, default=300.0, help="time budget for the whole scan (s)")
+    p.add_argument("--reply-timeout", type=positive_float, default=0.05, help="wait per serial address (s)")
     p.add_argument("--quiet", action="store_true", help="no progress output")
+    with_json(p)
     p.set_defaults(func=cmd_scan)
     p = bench_parser("terminal", "an interactive console in the axis's own protocol, with history")
-    p.add_argument("axis")
+    p.add_argument("axis", metavar="AXIS")
     p.set_defaults(func=cmd_terminal)
-    p = sub.add_parser("config", help="read, compare, apply or store the bench file's drive parameters")
+    p = sub.add_parser("config", help="read, compare, apply or store the bench file's drive parameters",
+                       parents=parents)
     p.add_argument("action", choices=("read", "diff", "apply", "store"))
     p.add_argument("bench", metavar="BENCH")
     p.add_argument("--axis", action="append", help="only this axis (repeatable)")
     p.add_argument("--all", action="store_true", help="read: every parameter the drive has, not just the file's")
-    p.add_argument("--sim", action="store_true", help="run against the bench's simulated twin")
+    p.add_argument("--sim", action="store_true",
+                   help="run against the bench's simulated twin (a fresh twin for this command only)")
+    with_json(p)
     p.set_defaults(func=cmd_config)
 
 

@@ -1,11 +1,22 @@
-"""``motorbus monitor BENCH [--rate HZ] [--axis NAME]... [--sim]`` — watch a bench live.
+"""``motorbus monitor BENCH [--rate HZ] [--axis NAME]... [--ask] [--sim]`` — watch a bench live.
 
 A table (one row per axis: position, velocity, state, what the drive says) redrawn
-``--rate`` times a second (default 10) with rich.  The monitor only reads, through
-the Drive API: it never commands motion and stops nothing, neither while it runs
-nor when it leaves (its drives are closed, not stopped), so it can watch a bench
-another program is moving (a bench file pointing at the same CAN bus; a serial
-line has room for one program).  ``q`` or Ctrl-C quits with exit code 0.
+``--rate`` times a second (default 10) with rich.  The monitor never commands motion
+and stops nothing, neither while it runs nor when it leaves.  ``q`` or Ctrl-C quits
+with exit code 0.  ``--axis`` opens only the lines and buses of the axes named.
+
+What it does to the drives, by transport (docs/monitor.md says the same):
+
+* a **serial** axis is asked (its position, speed and status, through the Drive API):
+  a serial port is opened by one program at a time, so no other program can be
+  talking to it — if one is, the monitor exits with the "busy" code (4);
+* a **CAN** axis is, by default, only **listened to**: the monitor sends nothing to it
+  and shows what the node sends by itself (heartbeat state, EMCY codes, PDOs or
+  cyclic frames another program set up, with their count).  Asking a CANopen node
+  would mean SDO requests on the COB-IDs another program uses for its own requests,
+  and each would get the other's answers.  ``--ask`` polls CAN axes too: only when no
+  other program talks to those nodes.  Under ``--sim`` the twin is the monitor's own
+  and every axis is asked.
 
 An axis that does not answer keeps its row, with the error in place of its readings.
 """
@@ -15,14 +26,17 @@ import argparse
 import os
 import select
 import sys
+import threading
 import time
 from contextlib import contextmanager
 from typing import Any, Iterator, Optional
 
 from . import _core
-from .bench import Bench, BenchFileError
+from .bench import Bench
+from .cli_bench import EXIT_OK, EXIT_USAGE, NotOpened, error_text, exit_code, load_bench
 
-EXIT_OK, EXIT_USAGE = 0, 2
+#: NMT states as a heartbeat carries them (CiA 301).
+_NMT = {0x00: "boot-up", 0x04: "stopped", 0x05: "operational", 0x7F: "pre-operational"}
 
 
 def _fmt(v: float) -> str:
@@ -36,11 +50,67 @@ def _flags(st: Any) -> str:
     return " ".join(on) or "-"
 
 
-def read_rows(bench: Bench, names: list[str]) -> list[tuple]:
+class Listener:
+    """What a CAN node sends by itself, heard without asking it (see the module doc)."""
+
+    def __init__(self, bus: Any, cfg: Any) -> None:
+        self.lock = threading.Lock()
+        self.heartbeat: Optional[int] = None
+        self.emcy: Optional[int] = None
+        self.frames = 0
+        self.last = ""
+        self.ids: tuple = ()
+        address = str(cfg.address)
+        if address.isdigit():                 # a CANopen node-ID
+            node = int(address)
+            self.node = node
+            self.ids = tuple(fc + node for fc in (0x080, 0x180, 0x280, 0x380, 0x480, 0x700))
+        else:                                 # a receive id (UNITEK): the drive answers on its transmit id
+            tx = cfg.options.get("tx_id")
+            self.node = None
+            self.ids = (int(tx) if tx is not None else int(address, 0) - 0x80,)
+        self._handles = [bus.subscribe(self._on_frame, id=i, mask=0x7FF) for i in self.ids]
+        self._bus = bus
+
+    def _on_frame(self, f: Any) -> None:
+        with self.lock:
+            if self.node is not None and f.id == 0x700 + self.node and f.dlc >= 1:
+                self.heartbeat = f.data[0] & 0x7F
+                return
+            if self.node is not None and f.id == 0x080 + self.node and f.dlc >= 2:
+                self.emcy = int.from_bytes(f.data[:2], "little")
+                return
+            self.frames += 1
+            self.last = f"{f.id:03X}#{f.data.hex().upper()}"
+
+    def row(self, name: str, kind: str, units: str) -> tuple:
+        with self.lock:
+            said = []
+            if self.heartbeat is not None:
+                said.append(f"heartbeat: {_NMT.get(self.heartbeat, hex(self.heartbeat))}")
+            said.append(f"{self.frames} frames sent by the drive" + (f" (last {self.last})" if self.last else ""))
+            said.append("not asked: --ask polls it")
+            fault = "-" if not self.emcy else f"EMCY 0x{self.emcy:04X}"
+            return (name, kind, "-", "-", units, "listening", fault, "; ".join(said))
+
+    def close(self) -> None:
+        for h in self._handles:
+            try:
+                self._bus.unsubscribe(h)
+            except _core.MotorbusError:
+                pass
+
+
+def read_rows(bench: Bench, names: list[str], listeners: Optional[dict] = None) -> list[tuple]:
     """``(axis, kind, position, velocity, units, state, fault, drive says)`` per axis,
-    read now; an axis that fails to answer says why instead."""
+    read now (or, for an axis only listened to, what it has sent); an axis that fails to
+    answer says why instead."""
     rows = []
     for name in names:
+        if listeners and name in listeners:
+            cfg = bench.config[name]
+            rows.append(listeners[name].row(name, cfg.kind, cfg.units.name if cfg.units else "native"))
+            continue
         d = bench[name]
         try:
             st = d.status
@@ -51,7 +121,7 @@ def read_rows(bench: Bench, names: list[str]) -> list[tuple]:
     return rows
 
 
-def render(bench: Bench, names: list[str], rate: float, frame: int) -> Any:
+def render(bench: Bench, names: list[str], rate: float, frame: int, listeners: Optional[dict] = None) -> Any:
     from rich.table import Table
 
     sim = " (simulated twin)" if bench.simulated else ""
@@ -60,7 +130,7 @@ def render(bench: Bench, names: list[str], rate: float, frame: int) -> Any:
     for col, justify in (("axis", "left"), ("kind", "left"), ("position", "right"), ("velocity", "right"),
                          ("units", "left"), ("state", "left"), ("fault", "left"), ("drive says", "left")):
         table.add_column(col, justify=justify, no_wrap=col != "drive says")
-    for row in read_rows(bench, names):
+    for row in read_rows(bench, names, listeners):
         style = "bold red" if row[6] != "-" else None
         table.add_row(*row, style=style)
     return table
@@ -120,27 +190,31 @@ def cmd_monitor(args: argparse.Namespace) -> int:
     if not args.rate > 0:
         print(f"motorbus monitor: --rate: a rate above 0 Hz, not {args.rate:g}", file=sys.stderr)
         return EXIT_USAGE
+    # CAN axes are listened to, not asked, unless --ask (or the twin is this monitor's own).
+    ask_can = args.ask or args.sim
     try:
-        bench = Bench.load(args.bench, sim=args.sim)
-    except BenchFileError as e:
-        print(f"motorbus: {e}", file=sys.stderr)
-        return EXIT_USAGE
+        bench = load_bench(args.bench, sim=args.sim, axes=args.axis,
+                           open_axis=lambda cfg: ask_can or cfg.bus is None)
+    except _core.MotorbusError as e:
+        print(error_text(e), file=sys.stderr)
+        return exit_code(e)
+    listeners: dict = {}
     try:
         for d in bench.axes.values():
             # Watching must not change what it watches: no stop when the monitor leaves.
             d.on_error = None
             d.on_exit = None
-        try:
-            names = list(bench.select(args.axis))
-        except _core.InvalidArgument as e:
-            print(f"motorbus: {e}", file=sys.stderr)
-            return EXIT_USAGE
+        names = list(bench.axes)
+        for name in names:
+            if isinstance(bench[name], NotOpened):
+                cfg = bench.config[name]
+                listeners[name] = Listener(bench.buses[cfg.bus], cfg)
         period = 1.0 / args.rate
         keys = _Keys(sys.stdin)
         console = Console()
         frame = 0
         try:
-            with _cbreak(sys.stdin), Live(render(bench, names, args.rate, frame), console=console,
+            with _cbreak(sys.stdin), Live(render(bench, names, args.rate, frame, listeners), console=console,
                                           auto_refresh=False, transient=False) as live:
                 next_t = time.monotonic()
                 while True:
@@ -151,18 +225,24 @@ def cmd_monitor(args: argparse.Namespace) -> int:
                     if time.monotonic() > next_t + period:   # slow drives: do not try to catch up
                         next_t = time.monotonic()
                     frame += 1
-                    live.update(render(bench, names, args.rate, frame), refresh=True)
+                    live.update(render(bench, names, args.rate, frame, listeners), refresh=True)
         except KeyboardInterrupt:
             pass
         return EXIT_OK
     finally:
+        for listener in listeners.values():
+            listener.close()
         bench.close()     # closes the links; stops nothing
 
 
-def add_commands(sub: Any) -> None:
-    p = sub.add_parser("monitor", help="a live table of every axis (reads only; q or Ctrl-C quits)")
+def add_commands(sub: Any, common: Any = None) -> None:
+    p = sub.add_parser("monitor", help="a live table of every axis (reads only; q or Ctrl-C quits)",
+                       parents=[common] if common is not None else [])
     p.add_argument("bench", metavar="BENCH", help="the bench file (TOML)")
     p.add_argument("--rate", type=float, default=10.0, metavar="HZ", help="redraws per second (default 10)")
     p.add_argument("--axis", action="append", help="only this axis (repeatable; default every axis)")
-    p.add_argument("--sim", action="store_true", help="watch the bench's simulated twin")
+    p.add_argument("--ask", action="store_true",
+                   help="also poll CAN axes (SDO/requests): only when no other program talks to those nodes; "
+                        "by default a CAN axis is only listened to")
+    p.add_argument("--sim", action="store_true", help="watch the bench's simulated twin (a fresh one, asked)")
     p.set_defaults(func=cmd_monitor)
