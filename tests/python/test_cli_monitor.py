@@ -4,6 +4,7 @@ monitor opened the line), q and Ctrl-C quit with 0 — and the axis is still jog
 afterwards: the monitor stops nothing."""
 from __future__ import annotations
 
+import os
 import re
 import subprocess
 import sys
@@ -108,3 +109,29 @@ def test_monitor_arguments(tmp_path):
                          input="q", capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert re.search(r"│ x\s+│ arcus\s+│\s+0 │\s+0 │", out.stdout), out.stdout
+
+
+@pytest.mark.subprocess
+def test_monitor_sends_nothing_to_a_can_axis_unless_asked(served, tmp_path):
+    """Beside another program on the CAN bus, the monitor's SDO requests would cross that
+    program's: by default it only listens to a CAN axis (not one frame from it reaches the
+    bus), and polls it only with --ask."""
+    srv = served.can.servers[0]
+
+    def watch(*extra: str) -> tuple[str, int]:
+        before = srv.stats.frames_to_bus
+        proc = subprocess.Popen([sys.executable, "-m", "motorbus", "monitor", "bench.toml", "--rate", "20", *extra],
+                                cwd=tmp_path, env={**os.environ, "COLUMNS": "200"}, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                text=True)
+        time.sleep(2.0)                       # some 20 redraws (the first one opens the bench)
+        out, err = proc.communicate("q", timeout=30)
+        assert proc.returncode == 0, err
+        return out, srv.stats.frames_to_bus - before
+
+    out, sent = watch("--axis", "z")
+    assert sent == 0, out
+    assert re.search(r"│ z\s+│ cia402\s+│\s+- │\s+- │ native\s+│ listening", out), out
+    assert "not asked: --ask polls it" in out
+    out, sent = watch("--axis", "z", "--ask")
+    assert sent > 10, out                    # SDO requests, every redraw
+    assert re.search(r"│ z\s+│ cia402\s+│\s+0 │\s+0 │", out), out
