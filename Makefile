@@ -9,10 +9,12 @@ JOBS   ?= $(shell nproc)
 APT_PACKAGES := cmake ninja-build g++ libeigen3-dev libgtest-dev clang libclang-rt-14-dev ccache tmux ser2net
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # ccache (when installed) with paths relative to the checkout, so a fresh clone
-# in another directory reuses earlier compilations.
+# in another directory reuses earlier compilations.  Whether it is installed is
+# asked in the build recipe, not when make reads this file: `deps` installs it
+# during this same run on a fresh machine, and the first build must use it too.
 export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := 1
-CCACHE := $(shell command -v ccache >/dev/null && echo -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache)
+CCACHE_LAUNCHER = $$(command -v ccache >/dev/null && echo -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache)
 
 .PHONY: demo test deps venv build cpp-test py-test sanitize fuzz fuzz-smoke bench soak stubs clean
 
@@ -37,7 +39,7 @@ $(VENV)/.deps: requirements-dev.txt
 build: deps
 	$(PY) -m pip install -q --no-build-isolation --no-deps -e . \
 	  -Cbuild-dir=$(BUILD) -Ccmake.define.MOTORBUS_TESTS=ON -Ccmake.define.MOTORBUS_BENCH=ON -Ccmake.define.MOTORBUS_EXAMPLES=ON \
-	  -Cbuild.tool-args=-j$(JOBS) $(CCACHE)
+	  -Cbuild.tool-args=-j$(JOBS) $(CCACHE_LAUNCHER)
 
 cpp-test: build
 	ctest --test-dir $(BUILD) --output-on-failure

@@ -39,7 +39,10 @@ def test_pip_install_into_a_clean_venv_then_every_command(tmp_path):
     env_dir = tmp_path / "venv"
     venv.EnvBuilder(with_pip=True, clear=True).create(env_dir)
     py, mb = env_dir / "bin" / "python", env_dir / "bin" / "motorbus"
+    wheel_builds = lambda: sorted(p.name for p in (ROOT / "build").glob("cp3*"))  # noqa: E731 - build/<wheel tag>
+    before = wheel_builds()
     _run([py, "-m", "pip", "install", "-q", str(ROOT)], timeout=3000, cwd=tmp_path)
+    assert wheel_builds() == before, "pip install wrote its build into the source tree (pyproject build-dir)"
     # the installed package, not the checkout: run from tmp_path with no PYTHONPATH
     out = _run([py, "-c", "import motorbus, can, serial; print(motorbus.__file__)"], 120, tmp_path)
     assert str(env_dir) in out
