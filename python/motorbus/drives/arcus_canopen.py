@@ -28,7 +28,8 @@ from typing import Any, Optional, Union
 
 from .. import _core
 from ..canopen.cia402 import Cia402, Controlword, OpMode
-from ..drive import Capability, ParamInfo, Params, Units
+from ..drive import (Capability, DriveStatus, LimitReached, MoveFaulted, MoveStalled, ParamInfo, Params, StopReason,
+                     Units)
 from ..registry import DrivePlugin
 from . import arcus as _arcus
 from .cia402 import Cia402Drive, poll_fields as _cia402_poll_fields
@@ -43,6 +44,7 @@ _BY_KEY = {(r[0], r[1]): r for r in OBJECTS}
 _SIZES = {"U8": 1, "I8": 1, "U16": 2, "I16": 2, "U32": 4, "I32": 4}
 
 _SW_TARGET_REACHED = 1 << 10
+_SW_INTERNAL_LIMIT = 1 << 11
 _SW_BIT12 = 1 << 12
 _SW_BIT13 = 1 << 13
 _CW_HALT = 1 << 8
@@ -280,10 +282,14 @@ def _key(index: int, sub: int) -> str:
 
 class ArcusCanopenParams(Params):
     """Objects by index (``"0x6081"``, ``"0x2001:03"``, ``"2001h:03"``) or by name
-    (``"Run current"``), read and written by SDO."""
+    (``"Run current"``), read and written by SDO.
+
+    Write-only objects (6060h, Modes of operation: the drive aborts a read with
+    06010001) are described as such, written like any other, left out of the
+    iteration (what ``config read --all`` reads) and refused by name when read."""
 
     def _names(self) -> list[str]:
-        return [_key(r[0], r[1]) for r in OBJECTS]
+        return [_key(r[0], r[1]) for r in OBJECTS if r[4] != "wo"]
 
     def _key(self, name: str) -> str:
         name = super()._key(name).strip()
@@ -312,10 +318,15 @@ class ArcusCanopenParams(Params):
         writable = access in ("rw", "wo")
         return ParamInfo(name=name, type="str" if dtype == "VISIBLE_STRING" else "int",
                          minimum=low if writable else None, maximum=high if writable else None, unit=unit,
-                         default=default, persists=bool(persists), writable=writable, description=n)
+                         default=default, persists=bool(persists), writable=writable,
+                         description=f"{n} (write-only: the drive cannot read it back)" if access == "wo" else n)
 
     def _read(self, info: ParamInfo) -> Any:
         r = self._row(info.name)
+        if r[4] == "wo":
+            raise _core.InvalidArgument(
+                f"{self._drive.name}: parameter {info.name} ({r[2]}) is write-only: the DMX-CAN aborts a read of it "
+                f"(06010001); the mode in effect is 0x6061")
         return self._drive.native.read(r[0], r[1])
 
     def _write(self, info: ParamInfo, value: Any) -> None:
@@ -327,6 +338,13 @@ class ArcusCanopenDrive(Cia402Drive):
     """A DMX-CAN on CANopen behind :class:`motorbus.Drive` (the generic CiA 402
     adapter with the Arcus differences: no watchdog, no 603Fh, the manual's
     homing methods, clear-error and store handshakes).
+
+    A move ends at its target within the StepNLoop tolerance 2001h:03 (exactly, with
+    StepNLoop off) or raises the :class:`motorbus.MoveFailed` that says why: a limit
+    error (LimitReached), a StepNLoop stall, range or attempt error (2003h 10/8/9:
+    MoveStalled), a halt or quick stop from elsewhere (MoveInterrupted);
+    docs/drives/arcus.md "How a move ends".  ``velocity=`` sets 6081h for that move
+    only (put back when it ends).
 
     Native units: encoder counts and counts/s with StepNLoop on (2001h:01 = 1, the
     default), pulses and pulses/s with it off.  No watchdog (the manual documents
@@ -366,8 +384,7 @@ class ArcusCanopenDrive(Cia402Drive):
         # makes bit 5 = 1 a buffered "set of set-points" (native.move_to(..., immediate=True)).
         try:
             self._use_mode(OpMode.PROFILE_POSITION)
-            if velocity is not None:
-                self._u32(0x6081, velocity)  # stays the profile velocity for later moves too
+            self._speed_for_this_move(velocity)
             self.native.move_to(int(round(target)), relative=relative, immediate=False)
         except _core.TimeoutError:
             # Not acknowledged: say why (checked only on failure: it costs SDO reads).
@@ -375,6 +392,11 @@ class ArcusCanopenDrive(Cia402Drive):
             if self._velocity() != 0:
                 raise _core.DriveFault("arcus-canopen: move refused while the motor moves (the drive takes "
                                        "a single set-point once the move is done; stop() first)") from None
+            distance = abs(target if relative else target - self._position())
+            if distance > _core.ARCUS_MAX_MOVE_DISTANCE:
+                raise _core.InvalidArgument(
+                    f"{self.name}: move of {distance:g} refused by the drive: at most "
+                    f"{_core.ARCUS_MAX_MOVE_DISTANCE} per move (the firmware's limit; split it)") from None
             raise
 
     def _jog(self, velocity: float) -> None:
@@ -391,23 +413,54 @@ class ArcusCanopenDrive(Cia402Drive):
             raise
         self.native.set_velocity(int(round(velocity)))
 
-    def _homing_done(self) -> bool:
-        sw = self.native.statusword
-        if (sw & 0x4F) == 0x08:
-            raise _core.DriveFault(f"arcus-canopen: fault during homing (StepNLoop status {self._snl_text()})")
-        if sw & _SW_BIT13:
-            self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
-            raise _core.DriveFault("arcus-canopen: homing error (statusword bit 13)")
-        if (sw & (_SW_BIT12 | _SW_TARGET_REACHED)) == (_SW_BIT12 | _SW_TARGET_REACHED):
-            self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
-            return True
-        return False
+    # _is_idle and _homing_done: the CiA 402 ones (at rest for any reason; a homing error
+    # or a fault raises what _stop_reason below finds).
 
-    def _is_idle(self) -> bool:
-        sw = self.native.statusword
-        if (sw & 0x4F) == 0x08:
-            raise _core.DriveFault(f"arcus-canopen: fault while moving (StepNLoop status {self._snl_text()})")
-        return bool(sw & _SW_TARGET_REACHED) and self._velocity() == 0
+    def _in_position_window(self) -> float:
+        """StepNLoop on (2001h:01): its tolerance 2001h:03 (SLT, encoder counts: the drive
+        corrects a larger error at the end of a move); off: 0 (an open-loop pulse counter
+        ends exactly on its target).  Read at each judged move (two SDO reads): the manual
+        has no 6067h."""
+        if not self.native.read(0x2001, 1):
+            return 0.0
+        return float(self.native.read(0x2001, 3))
+
+    def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
+        return (None, None)          # Table 10.1 has no 607Dh: no software limits
+
+    def _limit_side(self, status: DriveStatus) -> tuple[int, str]:
+        # 60FDh shows a switch still pressed; else the direction the move was going
+        # (the ASCII persona's MST bits 6/7 say which, CANopen has no object for them).
+        if status.limit_positive:
+            return 1, "the +limit switch (60FDh bit 1)"
+        if status.limit_negative:
+            return -1, "the -limit switch (60FDh bit 0)"
+        move = self._move
+        if move is not None and move.target is not None:
+            side = 1 if move.target > self._position() else -1
+            return side, f"the {'+' if side > 0 else '-'}limit (the switch no longer reads active; side from the move)"
+        return 0, "a limit (the drive does not say which)"
+
+    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+        """A latched error is the FAULT state (B-A18, B-A22); which one, from StepNLoop
+        status 2003h (10 stall, 8 correction range, 9 attempts, 11 limit) and the limit
+        bits (statusword 11, 60FDh).  The DMX-CAN has no 603Fh: a fault has no code beyond
+        the StepNLoop status.  Out of FAULT: as any CiA 402 drive (quick stop, halt...)."""
+        sw = int(status.raw)
+        state = _core.cia402_decode_statusword(sw)
+        if state not in ("FAULT", "FAULT REACTION ACTIVE"):
+            return super()._stop_reason(status)
+        sls = int(self.native.read(0x2003))
+        if sls in (SnlStatus.STALL_ERROR, SnlStatus.CORRECTION_RANGE_ERROR, SnlStatus.CORRECTION_ATTEMPT_ERROR):
+            words = {10: "stall", 8: "correction range", 9: "max attempts"}[sls]
+            return StopReason(MoveStalled, f"StepNLoop error: {words} (2003h = {sls})", code=sls)
+        if sls == SnlStatus.LIMIT_ERROR or sw & _SW_INTERNAL_LIMIT or status.limit_positive or status.limit_negative:
+            side, text = self._limit_side(status)
+            return StopReason(LimitReached, f"{text}: a limit error (statusword bit 11"
+                                            f"{', StepNLoop status 11' if sls == SnlStatus.LIMIT_ERROR else ''})",
+                              code=sls if sls == SnlStatus.LIMIT_ERROR else None, side=side)
+        return StopReason(MoveFaulted, f"a fault (statusword 0x{sw:04X}, StepNLoop status {sls}; the DMX-CAN "
+                                       "has no error code object)", code=sls)
 
     def _clear_faults(self) -> None:
         self.native.clear_errors()
@@ -453,9 +506,14 @@ def open(*, line: Any = None, bus: Any = None, address: str = "1", units: Option
 
 
 # The same drive as 'arcus' behind its CAN front end: the same faults.
+# Standard names ("limit", "stall") and the older alias; the DMX-CAN has no other fault
+# (no 603Fh: its errors are the limit and StepNLoop ones) and no stop input.
 SIM_FAULTS = {
-    "trip_limit": lambda sim, direction=-1: sim.force_limit(int(direction), True),
+    # a limit switch closes (+1 / -1): a motion toward it stops and latches a limit error
+    "limit": lambda sim, direction=1: sim.force_limit(int(direction), True),
+    # the rotor jams: StepNLoop sees the error grow past 2001h:05, stall error (2003h = 10)
     "stall": lambda sim: sim.set_blocked(True),
+    "trip_limit": lambda sim, direction=-1: sim.force_limit(int(direction), True),
 }
 
 def plan_move(drive: Any, start: float, target: float) -> Any:

@@ -30,11 +30,14 @@ from __future__ import annotations
 import contextlib
 import struct
 import threading
+import time
+import weakref
 from typing import Any, Iterator, Optional, Sequence, Union
 
 from .. import _core
 from ..canopen.cia402 import Cia402, Cia402Device, Controlword, OpMode
-from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params, Units
+from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, MoveStalled,
+                     ParamInfo, Params, StopReason, Units)
 from ..registry import DrivePlugin
 
 __all__ = ["Cia402Drive", "Cia402Sim", "PLUGIN", "SYNC_START_RPDO", "make_sim", "open", "OBJECTS",
@@ -45,8 +48,9 @@ _SW_REMOTE = 1 << 9
 _SW_TARGET_REACHED = 1 << 10
 _SW_INTERNAL_LIMIT = 1 << 11
 _SW_BIT12 = 1 << 12   # PV: speed zero; HM: homing attained (bit 12 of PP is the set-point ack)
-_SW_BIT13 = 1 << 13   # HM: homing error
+_SW_BIT13 = 1 << 13   # HM: homing error; PP: following error
 _SIM_BITS = _SW_REMOTE | _SW_TARGET_REACHED | _SW_INTERNAL_LIMIT | _SW_BIT13
+_I32_MIN, _I32_MAX = -(1 << 31), (1 << 31) - 1
 
 _CW_NEW_SETPOINT = 1 << 4
 _CW_IMMEDIATE = 1 << 5
@@ -60,6 +64,11 @@ OBJECTS = [
     (0x1001, 0, "Error register", "U8", "ro", 0, None, None, "", False, "CiA 301 error register"),
     (0x1008, 0, "Manufacturer device name", "VISIBLE_STRING", "ro", "motorbus CiA 402 sim", None, None, "", False,
      "device name"),
+    # Identity (CiA 301): vendor 0 = no CiA-assigned vendor (a simulator); serial = the node-ID (set per sim).
+    (0x1018, 1, "Vendor-ID", "U32", "ro", 0, None, None, "", False, "identity: vendor"),
+    (0x1018, 2, "Product code", "U32", "ro", 0x402, None, None, "", False, "identity: product"),
+    (0x1018, 3, "Revision number", "U32", "ro", 0x00010000, None, None, "", False, "identity: revision"),
+    (0x1018, 4, "Serial number", "U32", "ro", 0, None, None, "", False, "identity: serial (the node-ID)"),
     (0x603F, 0, "Error code", "U16", "ro", 0, None, None, "", False, "last fault's CiA 402 error code"),
     (0x6007, 0, "Abort connection option code", "I16", "rw", 1, 0, 3, "", True,
      "what a lost master does: 1 fault, 2 disable voltage, 3 quick stop"),
@@ -67,9 +76,17 @@ OBJECTS = [
     (0x6060, 0, "Modes of operation", "I8", "rw", 0, None, None, "", False, "1 PP, 3 PV, 6 HM"),
     (0x6061, 0, "Modes of operation display", "I8", "ro", 0, None, None, "", False, "the mode in effect"),
     (0x6064, 0, "Position actual value", "I32", "ro", 0, None, None, "inc", False, "position"),
+    (0x6065, 0, "Following error window", "U32", "rw", 1000, 0, 0xFFFFFFFF, "inc", True,
+     "a larger lag of the rotor behind the demand is a following error (fault 0x8611)"),
+    (0x6067, 0, "Position window", "U32", "rw", 10, 0, 0xFFFFFFFF, "inc", True,
+     "a move within this of its target is at target"),
     (0x606C, 0, "Velocity actual value", "I32", "ro", 0, None, None, "inc/s", False, "velocity"),
     (0x607A, 0, "Target position", "I32", "rw", 0, None, None, "inc", False, "PP target"),
     (0x607C, 0, "Home offset", "I32", "rw", 0, None, None, "inc", True, "position after homing"),
+    (0x607D, 1, "Min position limit", "I32", "rw", _I32_MIN, None, None, "inc", True,
+     "software position limit: PP targets below are clipped to it"),
+    (0x607D, 2, "Max position limit", "I32", "rw", _I32_MAX, None, None, "inc", True,
+     "software position limit: PP targets above are clipped to it"),
     (0x6081, 0, "Profile velocity", "U32", "rw", 1000, 1, 10_000_000, "inc/s", True, "PP speed"),
     (0x6083, 0, "Profile acceleration", "U32", "rw", 10000, 1, 100_000_000, "inc/s²", True, "PP/PV acceleration"),
     (0x6084, 0, "Profile deceleration", "U32", "rw", 10000, 1, 100_000_000, "inc/s²", True, "PP/PV deceleration"),
@@ -80,7 +97,8 @@ OBJECTS = [
     (0x6099, 1, "Speed during search for switch", "U32", "rw", 5000, 1, 10_000_000, "inc/s", True, "homing"),
     (0x6099, 2, "Speed during search for zero", "U32", "rw", 1000, 1, 10_000_000, "inc/s", True, "homing"),
     (0x609A, 0, "Homing acceleration", "U32", "rw", 20000, 1, 100_000_000, "inc/s²", True, "homing"),
-    (0x60FD, 0, "Digital inputs", "U32", "ro", 0, None, None, "", False, "bit 0 negative limit, 1 positive, 2 home"),
+    (0x60FD, 0, "Digital inputs", "U32", "ro", 0, None, None, "", False,
+     "bit 0 negative limit, 1 positive, 2 home; bit 16 the simulator's quick-stop input"),
     (0x60FF, 0, "Target velocity", "I32", "rw", 0, None, None, "inc/s", False, "PV target"),
     (0x6502, 0, "Supported drive modes", "U32", "ro", 0b100101, None, None, "", False, "PP, PV, HM"),
 ]
@@ -89,6 +107,19 @@ _PERSISTENT = {(row[0], row[1]) for row in OBJECTS if row[9]}
 _MAPPABLE = {0x6040, 0x6041, 0x6060, 0x6061, 0x6064, 0x606C, 0x607A, 0x60FF}
 _SIZES = {"U8": 1, "I8": 1, "U16": 2, "I16": 2, "U32": 4, "I32": 4}
 _SAVE = int.from_bytes(b"save", "little")  # CiA 301 0x1010 signature
+
+
+def _weak_call(obj: Any, name: str) -> Any:
+    """A callback for C++ to keep that reaches ``obj`` through a weak reference.  A bound
+    method kept by the motor model, the object dictionary or the heartbeat service closes
+    a reference cycle through C++, which the garbage collector does not see: every
+    simulator (~164 KB) would then live until the process ends (issue 28)."""
+    ref = weakref.ref(obj)
+
+    def call(*args: Any) -> Any:
+        target = ref()
+        return None if target is None else getattr(target, name)(*args)
+    return call
 
 
 def _check_node(address: Union[str, int]) -> str:
@@ -111,7 +142,12 @@ class Cia402Sim:
     (0x1017 at boot, default 0 = off, as CiA 301), ``start_position``.
     Time comes from ``clock`` (a RealClock by default): the motion is evaluated
     when the host looks (each SDO access), so a SimClock test advances the
-    clock and reads."""
+    clock and reads.
+
+    Test hooks: :meth:`inject_fault` (a fault with a 603Fh code), :meth:`force_limit`
+    (a limit switch closes), :meth:`jam` (the rotor blocks: a following error past
+    6065h faults the drive with 0x8611), :meth:`set_stop_input` (a quick-stop input,
+    60FDh bit 16)."""
 
     def __init__(self, node_id: int, clock: Optional[_core.Clock] = None, *, steps_per_rev: float = 3200,
                  home: tuple = (1000, 1400), minus_limit: Optional[float] = -100000,
@@ -137,9 +173,16 @@ class Cia402Sim:
         self._homing: Optional[Any] = None
         self._activity = "idle"              # idle | pp | pv | homing | stopping
         self._limit_hit = False
+        self._forced: dict[int, bool] = {1: False, -1: False}   # force_limit: +1 / -1 switch closed
+        self._soft_limit_side = 0       # the PP target was clipped to 607Dh on this side
+        self._following_error = False   # PP statusword bit 13 until the next set-point
+        self._slip0 = 0.0               # the rotor's lag when the current motion began
+        self._stop_input = False
         self._heartbeat_ms = int(heartbeat_ms)
         self.od = self._build_od()
-        self.motor.add_listener(self._on_motor_event)
+        self._values[(0x1018, 4)] = self.node_id
+        # Weak: a bound method kept by C++ would keep this simulator alive forever.
+        self.motor.add_listener(_weak_call(self, "_on_motor_event"))
         self.node: Optional[_core.LocalNode] = None
         self.heartbeat: Optional[_core.HeartbeatService] = None
         self.lost_master = threading.Event()
@@ -155,7 +198,7 @@ class Cia402Sim:
         self.node = _core.LocalNode(bus, self.node_id, self.od)
         self.heartbeat = _core.HeartbeatService(self.node, consumer_entries=4, producer_ms=self._heartbeat_ms)
         self.pdo = _core.PdoService(self.node, rpdos=4, tpdos=4)
-        self.heartbeat.set_lost_callback(self._master_lost)
+        self.heartbeat.set_lost_callback(_weak_call(self, "_master_lost"))
         return self
 
     def close(self) -> None:
@@ -174,6 +217,38 @@ class Cia402Sim:
             self.device.fault_reaction_done()
             self._values[(0x603F, 0)] = int(error_code)
             self._values[(0x1001, 0)] = 0x01
+
+    def force_limit(self, direction: int, active: bool = True) -> None:
+        """The +limit (``direction`` +1) or -limit (-1) switch closes (``active``) whatever
+        the position: a motion toward it stops at once (statusword bit 11, 60FDh bit 1 / 0),
+        as at a switch met at its place."""
+        if direction not in (1, -1):
+            raise _core.InvalidArgument(f"cia402 sim force_limit: direction +1 or -1, not {direction!r}")
+        with self._lock:
+            self._update()
+            self._forced[direction] = bool(active)
+            self._check_forced_limits()
+
+    def jam(self, jammed: bool = True) -> None:
+        """The rotor blocks (``jammed``): the demand runs on, the lag grows, and past the
+        following error window 6065h the drive faults with 0x8611 (statusword bit 13)."""
+        with self._lock:
+            self._update()
+            self.motor.set_jammed(bool(jammed))
+
+    def set_stop_input(self, active: bool = True) -> None:
+        """The drive's quick-stop input (60FDh bit 16 while active): its rising edge makes a
+        moving drive quick stop as a controlword Quick Stop would (605Ah decides the rest)."""
+        with self._lock:
+            self._update()
+            rising = bool(active) and not self._stop_input
+            self._stop_input = bool(active)
+            if rising and self.device.state == "OPERATION ENABLED":
+                self.device.on_controlword(int(Controlword.QUICK_STOP))
+                if self.device.state == "QUICK STOP ACTIVE":
+                    self._begin_quick_stop()
+                else:
+                    self._stop_now()
 
     @property
     def position(self) -> float:
@@ -202,26 +277,44 @@ class Cia402Sim:
                 if access != "ro":
                     var.set_write_hook(self._writer(index, sub, dtype))
         cw = od.add_variable(0x6040, "Controlword", "U16", default=0, pdo_mappable=True)
-        cw.set_write_hook(lambda var, data: self._controlword(int.from_bytes(data, "little")))
+        # The hooks reach this simulator weakly (see _weak_call): the OD is kept by C++.
+        ref = weakref.ref(self)
+
+        def on_controlword(var: Any, data: bytes) -> Optional[int]:
+            sim = ref()
+            return None if sim is None else sim._controlword(int.from_bytes(data, "little"))
+
+        def read_statusword(var: Any, current: bytes) -> Optional[bytes]:
+            sim = ref()
+            return None if sim is None else sim._statusword().to_bytes(2, "little")
+
+        def on_store(var: Any, data: bytes) -> Optional[int]:
+            sim = ref()
+            return None if sim is None else sim._store(int.from_bytes(data, "little"))
+        cw.set_write_hook(on_controlword)
         sw = od.add_variable(0x6041, "Statusword", "U16", access="ro", default=0, pdo_mappable=True)
-        sw.set_read_hook(lambda var, current: self._statusword().to_bytes(2, "little"))
+        sw.set_read_hook(read_statusword)
         od.add_record(0x1010, "Store parameters", array=True)
         store = od.add_member(0x1010, 1, "Save all parameters", "U32", default=1)
-        store.set_write_hook(lambda var, data: self._store(int.from_bytes(data, "little")))
+        store.set_write_hook(on_store)
         return od
 
     def _reader(self, index: int, sub: int, dtype: str):
         size, signed = _SIZES[dtype], dtype.startswith("I")
+        ref = weakref.ref(self)   # the hook is kept by C++ (see _weak_call)
 
-        def read(var: Any, current: bytes) -> bytes:
-            return int(self._value(index, sub)).to_bytes(size, "little", signed=signed)
+        def read(var: Any, current: bytes) -> Optional[bytes]:
+            sim = ref()
+            return None if sim is None else int(sim._value(index, sub)).to_bytes(size, "little", signed=signed)
         return read
 
     def _writer(self, index: int, sub: int, dtype: str):
         signed = dtype.startswith("I")
+        ref = weakref.ref(self)
 
         def write(var: Any, data: bytes) -> Optional[int]:
-            return self._write(index, sub, int.from_bytes(data, "little", signed=signed))
+            sim = ref()
+            return None if sim is None else sim._write(index, sub, int.from_bytes(data, "little", signed=signed))
         return write
 
     def _value(self, index: int, sub: int) -> int:
@@ -235,7 +328,8 @@ class Cia402Sim:
                 return self.device.mode
             if index == 0x60FD:
                 m = self.motor
-                return (m.minus_limit_active << 0) | (m.plus_limit_active << 1) | (m.home_active << 2)
+                return ((m.minus_limit_active or self._forced[-1]) << 0) | ((m.plus_limit_active or self._forced[1]) << 1) \
+                    | (m.home_active << 2) | (self._stop_input << 16)
             return int(self._values[(index, sub)])
 
     def _write(self, index: int, sub: int, value: int) -> Optional[int]:
@@ -299,6 +393,10 @@ class Cia402Sim:
             mode = self.device.mode
             rising = bool(value & _CW_NEW_SETPOINT) and not (before_cw & _CW_NEW_SETPOINT)
             if value & _CW_HALT:
+                if self._activity == "homing" and self._homing is not None:
+                    # A halted homing is over, not attained (CiA 402: bits 10/12/13 = 1/0/0).
+                    self._homing.abort()
+                    self._homing = None
                 if self.motor.moving and self._activity != "stopping":
                     self._decelerate()
                 return None
@@ -317,11 +415,21 @@ class Cia402Sim:
             self._pp = _core.Cia402ProfilePosition(self._params(), self.motor.pulse_position)
             self._pp_t0 = self.clock.now()
         self.last_setpoint_ns = self.clock.now()
-        self._pp.new_setpoint(self._now_s(), target, relative=bool(cw & _CW_RELATIVE),
+        t = self._now_s()
+        self._pp.new_setpoint(t, target, relative=bool(cw & _CW_RELATIVE),
                               change_immediately=bool(cw & _CW_IMMEDIATE))
+        # Software position limits (607Dh): a target beyond one is clipped to it (CiA 402),
+        # and the drive shows internal limit active (bit 11) once it stands there.
+        lo, hi = float(self._values[(0x607D, 1)]), float(self._values[(0x607D, 2)])
+        end = self._pp.profile.position(self._pp.profile.duration)
+        self._soft_limit_side = 1 if end > hi else -1 if end < lo else 0
+        if self._soft_limit_side:
+            self._pp.new_setpoint(t, hi if self._soft_limit_side > 0 else lo, change_immediately=True)
         self.motor.command(self._pp.profile, start_ns=self._pp_t0)
         self._activity = "pp"
         self._limit_hit = False
+        self._following_error = False
+        self._check_forced_limits()
 
     def _apply_velocity(self) -> None:
         v = float(self._values[(0x60FF, 0)])
@@ -371,27 +479,66 @@ class Cia402Sim:
 
     def _update(self) -> None:
         self.motor.update()
+        self._check_forced_limits()
+        self._check_following_error()
         if self._activity == "quick_stop" and not self.motor.moving:
             self.device.motion_stopped()
             self._activity = "idle"
+
+    def _check_forced_limits(self) -> None:
+        # A switch closed by force_limit stops a motion toward it, as one met at its place.
+        m = self.motor
+        if self._activity == "homing" or not m.moving:
+            return
+        v = m.commanded_velocity
+        for side in (1, -1):
+            if self._forced[side] and v * side > 0:
+                m.halt()
+                self._limit_hit = True
+                self._activity = "idle"
+                return
+
+    def _check_following_error(self) -> None:
+        # The rotor lags the demand by more than 6065h: stop, fault 0x8611 (following error),
+        # and report where the rotor is (the position a real drive's encoder shows).
+        # The lag counts from where it was when the motion began: steps a jam lost earlier
+        # are lost for good (an open-loop counter), not a following error of this motion.
+        m = self.motor
+        if not m.moving:
+            self._slip0 = m.slip
+            return
+        if abs(m.slip - self._slip0) <= float(self._values[(0x6065, 0)]):
+            return
+        rotor = m.pulse_position - (m.slip - self._slip0)
+        self._stop_now()
+        m.set_pulse_position(rotor)
+        m.set_encoder(int(round(rotor)))
+        self._following_error = True
+        self.device.fault(0x8611)
+        self.device.fault_reaction_done()
+        self._values[(0x603F, 0)] = 0x8611
+        self._values[(0x1001, 0)] = 0x01
 
     def _statusword(self) -> int:
         with self._lock:
             self._update()
             mode = self.device.mode
             bits = _SW_REMOTE
-            if self._limit_hit or self.motor.minus_limit_active or self.motor.plus_limit_active:
+            if self._limit_hit or self.motor.minus_limit_active or self.motor.plus_limit_active \
+                    or (self._soft_limit_side and not self.motor.moving):
                 bits |= _SW_INTERNAL_LIMIT
             if mode == OpMode.PROFILE_POSITION:
                 if not self.motor.moving:  # the set-point (and any buffered one) is played out
                     bits |= _SW_TARGET_REACHED
+                if self._following_error:
+                    bits |= _SW_BIT13
             elif mode == OpMode.PROFILE_VELOCITY:
                 target = float(self._values[(0x60FF, 0)])
                 if abs(self.motor.pulse_velocity - target) < 0.5 or not self.motor.moving:
                     bits |= _SW_TARGET_REACHED
             elif mode == OpMode.HOMING:
                 h = self._homing
-                if h is None or h.result != 0:  # HomingResult.Running == 0
+                if (h is None and not self.motor.moving) or (h is not None and h.result != 0):  # Running == 0
                     bits |= _SW_TARGET_REACHED
                 if h is not None and h.error:
                     bits |= _SW_BIT13
@@ -432,6 +579,61 @@ def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None
 
 
 # ---- the Drive adapter --------------------------------------------------------------------
+
+#: 603Fh error codes as CiA 402 (IEC 61800-7-201) names them: the ones a drive
+#: commonly shows; any other code is named by its group (:func:`error_text`).
+ERROR_CODES = {
+    0x0000: "no error",
+    0x1000: "generic error",
+    0x2220: "continuous over-current (device internal)",
+    0x2310: "continuous over-current",
+    0x2320: "short circuit / earth leakage",
+    0x2330: "earth leakage",
+    0x2340: "short circuit",
+    0x3110: "mains over-voltage",
+    0x3120: "mains under-voltage",
+    0x3130: "phase failure",
+    0x3210: "DC link over-voltage",
+    0x3220: "DC link under-voltage",
+    0x4110: "ambient temperature too high",
+    0x4210: "excess temperature device",
+    0x4310: "excess temperature drive",
+    0x5114: "supply voltage too low (electronics)",
+    0x5441: "contacts error 1 (an interlock input)",
+    0x5530: "EEPROM error",
+    0x6010: "reset by watchdog",
+    0x6320: "parameter error",
+    0x7121: "motor blocked",
+    0x7122: "commutation error",
+    0x7305: "incremental sensor 1 fault",
+    0x7310: "speed error",
+    0x7320: "position error",
+    0x7500: "communication error",
+    0x8110: "CAN overrun",
+    0x8120: "CAN error passive",
+    0x8130: "life guard or heartbeat error",
+    0x8140: "recovered from bus-off",
+    0x8311: "torque too high",
+    0x8611: "following error",
+    0x8612: "reference limit",
+}
+_ERROR_GROUPS = {0x1: "generic error", 0x2: "current", 0x3: "voltage", 0x4: "temperature",
+                 0x5: "device hardware", 0x6: "device software", 0x7: "additional modules",
+                 0x8: "monitoring", 0x9: "external error", 0xF: "additional functions"}
+#: Codes that mean the rotor did not follow (MoveStalled rather than MoveFaulted).
+STALL_CODES = {0x7121, 0x8611}
+
+
+def error_text(code: int) -> str:
+    """``"fault 0x8611 following error"``: a 603Fh code in CiA 402's words."""
+    if code in ERROR_CODES:
+        name = ERROR_CODES[code]
+    elif code >= 0xFF00:
+        name = "manufacturer-specific error (the drive's manual)"
+    else:
+        name = f"{_ERROR_GROUPS.get(code >> 12, 'unknown')} error (group 0x{code >> 8:02X}xx)"
+    return f"fault 0x{code:04X} {name}"
+
 
 class Cia402Params(Params):
     """Objects by index (``"0x6081"``, ``"0x6099:01"``, ``"6081h"``) or by the names of the
@@ -483,10 +685,18 @@ class Cia402Params(Params):
         index, sub, dtype = self._where(info)
         self._drive._sdo.download(index, sub, int(value).to_bytes(_SIZES[dtype], "little",
                                                                     signed=dtype.startswith("I")))
+        if index == 0x6067:
+            self._drive._window = None      # the cached position window is read again
 
 
 class Cia402Drive(Drive):
-    """The Drive API over any CiA 402 node (profile position, profile velocity, homing)."""
+    """The Drive API over any CiA 402 node (profile position, profile velocity, homing).
+
+    A move ends at its target within 6067h (position window, read once) or raises the
+    :class:`motorbus.MoveFailed` that says why, from the statusword and what it points to
+    (603Fh, 60FDh, 607Dh, 6040h): docs/drives/cia402.md "How a move ends".
+    ``velocity=`` sets 6081h (profile velocity) for that move only: it is put back when
+    the move ends, however it ends."""
 
     kind = "cia402"
     capabilities = frozenset({Capability.POSITION, Capability.VELOCITY, Capability.HOMING, Capability.STORE,
@@ -503,6 +713,11 @@ class Cia402Drive(Drive):
         self._sync_bus: Optional[_core.Bus] = None
         self._held_cw: Optional[int] = None
         self._sync_rpdo_cob: Optional[int] = None
+        self._homed = False                      # the last homing attained (sticky until the next)
+        self._window: Optional[float] = None     # 6067h, read at the first judged move
+        self._at_limit_since: Optional[float] = None
+        self._homing_since = 0.0
+        self._homing_ran = False
 
     # ---- helpers ----
     def _u32(self, index: int, value: float) -> None:
@@ -530,10 +745,15 @@ class Cia402Drive(Drive):
     def _disable(self) -> None:
         self.native.disable()
 
+    def _speed_for_this_move(self, velocity: Optional[float]) -> None:
+        """velocity= is for this move only: 6081h is put back when the move ends."""
+        if velocity is not None:
+            self._for_this_move(lambda: int.from_bytes(self._sdo.upload(0x6081, 0), "little"),
+                                lambda v: self._u32(0x6081, v), int(round(velocity)))
+
     def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
         self._use_mode(OpMode.PROFILE_POSITION)
-        if velocity is not None:
-            self._u32(0x6081, velocity)  # stays the profile velocity for later moves too
+        self._speed_for_this_move(velocity)
         if self._sync_bus is not None:
             self._hold_set_point(int(round(target)), relative)
             return
@@ -615,29 +835,156 @@ class Cia402Drive(Drive):
             if not isinstance(method, int) or not _core.Cia402Homing.supported(method):
                 raise _core.InvalidArgument(f"cia402 home: method 7, 11, 17-20 or 33-35, not {method!r}")
             self._sdo.download(0x6098, 0, int(method).to_bytes(1, "little", signed=True))
+        self._start_homing()
+
+    def _start_homing(self) -> None:
+        self._homed = False          # this homing decides; an earlier one no longer counts
+        self._homing_since = time.monotonic()
+        self._homing_ran = False
         self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
         self.native.write_controlword(int(Controlword.ENABLE_OPERATION) | _CW_NEW_SETPOINT)
 
+    #: Seconds after the homing start in which "target reached without homing attained"
+    #: still means "not started yet" rather than "interrupted" (CiA 402 shows both alike).
+    homing_start_grace = 0.2
+
     def _homing_done(self) -> bool:
+        """CiA 402 homing bits 13/12/10: error / attained / reached.  Ends on attained,
+        raises the MoveFailed that says why on an error or a fault, and returns True on an
+        interrupted homing (reached without attained, or the drive left Operation Enabled)
+        so that the outcome is judged (a halt or quick stop: MoveInterrupted)."""
         sw = self.native.statusword
-        if sw & _SW_BIT13:
-            self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
-            raise _core.DriveFault("cia402: homing error (statusword bit 13)")
-        if (sw & 0x4F) == 0x08:
-            raise _core.DriveFault(f"cia402: fault during homing (0x603F = 0x{self._read_u16(0x603F):04X})")
+        state = _core.cia402_decode_statusword(sw)
+        if state in ("FAULT", "FAULT REACTION ACTIVE") or sw & _SW_BIT13:
+            if sw & _SW_BIT13 and state == "OPERATION ENABLED":
+                self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
+            if state == "FAULT REACTION ACTIVE":
+                return False
+            status = self._status()
+            reason = self._stop_reason(status)
+            if reason is None or reason.error is MoveInterrupted:
+                reason = StopReason(MoveFaulted, "a homing error (statusword bit 13)")
+            elif not state.startswith("FAULT"):
+                reason = StopReason(reason.error, f"a homing error (statusword bit 13) at {reason.text}",
+                                    reason.code, reason.side)
+            raise self._failure(self._move, reason, status=status)
+        if state != "OPERATION ENABLED":
+            return True             # quick stopped or disabled: judged (MoveInterrupted)
+        reached = bool(sw & _SW_TARGET_REACHED)
         if (sw & (_SW_BIT12 | _SW_TARGET_REACHED)) == (_SW_BIT12 | _SW_TARGET_REACHED):
             self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
             return True
+        if not reached:
+            self._homing_ran = True
+            return False
+        # Reached, not attained, no error: interrupted (a halt) -- or not started yet.
+        if self._homing_ran or time.monotonic() - self._homing_since > self.homing_start_grace:
+            return self._velocity() == 0
         return False
 
     def _read_u16(self, index: int) -> int:
         return int.from_bytes(self._sdo.upload(index, 0), "little")
 
+    def _controlword_now(self) -> int:
+        """6040h as the drive holds it (another program may have written it)."""
+        return int.from_bytes(self._sdo.upload(0x6040, 0), "little")
+
+    #: Seconds a drive must stand still at an internal limit (bit 11) without showing
+    #: target reached before it counts as at rest (a move leaving a limit starts at v = 0).
+    limit_rest_time = 0.1
+
     def _is_idle(self) -> bool:
+        """At rest, whatever the reason: Operation Enabled with target reached (PP: the
+        target, or a halt: CiA 402 sets bit 10 once a halted axis stands), a following
+        error (bit 13), a standstill at an internal limit (bit 11); or out of Operation
+        Enabled (fault, quick stop done, disabled) -- with the velocity 0."""
         sw = self.native.statusword
-        if (sw & 0x4F) == 0x08:
-            raise _core.DriveFault(f"cia402: fault while moving (0x603F = 0x{self._read_u16(0x603F):04X})")
-        return bool(sw & _SW_TARGET_REACHED) and self._velocity() == 0
+        state = _core.cia402_decode_statusword(sw)
+        if state == "FAULT REACTION ACTIVE":
+            return False
+        if state == "OPERATION ENABLED":
+            settled = bool(sw & _SW_TARGET_REACHED)
+            if not settled and self._mode == OpMode.PROFILE_POSITION and sw & _SW_BIT13:
+                settled = True
+            if not settled and sw & _SW_INTERNAL_LIMIT:
+                since = self._at_limit_since
+                now = time.monotonic()
+                if since is None:
+                    self._at_limit_since = now
+                elif now - since >= self.limit_rest_time:
+                    settled = True
+            else:
+                self._at_limit_since = None
+            if not settled:
+                return False
+        self._at_limit_since = None
+        return self._velocity() == 0
+
+    def _in_position_window(self) -> float:
+        """6067h (position window), read once and kept: it is a setting, not a reading."""
+        if self._window is None:
+            try:
+                self._window = float(int.from_bytes(self._sdo.upload(0x6067, 0), "little"))
+            except _core.SdoAbortError:
+                self._window = self.in_position_window   # a drive without 6067h: exactly
+        return self._window
+
+    def _limit_side(self, status: DriveStatus) -> tuple[int, str]:
+        """Which limit the drive stands at, in its own terms (60FDh, then 607Dh)."""
+        bit11 = "; statusword bit 11 internal limit active" if int(status.raw) & _SW_INTERNAL_LIMIT else ""
+        if status.limit_positive:
+            return 1, f"the +limit switch (60FDh bit 1{bit11})"
+        if status.limit_negative:
+            return -1, f"the -limit switch (60FDh bit 0{bit11})"
+        lo, hi = self._travel_limits()
+        position = self._position()
+        if hi is not None and position >= hi:
+            return 1, f"the software position limit 607Dh:02 = {hi:g}{bit11.replace(';', ' (') + ')' if bit11 else ''}"
+        if lo is not None and position <= lo:
+            return -1, f"the software position limit 607Dh:01 = {lo:g}{bit11.replace(';', ' (') + ')' if bit11 else ''}"
+        return 0, "an internal limit (statusword bit 11; the drive does not say which)"
+
+    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+        """The statusword and what it points to: a fault (603Fh code and CiA 402 text; a
+        following error 0x8611 or motor blocked 0x7121 is a stall), a following error (PP
+        bit 13), a limit (60FDh switches, 607Dh soft limits, bit 11), a quick stop, the
+        drive out of Operation Enabled, or a halt (6040h bit 8) that this program did not
+        send."""
+        sw = int(status.raw)
+        state = _core.cia402_decode_statusword(sw)
+        ours = self._move is not None and self._move.stopped_by is not None
+        if state in ("FAULT", "FAULT REACTION ACTIVE"):
+            code = self._read_u16(0x603F)
+            error = MoveStalled if code in STALL_CODES else MoveFaulted
+            return StopReason(error, error_text(code), code=code)
+        if self._mode == OpMode.PROFILE_POSITION and sw & _SW_BIT13:
+            return StopReason(MoveStalled, "a following error (statusword bit 13)")
+        if sw & _SW_INTERNAL_LIMIT or status.limit_positive or status.limit_negative:
+            side, text = self._limit_side(status)
+            return StopReason(LimitReached, text, side=side)
+        if ours:
+            return None             # this program's stop()/quick_stop(): Drive says so
+        if state == "QUICK STOP ACTIVE":
+            return StopReason(MoveInterrupted, "a quick stop (state QUICK STOP ACTIVE) from another program or a "
+                                               "stop input (CiA 402 does not say which)")
+        if state != "OPERATION ENABLED":
+            return StopReason(MoveInterrupted, f"the drive leaving OPERATION ENABLED (now {state}): a quick stop, "
+                                               "disable or shutdown from another program, a stop input or a lost "
+                                               "heartbeat")
+        if self._controlword_now() & _CW_HALT:
+            return StopReason(MoveInterrupted, "a halt (controlword bit 8) from another program")
+        return None
+
+    def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
+        """607Dh:01/02 (software position limits); the I32 extremes mean none."""
+        try:
+            lo = int.from_bytes(self._sdo.upload(0x607D, 1), "little", signed=True)
+            hi = int.from_bytes(self._sdo.upload(0x607D, 2), "little", signed=True)
+        except _core.SdoAbortError:
+            return (None, None)      # the drive has no 607Dh
+        if lo >= hi:
+            return (None, None)      # CiA 402: min >= max switches the limits off on many drives
+        return (None if lo <= _I32_MIN else float(lo), None if hi >= _I32_MAX else float(hi))
 
     def _clear_faults(self) -> None:
         self.native.fault_reset()
@@ -659,7 +1006,7 @@ class Cia402Drive(Drive):
         """The status line; a vendor kind adds what its drive says beyond CiA 402."""
         text = f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}"
         if fault:
-            text += f", error 0x{self._read_u16(0x603F):04X}"
+            text += f", {error_text(self._read_u16(0x603F))}"
         return text
 
     def _status(self) -> DriveStatus:
@@ -669,11 +1016,14 @@ class Cia402Drive(Drive):
         velocity = self._velocity()
         mode = self._mode
         fault = state in ("FAULT", "FAULT REACTION ACTIVE")
-        at_target = bool(sw & _SW_TARGET_REACHED)
+        # PP with halt (6040h bit 8) set: bit 10 means "stands still", not "at target" (CiA 402).
+        at_target = bool(sw & _SW_TARGET_REACHED) and state == "OPERATION ENABLED" and not (
+            mode == OpMode.PROFILE_POSITION and self._controlword_now() & _CW_HALT)
         homed = mode == OpMode.HOMING and bool(sw & _SW_BIT12)
-        self._homed = getattr(self, "_homed", False) or homed
+        self._homed = self._homed or homed
         text = self._status_text(state, mode, sw, fault)
-        return DriveStatus(enabled=state == "OPERATION ENABLED", moving=velocity != 0 or not at_target,
+        return DriveStatus(enabled=state == "OPERATION ENABLED",
+                           moving=velocity != 0 or not (sw & _SW_TARGET_REACHED or state != "OPERATION ENABLED"),
                            homed=self._homed, fault=fault, at_target=at_target,
                            limit_positive=bool(inputs & 2), limit_negative=bool(inputs & 1), raw=sw, text=text)
 
@@ -743,11 +1093,19 @@ def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Uni
 
 
 # Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+# The standard names ("limit", "fault", "stall", "stop_input") and the older alias.
 SIM_FAULTS = {
-    # the drive detects a fault (an error code, default 0x5441 interlock): motor stops, state FAULT
+    # a limit switch closes (+1 / -1): a motion toward it stops at once (bit 11, 60FDh)
+    "limit": lambda sim, direction=1: sim.force_limit(int(direction), True),
+    # the drive detects a fault (603Fh code, default 0x5441 interlock): motor stops, state FAULT
+    "fault": lambda sim, code=0x5441: sim.inject_fault(int(code)),
+    # the rotor jams: the following error passes 6065h, fault 0x8611 (statusword bit 13)
+    "stall": lambda sim: sim.jam(True),
+    # the simulator's quick-stop input (60FDh bit 16) fires: a quick stop, as by controlword
+    "stop_input": lambda sim: sim.set_stop_input(True),
     "drive_fault": lambda sim, code=0x5441: sim.inject_fault(int(code)),
-    # (no "stall": the generic simulator reports the commanded position, a jam would not show)
 }
+
 def poll_fields(drive: Cia402Drive, fields: Sequence[str]):
     """motorbus.Poller: 6064h/606Ch/6041h by SDO through the drive's own client."""
     from ..canopen.poll import CIA402_POLL_OBJECTS, sdo_poll_spec

@@ -386,7 +386,10 @@ std::uint32_t Sim::od_read(std::uint16_t index, std::uint8_t sub, std::uint32_t&
                 reached = (co.cw & kHalt) ? idle : std::abs(vnow - target) < 0.5 && !co.pv_pending;
                 bit12 = std::abs(vnow) < 0.5;  // speed zero
             } else if (oe && co.active_mode == 6) {
-                reached = co.homing_started ? (co.homing_attained || co.homing_error) : idle;
+                // A halted homing stands without attained or error: bits 10/12/13 = 1/0/0,
+                // "interrupted" (CiA 402), so the host sees it at rest.
+                const bool halted = (co.cw & kHalt) && idle;
+                reached = co.homing_started ? (co.homing_attained || co.homing_error || halted) : idle;
                 bit12 = co.homing_attained;
                 bit13 = co.homing_error;
             }
