@@ -1112,6 +1112,10 @@ class LineLink:
         """
     def send(self, request: typing.Any) -> None:
         ...
+    def set_trace(self, callback: typing.Any) -> None:
+        """
+        A protocol trace: callback(direction, data) with '>' and each request written (a list of byte values, without its terminator), '<' and each reply line read, '!' and a note when a request got no reply in time; on the transacting thread (it must not use this link).  None turns it off.
+        """
     def transact(self, request: typing.Any, timeout: typing.Any = None) -> bytes:
         """
         Sends request + terminator and returns the reply without its terminator. timeout None = the link's reply_timeout.
