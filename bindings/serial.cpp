@@ -353,6 +353,25 @@ void bind_serial(py::module_& m) {
             },
             py::arg("timeout") = py::none(),
             "One line (e.g. unsolicited) or None on timeout; a partial line stays buffered.")
+        .def(
+            "set_trace",
+            [](LineLink& l, const py::object& callback) {
+                if (callback.is_none()) {
+                    l.set_trace({});
+                    return;
+                }
+                if (!PyCallable_Check(callback.ptr())) throw InvalidArgument("set_trace: a callable or None");
+                py_helpers::PyCallable f(py::reinterpret_borrow<py::function>(callback));
+                l.set_trace([f](char direction, const std::string& text) {
+                    // Plain C++ values: PyCallable converts them once it holds the GIL
+                    // (the data as a list of byte values; the Python side makes bytes of it).
+                    f(std::string(1, direction), std::vector<std::uint8_t>(text.begin(), text.end()));
+                });
+            },
+            py::arg("callback"),
+            "A protocol trace: callback(direction, data) with '>' and each request written (a list of byte values, without "
+            "its terminator), '<' and each reply line read, '!' and a note when a request got no reply in "
+            "time; on the transacting thread (it must not use this link).  None turns it off.")
         .def_property_readonly("counters", &LineLink::counters, "LineCounters (a snapshot)")
         .def_property_readonly("port", [](LineLink& l) { return &l.port(); }, py::return_value_policy::reference_internal)
         .def_property_readonly("max_line", [](const LineLink& l) { return l.options().max_line; })

@@ -589,9 +589,19 @@ def cmd_terminal(args: argparse.Namespace) -> int:
             readline = None
 
     def work(bench: Bench) -> int:
+        from .drive import Drive
+
         d = bench[args.axis]
+        if type(d)._console is Drive._console:
+            raise _core.InvalidArgument(f"terminal: axis {args.axis!r} ({d.kind}) has no protocol console "
+                                        "in motorbus")
         if interactive:
-            _say(f"{args.axis}: {d.kind} — its own protocol; 'quit' leaves")
+            if getattr(d.native, "sdo", None) is not None:    # a CANopen node: SDO reads and writes
+                from .canopen.console import CONSOLE_HELP
+                _say(f"{args.axis}: {d.kind} (CANopen) — SDO reads and writes; 'quit' leaves")
+                _say(CONSOLE_HELP)
+            else:
+                _say(f"{args.axis}: {d.kind} — its own protocol; 'quit' leaves")
         while True:
             try:
                 line = input(f"{args.axis}> " if interactive else "")

@@ -270,13 +270,33 @@ def test_trace_shows_frames_and_lines(served):
     assert r.returncode == 0, r.stderr
     err = r.stderr
     # serial: the arcus requests and replies; CAN: the SDO requests and answers on node 5
-    assert re.search(r"motorbus\.trace: l0 > @01", err) or re.search(r"motorbus\.trace: l0 > ", err), err
+    assert re.search(r"motorbus\.trace: l0 > @01MST$", err, re.M), err
     assert re.search(r"motorbus\.trace: l0 < ", err), err
     assert re.search(r"motorbus\.trace: can0 605#\w+  \(SDO request, node 5\)", err), err
     assert re.search(r"motorbus\.trace: can0 585#\w+  \(SDO answer, node 5\)", err), err
     r = cli("-vv", "move", served.path, "x", "0.25")
     assert r.returncode == 0
     assert "motorbus.drive: x: move_to 0.25 mm" in r.stderr and "motorbus.trace" not in r.stderr, r.stderr
+
+
+def test_line_link_trace_reports_requests_replies_and_timeouts():
+    from motorbus import _core
+    seen = []
+    with _core.PtyLineServer([_core.EchoLineDevice("E:")]) as server:
+        link = _core.LineLink(_core.open_port(server.slave_path), reply_timeout=0.2)
+        link.set_trace(lambda direction, data: seen.append((direction, bytes(data))))
+        assert link.transact("hello\x01") == b"E:hello\x01"
+        link.set_trace(None)
+        assert link.transact("quiet") == b"E:quiet"
+    assert seen == [(">", b"hello\x01"), ("<", b"E:hello\x01")]
+    with _core.PtyPair() as pair:          # nobody answers on the other side
+        link = _core.LineLink(pair.open_slave(), reply_timeout=0.1)
+        link.set_trace(lambda direction, data: seen.append((direction, bytes(data))))
+        with pytest.raises(motorbus.TimeoutError):
+            link.transact("ping")
+        with pytest.raises(motorbus.InvalidArgument):
+            link.set_trace(42)
+    assert seen[2:] == [(">", b"ping"), ("!", b"no reply within 100 ms")]
 
 
 # ---- read-only commands leave a moving axis alone (issue 28, item 2) ------------------------------------

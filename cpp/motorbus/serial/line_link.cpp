@@ -4,6 +4,7 @@
 #include <mutex>
 #include <thread>
 
+#include "motorbus/runtime/callback_slot.hpp"
 #include "motorbus/runtime/fifo_mutex.hpp"
 #include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/serial/line_framer.hpp"
@@ -44,6 +45,7 @@ struct LineLink::Impl {
     std::vector<std::uint8_t> pending;  // read but not yet framed
     std::string echo;                   // bytes we expect back from an echoing adapter
     std::size_t echo_pos = 0;
+    CallbackSlot<void(char, const std::string&)> trace;  // set_trace (may change while in use)
 
     struct {
         std::atomic<std::uint64_t> bytes_in{0}, bytes_out{0}, requests{0}, replies{0}, timeouts{0},
@@ -88,6 +90,7 @@ struct LineLink::Impl {
         port->write({reinterpret_cast<const std::uint8_t*>(out.data()), out.size()});
         c.bytes_out += out.size();
         ++c.requests;
+        trace('>', std::string(request));
     }
 
     // Newly read bytes go through echo suppression, then into `pending`.
@@ -150,6 +153,7 @@ struct LineLink::Impl {
                                to_vec(line.text));
         }
         ++c.replies;
+        trace('<', line.text);
         return line.text;
     }
 };
@@ -193,6 +197,8 @@ std::string LineLink::transact(std::string_view request, std::optional<Duration>
                                " and no terminator arrived");
         }
         ++d.c.timeouts;
+        d.trace('!', "no reply within " +
+                         std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(t).count()) + " ms");
         std::size_t partial = d.framer.partial_bytes() + d.pending.size();
         d.framer.reset();
         d.pending.clear();
@@ -223,6 +229,8 @@ std::optional<std::string> LineLink::read_line(Duration timeout) {
 const LineOptions& LineLink::options() const { return impl_->options; }
 
 Port& LineLink::port() { return *impl_->port; }
+
+void LineLink::set_trace(Trace trace) { impl_->trace = std::move(trace); }
 
 LineCounters LineLink::counters() const {
     const auto& c = impl_->c;

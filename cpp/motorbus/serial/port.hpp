@@ -4,6 +4,7 @@
 #pragma once
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -159,6 +160,12 @@ public:
     const LineOptions& options() const;
     Port& port();
     LineCounters counters() const;
+    // A protocol trace: called with '>' and each request written (without its
+    // terminator), '<' and each reply line read, '!' and a note when a request gets
+    // no reply in time.  Runs on the transacting thread inside the link's lock (it
+    // must not use this link); an empty function turns it off.
+    using Trace = std::function<void(char direction, const std::string& text)>;
+    void set_trace(Trace trace);
 
 private:
     struct Impl;
