@@ -237,6 +237,9 @@ def _run(args: argparse.Namespace, work: Callable[[Bench], int], *, axes: Option
     except _core.MotorbusError as e:
         _err(error_text(e))
         return exit_code(e)
+    log.info("%s: opened %s%s (lines: %s; buses: %s)", bench.source, ", ".join(bench.axes),
+             " on its simulated twin" if bench.simulated else "", ", ".join(bench.lines) or "none",
+             ", ".join(bench.buses) or "none")
     try:
         try:
             return work(bench)
@@ -245,6 +248,7 @@ def _run(args: argparse.Namespace, work: Callable[[Bench], int], *, axes: Option
             return exit_code(e)
         finally:
             if stop_on_exit:
+                log.info("stopping %s on the way out", ", ".join(bench.axes))
                 for name, e in bench.stop_all():
                     _err(f"motorbus: {name}: could not stop: {type(e).__name__}: {e}")
     finally:
@@ -399,6 +403,7 @@ def _motion(args: argparse.Namespace, bench: Bench, what: str, action: Callable[
         _say(f"{args.axis}: homed at {_fmt(position)} {d.units.name}")
     else:
         _say(f"{args.axis}: {_fmt(position)} {d.units.name}")
+    log.info("%s: %s ended with exit code %d", args.axis, what, code)
     return code
 
 

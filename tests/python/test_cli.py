@@ -205,6 +205,10 @@ def test_enable_disable_clear_and_move_json(served):
     out = json.loads(r.stdout)
     assert out == {"axis": "z", "kind": "cia402", "what": "move", "target": 12.5, "position": 12.5, "units": "mm",
                    "outcome": "done", "reason": "", "code": None, "exit_code": 0}
+    r = cli("home", served.path, "z", "--method", "35", "--json")        # 35: here is home
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout) == {"axis": "z", "kind": "cia402", "what": "home", "target": None, "position": 0.0,
+                                    "units": "mm", "outcome": "done", "reason": "", "code": None, "exit_code": 0}
     r = cli("move", served.path, "x", "0.5", "--by")
     assert r.returncode == 0 and r.stdout == "x: 0.5 mm\n", r
     r = cli("disable", served.path, "z")
@@ -277,6 +281,11 @@ def test_trace_shows_frames_and_lines(served):
     r = cli("-vv", "move", served.path, "x", "0.25")
     assert r.returncode == 0
     assert "motorbus.drive: x: move_to 0.25 mm" in r.stderr and "motorbus.trace" not in r.stderr, r.stderr
+    assert "motorbus.drive: x: move ended: done" in r.stderr
+    r = cli("move", served.path, "x", "0.5", "-v")          # -v after the command works too: INFO only
+    assert r.returncode == 0
+    assert "motorbus.cli_bench: " in r.stderr and "opened x (lines: l0; buses: none)" in r.stderr, r.stderr
+    assert "motorbus.drive" not in r.stderr
 
 
 def test_line_link_trace_reports_requests_replies_and_timeouts():
