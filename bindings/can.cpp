@@ -22,6 +22,7 @@ using motorbus::py_helpers::duration_arg;
 using motorbus::py_helpers::finite_forever;
 using motorbus::py_helpers::Forever;
 using motorbus::py_helpers::interruptible_wait;
+using motorbus::py_helpers::blocking_call;
 using motorbus::py_helpers::arg_cast;
 using motorbus::py_helpers::arg_iterable;
 using motorbus::py_helpers::not_none;
@@ -52,6 +53,10 @@ Frame frame_from_py(std::uint32_t id, const py::object& data, bool extended, boo
         }
     }
     int rtr_dlc = dlc.is_none() ? -1 : arg_cast<int>(dlc, "frame dlc", "an int 0-8 or None");
+    // -1 is the core's "not given" (None here): an explicit negative DLC is wrong,
+    // not a request for the default (Frame(rtr=True, dlc=-1) used to pass as DLC 0).
+    if (!dlc.is_none() && rtr_dlc < 0)
+        throw InvalidArgument("frame dlc: " + std::to_string(rtr_dlc) + ", must be 0-8 (or None)");
     if (!rtr && rtr_dlc >= 0 && static_cast<std::size_t>(rtr_dlc) != bytes.size())
         throw InvalidArgument("frame dlc: " + std::to_string(rtr_dlc) + " does not match " +
                               std::to_string(bytes.size()) + " data bytes");
@@ -102,8 +107,9 @@ void bind_can(py::module_& m) {
         .def("send",
              [](Bus& b, const Frame& f, const py::object& timeout) {
                  auto t = finite_forever(seconds_to_ns(timeout));
-                 py::gil_scoped_release nogil;
-                 b.send(f, t);
+                 // A blocking call: a send waiting on a full queue returns to
+                 // Python for Ctrl-C every kInterruptSlice.
+                 blocking_call([&] { b.send(f, t); });
              },
              py::arg("frame"), py::arg("timeout") = 1.0)
         .def("recv",

@@ -1,6 +1,9 @@
 // Bindings for cpp/motorbus/canopen: object dictionary, EDS, SDO client,
 // LocalNode, and the SDO errors (SdoAbortError, SdoTimeout, SdoProtocolError)
 // through the error table of errors.hpp.
+#include <cmath>
+#include <limits>
+
 #include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -425,11 +428,13 @@ void bind_canopen(py::module_& m) {
         .def_readonly("retransmit_requests", &SdoClientCounters::retransmit_requests,
                       "block: sub-blocks acknowledged short (lost frames)")
         .def_readonly("fallbacks", &SdoClientCounters::fallbacks, "block refused, retried segmented")
+        .def_readonly("foreign_responses", &SdoClientCounters::foreign_responses,
+                      "initiate responses / aborts naming another object: another client's on the same COB-IDs, ignored")
         .def("__repr__", [](const SdoClientCounters& c) {
             return "SdoClientCounters(transfers=" + u64s(c.transfers) + ", aborts_received=" + u64s(c.aborts_received) +
                    ", aborts_sent=" + u64s(c.aborts_sent) + ", timeouts=" + u64s(c.timeouts) + ", ignored_frames=" +
                    u64s(c.ignored_frames) + ", retransmit_requests=" + u64s(c.retransmit_requests) +
-                   ", fallbacks=" + u64s(c.fallbacks) + ")";
+                   ", fallbacks=" + u64s(c.fallbacks) + ", foreign_responses=" + u64s(c.foreign_responses) + ")";
         });
     py::class_<SdoServerCounters>(m, "SdoServerCounters", "Counters of a LocalNode's SDO server.")
         .def_readonly("requests", &SdoServerCounters::requests)
@@ -462,9 +467,10 @@ void bind_canopen(py::module_& m) {
     py::class_<SdoClient>(m, "SdoClient", "SDO client for one node (requests 0x600+n, responses 0x580+n).")
         .def(py::init([](can::Bus& bus, std::uint8_t node_id, double timeout, std::size_t max_transfer,
                          std::uint8_t block_size, unsigned read_retries, std::uint32_t request_id,
-                         std::uint32_t response_id, bool block_fallback) {
+                         std::uint32_t response_id, bool block_fallback, bool block_crc) {
                  SdoClientOptions o;
                  o.fallback_to_segmented = block_fallback;
+                 o.block_crc = block_crc;
                  // 0 would time every transfer out before its first response; inf waits
                  // forever (Ctrl-C still ends it).
                  if (timeout == 0) throw InvalidArgument("SdoClient timeout: must be > 0 s (inf = wait forever)");
@@ -478,7 +484,10 @@ void bind_canopen(py::module_& m) {
              }),
              py::arg("bus"), py::arg("node_id"), py::arg("timeout") = 1.0, py::arg("max_transfer") = 1u << 20,
              py::arg("block_size") = 127, py::arg("read_retries") = 0, py::arg("request_id") = 0,
-             py::arg("response_id") = 0, py::arg("block_fallback") = false, py::keep_alive<1, 2>())
+             py::arg("response_id") = 0, py::arg("block_fallback") = false, py::arg("block_crc") = true,
+             py::keep_alive<1, 2>(),
+             "block_crc: block transfers offer and require CRC-16 (a server answering without it is "
+             "refused, abort 0x05040004); False for a server without CRC, whose block data is then unchecked.")
         .def("upload", [](SdoClient& c, std::uint16_t i, std::uint8_t s, bool block) {
                  Bytes b;
                  b = blocking_call([&] { return c.upload(i, s, block ? TransferMode::Block : TransferMode::Auto); });
@@ -499,8 +508,18 @@ void bind_canopen(py::module_& m) {
          py::arg("subindex"), py::arg("value"))
         MB_RW(std::uint8_t, u8) MB_RW(std::uint16_t, u16) MB_RW(std::uint32_t, u32) MB_RW(std::uint64_t, u64)
         MB_RW(std::int8_t, i8) MB_RW(std::int16_t, i16) MB_RW(std::int32_t, i32) MB_RW(std::int64_t, i64)
-        MB_RW(float, f32) MB_RW(double, f64)
+        MB_RW(double, f64)
 #undef MB_RW
+        .def("read_f32", &Blocking<&SdoClient::read_f32>::call, py::arg("index"), py::arg("subindex") = 0)
+        .def("write_f32", [](SdoClient& c, std::uint16_t i, std::uint8_t s, double v) {
+                 // A Python float is a double: past the float range the cast stored inf.
+                 // inf and nan themselves are REAL32 values and pass.
+                 if (std::isfinite(v) && std::fabs(v) > static_cast<double>(std::numeric_limits<float>::max()))
+                     throw InvalidArgument("write_f32 value: " + py::repr(py::float_(v)).cast<std::string>() +
+                                           " is outside the REAL32 range (|v| <= 3.4028235e38)");
+                 blocking_call([&] { c.write_f32(i, s, static_cast<float>(v)); });
+             },
+             py::arg("index"), py::arg("subindex"), py::arg("value"))
         .def("read_string", &Blocking<&SdoClient::read_string>::call, py::arg("index"), py::arg("subindex") = 0)
         .def("write_string", [](SdoClient& c, std::uint16_t i, std::uint8_t s, const std::string& v) {
                  blocking_call([&] { c.write_string(i, s, v); });

@@ -141,8 +141,8 @@ void bind_slcan(py::module_& m) {
               }
               o.bus.receive_own = receive_own;
               o.bus.rx_queue_size = rx_queue_size;
-              py::gil_scoped_release nogil;
-              return open_slcan(path, bitrate, o);
+              // The open sequence waits for the adapter in slices: Ctrl-C returns at once.
+              return blocking_call([&] { return open_slcan(path, bitrate, o); });
           },
           py::arg("path"), py::arg("bitrate") = 500000, py::arg("timestamps") = false,
           py::arg("echo_suppression") = false, py::arg("listen_only") = false,

@@ -16,6 +16,7 @@ using namespace motorbus::can;
 using motorbus::py_helpers::Record;
 using motorbus::py_helpers::seconds_to_ns;
 using motorbus::py_helpers::interruptible_wait;
+using motorbus::py_helpers::blocking_call;
 using motorbus::py_helpers::not_none;
 using motorbus::py_helpers::duration_arg;
 using motorbus::py_helpers::finite_forever;
@@ -69,8 +70,8 @@ void bind_socketcand(py::module_& m) {
                      return;
                  } catch (const motorbus::TimeoutError&) {
                  }
-                 py::gil_scoped_release nogil;
-                 b.send(f, t.count() < 0 ? std::chrono::hours(24 * 365) : t);
+                 // Ctrl-C live while the server is not reading (the wait is sliced).
+                 blocking_call([&] { b.send(f, t.count() < 0 ? std::chrono::hours(24 * 365) : t); });
              },
              py::arg("frame"), py::arg("timeout") = 1.0)
         .def("recv",
@@ -103,8 +104,8 @@ void bind_socketcand(py::module_& m) {
             o.keepalive_misses = keepalive_misses;
             o.tcp_keepalive = tcp_keepalive;
             o.tx_buffer_bytes = tx_buffer_bytes;
-            py::gil_scoped_release nogil;
-            return open_socketcand(host, port, channel, o);
+            // Connect and handshake poll in slices: Ctrl-C returns at once.
+            return blocking_call([&] { return open_socketcand(host, port, channel, o); });
         },
         py::arg("host"), py::arg("port"), py::arg("channel"), py::arg("receive_own") = false,
         py::arg("rx_queue_size") = 65536, py::arg("connect_timeout") = 3.0,

@@ -59,6 +59,46 @@ void Bus::link_lost(const std::string& reason) {
     }
     if (!closed_.load()) set_state(BusState::BusOff);
     rx_cv_.notify_all();
+    link_interrupted(reason);
+}
+
+void Bus::link_interrupted(const std::string& reason) {
+    {
+        std::lock_guard lock(watch_mutex_);
+        last_link_loss_ = reason;
+        // Counted under the lock that guards the reason: a reader that sees the
+        // new count also sees its reason.
+        link_losses_.fetch_add(1, std::memory_order_acq_rel);
+    }
+    notify_link_watchers();
+}
+
+std::string Bus::link_loss_reason() const {
+    std::lock_guard lock(watch_mutex_);
+    return last_link_loss_;
+}
+
+SubscriptionId Bus::watch_link(std::function<void()> cb) {
+    const SubscriptionId id = next_sub_++;
+    std::lock_guard lock(watch_mutex_);
+    watchers_.emplace_back(id, std::make_shared<const std::function<void()>>(std::move(cb)));
+    return id;
+}
+
+void Bus::unwatch_link(SubscriptionId id) {
+    std::lock_guard lock(watch_mutex_);
+    std::erase_if(watchers_, [&](const auto& w) { return w.first == id; });
+}
+
+void Bus::notify_link_watchers() {
+    std::vector<std::shared_ptr<const std::function<void()>>> cbs;
+    {
+        std::lock_guard lock(watch_mutex_);
+        for (const auto& w : watchers_) cbs.push_back(w.second);
+    }
+    // No lock held: a watcher takes its own (an SDO client's), which its owner
+    // may hold while it calls send() -- the very call that may find the link dead.
+    for (const auto& cb : cbs) (*cb)();
 }
 
 // Waits until the recv() queue has a frame: false after `timeout` (negative =
@@ -82,6 +122,7 @@ bool Bus::wait_for_rx(std::unique_lock<std::mutex>& lock, Duration timeout) {
 
 std::optional<Frame> Bus::recv(Duration timeout) {
     std::unique_lock lock(rx_mutex_);
+    recv_used_ = true;
     if (!wait_for_rx(lock, timeout)) return std::nullopt;
     Frame f = rx_queue_.front();
     rx_queue_.pop_front();
@@ -90,8 +131,9 @@ std::optional<Frame> Bus::recv(Duration timeout) {
 
 std::vector<Frame> Bus::recv_many(std::size_t max, Duration timeout) {
     std::vector<Frame> out;
-    if (max == 0) return out;
     std::unique_lock lock(rx_mutex_);
+    recv_used_ = true;
+    if (max == 0) return out;
     if (!wait_for_rx(lock, timeout)) return out;
     const auto n = static_cast<std::ptrdiff_t>(std::min(max, rx_queue_.size()));
     out.assign(rx_queue_.begin(), rx_queue_.begin() + n);
@@ -101,6 +143,7 @@ std::vector<Frame> Bus::recv_many(std::size_t max, Duration timeout) {
 
 void Bus::set_filters(std::vector<Filter> filters) {
     std::lock_guard lock(rx_mutex_);
+    recv_used_ = true;  // filters are for recv(): someone means to read
     filters_ = std::move(filters);
 }
 
@@ -161,7 +204,8 @@ void Bus::dispatch_batch(std::span<const Frame> frames) {
         std::lock_guard lock(table_mutex_);
         table = table_;
     }
-    if (!table->by_id.empty() || !table->masked.empty()) {
+    const bool callbacks = !table->by_id.empty() || !table->masked.empty();
+    if (callbacks) {
         std::lock_guard running(dispatch_mutex_);
         dispatch_thread_.store(std::this_thread::get_id());
         for (const Frame& frame : frames) {
@@ -174,12 +218,15 @@ void Bus::dispatch_batch(std::span<const Frame> frames) {
     }
     {
         std::lock_guard lock(rx_mutex_);
+        // Read only through callbacks so far: keep a few frames, not rx_queue_size.
+        const std::size_t cap =
+            callbacks && !recv_used_ ? std::min(options_.rx_queue_size, kUnreadQueueCap) : options_.rx_queue_size;
         for (const Frame& frame : frames) {
             if (!filters_.empty() &&
                 std::none_of(filters_.begin(), filters_.end(),
                              [&](const Filter& f) { return f.matches(frame); }))
                 continue;
-            if (rx_queue_.size() >= options_.rx_queue_size) {
+            while (rx_queue_.size() >= cap) {
                 rx_queue_.pop_front();
                 rx_dropped_.fetch_add(1, std::memory_order_relaxed);
             }
@@ -208,6 +255,9 @@ BusCounters Bus::counters() const {
 void Bus::close() {
     std::call_once(close_once_, [&] {
         closed_.store(true);
+        // Before do_close(), which may take a while (joins): a transfer waiting
+        // for a response on another thread ends now with ClosedError.
+        notify_link_watchers();
         do_close();
         state_.store(BusState::Closed);
         rx_cv_.notify_all();

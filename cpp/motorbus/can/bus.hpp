@@ -49,9 +49,18 @@ struct BusCounters {
 using FrameCallback = std::function<void(const Frame&)>;
 using SubscriptionId = std::uint64_t;
 
+// A bus with subscribers (callbacks) on which recv()/recv_many()/set_filters()
+// was never called keeps at most this many frames for a recv() that may never
+// come: a simulated node or a server endpoint consumes frames only through its
+// callbacks, and 127 of them kept 65 536 unread frames each (811 MB).  The first
+// recv() (or set_filters()) lifts the cap to rx_queue_size; the newest frames
+// are kept, the others counted in rx_dropped.
+constexpr std::size_t kUnreadQueueCap = 1024;
+
 struct BusOptions {
     // Frames kept for recv(); the oldest is dropped past this.  >= 1
     // (InvalidArgument otherwise: 0 used to pop from an empty queue).
+    // See kUnreadQueueCap for a bus read only through callbacks.
     std::size_t rx_queue_size = 65536;
     bool receive_own = false;           // deliver frames we sent back to recv()/subscribers
 };
@@ -104,6 +113,21 @@ public:
     // Stops the backend, wakes every waiter.  Idempotent.
     void close();
 
+    // Link watchers: `cb` runs (on whichever thread notices, with no bus lock
+    // held) when the link is lost -- for good (link_lost()) or while the backend
+    // reconnects (link_interrupted()) -- and when close() starts.  For a waiter
+    // that is not in recv() (an SDO transfer waiting for its response) to wake at
+    // once instead of at its timeout.  `cb` must be quick and must not call back
+    // into this bus; it may still run once just after unwatch_link() returns,
+    // so it must capture only what outlives that (a shared_ptr).
+    SubscriptionId watch_link(std::function<void()> cb);
+    void unwatch_link(SubscriptionId id);
+    // How many times the link was lost or interrupted since the bus opened, and
+    // why the last time (empty if never): a transfer that sees the count change
+    // while it waits knows frames of its exchange may have been lost.
+    std::uint64_t link_losses() const { return link_losses_.load(std::memory_order_acquire); }
+    std::string link_loss_reason() const;
+
     // Identity of the medium this endpoint is on: endpoints that see each
     // other's frames as one bus share it (all endpoints of one virtual hub).
     // Default: this bus object.  Lets a node-ID be claimed once per medium.
@@ -128,6 +152,10 @@ protected:
     // recv_many() waiter -- now or later, once the queue is drained -- gets
     // LinkDown(reason) instead of waiting forever.  Not for our own close().
     void link_lost(const std::string& reason);
+    // The link dropped but the backend reconnects by itself (an SLCAN adapter
+    // unplugged): recv() goes on, but link watchers are told and link_losses()
+    // counts it, since frames in flight were lost.
+    void link_interrupted(const std::string& reason);
 
     // True while anyone is subscribed; lets a backend skip its thread hop
     // when there is no callback to run (frames then go straight to recv()).
@@ -170,6 +198,7 @@ private:
     std::vector<Filter> filters_;
     std::atomic<bool> link_lost_{false};
     std::string link_lost_reason_;  // rx_mutex_
+    bool recv_used_ = false;        // rx_mutex_: recv()/recv_many()/set_filters() was called
 
     // subscribers: copy-on-write table, read under table_mutex_ by dispatch()
     std::mutex table_mutex_;
@@ -178,6 +207,13 @@ private:
     std::atomic<std::thread::id> dispatch_thread_{};
     std::atomic<SubscriptionId> next_sub_{1};
     std::atomic<int> subscriber_count_{0};
+
+    // link watchers (watch_link): called without any lock held
+    void notify_link_watchers();
+    mutable std::mutex watch_mutex_;
+    std::vector<std::pair<SubscriptionId, std::shared_ptr<const std::function<void()>>>> watchers_;
+    std::atomic<std::uint64_t> link_losses_{0};
+    std::string last_link_loss_;  // watch_mutex_
 
     std::atomic<std::uint64_t> rx_frames_{0}, tx_frames_{0}, rx_dropped_{0}, tx_dropped_{0},
         overruns_{0}, parse_errors_{0}, bus_errors_{0}, ignored_{0};

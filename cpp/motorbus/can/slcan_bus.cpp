@@ -105,6 +105,14 @@ void SlcanBus::command_inline(serial::Port& port, const std::string& line, bool 
             throw TimeoutError("slcan " + channel() + ": no answer to '" + line +
                                "' (an adapter that never answers needs wait_for_acks=False)");
         }
+        if (interruptible()) {  // Ctrl-C while an adapter does not answer the open sequence
+            try {
+                interruption_point();
+            } catch (...) {
+                awaiting_ = false;
+                throw;
+            }
+        }
         auto slice = std::min<Duration>(deadline - now, kReadSlice);
         std::size_t n = port.read(buf, slice);
         if (n) decoder_.feed(std::span(buf.data(), n), [&](const Event& e) { handle(e); });
@@ -123,7 +131,8 @@ void SlcanBus::do_send(const Frame& frame, Deadline deadline) {
     std::shared_ptr<serial::Port> port;
     {
         std::unique_lock lock(mutex_);
-        const bool ok = cv_.wait_until(lock, deadline, [&] {
+        // Interruptible: Ctrl-C while the adapter does not acknowledge.
+        const bool ok = interruptible_wait_until(cv_, lock, deadline, [&] {
             return stop_ || !link_up_ ||
                    ((!opts_.wait_for_acks || pending_.size() < opts_.tx_window) &&
                     txbuf_.size() + n <= kTxBufMax);
@@ -209,7 +218,7 @@ void SlcanBus::tx_writer() {
 void SlcanBus::claim_writer(std::unique_lock<std::mutex>& lock, Deadline deadline) {
     // One whole line at a time on the port, and (with acks) at most tx_window
     // unanswered commands: back-pressure instead of an adapter FIFO overflow.
-    const bool ok = cv_.wait_until(lock, deadline, [&] {
+    const bool ok = interruptible_wait_until(cv_, lock, deadline, [&] {
         return stop_ || !link_up_ ||
                (!writing_ && txbuf_.empty() &&
                 (!opts_.wait_for_acks || pending_.size() < opts_.tx_window));
@@ -419,7 +428,7 @@ void SlcanBus::expire_pending(Deadline now) {
     if (any) cv_.notify_all();
 }
 
-void SlcanBus::link_lost(const std::string&) {
+void SlcanBus::link_lost(const std::string& why) {
     std::shared_ptr<serial::Port> port;
     {
         std::lock_guard lock(mutex_);
@@ -439,6 +448,9 @@ void SlcanBus::link_lost(const std::string&) {
     cv_.notify_all();
     // Wakes a writer blocked on the dead port; the receive thread reconnects.
     if (port) port->close();
+    // Frames in flight are lost: a waiting SDO transfer ends with LinkDown now
+    // rather than at its timeout (Bus link watchers).
+    if (!closed()) link_interrupted(why);
 }
 
 bool SlcanBus::reopen() {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "motorbus/errors.hpp"
+#include "motorbus/runtime/interrupt.hpp"
 
 namespace motorbus::can {
 
@@ -36,9 +37,11 @@ void write_all(int fd, const std::string& s, Deadline deadline) {
         if (r < 0 && errno == EINTR) continue;
         if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
             pollfd p{fd, POLLOUT, 0};
-            if (::poll(&p, 1, net::poll_ms_until(deadline)) == 0 &&
-                std::chrono::steady_clock::now() >= deadline)
-                throw TimeoutError("socketcand: handshake write timed out");
+            if (::poll(&p, 1, net::poll_ms_until(deadline)) == 0) {
+                if (std::chrono::steady_clock::now() >= deadline)
+                    throw TimeoutError("socketcand: handshake write timed out");
+                interruption_point();
+            }
             continue;
         }
         throw LinkDown(std::string("socketcand: write failed: ") + std::strerror(errno));
@@ -99,6 +102,9 @@ void SocketcandBus::handshake(const std::string& channel, Deadline deadline) {
                 throw TimeoutError(std::string("socketcand: no ") +
                                    (step == WantHi ? "< hi >" : "< ok >") + " from " + host_ +
                                    " within the handshake timeout");
+            // A server that accepted but never says < hi >: Ctrl-C must not wait
+            // for the whole handshake timeout (poll_ms_until slices it).
+            interruption_point();
             continue;
         }
         ssize_t r = ::recv(sock_.get(), buf, sizeof buf, 0);
@@ -213,6 +219,7 @@ bool SocketcandBus::write_some(bool wait_turn) {
         return true;
     }
     bool ok = true;
+    std::string failure;
     for (;;) {
         if (writing_off_ == writing_.size()) {
             writing_.clear();
@@ -238,13 +245,18 @@ bool SocketcandBus::write_some(bool wait_turn) {
             if (!tx_pending_.exchange(true)) wake_.signal();
             break;
         } else {
-            mark_link_down(std::string("socketcand: write failed: ") + std::strerror(errno));
+            failure = std::string("socketcand: write failed: ") + std::strerror(errno);
             ok = false;
             break;
         }
     }
     w.unlock();
-    if (!ok) tx_space_cv_.notify_all();
+    // After unlocking: marking the link down runs the bus's link watchers (an
+    // SDO client's wake-up), which must not run under our writer lock.
+    if (!ok) {
+        mark_link_down(failure);
+        tx_space_cv_.notify_all();
+    }
     return ok;
 }
 
@@ -266,6 +278,11 @@ void SocketcandBus::do_send(const Frame& frame, Deadline deadline) {
                                    std::to_string(unsent_.load()) + " bytes still unsent");
             tx_space_cv_.wait_until(lk, std::min(deadline, std::chrono::steady_clock::now() +
                                                                std::chrono::milliseconds(5)));
+            if (interruptible()) {  // Ctrl-C while the server is not reading
+                lk.unlock();
+                interruption_point();
+                lk.lock();
+            }
         }
         if (link_down_.load()) throw LinkDown(link_down_reason());
         // The element goes in whole or not at all, so the stream never carries half a frame.

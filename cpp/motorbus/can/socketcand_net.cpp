@@ -15,6 +15,7 @@
 #include <cstring>
 
 #include "motorbus/errors.hpp"
+#include "motorbus/runtime/interrupt.hpp"
 
 namespace motorbus::can::net {
 
@@ -50,6 +51,9 @@ void set_tcp_keepalive(int fd, std::chrono::seconds idle, std::chrono::seconds i
 }
 
 int poll_ms_until(Deadline d, int cap) {
+    // A caller with an interrupt check (Python's main thread: Ctrl-C) polls in
+    // slices and runs the check between them (interruption_point()).
+    if (interruptible()) cap = std::min<int>(cap, static_cast<int>(kInterruptSlice.count()));
     auto left = std::chrono::duration_cast<std::chrono::milliseconds>(d - std::chrono::steady_clock::now());
     if (left.count() <= 0) return 0;
     return left.count() > cap ? cap : static_cast<int>(left.count()) + 1;
@@ -102,6 +106,7 @@ Fd tcp_connect(const std::string& host, std::uint16_t port, Deadline deadline) {
                 if (std::chrono::steady_clock::now() >= deadline)
                     throw TimeoutError("socketcand: connecting to " + host + ":" +
                                        std::to_string(port) + " timed out");
+                interruption_point();  // Ctrl-C while the server does not answer
                 continue;
             }
             int err = 0;

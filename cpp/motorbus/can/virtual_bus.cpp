@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "motorbus/errors.hpp"
+#include "motorbus/runtime/interrupt.hpp"
 
 namespace motorbus::can {
 
@@ -74,7 +75,11 @@ public:
         std::unique_lock lock(mutex_);
         ensure_wire();
         auto& q = tx_[p.sender];
-        if (timed() && !space_cv_.wait_until(lock, deadline, [&] { return q.size() < cap || stopping_; }))
+        // Interruptible: Ctrl-C while the wire is saturated (the check runs
+        // with the hub unlocked; `q` stays valid, only forget_sender() erases it,
+        // and not while its endpoint is sending).
+        if (timed() &&
+            !interruptible_wait_until(space_cv_, lock, deadline, [&] { return q.size() < cap || stopping_; }))
             return false;
         if (!timed()) {
             delayed_.push(Due{p.enqueued + p.delay, seq_++, p.frame, p.sender});
@@ -382,9 +387,11 @@ void check_options(const FaultOptions& f) {
 }
 
 void check_options(const VirtualOptions& opts) {
-    if (!(opts.bitrate >= 0) || std::isinf(opts.bitrate))  // NaN fails the comparison
+    // 0 = no wire time; otherwise a rate whose frame times are representable:
+    // 1e-9 bit/s made a frame last 1.6e20 ns, past Nanos (UBSan: float-cast-overflow).
+    if (!(opts.bitrate == 0 || (opts.bitrate >= kMinVirtualBitrate && opts.bitrate <= kMaxVirtualBitrate)))
         throw InvalidArgument("virtual bus bitrate: " + std::to_string(opts.bitrate) +
-                              ", must be a finite number >= 0 (0 = no wire time)");
+                               " bit/s, must be 0 (no wire time) or 1 to 1e9 bit/s");
     if (opts.rx_spin.count() < 0) throw InvalidArgument("virtual bus rx_spin: must be >= 0");
     if (opts.tx_queue == 0) throw InvalidArgument("virtual bus tx_queue: 0, must be >= 1 (frames waiting for the wire)");
     if (opts.rx_queue_size == 0)

@@ -25,8 +25,13 @@ struct FaultOptions {
     std::uint64_t seed = 0x5eed;       // for the probabilistic faults (reproducible)
 };
 
+// Bit rates a timed hub accepts (besides 0 = no wire time): from 1 bit/s (a
+// frame lasts minutes, still a count of nanoseconds) to 1 Gbit/s.
+constexpr double kMinVirtualBitrate = 1.0;
+constexpr double kMaxVirtualBitrate = 1e9;
+
 struct VirtualOptions : BusOptions {
-    double bitrate = 0.0;         // bit/s; 0 = no wire time.  All endpoints of a hub must agree.
+    double bitrate = 0.0;         // bit/s; 0 = no wire time, else kMin/kMaxVirtualBitrate.  All endpoints of a hub must agree.
     std::size_t tx_queue = 64;    // frames waiting for the wire before send() blocks, >= 1
     FaultOptions faults;
     // How long an endpoint's receive thread polls for the next frame before it

@@ -276,11 +276,17 @@ void LocalNode::on_sdo_frame(const can::Frame& f) {
 void LocalNode::worker() {
     std::unique_lock lock(mutex_);
     while (!stopping_) {
+        // The SDO server's deadline is read without mutex_ held: sdo_mutex_ is
+        // never taken inside mutex_, so a write hook running under sdo_mutex_
+        // (a PDO parameter written by SDO) may call wake(), which takes mutex_.
+        lock.unlock();
         Nanos next = kNoDeadline;
         {
             std::lock_guard sl(sdo_mutex_);
             next = server_.next_deadline();
         }
+        lock.lock();
+        if (stopping_) break;
         for (auto& s : services_) next = std::min(next, s.deadline);
         auto ready = [&] { return stopping_ || mailbox_ || woken_; };
         if (next == kNoDeadline)

@@ -83,17 +83,24 @@ PdoService::~PdoService() {
 
 std::shared_ptr<PdoService> PdoService::attach(LocalNode& node, PdoServiceOptions options) {
     std::shared_ptr<PdoService> s(new PdoService(node, options));
-    s->install();
+    s->install(s);
     node.add_service(s);
     s->engine_->set_operational(node.nmt_state() == NmtState::Operational);
     return s;
 }
 
-void PdoService::install() {
+void PdoService::install(const std::weak_ptr<PdoService>& self) {
     auto& od = node_.od();
     auto* eng = engine_.get();
-    auto hook = [eng](const Variable& var, std::span<const std::uint8_t> data) {
-        return eng->write(var.index(), var.subindex(), data);
+    auto hook = [eng, self](const Variable& var, std::span<const std::uint8_t> data) {
+        const std::uint32_t code = eng->write(var.index(), var.subindex(), data);
+        // A PDO (re)configured while OPERATIONAL (CiA 301: invalidate, map,
+        // validate) must be scheduled now: the node runs this service's timer
+        // only at the deadline it last returned -- none for a PDO that was
+        // invalid -- so it used to stay silent until the next NMT change.
+        if (code == 0)
+            if (auto s = self.lock()) s->wake_node();
+        return code;
     };
     auto ensure = [&](std::uint16_t index, const char* name, bool tpdo, bool map, unsigned n) {
         const bool existed = od.object(index).has_value();
@@ -188,10 +195,20 @@ Nanos PdoService::on_timer(LocalNode&, Nanos now) {
     return next < 0 ? kNoDeadline : next;
 }
 
-void PdoService::on_detach(LocalNode& node) {
+void PdoService::wake_node() {
+    // Under detach_m_: once on_detach() has run, the node may be gone.
     std::lock_guard l(detach_m_);
-    if (detached_) return;
-    detached_ = true;
+    if (!detached_) node_.wake();
+}
+
+void PdoService::on_detach(LocalNode& node) {
+    {
+        // Not held while unsubscribing: that waits for a receive thread that
+        // may be in wake_node() (an SDO write to a PDO parameter).
+        std::lock_guard l(detach_m_);
+        if (detached_) return;
+        detached_ = true;
+    }
     node.bus().unsubscribe(sub_);
     for (auto& [v, h] : listeners_) v->remove_change_listener(h);
     listeners_.clear();

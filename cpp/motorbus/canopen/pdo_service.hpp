@@ -57,8 +57,9 @@ public:
 
 private:
     PdoService(LocalNode& node, PdoServiceOptions options);
-    void install();
+    void install(const std::weak_ptr<PdoService>& self);
     void reload();
+    void wake_node();  // a PDO parameter changed: run the engine's timers now
     LocalNode& node_;
     PdoServiceOptions options_;
     RealClock clock_;

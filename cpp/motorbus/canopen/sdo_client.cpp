@@ -1,5 +1,6 @@
 #include "motorbus/runtime/interrupt.hpp"
 #include "motorbus/canopen/sdo_client.hpp"
+#include "motorbus/errors.hpp"
 
 #include <algorithm>
 #include <exception>
@@ -161,12 +162,34 @@ bool SdoClientMachine::check_mux(std::span<const std::uint8_t> p, Outbox& out) {
     return true;
 }
 
+// A frame that carries a multiplexer (an initiate response of any protocol, an
+// abort) naming another object than ours: the response to another client on
+// the same COB-IDs (two processes asking one node).  Not inside a block
+// upload's sub-block, where byte 0 is a sequence number, not a specifier.
+bool SdoClientMachine::foreign(std::span<const std::uint8_t> p) const {
+    if (phase_ == Phase::BlkUpSub || p.size() < 4) return false;
+    const std::uint8_t cs = p[0];
+    const bool carries_mux = scs_of(cs) == Scs::InitiateUpload || scs_of(cs) == Scs::InitiateDownload ||
+                             scs_of(cs) == Scs::Abort ||
+                             (cs & 0xE1) == 0xC0 ||  // block upload initiate response (ss 0)
+                             (cs & 0xE3) == 0xA0;    // block download initiate response (ss 0)
+    if (!carries_mux) return false;
+    const auto m = multiplexer_of(p);
+    return m && *m != mux_;
+}
+
 void SdoClientMachine::on_frame(std::span<const std::uint8_t> p, Nanos now, Outbox& out) {
     if (status_ != Status::Running) {  // C8: stray response, nothing to queue
         ++counters_.ignored_frames;
         return;
     }
     if (p.empty()) return fail_abort(ac::kCommandSpecifier, out, p, "empty response");
+    if (foreign(p)) {
+        // Another client's: ours is still to come.  It does not restart our
+        // timeout, so a busy neighbour cannot keep this transfer waiting forever.
+        ++counters_.foreign_responses;
+        return;
+    }
     const bool in_segments = phase_ == Phase::BlkUpSub;
     if ((in_segments && p[0] == 0x80) || (!in_segments && scs_of(p[0]) == Scs::Abort))
         return fail_peer_abort(p, out);  // C3: unconfirmed, no reply
@@ -293,6 +316,12 @@ void SdoClientMachine::on_block_upload(std::span<const std::uint8_t> p, Nanos no
     };
     if (phase_ == Phase::BlkUpInitiate) {
         if (scs_of(p[0]) == Scs::InitiateUpload) {  // protocol switch by the server
+            // Only when we allowed it (pst > 0): the plain protocol has no CRC,
+            // and a block initiate response with one flipped bit reads as an
+            // expedited response carrying the size as the value.
+            if (config_.protocol_switch == 0)
+                return fail_abort(ac::kCommandSpecifier, out, p,
+                                  "server switched to a non-block upload (no CRC) the client did not allow");
             phase_ = Phase::UpInitiate;
             return on_upload(p, out);
         }
@@ -308,7 +337,9 @@ void SdoClientMachine::on_block_upload(std::span<const std::uint8_t> p, Nanos no
             indicated_ = size;
             data_.reserve(std::min<std::size_t>(size + 7, 1u << 20));
         }
-        crc_ = config_.block_crc && (p[0] & 0x04);
+        if (config_.block_crc && !(p[0] & 0x04))
+            return fail_abort(ac::kCrc, out, p, "server declined the CRC of the block upload (its data would be unchecked)");
+        crc_ = config_.block_crc;
         blksize_ = config_.block_size;
         seq_ = 0;
         phase_ = Phase::BlkUpSub;
@@ -397,7 +428,9 @@ void SdoClientMachine::on_block_download(std::span<const std::uint8_t> p, Outbox
         if (p.size() < 5) return fail_abort(ac::kCommandSpecifier, out, p, "block size missing");
         if (p[4] == 0 || p[4] > kMaxBlockSize)  // B8
             return fail_abort(ac::kBlockSize, out, p, "invalid block size " + std::to_string(p[4]));
-        crc_ = config_.block_crc && (p[0] & 0x04);
+        if (config_.block_crc && !(p[0] & 0x04))
+            return fail_abort(ac::kCrc, out, p, "server declined the CRC of the block download (it would not check the data)");
+        crc_ = config_.block_crc;
         blksize_ = p[4];
         pos_ = 0;
         phase_ = Phase::BlkDnSub;
@@ -479,9 +512,21 @@ SdoClient::SdoClient(can::Bus& bus, std::uint8_t node_id, SdoClientOptions optio
     c.fallback_to_segmented = options.fallback_to_segmented;
     machine_.set_config(c);
     sub_ = bus_.subscribe_id(response_id_, false, [this](const can::Frame& f) { on_frame(f); });
+    // Link lost or bus closed: wake a waiting transfer now (run() sees which).
+    // Taking the mutex orders the wake-up after the waiter's predicate check;
+    // the one thread that must not take it is the one sending under it.
+    link_watch_ = bus_.watch_link([s = sync_] {
+        if (s->sending.load() != std::this_thread::get_id()) {
+            std::lock_guard barrier(s->mutex);  // held for no work: only the ordering
+        }
+        s->cv.notify_all();
+    });
 }
 
-SdoClient::~SdoClient() { bus_.unsubscribe(sub_); }
+SdoClient::~SdoClient() {
+    bus_.unwatch_link(link_watch_);
+    bus_.unsubscribe(sub_);
+}
 
 void SdoClient::set_timeout(std::chrono::nanoseconds t) {
     std::lock_guard tl(transfer_mutex_);
@@ -498,6 +543,11 @@ SdoClientCounters SdoClient::counters() const {
 }
 
 void SdoClient::send_out() {
+    struct Sending {
+        std::atomic<std::thread::id>& who;
+        explicit Sending(std::atomic<std::thread::id>& w) : who(w) { who.store(std::this_thread::get_id()); }
+        ~Sending() { who.store(std::thread::id{}); }
+    } sending(sync_->sending);
     for (const auto& p : outbox_) {
         can::Frame f;
         f.id = request_id_;
@@ -521,8 +571,17 @@ void SdoClient::on_frame(const can::Frame& f) {
         sooner = machine_.next_deadline() < before;
         try {
             send_out();
+        } catch (const LinkDown&) {
+            // The link is gone or the bus closed: the transfer ends with that now.
+            outbox_.clear();
+            if (machine_.busy()) send_error_ = std::current_exception();
+            sooner = true;
+        } catch (const ClosedError&) {
+            outbox_.clear();
+            if (machine_.busy()) send_error_ = std::current_exception();
+            sooner = true;
         } catch (const std::exception&) {
-            // The medium refused (full, closed): the transfer runs into its timeout.
+            // The medium refused (full): the transfer runs into its timeout.
             outbox_.clear();
         }
         done = !machine_.busy();
@@ -537,13 +596,19 @@ void SdoClient::on_frame(const can::Frame& f) {
     }
 }
 
-void SdoClient::run(std::unique_lock<std::mutex>& lock) {
+void SdoClient::run(std::unique_lock<std::mutex>& lock, std::uint64_t link_losses) {
+    send_error_ = nullptr;
     try {
         send_out();
     } catch (...) {
         machine_.reset();
         throw;
     }
+    // Why the bus will not bring our response: closed, or its link lost (or
+    // interrupted) since the transfer started.  Checked by the wait's predicate.
+    auto bus_gone = [&] {
+        return send_error_ || bus_.closed() || bus_.link_losses() != link_losses;
+    };
     if (options_.spin.count() > 0 && machine_.busy()) {
         idle_.store(false, std::memory_order_relaxed);
         lock.unlock();
@@ -568,8 +633,21 @@ void SdoClient::run(std::unique_lock<std::mutex>& lock) {
                            // A timer armed after we went to sleep (next_deadline() < dl)
                            // must wake us too, or it fires only at the old deadline.
                            return !machine_.busy() || machine_.next_deadline() < dl ||
-                                  monotonic_ns() >= machine_.next_deadline();
+                                  monotonic_ns() >= machine_.next_deadline() || bus_gone();
                        });
+        if (machine_.busy() && bus_gone()) {
+            // No abort to send: the bus cannot carry it.  The server drops its
+            // side at its own timeout.  (reset_on_throw forgets the transfer.)
+            char what[40];
+            std::snprintf(what, sizeof what, "SDO 0x%04X:%02X: ", machine_.multiplexer().index,
+                          machine_.multiplexer().subindex);
+            if (send_error_) std::rethrow_exception(send_error_);
+            if (bus_.closed())
+                throw ClosedError(std::string(what) + "bus " + bus_.channel() + " closed during the transfer");
+            const std::string why = bus_.link_loss_reason();
+            throw LinkDown(std::string(what) + "link of " + bus_.channel() + " lost during the transfer" +
+                           (why.empty() ? "" : ": " + why));
+        }
         if (machine_.busy() && monotonic_ns() >= machine_.next_deadline()) {
             machine_.on_timer(monotonic_ns(), outbox_);
             try {
@@ -590,9 +668,10 @@ Bytes SdoClient::upload(std::uint16_t index, std::uint8_t subindex, TransferMode
     std::lock_guard tl(transfer_mutex_);
     for (unsigned attempt = 0;; ++attempt) {
         std::unique_lock lock(mutex_);
+        const std::uint64_t losses = bus_.link_losses();
         machine_.start_upload(index, subindex, mode, monotonic_ns(), outbox_);
         try {
-            run(lock);
+            run(lock, losses);
         } catch (const SdoTimeout&) {
             if (attempt < options_.read_retries) continue;  // reads are idempotent
             throw;
@@ -607,8 +686,9 @@ void SdoClient::download(std::uint16_t index, std::uint8_t subindex,
                          std::span<const std::uint8_t> data, TransferMode mode) {
     std::lock_guard tl(transfer_mutex_);
     std::unique_lock lock(mutex_);
+    const std::uint64_t losses = bus_.link_losses();
     machine_.start_download(index, subindex, data, mode, monotonic_ns(), outbox_);
-    run(lock);
+    run(lock, losses);
     machine_.reset();
 }
 

@@ -14,6 +14,10 @@
 // Threading: one transfer per client (= per SDO channel) at a time; threads
 // sharing a client are serialized in arrival order.  Clients for different
 // nodes (or channels) run concurrently; each costs one O(1) subscription.
+//
+// A transfer waiting for its response ends at once with LinkDown when the
+// bus's link is lost (or interrupted: frames of the exchange may be gone) and
+// with ClosedError when the bus is closed, from any thread (Bus::watch_link).
 #pragma once
 #include <atomic>
 #include <chrono>
@@ -24,6 +28,7 @@
 #include <mutex>
 #include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
@@ -47,8 +52,15 @@ struct SdoClientConfig {
     Nanos timeout_ns = 1'000'000'000;      // per response (restarted by every frame received)
     std::size_t max_transfer = 1u << 20;   // larger uploads abort 0x05040005 before allocating
     std::uint8_t block_size = 127;         // sub-block size we offer in block upload (1..127)
-    bool block_crc = true;                 // offer CRC in block transfers
-    std::uint8_t protocol_switch = 0;      // pst of block upload (0 = always block)
+    // Offer CRC in block transfers, and require it: a server that answers
+    // without CRC gets abort 0x05040004 (a block transfer delivers CRC-checked
+    // data or fails).  false = no CRC asked for, none checked.
+    bool block_crc = true;
+    // pst of block upload: the server may switch to the plain upload protocol
+    // (expedited / segmented, no CRC) for data up to this many bytes.  0 = never:
+    // a switch is then refused (abort 0x05040001) -- under bit errors a block
+    // initiate response read as an expedited one delivered its size as the value.
+    std::uint8_t protocol_switch = 0;
     // Server refuses block mode (abort 0x05040001 / 0x06010000 to the block
     // initiate) -> retry the same transfer segmented (no CRC).  Off by default:
     // a caller who asked for block gets block or SdoAbortError.
@@ -67,6 +79,10 @@ struct SdoClientCounters {
     std::uint64_t ignored_frames = 0;    // responses while idle (C8) or duplicates
     std::uint64_t retransmit_requests = 0;  // block: sub-blocks acked short (lost frames)
     std::uint64_t fallbacks = 0;          // block refused, retried segmented
+    // Initiate responses and aborts naming another multiplexer than the one we
+    // asked: another client's (two processes on one node's default SDO channel),
+    // ignored -- the transfer waits on for its own response.
+    std::uint64_t foreign_responses = 0;
 };
 
 // One transfer at a time; feed it every frame from the response COB-ID and
@@ -97,6 +113,7 @@ public:
     std::exception_ptr error() const { return error_; }      // Failed
     const SdoClientCounters& counters() const { return counters_; }
     const SdoClientConfig& config() const { return config_; }
+    sdo::Multiplexer multiplexer() const { return mux_; }    // of the current transfer
     void set_config(const SdoClientConfig& c) { config_ = c; }
 
 private:
@@ -112,6 +129,7 @@ private:
     void fail_peer_abort(std::span<const std::uint8_t> frame, Outbox& out);
     void touch(Nanos now);
     bool check_mux(std::span<const std::uint8_t> p, Outbox& out);
+    bool foreign(std::span<const std::uint8_t> p) const;
     void finish();
     void send_next_download_segment(Outbox& out);
     void send_block_download_subblock(Outbox& out);
@@ -154,7 +172,7 @@ struct SdoClientOptions {
     std::chrono::nanoseconds timeout = std::chrono::seconds(1);
     std::size_t max_transfer = 1u << 20;  // >= 1 (InvalidArgument otherwise)
     std::uint8_t block_size = 127;        // 1-127 (InvalidArgument otherwise)
-    bool block_crc = true;
+    bool block_crc = true;                // offer and require CRC (SdoClientConfig::block_crc)
     // Opt-in: a server that refuses block mode gets the transfer segmented
     // (Python: SdoClient(..., block_fallback=True)).  Default: SdoAbortError.
     bool fallback_to_segmented = false;
@@ -227,20 +245,35 @@ private:
     T read_le(std::uint16_t i, std::uint8_t s);
     template <class T>
     void write_le(std::uint16_t i, std::uint8_t s, T v);
-    void run(std::unique_lock<std::mutex>& lock);
+    void run(std::unique_lock<std::mutex>& lock, std::uint64_t link_losses);
     void send_out();
     void on_frame(const can::Frame& f);
+
+    // The caller's wait: shared with the bus's link watcher, which may still
+    // run once after the client is gone (Bus::unwatch_link).
+    struct Sync {
+        std::mutex mutex;               // guards machine_, outbox_, send_error_
+        std::condition_variable cv;
+        // The thread sending with `mutex` held: a link watcher it triggers
+        // itself (its send found the link dead) must not lock `mutex` again.
+        std::atomic<std::thread::id> sending{};
+    };
 
     can::Bus& bus_;
     std::uint8_t node_id_;
     SdoClientOptions options_;
     std::uint32_t request_id_, response_id_;
     std::mutex transfer_mutex_;   // one transfer per channel
-    mutable std::mutex mutex_;    // guards machine_ and outbox_
-    std::condition_variable cv_;
+    std::shared_ptr<Sync> sync_ = std::make_shared<Sync>();
+    std::mutex& mutex_ = sync_->mutex;
+    std::condition_variable& cv_ = sync_->cv;
+    // A send from the receive thread (the next request of a transfer) failed
+    // because the link is gone or the bus closed: the transfer ends with it.
+    std::exception_ptr send_error_;
     SdoClientMachine machine_;
     SdoClientMachine::Outbox outbox_;
     can::SubscriptionId sub_ = 0;
+    can::SubscriptionId link_watch_ = 0;
     std::atomic<bool> idle_{true};  // the machine is not Running (for the spin-wait)
 };
 

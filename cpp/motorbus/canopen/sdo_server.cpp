@@ -274,7 +274,10 @@ void SdoServerMachine::block_download_initiate(std::span<const std::uint8_t> p, 
     blksize_ = config_.block_size;
     seq_ = 0;
     buffer_.reserve(std::min<std::size_t>(limit_ + 7, 4096));
-    emit(block_download_initiate_response(m, true, blksize_), out);
+    // CRC only if the client offered it (CiA 301: used when both support it).
+    // Saying yes regardless let a request whose cc bit was lost (a flipped bit)
+    // commit data nobody checked; now such a client sees sc=0 and refuses.
+    emit(block_download_initiate_response(m, crc_, blksize_), out);
     phase_ = Phase::BlkDnSub;
     touch(now);
     sub_deadline_ = now + static_cast<Nanos>(config_.timeout_ns * 0.7);

@@ -113,15 +113,53 @@ TEST_F(ClientFixture, C1_TimeoutSendsAbortWithMultiplexer) {
     static_assert(std::is_base_of_v<motorbus::TimeoutError, SdoTimeout>);
 }
 
-TEST_F(ClientFixture, C2_WrongMultiplexer) {
-    up(0x6001, 0);
-    EXPECT_EQ(rx("4F 02 60 00 08 00 00 00"), Strs{abort_of(0x6001, 0, 0x06040043)});
-    auto e = error<SdoProtocolError>();
-    EXPECT_EQ(e.code, 0x06040043u);
-    EXPECT_EQ(hex(e.bytes), "4F 02 60 00 08 00 00 00");
-    EXPECT_NE(std::string(e.what()).find("mismatch"), std::string::npos);
+// C2, revised (issue 22): two processes asking one node share its COB-IDs, so
+// an initiate response or an abort naming another multiplexer is the other
+// client's.  It is ignored (counted, no abort sent, no timeout restart) and the
+// transfer waits on for its own; it used to fail with "response names 0x606C:00".
+TEST_F(ClientFixture, C2_ResponseForAnotherMultiplexerIsAnotherClients) {
+    up(0x6064, 0);
+    now += kSec / 2;
+    EXPECT_EQ(rx("43 6C 60 00 10 27 00 00"), Strs{});  // the other client's 606Ch answer
+    EXPECT_EQ(cli.status(), SdoClientMachine::Status::Running);
+    EXPECT_EQ(cli.counters().foreign_responses, 1u);
+    EXPECT_EQ(cli.counters().aborts_sent, 0u);
+    EXPECT_EQ(cli.next_deadline(), 5000 + kSec);  // the foreign frame did not restart our timeout
+    EXPECT_EQ(rx("80 6C 60 00 00 00 02 06"), Strs{});  // the server aborting the other's request
+    EXPECT_EQ(rx("60 40 60 00 00 00 00 00"), Strs{});  // the other's download confirmation
+    EXPECT_EQ(rx("C6 6C 60 00 04 00 00 00"), Strs{});  // the other's block initiate response
+    EXPECT_EQ(cli.counters().foreign_responses, 4u);
+    EXPECT_EQ(rx("43 64 60 00 78 56 34 12"), Strs{});  // ours
+    ASSERT_EQ(cli.status(), SdoClientMachine::Status::Done);
+    EXPECT_EQ(hex(cli.result()), "78 56 34 12");
     down(0x2003, 0, {1});
-    EXPECT_EQ(rx("60 03 20 01 00 00 00 00"), Strs{abort_of(0x2003, 0, 0x06040043)});
+    EXPECT_EQ(rx("60 03 20 01 00 00 00 00"), Strs{});  // sub 1: not ours
+    EXPECT_EQ(rx("60 03 20 00 00 00 00 00"), Strs{});
+    EXPECT_EQ(cli.status(), SdoClientMachine::Status::Done);
+    EXPECT_EQ(cli.counters().foreign_responses, 5u);
+}
+
+// Everything else stays strict: an abort for OUR multiplexer raises, a frame
+// too short to name one is a protocol error, so is a wrong toggle bit.
+TEST_F(ClientFixture, C2_StrictForOurOwnMultiplexer) {
+    up(0x6064, 0);
+    rx("80 64 60 00 00 00 02 06");
+    EXPECT_EQ(error<SdoAbortError>().code, 0x06020000u);
+    up(0x6064, 0);
+    EXPECT_EQ(rx("43 64"), Strs{abort_of(0x6064, 0, 0x05040001)});
+    EXPECT_EQ(cli.status(), SdoClientMachine::Status::Failed);
+    up(0x1008, 0);
+    EXPECT_EQ(rx("41 08 10 00 0A 00 00 00"), Strs{"60 00 00 00 00 00 00 00"});
+    // Between our segments: the other client's expedited answer is still not ours...
+    EXPECT_EQ(rx("43 6C 60 00 10 27 00 00"), Strs{});
+    EXPECT_EQ(cli.status(), SdoClientMachine::Status::Running);
+    // ...but an initiate response naming our object is a protocol error there.
+    EXPECT_EQ(rx("41 08 10 00 0A 00 00 00"), Strs{abort_of(0x1008, 0, 0x05040001)});
+    EXPECT_EQ(cli.status(), SdoClientMachine::Status::Failed);
+    up(0x1008, 0);
+    rx("41 08 10 00 0A 00 00 00");
+    EXPECT_EQ(rx("10 41 42 43 44 45 46 47"), Strs{abort_of(0x1008, 0, 0x05030000)});
+    EXPECT_EQ(cli.status(), SdoClientMachine::Status::Failed);
 }
 
 TEST_F(ClientFixture, C3_ServerAbortMidTransfer) {
@@ -359,10 +397,44 @@ TEST_F(ClientFixture, B16_FallBackToSegmented) {
     EXPECT_EQ(error<SdoAbortError>().code, 0x05040001u);
 }
 
-TEST_F(ClientFixture, BlockUploadProtocolSwitchAccepted) {
+// Issue 28 item 5: the client sends pst 0 ("no switch"), so a non-block answer
+// is refused -- the plain protocol has no CRC, and under bit errors a block
+// initiate response (C6 .. size) read as expedited (46 ..) delivered its size as
+// the value.  With a threshold the switch is taken.
+TEST_F(ClientFixture, BlockUploadProtocolSwitchRefusedUnlessAllowed) {
+    EXPECT_EQ(SdoClientConfig{}.protocol_switch, 0u);
     up(0x6001, 0, TransferMode::Block);
+    EXPECT_EQ(rx("4F 01 60 00 08 00 00 00"), Strs{abort_of(0x6001, 0, 0x05040001)});
+    EXPECT_NE(std::string(error<SdoProtocolError>().what()).find("did not allow"), std::string::npos);
+    up(0x2201, 0, TransferMode::Block);
+    EXPECT_EQ(rx("46 01 22 00 14 00 00 00"), Strs{abort_of(0x2201, 0, 0x05040001)});  // C6 with bit 7 flipped
+    EXPECT_EQ(cli.status(), SdoClientMachine::Status::Failed);
+    auto c = cli.config();
+    c.protocol_switch = 4;
+    cli.set_config(c);
+    EXPECT_EQ(up(0x6001, 0, TransferMode::Block), Strs{"A4 01 60 00 7F 04 00 00"});
     EXPECT_EQ(rx("4F 01 60 00 08 00 00 00"), Strs{});
     EXPECT_EQ(hex(cli.result()), "08");
+}
+
+// A block transfer delivers CRC-checked data or fails: a server answering
+// without CRC (or a request whose cc bit was lost) is refused with 0x05040004,
+// unless the caller turned CRC off.
+TEST_F(ClientFixture, BlockTransferWithoutCrcRefused) {
+    up(0x2201, 0, TransferMode::Block);
+    EXPECT_EQ(rx("C2 01 22 00 03 00 00 00"), Strs{abort_of(0x2201, 0, 0x05040004)});
+    EXPECT_EQ(error<SdoProtocolError>().code, 0x05040004u);
+    down(0x2201, 0, Bytes(20, 0x42), TransferMode::Block);
+    EXPECT_EQ(rx("A0 01 22 00 02 00 00 00"), Strs{abort_of(0x2201, 0, 0x05040004)});
+    EXPECT_EQ(cli.status(), SdoClientMachine::Status::Failed);
+    auto c = cli.config();
+    c.block_crc = false;
+    cli.set_config(c);
+    EXPECT_EQ(up(0x2201, 0, TransferMode::Block), Strs{"A0 01 22 00 7F 00 00 00"});
+    EXPECT_EQ(rx("C2 01 22 00 03 00 00 00"), Strs{"A3 00 00 00 00 00 00 00"});
+    rx("81 01 02 03 00 00 00 00");
+    EXPECT_EQ(rx("D1 00 00 00 00 00 00 00"), Strs{"A1 00 00 00 00 00 00 00"});
+    EXPECT_EQ(hex(cli.result()), "01 02 03");
 }
 
 // Hardening (defect 4): a caller who asked for block gets block or an error.
