@@ -235,8 +235,7 @@ def _run(args: argparse.Namespace, work: Callable[[Bench], int], *, axes: Option
     try:
         bench = load_bench(args.bench, sim=args.sim, axes=axes)
     except _core.MotorbusError as e:
-        _err(error_text(e))
-        return exit_code(e)
+        return _failed(args, e)
     log.info("%s: opened %s%s (lines: %s; buses: %s)", bench.source, ", ".join(bench.axes),
              " on its simulated twin" if bench.simulated else "", ", ".join(bench.lines) or "none",
              ", ".join(bench.buses) or "none")
@@ -244,8 +243,7 @@ def _run(args: argparse.Namespace, work: Callable[[Bench], int], *, axes: Option
         try:
             return work(bench)
         except _core.MotorbusError as e:
-            _err(error_text(e))
-            return exit_code(e)
+            return _failed(args, e)
         finally:
             if stop_on_exit:
                 log.info("stopping %s on the way out", ", ".join(bench.axes))
@@ -253,6 +251,16 @@ def _run(args: argparse.Namespace, work: Callable[[Bench], int], *, axes: Option
                     _err(f"motorbus: {name}: could not stop: {type(e).__name__}: {e}")
     finally:
         bench.close()
+
+
+def _failed(args: argparse.Namespace, e: BaseException) -> int:
+    """An error that ended the command: on stderr, and with --json also as the result on
+    stdout (``{"error", "message", "exit_code"}``) so a script parsing stdout gets one."""
+    code = exit_code(e)
+    _err(error_text(e))
+    if getattr(args, "json", False):
+        _json({"error": type(e).__name__, "message": str(e), "exit_code": code})
+    return code
 
 
 def _fmt(v: Any) -> str:
@@ -553,8 +561,7 @@ def cmd_scan(args: argparse.Namespace) -> int:
         result = discover(args.serial or (), args.can or (), kinds=args.kind, timeout=args.timeout,
                           reply_timeout=args.reply_timeout, progress=not args.quiet and not args.json)
     except _core.MotorbusError as e:
-        _err(error_text(e))
-        return exit_code(e)
+        return _failed(args, e)
     if args.json:
         _json({"found": [{"kind": f.kind, "address": f.address, "line": f.line, "bus": f.bus, "baud": f.baud,
                           "identity": f.identity} for f in result.found],

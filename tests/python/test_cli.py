@@ -229,6 +229,25 @@ def test_config_read_json(served):
     assert r.returncode == 0 and json.loads(r.stdout) == {"x": {}, "z": {"0x6081": 12345}}, r
 
 
+def test_scan_shows_identities_in_hex_and_writes_a_bench_that_works(served, tmp_path):
+    out = tmp_path / "found.toml"
+    r = cli("scan", "--can", served.socketcand, "--kind", "cia402", "--quiet", "--write", out)
+    assert r.returncode == 0, r.stderr
+    assert re.search(r"^cia402\s+5\s+socketcand:\S+\s+device_type=0x00420192, vendor_id=0x", r.stdout, re.M), r.stdout
+    r = cli("scan", "--can", served.socketcand, "--kind", "cia402", "--json")
+    found = json.loads(r.stdout)["found"]
+    assert [(f["kind"], f["address"], f["identity"]["device_type"]) for f in found] == [("cia402", "5", 0x00420192)]
+    r = cli("status", out, "--json")
+    assert r.returncode == 0 and [a["kind"] for a in json.loads(r.stdout)["axes"].values()] == ["cia402"], r
+
+
+def test_json_commands_say_their_errors_in_json(served):
+    r = cli("move", served.path, "nope", "1", "--json")
+    assert r.returncode == 2
+    assert json.loads(r.stdout) == {"error": "InvalidArgument", "exit_code": 2,
+                                    "message": f"bench {served.path}: no axis 'nope' (axes: x, z)"}
+
+
 def test_busy_port_has_its_own_exit_code(served):
     # A program holding the serial line: the command cannot open it, and says who has it.
     holder = subprocess.Popen([*MOTORBUS, "move", served.path, "x", "50"], stdout=subprocess.PIPE,
