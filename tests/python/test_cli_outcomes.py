@@ -218,3 +218,27 @@ def test_every_kind_a_limit_during_a_move_exits_11(tmp_path, kind):
         assert f"a: stopped at {res['position']:g} mm by " in err and "target 100 mm" in err, err
     finally:
         s.close()
+
+
+def test_the_demo_bench_served_by_sim_serve_bench(tmp_path):
+    """`motorbus sim serve --bench` (the shipped demo bench, every family) in one process;
+    status, move and a limit injected during a move, each from a separate command."""
+    from importlib.resources import files
+
+    from motorbus.sim import ServedBench
+
+    with ServedBench(str(files("motorbus") / "demo_bench.toml")) as served:
+        r = run("status", served.bench_file, "--json")
+        assert r.returncode == 0, r.stderr
+        axes = json.loads(r.stdout)["axes"]
+        assert {a["kind"] for a in axes.values()} == {"arcus", "dmac", "cia402", "arcus-canopen", "pmc007", "unitek"}
+        r = run("move", served.bench_file, "z", "5", "--velocity", "50")
+        assert r.returncode == 0 and r.stdout == "z: 5 mm\n", r
+        mover = start("move", served.bench_file, "z", "150", "--velocity", "20")
+        assert mover.stderr.readline().startswith("z: moving to 150 mm")
+        time.sleep(0.5)
+        served.inject("z", "limit", direction=1)
+        out, err = mover.communicate(timeout=30)
+        assert mover.returncode == 11, (out, err)
+        pos = float(out.split()[1])
+        assert 5 < pos < 150 and f"z: stopped at {pos:g} mm by the +limit switch" in err, err
