@@ -156,7 +156,7 @@ def _sim_serve_bench(args: argparse.Namespace) -> int:
                          strict_baud=args.strict_baud, bitrate=args.bitrate, store_dir=args.store_dir)
     except TwinBusy as e:
         print(f"motorbus: {e}", file=sys.stderr)
-        return 1
+        return 4   # busy, as for a serial port another process holds (cli_bench.EXIT_BUSY)
     stop, usr1 = threading.Event(), threading.Event()
 
     def on_signal(signum: int, frame: Any) -> None:
@@ -304,7 +304,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "Each serial line is the symlink LINK_DIR/<line name> to its pty (default LINK_DIR: "
                     "$TMPDIR or /tmp, then motorbus-sim-<uid>/<bench file name without .toml>); each bus a "
                     "socketcand server on 127.0.0.1 (--port fixes the port). Prints `line NAME LINK -> PTY`, "
-                    "`bus NAME SPEC`, then `bench FILE` once written. Exit 1 if another twin serves LINK_DIR.\n\n"
+                    "`bus NAME SPEC`, then `bench FILE` once written. Exit 4 (busy) if another twin serves LINK_DIR.\n\n"
                     "--control: commands on stdin, one per line, each answered by one line `ok ...` or "
                     "`error: ...`: `fault AXIS NAME [key=value ...]` (the kind's sim_faults, values read as "
                     "true/false, int, float or text), `faults AXIS` (the names), `axes`. End of stdin stops "

@@ -235,10 +235,10 @@ def test_fixed_ports_stable_links_and_one_twin_per_link_dir(tmp_path):
         assert f"bus can0 socketcand:127.0.0.1:{base}/can0" in lines
         assert f"bus can1 socketcand:127.0.0.1:{base + 1}/can0" in lines
         assert f"line rs485 {links / 'rs485'} -> {os.readlink(links / 'rs485')}" in lines
-        # Another twin on the same link directory is refused (exit 1), naming the process serving it.
+        # Another twin on the same link directory is refused (exit 4, busy), naming the process serving it.
         r = subprocess.run([sys.executable, "-m", "motorbus", "sim", "serve", "--bench", str(DEMO_BENCH),
                             "--link-dir", str(links)], capture_output=True, text=True, timeout=60)
-        assert r.returncode == 1
+        assert r.returncode == 4
         assert f"{links} is served by another `motorbus sim serve --bench` (pid {first.pid})" in r.stderr
         written = (tmp_path / "twin.toml").read_text()
     finally:
