@@ -1016,10 +1016,17 @@ class Cia402Drive(Drive):
         velocity = self._velocity()
         mode = self._mode
         fault = state in ("FAULT", "FAULT REACTION ACTIVE")
-        # PP with halt (6040h bit 8) set: bit 10 means "stands still", not "at target" (CiA 402).
+        if mode is None:        # not set by this Drive yet: the mode in effect (6061h), for the text
+            try:
+                mode = int.from_bytes(self._sdo.upload(0x6061, 0), "little", signed=True)
+                OpMode(mode)
+            except (_core.SdoAbortError, ValueError):
+                mode = None
+        # With halt (6040h bit 8) set, bit 10 means "stands still", not "at target" (CiA 402),
+        # whoever set it.
         at_target = bool(sw & _SW_TARGET_REACHED) and state == "OPERATION ENABLED" and not (
-            mode == OpMode.PROFILE_POSITION and self._controlword_now() & _CW_HALT)
-        homed = mode == OpMode.HOMING and bool(sw & _SW_BIT12)
+            self._controlword_now() & _CW_HALT)
+        homed = self._mode == OpMode.HOMING and bool(sw & _SW_BIT12)
         self._homed = self._homed or homed
         text = self._status_text(state, mode, sw, fault)
         return DriveStatus(enabled=state == "OPERATION ENABLED",
