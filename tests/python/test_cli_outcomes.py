@@ -142,6 +142,22 @@ def test_a_drive_stop_input_exits_10(served):
     assert f"motorbus: z: stopped at {pos:g} mm by " in err and err.rstrip().endswith("target 150 mm"), err
 
 
+def test_a_stop_from_another_process_exits_10(served):
+    # `motorbus move ... &` then `motorbus stop BENCH z` from another shell: the mover says
+    # it was stopped short, by another program, and exits 10 (it printed "z: 72.803 mm", 0).
+    mover = start("move", served.path, "z", "150", "--velocity", "20")
+    assert mover.stderr.readline().startswith("z: moving to 150 mm")
+    time.sleep(0.5)
+    r = run("stop", served.path, "z")
+    assert r.returncode == 0 and r.stdout == "z: stopped\n", r
+    out, err = mover.communicate(timeout=30)
+    assert mover.returncode == 10, (out, err)
+    pos = float(out.split()[1])
+    assert 0 < pos < 150
+    assert f"motorbus: z: stopped at {pos:g} mm by " in err and "from another program" in err, err
+    assert err.rstrip().endswith("target 150 mm")
+
+
 def test_a_drive_fault_during_the_move_exits_12_with_the_code(served):
     names = motorbus.registry.drive_plugin("cia402").sim_faults
     name = "fault" if "fault" in names else "drive_fault"
