@@ -26,6 +26,7 @@ In-process, :func:`serve_line` and :class:`SimBench` give the same simulators;
 from __future__ import annotations
 
 import copy
+import dataclasses
 import datetime
 import fcntl
 import json
@@ -332,18 +333,28 @@ class BenchTwin:
         self.buses[name] = served
         for a in self.config.values():
             if a.bus == name:
-                sim = self._make_sim(a, store_dir, clock)
-                sim.attach(served.endpoint())
+                sim = self._make_sim(a, store_dir, clock, attach=served.endpoint)
                 self._can_sims.append(sim)
                 self.sims[a.name] = sim
         srv = served.servers[0]
         self.specs[name] = f"socketcand:{srv.host}:{srv.port}/{self.channel}"
 
-    def _make_sim(self, a: Any, store_dir: Optional[str], clock: Any) -> Any:
-        try:
-            return make_sim(a.kind, a.address, clock=clock, store_dir=store_dir, **a.sim)
+    def _make_sim(self, a: Any, store_dir: Optional[str], clock: Any, attach: Any = None) -> Any:
+        """The axis's simulator as ``Bench(sim=True)`` makes it (its errors name the
+        option and the file's line), attached to ``attach()`` for a CAN kind."""
+        plugin = registry.drive_plugin(a.kind)
+        if store_dir is not None and plugin.store_options is not None:
+            a = dataclasses.replace(a, sim={**plugin.store_options(store_dir, a.address), **a.sim})
+        bench_make = getattr(self._parsed, "_make_sim", None)
+        if bench_make is not None:
+            return bench_make(a, clock, attach=attach)
+        try:      # a Bench without its own simulator maker
+            sim = make_sim(a.kind, a.address, clock=clock, **a.sim)
         except (_core.InvalidArgument, TypeError) as e:
             raise self._parsed._fail(str(e), "axis", a.name, "sim") from None
+        if attach is not None:
+            sim.attach(attach())
+        return sim
 
     # ---- what is served --------------------------------------------------------------------
     def announce(self) -> list[str]:
