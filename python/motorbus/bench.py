@@ -507,7 +507,7 @@ def parse_text(text: str, source: str = "<bench>") -> dict:
         # tomllib takes quadratic time in the parts of a dotted key: a 1 MB line of "a".
         # parts takes minutes.  No bench line comes near this.
         raise BenchFileError(f"a line of {len(lines[n - 1])} characters: longer than a bench file's lines may be "
-                             f"({MAX_LINE_CHARS})", source=source, line=n)
+                             f"({MAX_LINE_CHARS})", source=source, line=n, key=_Locator(text).key_on(n))
     bad = _prescan(text)
     if bad is not None:
         raise BenchFileError(bad[1], source=source, line=bad[0], key=_Locator(text).key_on(bad[0]))
