@@ -288,7 +288,9 @@ def build_parser() -> argparse.ArgumentParser:
     pl.add_argument("--speed", type=float, default=1.0, help="1 = original timing, 0 = as fast as possible")
     pl.set_defaults(func=cmd_bus_play)
 
-    sim = sub.add_parser("sim", help="simulated drives").add_subparsers(dest="sim_cmd", required=True)
+    sim = sub.add_parser("sim", help="simulated drives; `sim serve --bench FILE` serves a bench's twin that lasts "
+                                     "(--sim on other commands makes a fresh one per command)"
+                         ).add_subparsers(dest="sim_cmd", required=True)
     ss = sim.add_parser(
         "serve", help="serve simulated drives: serial kinds on ptys, CAN kinds on a served bus",
         formatter_class=argparse.RawDescriptionHelpFormatter,
