@@ -115,7 +115,9 @@ void bind_pmc007(py::module_& m) {
     py::class_<BoundSim, std::shared_ptr<BoundSim>>(m, "Pmc007Sim",
                                                     "A simulated CQPUSI PMC007 CANopen node (see sim.hpp).")
         .def(py::init([](int node_id, std::shared_ptr<Clock> clock, double steps_per_rev, double pull_out_speed,
-                         std::optional<std::pair<double, double>> ext1_switch, std::string store_path) {
+                         std::optional<std::pair<double, double>> ext1_switch, std::string store_path,
+                         std::uint32_t vendor_id, std::uint32_t product_code, std::uint32_t revision,
+                         std::uint32_t serial) {
                  if (node_id < 1 || node_id > 127)
                      throw InvalidArgument("pmc007 sim: node-ID must be 1..127, not " + std::to_string(node_id));
                  Pmc007SimOptions o;
@@ -123,11 +125,13 @@ void bind_pmc007(py::module_& m) {
                  o.pull_out_speed = pull_out_speed;
                  o.ext1_switch = ext1_switch;
                  o.store_path = std::move(store_path);
+                 o.identity = {vendor_id, product_code, revision, serial};
                  return std::make_shared<BoundSim>(std::move(clock), std::uint8_t(node_id), o);
              }),
              py::arg("node_id") = 5, py::arg("clock") = nullptr, py::arg("steps_per_rev") = 200.0,
              py::arg("pull_out_speed") = 0.0, py::arg("ext1_switch") = py::none(),
-             py::arg("store_path") = "")
+             py::arg("store_path") = "", py::arg("vendor_id") = 0u, py::arg("product_code") = 7u,
+             py::arg("revision") = 0x00010000u, py::arg("serial") = 1u)
         .def("attach", [](BoundSim& s, can::Bus& bus) { py::gil_scoped_release nogil; s.attach(bus); },
              py::arg("bus"), py::keep_alive<1, 2>())
         .def("close", &BoundSim::close, rel)

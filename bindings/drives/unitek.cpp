@@ -447,6 +447,10 @@ void bind_unitek(py::module_& m) {
             py::gil_scoped_release nogil;
             h.sim->force_limit(dir, a);
         }, py::arg("direction"), py::arg("active"))
+        .def("force_error", [](SimHolder& h, std::uint32_t bits) {
+            py::gil_scoped_release nogil;
+            h.sim->force_error(bits);
+        }, py::arg("bits"), "latch NDrive error (0-15: power stage off) / warning (16-31) bits in 0x8F")
         .def("set_calibrated", [](SimHolder& h, bool on) {
             py::gil_scoped_release nogil;
             h.sim->set_calibrated(on);

@@ -34,7 +34,8 @@ import time
 from typing import Any, Callable, Iterable, Optional, Union
 
 from .. import _core
-from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params, Units
+from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, MoveStalled,
+                     ParamInfo, Params, StopReason, Units)
 from ..registry import DrivePlugin
 
 __all__ = ["ControllerStatus", "ErrorStatus", "Pmc007", "Pmc007Drive", "PLUGIN", "make_sim", "open", "OBJECTS",
@@ -66,6 +67,12 @@ class ErrorStatus(enum.IntFlag):
     BOC = 1 << 3    # coil B over-current
     AOC = 1 << 4    # coil A over-current
     TSD = 1 << 5    # over-temperature shutdown
+
+
+#: 6000h bits in the manual's words (003 §4.5.1).
+ERROR_TEXT = {ErrorStatus.UVLO: "UVLO low voltage", ErrorStatus.BERR: "BERR coil B error",
+              ErrorStatus.AERR: "AERR coil A error", ErrorStatus.BOC: "BOC coil B over-current",
+              ErrorStatus.AOC: "AOC coil A over-current", ErrorStatus.TSD: "TSD over-temperature shutdown"}
 
 
 class ControllerStatus(enum.IntFlag):
@@ -114,11 +121,21 @@ def disassemble(words: Iterable[int]) -> str:
 
 
 def _check_node(address: Union[str, int]) -> str:
-    text = str(address).strip()
-    try:
-        node = int(text, 0)
-    except ValueError:
-        raise _core.InvalidArgument(f"pmc007 address: a CANopen node-ID 1..127, not {address!r}") from None
+    """The node-ID 1..127: an int means that integer; text is decimal or 0x hex."""
+    if isinstance(address, bool):
+        raise _core.InvalidArgument(f"pmc007 address: a CANopen node-ID 1..127, not {address!r}")
+    if isinstance(address, int):
+        node = address
+    else:
+        text = str(address).strip()
+        node = None
+        if len(text) <= 12:     # a 100 000-digit "address" is refused, not converted
+            try:
+                node = int(text, 0)
+            except ValueError:
+                node = int(text, 10) if text.isdigit() else None   # "05": decimal with a leading zero
+        if node is None:
+            raise _core.InvalidArgument(f"pmc007 address: a CANopen node-ID 1..127, not {address!r}")
     if not 1 <= node <= 127:
         raise _core.InvalidArgument(f"pmc007 address: node-ID {node} is outside 1..127")
     return str(node)
@@ -495,8 +512,11 @@ def make_sim(address: Union[str, int] = "5", clock: Optional[_core.Clock] = None
     Options: ``steps_per_rev`` (200), ``pull_out_speed`` (0 = never stalls by speed),
     ``ext1_switch=(lo, hi)``: a switch wired to EXT1, low while the position is inside
     (default (-1e9, -1000): a home switch on the negative side, for homing into EXT1),
-    ``store_path``: the file holding the sim's flash between runs (2007h=2, 6019h:03, 602Ah)."""
-    known = {"steps_per_rev", "pull_out_speed", "ext1_switch", "store_path"}
+    ``store_path``: the file holding the sim's flash between runs (2007h=2, 6019h:03, 602Ah),
+    ``vendor_id``/``product_code``/``revision``/``serial``: what 1018h reads (the manual gives
+    no identity; default vendor 0 = none claimed, product 7, revision 0x00010000, serial 1)."""
+    known = {"steps_per_rev", "pull_out_speed", "ext1_switch", "store_path", "vendor_id", "product_code", "revision",
+             "serial"}
     options.setdefault("ext1_switch", (-1e9, -1000.0))
     unknown = set(options) - known
     if unknown:
@@ -544,21 +564,38 @@ class Pmc007Params(Params):
         self._drive.native.write(info.name, int(value))
 
 
+#: External stop inputs: 6001h latch bit -> (name, 600Fh enable bit).
+_EXT_INPUTS = {ControllerStatus.EXT1: ("EXT1", 0x01), ControllerStatus.EXT2: ("EXT2", 0x02),
+               ControllerStatus.EXT3: ("EXT3", 0x10)}
+
+
 class Pmc007Drive(Drive):
     """The Drive API over a PMC007: position mode (6004h relative, 601Ch absolute), speed mode,
-    stop (6020h), enable/release (600Eh), homing into an external stop input."""
+    stop (6020h), enable/release (600Eh), homing into an external stop input.
+
+    ``velocity=`` (pps) sets 6003h for that move only: the drive's own value is put back
+    when the move ends, however it ends.  How a move ends (``_stop_reason``): 6000h error
+    bits → MoveFaulted (code = 6000h), 6001h STALL → MoveStalled, an external stop input
+    (EXT1/EXT2/EXT3 latch) → MoveInterrupted naming the input, or LimitReached when
+    ``ext_limits`` declares that input a limit switch (``{"ext2": +1}``: EXT2 is wired to
+    the + limit), the motor released (600Eh = 0) → MoveInterrupted.  The in-position
+    window is 0: 600Ch is the drive's own step counter (open loop), it ends exactly on
+    the target unless stopped."""
 
     kind = "pmc007"
     capabilities = frozenset({Capability.POSITION, Capability.VELOCITY, Capability.HOMING, Capability.STORE})
     has_watchdog = False
+    in_position_window = 0.0
 
     def __init__(self, native: Pmc007, *, units: Optional[Units] = None, on_error: Optional[str] = "stop",
-                 on_exit: Optional[str] = "stop", close_native=None, home_speed: int = 2000) -> None:
+                 on_exit: Optional[str] = "stop", close_native=None, home_speed: int = 2000,
+                 ext_limits: Optional[dict] = None) -> None:
         super().__init__(native, units=units, on_error=on_error, on_exit=on_exit, close_native=close_native)
         self._home_speed = int(home_speed)
         self._homing: Optional[ControllerStatus] = None
         self._homed = False
         self._speed_mode = False
+        self._ext_limits = _check_ext_limits(ext_limits)
 
     def _refusing(self, what: str, fn: Callable[[], None]) -> None:
         try:
@@ -577,6 +614,17 @@ class Pmc007Drive(Drive):
             self.native.set_mode(False)
             self._speed_mode = False
 
+    def _speed_for_this_move(self, velocity: Optional[float], sign: int = 1) -> Optional[int]:
+        """6003h for this move only (Drive puts the old value back when it ends)."""
+        if velocity is None:
+            return None
+        pps = abs(int(round(velocity)))
+        if not 1 <= pps <= 32000:
+            raise _core.InvalidArgument(f"pmc007: velocity {velocity:g} pps is outside 1..32000 (6003h)")
+        n = self.native
+        self._for_this_move(lambda: n.speed, lambda v: setattr(n, "speed", v), pps if sign >= 0 else -pps)
+        return pps
+
     # ---- Drive ----
     def _enable(self) -> None:
         self.native.enable(True)
@@ -594,14 +642,15 @@ class Pmc007Drive(Drive):
     def _move_to(self, target: float, velocity: Optional[float]) -> None:
         self._leave_speed_mode()
         self._wait_stopped()
-        speed = abs(int(round(velocity))) if velocity is not None else None
-        self._refusing("move", lambda: self.native.move_absolute(int(round(target)), speed))
+        self._speed_for_this_move(velocity)
+        self._refusing("move", lambda: self.native.move_absolute(int(round(target))))
 
     def _move_by(self, distance: float, velocity: Optional[float]) -> None:
         self._leave_speed_mode()
         self._wait_stopped()
-        speed = abs(int(round(velocity))) if velocity is not None else None
-        self._refusing("move", lambda: self.native.step(int(round(distance)), speed))
+        steps = int(round(distance))
+        self._speed_for_this_move(velocity, 1 if steps >= 0 else -1)
+        self._refusing("move", lambda: self.native.step(steps))
 
     def _jog(self, velocity: float) -> None:
         pps = int(round(velocity))
@@ -624,13 +673,18 @@ class Pmc007Drive(Drive):
         if method not in inputs:
             raise _core.InvalidArgument(f"pmc007 home: 'ext1', 'ext2', 'ext3' or None, not {method!r}")
         bit = inputs[method]
-        enable_bit = {ControllerStatus.EXT1: 0x01, ControllerStatus.EXT2: 0x02, ControllerStatus.EXT3: 0x10}[bit]
+        enable_bit = _EXT_INPUTS[bit][1]
         n = self.native
         n.stop()
         n.clear_status(int(bit))
         n.write("external_emergency_stop.enable", int(n.read("external_emergency_stop.enable")) | enable_bit)
         n.write("external_emergency_stop.trigger_mode",
                 int(n.read("external_emergency_stop.trigger_mode")) & ~enable_bit)  # falling edge
+        old_speed = n.speed
+        if self._move is not None:
+            # The homing runs in speed mode at -home_speed: 6003h is put back once it has
+            # ended, but never while speed mode still runs (the write would set its speed).
+            self._move.restore.append(lambda: None if self._speed_mode else setattr(n, "speed", old_speed))
         self._homing = bit
         self._homed = False
         self._speed_mode = True
@@ -638,20 +692,68 @@ class Pmc007Drive(Drive):
 
     def _homing_done(self) -> bool:
         n = self.native
+        err = n.error_status
         st = n.controller_status
-        if st & ControllerStatus.STALL:
-            raise _core.DriveFault("pmc007: stall during homing")
-        if self._homing is not None and st & self._homing and not st & ControllerStatus.BUSY:
+        if self._homing is None:
+            return not st & ControllerStatus.BUSY
+        failure = None
+        if err or st & ControllerStatus.STALL or not n.enabled:
+            failure = self._stop_reason_of(err, st, n.enabled)
+        elif st & self._homing and not st & ControllerStatus.BUSY:
             n.clear_status(int(self._homing))
             self._leave_speed_mode()
             n.position = 0
             self._homing = None
             self._homed = True
             return True
-        return False
+        elif st & ~self._homing & (ControllerStatus.EXT1 | ControllerStatus.EXT2 | ControllerStatus.EXT3):
+            failure = self._stop_reason_of(err, ControllerStatus(st & ~self._homing), True)
+        elif not st & ControllerStatus.BUSY:
+            by = self._move.stopped_by if self._move is not None else None
+            failure = StopReason(MoveInterrupted, f"{by} of this program" if by else
+                                 f"a stop before the {_EXT_INPUTS[self._homing][0]} input fired (another "
+                                 "program's stop?)")
+        if failure is None:
+            return False
+        self._homing = None
+        self._leave_speed_mode()
+        where = self._position()
+        kw = {"side": failure.side} if issubclass(failure.error, LimitReached) else {}
+        raise failure.error(f"{self.name}: homing stopped at {self._units.to_user(where):g} {self._units.name} "
+                            f"by {failure.text}", axis=self.name, position=self._units.to_user(where),
+                            reason=failure.text, code=failure.code, status=(int(err), int(st)),
+                            units=self._units.name, **kw)
 
     def _is_idle(self) -> bool:
-        return not self.native.busy
+        try:
+            return not self.native.busy
+        except _core.SdoProtocolError:
+            # A reply to another program's request on the same COB-IDs (a second SDO
+            # client on the bus): not an answer; ask again on the next poll.
+            return False
+
+    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+        err, st = status.raw
+        return self._stop_reason_of(ErrorStatus(err), ControllerStatus(st), status.enabled)
+
+    def _stop_reason_of(self, err: ErrorStatus, st: ControllerStatus, enabled: bool) -> Optional[StopReason]:
+        if err:
+            words = ", ".join(text for bit, text in ERROR_TEXT.items() if err & bit)
+            return StopReason(MoveFaulted, f"the error status 6000h = 0x{int(err):02X} ({words})", code=int(err))
+        if st & ControllerStatus.STALL:
+            return StopReason(MoveStalled, "the stall detection (6001h bit 2 STALL)", code=int(st))
+        for bit, (name, _) in _EXT_INPUTS.items():
+            if st & bit:
+                where = {ControllerStatus.EXT1: "bit 0", ControllerStatus.EXT2: "bit 1",
+                         ControllerStatus.EXT3: "bit 4"}[bit]
+                side = self._ext_limits.get(name.lower())
+                if side:
+                    return StopReason(LimitReached, f"the {'+' if side > 0 else '-'}limit switch on the {name} "
+                                                    f"input (6001h {where})", code=int(st), side=side)
+                return StopReason(MoveInterrupted, f"the {name} external stop input (6001h {where})", code=int(st))
+        if not enabled:
+            return StopReason(MoveInterrupted, "the release of the motor (600Eh = 0)")
+        return None
 
     def _clear_faults(self) -> None:
         self.native.clear_errors()
@@ -682,14 +784,18 @@ class Pmc007Drive(Drive):
         err = n.error_status
         st = n.controller_status
         enabled = n.enabled
-        fault = bool(err) or bool(st & (ControllerStatus.EXT1 | ControllerStatus.EXT2 | ControllerStatus.STALL |
-                                          ControllerStatus.EXT3))
-        if self._homing is not None:
-            fault = bool(err) or bool(st & ControllerStatus.STALL)
+        fault = bool(err) or bool(st & ControllerStatus.STALL)
         busy = bool(st & ControllerStatus.BUSY)
+        lim = {side: any(st & bit for bit, (name, _) in _EXT_INPUTS.items() if self._ext_limits.get(name.lower()) == side)
+               for side in (1, -1)}
         text = f"6000h={err!r} 6001h={st!r} {'enabled' if enabled else 'released'}"
         return DriveStatus(enabled=enabled, moving=busy, homed=self._homed, fault=fault, at_target=not busy,
-                           limit_positive=False, limit_negative=False, raw=(int(err), int(st)), text=text)
+                           limit_positive=lim[1], limit_negative=lim[-1], raw=(int(err), int(st)), text=text)
+
+    def _console(self, line: str) -> str:
+        # SDO reads and writes by index (motorbus.canopen.console has the syntax).
+        from ..canopen.console import sdo_console
+        return sdo_console(self.native.sdo, line)
 
     def _make_params(self) -> Params:
         return Pmc007Params(self)
@@ -698,18 +804,34 @@ class Pmc007Drive(Drive):
         self.native.close()
 
 
+def _check_ext_limits(ext_limits: Optional[dict]) -> dict:
+    """``{"ext1": -1, "ext2": +1}``: which external stop inputs are wired as limit switches."""
+    if ext_limits is None:
+        return {}
+    if not isinstance(ext_limits, dict):
+        raise _core.InvalidArgument(f"pmc007 ext_limits: a table {{input: +1 or -1}}, not {ext_limits!r}")
+    out = {}
+    for k, v in ext_limits.items():
+        name = str(k).lower()
+        if name not in ("ext1", "ext2", "ext3") or isinstance(v, bool) or v not in (1, -1):
+            raise _core.InvalidArgument(f"pmc007 ext_limits: {k!r} = {v!r}; inputs ext1/ext2/ext3, sides +1 or -1")
+        out[name] = int(v)
+    return out
+
+
 def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Units] = None,
          timeout: float = 1.0, on_error: Optional[str] = "stop", on_exit: Optional[str] = "stop",
-         home_speed: int = 2000) -> Pmc007Drive:  # noqa: A001 - the plugin's verb
-    """``open_drive("pmc007", bus=..., address=5)``."""
+         home_speed: int = 2000, ext_limits: Optional[dict] = None) -> Pmc007Drive:  # noqa: A001
+    """``open_drive("pmc007", bus=..., address=5)``; ``ext_limits={"ext2": +1}``: external stop
+    inputs wired as limit switches (their stop is then LimitReached, not MoveInterrupted)."""
     from ..bus import open_bus
 
     owns = isinstance(bus, str)
     b = open_bus(bus) if owns else bus
     try:
-        native = Pmc007(b, int(address), timeout=timeout, on_error=None, on_exit=None)
+        native = Pmc007(b, int(_check_node(address)), timeout=timeout, on_error=None, on_exit=None)
         drive = Pmc007Drive(native, units=units, on_error=on_error, on_exit=on_exit,
-                            close_native=b.close if owns else None, home_speed=home_speed)
+                            close_native=b.close if owns else None, home_speed=home_speed, ext_limits=ext_limits)
     except Exception:
         if owns:
             b.close()
@@ -717,14 +839,43 @@ def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Uni
     return drive
 
 
-# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+def _sim_stall(sim: Any) -> None:
+    """The rotor jams and the drive detects it: an open-loop PMC007 sees a stall only with
+    stall detection set up (6017h threshold != 0), so a sim without it gets the manual's
+    first reference row (0x64E6) and stop-on-stall (601Bh = 1) first."""
+    od = sim.od
+    if int(od[(0x6017, 0)].value) >> 8 == 0:
+        od[(0x6017, 0)].value = STALL_EXAMPLES["28mm 5.7mH 900mA 24V 8 microsteps"]
+        od[(0x601B, 0)].value = 1
+    sim.set_jammed(True)
+
+
+def _sim_stop_input(sim: Any, input: str = "ext2") -> None:  # noqa: A002 - the input's name
+    """An external stop input fires (B-P22): enabled in 600Fh:01 on its falling edge if it is
+    not, then driven low; it counts after the 601Ah debounce (100 ms by default).  EXT2 by
+    default: EXT1 carries the sim's home switch."""
+    bit, port = {"ext1": (0x01, 7), "ext2": (0x02, 8), "ext3": (0x10, 9)}[str(input).lower()]
+    od = sim.od
+    od[(0x600F, 1)].value = int(od[(0x600F, 1)].value) | bit
+    od[(0x600F, 2)].value = int(od[(0x600F, 2)].value) & ~bit
+    sim.set_input(port, False)
+
+
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture): the standard
+# names ("fault", "stall", "stop_input") and this kind's own.  No "limit": the PMC007 has
+# no limit switch input; an external stop input wired as one is "stop_input" with
+# ext_limits= on the Drive.
 SIM_FAULTS = {
+    # a drive fault: 6000h error bits (default UVLO low voltage); the motor stops
+    "fault": lambda sim, bits=1: sim.inject_error(int(bits)),
+    # the rotor jams and the drive's stall detection sees it (6001h bit 2)
+    "stall": _sim_stall,
+    # an external stop input fires (EXT2 unless input="ext1"/"ext3")
+    "stop_input": _sim_stop_input,
     # the supply falls below the drive's threshold: the UVLO error bit (ErrorStatus bit 0)
     "supply_drop": lambda sim: sim.inject_error(1),
     # any error-status bits (ErrorStatus), e.g. 0x20 = over-temperature shutdown
     "error": lambda sim, bits=1: sim.inject_error(int(bits)),
-    # a load blocks the rotor: with stall detection set up (6017h) the drive reports it
-    "stall": lambda sim: sim.set_jammed(True),
 }
 def poll_fields(drive: "Pmc007Drive", fields: Any):
     """motorbus.Poller: 600Ch (position) and the controller status by SDO.  The
@@ -778,12 +929,15 @@ PLUGIN = DrivePlugin(
     make_sim=make_sim,
     check_address=_check_node,
     default_address="5",
-    sim_options=("steps_per_rev", "pull_out_speed", "ext1_switch", "store_path"),
+    sim_options=("steps_per_rev", "pull_out_speed", "ext1_switch", "store_path", "vendor_id", "product_code",
+                 "revision", "serial"),
     store_options=lambda store_dir, address: {"store_path": os.path.join(store_dir, f"pmc007-{address}.flash")},
-    # Discovery: the manual gives the PMC007 no device type and no identity (1000h and
-    # 1018h all 0), so a node reporting exactly that is taken for one; weak, but the
-    # only mark the manual leaves.  A CiA 402 drive reports its profile instead.
-    canopen_match=lambda node: 2 if node.device_type == 0 and not node.vendor_id and not node.product_code else 0,
+    # Discovery: the manual gives the PMC007 no device type and no identity (1000h 0,
+    # no vendor), so a node reporting device type 0 and no vendor is taken for one (the
+    # simulator's product code 7 makes it surer); weak, but the only mark the manual
+    # leaves.  A CiA 402 drive reports its profile instead.
+    canopen_match=lambda node: (0 if node.device_type != 0 or node.vendor_id else
+                                3 if node.product_code == 7 else 2 if not node.product_code else 0),
     sim_faults=SIM_FAULTS,
     poll_fields=poll_fields,
     plan_move=plan_move,

@@ -47,11 +47,13 @@ from __future__ import annotations
 
 import enum
 import threading
+import time
 from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
 
 from .. import _core
-from ..drive import Capability, Drive, DriveStatus, ParamInfo, Params, Units
+from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, ParamInfo, Params,
+                     StopReason, Units)
 from ..registry import DrivePlugin, PollSpec
 
 __all__ = ["FrameError", "UnknownRegister", "CyclicLimit", "Reg", "Status", "ModeBit", "Unitek", "UnitekDrive", "UnitekSim", "Stream", "PLUGIN", "make_sim",
@@ -85,6 +87,7 @@ class Reg(enum.IntEnum):
     EEPROM_WRITE = 0x84
     TORQUE_CMD = 0x90
     REG_A8 = 0xA8
+    ERR_WARN = 0x8F     # NDrive list, not in 002 (unitek_ndrive.toml)
 
 
 class Status(enum.IntFlag):
@@ -98,6 +101,38 @@ class Status(enum.IntFlag):
     SPEED_CONTROL = 1 << 8
     CAL = 1 << 12
     TOL = 1 << 13
+
+
+#: NDrive's error bits of ERR_WARN (0x8F, bits 0-15; the NDrive register list and the
+#: BAMOCAR manuals' "error signals" table, not manual 002): each switches the power
+#: stage off.  bit -> (NDrive name, what it means).  Bits 12 and 13 are not used.
+ERRORS = {
+    0: ("BADPARAS", "parameters damaged"),
+    1: ("POWERFAULT", "hardware error of the power stage"),
+    2: ("RFE", "safety circuit (RFE input) faulty"),
+    3: ("BUS_TIMEOUT", "CAN time-out (the T-Out time was exceeded)"),
+    4: ("FEEDBACK", "bad or wrong encoder / resolver signal"),
+    5: ("POWERVOLTAGE", "power voltage missing"),
+    6: ("MOTORTEMP", "motor temperature too high"),
+    7: ("DEVICETEMP", "device temperature too high"),
+    8: ("OVERVOLTAGE", "overvoltage (above 1.8 x UN)"),
+    9: ("I_PEAK", "overcurrent or strongly oscillating current"),
+    10: ("RACEAWAY", "race-away (speed without a set-point, or the wrong direction)"),
+    11: ("USER", "user-selected error"),
+    14: ("HW_ERR", "current measurement error"),
+    15: ("BALLAST", "ballast circuit overloaded"),
+}
+
+
+def error_text(err_warn: int) -> str:
+    """The error bits of an ERR_WARN value in NDrive's words (``"error 8 OVERVOLTAGE:
+    overvoltage (above 1.8 x UN)"``; several joined by ``; ``), "" when none is set."""
+    parts = []
+    for bit in range(16):
+        if err_warn >> bit & 1:
+            name, meaning = ERRORS.get(bit, (f"ERR{bit}", "not used by NDrive"))
+            parts.append(f"error {bit} {name}: {meaning}")
+    return "; ".join(parts)
 
 
 class ModeBit(enum.IntFlag):
@@ -547,29 +582,50 @@ class UnitekDrive(Drive):
     """The Drive API over a UNITEK servo.  Native units: position num (65536 per
     revolution), velocity num/s of position (a speed command is num of N max).
 
-    * move_to / move_by: POS_DEST (position control); finished when Tol (bit 12+1)
-      is set and the speed is 0.  The positioning speed is an NDrive parameter (no
-      REGID in 002): ``velocity=`` is refused.
+    * move_to / move_by: POS_DEST (position control), read back until the drive shows
+      the new target (writes are never acknowledged: a move is judged only once the
+      drive has taken it).  The positioning speed is an NDrive parameter (no REGID in
+      002): ``velocity=`` is refused.
+    * at rest (``wait_idle``): SPEED_IST 0 and either Tol with POS_IST within the
+      in-position window of the target, or a stop the drive shows (the limit switch
+      on the side of travel, Ena gone), or the position still over a poll.
+    * how a move ended (``_stop_reason``): ERR_WARN (0x8F, NDrive) error bits →
+      MoveFaulted (code = the error bits), Ena lost although enabled → MoveFaulted,
+      Lim+/Lim− on the side of travel → LimitReached; otherwise a move short of its
+      target was stopped by a speed command 0 (this program's stop() or another
+      program's): MoveInterrupted.
+    * in-position window: ``tol_num`` (default 64 num), the drive's Tol window; NDrive
+      sets it on the drive, 002 has no REGID for it: give the drive's value.
     * jog: SPEED_CMD from num/s via N max; stop / quick_stop: SPEED_CMD 0 (the
       drive's ramp; the protocol has no faster stop but disable).
     * torque: ``drive.torque(percent)`` (TORQUE_CMD).
     * home: no homing REGID in 002: ``home()`` requires the calibrated bit (Cal,
       the drive knows its absolute position) and positions to 0.
-    * fault: the adapter asked for enable but KERN_STATUS has no Ena (hardware
-      enable missing or the drive's own protection); ``clear_faults`` writes MODE
-      again.
+    * fault: an error bit in ERR_WARN, or the adapter asked for enable but KERN_STATUS
+      has no Ena (hardware enable missing); ``clear_faults`` writes MODE again.
     """
 
     kind = "unitek"
     capabilities = frozenset({Capability.POSITION, Capability.VELOCITY, Capability.HOMING, Capability.TORQUE,
                               Capability.STORE, Capability.ENCODER})
     has_watchdog = False
+    #: Seconds a move may show no motion before a still motor counts as at rest (a
+    #: stop that came before the motor got going); a drive showing why it stopped, or
+    #: Tol at the target, is at rest at once.
+    start_grace: float = 0.1
 
     def __init__(self, native: Unitek, *, units: Optional[Units] = None, on_error: Optional[str] = "stop",
-                 on_exit: Optional[str] = "stop", close_native: Any = None) -> None:
+                 on_exit: Optional[str] = "stop", close_native: Any = None, tol_num: float = 64) -> None:
         super().__init__(native, units=units, on_error=on_error, on_exit=on_exit, close_native=close_native)
+        if isinstance(tol_num, bool) or not isinstance(tol_num, (int, float)) or not 0 <= tol_num < 2 ** 31:
+            raise _core.InvalidArgument(f"unitek tol_num: the drive's Tol window in num (>= 0), not {tol_num!r}")
+        self._tol_num = float(tol_num)
         self._want_enabled = False
         self._activity: Optional[str] = None
+        self._target: Optional[int] = None     # POS_DEST of the move in progress
+        self._direction = 0                    # +1 / -1: the side a limit switch stops it on
+        self._seen_motion = False
+        self._started = 0.0
         n_max = native.scalings.n_max_rpm
         self._counts_per_s_per_num = n_max / 60.0 * COUNTS_PER_REV / FULL_SCALE
 
@@ -581,8 +637,22 @@ class UnitekDrive(Drive):
         st = self._st()
         if not st & Status.ENA:
             why = "fault: Ena is 0 although enabled" if self._want_enabled else "disabled"
-            raise _core.DriveFault(f"unitek: {what} refused, drive {why} (KERN_STATUS 0x{int(st):04X}; "
+            errors = error_text(self._errors() or 0)
+            raise _core.DriveFault(f"unitek: {what} refused, drive {why} (KERN_STATUS 0x{int(st):04X}"
+                                   f"{'; ' + errors if errors else ''}; "
                                    f"{'clear_faults()/hardware enable' if self._want_enabled else 'enable() first'})")
+
+    def _errors(self) -> Optional[int]:
+        """ERR_WARN (0x8F), None when the drive does not answer it (a firmware without it)."""
+        try:
+            return int(self.native.read(Reg.ERR_WARN))
+        except (_core.TimeoutError, _core.InvalidArgument):
+            return None
+
+    def _begin(self, activity: str, target: Optional[int], direction: int) -> None:
+        self._activity, self._target, self._direction = activity, target, direction
+        self._seen_motion = False
+        self._started = time.monotonic()
 
     # ---- Drive ----
     def _enable(self) -> None:
@@ -602,8 +672,21 @@ class UnitekDrive(Drive):
         num = int(round(target))
         if not -2147483647 <= num <= 2147483647:
             raise _core.InvalidArgument(f"unitek: position {num} is outside ±2147483647 num (POS_DEST)")
-        self.native.write(Reg.POS_DEST, num)
-        self._activity = "position"
+        start = self._position()
+        self._put_pos_dest(num)
+        self._begin("position", num, (num > start) - (num < start))
+
+    def _put_pos_dest(self, num: int) -> None:
+        # Writes are never acknowledged, and a reply can be a cyclic frame the drive
+        # sent before it took the write: POS_DEST is read back until it shows the new
+        # target, so nothing read afterwards judges the move by the drive's state
+        # before it (issue 28: 5 of 2 860 moves returned at the previous target).
+        for _ in range(2):
+            self.native.write(Reg.POS_DEST, num)
+            for _ in range(4):
+                if self.native.read(Reg.POS_DEST) == num:
+                    return
+        raise _core.DriveFault(f"unitek move: POS_DEST does not read back {num} after two writes")
 
     def _jog(self, velocity: float) -> None:
         self._require_enabled("jog")
@@ -612,14 +695,14 @@ class UnitekDrive(Drive):
             raise _core.InvalidArgument(f"unitek: jog velocity {velocity:g} num/s is above N max "
                                         f"({FULL_SCALE * self._counts_per_s_per_num:g} num/s)")
         self.native.write(Reg.SPEED_CMD, num)
-        self._activity = "speed"
+        self._begin("speed", None, (num > 0) - (num < 0))
 
     def torque(self, percent: float) -> None:
         """Torque command in % of the drive's maximum (TORQUE_CMD, ±32767 = ±100 %)."""
         self._check_open()
         self._require_enabled("torque")
         self.native.torque_percent(self._number("torque", percent))
-        self._activity = "torque"
+        self._begin("torque", None, (percent > 0) - (percent < 0))
 
     def _stop(self) -> None:
         # Writes are never acknowledged: a stop is read back, so it has reached the drive
@@ -646,7 +729,21 @@ class UnitekDrive(Drive):
         self._move_to(0, None)
 
     def _homing_done(self) -> bool:
-        return self._is_idle()
+        if not self._is_idle():
+            return False
+        # Homing is a move to 0: short of it, it failed the way a move does.
+        position = self._position()
+        if self._target is not None and abs(position - self._target) > self._in_position_window():
+            reason = self._stop_reason(self._status())
+            if reason is None:
+                by = self._move.stopped_by if self._move is not None else None
+                reason = StopReason(MoveInterrupted, f"{by} of this program" if by else
+                                    "a stop before the position 0 (a speed command 0 from another program)")
+            raise reason.error(f"{self.name}: homing (a move to 0) stopped at {position:g} num by {reason.text}",
+                               axis=self.name, position=self._units.to_user(position), reason=reason.text,
+                               code=reason.code, units=self._units.name,
+                               **({"side": reason.side} if issubclass(reason.error, LimitReached) else {}))
+        return True
 
     def _clear_faults(self) -> None:
         if self._want_enabled:
@@ -661,24 +758,63 @@ class UnitekDrive(Drive):
     def _velocity(self) -> float:
         return self.native.read(Reg.SPEED_IST) * self._counts_per_s_per_num
 
-    def _is_idle(self) -> bool:
-        st = self._st()
+    def _shows_stop(self, st: Status) -> bool:
+        """The drive shows why it would be at rest: Ena gone while enabled, or the limit
+        switch on the side of travel (a switch behind the motion stops nothing)."""
         if self._want_enabled and not st & Status.ENA:
-            raise _core.DriveFault(f"unitek: drive lost Ena while moving (KERN_STATUS 0x{int(st):04X})")
-        if self._activity == "position" and not st & Status.TOL:
+            return True
+        return bool((self._direction > 0 and st & Status.LIM_PLUS) or (self._direction < 0 and st & Status.LIM_MINUS))
+
+    def _is_idle(self) -> bool:
+        # At rest whatever the reason (target, limit, fault, stop); never raises for a
+        # fault: the outcome is judged afterwards (_stop_reason).
+        st = self._st()
+        if self.native.read(Reg.SPEED_IST) != 0:
+            self._seen_motion = True
             return False
-        return self.native.read(Reg.SPEED_IST) == 0
+        position = self._position()
+        if (self._activity == "position" and st & Status.TOL and self._target is not None
+                and abs(position - self._target) <= self._in_position_window()):
+            return True
+        if self._shows_stop(st):
+            return True
+        if not self._seen_motion and time.monotonic() - self._started < self.start_grace:
+            return False        # not started yet, or a reply older than the command
+        time.sleep(self.poll_interval)
+        if self.native.read(Reg.SPEED_IST) != 0:
+            self._seen_motion = True
+            return False
+        return abs(self._position() - position) <= max(self._tol_num, 1.0)
+
+    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+        st = Status(status.raw)
+        errors = self._errors()
+        if errors and errors & 0xFFFF:
+            return StopReason(MoveFaulted, f"{error_text(errors)} (ERR_WARN 0x8F = 0x{errors:08X})",
+                              code=errors & 0xFFFF)
+        if self._want_enabled and not st & Status.ENA:
+            return StopReason(MoveFaulted, "the loss of Ena (KERN_STATUS bit 0) although enabled: the hardware "
+                                           "enable (RUN) input is off or the drive switched itself off")
+        limits = [(1, Status.LIM_PLUS, "the +limit switch (KERN_STATUS bit 2 Lim+)"),
+                  (-1, Status.LIM_MINUS, "the -limit switch (KERN_STATUS bit 3 Lim-)")]
+        for side, bit, text in limits:
+            if st & bit and self._direction in (0, side):
+                return StopReason(LimitReached, text, side=side)
+        return None
+
+    def _in_position_window(self) -> float:
+        return self._tol_num
 
     def _status(self) -> DriveStatus:
         st = self._st()
         speed = self.native.read(Reg.SPEED_IST)
         at_target = bool(st & Status.TOL)
         fault = self._want_enabled and not st & Status.ENA
-        moving = speed != 0 or (self._activity == "position" and not at_target and not fault)
+        moving = speed != 0
         names = [f.name for f in Status if f & st] or ["none"]
         text = f"KERN_STATUS 0x{int(st):04X} ({' '.join(names)})"
         if fault:
-            text += ", fault: no Ena although enabled (hardware enable?)"
+            text += ", fault: no Ena although enabled (hardware enable or a drive error)"
         return DriveStatus(enabled=bool(st & Status.ENA), moving=moving, homed=bool(st & Status.CAL), fault=fault,
                            at_target=at_target, limit_positive=bool(st & Status.LIM_PLUS),
                            limit_negative=bool(st & Status.LIM_MINUS), raw=int(st), text=text)
@@ -693,8 +829,9 @@ class UnitekDrive(Drive):
 def open(*, line: Any = None, bus: Any = None, address: Union[str, int] = "0x201",  # noqa: A001 - the plugin's verb
          units: Optional[Units] = None, timeout: float = 0.2, on_error: Optional[str] = "stop",
          on_exit: Optional[str] = "stop", tx_id: Optional[int] = None, registers: Any = None,
-         n_max_rpm: float = 3000.0, device: str = "DS 205/405") -> UnitekDrive:
-    """``open_drive("unitek", bus=..., address="0x201")``."""
+         n_max_rpm: float = 3000.0, device: str = "DS 205/405", tol_num: float = 64) -> UnitekDrive:
+    """``open_drive("unitek", bus=..., address="0x201")``; ``tol_num``: the drive's Tol window
+    (num), the in-position window a move is judged by."""
     from ..bus import open_bus
 
     if bus is None:
@@ -705,7 +842,7 @@ def open(*, line: Any = None, bus: Any = None, address: Union[str, int] = "0x201
         native = Unitek(b, int(check_address(address), 16), tx_id, timeout=timeout, registers=registers,
                         n_max_rpm=n_max_rpm, device=device, on_error=None, on_exit=None)
         drive = UnitekDrive(native, units=units, on_error=on_error, on_exit=on_exit,
-                            close_native=b.close if owns else None)
+                            close_native=b.close if owns else None, tol_num=tol_num)
     except Exception:
         if owns:
             b.close()
@@ -759,8 +896,15 @@ def capture_fields(drive: UnitekDrive, fields: Sequence[str], period: float) -> 
                     stamped=True, close=source.close)
 
 
-# Faults the simulator can be given (the pytest plugin's sim_faults fixture).
+# Faults the simulator can be given (the pytest plugin's sim_faults fixture): the standard
+# names ("limit", "fault") and this kind's own.  No "stall" (a servo: no stall detection on
+# this protocol) and no "stop_input" (002 documents no stop input; the RUN input is
+# "enable_off", a fault).
 SIM_FAULTS = {
+    # a limit switch closes (direction +1 / -1): a motion towards it stops
+    "limit": lambda sim, direction=1: sim.force_limit(int(direction), True),
+    # a drive error: ERR_WARN bits (default bit 8 OVERVOLTAGE) switch the power stage off
+    "fault": lambda sim, bits=0x0100: sim.force_error(int(bits)),
     # a limit switch input goes active (direction -1 or +1)
     "trip_limit": lambda sim, direction=-1: sim.force_limit(int(direction), True),
     # the hardware enable (RUN) input drops: the power stage switches off

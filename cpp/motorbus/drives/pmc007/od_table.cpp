@@ -172,7 +172,7 @@ const OdRow* pmc007_od_row(std::uint16_t index, std::uint8_t sub) {
     return nullptr;
 }
 
-std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id) {
+std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id, const Pmc007Identity& identity) {
     if (node_id == 0 || node_id > 127) throw InvalidArgument("pmc007: node-ID must be 1..127");
     auto od = std::make_shared<canopen::ObjectDictionary>();
     od->set_node_id(node_id);
@@ -200,7 +200,12 @@ std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id)
         if (r.text) {
             spec.default_value = canopen::Bytes(r.text, r.text + std::char_traits<char>::length(r.text));
         } else {
-            const std::int64_t d = r.node_offset >= 0 ? r.node_offset + node_id : r.def;
+            std::int64_t d = r.node_offset >= 0 ? r.node_offset + node_id : r.def;
+            if (r.index == 0x1018 && r.sub >= 1 && r.sub <= 4) {
+                const std::uint32_t ids[] = {identity.vendor_id, identity.product_code, identity.revision,
+                                             identity.serial};
+                d = ids[r.sub - 1];
+            }
             if (is_signed)
                 spec.default_value = d;
             else

@@ -50,7 +50,7 @@ constexpr std::pair<std::uint16_t, std::uint8_t> kLive[] = {
 }  // namespace
 
 Pmc007Sim::Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions options)
-    : node_id_(node_id), clock_(clock), opt_(options), od_(build_pmc007_od(node_id)), motor_(clock, [&] {
+    : node_id_(node_id), clock_(clock), opt_(options), od_(build_pmc007_od(node_id, options.identity)), motor_(clock, [&] {
           motion::MotorConfig c;
           c.steps_per_rev = options.steps_per_rev;
           c.counts_per_rev = options.steps_per_rev;

@@ -72,6 +72,10 @@ struct Pmc007SimOptions {
     // Where the "flash" lives between runs (ROM objects saved by 2007h=2, the
     // offline program saved by 6019h:03, the 602Ah position); "" = memory only.
     std::string store_path{};
+    // What 1018h reads (003 documents no identity): vendor 0 = none claimed (a CiA
+    // vendor ID is assigned, not invented), product code 7 ("PMC007"), revision 1.0
+    // (as 100Ah "SW1.0"), serial 1.  A bench can give each sim its own.
+    Pmc007Identity identity{0, 7, 0x00010000, 1};
 };
 
 class Pmc007Sim {

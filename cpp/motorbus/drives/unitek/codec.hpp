@@ -39,6 +39,11 @@ inline constexpr std::uint8_t kRegA8 = 0xA8;           // unnamed, §5.2's reque
 // register list (outside this manual) has it; the sim serves it and the Python
 // adapter adds it from its TOML file (python/motorbus/drives/unitek_ndrive.toml).
 inline constexpr std::uint8_t kRegPosActual = 0x6D;
+// Not in 002 either: NDrive's error/warning register (32 bit, read-only): bits 0-15
+// the errors (each switches the power stage off), bits 16-31 the warnings.  The sim
+// serves it; the Python adapter reads it to say why a move ended.
+inline constexpr std::uint8_t kRegErrWarn = 0x8F;
+inline constexpr std::uint32_t kErrorBits = 0x0000FFFF;
 
 inline constexpr std::uint32_t kDefaultRxId = 0x201;
 inline constexpr std::uint32_t kDefaultTxId = 0x181;

@@ -42,6 +42,15 @@ RegisterTable sim_default_table() {
     r.unit = "rev";
     r.description = "actual position (NDrive list, not in 002)";
     t.add(r);
+    Register e;
+    e.regid = kRegErrWarn;
+    e.name = "ERR_WARN";
+    e.bits = 32;
+    e.is_signed = false;
+    e.access = Access::ReadOnly;
+    e.quantity = Quantity::Raw;
+    e.description = "errors (bits 0-15) and warnings (bits 16-31) (NDrive list, not in 002)";
+    t.add(e);
     return t;
 }
 
@@ -72,6 +81,7 @@ void UnitekSim::reset_ram_locked() {
     for (const auto& r : table_.rows()) regs_[r.regid] = 0;
     regs_[kRegEventMask] = kDefaultEventMask;
     mode_ = 0;
+    err_warn_ = 0;
     slots_.clear();
     activity_ = Activity::Idle;
 }
@@ -308,6 +318,7 @@ void UnitekSim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
         case kRegMode: {
             const auto old = mode_;
             mode_ = static_cast<std::uint16_t>(v);
+            if (!(mode_ & kModeDisable)) err_warn_ &= ~kErrorBits;  // enabling again clears the errors
             if ((mode_ & kModeEvents) && !(old & kModeEvents)) last_status_ = status_locked();  // no frame at activation
             apply_enable_locked();
             break;
@@ -375,7 +386,7 @@ void UnitekSim::apply_enable_locked() {
 
 std::uint32_t UnitekSim::status_locked() {
     std::uint32_t s = 0;
-    if (!(mode_ & kModeDisable) && hw_enable_) s |= kStatusEna;
+    if (!(mode_ & kModeDisable) && hw_enable_ && !(err_warn_ & kErrorBits)) s |= kStatusEna;
     if (motor_.plus_limit_active()) s |= kStatusLimPlus;
     if (motor_.minus_limit_active()) s |= kStatusLimMinus;
     if (cfg_.position_control) s |= kStatusPositionControl;
@@ -394,6 +405,7 @@ std::uint32_t UnitekSim::status_locked() {
 std::int64_t UnitekSim::value_locked(std::uint8_t regid) {
     switch (regid) {
         case kRegStatus: return status_locked() & 0xFFFF;  // C-U02: 16 bits in a read reply
+        case kRegErrWarn: return err_warn_;
         case kRegPosActual: {
             const double p = std::clamp(motor_.pulse_position(), -2147483647.0, 2147483647.0);
             return static_cast<std::int64_t>(std::llround(p));
@@ -437,6 +449,8 @@ void UnitekSim::force_limit(int direction, std::optional<bool> active) {
 void UnitekSim::set_calibrated(bool on) { UNITEK_SIM_LOCKED(calibrated_ = on); }
 
 void UnitekSim::force_icns(std::optional<bool> active) { UNITEK_SIM_LOCKED(icns_forced_ = active); }
+
+void UnitekSim::force_error(std::uint32_t bits) { UNITEK_SIM_LOCKED(err_warn_ |= bits; apply_enable_locked()); }
 
 void UnitekSim::power_cycle() {
     std::lock_guard l(m_);

@@ -88,6 +88,11 @@ public:
     void force_limit(int direction, std::optional<bool> active);  // +1 / -1; nullopt: follow the position
     void set_calibrated(bool on);
     void force_icns(std::optional<bool> active);
+    // NDrive's error/warning register (0x8F): set bits latch.  An error bit (0-15)
+    // switches the power stage off (Ena 0, the rotor stops where it is) until a
+    // MODE write that enables the drive clears the errors (this sim's reading: how
+    // NDrive clears an error is not in 002).  Warning bits (16-31) only show.
+    void force_error(std::uint32_t bits);
     void power_cycle();  // EEPROM values back, RAM values lost, cyclic/events off, motor stopped
 
     // ---- introspection ----
@@ -144,6 +149,7 @@ private:
     bool hw_enable_ = true;
     bool calibrated_;
     std::optional<bool> icns_forced_;
+    std::uint32_t err_warn_ = 0;  // 0x8F
     std::optional<bool> limit_forced_[2];  // [0] minus, [1] plus
     Activity activity_ = Activity::Idle;
     std::uint32_t last_status_ = 0;
