@@ -552,16 +552,22 @@ class ServedBench:
       the server's reason;
     * ``faults(axis)``: the names offered; ``close()``: SIGINT, then waits.
 
+    ``bench_file``: a path, or a dict as ``Bench.from_dict`` takes it.
     ``link_dir`` defaults to a fresh temporary directory (tests side by side do
     not share one); ``port``: as ``--port``; ``args``: more ``sim serve``
     arguments.  ``timeout``: seconds to wait for the twin to start, and for each
     answer."""
 
-    def __init__(self, bench_file: "str | os.PathLike[str]", *, write: Optional[str] = None,
+    def __init__(self, bench_file: "str | os.PathLike[str] | Mapping[str, Any]", *, write: Optional[str] = None,
                  link_dir: Optional[str] = None, port: "int | str | None" = None, args: Sequence[str] = (),
                  timeout: float = 30.0) -> None:
         self._tmp = tempfile.mkdtemp(prefix="motorbus-served-")
         self.timeout = timeout
+        if isinstance(bench_file, Mapping):   # a bench as Bench.from_dict takes it: written as TOML first
+            source = os.path.join(self._tmp, "source.toml")
+            with open(source, "w", encoding="utf-8") as f:
+                f.write(_toml_document(bench_file))
+            bench_file = source
         self.bench_file = os.path.abspath(write or os.path.join(self._tmp, "bench.toml"))
         self.link_dir = os.path.abspath(link_dir or os.path.join(self._tmp, "links"))
         self.announced: list[str] = []

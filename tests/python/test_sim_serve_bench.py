@@ -197,6 +197,20 @@ def test_control_names_faults_and_refuses_bad_ones(served):
         served.inject("x", "trip_limit", direction=[1])
 
 
+def test_served_bench_from_a_dict_of_every_kind():
+    """Every registered kind serves: a dict (the pytest plugin's one-axis-per-kind bench)
+    written, served, opened by this process; each axis offers its kind's faults."""
+    from motorbus.pytest_plugin import default_bench
+
+    data = default_bench()
+    with ServedBench(data) as served:
+        assert {c.split("=")[0] for c in served.command("axes").split()} == set(data["axis"])
+        for axis, table in data["axis"].items():
+            assert served.faults(axis) == sorted(registry.drive_plugin(table["kind"]).sim_faults or {})
+        status = read_bench(served.bench_file, lambda b: {n: d.status for n, d in b.axes.items()})
+        assert set(status) == set(data["axis"]) and not any(s.moving or s.fault for s in status.values())
+
+
 def test_injected_limit_is_seen_by_another_process(tmp_path):
     """A fault injected through --control acts on the simulator the commands talk to."""
     with ServedBench(DEMO_BENCH) as served:
