@@ -74,8 +74,12 @@ def _discover(bench: Bench) -> tuple[list[tuple[str, str, str, str]], list[str]]
             f = on_can.get((_served_spec(bench, cfg.bus), cfg.address))
             got = f"{f.kind} {f.identity.get('model', '')}".strip() if f else "nothing"
         else:   # the line is the bench's own: ask this axis's address with the kind's identity probe
-            ident = plugin.probe(bench.lines[cfg.line], cfg.address) if plugin.probe else None
-            got = f"{cfg.kind} {ident.get('model', '')}".strip() if ident else "nothing"
+            try:
+                ident = plugin.probe(bench.lines[cfg.line], cfg.address) if plugin.probe else None
+            except _core.MotorbusError as e:   # the demo goes on: the table says what the probe met
+                ident, got = None, f"nothing ({type(e).__name__})"
+            else:
+                got = f"{cfg.kind} {ident.get('model', '')}".strip() if ident else "nothing"
         rows.append((name, cfg.kind, cfg.address, got))
     listed = {(_served_spec(bench, c.bus), c.address) for c in bench.config.values() if c.bus}
     extra = [f"{f.kind} {f.address} on {f.bus}" for f in found if (f.bus, f.address) not in listed]
