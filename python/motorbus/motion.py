@@ -43,6 +43,7 @@ from ._core import (  # noqa: F401
     unitek_speed_profile,
     ArcusSpeedWindow,
     DmacMotion,
+    InvalidArgument,
     DmacProfileParams,
     LimitExceeded,
     Limits,
@@ -95,10 +96,10 @@ _SHAPES = {"trapezoid": RampShape.TRAPEZOID, "s_curve": RampShape.SCURVE, "scurv
 def _shape(shape: str | RampShape) -> RampShape:
     if isinstance(shape, RampShape):
         return shape
-    try:
-        return _SHAPES[shape.lower()]
-    except KeyError:
-        raise ValueError(f"shape must be one of {sorted(_SHAPES)}, not {shape!r}") from None
+    # InvalidArgument (a ValueError too): None or a number is a wrong argument like a wrong name.
+    if not isinstance(shape, str) or shape.lower() not in _SHAPES:
+        raise InvalidArgument(f"motion.plan shape: one of {sorted(_SHAPES)} or a RampShape, not {shape!r}")
+    return _SHAPES[shape.lower()]
 
 
 def plan(target: float, *, start: float = 0.0, v0: float = 0.0, a0: float = 0.0,

@@ -53,6 +53,9 @@ __all__ = ["Poller", "FIELDS", "load_frame"]
 FIELDS = ("position", "velocity", "status")
 _SCALED = ("position", "velocity")   # converted to user units; status stays the raw word
 _START_DELAY_NS = 20_000_000         # deadline 0: after every thread is up
+#: Default seconds of rows frame() retains.  Unbounded, a 1 kHz poll of 2 axes grew ~1 GB/h
+#: even for a caller that consumed read(); 10 minutes of it is ~43 MB.
+KEEP_S = 600.0
 MODES = ("auto", "capture", "ask")
 
 
@@ -92,13 +95,18 @@ class Poller:
       kind can push, i.e. its plugin has ``capture_fields`` — TPDOs on the
       event timer, cyclic registers — and ask the others), ``"capture"`` (every axis captured; an
       axis whose kind cannot push is an InvalidArgument) or ``"ask"`` (always
-      ask, one request per field per sample).  ``modes`` says per axis.
+      ask, one request per field per sample).  ``modes`` says per axis;
+    * ``keep``: seconds of rows ``frame()`` and ``save()`` retain (default
+      :data:`KEEP_S`, 10 minutes: bounded memory however long the poller runs;
+      ``None``: every row since start; ``0``: none — for a caller that consumes
+      ``read()``).  Rows that age out are counted in ``discarded``; ``read()``
+      is not affected.
     """
 
     def __init__(self, axes: Any, fields: Iterable[str] = FIELDS, rate_hz: float = 1000.0, *,
                  capacity: Optional[int] = None, spin_us: float = 0.0, realtime: bool = False,
                  candump: Optional[Union[str, "os.PathLike[str]"]] = None, mode: str = "auto",
-                 start: bool = True) -> None:
+                 keep: Optional[float] = KEEP_S, start: bool = True) -> None:
         named = _named_axes(axes)
         fields = _check_fields(fields)
         if isinstance(rate_hz, bool) or not isinstance(rate_hz, (int, float)) or not math.isfinite(rate_hz) \
@@ -116,6 +124,14 @@ class Poller:
                                         f"not {spin_us!r}")
         if mode not in MODES:
             raise _core.InvalidArgument(f"Poller mode: one of {', '.join(repr(m) for m in MODES)}, not {mode!r}")
+        if keep is not None and (isinstance(keep, bool) or not isinstance(keep, (int, float))
+                                 or not math.isfinite(keep) or keep < 0):
+            raise _core.InvalidArgument(f"Poller keep: seconds >= 0 of rows frame() retains, or None for all, "
+                                        f"not {keep!r}")
+        #: Rows frame() retains (None: all).
+        self.keep_rows: Optional[int] = None if keep is None else int(math.ceil(keep * rate_hz))
+        #: Rows that aged out of what frame() retains (read() returned each of them once).
+        self.discarded = 0
         self.fields = fields
         self.rate_hz = float(rate_hz)
         self.mode = mode
@@ -150,6 +166,7 @@ class Poller:
         self._realtime = bool(realtime)
         self._candump = os.fspath(candump) if candump is not None else None
         self._chunks: list[dict[str, np.ndarray]] = []
+        self._retained = 0
         self._t0_ns = 0
         self._started = False
         self._stopped = False
@@ -256,12 +273,35 @@ class Poller:
             parts.append((g, k[:n], t[:n], v[:n]))
             g.pending = (k[n:], t[n:], v[n:])
         chunk = self._merge(parts)
-        if len(chunk["t"]):
+        if len(chunk["t"]) and self.keep_rows != 0:
             self._chunks.append(chunk)
+            self._retained += len(chunk["t"])
+            self._trim()
+        elif len(chunk["t"]):
+            self.discarded += len(chunk["t"])
         return chunk
 
+    def _trim(self) -> None:
+        """Drops the oldest retained rows beyond keep_rows (whole chunks, then a slice)."""
+        if self.keep_rows is None:
+            return
+        excess = self._retained - self.keep_rows
+        while excess > 0 and self._chunks:
+            first = self._chunks[0]
+            n = len(first["t"])
+            if n <= excess:
+                self._chunks.pop(0)
+                cut = n
+            else:   # a copy: a view would keep the whole chunk alive
+                self._chunks[0] = {k: v[excess:].copy() for k, v in first.items()}
+                cut = excess
+            self._retained -= cut
+            self.discarded += cut
+            excess -= cut
+
     def frame(self) -> dict[str, np.ndarray]:
-        """Every sample since start (reads what is new first)."""
+        """The retained samples (reads what is new first): every row since start with
+        ``keep=None``, else the last ``keep`` seconds of rows (``discarded`` counts the rest)."""
         self.read()
         if not self._chunks:
             return self._merge([(g, np.empty(0, np.int64), np.empty(0, np.int64),
@@ -321,7 +361,7 @@ class Poller:
         return out
 
     def save(self, path: Union[str, "os.PathLike[str]"]) -> None:
-        """Every sample since start to ``.npz`` (numpy arrays by column) or ``.csv`` (a header row of column names)."""
+        """The retained samples (``frame()``) to ``.npz`` (numpy arrays by column) or ``.csv`` (a header row of column names)."""
         path = os.fspath(path)
         frame = self.frame()
         if path.endswith(".npz"):
