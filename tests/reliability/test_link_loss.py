@@ -97,3 +97,38 @@ def test_frozen_then_killed_server(round_):
             proc.wait(10)
         for b in buses:
             b.close()
+
+
+@pytest.mark.subprocess
+@pytest.mark.parametrize("round_", range(ROUNDS))
+def test_sdo_transfer_in_flight_when_the_server_is_killed(round_):
+    """Issue 28 item 4: an SDO transfer waiting for its response (timeout=inf: only the link can
+    end it) wakes with LinkDown when the server process is SIGKILLed, as recv() does."""
+    proc, host, port = _serve()
+    cli = None
+    try:
+        cli = open_socketcand(host, port, "can0", keepalive=None)
+        sdo = SdoClient(cli, 9, timeout=float("inf"))     # node 9 does not exist: no answer comes
+        outcome = []
+
+        def run():
+            try:
+                sdo.upload(0x2000, 0, block=round_ % 2 == 1)
+            except BaseException as e:  # noqa: BLE001 - the type is what we check
+                outcome.append(e)
+        t = threading.Thread(target=run, daemon=True)
+        t.start()
+        t.join(0.3)
+        assert t.is_alive(), outcome
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(10)
+        t.join(10)
+        assert not t.is_alive(), "an SDO transfer with timeout=inf still waits after the server was killed"
+        assert isinstance(outcome[0], motorbus.LinkDown), outcome
+        assert "lost during the transfer" in str(outcome[0])
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(10)
+        if cli is not None:
+            cli.close()
