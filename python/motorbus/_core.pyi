@@ -1471,6 +1471,11 @@ class SdoClientCounters:
         block refused, retried segmented
         """
     @property
+    def foreign_responses(self) -> int:
+        """
+        initiate responses / aborts naming another object: another client's on the same COB-IDs, ignored
+        """
+    @property
     def ignored_frames(self) -> int:
         """
         responses while idle, duplicates
@@ -1553,8 +1558,10 @@ class SdoClient:
     """
     SDO client for one node (requests 0x600+n, responses 0x580+n).
     """
-    def __init__(self, bus: Bus, node_id: typing.SupportsInt | typing.SupportsIndex, timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0, max_transfer: typing.SupportsInt | typing.SupportsIndex = 1048576, block_size: typing.SupportsInt | typing.SupportsIndex = 127, read_retries: typing.SupportsInt | typing.SupportsIndex = 0, request_id: typing.SupportsInt | typing.SupportsIndex = 0, response_id: typing.SupportsInt | typing.SupportsIndex = 0, block_fallback: bool = False) -> None:
-        ...
+    def __init__(self, bus: Bus, node_id: typing.SupportsInt | typing.SupportsIndex, timeout: typing.SupportsFloat | typing.SupportsIndex = 1.0, max_transfer: typing.SupportsInt | typing.SupportsIndex = 1048576, block_size: typing.SupportsInt | typing.SupportsIndex = 127, read_retries: typing.SupportsInt | typing.SupportsIndex = 0, request_id: typing.SupportsInt | typing.SupportsIndex = 0, response_id: typing.SupportsInt | typing.SupportsIndex = 0, block_fallback: bool = False, block_crc: bool = True) -> None:
+        """
+        block_crc: block transfers offer and require CRC-16 (a server answering without it is refused, abort 0x05040004); False for a server without CRC, whose block data is then unchecked.
+        """
     def download(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, data: typing.Any, block: bool = False, segmented: bool = False) -> None:
         ...
     def read_domain(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex = 0, block: bool = False) -> bytes:
