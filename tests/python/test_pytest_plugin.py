@@ -213,7 +213,7 @@ def test_sim_faults_vocabulary_per_kind_and_bench_faults(pytester, every_kind):
                 assert sim_faults.offered(name), kind
 
         def test_unknown_fault_lists_what_the_simulator_offers(sim_faults):
-            with pytest.raises(motorbus.InvalidArgument, match=r"no fault 'meteor' \\(it has: drive_fault\\)"):
+            with pytest.raises(motorbus.InvalidArgument, match=r"no fault 'meteor' \\(it has: drive_fault, fault, limit, stall, stop_input\\)"):
                 sim_faults.inject("cia402", "meteor")
 
         def test_drive_fault_latches(bench, sim_faults):
