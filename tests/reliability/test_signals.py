@@ -81,10 +81,12 @@ def _assert_at_rest(served, ended_at: float) -> dict:
     assert served.moving(settle=0.2) == []
     for k, t in took.items():
         assert t <= STOP_TIME[k], (k, t)
+    print("at rest after the child's end (s, 0.1 s resolution):", {k: round(t, 2) for k, t in sorted(took.items())})
     return took
 
 
 def _end(proc, sig, timeout=30.0):
+    sent = time.monotonic()
     proc.send_signal(sig)
     try:
         out, _ = proc.communicate(timeout=timeout)
@@ -92,7 +94,9 @@ def _end(proc, sig, timeout=30.0):
         proc.kill()
         out, _ = proc.communicate()
         pytest.fail(f"{sig.name}: the child did not end in {timeout} s: {out}")
-    return out, time.monotonic()
+    ended = time.monotonic()
+    print(f"{sig.name} to the child's end: {1000 * (ended - sent):.0f} ms")
+    return out, ended
 
 
 _CHILD_BENCH = """
@@ -186,8 +190,7 @@ def test_signal_during_cli_move_stops_the_axis(served, tmp_path, sig):
                 subprocess.run([sys.executable, "-m", "motorbus", "config", "apply", str(path)], check=True,
                                capture_output=True, timeout=60, preexec_fn=_signals_default)
                 procs[name] = subprocess.Popen(
-                    [sys.executable, "-m", "motorbus", "move", str(path), name, "2000", "--by",
-                     "--velocity", str(served.jog[name]), "--timeout", "600"],
+                    [sys.executable, "-m", "motorbus", "move", str(path), name, "2000", "--by", "--timeout", "600"],
                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, preexec_fn=_signals_default)
             deadline = time.monotonic() + 60
             while sorted(served.moving(settle=0.15)) != sorted(served.kinds):
