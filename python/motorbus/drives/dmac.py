@@ -177,6 +177,7 @@ __all__ = [
     "CommandRejected",
     "DEFAULT_ADDRESS",
     "DEFAULT_BAUD",
+    "DEFAULT_REFERENCE_SWITCH",
     "DmacClient",
     "DmacClientCounters",
     "DmacDrive",
@@ -195,7 +196,6 @@ __all__ = [
     "HomingInterrupted",
     "HomingLimitReached",
     "HomingTimedOut",
-    "DEFAULT_REFERENCE_SWITCH",
     "LINE_SETTINGS",
     "PLUGIN",
     "UnknownCommand",
@@ -329,7 +329,7 @@ def make_sim(address: Any = "00", clock: Any = None, **options: Any) -> DmacSim:
     ``end_switch_active_low``, ``reference_switch`` (position where a switch
     on IN5 turns on and stays on beyond: REFERENCE homing and #CAPTURE;
     default ``DEFAULT_REFERENCE_SWITCH``, 3000 = 0.3 rev, so the Drive's default
-    homing works on a served twin; None = no switch).
+    homing works on a served twin; None or False = no switch).
     ``clock`` is a motorbus Clock (SimClock for tests); None = real time.
     """
     allowed = {"model", "supply_voltage", "baudrate", "request_terminator", "reply_terminator",
@@ -345,6 +345,8 @@ def make_sim(address: Any = "00", clock: Any = None, **options: Any) -> DmacSim:
     if "baudrate" in options:
         options["baudrate"] = int(options["baudrate"])
     options.setdefault("reference_switch", DEFAULT_REFERENCE_SWITCH)
+    if options["reference_switch"] is False:     # a bench file's way to say "no switch" (TOML has no None)
+        options["reference_switch"] = None
     return DmacSim(clock, address=_parse_address(address), **options)
 
 
