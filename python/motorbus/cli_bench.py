@@ -645,7 +645,8 @@ def add_commands(sub: Any, common: Any = None) -> None:
     parents = [common] if common is not None else []
 
     def bench_parser(name: str, help: str) -> argparse.ArgumentParser:
-        p = sub.add_parser(name, help=help, parents=parents)
+        p = sub.add_parser(name, help=help, description=help, parents=parents, epilog=exit_codes_text(),
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
         p.add_argument("bench", metavar="BENCH", help="the bench file (TOML)")
         p.add_argument("--sim", action="store_true",
                        help="run against the bench's simulated twin (a fresh twin for this command only)")
@@ -658,8 +659,8 @@ def add_commands(sub: Any, common: Any = None) -> None:
     with_json(p)
     p.set_defaults(func=cmd_status)
     p = bench_parser("move", "move an axis (in the bench's units); Ctrl-C stops it")
-    p.add_argument("axis", metavar="AXIS")
-    p.add_argument("position", metavar="POSITION", type=finite_float)
+    p.add_argument("axis", metavar="AXIS", help="an axis of the bench file")
+    p.add_argument("position", metavar="POSITION", type=finite_float, help="where to, in the axis's units")
     p.add_argument("--by", action="store_true", help="relative move")
     p.add_argument("--velocity", type=positive_float, default=None,
                    help="speed for this move only (user units/s); the drive's own setting is put back")
