@@ -948,7 +948,8 @@ class Bench:
                 d.close()
             except Exception:  # noqa: BLE001 - close the rest
                 pass
-        for link in list(self.lines.values()) + list(self.buses.values()):
+        # A LineLink has no close of its own: its port holds the line (and its lock).
+        for link in [ln.port for ln in self.lines.values()] + list(self.buses.values()):
             try:
                 link.close()
             except Exception:  # noqa: BLE001

@@ -458,3 +458,20 @@ def test_a_failed_sync_block_starts_nothing(tmp_path):
         assert bench.sims["a"].last_setpoint_ns is None and a.position == 0
         a.move_to(100, timeout=10)                 # and the axis still moves normally
         assert a.position == 100
+
+
+def test_a_closed_bench_releases_its_serial_lines(tmp_path):
+    """Bench.close() gives its lines back at once (not when the object is collected): the
+    same program opens the same bench file again (it got "busy … already open by this
+    process" before)."""
+    from motorbus.sim import ServedBench
+
+    src = tmp_path / "bench.toml"
+    src.write_text('[line.l]\nport = "/dev/null"\n\n[axis.a]\nkind = "arcus"\nline = "l"\naddress = "01"\n')
+    with ServedBench(src) as served:
+        first = Bench.load(served.bench_file)
+        position = first["a"].position
+        first.close()
+        with Bench.load(served.bench_file) as again:       # kept `first` alive on purpose
+            assert again["a"].position == position
+        assert first.closed
