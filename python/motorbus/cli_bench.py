@@ -389,7 +389,7 @@ def _motion(args: argparse.Namespace, bench: Bench, what: str, action: Callable[
         except KeyboardInterrupt:      # a second Ctrl-C: the fastest stop, no more waiting
             d.quick_stop()
     if isinstance(error, MoveFailed) and error.outcome == "timeout":
-        d.stop()                          # do not leave it running past the time it was given
+        _stop_and_settle(d)               # not left running past the time it was given; said at rest
     position = d.position
     if interrupted:
         rest = "at rest" if not d.status.moving else "still braking"

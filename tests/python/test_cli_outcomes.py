@@ -178,8 +178,11 @@ def test_a_timeout_exits_14_and_the_axis_is_stopped(served):
     r = run("move", served.path, "z", "150", "--velocity", "20", "--timeout", "0.5")
     assert r.returncode == 14, r
     assert "the timeout (0.5 s)" in r.stderr
+    said = float(r.stdout.split()[1])
     r = run("status", served.path, "--json")
-    assert json.loads(r.stdout)["axes"]["z"]["moving"] is False     # stopped, not left running
+    z = json.loads(r.stdout)["axes"]["z"]
+    assert z["moving"] is False                                     # stopped, not left running
+    assert z["position"] == pytest.approx(said, abs=0.01)           # and said where it came to rest
 
 
 def test_ctrl_c_stops_and_waits_for_rest_before_saying_where(served):
