@@ -420,7 +420,9 @@ def test_pmc007_identity_and_console():
         n = s.drive.native
         assert n.read((0x1018, 2)) == 7 and n.read((0x1018, 3)) == 0x00010000 and n.read((0x1018, 4)) == 1234
         assert n.read((0x1018, 1)) == 0                  # no vendor claimed: the manual names none
-        assert "0x00000007" in s.drive.console("r 0x1018:2 u32").lower() or "7" in s.drive.console("r 0x1018:2 u32")
+        # `terminal` on a pmc007 axis: SDO by index, as on every CANopen kind.
+        assert s.drive.console("r 0x1018:2 u32") == "7"
+        assert s.drive.console("r 0x1018:4 u32") == "1234"
     finally:
         s.close()
 
@@ -431,3 +433,14 @@ def test_pmc007_integer_address_means_that_integer():
     for bad in (0, 128, True, "x", "9" * 100):
         with pytest.raises(motorbus.InvalidArgument, match="pmc007 address"):
             check(bad)
+
+
+def test_bench_file_integer_addresses_mean_those_integers(tmp_path):
+    # Issue 22: `address = 0x201` (a TOML integer, 513) was refused as "receive id 0x513".
+    p = tmp_path / "bench.toml"
+    p.write_text('[bus.can]\nspec = "virtual:outcomes-can-int-address"\n\n'
+                 '[axis.z]\nkind = "unitek"\nbus = "can"\naddress = 0x201\n\n'
+                 '[axis.p]\nkind = "pmc007"\nbus = "can"\naddress = 5\n')
+    with motorbus.Bench.load(p, sim=True) as bench:
+        assert bench.config["z"].address == "0x201" and bench.config["p"].address == "5"
+        assert bench["z"].native.rx_id == 0x201 and bench["p"].native.node == 5
