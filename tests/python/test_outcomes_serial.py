@@ -213,7 +213,7 @@ def test_dmac_supply_drop_as_in_the_issue_raises_and_the_cause_is_named(rig):
     # The issue: supply_drop 0.3 s into an 8 mm move, move_to returned at 4.36 mm.
     r = rig("dmac", units=Units("mm", 0.001))
     d = r.drive
-    d.params["#HIGH_SPEED"] = 6000                    # 60 rpm: 10 mm/s
+    d.params["#HIGH_SPEED"] = 3000                    # 30 rpm: 5 mm/s, 1.6 s for the move
     timer = threading.Timer(0.3, r.faults["supply_drop"], args=(r.sim,))
     timer.start()
     with pytest.raises(MoveFaulted, match="undervoltage") as failed:
@@ -299,6 +299,19 @@ def test_a_stop_from_another_client_on_the_line_raises_move_interrupted(rig, kin
     assert e.reason.startswith("a command from another client on the line (STOP, ")
     assert_stopped_short(e, d, start, target)
     other.close()
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_a_second_process_cannot_open_the_line(rig, kind):
+    # Why "another program" is another client on the same line here (the docs say so).
+    import subprocess
+    import sys
+    r = rig(kind)
+    code = (f"import motorbus; motorbus.open_drive({kind!r}, line={r.line.pty_path!r}, "
+            f"address={r.address!r})")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode != 0
+    assert "is busy: already open by pid" in out.stderr and "opened exclusively" in out.stderr
 
 
 def test_arcus_power_off_from_another_client_is_named(rig):
