@@ -621,6 +621,7 @@ class UnitekDrive(Drive):
             raise _core.InvalidArgument(f"unitek tol_num: the drive's Tol window in num (>= 0), not {tol_num!r}")
         self._tol_num = float(tol_num)
         self._want_enabled = False
+        self._no_err_warn = False
         self._activity: Optional[str] = None
         self._target: Optional[int] = None     # POS_DEST of the move in progress
         self._direction = 0                    # +1 / -1: the side a limit switch stops it on
@@ -643,10 +644,14 @@ class UnitekDrive(Drive):
                                    f"{'clear_faults()/hardware enable' if self._want_enabled else 'enable() first'})")
 
     def _errors(self) -> Optional[int]:
-        """ERR_WARN (0x8F), None when the drive does not answer it (a firmware without it)."""
+        """ERR_WARN (0x8F), None when the drive does not answer it (a firmware without it:
+        asked once, then no more, so a move's judgement does not wait a timeout each time)."""
+        if self._no_err_warn:
+            return None
         try:
             return int(self.native.read(Reg.ERR_WARN))
-        except (_core.TimeoutError, _core.InvalidArgument):
+        except _core.TimeoutError:
+            self._no_err_warn = True
             return None
 
     def _begin(self, activity: str, target: Optional[int], direction: int) -> None:
