@@ -40,8 +40,8 @@ from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, 
                      ParamInfo, Params, StopReason, Units)
 from ..registry import DrivePlugin
 
-__all__ = ["Cia402Drive", "Cia402Sim", "PLUGIN", "SYNC_START_RPDO", "make_sim", "open", "OBJECTS",
-           "synchronised_start"]
+__all__ = ["Cia402Drive", "Cia402Sim", "ERROR_CODES", "PLUGIN", "SYNC_START_RPDO", "make_sim", "open", "OBJECTS",
+           "error_text", "synchronised_start"]
 
 # Statusword bits the simulator drives itself (the state bits come from Cia402Device).
 _SW_REMOTE = 1 << 9
@@ -921,12 +921,14 @@ class Cia402Drive(Drive):
         return self._velocity() == 0
 
     def _in_position_window(self) -> float:
-        """6067h (position window), read once and kept: it is a setting, not a reading."""
+        """6067h (position window), read once and kept: it is a setting, not a reading.
+        FFFFFFFFh switches the drive's window off (CiA 402): then, as without 6067h, exactly."""
         if self._window is None:
             try:
-                self._window = float(int.from_bytes(self._sdo.upload(0x6067, 0), "little"))
+                window = int.from_bytes(self._sdo.upload(0x6067, 0), "little")
             except _core.SdoAbortError:
-                self._window = self.in_position_window   # a drive without 6067h: exactly
+                window = 0xFFFFFFFF
+            self._window = self.in_position_window if window == 0xFFFFFFFF else float(window)
         return self._window
 
     def _limit_side(self, status: DriveStatus) -> tuple[int, str]:
