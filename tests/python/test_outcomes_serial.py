@@ -125,6 +125,15 @@ def test_a_move_that_arrives_returns_and_records_done(rig, kind):
     assert d.status.last_move.target == pytest.approx(start - 2.0)
 
 
+def test_arcus_a_move_longer_than_the_drives_largest_is_refused_naming_it(rig):
+    r = rig("arcus")
+    d = r.drive
+    with pytest.raises(motorbus.InvalidArgument, match=r"at most 262143 in one X \(Table 11.0\)"):
+        d.move_to(300_000)
+    assert not d.status.moving and d.status.last_move is None
+    d.move_to(2000)                                   # the Drive still works
+
+
 def test_arcus_open_loop_window_is_zero(rig):
     r = rig("arcus")
     d = r.drive

@@ -506,7 +506,18 @@ class ArcusDrive(_drive.Drive):
         self._speed_for_this_move(velocity)
         self._use_mode(False)
         self._target, self._direction = goal, 0   # direction: worked out when velocity is read
-        self.native.move(goal)
+        try:
+            self.native.move(goal)
+        except _core.ArcusUnknownCommand:
+            # "?X..." also answers a move longer than the drive's largest (Table 11.0):
+            # say which, in the Drive's words (read only on this path: a move stays one request).
+            here = self._position()
+            if abs(goal - here) > _core.ARCUS_MAX_MOVE_DISTANCE:
+                raise _core.InvalidArgument(
+                    f"arcus {self.native.address:02d}: a move from {here:g} to {goal} is "
+                    f"{abs(goal - here):g} {'counts' if self._snl else 'pulses'}; the DMX-CAN moves at most "
+                    f"{_core.ARCUS_MAX_MOVE_DISTANCE} in one X (Table 11.0): split it") from None
+            raise
 
     def _move_by(self, distance: float, velocity: Optional[float]) -> None:
         # An absolute X to the target Drive judges the move by (where the axis was read
