@@ -421,6 +421,18 @@ def test_arcus_homing_into_a_limit_is_a_limit_reached(rig):
     assert d.status.last_move.what == "home" and d.status.last_move.state == "limit"
 
 
+def test_arcus_homing_stopped_by_this_program_is_interrupted_and_not_homed(rig):
+    r = rig("arcus", home=(400000, 400400))
+    d = r.drive
+    d.params["HSPD"] = 4000
+    d.home("H+", wait=False)
+    wait_until_away(d, 0.0, 100)
+    d.stop()
+    with pytest.raises(MoveInterrupted, match=r"stop\(\) of this program"):
+        d.wait_idle(timeout=10)
+    assert not d.status.homed and d.status.last_move.state == "interrupted"
+
+
 def test_arcus_homing_stalled(rig):
     r = rig("arcus", home=(400000, 400400))
     d = r.drive
@@ -460,18 +472,21 @@ def test_dmac_homing_without_a_switch_times_out_naming_the_in5_edge(rig):
     assert dmac.DmacStatus.REFERENCE not in d.native.status
 
 
-def test_dmac_homing_stopped_by_another_client_is_interrupted(rig):
+@pytest.mark.parametrize("who", ("this program", "another client"))
+def test_dmac_homing_stopped_is_interrupted(rig, who):
     r = rig("dmac", reference_switch=2_000_000)
     d = r.drive
     d.params["#LOW_SPEED"] = 60000
     d.home(wait=False)
     wait_until_away(d, 0.0)
     other = r.other_client()
-    other.stop()
+    d.stop() if who == "this program" else other.stop()
     with pytest.raises(dmac.HomingInterrupted) as failed:
         d.wait_idle(timeout=10)
-    assert isinstance(failed.value, MoveInterrupted)
-    assert "another client on the line" in failed.value.reason and "IN5 reference edge" in failed.value.reason
+    e = failed.value
+    assert isinstance(e, MoveInterrupted) and "IN5 reference edge" in e.reason
+    assert ("stop() of this program" if who == "this program" else "another client on the line") in e.reason
+    assert not d.status.homed and dmac.DmacStatus.REFERENCE not in d.native.status
     other.close()
 
 

@@ -569,7 +569,8 @@ class ArcusDrive(_drive.Drive):
             raise error(f"arcus {self.native.address:02d}: homing failed: {reason.text}")
         # Nothing the drive shows tells a homing that found its switch from one a STOP
         # of another client on the line ended (docs/drives/arcus.md): it counts as homed.
-        self._homed = reason is None
+        move = self._move
+        self._homed = reason is None and (move is None or move.stopped_by is None)
         return True
 
     def _clear_faults(self) -> None:
