@@ -490,6 +490,18 @@ def test_dmac_homing_stopped_is_interrupted(rig, who):
     other.close()
 
 
+def test_dmac_a_move_after_an_abandoned_homing_disarms_reference(rig):
+    r = rig("dmac", reference_switch=50_000)
+    d = r.drive
+    d.params["#LOW_SPEED"] = 60000
+    d.home(wait=False)                                # search for IN5 ...
+    wait_until_away(d, 0.0)
+    assert dmac.DmacStatus.REFERENCE in d.native.status
+    d.move_to(-10_000)                                # ... abandoned for a move: REFERENCE is
+    assert dmac.DmacStatus.REFERENCE not in d.native.status   # off, no silent re-homing at IN5 later
+    assert d.position == -10_000.0 and not d.status.homed
+
+
 def test_dmac_homing_into_an_end_stop_is_a_limit_reached(rig):
     r = rig("dmac", positive_end_switch=2000)
     d = r.drive

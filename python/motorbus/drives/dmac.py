@@ -572,8 +572,16 @@ class DmacDrive(Drive):
     def _set_high_speed(self, value: int) -> None:
         self.native.high_speed = value
 
+    def _abandon_homing(self) -> None:
+        # A reference run nobody waited to the end of: REFERENCE ON would otherwise stay
+        # armed and silently re-home the axis at the next IN5 edge turning clockwise.
+        if self._homing is not None:
+            self._homing = None
+            self.native.reference(False)
+
     def _move_to(self, target: float, velocity: Optional[float]) -> None:
         goal = self._increments(target)
+        self._abandon_homing()
         self._speed_for_this_move(velocity)
         with self._refused_in_drive_words(f"move_to (MOVE_TO {goal})"):
             self.native.move_to(goal)
@@ -582,6 +590,7 @@ class DmacDrive(Drive):
         # MOVE_ON counts from where the axis is at rest (the sim and the manual: from the
         # target of a move in progress), which is where Drive read the start it judges by.
         step = self._increments(distance)
+        self._abandon_homing()
         self._speed_for_this_move(velocity)
         with self._refused_in_drive_words(f"move_by (MOVE_ON {step})"):
             self.native.move_on(step)
@@ -593,6 +602,7 @@ class DmacDrive(Drive):
         if speed == 0:
             self.native.stop()
             return
+        self._abandon_homing()
         with self._refused_in_drive_words(f"jog (MOVE_SPEED {speed})"):
             self.native.move_speed(speed)  # the module limits |speed| to #HIGH_SPEED
 
@@ -611,7 +621,7 @@ class DmacDrive(Drive):
         if method not in self.HOME_METHODS:
             raise _core.InvalidArgument(f"dmac: home method {method!r} is not one of {self.HOME_METHODS}")
         self._homed = False
-        self._homing = None
+        self._abandon_homing()
         if method == "here":
             self.native.position = 0
             self._homed = True
