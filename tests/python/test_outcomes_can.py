@@ -182,12 +182,12 @@ def test_unitek_stop_from_a_second_program_is_move_interrupted(unitek):
     d = unitek.drive
     other = SecondProgram(unitek)
     try:
-        d.move_to(8 * REV, wait=False)
-        time.sleep(0.2)
-        other.send(0x201, bytes([0x31, 0x00, 0x00]))     # SPEED_CMD 0 (ex 3's frame with 0)
+        # SPEED_CMD 0 (ex 3's frame with 0) from the other program while this one waits.
+        unitek.later(0.2, other.send, 0x201, bytes([0x31, 0x00, 0x00]))
         with pytest.raises(MoveInterrupted) as e:
-            d.wait_idle(5)
+            d.move_to(8 * REV, timeout=10)
     finally:
+        time.sleep(0.1)
         other.close()
     assert "another program" in e.value.reason
     assert 0 < unitek.sim.position_num < 8 * REV
@@ -371,21 +371,28 @@ def test_pmc007_stop_from_another_thread_is_move_interrupted(pmc007):
 def test_pmc007_stop_from_a_second_program_is_move_interrupted(pmc007):
     d = pmc007.drive
     other = SecondProgram(pmc007)
+    confirmed = []
+
+    def second_program_stops() -> None:
+        # Another program writes 6020h (immediate stop) by SDO on the node's COB-IDs while
+        # this one polls: the node has one request slot (a colliding request is dropped),
+        # so it does what an SDO client does, asks again until the node confirms.
+        for _ in range(10):
+            other.send(0x605, bytes([0x2F, 0x20, 0x60, 0x00, 0x00, 0x00, 0x00, 0x00]))
+            if other.reply(0x585, bytes([0x60, 0x20, 0x60, 0x00]), timeout=0.2):
+                confirmed.append(True)
+                return
+
     try:
-        d.move_to(20000, wait=False)
-        time.sleep(0.15)
-        # Another program writes 6020h (immediate stop) by SDO on the node's COB-IDs.  Not
-        # while this program polls: two SDO clients on one node's COB-IDs take each other's
-        # replies (and the node may drop a request that collides), a CiA 301 limit the docs
-        # state (docs/drives/pmc007.md, "How a move ends").
-        other.send(0x605, bytes([0x2F, 0x20, 0x60, 0x00, 0x00, 0x00, 0x00, 0x00]))
-        assert other.reply(0x585, bytes([0x60, 0x20, 0x60, 0x00])), "the node did not confirm the stop"
+        pmc007.later(0.15, second_program_stops)
         with pytest.raises(MoveInterrupted) as e:
-            d.wait_idle(5)
+            d.move_to(20000, timeout=10)
     finally:
+        time.sleep(0.3)
         other.close()
+    assert confirmed, "the node never confirmed the second program's stop"
     assert "another program" in e.value.reason
-    assert 0 < pmc007.sim.position < 20000
+    assert 0 < pmc007.sim.position < 20000 and not pmc007.sim.busy
 
 
 def test_pmc007_timeout_is_move_timed_out(pmc007):

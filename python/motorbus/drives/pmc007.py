@@ -595,6 +595,7 @@ class Pmc007Drive(Drive):
         self._homing: Optional[ControllerStatus] = None
         self._homed = False
         self._speed_mode = False
+        self._sdo_misses = 0
         self._ext_limits = _check_ext_limits(ext_limits)
 
     def _refusing(self, what: str, fn: Callable[[], None]) -> None:
@@ -725,12 +726,21 @@ class Pmc007Drive(Drive):
                             units=self._units.name, **kw)
 
     def _is_idle(self) -> bool:
+        # Another program's SDO requests to this node (a second client on the same COB-IDs)
+        # can take our reply (SdoProtocolError: it names another object) or take the node's
+        # single request slot so ours is dropped (SdoTimeout): neither is an answer, so
+        # the poll asks again; a second timeout in a row is a link that is gone.
         try:
-            return not self.native.busy
+            busy = self.native.busy
         except _core.SdoProtocolError:
-            # A reply to another program's request on the same COB-IDs (a second SDO
-            # client on the bus): not an answer; ask again on the next poll.
             return False
+        except _core.SdoTimeout:
+            self._sdo_misses += 1
+            if self._sdo_misses > 1:
+                raise
+            return False
+        self._sdo_misses = 0
+        return not busy
 
     def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
         err, st = status.raw
