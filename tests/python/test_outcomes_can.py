@@ -107,8 +107,9 @@ def test_unitek_plus_limit_ends_the_move_with_limit_reached(unitek):
     err = e.value
     assert err.side == 1 and "+limit" in err.reason and "Lim+" in err.reason
     assert err.target == 20 * REV
-    # The sim halts at its evaluation time after the switch: within a few ms of travel.
-    assert 10 * REV <= unitek.sim.position_num <= 10.5 * REV
+    # The sim halts at its evaluation time after the switch (every ms; later on a loaded
+    # host): at 10 rev/s, 0.1 rev per 10 ms late.
+    assert 10 * REV <= unitek.sim.position_num <= 11 * REV
     assert abs(err.position - unitek.sim.position_num) <= 64
     assert err.status & utk.Status.LIM_PLUS
     st = d.status
