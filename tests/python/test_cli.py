@@ -373,3 +373,22 @@ def test_status_and_config_from_another_process_do_not_stop_a_jog(tmp_path, kind
             d.close()
     finally:
         s.close()
+
+
+def test_terminal_on_a_canopen_axis_says_it_speaks_sdo(tmp_path, bench_file):
+    import shutil
+    if shutil.which("tmux") is None:
+        pytest.skip("tmux is not installed (Makefile APT_PACKAGES)")
+    from test_cli_terminal import Pane
+
+    pane = Pane(tmp_path)
+    try:
+        pane.type(f"{sys.executable} -m motorbus terminal {bench_file} z --sim")
+        text = pane.wait_for("\nz>", 60)
+        assert "z: cia402 (CANopen) — SDO reads and writes; 'quit' leaves" in text
+        assert "r INDEX[:SUB] [TYPE]" in text and "w INDEX[:SUB] VALUE [TYPE]" in text
+        pane.type("r 0x1000 u32")
+        assert "4325778" in pane.wait_for("4325778", 20)       # 0x00420192: profile 402
+        pane.type("quit; echo EXIT\"\"=$?")
+    finally:
+        pane.close()
