@@ -38,7 +38,9 @@ from typing import Any, Optional
 __all__ = ["TerminatedBySignal", "handle_signal", "stop_all", "track", "untrack", "SIGNALS"]
 
 _live: "weakref.WeakSet[Any]" = weakref.WeakSet()
-_lock = threading.Lock()
+# Re-entrant: the signal handler runs in the main thread between two bytecodes, possibly
+# inside track() or untrack() of that same thread.
+_lock = threading.RLock()
 
 #: The signals that stop the drives before the process ends (SIGINT is Ctrl-C's
 #: KeyboardInterrupt, which Python already raises).
@@ -210,6 +212,20 @@ def _at_exit() -> None:
 
 
 atexit.register(_at_exit)
+
+
+def _forked_child() -> None:
+    # A forked child (multiprocessing) shares its parent's links: the drives are the
+    # parent's to stop, not the child's, at its exit or on its signal.  The handlers stay:
+    # with nothing tracked they end the child as SIG_DFL would.
+    global _live, _lock, _pending
+    _live = weakref.WeakSet()
+    _lock = threading.RLock()
+    _pending = None
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forked_child)
 
 
 def halt(how, stop, quick_stop, disable) -> None:

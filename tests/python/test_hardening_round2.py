@@ -210,3 +210,36 @@ def test_poller_default_retention_is_ten_minutes(tmp_path):
 def test_plan_with_a_wrong_shape_is_invalid_argument(shape):
     with pytest.raises(motorbus.InvalidArgument, match="motion.plan shape"):
         motion.plan(10, max_velocity=1, max_acceleration=1, shape=shape)
+
+
+# ---- item 1: a forked child does not stop its parent's drives --------------------------------------
+def test_a_forked_child_ended_by_sigterm_leaves_the_parents_drives_alone(tmp_path):
+    import os
+    import signal
+
+    from motorbus import _stop_at_exit
+
+    with _load(tmp_path, _CAN) as bench:
+        z = bench["z"]
+        z.enable()
+        z.jog(1000)
+        r, w = os.pipe()
+        pid = os.fork()
+        if pid == 0:   # the child: tracks nothing of its own, ends by SIG_DFL at once
+            try:
+                os.close(r)
+                os.write(w, b"%d" % len(_stop_at_exit._live))
+                os.close(w)
+                time.sleep(30)
+            finally:   # whatever happens, the child never returns into pytest
+                os._exit(0)
+        os.close(w)
+        tracked_in_child = os.read(r, 16)
+        os.close(r)
+        os.kill(pid, signal.SIGTERM)
+        _, status = os.waitpid(pid, 0)
+        assert tracked_in_child == b"0"
+        assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM
+        time.sleep(0.1)
+        assert z.status.moving           # the parent's jog goes on
+        z.stop()
