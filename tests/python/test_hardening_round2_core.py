@@ -225,6 +225,9 @@ def test_a_second_capturing_poller_on_a_cia402_sim_gets_fresh_samples():
     with _cia402_bench() as bench:
         z = bench["z"]
         for run in range(2):
+            # Some time after the first Poller stopped (its close disabled the TPDO): long
+            # enough for the node to have run the PDO timer and found nothing to schedule.
+            time.sleep(0.3 * run)
             with Poller({"z": z}, rate_hz=200) as poller:
                 assert poller.modes == {"z": "capture"}
                 time.sleep(0.6)
@@ -285,9 +288,9 @@ def test_127_simulated_nodes_keep_bounded_receive_queues():
 # item 10: Ctrl-C slices, bad values refused
 
 CTRL_C = {
-    # A 100 bit/s wire (a frame ~1 s) with one transmit slot: the third send waits.
-    "send_full_queue": ("b = _core.open_virtual('sig', bitrate=100, tx_queue=1); "
-                        "r = _core.open_virtual('sig', bitrate=100, tx_queue=1); "
+    # A 1 bit/s wire (a frame lasts 47 s) with one transmit slot: the third send waits for room.
+    "send_full_queue": ("b = _core.open_virtual('sig', bitrate=1, tx_queue=1); "
+                        "r = _core.open_virtual('sig', bitrate=1, tx_queue=1); "
                         "b.send(_core.Frame(1, b'')); b.send(_core.Frame(1, b'')); ready(); "
                         "[b.send(_core.Frame(1, b''), timeout=30) for _ in range(10)]"),
     # A server that accepts the connection (the kernel does) and never says < hi >.
