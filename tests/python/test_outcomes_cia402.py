@@ -277,8 +277,8 @@ def test_velocity_is_for_that_move_only(rig):
 def test_homing_halted_by_another_program_is_interrupted(rig):
     """A homing halted (6040h bit 8) ends reached-not-attained: MoveInterrupted, not a hang."""
     d = rig.drive
-    d.params["0x6099:01"] = 2000      # a slow search, so the halt comes before the switch
-    d.params["0x6099:02"] = 1000
+    d.params["0x6099:01"] = 500       # a slow search: the halt comes long before the switch
+    d.params["0x6099:02"] = 200
     d.home(20, wait=False)            # both: a search away from the home switch window
     time.sleep(0.3)
     d.native.sdo.download(0x6040, 0, (0x011F).to_bytes(2, "little"))   # halt, as another program would
@@ -292,7 +292,7 @@ def test_homing_into_a_fault_raises_move_faulted_with_the_code(rig):
     if "fault" not in rig.faults:
         pytest.skip("the DMX-CAN has no fault with a code")
     d = rig.drive
-    d.params["0x6099:01"] = 2000
+    d.params["0x6099:01"] = 500       # slow: the fault comes long before the homing could end
     d.home(20, wait=False)
     time.sleep(0.3)
     rig.inject("fault", code=0x4310)
