@@ -135,13 +135,15 @@ def test_typed_errors(setup):
 def test_protocol_error_carries_frame():
     name = f"virtual:sdo-py-{next(_hub)}"
     with motorbus.open_bus(name) as host, motorbus.open_bus(name) as fake:
-        fake.subscribe(lambda f: f.data[0] == 0x40 and fake.send(Frame(0x585, h("4F 02 60 00 08 00 00 00"))),
+        # An unknown command specifier (C6).  (A response naming another multiplexer, C2, is no
+        # longer an error: it is another client's on the same COB-IDs -- issue 22.)
+        fake.subscribe(lambda f: f.data[0] == 0x40 and fake.send(Frame(0x585, h("E0 01 60 00 08 00 00 00"))),
                        id=0x605)
         sdo = SdoClient(host, 5, timeout=0.5)
         with pytest.raises(SdoProtocolError) as e:
             sdo.read_u8(0x6001, 0)
-        assert e.value.code == 0x06040043  # C2
-        assert e.value.data == h("4F 02 60 00 08 00 00 00")
+        assert e.value.code == 0x05040001  # C6
+        assert e.value.data == h("E0 01 60 00 08 00 00 00")
 
 
 def test_many_threads_share_a_client(setup):
