@@ -4169,7 +4169,7 @@ class Pmc007Sim:
     """
     A simulated CQPUSI PMC007 CANopen node (see sim.hpp).
     """
-    def __init__(self, node_id: typing.SupportsInt | typing.SupportsIndex = 5, clock: Clock = None, steps_per_rev: typing.SupportsFloat | typing.SupportsIndex = 200.0, pull_out_speed: typing.SupportsFloat | typing.SupportsIndex = 0.0, ext1_switch: tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex] | None = None, store_path: str = '') -> None:
+    def __init__(self, node_id: typing.SupportsInt | typing.SupportsIndex = 5, clock: Clock = None, steps_per_rev: typing.SupportsFloat | typing.SupportsIndex = 200.0, pull_out_speed: typing.SupportsFloat | typing.SupportsIndex = 0.0, ext1_switch: tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex] | None = None, store_path: str = '', vendor_id: typing.SupportsInt | typing.SupportsIndex = 0, product_code: typing.SupportsInt | typing.SupportsIndex = 7, revision: typing.SupportsInt | typing.SupportsIndex = 65536, serial: typing.SupportsInt | typing.SupportsIndex = 1) -> None:
         ...
     def attach(self, bus: Bus) -> None:
         ...
@@ -4600,6 +4600,10 @@ class UnitekSim:
         ...
     def eeprom(self) -> dict[int, int]:
         ...
+    def force_error(self, bits: typing.SupportsInt | typing.SupportsIndex) -> None:
+        """
+        latch NDrive error (0-15: power stage off) / warning (16-31) bits in 0x8F
+        """
     def force_icns(self, active: bool | None) -> None:
         ...
     def force_limit(self, direction: typing.SupportsInt | typing.SupportsIndex, active: bool | None) -> None:
