@@ -296,7 +296,7 @@ class _Checker:
                 raise self.fail(f"expected a table [{section}.{name}]", section, name)
             unknown = sorted(set(table) - allowed)
             if unknown:
-                raise self.fail(f"unknown key (a {section} takes: {', '.join(sorted(allowed))})",
+                raise self.fail(f"unknown key ([{section}.{name}] takes: {', '.join(sorted(allowed))})",
                                 section, name, unknown[0])
             out[name] = dict(table)
         return out

@@ -517,12 +517,6 @@ def cmd_config(args: argparse.Namespace) -> int:
 
 
 #: Identity fields that are codes, shown in hex as the manuals print them.
-_HEX_IDENTITY = {"device_type", "vendor_id", "product_code", "revision", "serial"}
-
-
-def _identity_text(identity: dict) -> str:
-    return ", ".join(f"{k}=0x{v:08X}" if k in _HEX_IDENTITY and isinstance(v, int) and not isinstance(v, bool)
-                     else f"{k}={v}" for k, v in identity.items())
 
 
 def _check_writable(path: str) -> Optional[str]:
@@ -545,7 +539,7 @@ def _check_writable(path: str) -> Optional[str]:
 
 def cmd_scan(args: argparse.Namespace) -> int:
     from . import trace
-    from .discovery import discover
+    from .discovery import discover, identity_text
 
     if not args.serial and not args.can:
         _err("motorbus scan: give --serial PORT and/or --can SPEC")
@@ -567,7 +561,7 @@ def cmd_scan(args: argparse.Namespace) -> int:
                           "identity": f.identity} for f in result.found],
                "skipped": [str(s) for s in result.skipped], "wrote": args.write})
     else:
-        rows = [(f.kind, f.address, f.line or f.bus, f.baud or "", _identity_text(f.identity))
+        rows = [(f.kind, f.address, f.line or f.bus, f.baud or "", identity_text(f.identity))
                 for f in result.found]
         _say(table(rows, ("kind", "address", "where", "baud", "identity")) if rows else "no drive answered")
     for s in result.skipped:

@@ -212,6 +212,16 @@ def _node_identity(node: Any) -> dict:
     return {k: v for k, v in out.items() if v is not None}
 
 
+#: CANopen identity fields (1000h, 1018h) are written in hex, as the manuals and EDS files do.
+_HEX_IDENTITY = {"device_type", "vendor_id", "product_code", "revision", "serial"}
+
+
+def identity_text(identity: dict) -> str:
+    """``{"vendor_id": 0x1F4, "model": "DMX"}`` -> ``vendor_id=0x000001F4, model=DMX``."""
+    return ", ".join(f"{k}=0x{v:08X}" if k in _HEX_IDENTITY and isinstance(v, int) and not isinstance(v, bool)
+                     else f"{k}={v}" for k, v in identity.items())
+
+
 def _toml_str(v: Any) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
@@ -235,7 +245,7 @@ def bench_toml(found: Sequence[Found]) -> str:
             buses[f.bus] = name
             out += [f"[bus.{name}]", f"spec = {_toml_str(f.bus)}", ""]
     for i, f in enumerate(found, start=1):
-        ident = ", ".join(f"{k}={v}" for k, v in f.identity.items())
+        ident = identity_text(f.identity)
         out += [f"[axis.{f.kind.replace('-', '_')}_{i}]" + (f"  # {ident}" if ident else ""),
                 f"kind = {_toml_str(f.kind)}"]
         out.append(f"line = {_toml_str(lines[(f.line, f.baud)])}" if f.line is not None

@@ -88,3 +88,12 @@ def test_scan_command_prints_a_table_and_writes_the_file(wired, tmp_path):
     assert rows[0].split()[:3] == ["kind", "address", "where"]
     assert sum(1 for row in rows if row.startswith("cia402")) == 2
     assert 'kind = "cia402"' in out.read_text()
+
+
+def test_written_bench_file_and_table_give_identities_in_hex():
+    from motorbus.discovery import Found, bench_toml, identity_text
+
+    ident = {"device_type": 0x00420192, "vendor_id": 0x1F4, "model": "DMX-K"}
+    assert identity_text(ident) == "device_type=0x00420192, vendor_id=0x000001F4, model=DMX-K"
+    f = Found(kind="cia402", address="5", bus="socketcand:127.0.0.1:1/can0", identity=ident)
+    assert "# device_type=0x00420192, vendor_id=0x000001F4" in bench_toml([f])
