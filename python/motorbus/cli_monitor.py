@@ -65,7 +65,7 @@ class Listener:
             node = int(address)
             self.node = node
             self.ids = tuple(fc + node for fc in (0x080, 0x180, 0x280, 0x380, 0x480, 0x700))
-        else:                                 # a receive id (UNITEK): the drive answers on its transmit id
+        else:                                 # a receive id (a REGID kind): the drive answers on its transmit id
             tx = cfg.options.get("tx_id")
             self.node = None
             self.ids = (int(tx) if tx is not None else int(address, 0) - 0x80,)

@@ -136,8 +136,8 @@ class MoveFaulted(MoveFailed):
 
 
 class MoveStalled(MoveFailed):
-    """The rotor stalled or the following error grew too large (PMC007 stall detection,
-    Arcus StepNLoop)."""
+    """The rotor stalled or the following error grew too large (a drive's stall
+    detection, a closed-loop stepper giving up its correction)."""
 
     __module__ = "motorbus"
 
@@ -793,8 +793,8 @@ def open_drive(kind: str, *, line: Any = None, bus: Any = None, address: Union[s
     * ``options``: the vendor's (``on_error``, ``on_exit``, timeouts...).
     """
     plugin = registry.drive_plugin(kind)
-    # An integer means that integer for every kind (a UNITEK id 0x201 is 513, not "513"
-    # read as hex text); text is the vendor's own notation.
+    # An integer means that integer for every kind (a CAN id 0x201 is 513, not "513" read
+    # as hex text by a kind that writes its ids in hex); text is the vendor's own notation.
     is_int = isinstance(address, int) and not isinstance(address, bool)
     canonical = plugin.check_address(address if is_int else str(address).strip())
     if plugin.transport == "serial":
