@@ -650,7 +650,7 @@ class UnitekDrive(Drive):
             return None
         try:
             return int(self.native.read(Reg.ERR_WARN))
-        except _core.TimeoutError:
+        except (_core.TimeoutError, UnknownRegister):   # no reply, or a table without 0x8F
             self._no_err_warn = True
             return None
 
