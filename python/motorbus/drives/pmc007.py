@@ -569,6 +569,12 @@ _EXT_INPUTS = {ControllerStatus.EXT1: ("EXT1", 0x01), ControllerStatus.EXT2: ("E
                ControllerStatus.EXT3: ("EXT3", 0x10)}
 
 
+def _flags(value: Any) -> str:
+    """A status byte for a person: ``0x09 (EXT1|BUSY)``, ``0x00 (none)``."""
+    names = "|".join(f.name for f in type(value) if f in value) or "none"
+    return f"0x{int(value):02X} ({names})"
+
+
 class Pmc007Drive(Drive):
     """The Drive API over a PMC007: position mode (6004h relative, 601Ch absolute), speed mode,
     stop (6020h), enable/release (600Eh), homing into an external stop input.
@@ -608,7 +614,7 @@ class Pmc007Drive(Drive):
 
     def _fault_text(self) -> str:
         n = self.native
-        return f"6000h={n.error_status!r}, 6001h={n.controller_status!r}, enabled={n.enabled}"
+        return f"6000h {_flags(n.error_status)}, 6001h {_flags(n.controller_status)}, enabled={n.enabled}"
 
     def _leave_speed_mode(self) -> None:
         if self._speed_mode:
@@ -798,7 +804,7 @@ class Pmc007Drive(Drive):
         busy = bool(st & ControllerStatus.BUSY)
         lim = {side: any(st & bit for bit, (name, _) in _EXT_INPUTS.items() if self._ext_limits.get(name.lower()) == side)
                for side in (1, -1)}
-        text = f"6000h={err!r} 6001h={st!r} {'enabled' if enabled else 'released'}"
+        text = f"6000h {_flags(err)}, 6001h {_flags(st)}, {'enabled' if enabled else 'released'}"
         return DriveStatus(enabled=enabled, moving=busy, homed=self._homed, fault=fault, at_target=not busy,
                            limit_positive=lim[1], limit_negative=lim[-1], raw=(int(err), int(st)), text=text)
 
