@@ -206,30 +206,61 @@ def test_stop_from_another_thread_raises_move_interrupted(rig):
     check_failure(d, e, start, target)
 
 
-def test_a_halt_from_a_second_independent_client_raises_move_interrupted(rig):
-    """A second program on its own socketcand connection (python-can) writes the controlword
-    with halt (bit 8) by a raw expedited SDO download; the mover did not ask for it."""
+def _halt_from_another_client(spec: str, node: int) -> None:
+    """A second program: its own socketcand connection (python-can), a raw expedited SDO
+    download of the controlword with halt (bit 8) — its reply told from the mover's ones."""
     can = pytest.importorskip("can")
-    d = rig.drive
-    node = int(rig.address)
-    host_port = rig.spec.split(":", 1)[1].split("/")[0]
-    host, port = host_port.rsplit(":", 1)
-    start, target = start_far_move(d)
-    # The mover is not polling now (wait=False): the two SDO conversations do not cross.
+    host, port = spec.split(":", 1)[1].split("/")[0].rsplit(":", 1)
+    halt = 0x010F
     with can.Bus(interface="socketcand", host=host, port=int(port), channel="can0") as other:
-        halt = 0x010F
+        # First it looks, as a status command would (1000h, an object the mover never reads,
+        # 30 times): replies the mover's client must not take for its own.
+        for _ in range(30):
+            other.send(can.Message(arbitration_id=0x600 + node, is_extended_id=False,
+                                   data=bytes([0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])))
+            t_end = time.monotonic() + 1
+            while time.monotonic() < t_end:
+                reply = other.recv(timeout=max(0.0, t_end - time.monotonic()))
+                if reply is not None and reply.arbitration_id == 0x580 + node and bytes(reply.data[1:3]) == b"\x00\x10":
+                    break
         other.send(can.Message(arbitration_id=0x600 + node, is_extended_id=False,
                                data=bytes([0x2B, 0x40, 0x60, 0x00, halt & 0xFF, halt >> 8, 0, 0])))
         t_end = time.monotonic() + 5
         while True:
             reply = other.recv(timeout=max(0.0, t_end - time.monotonic()))
             assert reply is not None, "no SDO reply to the halt"
-            if reply.arbitration_id == 0x580 + node:
-                assert reply.data[:4] == bytes([0x60, 0x40, 0x60, 0x00])
-                break
-    with pytest.raises(MoveInterrupted) as failed:
-        d.wait_idle(timeout=20)
-    e = failed.value
+            if reply.arbitration_id == 0x580 + node and bytes(reply.data[:4]) == bytes([0x60, 0x40, 0x60, 0x00]):
+                return
+
+
+@pytest.mark.parametrize("while_polling", [False, True], ids=["idle", "polling"])
+def test_a_halt_from_a_second_independent_client_raises_move_interrupted(rig, while_polling):
+    """``polling``: this program waits (SDO reads every 5 ms) while the other one writes: the
+    two clients share the node's COB-IDs and see each other's replies, which must cost this
+    program nothing but a repeated read."""
+    d = rig.drive
+    start, target = start_far_move(d)
+    outcome: list = []
+    waiter = None
+    if while_polling:
+        def wait() -> None:
+            try:
+                d.wait_idle(timeout=20)
+                outcome.append(None)
+            except BaseException as e:  # noqa: BLE001 - the test inspects it
+                outcome.append(e)
+        waiter = threading.Thread(target=wait)
+        waiter.start()
+        time.sleep(0.2)
+    _halt_from_another_client(rig.spec, int(rig.address))
+    if waiter is not None:
+        waiter.join(30)
+        e = outcome[0]
+    else:
+        with pytest.raises(MoveInterrupted) as failed:
+            d.wait_idle(timeout=20)
+        e = failed.value
+    assert isinstance(e, MoveInterrupted), repr(e)
     assert e.reason == "a halt (controlword bit 8) from another program"
     check_failure(d, e, start, target)
     # The issue's "halted at 10.2 of 60 mm shows at target": a Drive that did not start the

@@ -365,7 +365,7 @@ class ArcusCanopenDrive(Cia402Drive):
 
     def _snl_text(self) -> str:
         try:
-            return SnlStatus(self.native.read(0x2003)).name
+            return SnlStatus(self._read(0x2003)).name
         except ValueError:
             return "?"
 
@@ -413,6 +413,10 @@ class ArcusCanopenDrive(Cia402Drive):
             raise
         self.native.set_velocity(int(round(velocity)))
 
+    def _read(self, index: int, sub: int = 0) -> Any:
+        """One object, decoded, through the read that survives a second SDO client."""
+        return _decode(_BY_KEY[(index, sub)], self._upload(index, sub))
+
     # _is_idle and _homing_done: the CiA 402 ones (at rest for any reason; a homing error
     # or a fault raises what _stop_reason below finds).
 
@@ -421,9 +425,9 @@ class ArcusCanopenDrive(Cia402Drive):
         corrects a larger error at the end of a move); off: 0 (an open-loop pulse counter
         ends exactly on its target).  Read at each judged move (two SDO reads): the manual
         has no 6067h."""
-        if not self.native.read(0x2001, 1):
+        if not self._read(0x2001, 1):
             return 0.0
-        return float(self.native.read(0x2001, 3))
+        return float(self._read(0x2001, 3))
 
     def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         return (None, None)          # Table 10.1 has no 607Dh: no software limits
@@ -450,7 +454,7 @@ class ArcusCanopenDrive(Cia402Drive):
         state = _core.cia402_decode_statusword(sw)
         if state not in ("FAULT", "FAULT REACTION ACTIVE"):
             return super()._stop_reason(status)
-        sls = int(self.native.read(0x2003))
+        sls = int(self._read(0x2003))
         if sls in (SnlStatus.STALL_ERROR, SnlStatus.CORRECTION_RANGE_ERROR, SnlStatus.CORRECTION_ATTEMPT_ERROR):
             words = {10: "stall", 8: "correction range", 9: "max attempts"}[sls]
             return StopReason(MoveStalled, f"StepNLoop error: {words} (2003h = {sls})", code=sls)
@@ -469,7 +473,7 @@ class ArcusCanopenDrive(Cia402Drive):
         self.native.store()
 
     def _digital_inputs(self) -> int:
-        return int(self.native.read(0x60FD))
+        return int(self._read(0x60FD))
 
     def _status_text(self, state: str, mode: Optional[int], sw: int, fault: bool) -> str:
         return (f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}, "

@@ -726,8 +726,32 @@ class Cia402Drive(Drive):
     def _i32(self, index: int, value: float) -> None:
         self._sdo.download(index, 0, int(round(value)).to_bytes(4, "little", signed=True))
 
+    #: Attempts of one read when another SDO client on the node takes the reply.
+    sdo_read_attempts = 5
+
+    def _upload(self, index: int, sub: int = 0) -> bytes:
+        """One SDO read that survives another program's SDO client on this node (its
+        requests and ours share the COB-IDs): a reply naming another object is not our
+        answer (ask again), and one dropped request is a collision (ask once more); a
+        second timeout in a row is a link that is gone."""
+        timeouts = 0
+        for attempt in range(self.sdo_read_attempts):
+            try:
+                return bytes(self._sdo.upload(index, sub))
+            except _core.SdoProtocolError:
+                if attempt + 1 == self.sdo_read_attempts:
+                    raise
+            except _core.SdoTimeout:
+                timeouts += 1
+                if timeouts > 1 or attempt + 1 == self.sdo_read_attempts:
+                    raise
+        raise AssertionError("unreachable")
+
+    def _statusword(self) -> int:
+        return int.from_bytes(self._upload(0x6041, 0), "little")
+
     def _read_i32(self, index: int) -> int:
-        return int.from_bytes(self._sdo.upload(index, 0), "little", signed=True)
+        return int.from_bytes(self._upload(index, 0), "little", signed=True)
 
     def _use_mode(self, mode: OpMode) -> None:
         if self._mode != mode:
@@ -748,7 +772,7 @@ class Cia402Drive(Drive):
     def _speed_for_this_move(self, velocity: Optional[float]) -> None:
         """velocity= is for this move only: 6081h is put back when the move ends."""
         if velocity is not None:
-            self._for_this_move(lambda: int.from_bytes(self._sdo.upload(0x6081, 0), "little"),
+            self._for_this_move(lambda: int.from_bytes(self._upload(0x6081, 0), "little"),
                                 lambda v: self._u32(0x6081, v), int(round(velocity)))
 
     def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
@@ -853,7 +877,7 @@ class Cia402Drive(Drive):
         raises the MoveFailed that says why on an error or a fault, and returns True on an
         interrupted homing (reached without attained, or the drive left Operation Enabled)
         so that the outcome is judged (a halt or quick stop: MoveInterrupted)."""
-        sw = self.native.statusword
+        sw = self._statusword()
         state = _core.cia402_decode_statusword(sw)
         if state in ("FAULT", "FAULT REACTION ACTIVE") or sw & _SW_BIT13:
             if sw & _SW_BIT13 and state == "OPERATION ENABLED":
@@ -883,11 +907,11 @@ class Cia402Drive(Drive):
         return False
 
     def _read_u16(self, index: int) -> int:
-        return int.from_bytes(self._sdo.upload(index, 0), "little")
+        return int.from_bytes(self._upload(index, 0), "little")
 
     def _controlword_now(self) -> int:
         """6040h as the drive holds it (another program may have written it)."""
-        return int.from_bytes(self._sdo.upload(0x6040, 0), "little")
+        return int.from_bytes(self._upload(0x6040, 0), "little")
 
     #: Seconds a drive must stand still at an internal limit (bit 11) without showing
     #: target reached before it counts as at rest (a move leaving a limit starts at v = 0).
@@ -898,7 +922,7 @@ class Cia402Drive(Drive):
         target, or a halt: CiA 402 sets bit 10 once a halted axis stands), a following
         error (bit 13), a standstill at an internal limit (bit 11); or out of Operation
         Enabled (fault, quick stop done, disabled) -- with the velocity 0."""
-        sw = self.native.statusword
+        sw = self._statusword()
         state = _core.cia402_decode_statusword(sw)
         if state == "FAULT REACTION ACTIVE":
             return False
@@ -925,7 +949,7 @@ class Cia402Drive(Drive):
         FFFFFFFFh switches the drive's window off (CiA 402): then, as without 6067h, exactly."""
         if self._window is None:
             try:
-                window = int.from_bytes(self._sdo.upload(0x6067, 0), "little")
+                window = int.from_bytes(self._upload(0x6067, 0), "little")
             except _core.SdoAbortError:
                 window = 0xFFFFFFFF
             self._window = self.in_position_window if window == 0xFFFFFFFF else float(window)
@@ -980,8 +1004,8 @@ class Cia402Drive(Drive):
     def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         """607Dh:01/02 (software position limits); the I32 extremes mean none."""
         try:
-            lo = int.from_bytes(self._sdo.upload(0x607D, 1), "little", signed=True)
-            hi = int.from_bytes(self._sdo.upload(0x607D, 2), "little", signed=True)
+            lo = int.from_bytes(self._upload(0x607D, 1), "little", signed=True)
+            hi = int.from_bytes(self._upload(0x607D, 2), "little", signed=True)
         except _core.SdoAbortError:
             return (None, None)      # the drive has no 607Dh
         if lo >= hi:
@@ -1002,7 +1026,7 @@ class Cia402Drive(Drive):
 
     def _digital_inputs(self) -> int:
         """60FDh (bit 0 negative limit, bit 1 positive limit)."""
-        return int.from_bytes(self._sdo.upload(0x60FD, 0), "little")
+        return int.from_bytes(self._upload(0x60FD, 0), "little")
 
     def _status_text(self, state: str, mode: Optional[int], sw: int, fault: bool) -> str:
         """The status line; a vendor kind adds what its drive says beyond CiA 402."""
@@ -1012,7 +1036,7 @@ class Cia402Drive(Drive):
         return text
 
     def _status(self) -> DriveStatus:
-        sw = self.native.statusword
+        sw = self._statusword()
         state = _core.cia402_decode_statusword(sw)
         inputs = self._digital_inputs()
         velocity = self._velocity()
@@ -1020,7 +1044,7 @@ class Cia402Drive(Drive):
         fault = state in ("FAULT", "FAULT REACTION ACTIVE")
         if mode is None:        # not set by this Drive yet: the mode in effect (6061h), for the text
             try:
-                mode = int.from_bytes(self._sdo.upload(0x6061, 0), "little", signed=True)
+                mode = int.from_bytes(self._upload(0x6061, 0), "little", signed=True)
                 OpMode(mode)
             except (_core.SdoAbortError, ValueError):
                 mode = None
