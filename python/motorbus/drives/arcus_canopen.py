@@ -43,11 +43,7 @@ OBJECTS = [tuple(row) for row in _core.arcus_canopen_objects()]
 _BY_KEY = {(r[0], r[1]): r for r in OBJECTS}
 _SIZES = {"U8": 1, "I8": 1, "U16": 2, "I16": 2, "U32": 4, "I32": 4}
 
-_SW_TARGET_REACHED = 1 << 10
 _SW_INTERNAL_LIMIT = 1 << 11
-_SW_BIT12 = 1 << 12
-_SW_BIT13 = 1 << 13
-_CW_HALT = 1 << 8
 
 
 class ArcusHomingMethod(enum.IntEnum):
