@@ -181,14 +181,23 @@ def _one_axis_files(served, tmp_path) -> dict:
 
 @pytest.mark.parametrize("sig", SIGNALS, ids=lambda s: s.name)
 def test_signal_during_cli_move_stops_the_axis(served, tmp_path, sig):
-    """`motorbus move BENCH AXIS FAR --velocity V`, one process per kind, all ended by the signal."""
-    files = _one_axis_files(served, tmp_path)
-    for _ in range(ROUNDS):
+    """`motorbus move BENCH AXIS +2000 mm`, one process per kind, all ended by the signal."""
+    for round_ in range(ROUNDS):
+        if round_:   # fresh simulators at 0: another +2000 mm would run into a limit switch
+            served.close()
+            (tmp_path / f"round{round_}").mkdir()
+            served = ServedBench(tmp_path / f"round{round_}")
+        files = _one_axis_files(served, tmp_path / (f"round{round_}" if round_ else ""))
         procs = {}
         try:
             for name, path in files.items():
-                subprocess.run([sys.executable, "-m", "motorbus", "config", "apply", str(path)], check=True,
-                               capture_output=True, timeout=60, preexec_fn=_signals_default)
+                for attempt in (1, 2):   # the test profile; what is tested is the move below
+                    done = subprocess.run([sys.executable, "-m", "motorbus", "config", "apply", str(path)],
+                                          capture_output=True, text=True, timeout=60, preexec_fn=_signals_default)
+                    if done.returncode == 0:
+                        break
+                    print(f"{name}: config apply, attempt {attempt}: {done.stdout}{done.stderr}")
+                assert done.returncode == 0, f"{name}: config apply: {done.stdout}{done.stderr}"
                 procs[name] = subprocess.Popen(
                     [sys.executable, "-m", "motorbus", "move", str(path), name, "2000", "--by", "--timeout", "600"],
                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, preexec_fn=_signals_default)
@@ -206,7 +215,11 @@ def test_signal_during_cli_move_stops_the_axis(served, tmp_path, sig):
                 if p.poll() is None:
                     p.kill()
                     p.communicate()
-        _assert_at_rest(served, ended)
+        try:
+            _assert_at_rest(served, ended)
+        finally:
+            if round_:
+                served.close()
         for name, p in procs.items():
             assert p.returncode == -sig, f"{name}: rc {p.returncode}: {outs[name]}"
             assert "interrupted: axis stopped" in outs[name], outs[name]
