@@ -26,7 +26,9 @@ socketcand on 127.0.0.1 — so a file written for hardware runs unchanged
 without it.  Nothing here names a vendor: every registered kind works.
 
 Errors in a file are :class:`BenchFileError` (an ``InvalidArgument``) reading
-``file:line: key: what was expected``.
+``file:line: key: what was expected``.  ``Bench.load`` reads a regular file of at
+most :data:`MAX_FILE_BYTES`, with the line, key and nesting limits below, so that
+any file ends in a Bench or an error within about a second (docs/bench-files.md).
 """
 from __future__ import annotations
 

@@ -19,7 +19,9 @@ The bench is opened once per session, the first time a test asks for it: a
 suite that uses none of the fixtures opens nothing.  After every test that used
 it every axis is stopped (stop, then quick_stop for an axis that refuses or does
 not come to rest) — after a pass, a failure, an error, a timeout; on Ctrl-C and
-at the end of the session too.
+at the end of the session too.  SIGTERM and SIGHUP (a cancelled CI job) take the
+Ctrl-C path: motorbus raises ``TerminatedBySignal``, a ``KeyboardInterrupt``, and the
+process then dies by the signal (docs/reliability.md, "Signals").
 """
 from __future__ import annotations
 
