@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -179,7 +180,11 @@ def test_a_failed_plan_stops_the_motor_it_moved(bench, motors, RE):
     try:
         with pytest.raises(RuntimeError, match="plan failed mid-move"):
             RE(plan())
-        sim_drive.wait_idle(timeout=5)
+        try:        # the move's own wait (on the device's thread) may have judged it first
+            sim_drive.wait_idle(timeout=5)
+        except motorbus.MoveInterrupted as e:
+            assert "stop() of this program" in str(e)
+        assert sim_drive.status.last_move.state == "interrupted"   # the stop cut the move short
         at = sim_drive.position
         assert start < at < start + 10.0, at     # stopped on the way, far from the target
         time.sleep(0.2)
@@ -205,7 +210,11 @@ def test_abort_from_a_pause_stops_the_motor(bench, motors, RE):
             RE(scan([], x, start + 40.0, start + 41.0, 2))
         assert RE.state == "paused"
         RE.abort("test")
-        drive.wait_idle(timeout=5)
+        try:        # the move's own wait may have judged it first
+            drive.wait_idle(timeout=5)
+        except motorbus.MoveInterrupted:
+            pass
+        assert drive.status.last_move.state == "interrupted"
         assert not drive.status.moving
         assert start < drive.position < start + 10.0
     finally:
@@ -233,7 +242,10 @@ def test_stop_on_the_device_stops_the_axis(bench, motors):
     try:
         status = asyncio.run(go())
         assert status.done and not status.success
-        drive.wait_idle(timeout=5)
+        try:
+            drive.wait_idle(timeout=5)
+        except motorbus.MoveInterrupted:
+            pass
         assert not drive.status.moving
     finally:
         drive.params["0x6081"] = 20000
@@ -276,3 +288,30 @@ def test_a_target_beyond_the_drives_soft_limit_fails_before_moving(bench, motors
     assert dmac.travel_limits == (-math.inf, math.inf)
 
 
+
+
+def test_a_move_stopped_by_a_limit_fails_the_status_with_limit_reached(bench, motors, RE):
+    """The Drive API's outcome reaches the RunEngine: a limit switch mid-move fails the
+    status with LimitReached (its side, where it stopped), not a success."""
+    z = motors["cia402"]
+    drive = bench["cia402"]
+    drive.params["0x6081"] = 500              # slow: the limit closes while it moves
+    RE(ensure_connected(z))
+    start = drive.position
+    faults = registry.drive_plugin("cia402").sim_faults
+    timer = threading.Timer(0.3, faults["limit"], args=(bench.sims["cia402"],), kwargs={"direction": 1})
+    try:
+        timer.start()
+        with pytest.raises(FailedStatus) as failed:
+            RE(bps.mv(z, start + 40.0))
+        cause = failed.value.__cause__
+        assert isinstance(cause, motorbus.LimitReached), repr(cause)
+        assert cause.side == 1 and start < cause.position < start + 40.0
+        assert cause.target == pytest.approx(start + 40.0)
+    finally:
+        timer.cancel()
+        drive.params["0x6081"] = 20000
+        bench.sims["cia402"].force_limit(1, False)     # the switch opens again
+        drive.clear_faults()
+        drive.enable()
+        drive.move_to(start, timeout=30)
