@@ -316,12 +316,16 @@ void SdoClientMachine::on_block_upload(std::span<const std::uint8_t> p, Nanos no
     };
     if (phase_ == Phase::BlkUpInitiate) {
         if (scs_of(p[0]) == Scs::InitiateUpload) {  // protocol switch by the server
-            // Only when we allowed it (pst > 0): the plain protocol has no CRC,
-            // and a block initiate response with one flipped bit reads as an
-            // expedited response carrying the size as the value.
-            if (config_.protocol_switch == 0)
+            // Only when we allowed it: the plain protocol has no CRC, and a block
+            // initiate response with one flipped bit reads as an expedited
+            // response carrying the size as the value.  Allowed by a threshold
+            // (pst > 0), or by fallback_to_segmented: the caller accepts CRC-less
+            // transfers from servers without block mode, and some (the `canopen`
+            // package's) answer a block upload request with a plain one.
+            if (config_.protocol_switch == 0 && !config_.fallback_to_segmented)
                 return fail_abort(ac::kCommandSpecifier, out, p,
                                   "server switched to a non-block upload (no CRC) the client did not allow");
+            if (config_.protocol_switch == 0) ++counters_.fallbacks;
             phase_ = Phase::UpInitiate;
             return on_upload(p, out);
         }

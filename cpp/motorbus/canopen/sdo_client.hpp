@@ -59,7 +59,8 @@ struct SdoClientConfig {
     // pst of block upload: the server may switch to the plain upload protocol
     // (expedited / segmented, no CRC) for data up to this many bytes.  0 = never:
     // a switch is then refused (abort 0x05040001) -- under bit errors a block
-    // initiate response read as an expedited one delivered its size as the value.
+    // initiate response read as an expedited one delivered its size as the value
+    // -- unless fallback_to_segmented accepts CRC-less answers (counted in fallbacks).
     std::uint8_t protocol_switch = 0;
     // Server refuses block mode (abort 0x05040001 / 0x06010000 to the block
     // initiate) -> retry the same transfer segmented (no CRC).  Off by default:

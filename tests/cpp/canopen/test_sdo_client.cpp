@@ -415,6 +415,15 @@ TEST_F(ClientFixture, BlockUploadProtocolSwitchRefusedUnlessAllowed) {
     EXPECT_EQ(up(0x6001, 0, TransferMode::Block), Strs{"A4 01 60 00 7F 04 00 00"});
     EXPECT_EQ(rx("4F 01 60 00 08 00 00 00"), Strs{});
     EXPECT_EQ(hex(cli.result()), "08");
+    // block_fallback: the caller accepts CRC-less answers from a server without
+    // block upload (the `canopen` package answers plainly); counted as a fallback.
+    c.protocol_switch = 0;
+    c.fallback_to_segmented = true;
+    cli.set_config(c);
+    up(0x6001, 0, TransferMode::Block);
+    EXPECT_EQ(rx("4F 01 60 00 09 00 00 00"), Strs{});
+    EXPECT_EQ(hex(cli.result()), "09");
+    EXPECT_EQ(cli.counters().fallbacks, 1u);
 }
 
 // A block transfer delivers CRC-checked data or fails: a server answering
