@@ -107,7 +107,8 @@ class _Locator:
                     continue   # an array of tables: not bench syntax (the checker says so by key)
                 parts, j = _parse_key(raw, i + 1)
                 j = _skip_space(raw, j)
-                if parts and j < len(raw) and raw[j] == "]":
+                end = _skip_space(raw, j + 1)
+                if parts and j < len(raw) and raw[j] == "]" and (end == len(raw) or raw[end] == "#"):
                     # Beyond MAX_KEY_PARTS the file is refused anyway: only its line is needed,
                     # and every prefix of a 4 000-part name would cost the square of it.
                     table = tuple(parts[:MAX_KEY_PARTS])
@@ -135,6 +136,23 @@ class _Locator:
                 i += 1
             elif c == "#":
                 return
+            elif expect_key and stack[-1] is not None and (c in _BARE or c in "\"'"):
+                parts, j = _parse_key(raw, i)
+                k = _skip_space(raw, j)
+                if parts and k < len(raw) and raw[k] == "=":
+                    key = (stack[-1] + tuple(parts))[:MAX_KEY_PARTS]
+                    self.lines.setdefault(key, n)
+                    k = _skip_space(raw, k + 1)
+                    if k < len(raw) and raw[k] == "{":   # this key's value is a table: its keys nest under it
+                        stack.append(key if len(stack) <= self._DEPTH else None)
+                        k += 1
+                        expect_key = True
+                    else:
+                        expect_key = False
+                    i = k
+                else:
+                    expect_key = False
+                    i = max(j, _skip_string(raw, i) if c in "\"'" else i + 1)
             elif c in "\"'":
                 i = _skip_string(raw, i)
                 expect_key = False
@@ -152,23 +170,6 @@ class _Locator:
             elif c == ",":
                 expect_key = stack[-1] is not None
                 i += 1
-            elif expect_key and stack[-1] is not None:
-                parts, j = _parse_key(raw, i)
-                k = _skip_space(raw, j)
-                if parts and k < len(raw) and raw[k] == "=":
-                    key = (stack[-1] + tuple(parts))[:MAX_KEY_PARTS]
-                    self.lines.setdefault(key, n)
-                    k = _skip_space(raw, k + 1)
-                    if k < len(raw) and raw[k] == "{":   # this key's value is a table: its keys nest under it
-                        stack.append(key if len(stack) <= self._DEPTH else None)
-                        k += 1
-                        expect_key = True
-                    else:
-                        expect_key = False
-                    i = k
-                else:
-                    expect_key = False
-                    i = max(j, i + 1)
             else:
                 i += 1
 
