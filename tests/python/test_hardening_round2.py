@@ -243,3 +243,28 @@ def test_a_forked_child_ended_by_sigterm_leaves_the_parents_drives_alone(tmp_pat
         time.sleep(0.1)
         assert z.status.moving           # the parent's jog goes on
         z.stop()
+
+
+# ---- item 6: the linear locator places what the regular expressions placed ----------------------
+def test_the_locator_places_headers_keys_and_inline_keys():
+    from motorbus.bench import _Locator
+
+    text = ('# a bench\n'
+            '[ bus . "can 0" ]   # spaces and a quoted part\n'
+            'spec = "virtual:x"\n'
+            '[axis.z]\n'
+            'params = { "0x6081" = 20000, \'0x6083\' = 1, plain = "a = b, c = {" }\n'
+            'units = { name = "mm", scale = 0.01 }  # scale = 2 in a comment\n'
+            'see [the docs](x.md)\n')
+    lines = _Locator(text).lines
+    assert lines[("bus", "can 0")] == 2 and lines[("bus", "can 0", "spec")] == 3
+    assert lines[("axis", "z", "params", "0x6081")] == 5 and lines[("axis", "z", "params", "0x6083")] == 5
+    assert lines[("axis", "z", "params", "plain")] == 5
+    assert ("axis", "z", "params", "c") not in lines      # inside a string
+    assert lines[("axis", "z", "units", "scale")] == 6
+    assert ("the docs",) not in lines                       # not a header: text after "]"
+
+
+def test_a_quoted_parameter_the_drive_lacks_is_placed(tmp_path):
+    _refused(tmp_path, _CAN + 'params = { "0x6081" = 20000, "0x7FFF" = 1 }\n', 7, "axis.z.params.0x7FFF",
+             "has no parameter '0x7FFF'")
