@@ -170,7 +170,6 @@ def test_poller_retention_is_bounded_while_read_returns_every_row(tmp_path):
                 time.sleep(0.05)
                 got += len(poller.read()["t"])
             frame = poller.frame()
-        got += 0
         rows = len(frame["t"])
         assert 0 < rows <= 100
         assert poller.discarded > 0 and poller.discarded + rows >= got
