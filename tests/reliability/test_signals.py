@@ -339,3 +339,45 @@ def test_no_drive_open_the_signal_ends_the_process_at_once(tmp_path):
     assert first.strip() == "installed True", first
     assert proc.returncode == -signal.SIGTERM and "stopping" not in out, (proc.returncode, out)
     assert time.monotonic() - t0 < 5   # not the watchdog's GRACE: at once
+
+
+@pytest.mark.parametrize("sig", SIGNALS, ids=lambda s: s.name)
+def test_signal_during_cli_home_stops_the_axis(tmp_path, sig):
+    """`motorbus home`: a DMAC whose reference switch is far away (a search of seconds)."""
+    from motorbus.sim import SimBench
+
+    with SimBench(["dmac:00"], sim_options={"dmac": {"reference_switch": 5_000_000}}) as rig:
+        sim = rig.sims[("dmac", "00")]
+        path = tmp_path / "home.toml"
+        path.write_text(f'[line.l]\nport = "{rig.lines[0].pty_path}"\n[axis.d]\nkind = "dmac"\nline = "l"\n'
+                        'address = "00"\nparams = { "#LOW_SPEED" = 60000 }\n')
+        done = subprocess.run([sys.executable, "-m", "motorbus", "config", "apply", str(path)], capture_output=True,
+                              text=True, timeout=60, preexec_fn=_signals_default)
+        assert done.returncode == 0, done.stdout + done.stderr
+        proc = subprocess.Popen([sys.executable, "-m", "motorbus", "home", str(path), "d", "--timeout", "600"],
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                preexec_fn=_signals_default)
+        try:
+            deadline = time.monotonic() + 30
+            while True:
+                a = sim.state().position
+                time.sleep(0.15)
+                if sim.state().position != a:
+                    break
+                assert proc.poll() is None, proc.communicate()[0]
+                assert time.monotonic() < deadline, "the homing search never moved"
+            out, ended = _end(proc, sig)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
+        last = sim.state().position
+        while True:
+            time.sleep(0.1)
+            now = sim.state().position
+            if now == last:
+                break
+            last = now
+            assert time.monotonic() - ended < STOP_TIME["dmac"], "the homing search goes on"
+    assert proc.returncode == -sig, f"rc {proc.returncode}: {out}"
+    assert "interrupted: axis stopped" in out, out
