@@ -232,6 +232,23 @@ void bind_unitek(py::module_& m) {
             if (device == d.device) return continuous_current_num(d, amps);
         throw InvalidArgument("unitek device: 'DS 205/405', 'DS 412' or 'DS 420', not '" + device + "'");
     }, py::arg("device"), py::arg("amps"));
+    m.def("unitek_effective_current_limit_num", [](const std::string& device, std::int64_t motor_limit_num) {
+        return effective_current_limit_num(device_current(device), motor_limit_num);
+    }, py::arg("device"), py::arg("motor_limit_num"),
+       "§6.1: the smaller of the motor's and the device's peak current (num)");
+    m.def("unitek_bit_timings", [] {
+        py::list out;
+        for (const auto& b : bit_timings())
+            out.append(py::dict(py::arg("kbit_s") = b.kbit_s, py::arg("btr") = b.btr,
+                                py::arg("max_line_m") = b.max_line_m));
+        return out;
+    }, "§3.1: bit rate (kbit/s), BTR setting value, longest line (m)");
+    m.def("unitek_btr_for_bit_rate", [](double bit_s) { return bit_timing_for_bit_rate(bit_s).btr; },
+          py::arg("bit_rate"));
+    m.def("unitek_bit_rate_for_btr", [](std::int64_t btr) {
+        if (btr < 0 || btr > 0xFFFF) throw InvalidArgument("unitek BTR: a 16-bit setting value");
+        return bit_timing_for_btr(static_cast<std::uint16_t>(btr)).bit_rate();
+    }, py::arg("btr"));
     m.def("unitek_sim_default_table", &sim_default_table);
     m.def("unitek_event_status_mask", &event_status_mask, py::arg("mask"));
 
@@ -386,14 +403,16 @@ void bind_unitek(py::module_& m) {
         .def_readonly("refused", &SimCounters::refused)
         .def_readonly("cyclic_refused", &SimCounters::cyclic_refused)
         .def_readonly("frames_out", &SimCounters::frames_out)
-        .def_readonly("events_out", &SimCounters::events_out);
+        .def_readonly("events_out", &SimCounters::events_out)
+        .def_readonly("bit_rate_mismatch", &SimCounters::bit_rate_mismatch);
 
     py::class_<SimHolder>(m, "UnitekSim", "A simulated UNITEK servo on the register protocol (see sim.hpp).")
         .def(py::init([](std::shared_ptr<Clock> clock, std::uint32_t rx_id, std::uint32_t tx_id, double n_max_rpm,
                          double acc_ramp_ms, double dec_ramp_ms, bool position_control, bool speed_control,
                          bool calibrated, std::int64_t tol_num, std::optional<double> minus_limit_num,
                          std::optional<double> plus_limit_num, std::int64_t torque_continuous_num, int dummy,
-                         std::optional<RegisterTable> table) {
+                         std::optional<RegisterTable> table, std::string device,
+                         std::optional<std::int64_t> motor_i_max_num, std::int64_t btr) {
                  if (!clock) throw InvalidArgument("clock: None (a motorbus Clock is required)");
                  SimConfig c;
                  c.rx_id = rx_id;
@@ -410,6 +429,10 @@ void bind_unitek(py::module_& m) {
                  c.torque_continuous_num = torque_continuous_num;
                  if (dummy < 0 || dummy > 255) throw InvalidArgument("dummy: 0..255");
                  c.dummy = static_cast<std::uint8_t>(dummy);
+                 c.device = device;
+                 c.motor_i_max_num = motor_i_max_num;
+                 if (btr < 0 || btr > 0xFFFF) throw InvalidArgument("unitek sim btr: a 16-bit BTR setting value");
+                 c.btr = static_cast<std::uint16_t>(btr);
                  auto h = std::make_unique<SimHolder>();
                  h->clock = clock;
                  h->sim = std::make_unique<UnitekSim>(*clock, c, table ? *table : sim_default_table());
@@ -420,7 +443,8 @@ void bind_unitek(py::module_& m) {
              py::arg("position_control") = true, py::arg("speed_control") = true, py::arg("calibrated") = false,
              py::arg("tol_num") = 64, py::arg("minus_limit_num") = -100.0 * 65536,
              py::arg("plus_limit_num") = 100.0 * 65536, py::arg("torque_continuous_num") = 32767,
-             py::arg("dummy") = 0, py::arg("table") = py::none())
+             py::arg("dummy") = 0, py::arg("table") = py::none(), py::arg("device") = "DS 205/405",
+             py::arg("motor_i_max_num") = py::none(), py::arg("btr") = kDefaultBtr)
         .def("attach", [](SimHolder& h, std::shared_ptr<can::Bus> bus) {
             if (!bus) throw InvalidArgument("bus: None");
             h.bus = bus;
@@ -468,6 +492,10 @@ void bind_unitek(py::module_& m) {
         .def_property_readonly("position_num", [](SimHolder& h) { return h.sim->position_num(); })
         .def_property_readonly("speed_num", [](SimHolder& h) { return h.sim->speed_num(); })
         .def_property_readonly("rx_id", [](SimHolder& h) { return h.sim->rx_id(); })
+        .def_property_readonly("bit_rate", [](SimHolder& h) { return h.sim->bit_rate(); },
+                               "bit/s of its BTR (§3.1 table)")
+        .def_property_readonly("bus_bit_rate", [](SimHolder& h) { return h.sim->bus_bit_rate(); },
+                               "bit/s of the bus it is attached to (0: none modelled)")
         .def_property_readonly("tx_id", [](SimHolder& h) { return h.sim->tx_id(); })
         .def_property_readonly("cyclic", [](SimHolder& h) {
             std::vector<std::pair<int, int>> out;

@@ -88,6 +88,10 @@ class Reg(enum.IntEnum):
     TORQUE_CMD = 0x90
     REG_A8 = 0xA8
     ERR_WARN = 0x8F     # NDrive list, not in 002 (unitek_ndrive.toml)
+    I_ACT = 0x20        # NDrive list: actual current (num)
+    I_MAX = 0x24        # NDrive list: the motor's peak current limit (num)
+    I_CMD = 0x26        # NDrive list: current command, +/- 9 bit (§6.1)
+    DEVICE_I_MAX = 0xC4  # NDrive list: the device's peak current (num, §6.1 table)
 
 
 class Status(enum.IntFlag):
@@ -452,7 +456,7 @@ class Unitek:
 
 _SIM_OPTIONS = ("n_max_rpm", "acc_ramp_ms", "dec_ramp_ms", "position_control", "speed_control", "calibrated",
                 "tol_num", "minus_limit_num", "plus_limit_num", "torque_continuous_num", "dummy", "tx_id",
-                "registers", "t_out_ms", "store_path")
+                "registers", "t_out_ms", "store_path", "device", "motor_i_max_num", "btr")
 
 
 class UnitekSim:
@@ -464,7 +468,13 @@ class UnitekSim:
     On a SimClock call
     ``service()`` after advancing the clock.  ``t_out_ms`` models NDrive's T-Out:
     with no frame on the receive id for that long while enabled, the drive
-    disables itself (0 = off, the default: 002 does not say what T-Out does)."""
+    disables itself (0 = off, the default: 002 does not say what T-Out does).
+
+    ``device`` (§6.1 row: "DS 205/405", "DS 412", "DS 420") and ``motor_i_max_num``
+    (the motor's peak current limit in num, default the device's; I_MAX 0x24 over CAN):
+    I_ACT (0x20) is I_CMD (0x26, +/- 511) limited to the smaller of the two.  ``btr``
+    (§3.1 table, default 0x4025 = 500 kbit/s): on a bus modelling another bit rate
+    the node hears and sends nothing (``counters.bit_rate_mismatch``)."""
 
     def __init__(self, rx_id: int = 0x201, clock: Any = None, *, registers: Any = None, t_out_ms: float = 0,
                  store_path: Optional[str] = None, **options: Any) -> None:

@@ -194,6 +194,53 @@ std::int64_t continuous_current_num(const DeviceCurrent& d, double amps) {
     return static_cast<std::int64_t>(std::llround(d.i100_num / d.i_rms_a * amps));
 }
 
+const DeviceCurrent& device_current(const std::string& device) {
+    for (const auto& d : device_currents())
+        if (device == d.device) return d;
+    throw InvalidArgument("unitek device: 'DS 205/405', 'DS 412' or 'DS 420', not '" + device + "'");
+}
+
+std::int64_t effective_current_limit_num(const DeviceCurrent& d, std::int64_t motor_limit_num) {
+    if (motor_limit_num < 0)
+        throw InvalidArgument("unitek motor current limit: " + std::to_string(motor_limit_num) + " num, not >= 0");
+    return std::min(motor_limit_num, static_cast<std::int64_t>(d.i_max_num));
+}
+
+std::span<const BitTiming> bit_timings() {
+    // §3.1: transmission rate NBT, setting value BTR, line length max.
+    static const std::array<BitTiming, 5> table{{
+        {1000, 0x4002, 20}, {500, 0x4025, 70}, {625, 0x4014, 70}, {250, 0x405C, 100}, {100, 0x4425, 500},
+    }};
+    return table;
+}
+
+namespace {
+std::string btr_list() {
+    std::string s;
+    for (const auto& b : bit_timings()) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%s0x%04X (%d k)", s.empty() ? "" : ", ", b.btr, b.kbit_s);
+        s += buf;
+    }
+    return s;
+}
+}  // namespace
+
+const BitTiming& bit_timing_for_btr(std::uint16_t btr) {
+    for (const auto& b : bit_timings())
+        if (b.btr == btr) return b;
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "0x%04X", btr);
+    throw InvalidArgument(std::string("unitek BTR ") + buf + ": not in the manual's table (" + btr_list() + ")");
+}
+
+const BitTiming& bit_timing_for_bit_rate(double bit_s) {
+    for (const auto& b : bit_timings())
+        if (b.bit_rate() == bit_s) return b;
+    throw InvalidArgument("unitek bit rate " + std::to_string(static_cast<long long>(bit_s)) +
+                          " bit/s: not in the manual's table (" + btr_list() + ")");
+}
+
 ToDrive decode_to_drive(std::span<const std::uint8_t> data) {
     const std::size_t n = data.size();
     if (n > 8) throw FrameError("unitek frame to the drive: DLC " + std::to_string(n) + " > 8", 8, copy(data));

@@ -44,6 +44,15 @@ inline constexpr std::uint8_t kRegPosActual = 0x6D;
 // serves it; the Python adapter reads it to say why a move ended.
 inline constexpr std::uint8_t kRegErrWarn = 0x8F;
 inline constexpr std::uint32_t kErrorBits = 0x0000FFFF;
+// Not in 002 either: the current registers behind §6.1's current table (NDrive's
+// list; verify against your firmware's).  All in num, the device's current scale.
+inline constexpr std::uint8_t kRegCurrentActual = 0x20;     // I_ACT: the current the drive delivers (RO)
+inline constexpr std::uint8_t kRegCurrentLimit = 0x24;      // I_MAX: the motor's peak current limit (a parameter)
+inline constexpr std::uint8_t kRegCurrentCmd = 0x26;        // I_CMD: current command value
+inline constexpr std::uint8_t kRegDeviceCurrentMax = 0xC4;  // DEVICE_I_MAX: the device's peak current (RO)
+// §6.1 "Current command value range: max. value +/- 9 bit" (the position and speed
+// ranges, "+/- 31 bit" and "+/- 15 bit", are 2^31 - 1 and 2^15 - 1): +/- 511 num.
+inline constexpr std::int64_t kCurrentCommandMax = 511;
 
 inline constexpr std::uint32_t kDefaultRxId = 0x201;
 inline constexpr std::uint32_t kDefaultTxId = 0x181;
@@ -164,6 +173,26 @@ struct DeviceCurrent {
 std::span<const DeviceCurrent> device_currents();
 // I_con limit example: the num for `amps` of continuous current on `device`.
 std::int64_t continuous_current_num(const DeviceCurrent& d, double amps);
+// The row of §6.1 for `device` ("DS 205/405", "DS 412", "DS 420"); InvalidArgument naming them.
+const DeviceCurrent& device_current(const std::string& device);
+// §6.1 "Limitation in the parameter field. Motor and current. The smaller value is
+// effective": the peak current (num) the drive delivers at most.  InvalidArgument for
+// a negative motor limit.
+std::int64_t effective_current_limit_num(const DeviceCurrent& d, std::int64_t motor_limit_num);
+
+// ---- bit timing (§3.1 table) -----------------------------------------------------------
+// NDrive's CAN-Setup "NBT": each bit rate has a BTR setting value and a longest line.
+struct BitTiming {
+    int kbit_s;             // 1000, 500, 625, 250, 100
+    std::uint16_t btr;      // 0x4002, 0x4025, 0x4014, 0x405C, 0x4425
+    int max_line_m;         // 20, 70, 70, 100, 500
+    double bit_rate() const { return kbit_s * 1000.0; }
+};
+std::span<const BitTiming> bit_timings();
+inline constexpr std::uint16_t kDefaultBtr = 0x4025;  // "the UNITEK standard is 500 kB/s" (§4.1)
+// InvalidArgument naming the value and the five the table has.
+const BitTiming& bit_timing_for_btr(std::uint16_t btr);
+const BitTiming& bit_timing_for_bit_rate(double bit_s);
 
 // ---- frames --------------------------------------------------------------------------
 // What the drive receives, as the drive evaluates it (B-U01..B-U03): DLC 3 and 4 carry

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/motion/planner.hpp"
 
 namespace motorbus::unitek {
@@ -21,12 +22,20 @@ motion::MotorConfig motor_config(const SimConfig& c) {
     return m;
 }
 
-bool builtin_command(std::uint8_t regid) {
-    // Set-points and one-shot commands are not parameters: EEPROM does not keep them.
-    switch (regid) {
-        case kRegSpeedCmd: case kRegTorqueCmd: case kRegPosDest: case kRegMode: case kRegEeprom: return true;
-        default: return false;
-    }
+Register row(std::uint8_t id, const char* name, bool is_signed, Access a, Quantity q, std::int64_t lo,
+             std::int64_t hi, const char* what) {
+    Register r;
+    r.regid = id;
+    r.name = name;
+    r.bits = 16;
+    r.is_signed = is_signed;
+    r.access = a;
+    r.quantity = q;
+    r.unit = q == Quantity::Current ? "A" : "";
+    r.min = lo;
+    r.max = hi;
+    r.description = what;
+    return r;
 }
 }  // namespace
 
@@ -51,6 +60,15 @@ RegisterTable sim_default_table() {
     e.quantity = Quantity::Raw;
     e.description = "errors (bits 0-15) and warnings (bits 16-31) (NDrive list, not in 002)";
     t.add(e);
+    // §6.1's current table: the command is +/- 9 bit; the registers are NDrive's.
+    t.add(row(kRegCurrentCmd, "I_CMD", true, Access::ReadWrite, Quantity::Current, -kCurrentCommandMax,
+              kCurrentCommandMax, "current command value, +/- 9 bit (NDrive list, not in 002)"));
+    t.add(row(kRegCurrentActual, "I_ACT", true, Access::ReadOnly, Quantity::Current, 1, 0,
+              "actual current: the command within the smaller of motor and device limit (NDrive list)"));
+    t.add(row(kRegCurrentLimit, "I_MAX", false, Access::ReadWrite, Quantity::Current, 0, kCurrentCommandMax,
+              "the motor's peak current limit in num (NDrive list, not in 002)"));
+    t.add(row(kRegDeviceCurrentMax, "DEVICE_I_MAX", false, Access::ReadOnly, Quantity::Current, 1, 0,
+              "the device's peak current in num, §6.1 table (NDrive list)"));
     return t;
 }
 
@@ -63,6 +81,11 @@ void SimConfig::validate() const {
         throw InvalidArgument("unitek sim limits: minus_limit_num must be below plus_limit_num");
     if (torque_continuous_num < 0 || torque_continuous_num > 32767)
         throw InvalidArgument("unitek sim torque_continuous_num: 0..32767");
+    device_current(device);
+    bit_timing_for_btr(btr);
+    if (motor_i_max_num && (*motor_i_max_num < 0 || *motor_i_max_num > kCurrentCommandMax))
+        throw InvalidArgument("unitek sim motor_i_max_num: 0..511 num (the +/- 9-bit current range), not " +
+                              std::to_string(*motor_i_max_num));
 }
 
 UnitekSim::UnitekSim(Clock& clock, SimConfig cfg, RegisterTable table)
@@ -71,7 +94,9 @@ UnitekSim::UnitekSim(Clock& clock, SimConfig cfg, RegisterTable table)
     reset_ram_locked();
     regs_[kRegAccRamp] = static_cast<std::int64_t>(std::llround(cfg_.acc_ramp_ms));
     regs_[kRegRxId] = rx_id_;
-    eeprom_ = {{kRegAccRamp, regs_[kRegAccRamp]}, {kRegEventMask, kDefaultEventMask}, {kRegRxId, rx_id_}};
+    // The factory EEPROM: every writable register as it is at the first power-up.
+    for (const auto& r : table_.rows())
+        if (r.writable() && r.regid != kRegEeprom) eeprom_[r.regid] = regs_[r.regid];
     last_status_ = status_locked();
 }
 
@@ -80,6 +105,8 @@ UnitekSim::~UnitekSim() { close(); }
 void UnitekSim::reset_ram_locked() {
     for (const auto& r : table_.rows()) regs_[r.regid] = 0;
     regs_[kRegEventMask] = kDefaultEventMask;
+    regs_[kRegCurrentLimit] =
+        cfg_.motor_i_max_num.value_or(static_cast<std::int64_t>(device_current(cfg_.device).i_max_num));
     mode_ = 0;
     err_warn_ = 0;
     slots_.clear();
@@ -90,6 +117,8 @@ void UnitekSim::attach(can::Bus& bus) {
     std::lock_guard l(m_);
     if (bus_ != nullptr) throw InvalidArgument("unitek sim: already attached");
     bus_ = &bus;
+    // A medium with a bit rate (a virtual hub with wire time) must share the node's.
+    if (const auto* v = dynamic_cast<const can::VirtualBus*>(&bus)) bus_bit_rate_ = v->bitrate();
     out_ = [this](const can::Frame& f) {
         if (bus_ != nullptr && !bus_->closed()) bus_->send(f, std::chrono::milliseconds(100));
     };
@@ -124,6 +153,8 @@ void UnitekSim::send(const std::vector<can::Frame>& frames) {
     {
         std::lock_guard l(m_);
         out = out_;
+        // A controller at another bit rate than the wire's puts nothing readable on it.
+        if (bus_bit_rate_ > 0 && bus_bit_rate_ != bit_timing_for_btr(cfg_.btr).bit_rate()) return;
     }
     if (!out) return;
     for (const auto& f : frames) {
@@ -203,6 +234,11 @@ void UnitekSim::on_frame(const can::Frame& f) {
     std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb;
     {
         std::lock_guard l(m_);
+        if (bus_bit_rate_ > 0 && bus_bit_rate_ != bit_timing_for_btr(cfg_.btr).bit_rate()) {
+            // Another bit rate: the controller decodes nothing (it answers with error frames).
+            ++counters_.bit_rate_mismatch;
+            return;
+        }
         if (f.extended || f.rtr || f.is_fd() || (f.flags & can::kFlagError) || f.id != rx_id_) {
             // B-U20: the drive reads its own receive id only.  Our own transmit id
             // and every other node's traffic land here too (one subscription for all ids).
@@ -327,9 +363,10 @@ void UnitekSim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
             rx_id_ = static_cast<std::uint32_t>(v);  // effective at once (B-U12)
             break;
         case kRegEeprom:
-            for (auto id : {kRegAccRamp, kRegEventMask, kRegRxId}) eeprom_[id] = regs_[id];
-            for (const auto& row : table_.rows())  // user registers (an NDrive list) persist too
-                if (row.writable() && !builtin_command(row.regid)) eeprom_[row.regid] = regs_[row.regid];
+            // B-U13: both levels store every writable register (the set-points and
+            // MODE too: the spec's reading; 002 does not restrict what is stored).
+            for (const auto& row : table_.rows())
+                if (row.writable() && row.regid != kRegEeprom) eeprom_[row.regid] = regs_[row.regid];
             eeprom_dirty_ = true;
             break;
         default: break;
@@ -410,6 +447,14 @@ std::int64_t UnitekSim::value_locked(std::uint8_t regid) {
             const double p = std::clamp(motor_.pulse_position(), -2147483647.0, 2147483647.0);
             return static_cast<std::int64_t>(std::llround(p));
         }
+        case kRegCurrentActual: {
+            // The drive delivers the command within the smaller of the motor and
+            // device limits (§6.1); nothing while the power stage is off.
+            if (!(status_locked() & kStatusEna)) return 0;
+            const std::int64_t lim = current_limit_locked();
+            return std::clamp<std::int64_t>(regs_[kRegCurrentCmd], -lim, lim);
+        }
+        case kRegDeviceCurrentMax: return static_cast<std::int64_t>(device_current(cfg_.device).i_max_num);
         case kRegSpeedActual: {
             const double num = motor_.pulse_velocity() / unitek_num_to_counts_per_s(1.0, ramps_locked());
             return static_cast<std::int64_t>(std::llround(std::clamp(num, -kFull, kFull)));
@@ -419,6 +464,11 @@ std::int64_t UnitekSim::value_locked(std::uint8_t regid) {
             return it == regs_.end() ? 0 : it->second;
         }
     }
+}
+
+std::int64_t UnitekSim::current_limit_locked() const {
+    const auto it = regs_.find(kRegCurrentLimit);
+    return effective_current_limit_num(device_current(cfg_.device), it == regs_.end() ? 0 : it->second);
 }
 
 // ---- inputs / introspection ----------------------------------------------------------------------
@@ -459,6 +509,10 @@ void UnitekSim::power_cycle() {
     reset_ram_locked();
     for (const auto& [id, v] : eeprom_) regs_[id] = v;
     rx_id_ = static_cast<std::uint32_t>(regs_[kRegRxId]);
+    // A stored MODE is in effect from power-up (disable, status events).  Stored
+    // set-points read back but start no motion: the rotor is at rest until a
+    // command is written (the reading taken; 002 does not say).
+    mode_ = static_cast<std::uint16_t>(regs_[kRegMode]);
     last_status_ = status_locked();
 }
 
@@ -485,6 +539,13 @@ double UnitekSim::speed_num() {
     std::lock_guard l(m_);
     motor_.advance_to(std::max(clock_.now(), motor_.time()));
     return motor_.pulse_velocity() / unitek_num_to_counts_per_s(1.0, ramps_locked());
+}
+
+double UnitekSim::bit_rate() const { return bit_timing_for_btr(cfg_.btr).bit_rate(); }
+
+double UnitekSim::bus_bit_rate() const {
+    std::lock_guard l(m_);
+    return bus_bit_rate_;
 }
 
 std::uint32_t UnitekSim::rx_id() const {

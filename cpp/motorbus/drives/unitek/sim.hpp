@@ -11,7 +11,12 @@
 // command (no load: the rotor accelerates to N max at a rate proportional to
 // the torque), enable by MODE bit 2 and a hardware enable input, limit
 // switches, the calibration bit and the continuous current limit (Icns).
-// EEPROM (0x84) keeps the parameters over power_cycle().
+// EEPROM (0x84) keeps every writable register over power_cycle() (B-U13).
+// The current registers of NDrive's list (I_CMD 0x26, I_ACT 0x20, I_MAX 0x24,
+// DEVICE_I_MAX 0xC4) model §6.1's table: a current command of +/- 9 bit, the
+// delivered current limited by the smaller of the motor and device limits.
+// The node talks at its BTR's bit rate (§3.1 table): on a bus modelling
+// another bit rate it neither hears nor sends anything.
 //
 // Time: the sim is evaluated when a frame arrives and by a timer thread; on a
 // SimClock a test calls service() after advancing the clock to get every frame
@@ -48,6 +53,9 @@ struct SimConfig {
     std::optional<double> plus_limit_num = 100.0 * 65536;
     std::int64_t torque_continuous_num = 32767;  // |torque| above this: Icns (continuous current limit)
     std::uint8_t dummy = 0x00;       // the reply's dummy byte (B-U04: unspecified, 0x00)
+    std::string device = "DS 205/405";             // §6.1 current table row
+    std::optional<std::int64_t> motor_i_max_num;   // the motor's peak current limit (num); nullopt = the device's
+    std::uint16_t btr = kDefaultBtr;               // NDrive CAN-Setup NBT (§3.1): not changeable over CAN (B-U21)
     void validate() const;           // InvalidArgument naming the field
 };
 
@@ -60,6 +68,7 @@ struct SimCounters {
     std::uint64_t cyclic_refused = 0;  // a 9th cyclic register
     std::uint64_t frames_out = 0;
     std::uint64_t events_out = 0;
+    std::uint64_t bit_rate_mismatch = 0;  // frames on a bus of another bit rate: not decoded (error frames)
 };
 
 // The sim's registers: the documented ones plus POS_IST (0x6D, actual position, 32-bit signed, read-only).
@@ -100,6 +109,8 @@ public:
     std::int64_t value(std::uint8_t regid);   // the register as a read would return it; UnknownRegister
     double position_num();
     double speed_num();
+    double bit_rate() const;         // of its BTR, bit/s
+    double bus_bit_rate() const;     // of the bus attached (0: none modelled)
     std::uint32_t rx_id() const;
     std::uint32_t tx_id() const { return cfg_.tx_id; }
     std::vector<std::pair<std::uint8_t, int>> cyclic() const;  // (REGID, period ms)
@@ -134,6 +145,7 @@ private:
     UnitekRampParams ramps_locked() const;
     void send(const std::vector<can::Frame>& frames);
     void reset_ram_locked();
+    std::int64_t current_limit_locked() const;
 
     Clock& clock_;
     SimConfig cfg_;
@@ -145,6 +157,7 @@ private:
     std::vector<Slot> slots_;
     std::map<std::uint8_t, std::uint64_t> sent_;
     std::uint32_t rx_id_;
+    double bus_bit_rate_ = 0;  // the attached medium's, 0 = none modelled
     std::uint16_t mode_ = 0;
     bool hw_enable_ = true;
     bool calibrated_;
