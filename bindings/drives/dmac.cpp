@@ -237,6 +237,13 @@ void bind_dmac(py::module_& m) {
              "Sets an #ERROR bit; fault bits 2..5 also stop the motor as the real fault does.")
         .def("physical_outputs", &DmacSim::physical_outputs, py::call_guard<py::gil_scoped_release>())
         .def("power_cycle", &DmacSim::power_cycle, py::call_guard<py::gil_scoped_release>())
+        .def_static("chain_ultrasync", &DmacSim::chain_ultrasync, py::arg("modules"),
+                    "Wire IN6/OUT1 of these modules into one UltraSYNC chain (5.11), before serving them: "
+                    "with #INTERPOL_MODE:=-1 a segment ends when it is finished on every chained module.")
+        .def("set_speed_limit", &DmacSim::set_speed_limit, py::arg("inc_per_s"),
+             py::call_guard<py::gil_scoped_release>(),
+             "A mechanical limit (friction, a brake): an interpolation segment faster than this "
+             "(increments/s) lasts |offset|/limit instead of #INTERPOL_TIME. 0 = none.")
         .def_property_readonly("lines_handled", &DmacSim::lines_handled)
         .def_property_readonly("lines_rejected", &DmacSim::lines_rejected);
 

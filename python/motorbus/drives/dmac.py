@@ -200,6 +200,7 @@ __all__ = [
     "PLUGIN",
     "UnknownCommand",
     "XON_ERROR",
+    "chain_ultrasync",
     "check_address",
     "error_names",
     "format_value",
@@ -347,7 +348,35 @@ def make_sim(address: Any = "00", clock: Any = None, **options: Any) -> DmacSim:
     options.setdefault("reference_switch", DEFAULT_REFERENCE_SWITCH)
     if options["reference_switch"] is False:     # a bench file's way to say "no switch" (TOML has no None)
         options["reference_switch"] = None
+    if clock is None:
+        clock = _real_clock()    # one time line for every module, so a line's modules can be chained
     return DmacSim(clock, address=_parse_address(address), **options)
+
+
+_REAL_CLOCK: Any = None
+
+
+def _real_clock() -> Any:
+    global _REAL_CLOCK
+    if _REAL_CLOCK is None:
+        _REAL_CLOCK = _core.RealClock()
+    return _REAL_CLOCK
+
+
+def chain_ultrasync(sims: Sequence[DmacSim]) -> None:
+    """Wire IN6/OUT1 of these simulated modules into one UltraSYNC chain (manual 5.11),
+    before they are served.  With ``#INTERPOL_MODE:=-1`` each interpolation segment then
+    ends when it is finished on every chained module that interpolates in UltraSYNC: a
+    module that is done waits at rest on the segment's end (``sim.set_speed_limit`` makes
+    one axis slow, as friction or a brake does).  In SimpleSYNC (0) each times its own."""
+    DmacSim.chain_ultrasync(list(sims))
+
+
+def wire_line(sims: Sequence[DmacSim]) -> None:
+    """``motorbus sim serve``: the modules of one served line have IN6/OUT1 chained, the
+    UltraSYNC wiring (it changes nothing unless ``#INTERPOL_MODE:=-1``)."""
+    if len(sims) > 1:
+        chain_ultrasync(sims)
 
 
 def synchro(link: Any, what: str) -> None:

@@ -13,6 +13,10 @@ struct DmacSim::Pending {
     std::int32_t value;
 };
 
+struct DmacSim::Chain {
+    std::vector<DmacSim*> members;
+};
+
 namespace {
 
 constexpr std::int64_t kNsPerMs = 1'000'000;
@@ -114,12 +118,47 @@ DmacSim::DmacSim(std::shared_ptr<Clock> clock, SimOptions options)
     axis_ = std::make_unique<motion::MotorModel>(*clock_, axis_config(options_));
     epoch_ns_ = axis_->time();  // the model's time is the device's, tick for tick
     axis_->add_listener([this](const motion::MotorEvent& e) { on_axis_event(e); });
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     restart_motion_at(0);
     reset_locked(true);
 }
 
-DmacSim::~DmacSim() = default;
+DmacSim::~DmacSim() {
+    if (!chain_) return;
+    std::lock_guard lock(*mutex_);
+    auto& m = chain_->members;
+    m.erase(std::remove(m.begin(), m.end(), this), m.end());
+}
+
+void DmacSim::chain_ultrasync(const std::vector<std::shared_ptr<DmacSim>>& modules) {
+    std::vector<DmacSim*> ms;
+    for (const auto& m : modules) {
+        if (!m) throw InvalidArgument("DmacSim chain_ultrasync: a module is None");
+        if (std::find(ms.begin(), ms.end(), m.get()) == ms.end()) ms.push_back(m.get());
+    }
+    if (ms.size() < 2) throw InvalidArgument("DmacSim chain_ultrasync: two modules or more (IN6/OUT1 of each wired to the next)");
+    for (auto* m : ms) {
+        if (m->chain_) throw InvalidArgument("DmacSim chain_ultrasync: module " + std::to_string(m->address()) + " is already chained");
+        if (m->clock_ != ms.front()->clock_)
+            throw InvalidArgument("DmacSim chain_ultrasync: the chained modules must share one clock");
+    }
+    for (auto* m : ms) m->poll();  // each on the clock's now before they tick together
+    auto chain = std::make_shared<Chain>();
+    chain->members = ms;
+    auto mutex = std::make_shared<std::mutex>();
+    for (auto* m : ms) {
+        m->chain_ = chain;
+        m->mutex_ = mutex;
+    }
+}
+
+void DmacSim::set_speed_limit(double inc_per_s) {
+    if (!std::isfinite(inc_per_s) || inc_per_s < 0)
+        throw InvalidArgument("DmacSim speed limit: increments/s >= 0 (0 = none), not " + std::to_string(inc_per_s));
+    std::lock_guard lock(*mutex_);
+    catch_up_locked();
+    speed_limit_ = inc_per_s;
+}
 
 bool DmacSim::dmac34() const {
     return options_.model == Model::Dmac34_1 || options_.model == Model::Dmac34_2;
@@ -166,8 +205,17 @@ double DmacSim::user_position() const {
 
 std::int32_t DmacSim::position_locked() const { return wrap_i32(axis_->encoder()); }
 
+// #SPEED: the rotor's measured speed, whoever drives it -- the power stage,
+// or nothing while it runs down after POWER OFF/SC, a fault or MODULE_RESET.
 std::int32_t DmacSim::speed_locked() const {
     return round_i32(dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->velocity())));
+}
+
+// #PROFILE_SPEED: "the computed speed of the module" (5.24): what its profile
+// (or interpolation segment) asks for; nothing while the power stage is off.
+std::int32_t DmacSim::profile_speed_locked() const {
+    if (coasting_ || seg_wait_) return 0;
+    return round_i32(dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->commanded_velocity())));
 }
 
 bool DmacSim::moving_locked() const {
@@ -184,6 +232,7 @@ void DmacSim::coast(double tau) {
     interpolating_ = false;
     fifo_.clear();
     seg_elapsed_ms_ = 0;
+    seg_wait_ = false;
     pending_.reset();
     // Exponential run-down until below half an increment per second.
     if (std::fabs(v) > 0.5) {
@@ -201,13 +250,56 @@ void DmacSim::coast(double tau) {
     }
 }
 
+std::int64_t DmacSim::target_ms() const { return (clock_->now() - epoch_ns_) / kNsPerMs; }
+
+bool DmacSim::idle_locked() const {
+    const bool timers = vars_[static_cast<std::size_t>(Var::Timer1)] ||
+                        vars_[static_cast<std::size_t>(Var::Timer2)] ||
+                        vars_[static_cast<std::size_t>(Var::Timer3)];
+    return !seq_running_ && !timers && !moving_locked();
+}
+
+bool DmacSim::ultrasync_locked() const {
+    return chain_ && vars_[static_cast<std::size_t>(Var::InterpolMode)] == -1;
+}
+
 void DmacSim::catch_up_locked() {
-    const std::int64_t target = (clock_->now() - epoch_ns_) / kNsPerMs;
+    if (!chain_) {
+        catch_up_self_locked(target_ms());
+        return;
+    }
+    // Chained modules live on one time line: each step ticks every module whose
+    // next tick is the earliest due, then the chain releases a finished segment.
+    // A module with nothing evolving jumps to now on its own (the chain only ever
+    // releases modules that interpolate, which are never idle).
+    const auto& ms = chain_->members;
+    for (;;) {
+        Nanos next = std::numeric_limits<Nanos>::max();
+        for (auto* m : ms) {
+            if (m->now_ms_ >= m->target_ms()) continue;
+            if (m->idle_locked()) m->catch_up_self_locked(m->target_ms());
+            else next = std::min(next, m->tick_time() + kNsPerMs);
+        }
+        if (next == std::numeric_limits<Nanos>::max()) return;
+        for (auto* m : ms)
+            if (m->now_ms_ < m->target_ms() && !m->idle_locked() && m->tick_time() + kNsPerMs <= next)
+                m->tick_locked();
+        // IN6/OUT1: a segment ends when it is finished on every module in UltraSYNC.
+        bool any = false, all_done = true;
+        for (auto* m : ms)
+            if (m->interpolating_ && m->ultrasync_locked()) {
+                any = true;
+                all_done = all_done && m->seg_wait_;
+            }
+        if (any && all_done)
+            for (auto* m : ms)
+                if (m->seg_wait_) m->next_segment_locked();
+    }
+}
+
+void DmacSim::catch_up_self_locked(std::int64_t target) {
     while (now_ms_ < target) {
-        const bool timers = vars_[static_cast<std::size_t>(Var::Timer1)] ||
-                            vars_[static_cast<std::size_t>(Var::Timer2)] ||
-                            vars_[static_cast<std::size_t>(Var::Timer3)];
-        if (!seq_running_ && !timers && !moving_locked()) {
+        if (idle_locked()) {
             // Nothing evolves while idle: jump instead of ticking through it.
             now_ms_ = target;
             axis_->advance_to(tick_time());
@@ -228,11 +320,13 @@ void DmacSim::tick_locked() {
         coasting_ = false;
         restart_motion_at(user_position());
     }
-    if (interpolating_ && !fifo_.empty() && ++seg_elapsed_ms_ >= fifo_.front().duration_ms) {
-        // The segment's profile has just ended on its exact end position.
-        fifo_.pop_front();
-        if (!fifo_.empty()) start_interp_segment();
+    if (interpolating_ && !fifo_.empty() && !seg_wait_ && ++seg_elapsed_ms_ >= seg_duration_ms_) {
+        // The segment's profile has just ended on its exact end position.  In
+        // UltraSYNC the module waits there for the chain (catch_up_locked).
+        if (ultrasync_locked()) seg_wait_ = true;
+        else next_segment_locked();
     }
+    if (seg_wait_ && !ultrasync_locked()) next_segment_locked();  // the mode changed meanwhile
     if (interpolating_ && fifo_.empty()) {
         // FIFO ran dry: the movement stops; a new SYNCHRO INTERPOL is needed.
         interpolating_ = false;
@@ -267,7 +361,7 @@ void DmacSim::tick_locked() {
 }
 
 void DmacSim::poll() {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
 }
 
@@ -284,20 +378,41 @@ void DmacSim::halt_motion() {
     interpolating_ = false;
     fifo_.clear();
     seg_elapsed_ms_ = 0;
+    seg_wait_ = false;
     axis_->halt();
     restart_motion_at(user_position());
 }
 
 void DmacSim::command_axis() { axis_->command_from(motion_->profile(), motion_t(), tick_time()); }
 
+void DmacSim::next_segment_locked() {
+    seg_wait_ = false;
+    fifo_.pop_front();
+    if (!fifo_.empty()) {
+        start_interp_segment();
+        return;
+    }
+    // FIFO ran dry: the movement stops; a new SYNCHRO INTERPOL is needed.
+    interpolating_ = false;
+    seg_elapsed_ms_ = 0;
+    restart_motion_at(user_position());
+}
+
 void DmacSim::start_interp_segment() {
-    // One FIFO entry: #INTERPOL_TIME ms at constant speed, ending exactly on its offset.
+    // One FIFO entry: #INTERPOL_TIME ms at constant speed, ending exactly on its
+    // offset -- or longer, at the speed a mechanical limit allows.
     const Segment& s = fifo_.front();
-    const double v = static_cast<double>(s.offset) * 1000.0 / s.duration_ms;
+    int duration = std::max(s.duration_ms, 1);
+    const double need = std::fabs(static_cast<double>(s.offset)) * 1000.0 / duration;
+    if (speed_limit_ > 0 && need > speed_limit_)
+        duration = static_cast<int>(std::ceil(std::fabs(static_cast<double>(s.offset)) * 1000.0 / speed_limit_));
+    const double v = static_cast<double>(s.offset) * 1000.0 / duration;
     motion::Profile seg(motion::State{0, v, 0, 0});
-    seg.append_jump(s.duration_ms / 1000.0, v, 0, 0).finish(static_cast<double>(s.offset), 0);
+    seg.append_jump(duration / 1000.0, v, 0, 0).finish(static_cast<double>(s.offset), 0);
     axis_->command(seg);
     seg_elapsed_ms_ = 0;
+    seg_duration_ms_ = duration;
+    seg_wait_ = false;
 }
 
 // Advances the axis to t, stopping it where the commanded motion would first
@@ -458,6 +573,7 @@ void DmacSim::reset_locked(bool factory) {
     interpolating_ = false;
     fifo_.clear();
     seg_elapsed_ms_ = 0;
+    seg_wait_ = false;
     edit_ = false;
     seq_running_ = false;
     line_ = 0;
@@ -478,7 +594,7 @@ void DmacSim::reset_locked(bool factory) {
 }
 
 void DmacSim::power_cycle() {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
     reset_locked(false);
 }
@@ -525,8 +641,8 @@ std::optional<std::int32_t> DmacSim::read_var_locked(Var v, int bit) {
     std::int32_t value;
     switch (v) {
         case Var::Position: value = position_locked(); break;
-        case Var::Speed:
-        case Var::ProfileSpeed: value = speed_locked(); break;
+        case Var::Speed: value = speed_locked(); break;
+        case Var::ProfileSpeed: value = profile_speed_locked(); break;
         case Var::Status: value = wrap_i32(status_locked()); break;
         case Var::Error: value = wrap_i32(error_); break;
         case Var::Input: value = wrap_i32(logical_inputs()); break;
@@ -988,7 +1104,7 @@ std::string DmacSim::on_line(std::string_view line) {
     std::string reply;
     std::int32_t delay_us = 0;
     {
-        std::lock_guard lock(mutex_);
+        std::lock_guard lock(*mutex_);
         try {
             catch_up_locked();
             reply = handle_locked(line);
@@ -1008,7 +1124,7 @@ std::string DmacSim::on_line(std::string_view line) {
 }
 
 std::string DmacSim::on_overlong() {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
     ++lines_rejected_;
     // Beyond kOverlongWindow the address is lost with the line: every module flags it.
@@ -1018,7 +1134,7 @@ std::string DmacSim::on_overlong() {
 
 // ---- inspection -------------------------------------------------------------------
 SimState DmacSim::state() {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
     SimState s;
     s.now_ms = now_ms_;
@@ -1035,23 +1151,23 @@ SimState DmacSim::state() {
 }
 
 std::int32_t DmacSim::read(Var v) {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
     return read_var_locked(v, 0).value_or(0);
 }
 
 int DmacSim::address() {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     return address_;
 }
 
 std::int32_t DmacSim::baudrate() {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     return baudrate_;
 }
 
 std::string DmacSim::sequence_line(int n) {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     if (n < 1 || n > kSeqLines) return "";
     const auto& l = program_[static_cast<std::size_t>(n)];
     return l ? format_command(*l) : "";
@@ -1059,7 +1175,7 @@ std::string DmacSim::sequence_line(int n) {
 
 void DmacSim::set_input(int n, bool active) {
     if (n < 1 || n > 10) throw InvalidArgument("DmacSim input: " + std::to_string(n) + " is outside 1..10");
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
     if (active) physical_inputs_ |= bit_mask(n);
     else physical_inputs_ &= ~bit_mask(n);
@@ -1085,19 +1201,19 @@ void DmacSim::set_analog(int channel, std::int32_t mv) {
     if (channel < 1 || channel > (dmac34() ? 2 : 1))
         throw InvalidArgument("DmacSim analog channel: " + std::to_string(channel) + " (a " +
                               std::string(model_name(options_.model)) + " has " + (dmac34() ? "1 and 2)" : "1 only)"));
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     analog_[channel] = mv;
 }
 
 void DmacSim::set_supply_voltage(std::int32_t mv) {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
     options_.supply_voltage_mv = mv;
     check_supply_locked();
 }
 
 void DmacSim::set_temperature(Sensor which, std::int32_t tenths_c) {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
     switch (which) {
         case Sensor::Cpu: options_.cpu_temperature = tenths_c; break;
@@ -1109,7 +1225,7 @@ void DmacSim::set_temperature(Sensor which, std::int32_t tenths_c) {
 
 void DmacSim::inject_error(int bit) {
     if (bit < 1 || bit > 32) throw InvalidArgument("DmacSim error bit: 1..32");
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
     if (kFaultBits & bit_mask(bit)) fault_locked(bit);
     else flag(bit);
@@ -1139,7 +1255,7 @@ void DmacSim::check_supply_locked() {
 }
 
 std::uint32_t DmacSim::physical_outputs() {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     catch_up_locked();
     const std::uint32_t mask = dmac34() ? 0xFFu : 0x0Fu;
     auto logical = static_cast<std::uint32_t>(vars_[static_cast<std::size_t>(Var::Output)]);
@@ -1150,12 +1266,12 @@ std::uint32_t DmacSim::physical_outputs() {
 }
 
 std::uint64_t DmacSim::lines_handled() {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     return lines_handled_;
 }
 
 std::uint64_t DmacSim::lines_rejected() {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(*mutex_);
     return lines_rejected_;
 }
 

@@ -15,6 +15,14 @@
 // ticks (sequencer line, timers, FIFO segment progress, end-stop checks), so
 // a SimClock advanced by a test gives exact, repeatable times.  Switch edges
 // and soft end-stop crossings inside a tick stop the axis at their exact time.
+//
+// UltraSYNC (#INTERPOL_MODE:=-1, 5.11): modules whose IN6/OUT1 are chained
+// (chain_ultrasync) finish each interpolation segment together: one that is
+// done waits, at rest on the segment's end, until the segment is finished on
+// every chained module that interpolates in UltraSYNC, then all start the next
+// one at the same tick.  In SimpleSYNC each module times its segments alone.
+// Chained modules share one lock and one time line (they are advanced tick by
+// tick together), so they must share one Clock.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -125,12 +133,27 @@ public:
     void inject_error(int bit);
     std::uint32_t physical_outputs(); // after polarity and OUT1/OUT2 alternate functions
     void power_cycle();               // same as MODULE_RESET
+    // Wires IN6/OUT1 of these modules into one UltraSYNC chain (5.11).  Before
+    // they are served: the modules then share one lock.  InvalidArgument for
+    // fewer than two distinct modules, a module already chained, or modules on
+    // different clocks.
+    static void chain_ultrasync(const std::vector<std::shared_ptr<DmacSim>>& modules);
+    // A mechanical limit on the rotor (friction, a brake: the figure of 5.11):
+    // an interpolation segment faster than `inc_per_s` lasts |offset| / inc_per_s
+    // instead of #INTERPOL_TIME.  0 = none.
+    void set_speed_limit(double inc_per_s);
     std::uint64_t lines_handled();
     std::uint64_t lines_rejected();   // frames with at least one invalid command
 
 private:
     struct Pending;  // a move armed by SYNCHRO ON, started by SYNCHRO TOP
+    struct Chain;    // IN6/OUT1 UltraSYNC wiring between modules
     void catch_up_locked();
+    void catch_up_self_locked(std::int64_t target_ms);
+    std::int64_t target_ms() const;
+    bool idle_locked() const;
+    bool ultrasync_locked() const;
+    void next_segment_locked();  // the current FIFO segment is done: start the next or stop
     void tick_locked();
     std::string handle_locked(std::string_view line);
     std::string execute_locked(const Command& c, bool from_sequencer, bool global);
@@ -148,6 +171,7 @@ private:
     double user_position() const;  // encoder counts before quantisation
     std::int32_t position_locked() const;
     std::int32_t speed_locked() const;
+    std::int32_t profile_speed_locked() const;
     bool moving_locked() const;
     bool busy_locked() const;
     void coast(double tau_s);                  // power stage off: the rotor runs down
@@ -175,7 +199,8 @@ private:
 
     std::shared_ptr<Clock> clock_;
     SimOptions options_;
-    std::mutex mutex_;
+    std::shared_ptr<std::mutex> mutex_ = std::make_shared<std::mutex>();  // the chain's, when chained
+    std::shared_ptr<Chain> chain_;
     Nanos epoch_ns_ = 0;
     std::int64_t now_ms_ = 0;
 
@@ -215,6 +240,9 @@ private:
     std::deque<Segment> fifo_;
     bool interpolating_ = false;
     int seg_elapsed_ms_ = 0;
+    int seg_duration_ms_ = 0;   // of the segment in progress (longer than #INTERPOL_TIME if speed-limited)
+    bool seg_wait_ = false;     // UltraSYNC: done, waiting for the chained modules
+    double speed_limit_ = 0;    // inc/s, 0 = none
 
     // sequencer
     std::vector<std::optional<Command>> program_;  // index 1..500
