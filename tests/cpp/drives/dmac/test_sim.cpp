@@ -692,3 +692,64 @@ TEST(DmacSim, RejectsBadAddressBeforeAnything) {
     EXPECT_TRUE(bit_set(r.sim->state().error, error::kSyntax));
     EXPECT_THROW(DmacSim(r.clock, SimOptions{.address = 64}), InvalidArgument);
 }
+
+// ---- issue 23 items 17, 18 -------------------------------------------------------------------
+TEST(DmacSim, UltraSyncChainedModulesEndEachSegmentTogether) {  // 5.11
+    auto clock = std::make_shared<SimClock>();
+    SimOptions ox, oy;
+    oy.address = 1;
+    auto x = std::make_shared<DmacSim>(clock, ox);
+    auto y = std::make_shared<DmacSim>(clock, oy);
+    DmacSim::chain_ultrasync({x, y});
+    EXPECT_THROW(DmacSim::chain_ultrasync({x, y}), InvalidArgument);  // already chained
+    EXPECT_THROW(DmacSim::chain_ultrasync({x}), InvalidArgument);
+    y->set_speed_limit(5000);  // braked: a 1000-increment segment takes 200 ms
+    x->on_line("BRAKE OFF");
+    y->on_line("BRAKE OFF");
+    for (auto* a : {"00", "01"}) {
+        x->on_line(std::string(a) + "#INTERPOL_MODE:=-1, #INTERPOL_TIME:=100");
+        y->on_line(std::string(a) + "#INTERPOL_MODE:=-1, #INTERPOL_TIME:=100");
+        for (int i = 0; i < 2; ++i) {
+            x->on_line(std::string(a) + "MOVE_INTERPOL 1000");
+            y->on_line(std::string(a) + "MOVE_INTERPOL 1000");
+        }
+    }
+    x->on_line("SYNCHRO INTERPOL");
+    y->on_line("SYNCHRO INTERPOL");
+    clock->advance(150'000'000);
+    EXPECT_EQ(x->read(Var::Position), 1000);  // done, waiting for Y
+    EXPECT_EQ(x->read(Var::Speed), 0);
+    EXPECT_EQ(x->read(Var::ProfileSpeed), 0);
+    EXPECT_EQ(y->read(Var::Position), 750);
+    clock->advance(100'000'000);              // Y done at 200: both on segment 2
+    EXPECT_EQ(x->read(Var::Position), 1500);
+    EXPECT_EQ(y->read(Var::Position), 1250);
+    clock->advance(200'000'000);
+    EXPECT_EQ(x->read(Var::Position), 2000);
+    EXPECT_EQ(y->read(Var::Position), 2000);
+    EXPECT_FALSE(x->state().interpolating);
+    EXPECT_FALSE(y->state().interpolating);
+    EXPECT_THROW(y->set_speed_limit(-1), InvalidArgument);
+}
+
+TEST(DmacSim, UltraSyncWithoutAChainTimesItsOwnSegments) {
+    Rig r;
+    r.sim->set_speed_limit(5000);
+    r.tx("00#INTERPOL_MODE:=-1, #INTERPOL_TIME:=100, MOVE_INTERPOL 1000, MOVE_INTERPOL 1000");
+    r.tx("SYNCHRO INTERPOL");
+    r.ms(250);
+    EXPECT_EQ(r.read(Var::Position), 1250);  // nobody to wait for; the brake still slows it
+}
+
+TEST(DmacSim, ProfileSpeedIsNothingWhileTheRotorRunsDown) {  // 4.8, 5.24
+    Rig r;
+    r.tx("00#ACCEL_TIME:=100, MOVE_SPEED 60000");
+    r.ms(500);
+    EXPECT_EQ(r.read(Var::ProfileSpeed), 60000);
+    r.tx("00MODULE_RESET");
+    r.ms(10);
+    const auto s = r.read(Var::Speed);
+    EXPECT_NEAR(s, 60000 * std::exp(-0.5), 300);  // 10 ms of a 20 ms time constant
+    EXPECT_EQ(r.read(Var::ProfileSpeed), 0);
+    EXPECT_TRUE(bit_set(r.status(), status::kMovement));
+}

@@ -139,3 +139,26 @@ TEST(UnitekCodec, EventMaskTable) {  // C-U01
     EXPECT_EQ(event_status_mask(0x0020), kStatusIcns);
     EXPECT_EQ(event_status_mask(0x0101), 0x0101u);
 }
+
+TEST(UnitekCodec, BitTimingTable) {  // §3.1, C-U08
+    const auto t = bit_timings();
+    ASSERT_EQ(t.size(), 5u);
+    EXPECT_EQ(bit_timing_for_btr(0x4002).kbit_s, 1000);
+    EXPECT_EQ(bit_timing_for_btr(0x4025).max_line_m, 70);
+    EXPECT_EQ(bit_timing_for_btr(0x4014).kbit_s, 625);
+    EXPECT_EQ(bit_timing_for_bit_rate(250000).btr, 0x405C);
+    EXPECT_EQ(bit_timing_for_bit_rate(100000).max_line_m, 500);
+    EXPECT_EQ(kDefaultBtr, 0x4025);
+    EXPECT_THROW(bit_timing_for_btr(0x4026), InvalidArgument);
+    EXPECT_THROW(bit_timing_for_bit_rate(615000), InvalidArgument);  // "Labod 615 kB/s": not a row
+}
+
+TEST(UnitekCodec, SmallerOfMotorAndDeviceCurrentLimit) {  // §6.1
+    const auto& ds205 = device_current("DS 205/405");
+    EXPECT_EQ(effective_current_limit_num(ds205, 500), 160);
+    EXPECT_EQ(effective_current_limit_num(ds205, 44), 44);
+    EXPECT_EQ(effective_current_limit_num(device_current("DS 420"), 511), 200);
+    EXPECT_THROW(effective_current_limit_num(ds205, -1), InvalidArgument);
+    EXPECT_THROW(device_current("DS 999"), InvalidArgument);
+    EXPECT_EQ(kCurrentCommandMax, 511);
+}

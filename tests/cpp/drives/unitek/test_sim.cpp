@@ -468,3 +468,109 @@ TEST(UnitekClient, RingBufferReaderRacingTheWriter) {
     EXPECT_EQ(cursor, kTotal);
     EXPECT_EQ(got + lost, kTotal);
 }
+
+// ---- issue 23 items 15, 16 -----------------------------------------------------------------
+
+namespace {
+// The value of the one reply to `3D regid 00` (16-bit, sign-extended when asked).
+std::int64_t ask(UnitekSim& sim, std::vector<can::Frame>& out, std::uint8_t regid, bool is_signed = false) {
+    out.clear();
+    sim.on_frame(can::Frame::make(sim.rx_id(), Bytes{0x3D, regid, 0x00}));
+    EXPECT_EQ(out.size(), 1u);
+    if (out.empty()) return -999999;
+    const auto d = out.front().payload();
+    const auto v = static_cast<std::uint16_t>(d[1] | (d[2] << 8));
+    return is_signed ? static_cast<std::int16_t>(v) : v;
+}
+}  // namespace
+
+TEST(UnitekSim, EepromKeepsEveryWritableRegister) {  // B-U13, issue 23 item 15
+    SimClock clock;
+    UnitekSim sim(clock);
+    std::vector<can::Frame> out;
+    sim.set_output([&](const can::Frame& f) { out.push_back(f); });
+    const std::vector<Bytes> writes = {{0x51, 0x14, 0x00}, {0x35, 0xF4, 0x01}, {0x52, 0x12, 0x00},
+                                       {0x31, 0xCD, 0x0C}, {0x90, 0xFC, 0x3F}, {0x24, 0x64, 0x00},
+                                       {0x26, 0xB3, 0xFF}, {0x6E, 0xC0, 0xC6, 0x2D, 0x00}};
+    for (const auto& w : writes) sim.on_frame(can::Frame::make(0x201, w));
+    sim.on_frame(can::Frame::make(0x201, Bytes{0x84, 0x01, 0x00}));
+    EXPECT_EQ(sim.counters().refused + sim.counters().unknown, 0u);
+    for (const auto& w : writes) {  // RAM changes after the store: lost at power off
+        Bytes c = w;
+        c[1] ^= 0x01;
+        sim.on_frame(can::Frame::make(0x201, c));
+    }
+    sim.power_cycle();
+    const auto ee = sim.eeprom();
+    for (auto id : {0x31, 0x35, 0x51, 0x52, 0x68, 0x6E, 0x90, 0x24, 0x26}) EXPECT_EQ(ee.count(id), 1u) << id;
+    EXPECT_EQ(ee.count(kRegEeprom), 0u);  // the store command keeps no value
+    EXPECT_EQ(ask(sim, out, 0x35), 500);
+    EXPECT_EQ(ask(sim, out, 0x52), 0x12);
+    EXPECT_EQ(ask(sim, out, 0x31, true), 3277);
+    EXPECT_EQ(ask(sim, out, 0x90, true), 16380);
+    EXPECT_EQ(ask(sim, out, 0x24), 100);
+    EXPECT_EQ(ask(sim, out, 0x26, true), -77);
+    EXPECT_EQ(sim.value(kRegPosDest), 3000000);
+    EXPECT_EQ(sim.status() & kStatusEna, 0u);  // stored MODE bit 2: disabled from power-up
+    EXPECT_EQ(sim.speed_num(), 0.0);          // a stored set-point starts nothing
+}
+
+TEST(UnitekSim, CurrentCommandNineBitsAndTheSmallerLimit) {  // §6.1, B-U17, issue 23 item 16
+    SimClock clock;
+    SimConfig cfg;
+    cfg.device = "DS 412";
+    cfg.motor_i_max_num = 120;
+    UnitekSim sim(clock, cfg);
+    std::vector<can::Frame> out;
+    sim.set_output([&](const can::Frame& f) { out.push_back(f); });
+    EXPECT_EQ(ask(sim, out, kRegDeviceCurrentMax), 230);
+    EXPECT_EQ(ask(sim, out, kRegCurrentLimit), 120);
+    sim.on_frame(can::Frame::make(0x201, Bytes{0x26, 0x01, 0xFE}));  // -511
+    EXPECT_EQ(ask(sim, out, kRegCurrentActual, true), -120);           // the motor's limit is smaller
+    sim.on_frame(can::Frame::make(0x201, Bytes{0x24, 0xFF, 0x01}));  // motor 511 > device 230
+    EXPECT_EQ(ask(sim, out, kRegCurrentActual, true), -230);
+    sim.on_frame(can::Frame::make(0x201, Bytes{0x26, 0x00, 0x02}));  // 512: beyond 9 bit, ignored
+    sim.on_frame(can::Frame::make(0x201, Bytes{0x24, 0x00, 0x02}));
+    EXPECT_EQ(sim.counters().refused, 2u);
+    EXPECT_EQ(ask(sim, out, kRegCurrentCmd, true), -511);
+    sim.set_hardware_enable(false);
+    EXPECT_EQ(ask(sim, out, kRegCurrentActual, true), 0);  // power stage off: no current
+    cfg.motor_i_max_num = 512;
+    EXPECT_THROW(UnitekSim(clock, cfg), InvalidArgument);
+    cfg.motor_i_max_num.reset();
+    cfg.device = "DS 999";
+    EXPECT_THROW(UnitekSim(clock, cfg), InvalidArgument);
+}
+
+TEST(UnitekSim, NodeAtAnotherBitRateHearsAndSendsNothing) {  // §3.1, B-U21, issue 23 item 16
+    SimClock clock;
+    can::VirtualOptions vo;
+    vo.bitrate = 250000;
+    auto medium = can::open_virtual("unitek-btr-test", vo);
+    auto host = can::open_virtual("unitek-btr-test", vo);
+    std::atomic<int> seen{0};
+    host->subscribe(can::Filter{}, [&](const can::Frame&) { ++seen; });
+    SimConfig cfg;  // BTR 0x4025: 500 kbit/s
+    UnitekSim sim(clock, cfg);
+    sim.attach(*medium);
+    EXPECT_EQ(sim.bus_bit_rate(), 250000);
+    host->send(can::Frame::make(0x201, Bytes{0x3D, 0x40, 0x00}), 100ms);
+    const auto end = std::chrono::steady_clock::now() + 2s;
+    while (sim.counters().bit_rate_mismatch == 0 && std::chrono::steady_clock::now() < end)
+        std::this_thread::sleep_for(1ms);
+    std::this_thread::sleep_for(50ms);
+    EXPECT_EQ(sim.counters().bit_rate_mismatch, 1u);
+    EXPECT_EQ(sim.counters().frames_in, 0u);
+    EXPECT_EQ(seen.load(), 0);
+    sim.close();
+    cfg.btr = 0x405C;  // 250 k in NDrive
+    UnitekSim at250(clock, cfg);
+    at250.attach(*medium);
+    host->send(can::Frame::make(0x201, Bytes{0x3D, 0x40, 0x00}), 100ms);
+    const auto end2 = std::chrono::steady_clock::now() + 2s;
+    while (seen.load() == 0 && std::chrono::steady_clock::now() < end2) std::this_thread::sleep_for(1ms);
+    EXPECT_EQ(seen.load(), 1);
+    at250.close();
+    cfg.btr = 0x4026;
+    EXPECT_THROW(UnitekSim(clock, cfg), InvalidArgument);
+}
