@@ -147,6 +147,8 @@ void bind_pmc007(py::module_& m) {
         .def_property_readonly("enabled", &BoundSim::enabled)
         .def_property_readonly("gpio_value", &BoundSim::gpio_value)
         .def_property_readonly("active_baud_index", &BoundSim::active_baud_index)
+        .def_property_readonly("active_encoder_cpr", &BoundSim::active_encoder_cpr,
+                               "The encoder CPR in use: 6021h as it was at the last power-up or reset node (B-P40).")
         .def_property_readonly("od", &BoundSim::od_ptr)
         .def_property_readonly("flash_program", &BoundSim::flash_program)
         .def_property_readonly("ram_program", &BoundSim::ram_program)

@@ -4193,6 +4193,11 @@ class Pmc007Sim:
     def active_baud_index(self) -> int:
         ...
     @property
+    def active_encoder_cpr(self) -> int:
+        """
+        The encoder CPR in use: 6021h as it was at the last power-up or reset node (B-P40).
+        """
+    @property
     def attached(self) -> bool:
         ...
     @property

@@ -249,8 +249,10 @@ std::uint32_t PdoEngine::write_locked(std::uint16_t index, std::uint8_t sub, std
             const bool ext = v & kPdoExtended;
             const std::uint32_t id = v & can::kMaxExtendedId;
             if (!ext && id > can::kMaxStandardId) return kInvalidValue;   // P9: reserved bits
-            if (valid && !ext && restricted_id(id)) return kInvalidValue;  // P9: restricted
-            if (valid && id == 0) return kInvalidValue;
+            if (!opt_.allow_restricted_cob_ids) {
+                if (valid && !ext && restricted_id(id)) return kInvalidValue;  // P9: restricted
+                if (valid && id == 0) return kInvalidValue;
+            }
             if (strict && valid && p.valid() &&
                 (id != p.can_id() || ext != p.extended() ||
                  (p.tpdo && ((v ^ p.cob) & kPdoNoRtr))))
@@ -351,6 +353,11 @@ void PdoEngine::set_operational(bool operational) {
         }
     }
     process(clock_.now());
+}
+
+void PdoEngine::set_sync_cob_id(std::uint32_t cob_id) {
+    std::lock_guard l(m_);
+    opt_.sync_cob_id = cob_id & can::kMaxStandardId;
 }
 
 bool PdoEngine::operational() const {
@@ -486,7 +493,7 @@ bool PdoEngine::on_frame(const can::Frame& f) {
                         collision_ = true;
                         break;
                     }
-                    if (!operational_ || (p.cob & kPdoNoRtr)) {
+                    if (!operational_ || opt_.rtr == PdoRtrPolicy::Never || (p.cob & kPdoNoRtr)) {
                         ++counters_.rtr_ignored;
                         break;
                     }

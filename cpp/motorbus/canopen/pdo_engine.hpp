@@ -84,6 +84,12 @@ private:
     std::unordered_map<std::uint32_t, Object> objs_;
 };
 
+// Whether a remote frame (RTR) on a TPDO's COB-ID is answered with that TPDO.
+enum class PdoRtrPolicy : std::uint8_t {
+    ByCobId,  // CiA 301: answered while COB-ID bit 30 ("no RTR allowed") is 0
+    Never,    // never answered, whatever bit 30 says (a device without RTR support)
+};
+
 struct PdoEngineOptions {
     std::uint8_t node_id = 1;
     unsigned rpdo_count = 4;
@@ -96,6 +102,11 @@ struct PdoEngineOptions {
     std::uint32_t sync_cob_id = 0x080;
     std::uint8_t sync_overflow = 0;   // 0x1019
     std::uint32_t sync_window_us = 0; // 0x1007, 0 = no window (P5)
+    PdoRtrPolicy rtr = PdoRtrPolicy::ByCobId;
+    // false: a valid standard COB-ID in CiA 301's restricted ranges (NMT, SYNC/EMCY
+    // low ids, SDO, LSS, NMT error control) is refused 06090030 (P9).  true: any
+    // 11-bit COB-ID is accepted, for a device whose manual allows any.
+    bool allow_restricted_cob_ids = false;
 };
 
 class PdoEngine {
@@ -120,6 +131,8 @@ public:
 
     // ---- runtime ---------------------------------------------------------
     void set_operational(bool operational);
+    // The COB-ID SYNC is consumed on (0x1005 bits 0-10, standard frame); takes effect at once.
+    void set_sync_cob_id(std::uint32_t cob_id);
     bool operational() const;
     // Routes a frame (RPDO data, RTR on a TPDO, SYNC); returns true when used.
     // A data frame on one of our own TPDO COB-IDs is a node-id collision (N15).

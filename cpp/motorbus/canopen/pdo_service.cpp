@@ -52,6 +52,8 @@ PdoService::PdoService(LocalNode& node, PdoServiceOptions o)
     eo.max_mapped = o.max_mapped;
     eo.strict = o.strict;
     eo.sync_window_us = o.sync_window_us;
+    eo.rtr = o.rtr;
+    eo.allow_restricted_cob_ids = o.allow_restricted_cob_ids;
     engine_ = std::make_unique<PdoEngine>(
         objects_, clock_, eo,
         [this](const can::Frame& f) {
@@ -182,6 +184,11 @@ void PdoService::reload() {
             if (auto obj = od.object(static_cast<std::uint16_t>(base + n)))
                 for (auto& [sub, var] : obj->subs)
                     if (sub != 0 || base >= 0x1600) engine_->load(obj->index, sub, var->get());
+}
+
+void PdoService::reload_from_dictionary() {
+    reload();
+    wake_node();
 }
 
 void PdoService::on_nmt_state(LocalNode&, NmtState previous, NmtState now) {

@@ -39,6 +39,8 @@ struct PdoServiceOptions {
     unsigned max_mapped = 8;
     bool strict = true;  // see PdoEngineOptions::strict
     std::uint32_t sync_window_us = 0;
+    PdoRtrPolicy rtr = PdoRtrPolicy::ByCobId;    // see PdoEngineOptions::rtr
+    bool allow_restricted_cob_ids = false;       // see PdoEngineOptions
 };
 
 class PdoService : public NodeService {
@@ -47,6 +49,10 @@ public:
     ~PdoService() override;
 
     PdoEngine& engine() { return *engine_; }
+    // Rebuilds the engine from the dictionary's PDO parameters (as after a reset),
+    // for a device that restored them there itself (e.g. a factory reset), and
+    // reschedules the TPDO timers.
+    void reload_from_dictionary();
     // EMCY raised by the engine (P1, P2, P11, N15, N16).  Default: send the
     // EMCY frame from the node (error register bit 4, communication error).
     std::function<void(std::uint16_t code, bool active)> on_emcy;

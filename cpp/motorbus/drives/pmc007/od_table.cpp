@@ -35,7 +35,7 @@ std::vector<OdRow> make_rows() {
     var(0x1000, "Device type", U32, RO, false, Storage::Const, 0);
     var(0x1001, "Error register", U8, RO, true, RAM, 0);
     var(0x1002, "Manufacturer status register", U32, RO, true, RAM, 0);
-    mem(0x1003, 0, "Pre-defined error field", "Number of errors", U8, RW, false, RAM, 0, 0, 7);
+    mem(0x1003, 0, "Pre-defined error field", "Number of errors", U8, RW, false, RAM, 0);  // only 0 (06090030)
     for (std::uint8_t s = 1; s <= 7; ++s)
         mem(0x1003, s, "Pre-defined error field", "Standard error field", U32, RO, true, RAM, 0);
     var(0x1005, "COB-ID SYNC", U32, RW, false, ROM, 0x80);
@@ -93,7 +93,7 @@ std::vector<OdRow> make_rows() {
         mem(idx, 5, parent, "Event timer", U16, RW, false, ROM, 0);
     };
     auto map = [&](std::uint16_t idx, const char* parent) {
-        mem(idx, 0, parent, "Number of mapped objects", U8, RW, false, ROM, 0, 0, 8);
+        mem(idx, 0, parent, "Number of mapped objects", U8, RW, false, ROM, 0);  // > 8: 06040042 (PDO engine)
         for (std::uint8_t s = 1; s <= 8; ++s) mem(idx, s, parent, entry_names[s - 1], U32, RW, false, ROM, 0);
     };
     for (int k = 0; k < 4; ++k) comm(std::uint16_t(0x1400 + k), rpdo_comm[k], rpdo_expr[k], 0x200 + 0x100 * k);
@@ -115,7 +115,7 @@ std::vector<OdRow> make_rows() {
     var(0x6007, "Stop speed", U16, RW, false, ROM, 0);
     var(0x6008, "Acceleration coefficient", U8, RW, false, ROM, 0, 0, 8);
     var(0x6009, "Deceleration coefficient", U8, RW, false, ROM, 0, 0, 8);
-    var(0x600A, "Microstepping", U16, RW, false, ROM, 0, 0, 256);
+    var(0x600A, "Microstepping", U16, RW, false, ROM, 0);  // a set (06090030), not a range
     var(0x600B, "Maximum phase current", U16, RW, false, ROM, 0, 0, 6000);
     var(0x600C, "Motor position", S32, RW, true, RAM, 0);
     var(0x600D, "Current attenuation coefficient", U8, RW, false, ROM, 0, 0, 3);
@@ -137,7 +137,7 @@ std::vector<OdRow> make_rows() {
         100);
     mem(0x6018, 2, "Offline programming parameter 1", "Offline automatic operation", U8, RW, false, ROM, 0, 0, 1);
     mem(0x6019, 0, "Offline programming parameter 2", "Number of entries", U8, RO, false, Storage::Const, 5);
-    mem(0x6019, 1, "Offline programming parameter 2", "Program pointer", U8, RW, false, RAM, 0, 0, 99);
+    mem(0x6019, 1, "Offline programming parameter 2", "Program pointer", U8, RW, false, RAM, 0, 0, 100);
     mem(0x6019, 2, "Offline programming parameter 2", "Offline command", U32, RW, false, RAM, 0);
     mem(0x6019, 3, "Offline programming parameter 2", "Save offline commands", U8, RW, false, RAM, 0, 0, 1);
     mem(0x6019, 4, "Offline programming parameter 2", "GPIO mask", U16, RW, false, RAM, 0);
@@ -145,7 +145,7 @@ std::vector<OdRow> make_rows() {
     var(0x601A, "External stop stabilize delay", U16, RW, false, ROM, 100, 0, 200);
     var(0x601B, "Stall set", U8, RW, false, ROM, 0, 0, 1);
     var(0x601C, "Absolute displacement command", S32, RW, false, RAM, 0, -2147483647, 2147483647);
-    var(0x6020, "Stop stepping command", U8, RW, false, RAM, 0, 0, 0);
+    var(0x6020, "Stop stepping command", U8, RW, false, RAM, 0);  // 0 only (06090030)
     t.back().alt_size = 4;  // [D] App.1 UNSIGNED8, §4.5.7 UNSIGNED32: both accepted
     var(0x6021, "Encoder CPR", U16, RW, false, ROM, 500);
     var(0x6022, "Position save value", S32, RO, false, ROM, 0);

@@ -125,17 +125,20 @@ void Pmc007Sim::attach(can::Bus& bus) {
         if (node_ || attaching_)
             throw InvalidArgument("pmc007 sim " + std::to_string(node_id_.load()) + ": already attached");
         attaching_ = true;
-        bus_ = &bus;
+        // The node hears and is heard only at its 2003h baud in effect (issue 23 #11).
+        gate_ = std::make_unique<can::BitRateGate>(bus, [this] { return baud_index_bps(baud_index_.load()); });
+        bus_ = gate_.get();
     }
     std::unique_ptr<canopen::LocalNode> n;
     Services sv;
     try {
-        n = std::make_unique<canopen::LocalNode>(bus, node_id_.load(), od_, node_options());
+        n = std::make_unique<canopen::LocalNode>(*bus_, node_id_.load(), od_, node_options());
         sv = make_services(*n);
     } catch (...) {
         std::lock_guard lock(m_);
         attaching_ = false;
         bus_ = nullptr;
+        gate_.reset();
         throw;
     }
     std::lock_guard lock(m_);
@@ -150,7 +153,10 @@ Pmc007Sim::Services Pmc007Sim::make_services(canopen::LocalNode& n) {
     Services sv;
     canopen::PdoServiceOptions po;
     po.strict = false;  // B-P32: the manual's sequence changes a valid PDO in place
+    po.rtr = canopen::PdoRtrPolicy::Never;  // B-P35 / C-P16: remote frames are not supported (003 §4.2)
+    po.allow_restricted_cob_ids = true;     // B-P32 [D]: any COB-ID may be configured
     sv.pdo = canopen::PdoService::attach(n, po);
+    apply_sync_cob_id(sv.pdo);
     // 1016h consumers: the manual documents no reaction to a lost heartbeat: EMCY 8130h only [P].
     sv.hb = canopen::HeartbeatService::attach(
         n, {.consumer_entries = 3, .producer_ms = 0, .error_behaviour_without_1029 = 1});
@@ -230,11 +236,65 @@ void Pmc007Sim::switch_node_id(std::uint8_t new_id) {
 
 bool Pmc007Sim::attached() const {
     std::lock_guard lock(m_);
-    return node_ != nullptr;
+    return node_ != nullptr || (bus_ != nullptr && !attaching_);  // in the bootloader: off the bus, still attached
+}
+
+void Pmc007Sim::serve_again() {
+    can::Bus* bus = nullptr;
+    {
+        std::lock_guard lock(m_);
+        if (!bus_ || node_ || attaching_) return;
+        bus = bus_;
+        attaching_ = true;
+    }
+    std::unique_ptr<canopen::LocalNode> n;
+    Services sv;
+    try {
+        n = std::make_unique<canopen::LocalNode>(*bus, node_id_.load(), od_, node_options());  // boot-up sent
+        sv = make_services(*n);
+    } catch (const std::exception&) {
+        // [P] the ID is served by another node meanwhile: this one stays off the bus.
+        std::lock_guard lock(m_);
+        attaching_ = false;
+        return;
+    }
+    std::lock_guard lock(m_);
+    node_ = std::move(n);
+    pdo_ = sv.pdo;
+    hb_ = sv.hb;
+    ticker_ = sv.ticker;
+    attaching_ = false;
+}
+
+void Pmc007Sim::enter_bootloader() {
+    std::shared_ptr<canopen::LocalNode> n;
+    Services sv;
+    {
+        std::lock_guard lock(m_);
+        if (!node_) return;
+        n = std::shared_ptr<canopen::LocalNode>(std::move(node_));
+        sv = {std::move(pdo_), std::move(hb_), std::move(ticker_)};
+        emcy_queue_.clear();
+    }
+    // Closing joins the node's worker thread, which may be the one calling us (the
+    // ticker's poll): a helper thread does it.  The node and its services are kept
+    // (retired_): their hooks and listeners stay on the dictionary until a new node's
+    // services replace them.
+    n->set_nmt_state(NmtState::Stopped);  // silent from now on (no SDO, no PDO) while it closes
+    if (boot_.joinable()) boot_.join();
+    boot_ = std::thread([this, n, sv] {
+        n->close();
+        std::lock_guard lock(m_);
+        retired_.push_back(sv.pdo);
+        retired_.push_back(sv.hb);
+        retired_.push_back(sv.ticker);
+        retired_.push_back(n);
+    });
 }
 
 void Pmc007Sim::close() {
     if (renode_.joinable() && renode_.get_id() != std::this_thread::get_id()) renode_.join();
+    if (boot_.joinable() && boot_.get_id() != std::this_thread::get_id()) boot_.join();
     std::unique_ptr<canopen::LocalNode> n;
     Services sv;
     {
@@ -245,6 +305,18 @@ void Pmc007Sim::close() {
     }
     if (n) n->close();
     sv = {};  // destroyed without the lock (they unsubscribe from the bus)
+    std::unique_ptr<can::BitRateGate> gate;
+    {
+        std::lock_guard lock(m_);
+        gate = std::move(gate_);
+    }
+    if (gate) gate->close();
+}
+
+double baud_index_bps(int index) {
+    // 003 §4.3.2: 0 20k, 1 25k, 2 50k, 3 100k, 4 125k, 5 250k, 6 500k, 7 800k, 8 1M.
+    static constexpr double kBps[] = {20e3, 25e3, 50e3, 100e3, 125e3, 250e3, 500e3, 800e3, 1e6};
+    return index >= 0 && index <= 8 ? kBps[index] : -1.0;  // -1: matches no wire
 }
 
 // ---- values -------------------------------------------------------------------
@@ -275,10 +347,7 @@ void Pmc007Sim::publish() {
         std::lock_guard lock(m_);
         status = controller_status();
         errors = errors_;
-        if (errors_) er |= 0x01;
-        if (errors_ & (err::kAoc | err::kBoc)) er |= 0x02;
-        if (errors_ & err::kUvlo) er |= 0x04;
-        if (errors_ & err::kTsd) er |= 0x08;
+        er = error_register_locked();
         position_now = position();
         gpio = gpio_value();
         saved = saved_position_;
@@ -394,6 +463,8 @@ void Pmc007Sim::load_power_up(bool cold) {
         program_fault_ = false;
         bootloader_ = bootloader_pending_ = false;
         ram_program_ = flash_program_;
+        emcy_queue_.clear();
+        emcy_error_ = false;
     }
     t_publishing = true;  // values below are loaded, not "changed by the host"
     for (const auto& [r, var, flash] : power_up_) {
@@ -408,23 +479,47 @@ void Pmc007Sim::load_power_up(bool cold) {
     {
         std::lock_guard lock(m_);
         baud_index_ = static_cast<std::uint8_t>(u(0x2003));
+        cpr_ = static_cast<std::uint16_t>(u(0x6021));  // B-P40: takes effect at power-up
         motor_.set_pulse_position(u(0x602A) == 1 ? saved_position_ : 0);
         if (u(0x6018, 2) == 1 && u(0x6018, 1) > 0) {  // B-P41 auto-run
             running_ = true;
             pc_ = 0;
         }
     }
+    std::shared_ptr<canopen::PdoService> pdo;
+    {
+        std::lock_guard lock(m_);
+        pdo = pdo_;
+    }
+    apply_sync_cob_id(pdo);  // 1005h as loaded (reset node / power-up)
     publish();
 }
 
+void Pmc007Sim::apply_sync_cob_id(const std::shared_ptr<canopen::PdoService>& pdo) {
+    if (pdo) pdo->engine().set_sync_cob_id(static_cast<std::uint32_t>(u(0x1005)));
+}
+
 void Pmc007Sim::power_cycle() {
+    if (boot_.joinable() && boot_.get_id() != std::this_thread::get_id()) boot_.join();
     canopen::LocalNode* n;
+    bool from_bootloader = false;
     {
         std::lock_guard lock(m_);
         n = node_.get();
+        from_bootloader = !n && bus_ && bootloader_;
     }
     load_power_up(false);
-    if (n) {
+    if (from_bootloader) {
+        // B-P39: re-power leaves the bootloader: the application starts again (boot-up, PRE-OPERATIONAL).
+        serve_again();
+        schedule_node_id_switch();
+        std::thread t;
+        {
+            std::lock_guard lock(m_);
+            t = std::move(renode_);
+        }
+        if (t.joinable()) t.join();
+    } else if (n) {
         // As NMT reset node would: boot-up, pre-operational, PDO engine reloaded.
         n->set_nmt_state(NmtState::Initialising);
         n->send_boot_up();
@@ -442,7 +537,7 @@ void Pmc007Sim::power_cycle() {
 void Pmc007Sim::reset_to_new() {
     {
         std::lock_guard lock(m_);
-        if (node_ || attaching_)
+        if (node_ || attaching_ || bus_)
             throw InvalidArgument("pmc007 sim " + std::to_string(node_id_.load()) + ": reset_to_new while attached");
         // What the constructor starts from; load_power_up(true) then sets the rest.
         for (const auto& [r, var, flash] : power_up_)
@@ -453,6 +548,8 @@ void Pmc007Sim::reset_to_new() {
         saved_position_ = 0;
         emcy_sent_ = 0;
         last_emcy_ = -1;
+        emcy_queue_.clear();
+        emcy_error_ = false;
         reset_target_ = 0;
         baud_index_ = 4;
         motor_.reset();
@@ -495,7 +592,7 @@ double Pmc007Sim::velocity() {
 
 bool Pmc007Sim::active() {
     std::lock_guard lock(m_);
-    if (motor_.moving() || running_ || bootloader_pending_) return true;
+    if (motor_.moving() || running_ || bootloader_pending_ || !emcy_queue_.empty()) return true;
     for (const auto& p : pending_)
         if (p) return true;
     return false;
@@ -542,6 +639,7 @@ void Pmc007Sim::poll() {
     {
         std::lock_guard lock(m_);
         update_locked();
+        flush_emcy_locked();
         if (bootloader_pending_) {
             bootloader_pending_ = false;
             bootloader_ = true;
@@ -550,8 +648,9 @@ void Pmc007Sim::poll() {
         }
     }
     publish();
-    // B-P39 [P]: in the bootloader the application stops answering (until power cycle).
-    if (to_bootloader && n) n->set_nmt_state(NmtState::Stopped);
+    // B-P39: in the bootloader the application is gone until a power cycle: no NMT
+    // command brings it back (the node leaves the bus).
+    if (to_bootloader && n) enter_bootloader();
 }
 
 void Pmc007Sim::update_locked() {
@@ -689,28 +788,61 @@ void Pmc007Sim::on_motor_event(const motion::MotorEvent& e) {
     }
 }
 
+std::uint8_t Pmc007Sim::error_register_locked() const {
+    // 1001h [CiA]: bit 0 generic, 1 current, 2 voltage, 3 temperature.
+    std::uint8_t er = 0;
+    if (errors_) er |= 0x01;
+    if (errors_ & (err::kAoc | err::kBoc)) er |= 0x02;
+    if (errors_ & err::kUvlo) er |= 0x04;
+    if (errors_ & err::kTsd) er |= 0x08;
+    return er;
+}
+
 void Pmc007Sim::emcy_locked(std::uint16_t code) {
-    // 1003h history, newest first [CiA 301]: which errors the PMC007 logs is not documented;
-    // the sim logs what it signals by EMCY.
-    {
+    // 1003h history, newest first [CiA]: which errors the PMC007 logs is not documented;
+    // the sim logs what it signals by EMCY (not the 0000h "all clear").
+    if (code != 0) {
         const auto n = std::min<std::int64_t>(u(0x1003, 0) + 1, 7);
         for (std::uint8_t k = static_cast<std::uint8_t>(n); k > 1; --k) set(0x1003, k, u(0x1003, k - 1));
         set(0x1003, 1, code);
         set(0x1003, 0, n);
+        emcy_error_ = true;
     }
     if (!node_ || node_->nmt_state() == NmtState::Stopped || node_->nmt_state() == NmtState::Initialising) return;
-    const Nanos now = monotonic_ns();
-    const Nanos inhibit = Nanos(u(0x1015)) * 100'000;  // 100 us units
-    if (last_emcy_ >= 0 && now - last_emcy_ < inhibit) return;
-    last_emcy_ = now;
-    std::uint8_t er = errors_ ? 0x01 : 0;
-    if (code >= 0xFF00) er |= 0x80;  // manufacturer-specific
+    // The frame carries the state at the time of the event [CiA]: byte 2 = 1001h, bytes 3-4 = 6000h/6001h.
     const std::uint8_t status = static_cast<std::uint8_t>(latched_ | (motor_.moving() ? st::kBusy : 0));
-    auto f = canopen::encode_emcy(node_id_.load(), code, er, {errors_, status, 0, 0, 0});
-    try {
-        node_->send(f);
-        ++emcy_sent_;
-    } catch (const std::exception&) {
+    emcy_queue_.push_back(canopen::encode_emcy(node_id_.load(), code, error_register_locked(), {errors_, status, 0, 0, 0}));
+    // [P] a burst beyond what any inhibit time makes sense for keeps the newest frames.
+    while (emcy_queue_.size() > 32) emcy_queue_.pop_front();
+    flush_emcy_locked();
+}
+
+void Pmc007Sim::flush_emcy_locked() {
+    // 1015h [CiA]: an EMCY inside the inhibit time is delayed until it has passed, not dropped.
+    while (!emcy_queue_.empty()) {
+        if (!node_ || node_->nmt_state() == NmtState::Stopped || node_->nmt_state() == NmtState::Initialising) {
+            emcy_queue_.clear();
+            return;
+        }
+        const Nanos now = monotonic_ns();
+        const Nanos inhibit = Nanos(u(0x1015)) * 100'000;  // 100 us units
+        if (last_emcy_ >= 0 && now - last_emcy_ < inhibit) return;  // the ticker comes back (active())
+        last_emcy_ = now;
+        const can::Frame f = emcy_queue_.front();
+        emcy_queue_.pop_front();
+        try {
+            node_->send(f);
+            ++emcy_sent_;
+        } catch (const std::exception&) {
+        }
+    }
+}
+
+void Pmc007Sim::emcy_if_cleared_locked() {
+    // B-P30 [P]: EMCY 0000h when every error is clear again (6000h and the 6001h latches).
+    if (emcy_error_ && errors_ == 0 && (latched_ & (st::kExt1 | st::kExt2 | st::kStall | st::kExt3)) == 0) {
+        emcy_error_ = false;
+        emcy_locked(0x0000);
     }
 }
 
@@ -765,22 +897,31 @@ std::uint32_t Pmc007Sim::on_write(std::uint16_t index, std::uint8_t sub, std::sp
                     if (r.storage == Storage::Rom) flash_[{r.index, r.sub}] = od_->at(r.index, r.sub)->get();
                 write_store_locked();
             } else if (v == 3) {  // B-P38 / C-P19: factory values into the working copy only
-                for (const auto& r : pmc007_od_rows())
-                    if (r.storage == Storage::Rom && !(r.index >= 0x1400 && r.index <= 0x1BFF))
-                        od_->at(r.index, r.sub)->reset_to_default();
+                factory_reset_locked();
             } else {
                 return kAbortValueRange;
             }
             return 0;
-        case 0x6000: errors_ &= static_cast<std::uint8_t>(~v); return 0;  // write 1 to clear
+        case 0x1005:
+            // COB-ID SYNC [CiA]: the PMC007 consumes SYNC (bit 30 "generates" = 0) on an
+            // 11-bit id (standard frames only, 003 §4.2; bit 29 = 0).
+            if ((v & 0x40000000) || (v & 0x20000000) || (v & 0x1FFFF800)) return kAbortValueRange;
+            if (pdo_) pdo_->engine().set_sync_cob_id(static_cast<std::uint32_t>(v));
+            return 0;
+        case 0x6000:  // write 1 to clear
+            errors_ &= static_cast<std::uint8_t>(~v);
+            emcy_if_cleared_locked();
+            return 0;
         case 0x6001:  // write 1 clears bits 0-2 (and the EXT3 latch); busy cannot be cleared
             latched_ &= static_cast<std::uint8_t>(~(v & (st::kExt1 | st::kExt2 | st::kStall | st::kExt3)));
+            emcy_if_cleared_locked();
             return 0;
         case 0x6003: {  // B-P10: the sign sets the direction
+            // A refused speed-mode write changes nothing, not even the direction.
+            if (u(0x6005) == 1 && v != 0 && refused_locked()) return kAbortDeviceState;
             if (v > 0) od_->at(0x6002, 0)->try_set(Bytes{1});
             if (v < 0) od_->at(0x6002, 0)->try_set(Bytes{0});
             if (u(0x6005) == 1) {  // B-P12 speed mode: run at the new speed
-                if (v != 0 && refused_locked()) return kAbortDeviceState;
                 const motion::State s{motor_.pulse_position(), motor_.moving() ? motor_.pulse_velocity() : 0.0, 0, 0};
                 const double speed = double(v);
                 motor_.command(pmc007_speed_profile(s, speed, params_locked(std::max(1.0, std::fabs(speed))),
@@ -808,6 +949,15 @@ std::uint32_t Pmc007Sim::on_write(std::uint16_t index, std::uint8_t sub, std::sp
                 motor_.command(pmc007_speed_profile(s, 0.0, params_locked(std::max(1.0, std::fabs(s.v))), 0.0));
                 speed_mode_running_ = false;
             }
+            if (v == 1 && u(0x6005) == 0) {  // position -> speed: run at the current 6003h (B-P12)
+                const double speed = double(u(0x6003));
+                if (speed != 0) {
+                    if (refused_locked()) return kAbortDeviceState;  // B-P20: as a 6003h write would be
+                    const motion::State s{motor_.pulse_position(), motor_.moving() ? motor_.pulse_velocity() : 0.0, 0, 0};
+                    motor_.command(pmc007_speed_profile(s, speed, params_locked(std::fabs(speed)), 1e6));
+                    speed_mode_running_ = true;
+                }
+            }
             return 0;
         case 0x600A: return valid_microstepping(v) ? 0 : kAbortValueRange;
         case 0x600C: motor_.set_pulse_position(double(v)); return 0;
@@ -832,6 +982,9 @@ std::uint32_t Pmc007Sim::on_write(std::uint16_t index, std::uint8_t sub, std::sp
         case 0x6019:
             if (sub == 2) {
                 const auto ptr = static_cast<std::size_t>(u(0x6019, 1));
+                // [P] the pointer may read 100 (6019h:01 is 0-100), one past the 100 instructions:
+                // there is no instruction there to write.
+                if (ptr >= kMaxProgram) return kAbortDeviceState;
                 if (ram_program_.size() <= ptr) ram_program_.resize(ptr + 1, 0);
                 ram_program_[ptr] = static_cast<std::uint32_t>(v);
             } else if (sub == 3 && v == 1) {
@@ -842,9 +995,33 @@ std::uint32_t Pmc007Sim::on_write(std::uint16_t index, std::uint8_t sub, std::sp
                 if (ptr < ram_program_.size()) exec_locked(ram_program_[ptr], true);
             }
             return 0;
-        case 0x6020: stop_now_locked(); return 0;  // B-P14
+        case 0x6020:  // B-P14; [P] the value must be 0 (06090030 otherwise)
+            if (v != 0) return kAbortValueRange;
+            stop_now_locked();
+            return 0;
+        case 0x6021:  // B-P40: one of the documented CPRs; in use from the next power-up
+            return (v == 400 || v == 500 || v == 600 || v == 800 || v == 1000 || v == 1200 || v == 1600)
+                       ? 0
+                       : kAbortValueRange;
         default: return 0;
     }
+}
+
+void Pmc007Sim::factory_reset_locked() {
+    // Every ROM object to its factory value in the working copy (C-P19: flash untouched).
+    // The objects a service owns take it through that service: the heartbeat producer and
+    // consumers through their write hooks, the PDO parameters by rebuilding the engine
+    // from the dictionary (a zero mapping word is no value the engine's hooks accept).
+    for (const auto& r : pmc007_od_rows()) {
+        if (r.storage != Storage::Rom) continue;
+        auto var = od_->at(r.index, r.sub);
+        if ((r.index == 0x1016 || r.index == 0x1017) && canopen::writable(r.access))
+            var->remote_write(var->default_bytes());
+        else
+            var->reset_to_default();
+    }
+    if (pdo_) pdo_->reload_from_dictionary();
+    apply_sync_cob_id(pdo_);
 }
 
 // ---- offline program --------------------------------------------------------------
@@ -886,8 +1063,8 @@ bool Pmc007Sim::exec_locked(std::uint32_t word, bool single) {
             break;
         }
         case Opcode::FREE: od_->at(0x6005, 0)->try_set(Bytes{std::uint8_t(data & 1)}); break;
-        case Opcode::CLR2: latched_ &= ~st::kExt2; break;
-        case Opcode::CLR1: latched_ &= ~st::kExt1; break;
+        case Opcode::CLR2: latched_ &= ~st::kExt2; emcy_if_cleared_locked(); break;
+        case Opcode::CLR1: latched_ &= ~st::kExt1; emcy_if_cleared_locked(); break;
         case Opcode::VSET: {  // C-P13: abs(6003h) := data, the sign (direction) kept
             const std::int64_t sp = u(0x6002) == 1 ? std::int64_t(data) : -std::int64_t(data);
             Bytes b(4);

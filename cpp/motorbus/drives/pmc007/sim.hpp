@@ -21,6 +21,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <deque>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -31,6 +32,7 @@
 #include <utility>
 #include <vector>
 
+#include "motorbus/can/bit_rate_gate.hpp"
 #include "motorbus/can/bus.hpp"
 #include "motorbus/canopen/heartbeat_service.hpp"
 #include "motorbus/canopen/local_node.hpp"
@@ -78,6 +80,9 @@ struct Pmc007SimOptions {
     Pmc007Identity identity{0, 7, 0x00010000, 1};
 };
 
+// 2003h baud index -> bit/s (003 §4.3.2); -1 for an index outside 0..8.
+double baud_index_bps(int index);
+
 class Pmc007Sim {
 public:
     Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions options = {});
@@ -113,6 +118,9 @@ public:
     bool enabled();
     std::uint16_t gpio_value();                             // 6012h (1 = low)
     std::uint8_t active_baud_index() const { return baud_index_; }
+    // B-P40: the encoder CPR in use: 6021h as it was at the last power-up (or reset
+    // node); a 6021h write changes only the RAM copy until then.
+    std::uint16_t active_encoder_cpr() const { return cpr_; }
     canopen::ObjectDictionary& od() { return *od_; }
     std::shared_ptr<canopen::ObjectDictionary> od_ptr() { return od_; }
     canopen::LocalNode* node() { return node_.get(); }
@@ -122,6 +130,8 @@ public:
     std::uint32_t program_pointer();
     std::uint32_t program_counter_value();
     std::uint64_t emcy_sent() const { return emcy_sent_; }
+    // B-P39: after 2007h = 1 the application is gone until power_cycle(): no SDO,
+    // NMT, heartbeat, PDO or EMCY (the node is taken off the bus).
     bool in_bootloader() const { return bootloader_; }
 
     // ---- test hooks ----
@@ -164,6 +174,18 @@ private:
     void input_edge_locked(int bit, bool high, Nanos t);
     void level_change_locked(int bit, bool high, Nanos t);
     void emcy_locked(std::uint16_t code);
+    // EMCY 0000h once every signalled condition (6000h errors, 6001h latches) is clear.
+    void emcy_if_cleared_locked();
+    // Queued EMCY frames whose 1015h inhibit time has passed go out.
+    void flush_emcy_locked();
+    std::uint8_t error_register_locked() const;  // 1001h
+    // 2007h = 3: factory values into the working copy, through the services' hooks.
+    void factory_reset_locked();
+    // 1005h into the PDO engine (SYNC consumed on that COB-ID).
+    void apply_sync_cob_id(const std::shared_ptr<canopen::PdoService>& pdo);
+    void enter_bootloader();
+    // A fresh LocalNode and services on bus_ (attach and power-up after the bootloader).
+    void serve_again();
     void run_program_locked(Nanos now);
     bool exec_locked(std::uint32_t word, bool single);
     std::int64_t u(std::uint16_t i, std::uint8_t s = 0) const;
@@ -177,6 +199,7 @@ private:
     std::shared_ptr<canopen::ObjectDictionary> od_;
     motion::MotorModel motor_;
     mutable std::recursive_mutex m_;
+    std::unique_ptr<can::BitRateGate> gate_;  // bus_ while attached: the 2003h baud must match the wire's
     can::Bus* bus_ = nullptr;
     std::unique_ptr<canopen::LocalNode> node_;
     std::shared_ptr<canopen::PdoService> pdo_;
@@ -184,6 +207,7 @@ private:
     std::shared_ptr<canopen::NodeService> ticker_;
     bool attaching_ = false;
     std::thread renode_;
+    std::thread boot_;  // takes the node off the bus on entering the bootloader
     std::atomic<bool> renode_done_{false};
     std::vector<std::shared_ptr<void>> retired_;  // replaced nodes/services: their OD listeners stay valid
 
@@ -228,6 +252,10 @@ private:
     std::int32_t saved_position_ = 0;  // 6022h "EEPROM"
     std::atomic<std::uint64_t> emcy_sent_{0};
     Nanos last_emcy_ = -1;
+    // EMCY frames raised inside the 1015h inhibit time: sent when it has passed (B-P30).
+    std::deque<can::Frame> emcy_queue_;
+    bool emcy_error_ = false;  // an error EMCY was sent and no 0000h since
+    std::atomic<std::uint16_t> cpr_{500};
     // Offline program execution.
     bool running_ = false, paused_ = false, flag_ = false;
     std::uint32_t pc_ = 0, counter_ = 0;

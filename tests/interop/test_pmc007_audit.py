@@ -1,0 +1,378 @@
+"""The PMC007 defects of issue 23 (items 6-10, 12-14), each through a real transport: the
+simulator is served by socketcand from a SimBench in this process, python-can's socketcand
+interface is the client (SDO, NMT, SYNC, frames), and where python-can cannot say it (a
+remote frame: its socketcand interface sends every frame as data) a plain TCP socket speaks
+socketcand's ASCII protocol.  No motorbus code on the client side; the simulator object is
+used only to do what a wire cannot (inject a power-stage error, pull an input, re-power)."""
+from __future__ import annotations
+
+import re
+import socket
+import time
+
+import can
+import pytest
+
+from motorbus.sim import SimBench
+
+NODE = 5
+SDO_TX, SDO_RX, EMCY, HEARTBEAT = 0x600 + NODE, 0x580 + NODE, 0x080 + NODE, 0x700 + NODE
+
+
+def frame(text: str) -> bytes:
+    return bytes.fromhex(text.replace(" ", ""))
+
+
+# Frames that arrived while a test waited for an SDO reply: kept for the next look (an
+# EMCY sent from inside a write arrives before the write's reply).
+_backlog: dict[int, list[can.Message]] = {}
+
+
+def recv(bus: can.BusABC, timeout: float) -> can.Message | None:
+    kept = _backlog.get(id(bus))
+    if kept:
+        return kept.pop(0)
+    return bus.recv(timeout)
+
+
+def drain(bus: can.BusABC, seconds: float = 0.1) -> list[can.Message]:
+    out, deadline = [], time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        m = recv(bus, 0.02)
+        if m is not None:
+            out.append(m)
+    return out
+
+
+def exchange(bus: can.BusABC, data: bytes, timeout: float = 2.0) -> bytes | None:
+    bus.send(can.Message(arbitration_id=SDO_TX, data=data, is_extended_id=False))
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        m = bus.recv(0.05)
+        if m is not None and m.arbitration_id == SDO_RX:
+            return bytes(m.data)
+        if m is not None:
+            _backlog.setdefault(id(bus), []).append(m)
+    return None
+
+
+def download(bus, index: int, sub: int, value: int, size: int) -> bytes:
+    cmd = {1: 0x2F, 2: 0x2B, 4: 0x23}[size]
+    payload = (value & ((1 << (8 * size)) - 1)).to_bytes(size, "little").ljust(4, b"\0")
+    reply = exchange(bus, bytes([cmd]) + index.to_bytes(2, "little") + bytes([sub]) + payload)
+    assert reply is not None, f"no SDO reply to the write of {index:04X}h:{sub:02X}"
+    return reply
+
+
+def write_ok(bus, index: int, sub: int, value: int, size: int) -> None:
+    reply = download(bus, index, sub, value, size)
+    assert reply == bytes([0x60]) + index.to_bytes(2, "little") + bytes([sub, 0, 0, 0, 0]), reply.hex(" ")
+
+
+def write_abort(bus, index: int, sub: int, value: int, size: int) -> int:
+    reply = download(bus, index, sub, value, size)
+    assert reply[0] == 0x80 and reply[1:4] == index.to_bytes(2, "little") + bytes([sub]), reply.hex(" ")
+    return int.from_bytes(reply[4:8], "little")
+
+
+def read(bus, index: int, sub: int = 0) -> int:
+    reply = exchange(bus, bytes([0x40]) + index.to_bytes(2, "little") + bytes([sub, 0, 0, 0, 0]))
+    assert reply is not None and reply[0] in (0x4F, 0x4B, 0x43), reply
+    size = {0x4F: 1, 0x4B: 2, 0x43: 4}[reply[0]]
+    return int.from_bytes(reply[4:4 + size], "little")
+
+
+def nmt(bus, cs: int, node: int = NODE) -> None:
+    bus.send(can.Message(arbitration_id=0x000, data=[cs, node], is_extended_id=False))
+
+
+def wait_for(bus, cob_id: int, timeout: float = 3.0) -> can.Message | None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        m = recv(bus, 0.05)
+        if m is not None and m.arbitration_id == cob_id:
+            return m
+    return None
+
+
+class RawSocketcand:
+    """socketcand's ASCII protocol on a TCP socket (raw mode): what python-can cannot send."""
+
+    def __init__(self, host: str, port: int) -> None:
+        self.sock = socket.create_connection((host, port), timeout=5)
+        self.buf = ""
+        assert self.element() == "< hi >"
+        self.sock.sendall(b"< open can0 >")
+        assert self.element() == "< ok >"
+        self.sock.sendall(b"< rawmode >")
+        assert self.element() == "< ok >"
+        time.sleep(0.2)  # the server holds frames briefly after rawmode
+
+    def element(self, timeout: float = 5.0) -> str | None:
+        deadline = time.monotonic() + timeout
+        while ">" not in self.buf:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return None
+            self.sock.settimeout(left)
+            try:
+                chunk = self.sock.recv(4096)
+            except socket.timeout:
+                return None
+            if not chunk:
+                return None
+            self.buf += chunk.decode("ascii")
+        end = self.buf.index(">") + 1
+        el, self.buf = self.buf[:end].strip(), self.buf[end:]
+        return el
+
+    def elements(self, seconds: float) -> list[str]:
+        out, deadline = [], time.monotonic() + seconds
+        while (left := deadline - time.monotonic()) > 0:
+            el = self.element(left)
+            if el is not None:
+                out.append(el)
+        return out
+
+    def send_rtr(self, cob_id: int, dlc: int) -> None:
+        self.sock.sendall(f"< sendrtr {cob_id:03X} {dlc} >".encode())
+
+    def close(self) -> None:
+        self.sock.close()
+
+
+@pytest.fixture
+def served():
+    with SimBench([f"pmc007:{NODE}"], bus=f"virtual:pmc007-audit-{time.monotonic_ns()}") as bench:
+        srv = bench.can.servers[0]
+        bus = can.Bus(interface="socketcand", host=srv.host, port=srv.port, channel="can0")
+        try:
+            yield bench.sims[("pmc007", str(NODE))], bus, (srv.host, srv.port)
+        finally:
+            _backlog.pop(id(bus), None)
+            bus.shutdown()
+
+
+def map_tpdo1(bus, cob_id: int, ttype: int, event_ms: int = 0) -> None:
+    """TPDO1 maps 6001h (controller status, 8 bits), in the manual's order."""
+    write_ok(bus, 0x1800, 1, cob_id, 4)
+    write_ok(bus, 0x1800, 2, ttype, 1)
+    write_ok(bus, 0x1800, 5, event_ms, 2)
+    write_ok(bus, 0x1A00, 0, 1, 1)
+    write_ok(bus, 0x1A00, 1, 0x60010008, 4)
+
+
+# ---- item 6: no answer to a remote frame on a TPDO's COB-ID (B-P35, 003 §4.2) ----------
+
+def test_6_a_tpdo_does_not_answer_a_remote_frame(served):
+    sim, bus, (host, port) = served
+    map_tpdo1(bus, 0x187, 255)                   # the manual's own COB-ID: bit 30 = 0 ("RTR allowed")
+    raw = RawSocketcand(host, port)
+    try:
+        nmt(bus, 0x01)
+        assert wait_for(bus, 0x187) is not None  # the event TPDO on entering OPERATIONAL
+        raw.elements(0.3)                        # what the listener saw so far
+        raw.send_rtr(0x187, 1)
+        seen = raw.elements(0.8)
+        listener = RawSocketcand(host, port)
+        try:
+            listener.elements(0.1)
+            raw.send_rtr(0x187, 1)               # a second request, watched by a peer that did not send it
+            watched = listener.elements(0.8)
+        finally:
+            listener.close()
+    finally:
+        raw.close()
+    assert any(re.match(r"< rtr 187 ", e) for e in watched), watched   # the request was on the bus
+    assert not [e for e in seen + watched if re.match(r"< frame 187 ", e)], seen + watched
+    assert read(bus, 0x6001) == 0               # the node is alive and answering
+
+
+# ---- item 7: 2007h = 3 restores PDO and heartbeat parameters in their services ----------
+
+def test_7_factory_reset_restores_pdo_and_heartbeat_in_their_services(served):
+    sim, bus, _ = served
+    map_tpdo1(bus, 0x185, 255, event_ms=100)
+    write_ok(bus, 0x1017, 0, 100, 2)            # heartbeat every 100 ms
+    write_ok(bus, 0x1016, 1, 0x00010064, 4)     # consume node 1, 100 ms
+    nmt(bus, 0x01)
+    assert wait_for(bus, 0x185) is not None and wait_for(bus, HEARTBEAT) is not None
+    write_ok(bus, 0x2007, 0, 3, 1)
+    drain(bus, 0.15)
+    assert read(bus, 0x1800, 5) == 0 and read(bus, 0x1A00, 0) == 0 and read(bus, 0x1A00, 1) == 0
+    assert read(bus, 0x1800, 1) == 0x185 and read(bus, 0x1800, 2) == 255
+    assert read(bus, 0x1017) == 0 and read(bus, 0x1016, 1) == 0
+    # The services took the factory values: no TPDO (nothing mapped), no heartbeat, and node 1's
+    # heartbeat is no longer watched (one beat, then silence: no EMCY 8130h).
+    bus.send(can.Message(arbitration_id=0x701, data=[0x05], is_extended_id=False))
+    after = drain(bus, 0.8)
+    assert not [m for m in after if m.arbitration_id in (0x185, HEARTBEAT)], after
+    assert not [m for m in after if m.arbitration_id == EMCY and bytes(m.data[:2]) == frame("30 81")], after
+
+
+# ---- item 8: the bootloader stays silent until a power cycle --------------------------
+
+def test_8_bootloader_stays_silent_through_nmt_start_and_pre_operational(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x2007, 0, 1, 1)
+    drain(bus, 0.3)
+    assert sim.in_bootloader
+    assert exchange(bus, frame("40 01 60 00 00 00 00 00"), timeout=0.5) is None
+    for cs, node in ((0x01, NODE), (0x80, NODE), (0x01, 0), (0x80, 0)):
+        nmt(bus, cs, node)
+        drain(bus, 0.1)
+        assert exchange(bus, frame("40 01 60 00 00 00 00 00"), timeout=0.5) is None, (cs, node)
+    sim.power_cycle()
+    boot = wait_for(bus, HEARTBEAT)
+    assert boot is not None and bytes(boot.data) == b"\x00"
+    assert not sim.in_bootloader
+    assert read(bus, 0x6001) == 0
+
+
+# ---- item 9: 6021h is a set, in use from the next power-up --------------------------------
+
+def test_9_encoder_cpr_is_a_set_and_takes_effect_after_re_power(served):
+    sim, bus, _ = served
+    assert write_abort(bus, 0x6021, 0, 700, 2) == 0x06090030
+    assert read(bus, 0x6021) == 500
+    for cpr in (400, 500, 600, 800, 1200, 1600, 1000):
+        write_ok(bus, 0x6021, 0, cpr, 2)
+    assert read(bus, 0x6021) == 1000 and sim.active_encoder_cpr == 500
+    nmt(bus, 0x82)                              # reset communication is no re-power
+    assert wait_for(bus, HEARTBEAT) is not None
+    assert sim.active_encoder_cpr == 500
+    write_ok(bus, 0x2007, 0, 2, 1)              # saved, then reset node (= power-on, B-P28)
+    nmt(bus, 0x81)
+    assert wait_for(bus, HEARTBEAT) is not None
+    assert sim.active_encoder_cpr == 1000 and read(bus, 0x6021) == 1000
+    write_ok(bus, 0x6021, 0, 1600, 2)           # not saved: the power cycle brings 1000 back
+    sim.power_cycle()
+    assert sim.active_encoder_cpr == 1000 and read(bus, 0x6021) == 1000
+
+
+# ---- item 10: SYNC consumed on the COB-ID of 1005h ------------------------------------
+
+def test_10_sync_is_consumed_on_the_configured_cob_id(served):
+    sim, bus, _ = served
+    map_tpdo1(bus, 0x185, 1)                    # every SYNC
+    nmt(bus, 0x01)
+    drain(bus, 0.2)
+    bus.send(can.Message(arbitration_id=0x080, data=[], is_extended_id=False))
+    assert wait_for(bus, 0x185, timeout=1.0) is not None
+    assert write_abort(bus, 0x1005, 0, 0x40000081, 4) == 0x06090030   # the PMC007 produces no SYNC
+    assert write_abort(bus, 0x1005, 0, 0x20000081, 4) == 0x06090030   # standard frames only
+    write_ok(bus, 0x1005, 0, 0x81, 4)
+    drain(bus, 0.1)
+    bus.send(can.Message(arbitration_id=0x080, data=[], is_extended_id=False))
+    assert [m for m in drain(bus, 0.5) if m.arbitration_id == 0x185] == []
+    bus.send(can.Message(arbitration_id=0x081, data=[], is_extended_id=False))
+    assert wait_for(bus, 0x185, timeout=1.0) is not None
+    nmt(bus, 0x81)                              # not saved: reset node brings 0x80 back
+    assert wait_for(bus, HEARTBEAT) is not None
+    assert read(bus, 0x1005) == 0x80
+
+
+# ---- item 12: abort codes as the manual and the spec's readings say ----------------------
+
+def test_12_abort_codes_of_sets_and_mapping_length(served):
+    sim, bus, _ = served
+    assert write_abort(bus, 0x1A00, 0, 9, 1) == 0x06040042
+    assert write_abort(bus, 0x1600, 0, 9, 1) == 0x06040042
+    assert write_abort(bus, 0x1003, 0, 8, 1) == 0x06090030
+    assert write_abort(bus, 0x600A, 0, 512, 2) == 0x06090030
+    assert write_abort(bus, 0x6020, 0, 1, 1) == 0x06090030
+    assert write_abort(bus, 0x6020, 0, 1, 4) == 0x06090030   # the U32 form of 6020h
+    write_ok(bus, 0x6020, 0, 0, 1)
+
+
+def test_12_any_cob_id_may_be_configured(served):
+    sim, bus, _ = served
+    map_tpdo1(bus, 0x120, 255)                  # in CiA 301's restricted 0x101-0x180
+    assert read(bus, 0x1800, 1) == 0x120
+    write_ok(bus, 0x1400, 1, 0x5F0, 4)          # RPDO1 in the SDO range 0x581-0x5FF
+    assert read(bus, 0x1400, 1) == 0x5F0
+    nmt(bus, 0x01)
+    m = wait_for(bus, 0x120)
+    assert m is not None and bytes(m.data) == b"\x00"
+
+
+# ---- item 13: 6019h:01 = 100; a refused 6003h; speed mode at the current 6003h -----------
+
+def test_13_program_pointer_reaches_100(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x6019, 1, 100, 1)
+    assert read(bus, 0x6019, 1) == 100
+    assert write_abort(bus, 0x6019, 1, 101, 1) in (0x06090030, 0x06090031)
+    # [P] no 101st instruction: a word written at pointer 100 is refused.
+    assert write_abort(bus, 0x6019, 2, 0x01000001, 4) == 0x08000022
+
+
+def test_13_a_refused_speed_write_leaves_the_direction(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x6005, 0, 1, 1)              # speed mode, 6003h = 0: at rest
+    assert read(bus, 0x6002) == 0
+    sim.inject_error(0x01)                      # UVLO latched: motion refused (B-P19)
+    assert write_abort(bus, 0x6003, 0, 1000, 4) == 0x08000022
+    assert read(bus, 0x6002) == 0 and read(bus, 0x6003) == 0
+
+
+def test_13_switching_to_speed_mode_runs_at_the_current_speed(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x6003, 0, -800, 4)           # position mode: speed and direction only
+    assert read(bus, 0x6002) == 0 and read(bus, 0x6001) & 0x08 == 0
+    write_ok(bus, 0x6005, 0, 1, 1)
+    time.sleep(0.3)
+    assert read(bus, 0x6001) & 0x08             # busy: running
+    p1 = read(bus, 0x600C)
+    time.sleep(0.3)
+    p2 = read(bus, 0x600C)
+    p1, p2 = (p - (1 << 32) if p & 0x80000000 else p for p in (p1, p2))
+    assert p2 < p1 < 0                          # counting down: the sign of 6003h
+    write_ok(bus, 0x6020, 0, 0, 1)
+    sim.inject_error(0x01)                      # a refused switch: 08000022, no motion, mode kept
+    write_ok(bus, 0x6005, 0, 0, 1)
+    assert write_abort(bus, 0x6005, 0, 1, 1) == 0x08000022
+    assert read(bus, 0x6005) == 0 and read(bus, 0x6001) & 0x08 == 0
+
+
+# ---- item 14: EMCY byte 2 = 1001h, 0000h when clear, delayed by the inhibit time -----------
+
+def emcys(bus, seconds: float) -> list[can.Message]:
+    return [m for m in drain(bus, seconds) if m.arbitration_id == EMCY]
+
+
+def test_14_emcy_error_register_is_1001h_and_0000_when_clear(served):
+    sim, bus, _ = served
+    drain(bus, 0.1)
+    sim.inject_error(0x10)                      # AOC: EMCY 2300h
+    (e,) = emcys(bus, 0.4)
+    assert bytes(e.data[:2]) == frame("00 23") and e.data[2] == read(bus, 0x1001) == 0x03
+    assert e.data[3] == 0x10
+    write_ok(bus, 0x600F, 1, 0x01, 1)           # EXT1 enabled, falling edge, no debounce
+    write_ok(bus, 0x601A, 0, 0, 2)
+    sim.set_input(7, False)                     # EMCY FF01h: 1001h is unchanged (0x03)
+    (e,) = emcys(bus, 0.4)
+    assert bytes(e.data[:2]) == frame("01 FF") and e.data[2] == read(bus, 0x1001) == 0x03
+    write_ok(bus, 0x6000, 0, 0x10, 1)           # the error cleared, the EXT1 latch still set: no 0000h
+    assert emcys(bus, 0.3) == []
+    write_ok(bus, 0x6001, 0, 0x01, 1)           # all clear
+    (e,) = emcys(bus, 0.4)
+    assert bytes(e.data) == bytes(8), e          # 0000h, 1001h = 0, 6000h = 0, 6001h = 0
+    assert read(bus, 0x1001) == 0
+    assert read(bus, 0x1003, 1) == 0xFF01      # 0000h is not logged as an error
+
+
+def test_14_an_emcy_inside_the_inhibit_time_is_delayed_not_dropped(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x1015, 0, 5000, 2)           # 500 ms
+    drain(bus, 0.1)
+    t0 = time.monotonic()
+    sim.inject_error(0x01)                      # UVLO: 3200h at once
+    sim.inject_error(0x20)                      # TSD: 4200h inside the inhibit time
+    first = wait_for(bus, EMCY, timeout=1.0)
+    assert first is not None and bytes(first.data[:2]) == frame("00 32")
+    second = wait_for(bus, EMCY, timeout=3.0)
+    t1 = time.monotonic()
+    assert second is not None and bytes(second.data[:2]) == frame("00 42")
+    assert second.data[2] == 0x0D               # 1001h at the time of the event: generic, voltage, temperature
+    assert t1 - t0 >= 0.4                       # not before the inhibit time has passed
