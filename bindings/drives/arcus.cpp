@@ -84,10 +84,12 @@ void register_errors(py::module_& m) {
 SimOptions sim_options(int address, int response_type, const std::string& store_path, bool eo_boot, bool snl,
                        std::pair<double, double> home, std::optional<double> minus_limit,
                        std::optional<double> plus_limit, double z_position, double start_position, double tick,
-                       int comm_type = 0, int node_id = 1, double store_time = 0, double clear_time = 0) {
+                       int comm_type = 0, int node_id = 1, double store_time = 0, double clear_time = 0,
+                       int bit_rate = 5) {
     SimOptions o;
     o.comm_type = comm_type;
     o.node_id = node_id;
+    o.bit_rate = bit_rate;
     if (!(store_time >= 0) || !(clear_time >= 0) || store_time > 60 || clear_time > 60)
         throw InvalidArgument("store_time/clear_time: must be in [0, 60] seconds");
     o.store_ns = static_cast<std::int64_t>(store_time * 1e9);
@@ -245,19 +247,19 @@ void bind_arcus(py::module_& m) {
         .def(py::init([](std::shared_ptr<Clock> clock, int address, int response_type, const std::string& store_path,
                          bool eo_boot, bool snl, std::pair<double, double> home, std::optional<double> minus_limit,
                          std::optional<double> plus_limit, double z_position, double start_position, double tick,
-                         int comm_type, int node_id, double store_time, double clear_time) {
+                         int comm_type, int node_id, double store_time, double clear_time, int bit_rate) {
                  if (!clock) clock = std::make_shared<RealClock>();
                  return std::make_shared<Sim>(clock, sim_options(address, response_type, store_path, eo_boot, snl,
                                                                   home, minus_limit, plus_limit, z_position,
                                                                   start_position, tick, comm_type, node_id,
-                                                                  store_time, clear_time));
+                                                                  store_time, clear_time, bit_rate));
              }),
              py::arg("clock") = nullptr, py::arg("address") = 1, py::arg("response_type") = 0,
              py::arg("store_path") = "", py::arg("eo_boot") = false, py::arg("snl") = true,
              py::arg("home") = std::pair<double, double>{8000, 8400}, py::arg("minus_limit") = -400000.0,
              py::arg("plus_limit") = 400000.0, py::arg("z_position") = 1600.0, py::arg("start_position") = 0.0,
              py::arg("tick") = 1e-4, py::arg("comm_type") = 0, py::arg("node_id") = 1, py::arg("store_time") = 0.0,
-             py::arg("clear_time") = 0.0)
+             py::arg("clear_time") = 0.0, py::arg("bit_rate") = 5)
         .def(
             "on_line", [](Sim& s, const py::object& line) {
                 std::string l = bytes_or_str(line, "line");

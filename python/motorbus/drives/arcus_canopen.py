@@ -246,7 +246,14 @@ class ArcusCanopenSim:
 
 
 _SIM_OPTIONS = ("protocol", "store_path", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
-                "start_position", "tick", "store_time", "clear_time", "ascii_address")
+                "start_position", "tick", "store_time", "clear_time", "ascii_address", "bit_rate")
+
+#: How long 200Eh / 200Dh read 1 after a request on a served sim (real clock): a
+#: flash sector write and an error clear take that long on a small controller,
+#: and a master's polling loop (Fig. 8.1/8.2) must be exercised.  On a test's
+#: SimClock they finish at once unless ``store_time``/``clear_time`` are given.
+SERVED_STORE_TIME = 0.1
+SERVED_CLEAR_TIME = 0.02
 
 
 def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, *,
@@ -254,7 +261,12 @@ def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None
              **options: Any) -> ArcusCanopenSim:
     """A simulated DMX-CAN at node-ID ``address``.  ``protocol="canopen"``: a unit set
     up for CAN (200Ah = 2, the CANopen tables' defaults); ``"ascii"``: factory-fresh
-    (RS-232).  A ``store_path`` file written by either persona overrides both.
+    (RS-232).  A ``store_path`` file written by either persona overrides both; without
+    one, what is stored lasts as long as the sim (power cycles and NMT resets keep it).
+    ``bit_rate``: the factory 200Bh code (5 = 125 kbit/s); on a bus that models a bit
+    rate the node answers only when its code in effect gives that rate.
+    ``store_time``/``clear_time`` (s): how long 200Eh/200Dh read 1 (default
+    SERVED_STORE_TIME/SERVED_CLEAR_TIME on the real clock, 0 on a given clock).
     Other options: those of ``_core.ArcusSim`` (home, limits, snl, eo_boot, tick...)."""
     unknown = set(options) - set(_SIM_OPTIONS)
     if unknown:
@@ -262,6 +274,9 @@ def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None
     if protocol not in ("canopen", "ascii"):
         raise _core.InvalidArgument(f"arcus-canopen sim protocol: 'canopen' or 'ascii', not {protocol!r}")
     node = int(_check_node(address))
+    if clock is None:
+        options.setdefault("store_time", SERVED_STORE_TIME)
+        options.setdefault("clear_time", SERVED_CLEAR_TIME)
     core = _core.ArcusSim(clock, address=int(ascii_address), node_id=node,
                           comm_type=2 if protocol == "canopen" else 0, **options)
     sim = ArcusCanopenSim(core)

@@ -70,6 +70,17 @@ void ArcusHoming::run(double target, double, bool) {
     motor_.command(p);
 }
 
+void ArcusHoming::run_at(double target, double speed) {
+    const RampShape shape = params_.scv ? RampShape::SCurve : RampShape::Trapezoid;
+    Profile p = arcus_stepper_profile(State{motor_.pulse_position(), motor_.pulse_velocity(), 0, 0}, target, speed,
+                                      speed, arcus_accel(params_), arcus_decel(params_), shape);
+    if (p.empty()) {
+        motor_.halt();
+        return;
+    }
+    motor_.command(p);
+}
+
 void ArcusHoming::start(Method m, int direction) {
     motor_.update();
     method_ = m;
@@ -129,6 +140,16 @@ void ArcusHoming::stop_at_zero() {
 }
 
 void ArcusHoming::finish(HomingResult r) {
+    if (r == HomingResult::Done && opt_.final_target && stage_ != kFinalStage) {
+        // Zero found: on to the home offset (CANopen 607Ch), then zero there.
+        motor_.halt();
+        stage_ = kFinalStage;
+        if (std::llround(motor_.pulse_position() - *opt_.final_target) != 0) {
+            run_at(*opt_.final_target, params_.lspd);
+            if (motor_.moving()) return;
+        }
+        set_zero();
+    }
     result_ = r;
     stage_ = -1;
 }
@@ -137,9 +158,16 @@ void ArcusHoming::on_event(const MotorEvent& e) {
     using K = MotorEvent::Kind;
     if (result_ != HomingResult::Running) return;
     const bool limit_ahead = (e.kind == K::PlusLimitOn && e.direction > 0) || (e.kind == K::MinusLimitOn && e.direction < 0);
-    if (method_ != Method::L && limit_ahead) {
+    if ((method_ != Method::L || stage_ == kFinalStage) && limit_ahead) {
         motor_.halt();
         finish(HomingResult::LimitError);
+        return;
+    }
+    if (stage_ == kFinalStage) {
+        if (e.kind == K::ProfileDone) {
+            set_zero();
+            finish(HomingResult::Done);
+        }
         return;
     }
     switch (method_) {
@@ -193,7 +221,10 @@ void ArcusHoming::on_event(const MotorEvent& e) {
         case Method::L:
             if (stage_ == 0 && limit_ahead) {
                 motor_.halt();
-                run(motor_.pulse_position() - dir_ * opt_.lca, params_.hspd, true);
+                if (opt_.backoff_at_lspd)
+                    run_at(motor_.pulse_position() - dir_ * opt_.lca, params_.lspd);
+                else
+                    run(motor_.pulse_position() - dir_ * opt_.lca, params_.hspd, true);
                 stage_ = 1;
                 if (!motor_.moving()) {
                     set_zero();

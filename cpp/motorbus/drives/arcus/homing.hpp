@@ -19,6 +19,8 @@
 //   reverse).
 //
 #pragma once
+#include <optional>
+
 #include "motorbus/drives/arcus/profile.hpp"
 #include "motorbus/motion/homing.hpp"
 #include "motorbus/motion/motor_model.hpp"
@@ -32,6 +34,16 @@ struct ArcusHomingOptions {
     // Reset the encoder counter wherever the position counter is reset (a
     // drive that keeps PX and EX aligned, as the DMX-CAN simulator does).
     bool zero_encoder = false;
+    // The CANopen front end's home offset (607Ch, manual 000 §8 6098h): once
+    // the routine has found its zero, move at LSPD to this position (in the
+    // frame just zeroed, units of the motor's position) and make that point
+    // zero.  Methods 7/11 "change direction and move by the home offset",
+    // 33/34 "continue moving by the home offset amount", 19/20 "move back by
+    // the Home Offset amount" from the home edge.  nullopt = the routine's end.
+    std::optional<double> final_target{};
+    // Limit homing backs off at LSPD (CANopen 17/18: "ramp down to the zero
+    // position speed and move away by the home offset"); the ASCII L at HSPD.
+    bool backoff_at_lspd = false;
 };
 
 class ArcusHoming {
@@ -64,6 +76,8 @@ private:
     int listener_ = 0;
     void on_event(const MotorEvent& e);
     void run(double target_offset, double speed_pps, bool from_current);
+    void run_at(double target, double speed);  // start, cruise and stop at one speed
+    static constexpr int kFinalStage = 100;    // the move to final_target
     void jog(int direction, double hspd);
     void decel_stop(Nanos t);
     void finish(HomingResult r);

@@ -29,6 +29,8 @@ Sim::Sim(Clock& clock, SimOptions options)
     if (options_.comm_type < 0 || options_.comm_type > 2)
         throw InvalidArgument("arcus sim comm_type: must be 0 (RS-232), 1 (RS-485) or 2 (CAN)");
     if (options_.node_id < 1 || options_.node_id > 127) throw InvalidArgument("arcus sim node_id: must be 1..127");
+    if (options_.bit_rate < 1 || options_.bit_rate > 9)
+        throw InvalidArgument("arcus sim bit_rate: a 200Bh code 1..9 (10k 20k 50k 100k 125k 250k 500k 800k 1M)");
     if (options_.store_ns < 0 || options_.clear_ns < 0)
         throw InvalidArgument("arcus sim store/clear duration: must be >= 0");
     std::lock_guard lock(mutex_);
@@ -94,6 +96,9 @@ void Sim::boot() {
     auto motor = std::move(s.motor);  // the shaft stays where it is
     unsigned inputs = s.inputs;
     bool blocked = s.blocked;
+    // The flash outlives the power cycle, store file or not (issue 23 #1).
+    const bool stored = s.stored;
+    const Flash kept = s.flash;
     s = State{};
     s.motor = std::move(motor);
     s.inputs = inputs;
@@ -104,6 +109,7 @@ void Sim::boot() {
     s.flash.sl = options_.snl ? 1 : 0;
     s.flash.cm = options_.comm_type;
     s.flash.nid = options_.node_id;
+    s.flash.br = options_.bit_rate;
     if (options_.comm_type == 2) {
         // A unit set up for CANopen: the CANopen tables' defaults (Tables 8.11,
         // 8.21; DESIGN.md follows them for the CANopen persona).
@@ -112,12 +118,18 @@ void Sim::boot() {
         s.flash.curi = 500;
     }
     load_flash(options_.store_path, s.flash);
+    if (stored) {
+        // What this simulator stored (the file, when there is one, holds the same).
+        s.flash = kept;
+        s.stored = true;
+    }
     s.cfg = s.flash;
     s.active_address = static_cast<int>(std::clamp<std::int64_t>(s.cfg.dn, 1, 99));
     s.active_rt = s.cfg.rt ? 1 : 0;
     s.active_cm = static_cast<int>(std::clamp<std::int64_t>(s.cfg.cm, 0, 2));
     s.active_nid = static_cast<int>(std::clamp<std::int64_t>(s.cfg.nid, 1, 127));
     s.active_br = static_cast<int>(s.cfg.br);
+    bit_rate_code_.store(s.active_br);
     s.eo = s.cfg.eoboot ? 1 : 0;
     s.user_do = s.cfg.doboot & 7;
     motion::MotorModel& m = *s.motor;
@@ -582,6 +594,7 @@ std::string Sim::handle(const Request& req) {
     if (name == "INC") { s.inc_mode = 1; return ok; }
     if (name == "STORE") {
         s.flash = s.cfg;
+        s.stored = true;
         save_flash(options_.store_path, s.flash);
         return ok;
     }

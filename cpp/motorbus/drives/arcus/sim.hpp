@@ -8,6 +8,7 @@
 // SimClock.  Device time advances lazily: every request (and every test hook)
 // first integrates the axis up to clock.now().
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -40,7 +41,9 @@ struct SimWorld {
 struct SimOptions {
     int address = 1;            // factory DN (overridden by a store file that has DN)
     int response_type = 0;      // factory RT
-    std::string store_path;     // STORE writes here; read at boot ("" = flash not persisted)
+    // STORE writes here too; read at boot.  Without one (""), the flash lasts
+    // as long as the simulator object: a power cycle keeps what was stored.
+    std::string store_path;
     bool eo_boot = false;       // Table 7.11 ships EOBOOT=0: motor unpowered until EO=1
     bool snl = true;            // Table 7.11 ships SL=1
     SimWorld world;
@@ -51,8 +54,13 @@ struct SimOptions {
     // are the factory values, with 0/1 the ASCII ones (Table 7.11).
     int comm_type = 0;
     int node_id = 1;              // factory NID / 200Ch
-    std::int64_t store_ns = 0;    // 200Eh reads 1 this long after a store request
-    std::int64_t clear_ns = 0;    // 200Dh reads 1 this long after a clear request
+    int bit_rate = 5;             // factory BR / 200Bh code (1..9; 5 = 125 kbit/s)
+    // 200Eh / 200Dh read 1 this long after a store / clear request (Fig. 8.1,
+    // 8.2: the master polls until 0).  0 here (a SimClock test sees the result
+    // at once); the served sims (arcus_canopen.make_sim on a real clock) take
+    // realistic times.
+    std::int64_t store_ns = 0;
+    std::int64_t clear_ns = 0;
 };
 
 // One entry of the CANopen object dictionary (manual 000 Table 10.1 with the
@@ -70,6 +78,9 @@ struct CanopenObject {
     bool persists;  // saved by the 200Eh store (Table 8.40)
 };
 const std::vector<CanopenObject>& canopen_objects();
+// 200Bh code -> bit/s (Table 8.36: 1 10k, 2 20k, 3 50k, 4 100k, 5 125k, 6 250k,
+// 7 500k, 8 800k, 9 1M); 0 for any other code.
+double canopen_bit_rate_bps(int code);
 
 class Sim : public serial::LineDevice {
 public:
@@ -113,6 +124,8 @@ public:
     int active_protocol() const;  // communication type in effect: 0, 1 or 2
     int can_node_id() const;      // node-ID in effect (200Ch at the last boot)
     int can_bit_rate() const;     // bit-rate code in effect (200Bh at the last boot)
+    // The node talks only on a bus at that bit rate (see can::BitRateGate); a
+    // bus that models no bit rate (no wire time) carries it whatever its code.
 
     struct State;  // opaque; public only so the implementation's helpers can name it
 
@@ -131,7 +144,8 @@ private:
     // at clock.now(): a buffered set-point starts exactly where the previous move ended.
     std::optional<Nanos> at_;
     std::mutex bus_mutex_;
-    std::shared_ptr<can::Bus> bus_;
+    std::shared_ptr<can::Bus> bus_;  // a can::BitRateGate on the attached bus
+    std::atomic<int> bit_rate_code_{5};  // active_br, read by the gate on the bus thread
     std::vector<can::SubscriptionId> subs_;
     mutable std::mutex mutex_;
     std::shared_ptr<Clock> clock_owner_;

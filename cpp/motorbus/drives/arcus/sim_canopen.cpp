@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 
+#include "motorbus/can/bit_rate_gate.hpp"
 #include "motorbus/canopen/cia402.hpp"
 #include "motorbus/drives/arcus/sim_core.hpp"
 
@@ -67,10 +68,10 @@ const std::vector<CanopenObject>& canopen_objects() {
         {0x2000, 0, "Alarm/In-Position enable", "U8", "rw", 1, 0, 1, "", true},
         {0x2001, 0, "StepNLoop parameters: number of elements", "U8", "ro", 5, 0, 0, "", true},
         {0x2001, 1, "StepNLoop enable", "U32", "rw", 1, 0, 1, "", true},
-        {0x2001, 2, "Max attempt", "U32", "rw", 10, 0, kI32Max, "attempts", true},
-        {0x2001, 3, "Tolerance range", "U32", "rw", 10, 0, kI32Max, "pulses/counts", true},
-        {0x2001, 4, "Idle tolerance range", "U32", "rw", 5, 0, kI32Max, "pulses/counts", true},
-        {0x2001, 5, "Error range", "U32", "rw", 1000, 0, kI32Max, "pulses/counts", true},
+        {0x2001, 2, "Max attempt", "U32", "rw", 10, 0, kU32, "attempts", true},
+        {0x2001, 3, "Tolerance range", "U32", "rw", 10, 0, kU32, "pulses/counts", true},
+        {0x2001, 4, "Idle tolerance range", "U32", "rw", 5, 0, kU32, "pulses/counts", true},
+        {0x2001, 5, "Error range", "U32", "rw", 1000, 0, kU32, "pulses/counts", true},
         {0x2002, 0, "StepNLoop delta", "I32", "ro", 0, 0, 0, "counts", false},
         {0x2003, 0, "StepNLoop status", "U16", "ro", 0, 0, 0, "", false},
         {0x2004, 0, "Driver settings: number of elements", "U8", "ro", 4, 0, 0, "", true},
@@ -149,13 +150,25 @@ can::Frame sdo_frame(int node, std::uint8_t cs, std::uint16_t index, std::uint8_
 
 }  // namespace
 
+double canopen_bit_rate_bps(int code) {
+    // Table 8.36 (no 25 kbit/s); 0 for a code outside 1..9.
+    static constexpr double kBps[] = {0, 10e3, 20e3, 50e3, 100e3, 125e3, 250e3, 500e3, 800e3, 1e6};
+    return code >= 1 && code <= 9 ? kBps[code] : 0.0;
+}
+
 // ---- serving ---------------------------------------------------------------------
 
-void Sim::attach_can(std::shared_ptr<can::Bus> bus) {
-    if (!bus) throw InvalidArgument("arcus sim attach: bus is null");
+void Sim::attach_can(std::shared_ptr<can::Bus> medium) {
+    if (!medium) throw InvalidArgument("arcus sim attach: bus is null");
     {
         std::lock_guard lock(bus_mutex_);
         if (bus_) throw InvalidArgument("arcus sim attach: already attached to a bus");
+        // The node hears and is heard only at its own bit rate (200Bh at the
+        // last boot; issue 23 #4).  A code outside 1..9 matches no wire.
+        auto gate = std::make_shared<can::BitRateGate>(
+            *medium, [this] { const double r = canopen_bit_rate_bps(bit_rate_code_.load()); return r > 0 ? r : -1.0; },
+            medium);
+        std::shared_ptr<can::Bus> bus = gate;
         bus_ = bus;
         // Every SDO request id and NMT: the node-ID in effect changes at a power cycle.
         can::Filter sdo;
@@ -195,6 +208,7 @@ void Sim::detach_can() {
         } catch (const std::exception&) {
         }
     }
+    bus->close();  // the gate only: the medium is the caller's
 }
 
 void Sim::send_frames(const std::vector<can::Frame>& frames) {
@@ -462,9 +476,15 @@ std::uint32_t Sim::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t
     switch (index) {
         case 0x2000: cmd(line("EDO", v)); break;
         case 0x2001: {
-            static const char* names[] = {"", "SL", "SLA", "SLT", "SLM", "SLE"};
-            // The firmware refuses SL only while moving: "not in the present device state".
-            if (!cmd(line(names[sub], v))) return kAbortDeviceState;
+            if (sub == 1) {
+                // The firmware refuses SL only while moving: "not in the present device state".
+                if (!cmd(line("SL", v))) return kAbortDeviceState;
+                break;
+            }
+            // U32 objects: the whole 0..2^32-1 (the ASCII SLA/SLT/SLM/SLE stop at 2^31-1).
+            std::int64_t* field[] = {nullptr, nullptr, &s.cfg.sla, &s.cfg.slt, &s.cfg.slm, &s.cfg.sle};
+            *field[sub] = v;
+            e.configure_snl();
             break;
         }
         case 0x2004: {
@@ -583,8 +603,11 @@ void Sim::controlword(std::uint16_t v) {
     co.cw = v;
     const bool rising_fault_reset = (v & kFaultReset) && !(prev & kFaultReset);
     if (co.state == CoState::Fault) {
-        // T6': out of Fault only once the errors are gone (cleared by 200Dh).
-        if (rising_fault_reset && !errors_latched(s)) {
+        // Transition 6 (Fault -> Switch on disabled, "recovers from the fault"):
+        // the reset clears the latched limit / StepNLoop errors as 200Dh does,
+        // so a generic CiA 402 master (reset, shutdown, enable) gets the drive back.
+        if (rising_fault_reset) {
+            command("CLR");
             co.state = CoState::SwitchOnDisabled;
             command("EO=0");
         }
@@ -716,21 +739,35 @@ void Sim::controlword(std::uint16_t v) {
             return;
         }
         load_profile(s, co.home_switch_speed, co.home_zero_speed, co.homing_acceleration, co.homing_acceleration);
-        const std::int64_t offset = std::llabs(s.cfg.hofs);
-        s.hca = offset;
+        // 607Ch in the drive's frame: 607Eh bit 7 reverses it like every
+        // position value (B-A15), its sign kept (issue 23 #3).
+        const double offset = ((s.cfg.cpol & 0x80) ? -1.0 : 1.0) * static_cast<double>(s.cfg.hofs);
+        const int dir = (method == 7 || method == 17 || method == 19 || method == 33) ? 1 : -1;
         const std::int64_t lca = s.cfg.lca;
-        s.cfg.lca = offset;  // limit homing backs off by 607Ch (C-A11)
-        // Manual 000's directions (C-A06): 17/33 positive, 18/34 negative.
+        // Limit homing moves away from the limit by the offset's size (C-A11: 607Ch
+        // stands for LCA), at the zero-position speed; toward the limit is no option.
+        s.cfg.lca = std::llabs(s.cfg.hofs);
+        s.home_backoff_lspd = method == 17 || method == 18;
+        // 7/11: "change direction and move by the home offset"; 33/34: "continue
+        // moving by the home offset amount"; 19/20: from the home edge "move back
+        // by the Home Offset amount".  That end point is zero.
+        if (method == 7 || method == 11 || method == 19 || method == 20) s.home_final_target = -dir * offset;
+        if (method == 33 || method == 34) s.home_final_target = dir * offset;
+        // Manual 000's directions (C-A06): 17/33 positive, 18/34 negative.  19/20
+        // run H: zero at the home edge, ramp down to the zero-position speed and
+        // stop, then back to the offset from that edge.
         const char* c = method == 7    ? "ZH+"
                         : method == 11 ? "ZH-"
                         : method == 17 ? "L+"
                         : method == 18 ? "L-"
-                        : method == 19 ? "HL+"
-                        : method == 20 ? "HL-"
+                        : method == 19 ? "H+"
+                        : method == 20 ? "H-"
                         : method == 33 ? "Z+"
                                        : "Z-";
         if (command(c) != "OK") co.homing_error = true;
         s.cfg.lca = lca;
+        s.home_final_target.reset();
+        s.home_backoff_lspd = false;
         if (!s.motor->moving() && s.job == Job::None && !co.homing_error) {
             // Finished at once (a switch already active): decide now.
             const bool ok = !s.homing || s.homing->result() == motion::HomingResult::Done;

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "motorbus/drives/arcus/homing.hpp"
@@ -97,6 +98,7 @@ using namespace sim_detail;
 
 struct Sim::State {
     Flash flash;       // what STORE writes / boot reads
+    bool stored = false;  // STORE ran since the simulator was made: boot keeps `flash`
     Flash cfg;         // live values of the stored items
     int active_address = 1;
     int active_rt = 0;
@@ -123,6 +125,10 @@ struct Sim::State {
     std::unique_ptr<ArcusHoming> homing;
     int homing_listener = 0;  // runs after the homing's own listener
     int home_direction = 1;   // physical direction of the search
+    // Set by the CANopen front end for the homing it is about to start (607Ch):
+    // see ArcusHomingOptions.  Consumed by start_homing.
+    std::optional<double> home_final_target;
+    bool home_backoff_lspd = false;
 
     Job job = Job::None;
     bool stopping = false;
@@ -397,6 +403,10 @@ public:
         ho.lca = static_cast<double>(s.cfg.lca);
         ho.rz = s.rz != 0;
         ho.zero_encoder = true;  // PX and EX both read 0 at home
+        ho.final_target = s.home_final_target;
+        ho.backoff_at_lspd = s.home_backoff_lspd;
+        s.home_final_target.reset();
+        s.home_backoff_lspd = false;
         s.homing = std::make_unique<ArcusHoming>(m(), profile_params(), ho);
         State* sp = &s;
         const SimOptions* op = &o;

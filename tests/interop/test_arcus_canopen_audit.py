@@ -1,0 +1,363 @@
+"""Issue 23, DMX-CAN over CANopen (items 1-5) and the PMC007's baud index (item 11):
+the simulators served as `motorbus sim serve` serves them (motorbus.sim.SimBench, a
+socketcand server on 127.0.0.1), reached by python-can's socketcand interface with raw
+CiA 301 frames -- no motorbus code on the client side.  The simulator objects are used
+only for what a bench has and a bus does not: the shaft's physical position, a forced
+limit switch, a jammed rotor, and moving a drive from one bus to another.
+"""
+import time
+
+import can
+import pytest
+
+from motorbus.sim import SimBench
+
+NODE = 1
+KIND = "arcus-canopen"
+
+
+def _bus(bench: SimBench) -> can.BusABC:
+    srv = bench.can.servers[0]
+    return can.Bus(interface="socketcand", host=srv.host, port=srv.port, channel="can0")
+
+
+def _drain(bus, quiet: float = 0.05) -> None:
+    while bus.recv(quiet) is not None:
+        pass
+
+
+def _exchange(bus, node: int, request: bytes, timeout: float = 2.0):
+    """One SDO request; the reply's 8 bytes, or None when the node stays silent."""
+    bus.send(can.Message(arbitration_id=0x600 + node, data=request, is_extended_id=False))
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        m = bus.recv(max(0.0, deadline - time.monotonic()))
+        if m is not None and m.arbitration_id == 0x580 + node:
+            return bytes(m.data)
+    return None
+
+
+def _read(bus, index: int, sub: int = 0, node: int = NODE, signed: bool = False) -> int:
+    r = _exchange(bus, node, bytes([0x40, index & 0xFF, index >> 8, sub, 0, 0, 0, 0]))
+    assert r is not None, f"no reply to an upload of {index:04X}h:{sub:02X}"
+    assert r[0] & 0xE3 == 0x43, f"{index:04X}h:{sub:02X} aborted: {r.hex(' ')}"
+    size = 4 - ((r[0] >> 2) & 3)
+    return int.from_bytes(r[4:4 + size], "little", signed=signed)
+
+
+def _write(bus, index: int, sub: int, value: int, size: int, node: int = NODE) -> bytes:
+    cs = {1: 0x2F, 2: 0x2B, 4: 0x23}[size]
+    data = (value & ((1 << (8 * size)) - 1)).to_bytes(size, "little").ljust(4, b"\0")
+    r = _exchange(bus, node, bytes([cs, index & 0xFF, index >> 8, sub]) + data)
+    assert r is not None, f"no reply to a download of {index:04X}h:{sub:02X}"
+    return r
+
+
+def _ok(bus, index: int, sub: int, value: int, size: int, node: int = NODE) -> None:
+    r = _write(bus, index, sub, value, size, node)
+    assert r == bytes([0x60, index & 0xFF, index >> 8, sub, 0, 0, 0, 0]), r.hex(" ")
+
+
+def _handshake(bus, index: int, node: int = NODE, timeout: float = 3.0) -> list:
+    """Fig. 8.1 / 8.2: write 1, poll until the drive resets the object to 0; the reads seen."""
+    _ok(bus, index, 0, 1, 1, node)
+    seen = []
+    deadline = time.monotonic() + timeout
+    while True:
+        seen.append(_read(bus, index, node=node))
+        if seen[-1] == 0:
+            return seen
+        assert time.monotonic() < deadline, f"{index:04X}h still reads 1"
+        time.sleep(0.005)
+
+
+def _boot_up(bus, node: int, timeout: float = 1.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        m = bus.recv(max(0.0, deadline - time.monotonic()))
+        if m is not None and m.arbitration_id == 0x700 + node:
+            return bytes(m.data)
+    return None
+
+
+def _nmt(bus, command: int, node: int) -> None:
+    bus.send(can.Message(arbitration_id=0, data=bytes([command, node]), is_extended_id=False))
+
+
+# ---- item 1: the store lives as long as the simulator ------------------------------------
+
+def test_store_survives_nmt_reset_node_without_a_store_file():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        bus = _bus(bench)
+        try:
+            _ok(bus, 0x200C, 0, 5, 1)
+            _ok(bus, 0x607C, 0, -1234, 4)
+            _ok(bus, 0x2004, 2, 1800, 2)
+            _handshake(bus, 0x200E)
+            _drain(bus)
+            _nmt(bus, 0x81, NODE)                                       # reset node = power cycle
+            assert _boot_up(bus, 5) == b"\x00"                          # boots on 0x705, not 0x701
+            assert _exchange(bus, NODE, bytes.fromhex("40 0C 20 00 00 00 00 00"), 0.3) is None
+            assert _read(bus, 0x200C, node=5) == 5
+            assert _read(bus, 0x607C, node=5, signed=True) == -1234
+            assert _read(bus, 0x2004, 2, node=5) == 1800
+            # What was not stored is gone at the next power cycle.
+            _ok(bus, 0x607C, 0, 99, 4, node=5)
+            _drain(bus)
+            _nmt(bus, 0x81, 5)
+            assert _boot_up(bus, 5) == b"\x00"
+            assert _read(bus, 0x607C, node=5, signed=True) == -1234
+        finally:
+            bus.shutdown()
+
+
+# ---- item 2: controlword bit 7 recovers from a latched fault ----------------------------
+
+def _state(bus) -> int:
+    return _read(bus, 0x6041)
+
+
+def _enable(bus, mode: int) -> None:
+    _ok(bus, 0x6060, 0, mode, 1)
+    for cw in (0x06, 0x07, 0x0F):
+        _ok(bus, 0x6040, 0, cw, 2)
+    assert _state(bus) & 0x6F == 0x27
+
+
+def _generic_recovery(bus) -> None:
+    """What any CiA 402 master does: fault reset (rising bit 7), shutdown, switch on, enable."""
+    _ok(bus, 0x6040, 0, 0x00, 2)
+    _ok(bus, 0x6040, 0, 0x80, 2)
+    assert _state(bus) & 0x4F == 0x40                                  # Switch on disabled
+    assert _read(bus, 0x1001) == 0
+    _ok(bus, 0x6040, 0, 0x06, 2)
+    assert _state(bus) & 0x6F == 0x21
+    _ok(bus, 0x6040, 0, 0x07, 2)
+    _ok(bus, 0x6040, 0, 0x0F, 2)
+    assert _state(bus) & 0x6F == 0x27                                  # Operation enabled again
+
+
+def test_fault_reset_recovers_from_a_latched_limit_error():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        sim = bench.sims[(KIND, str(NODE))]
+        bus = _bus(bench)
+        try:
+            _enable(bus, 3)
+            sim.force_limit(1, True)
+            _ok(bus, 0x60FF, 0, 2000, 4)
+            sw = _state(bus)
+            assert sw & 0x4F == 0x08 and sw & 0x0800, hex(sw)          # Fault, internal limit
+            assert _read(bus, 0x2003) == 11 and _read(bus, 0x1001) == 1
+            sim.force_limit(1, None)
+            _generic_recovery(bus)
+            assert _read(bus, 0x2003) == 0
+        finally:
+            bus.shutdown()
+
+
+def test_fault_reset_recovers_from_a_stepnloop_stall():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        sim = bench.sims[(KIND, str(NODE))]
+        bus = _bus(bench)
+        try:
+            for index, value in ((0x6081, 20000), (0x6083, 20), (0x6084, 20)):
+                _ok(bus, index, 0, value, 4)
+            _enable(bus, 1)
+            sim.set_blocked(True)
+            _ok(bus, 0x607A, 0, 20000, 4)
+            _ok(bus, 0x6040, 0, 0x1F, 2)
+            deadline = time.monotonic() + 5
+            while _state(bus) & 0x4F != 0x08:
+                assert time.monotonic() < deadline, "no stall fault"
+                time.sleep(0.01)
+            assert _read(bus, 0x2003) == 10                              # stall error
+            sim.set_blocked(False)
+            _generic_recovery(bus)
+            assert _read(bus, 0x2003) == 0
+        finally:
+            bus.shutdown()
+
+
+# ---- item 3: the home offset 607Ch ------------------------------------------------------
+
+def _home(bus, node: int, method: int, offset: int, polarity: int = 0, speeds=(20000, 8000), timeout=10.0,
+          sample=None) -> None:
+    _ok(bus, 0x607E, 0, polarity, 1, node)
+    _ok(bus, 0x607C, 0, offset, 4, node)
+    _ok(bus, 0x6098, 0, method, 1, node)
+    _ok(bus, 0x6099, 1, speeds[0], 4, node)
+    _ok(bus, 0x6099, 2, speeds[1], 4, node)
+    _ok(bus, 0x609A, 0, 20, 4, node)
+    _ok(bus, 0x6060, 0, 6, 1, node)
+    for cw in (0x06, 0x07, 0x0F, 0x1F):
+        _ok(bus, 0x6040, 0, cw, 2, node)
+    deadline = time.monotonic() + timeout
+    while True:
+        sw = _read(bus, 0x6041, node=node)
+        if sw & 0x2000 or sw & 0x1400 == 0x1400:
+            break
+        if sample is not None:
+            sample(_read(bus, 0x606C, node=node, signed=True))
+        assert time.monotonic() < deadline, f"homing {method} did not end: {sw:#06x}"
+        time.sleep(0.005)
+    assert sw & 0x3400 == 0x1400, f"homing {method}: {sw:#06x}"      # attained, no error
+    assert _read(bus, 0x6064, node=node, signed=True) == 0
+
+
+# 500 counts = 400 motor steps (StepNLoop on: 4000 counts, 3200 steps a revolution).
+# (method, 607Eh, 607Ch, start, end shift in steps against the same homing without offset)
+OFFSET_CASES = [
+    (7, 0, 500, 0.0, -400),       # positive search; "change direction and move by the home offset"
+    (11, 0, 500, 12000.0, 400),   # negative search; change direction: +
+    (33, 0, 500, 0.0, 400),       # "continue moving by the home offset amount"
+    (34, 0, 500, 0.0, -400),
+    (19, 0, 500, 0.0, -400),      # "move back by the Home Offset amount"
+    (20, 0, 500, 12000.0, 400),
+    (33, 0, -500, 0.0, -400),     # its sign is kept
+    (33, 0x80, 500, 0.0, -400),   # 607Eh bit 7 reverses it like every position value
+]
+
+
+@pytest.mark.parametrize("method, polarity, offset, start, shift", OFFSET_CASES)
+def test_home_offset_sets_the_end_point(method, polarity, offset, start, shift):
+    # Node 1 homes without an offset, node 2 with: same world, same start.
+    with SimBench([f"{KIND}:1,2"], sim_options={KIND: {"start_position": start}}) as bench:
+        bus = _bus(bench)
+        try:
+            _home(bus, 1, method, 0, polarity)
+            _home(bus, 2, method, offset, polarity)
+            plain = bench.sims[(KIND, "1")].physical_position
+            offs = bench.sims[(KIND, "2")].physical_position
+            assert offs - plain == pytest.approx(shift, abs=1.5), (plain, offs)
+        finally:
+            bus.shutdown()
+
+
+@pytest.mark.parametrize("method, side", [(17, 1), (18, -1)])
+def test_limit_homing_backs_off_at_the_zero_position_speed(method, side):
+    speeds = (20000, 5000)
+    with SimBench([f"{KIND}:{NODE}"], sim_options={KIND: {"minus_limit": -3000.0, "plus_limit": 3000.0}}) as bench:
+        bus = _bus(bench)
+        away = []
+        try:
+            _home(bus, NODE, method, 4000, speeds=speeds,
+                  sample=lambda v: away.append(-side * v) if v * side < 0 else None)
+            # Away from the limit by 4000 counts = 3200 steps, end point zero.
+            assert bench.sims[(KIND, str(NODE))].physical_position == pytest.approx(side * (3000 - 3200), abs=2)
+        finally:
+            bus.shutdown()
+    assert away, "the back-off was never seen moving"
+    assert max(away) <= speeds[1] * 1.01, max(away)                   # never at the home-switch speed
+
+
+# ---- item 4 and 11: a stored bit rate takes effect -------------------------------------
+
+def test_stored_bit_rate_takes_effect_after_store_and_power_cycle():
+    with SimBench([f"{KIND}:{NODE}"], bitrate=125000) as old, \
+            SimBench([], bitrate=500000, socketcand=["127.0.0.1:0"]) as new:
+        sim = old.sims[(KIND, str(NODE))]
+        bus, bus2 = _bus(old), _bus(new)
+        try:
+            assert _read(bus, 0x200B) == 5                              # factory: 125 kbit/s, the wire's
+            _ok(bus, 0x200B, 0, 7, 1)                                   # 500 kbit/s
+            assert _read(bus, 0x200B) == 7                              # read back at once
+            _drain(bus)
+            _nmt(bus, 0x81, NODE)                                       # not stored: discarded
+            assert _boot_up(bus, NODE) == b"\x00"
+            assert _read(bus, 0x200B) == 5
+            _ok(bus, 0x200B, 0, 7, 1)
+            _handshake(bus, 0x200E)
+            assert _read(bus, 0x200B) == 7                              # still answering at 125k
+            _drain(bus)
+            _nmt(bus, 0x81, NODE)
+            assert _boot_up(bus, NODE, 0.5) is None                     # its boot-up is not on this wire
+            assert _exchange(bus, NODE, bytes.fromhex("40 0B 20 00 00 00 00 00"), 0.5) is None
+            assert sim.can_bit_rate == 7
+            # The same drive on a 500 kbit/s bus: reachable again.
+            sim.close()
+            sim.attach(new.can.endpoint())
+            assert _boot_up(bus2, NODE) == b"\x00"
+            assert _read(bus2, 0x200B) == 7
+            assert _read(bus2, 0x1000) & 0xFFFF == 0x0192
+        finally:
+            sim.close()
+            bus.shutdown()
+            bus2.shutdown()
+
+
+def test_pmc007_baud_index_takes_effect_at_reset_communication():
+    node = 5
+    with SimBench([f"pmc007:{node}"], bitrate=125000) as old, \
+            SimBench([], bitrate=500000, socketcand=["127.0.0.1:0"]) as new:
+        sim = old.sims[("pmc007", str(node))]
+        bus, bus2 = _bus(old), _bus(new)
+        try:
+            assert _read(bus, 0x2003, node=node) == 4                   # index 4 = 125 kbit/s
+            _ok(bus, 0x2003, 0, 6, 1, node)                             # 500 kbit/s (RAM)
+            assert _read(bus, 0x2003, node=node) == 6
+            _drain(bus)
+            _nmt(bus, 0x82, node)                                       # reset communication: in effect
+            assert _boot_up(bus, node, 0.5) is None
+            assert _exchange(bus, node, bytes.fromhex("40 03 20 00 00 00 00 00"), 0.5) is None
+            assert sim.active_baud_index == 6
+            sim.close()
+            sim.attach(new.can.endpoint())
+            assert _boot_up(bus2, node) == b"\x00"
+            assert _read(bus2, 0x2003, node=node) == 6
+        finally:
+            sim.close()
+            bus.shutdown()
+            bus2.shutdown()
+
+
+def test_a_bus_without_a_bit_rate_carries_any_code():
+    # No wire modelled (the default of `motorbus sim serve`): the node answers whatever 200Bh says.
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        bus = _bus(bench)
+        try:
+            _ok(bus, 0x200B, 0, 9, 1)
+            _handshake(bus, 0x200E)
+            _drain(bus)
+            _nmt(bus, 0x81, NODE)
+            assert _boot_up(bus, NODE) == b"\x00"
+            assert _read(bus, 0x200B) == 9
+        finally:
+            bus.shutdown()
+
+
+# ---- item 5: U32 StepNLoop parameters, handshakes that take time -------------------------
+
+@pytest.mark.parametrize("sub", [2, 3, 4, 5])
+def test_stepnloop_parameters_take_the_whole_u32_range(sub):
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        bus = _bus(bench)
+        try:
+            for value in (0x80000000, 0xFFFFFFFF):
+                _ok(bus, 0x2001, sub, value, 4)
+                assert _read(bus, 0x2001, sub) == value
+        finally:
+            bus.shutdown()
+
+
+def test_served_store_handshake_reads_1_while_it_runs():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        bus = _bus(bench)
+        try:
+            seen = _handshake(bus, 0x200E)
+            assert seen[0] == 1 and seen[-1] == 0, seen                 # the master's loop ran
+        finally:
+            bus.shutdown()
+
+
+def test_clear_handshake_reads_1_for_the_configured_time():
+    with SimBench([f"{KIND}:{NODE}"], sim_options={KIND: {"clear_time": 0.3, "store_time": 0.3}}) as bench:
+        bus = _bus(bench)
+        try:
+            t0 = time.monotonic()
+            seen = _handshake(bus, 0x200D)
+            assert seen[0] == 1 and seen[-1] == 0 and len(seen) > 2, seen
+            assert time.monotonic() - t0 >= 0.3
+            seen = _handshake(bus, 0x200E)
+            assert seen[0] == 1 and seen[-1] == 0, seen
+        finally:
+            bus.shutdown()
