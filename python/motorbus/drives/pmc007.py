@@ -280,9 +280,11 @@ class Pmc007:
         self.write("absolute_displacement_command", int(target))
 
     def run(self, pps: int) -> None:
-        """Speed mode at a signed speed."""
-        self.set_mode(True)
+        """Speed mode at a signed speed.  6003h first: switching to speed mode runs at once at
+        the 6003h in force (B-P12), so the mode goes second or the motor would start at the old
+        speed (and direction).  In speed mode already, the 6003h write changes the run."""
         self.speed = int(pps)
+        self.set_mode(True)
 
     def stop(self) -> None:
         """6020h: immediate stop in any mode."""
