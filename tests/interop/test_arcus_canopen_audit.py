@@ -361,3 +361,151 @@ def test_clear_handshake_reads_1_for_the_configured_time():
             assert seen[0] == 1 and seen[-1] == 0, seen
         finally:
             bus.shutdown()
+
+
+# ---- rows the audit saw exercised only on a SimClock: now through the transport ------------
+
+def test_table_8_40_store_set_survives_a_power_cycle_and_the_rest_reverts():
+    stored = [(0x2000, 0, 0, 1), (0x2001, 3, 25, 4), (0x2001, 2, 12, 4), (0x2001, 4, 7, 4), (0x2001, 5, 2000, 4),
+              (0x2004, 2, 1200, 2), (0x2004, 3, 300, 2), (0x2004, 4, 800, 2), (0x2005, 0, 5, 1),
+              (0x2006, 0, 1, 1), (0x200B, 0, 6, 1), (0x607C, 0, 77, 4), (0x607E, 0, 0x40, 1), (0x6086, 0, 1, 2)]
+    volatile = [(0x6081, 0, 5000, 4, 1000), (0x6082, 0, 50, 4, 100), (0x6083, 0, 50, 4, 300),
+                (0x6084, 0, 60, 4, 300), (0x6098, 0, 17, 1, 35), (0x6099, 1, 3000, 4, 1000),
+                (0x6099, 2, 300, 4, 100), (0x609A, 0, 40, 4, 300), (0x607A, 0, 1234, 4, 0), (0x2007, 0, 1, 1, 0)]
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        bus = _bus(bench)
+        try:
+            for index, sub, value, size in stored:
+                _ok(bus, index, sub, value, size)
+            for index, sub, value, size, _default in volatile:
+                _ok(bus, index, sub, value, size)
+            _handshake(bus, 0x200E)
+            _drain(bus)
+            _nmt(bus, 0x81, NODE)
+            assert _boot_up(bus, NODE) == b"\x00"
+            for index, sub, value, _size in stored:
+                assert _read(bus, index, sub) == value, f"{index:04X}h:{sub:02X}"
+            for index, sub, _value, _size, default in volatile:
+                assert _read(bus, index, sub) == default, f"{index:04X}h:{sub:02X}"
+            # Boot states in effect: outputs per 2005h = 5 (2000h = 0: DO1/DO3 are plain outputs),
+            # the motor powered per 2006h = 1: run/idle current flows (2004h:01 = idle 300 mA).
+            assert _read(bus, 0x60FE) == 5 << 16
+            assert _read(bus, 0x2004, 1) == 300
+        finally:
+            bus.shutdown()
+
+
+def test_profile_velocity_polarity_inputs_latch_and_delta_through_the_transport():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        sim = bench.sims[(KIND, str(NODE))]
+        bus = _bus(bench)
+        try:
+            _ok(bus, 0x2004, 2, 1300, 2)
+            for index, value in ((0x6083, 10), (0x6084, 10)):
+                _ok(bus, index, 0, value, 4)
+            _enable(bus, 3)
+            _ok(bus, 0x60FF, 0, 4000, 4)
+            deadline = time.monotonic() + 3
+            while _read(bus, 0x606C, signed=True) != 4000:
+                assert time.monotonic() < deadline
+                time.sleep(0.01)
+            sw = _state(bus)
+            assert sw & 0x0400 and not sw & 0x1000                      # reached, speed not zero
+            assert _read(bus, 0x2004, 1) == 1300                        # run current while moving
+            assert _read(bus, 0x2003) == 5                              # StepNLoop: jogging
+            # Latch on DI2 (2007h arms, 2008h 1 -> 2, 2009h:02 the encoder there).
+            _ok(bus, 0x2007, 0, 1, 1)
+            assert _read(bus, 0x2008) == 1
+            sim.set_input(2, True)
+            at = sim.encoder_position
+            assert _read(bus, 0x2008) == 2
+            latched = _read(bus, 0x2009, 2, signed=True)
+            assert 0 < latched <= at
+            assert _read(bus, 0x60FD) & (1 << 17)                       # DI2 = 60FDh bit 17
+            sim.set_input(2, False)
+            # Velocity polarity (607Eh bit 6): the same motion shown negative.
+            _ok(bus, 0x607E, 0, 0x40, 1)
+            assert _read(bus, 0x606C, signed=True) == -4000
+            _ok(bus, 0x607E, 0, 0x00, 1)
+            # Halt decelerates to a stop; the drive reports speed zero.
+            _ok(bus, 0x6040, 0, 0x10F, 2)
+            deadline = time.monotonic() + 3
+            while _read(bus, 0x606C, signed=True) != 0:
+                assert time.monotonic() < deadline
+                time.sleep(0.01)
+            assert _state(bus) & 0x1400 == 0x1400
+            pos = _read(bus, 0x6064, signed=True)
+            _ok(bus, 0x607E, 0, 0x80, 1)                                # position polarity
+            assert _read(bus, 0x6064, signed=True) == -pos
+            _ok(bus, 0x607E, 0, 0x00, 1)
+            # Inputs: a forced + limit is 60FDh bit 1, a home switch bit 2.
+            sim.force_limit(1, True)
+            sim.force_home(True)
+            assert _read(bus, 0x60FD) & 0b110 == 0b110
+            sim.force_limit(1, None)
+            sim.force_home(None)
+            assert _read(bus, 0x60FD) & 0b111 == 0
+            # A push on the shaft at rest beyond the error range (2001h:05 = 1000 counts): 2002h
+            # shows pulses minus encoder, 2003h the range error, and the drive is in Fault.
+            sim.disturb(1000)                                           # 1000 steps = 1250 counts
+            assert _read(bus, 0x2002, signed=True) == -1250
+            assert _read(bus, 0x2003) == 8
+            assert _state(bus) & 0x4F == 0x08 and _read(bus, 0x1001) == 1
+        finally:
+            bus.shutdown()
+
+
+def test_state_machine_motor_power_quick_stop_and_set_points_through_the_transport():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        sim = bench.sims[(KIND, str(NODE))]
+        bus = _bus(bench)
+        try:
+            for index, value in ((0x6081, 20000), (0x6082, 100), (0x6083, 20), (0x6084, 20)):
+                _ok(bus, index, 0, value, 4)
+            _ok(bus, 0x6060, 0, 1, 1)
+            assert _state(bus) & 0x4F == 0x40
+            _ok(bus, 0x6040, 0, 0x06, 2)                                # Shutdown
+            assert _state(bus) & 0x6F == 0x21 and _read(bus, 0x2004, 1) == 0   # motor unpowered
+            _ok(bus, 0x6040, 0, 0x07, 2)                                # T1: motor powered
+            assert _state(bus) & 0x6F == 0x23 and _read(bus, 0x2004, 1) > 0
+            _ok(bus, 0x6040, 0, 0x06, 2)                                # T2
+            assert _state(bus) & 0x6F == 0x21 and _read(bus, 0x2004, 1) == 0
+            _ok(bus, 0x6040, 0, 0x07, 2)
+            _ok(bus, 0x6040, 0, 0x0F, 2)                                # T3
+            assert _state(bus) & 0x6F == 0x27 and _read(bus, 0x6061) == 1
+            # A move, then a buffered one (bit 5) and a single one (refused: not acknowledged).
+            _ok(bus, 0x607A, 0, 4000, 4)
+            _ok(bus, 0x6040, 0, 0x1F, 2)
+            assert _state(bus) & 0x1000                                 # set-point acknowledged
+            _ok(bus, 0x6040, 0, 0x0F, 2)
+            _ok(bus, 0x607A, 0, 1000, 4)
+            _ok(bus, 0x6040, 0, 0x5F, 2)                                # relative, single: moving -> refused
+            assert not _state(bus) & 0x1000
+            _ok(bus, 0x6040, 0, 0x0F, 2)
+            _ok(bus, 0x6040, 0, 0x7F, 2)                                # relative, set of set-points
+            assert _state(bus) & 0x1000
+            _ok(bus, 0x6040, 0, 0x0F, 2)
+            deadline = time.monotonic() + 5
+            while not (_state(bus) & 0x0400 and _read(bus, 0x6064, signed=True) == 5000):
+                assert time.monotonic() < deadline, _read(bus, 0x6064, signed=True)
+                time.sleep(0.01)
+            # Quick stop while moving: immediate stop, Switch on disabled, motor unpowered.
+            _ok(bus, 0x607A, 0, 60000, 4)
+            _ok(bus, 0x6040, 0, 0x1F, 2)
+            time.sleep(0.1)
+            _ok(bus, 0x6040, 0, 0x02, 2)
+            assert _state(bus) & 0x4F == 0x40
+            assert _read(bus, 0x606C, signed=True) == 0 and not sim.busy
+            assert _read(bus, 0x2004, 1) == 0
+            # T4 / T5 / T6 from Operation enabled and Switched on.
+            _enable(bus, 1)
+            _ok(bus, 0x6040, 0, 0x07, 2)                                # T4
+            assert _state(bus) & 0x6F == 0x23
+            _ok(bus, 0x6040, 0, 0x0F, 2)
+            _ok(bus, 0x6040, 0, 0x06, 2)                                # T5
+            assert _state(bus) & 0x6F == 0x21
+            _ok(bus, 0x6040, 0, 0x07, 2)
+            _ok(bus, 0x6040, 0, 0x00, 2)                                # T6: disable voltage
+            assert _state(bus) & 0x4F == 0x40 and _read(bus, 0x2004, 1) == 0
+        finally:
+            bus.shutdown()

@@ -75,7 +75,10 @@ def test_the_persona_switch_both_ways_over_pty_and_socketcand(bench):
     assert sdo(pcan, bytes.fromhex("2B 04 20 02 39 05 00 00"))[0] == 0x60   # run current 1337 mA
     assert sdo(pcan, bytes.fromhex("2F 0A 20 00 00 00 00 00"))[0] == 0x60
     assert sdo(pcan, bytes.fromhex("2F 0E 20 00 01 00 00 00"))[0] == 0x60
-    assert sdo(pcan, bytes.fromhex("40 0E 20 00 00 00 00 00")) == bytes.fromhex("4F 0E 20 00 00 00 00 00")
+    deadline = time.monotonic() + 2                                         # Fig. 8.2: poll until 0
+    while sdo(pcan, bytes.fromhex("40 0E 20 00 00 00 00 00")) != bytes.fromhex("4F 0E 20 00 00 00 00 00"):
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
     pcan.send(can.Message(arbitration_id=0, data=bytes([0x81, 1]), is_extended_id=False))
     deadline = time.monotonic() + 2
     while sim.active_protocol != 0:

@@ -2,8 +2,8 @@
 //
 // A real CAN controller set to another bit rate than the wire's cannot decode
 // a frame: it answers every one with an error frame and transmits nothing the
-// others can read.  A simulated node (the DMX-CAN's 200Bh, the PMC007's 2003h)
-// attaches through this gate: frames pass both ways only while the node's bit
+// others can read.  A simulated node whose bit-rate object takes effect at its
+// power cycle or reset attaches through this gate: frames pass both ways only while the node's bit
 // rate in effect equals the medium's.  A medium that models no bit rate (a
 // virtual hub without wire time, a socketcand or SLCAN link, where the rate
 // lives in the adapter) has none to disagree with: everything passes.
