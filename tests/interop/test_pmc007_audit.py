@@ -376,3 +376,151 @@ def test_14_an_emcy_inside_the_inhibit_time_is_delayed_not_dropped(served):
     assert second is not None and bytes(second.data[:2]) == frame("00 42")
     assert second.data[2] == 0x0D               # 1001h at the time of the event: generic, voltage, temperature
     assert t1 - t0 >= 0.4                       # not before the inhibit time has passed
+
+
+# ---- every dictionary row through canopen (PyPI) over socketcand --------------------------
+#
+# Each of the 210 index:sub entries is read (size and default), each read-only one refuses a
+# write (06010002), each stored one takes a value that survives save + reset node (ROM) or
+# returns to its default (RAM), and 2007h = 3 brings the ROM ones back to the factory value
+# in the working copy only (C-P19).  Objects whose write is an action (motion, program, save,
+# stop, node-ID, bit rate) have their own tests above and in test_pmc007_pythoncan.
+
+import canopen  # noqa: E402
+
+from motorbus import _core  # noqa: E402
+from motorbus.drives.pmc007 import EDS_PATH  # noqa: E402
+
+_SIZE = {"U8": 1, "U16": 2, "U32": 4, "I32": 4}
+IDENTITY = {1: 0, 2: 7, 3: 0x00010000, 4: 1}  # the sim's 1018h (Pmc007SimOptions::identity)
+# A value for each stored RW row ((index, sub) -> value); RAM rows return to the default at reset.
+STORED = {
+    (0x1005, 0): 0x81, (0x1006, 0): 1000, (0x1007, 0): 500, (0x1015, 0): 10,
+    (0x1016, 1): 0x00010064, (0x1016, 2): 0x00020064, (0x1016, 3): 0x00030064, (0x1017, 0): 2000,
+    (0x1200, 3): 7, (0x1280, 1): 0x80000611, (0x1280, 2): 0x80000591, (0x1280, 3): 9,
+    (0x6003, 0): 1000, (0x6002, 0): 1, (0x6006, 0): 600, (0x6007, 0): 50, (0x6008, 0): 3, (0x6009, 0): 4,
+    (0x600A, 0): 16, (0x600B, 0): 1500, (0x600C, 0): 1234, (0x600D, 0): 2, (0x600E, 0): 0,
+    (0x600F, 1): 0x03, (0x600F, 2): 0x01, (0x6010, 0): 7, (0x6011, 1): 0x0003, (0x6011, 2): 0x1234,
+    (0x6012, 0): 0x0001, (0x6013, 1): 5, (0x6013, 2): 6, (0x6017, 0): 0x6400, (0x6018, 1): 3,
+    (0x6019, 1): 2, (0x6019, 2): 0x01000064, (0x6019, 4): 0x00FF, (0x601A, 0): 50, (0x601B, 0): 1,
+    (0x6021, 0): 800, (0x6023, 0): 60, (0x6024, 0): 61, (0x6025, 0): 33, (0x6026, 0): 9, (0x6027, 0): 10,
+    (0x6028, 0): 65, (0x6029, 0): 0, (0x602A, 0): 1,
+}
+for _k in range(4):
+    STORED[(0x1400 + _k, 1)] = 0x80000000 | (0x200 + 0x100 * _k + NODE)   # invalid, then mapped
+    STORED[(0x1800 + _k, 1)] = 0x80000000 | (0x180 + 0x100 * _k + NODE)
+    for _base in (0x1400, 0x1800):
+        STORED.update({(_base + _k, 2): 1, (_base + _k, 3): 20, (_base + _k, 4): 0, (_base + _k, 5): 300})
+    for _s in range(1, 9):
+        STORED[(0x1600 + _k, _s)] = 0x60010008    # 8 x 6001h = 64 bits (RPDO: writable, mappable)
+        STORED[(0x1A00 + _k, _s)] = 0x10010008    # 8 x 1001h (TPDO: readable, mappable)
+    STORED[(0x1600 + _k, 0)] = 8
+    STORED[(0x1A00 + _k, 0)] = 8
+# Written for their effect (tests above), read here only.
+ACTIONS = {(0x2002, 0), (0x2003, 0), (0x2007, 0), (0x6000, 0), (0x6001, 0), (0x6004, 0), (0x6005, 0),
+           (0x6018, 2), (0x6019, 3), (0x6019, 5), (0x601C, 0), (0x6020, 0), (0x1003, 0)}
+
+
+def _rows():
+    out = []
+    for (index, sub, name, parent, dtype, access, pdo, storage, default, low, high) in _core.pmc007_od_rows():
+        if index == 0x1018 and sub >= 1:
+            default = IDENTITY[sub]
+        elif (index, sub) == (0x1014, 0):
+            default = 0x80 + NODE
+        elif (index, sub) in ((0x1200, 1), (0x1200, 2)):
+            default = (0x600 if sub == 1 else 0x580) + NODE
+        elif sub == 1 and (0x1400 <= index <= 0x1403 or 0x1800 <= index <= 0x1803):
+            default = (0x200 if index < 0x1800 else 0x180) + 0x100 * (index & 3) + NODE
+        out.append(dict(index=index, sub=sub, name=name, type=dtype, access=access, storage=storage,
+                        default=default))
+    return out
+
+
+def _value(raw: bytes, dtype: str):
+    if dtype == "VISIBLE_STRING":
+        return raw.decode("ascii")
+    return int.from_bytes(raw, "little", signed=dtype == "I32")
+
+
+@pytest.fixture
+def co_node():
+    with SimBench([f"pmc007:{NODE}"], bus=f"virtual:pmc007-audit-od-{time.monotonic_ns()}") as bench:
+        srv = bench.can.servers[0]
+        bus = can.Bus(interface="socketcand", host=srv.host, port=srv.port, channel="can0")
+        net = canopen.Network(bus)
+        net.connect = lambda *a, **k: None  # the bus is already open
+        net.notifier = can.Notifier(bus, net.listeners, 0.1)
+        try:
+            yield bench.sims[("pmc007", str(NODE))], net.add_node(NODE, EDS_PATH)
+        finally:
+            net.notifier.stop()
+            bus.shutdown()
+
+
+def _read(node, r):
+    raw = node.sdo.upload(r["index"], r["sub"])
+    if r["type"] in _SIZE:
+        assert len(raw) == _SIZE[r["type"]], (hex(r["index"]), r["sub"], raw)
+    return _value(raw, r["type"])
+
+
+def _write(node, index: int, sub: int, value: int, dtype: str) -> None:
+    node.sdo.download(index, sub, int(value).to_bytes(_SIZE[dtype], "little", signed=dtype == "I32"))
+
+
+def _reset_node(node) -> None:
+    node.nmt.send_command(0x81)
+    deadline = time.monotonic() + 5
+    while True:  # answers again once it has booted
+        time.sleep(0.1)
+        try:
+            node.sdo.upload(0x1000, 0)
+            return
+        except (canopen.SdoCommunicationError, canopen.SdoAbortedError):
+            if time.monotonic() > deadline:
+                raise
+
+
+def test_every_row_reads_refuses_stores_and_resets_as_the_table_says(co_node):
+    sim, node = co_node
+    node.sdo.RESPONSE_TIMEOUT = 1.0
+    rows = _rows()
+    assert len(rows) == 210
+    for r in rows:                              # defaults, sizes (strings by segmented upload)
+        assert _read(node, r) == r["default"], (hex(r["index"]), r["sub"], r["name"])
+    for r in rows:                              # read-only and constant rows refuse writes
+        if r["access"] in ("ro", "const"):
+            with pytest.raises(canopen.SdoAbortedError) as e:
+                node.sdo.download(r["index"], r["sub"], b"\x00" * _SIZE.get(r["type"], 1))
+            assert e.value.code == 0x06010002, (hex(r["index"]), r["sub"])
+    rw = [r for r in rows if r["access"] == "rw"]
+    assert {(r["index"], r["sub"]) for r in rw} == set(STORED) | ACTIONS
+    # Mapping sub0 goes last (the entries first), the rest in table order.
+    order = sorted((r for r in rw if (r["index"], r["sub"]) in STORED),
+                   key=lambda r: (0x1600 <= r["index"] <= 0x1A03 and r["sub"] == 0, 0))
+    for r in order:
+        _write(node, r["index"], r["sub"], STORED[(r["index"], r["sub"])], r["type"])
+    for r in order:
+        want = STORED[(r["index"], r["sub"])]
+        assert _read(node, r) == want, (hex(r["index"]), r["sub"], r["name"])
+    _write(node, 0x2007, 0, 2, "U8")            # save every ROM object (B-P37)
+    _reset_node(node)                           # reset node = power-on (B-P28)
+    for r in order:
+        key = (r["index"], r["sub"])
+        if key == (0x600C, 0):
+            want = 1234                         # 602Ah = 1: the position saved at power-off (B-P17)
+        elif r["storage"] == "rom":
+            want = STORED[key]
+        else:
+            want = r["default"]
+        assert _read(node, r) == want, (hex(r["index"]), r["sub"], r["name"], r["storage"])
+    assert node.sdo.upload(0x6022, 0) == (1234).to_bytes(4, "little")
+    _write(node, 0x2007, 0, 3, "U8")            # factory values into the working copy (B-P38)
+    for r in order:
+        if r["storage"] == "rom":
+            assert _read(node, r) == r["default"], (hex(r["index"]), r["sub"], r["name"])
+    _reset_node(node)                           # not saved: the flash still holds the stored values (C-P19)
+    for r in order:
+        if r["storage"] == "rom":
+            assert _read(node, r) == STORED[(r["index"], r["sub"])], (hex(r["index"]), r["sub"])

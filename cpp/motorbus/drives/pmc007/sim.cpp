@@ -442,8 +442,10 @@ void Pmc007Sim::read_store() {
 }
 
 void Pmc007Sim::load_power_up(bool cold) {
+    std::uint16_t old_outputs = 0;
     {
         std::lock_guard lock(m_);
+        old_outputs = static_cast<std::uint16_t>(u(0x6011, 1) & 0x7F);
         if (!cold && u(0x602A) == 1) {  // B-P17: written to EEPROM at power loss
             saved_position_ = static_cast<std::int32_t>(position());
             write_store_locked();
@@ -480,6 +482,9 @@ void Pmc007Sim::load_power_up(bool cold) {
         std::lock_guard lock(m_);
         baud_index_ = static_cast<std::uint8_t>(u(0x2003));
         cpr_ = static_cast<std::uint16_t>(u(0x6021));  // B-P40: takes effect at power-up
+        // [P] the output latches start released (high, 6012h bit 0) at power-up: the pins
+        // that were or now are outputs are no longer driven low by the device.
+        levels_ = static_cast<std::uint16_t>(levels_ | old_outputs | (u(0x6011, 1) & 0x7F));
         motor_.set_pulse_position(u(0x602A) == 1 ? saved_position_ : 0);
         if (u(0x6018, 2) == 1 && u(0x6018, 1) > 0) {  // B-P41 auto-run
             running_ = true;
