@@ -249,6 +249,8 @@ void bind_unitek(py::module_& m) {
         if (btr < 0 || btr > 0xFFFF) throw InvalidArgument("unitek BTR: a 16-bit setting value");
         return bit_timing_for_btr(static_cast<std::uint16_t>(btr)).bit_rate();
     }, py::arg("btr"));
+    m.def("unitek_analog_command_num", &analog_command_num, py::arg("volts"),
+          "§6.1: the num of an analog command (10 V = 29490)");
     m.def("unitek_sim_default_table", &sim_default_table);
     m.def("unitek_event_status_mask", &event_status_mask, py::arg("mask"));
 
@@ -412,7 +414,7 @@ void bind_unitek(py::module_& m) {
                          bool calibrated, std::int64_t tol_num, std::optional<double> minus_limit_num,
                          std::optional<double> plus_limit_num, std::int64_t torque_continuous_num, int dummy,
                          std::optional<RegisterTable> table, std::string device,
-                         std::optional<std::int64_t> motor_i_max_num, std::int64_t btr) {
+                         std::optional<std::int64_t> motor_i_max_num, std::int64_t btr, int analog_command) {
                  if (!clock) throw InvalidArgument("clock: None (a motorbus Clock is required)");
                  SimConfig c;
                  c.rx_id = rx_id;
@@ -433,6 +435,7 @@ void bind_unitek(py::module_& m) {
                  c.motor_i_max_num = motor_i_max_num;
                  if (btr < 0 || btr > 0xFFFF) throw InvalidArgument("unitek sim btr: a 16-bit BTR setting value");
                  c.btr = static_cast<std::uint16_t>(btr);
+                 c.analog_command = analog_command;
                  auto h = std::make_unique<SimHolder>();
                  h->clock = clock;
                  h->sim = std::make_unique<UnitekSim>(*clock, c, table ? *table : sim_default_table());
@@ -444,7 +447,7 @@ void bind_unitek(py::module_& m) {
              py::arg("tol_num") = 64, py::arg("minus_limit_num") = -100.0 * 65536,
              py::arg("plus_limit_num") = 100.0 * 65536, py::arg("torque_continuous_num") = 32767,
              py::arg("dummy") = 0, py::arg("table") = py::none(), py::arg("device") = "DS 205/405",
-             py::arg("motor_i_max_num") = py::none(), py::arg("btr") = kDefaultBtr)
+             py::arg("motor_i_max_num") = py::none(), py::arg("btr") = kDefaultBtr, py::arg("analog_command") = 0)
         .def("attach", [](SimHolder& h, std::shared_ptr<can::Bus> bus) {
             if (!bus) throw InvalidArgument("bus: None");
             h.bus = bus;
@@ -475,6 +478,11 @@ void bind_unitek(py::module_& m) {
             py::gil_scoped_release nogil;
             h.sim->force_error(bits);
         }, py::arg("bits"), "latch NDrive error (0-15: power stage off) / warning (16-31) bits in 0x8F")
+        .def("set_analog_input", [](SimHolder& h, int channel, double volts) {
+            py::gil_scoped_release nogil;
+            h.sim->set_analog_input(channel, volts);
+        }, py::arg("channel"), py::arg("volts"),
+           "AIN1/AIN2 (+/- 10 V, 2949 num/V); the speed command when analog_command names the input")
         .def("set_calibrated", [](SimHolder& h, bool on) {
             py::gil_scoped_release nogil;
             h.sim->set_calibrated(on);

@@ -201,6 +201,32 @@ def test_client_refuses_a_current_command_beyond_9_bit_before_sending():
             assert d.read_physical(Reg.I_ACT) == pytest.approx(-10.0)  # 160 num = 10 A (DS 205/405)
 
 
+# ---- item 16: the analog command, 10 V = 29490 num ----------------------------------------
+
+def test_analog_command_10_volts_is_29490_num_and_90_percent_of_n_max():
+    opts = {"unitek": {"analog_command": 1, "acc_ramp_ms": 0}}
+    with SimBench(["unitek:0x201"], sim_options=opts) as b:
+        sim, peer = b.sims[("unitek", "0x201")], peer_of(b)
+        try:
+            for volts, num in ((10.0, 29490), (-10.0, -29490), (5.0, 14745), (0.0, 0)):
+                sim.set_analog_input(1, volts)
+                assert read(peer, 0xD5, signed=True) == num          # AIN1
+                end = time.monotonic() + 2
+                while read(peer, 0x30, signed=True) != num:          # SPEED_IST follows AIN1
+                    assert time.monotonic() < end, (volts, num)
+            sim.set_analog_input(2, 3.0)                             # AIN2 reads, commands nothing here
+            assert read(peer, 0xD6, signed=True) == 8847
+            assert read(peer, 0x30, signed=True) == 0
+            with pytest.raises(_core.InvalidArgument, match="10 V"):
+                sim.set_analog_input(1, 10.5)
+        finally:
+            peer.shutdown()
+    assert _core.unitek_analog_command_num(10.0) == 29490
+    # 29490 of 32767 is 90 % of N max: 2700 rpm on a 3000 rpm drive.
+    assert _core.UnitekScalings(n_max_rpm=3000).to_physical(_core.unitek_sim_default_table()[0xD5], 29490) \
+        == pytest.approx(2700, abs=0.1)
+
+
 # ---- item 16: the bit-timing table --------------------------------------------------------
 
 def test_bit_timing_table():

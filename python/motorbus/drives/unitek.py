@@ -92,6 +92,8 @@ class Reg(enum.IntEnum):
     I_MAX = 0x24        # NDrive list: the motor's peak current limit (num)
     I_CMD = 0x26        # NDrive list: current command, +/- 9 bit (§6.1)
     DEVICE_I_MAX = 0xC4  # NDrive list: the device's peak current (num, §6.1 table)
+    AIN1 = 0xD5         # NDrive list: analog command input 1 (10 V = 29490 num, §6.1)
+    AIN2 = 0xD6         # NDrive list: analog command input 2
 
 
 class Status(enum.IntFlag):
@@ -456,7 +458,8 @@ class Unitek:
 
 _SIM_OPTIONS = ("n_max_rpm", "acc_ramp_ms", "dec_ramp_ms", "position_control", "speed_control", "calibrated",
                 "tol_num", "minus_limit_num", "plus_limit_num", "torque_continuous_num", "dummy", "tx_id",
-                "registers", "t_out_ms", "store_path", "device", "motor_i_max_num", "btr")
+                "registers", "t_out_ms", "store_path", "device", "motor_i_max_num", "btr",
+                "analog_command")
 
 
 class UnitekSim:
@@ -474,7 +477,10 @@ class UnitekSim:
     (the motor's peak current limit in num, default the device's; I_MAX 0x24 over CAN):
     I_ACT (0x20) is I_CMD (0x26, +/- 511) limited to the smaller of the two.  ``btr``
     (§3.1 table, default 0x4025 = 500 kbit/s): on a bus modelling another bit rate
-    the node hears and sends nothing (``counters.bit_rate_mismatch``)."""
+    the node hears and sends nothing (``counters.bit_rate_mismatch``).  ``set_analog_input(1|2,
+    volts)``: AIN1/AIN2 read 2949 num/V (0xD5/0xD6); with ``analog_command`` = 1 or 2 (the
+    speed command's source in NDrive; 0 = the bus) that input is the speed command, 10 V =
+    29490 num = 90 % of N max (§6.1)."""
 
     def __init__(self, rx_id: int = 0x201, clock: Any = None, *, registers: Any = None, t_out_ms: float = 0,
                  store_path: Optional[str] = None, **options: Any) -> None:

@@ -206,6 +206,12 @@ std::int64_t effective_current_limit_num(const DeviceCurrent& d, std::int64_t mo
     return std::min(motor_limit_num, static_cast<std::int64_t>(d.i_max_num));
 }
 
+std::int64_t analog_command_num(double volts) {
+    if (!std::isfinite(volts) || std::fabs(volts) > kAnalogMaxVolts)
+        throw InvalidArgument("unitek analog input: " + std::to_string(volts) + " V is outside +/- 10 V");
+    return static_cast<std::int64_t>(std::llround(volts * kAnalogNumPerVolt));
+}
+
 std::span<const BitTiming> bit_timings() {
     // §3.1: transmission rate NBT, setting value BTR, line length max.
     static const std::array<BitTiming, 5> table{{

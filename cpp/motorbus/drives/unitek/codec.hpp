@@ -53,6 +53,14 @@ inline constexpr std::uint8_t kRegDeviceCurrentMax = 0xC4;  // DEVICE_I_MAX: the
 // §6.1 "Current command value range: max. value +/- 9 bit" (the position and speed
 // ranges, "+/- 31 bit" and "+/- 15 bit", are 2^31 - 1 and 2^15 - 1): +/- 511 num.
 inline constexpr std::int64_t kCurrentCommandMax = 511;
+// The analog command inputs (NDrive's list: AIN1 0xD5, AIN2 0xD6): "the analog
+// command value (AIN1, AIN2) 10 V corresponds to 29490 (90 % of the max. speed)" (§6.1).
+inline constexpr std::uint8_t kRegAin1 = 0xD5;
+inline constexpr std::uint8_t kRegAin2 = 0xD6;
+inline constexpr double kAnalogNumPerVolt = 2949.0;
+inline constexpr double kAnalogMaxVolts = 10.0;  // the inputs' +/- 10 V range
+// The num of `volts` on AIN1/AIN2; InvalidArgument outside +/- 10 V (or not finite).
+std::int64_t analog_command_num(double volts);
 
 inline constexpr std::uint32_t kDefaultRxId = 0x201;
 inline constexpr std::uint32_t kDefaultTxId = 0x181;

@@ -31,7 +31,7 @@ Register row(std::uint8_t id, const char* name, bool is_signed, Access a, Quanti
     r.is_signed = is_signed;
     r.access = a;
     r.quantity = q;
-    r.unit = q == Quantity::Current ? "A" : "";
+    if (q == Quantity::Current) r.unit.push_back('A');  // (GCC 12 -Wrestrict misfires on a ternary literal)
     r.min = lo;
     r.max = hi;
     r.description = what;
@@ -69,6 +69,14 @@ RegisterTable sim_default_table() {
               "the motor's peak current limit in num (NDrive list, not in 002)"));
     t.add(row(kRegDeviceCurrentMax, "DEVICE_I_MAX", false, Access::ReadOnly, Quantity::Current, 1, 0,
               "the device's peak current in num, §6.1 table (NDrive list)"));
+    Register a1 = row(kRegAin1, "AIN1", true, Access::ReadOnly, Quantity::Speed, 1, 0,
+                      "analog command input 1: 10 V = 29490 num (§6.1; NDrive list)");
+    a1.unit = "rpm";
+    t.add(a1);
+    a1.regid = kRegAin2;
+    a1.name = "AIN2";
+    a1.description = "analog command input 2: 10 V = 29490 num (§6.1; NDrive list)";
+    t.add(a1);
     return t;
 }
 
@@ -83,6 +91,11 @@ void SimConfig::validate() const {
         throw InvalidArgument("unitek sim torque_continuous_num: 0..32767");
     device_current(device);
     bit_timing_for_btr(btr);
+    if (analog_command < 0 || analog_command > 2) {
+        std::string what = "unitek sim analog_command: 0 (the bus), 1 (AIN1) or 2 (AIN2), not ";
+        what += std::to_string(analog_command);  // appended: GCC 12's -Wrestrict misfires on "..." + string
+        throw InvalidArgument(what);
+    }
     if (motor_i_max_num && (*motor_i_max_num < 0 || *motor_i_max_num > kCurrentCommandMax))
         throw InvalidArgument("unitek sim motor_i_max_num: 0..511 num (the +/- 9-bit current range), not " +
                               std::to_string(*motor_i_max_num));
@@ -357,6 +370,7 @@ void UnitekSim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
             if (!(mode_ & kModeDisable)) err_warn_ &= ~kErrorBits;  // enabling again clears the errors
             if ((mode_ & kModeEvents) && !(old & kModeEvents)) last_status_ = status_locked();  // no frame at activation
             apply_enable_locked();
+            if ((old & kModeDisable) && !(mode_ & kModeDisable)) analog_speed_locked();
             break;
         }
         case kRegRxId:
@@ -455,6 +469,8 @@ std::int64_t UnitekSim::value_locked(std::uint8_t regid) {
             return std::clamp<std::int64_t>(regs_[kRegCurrentCmd], -lim, lim);
         }
         case kRegDeviceCurrentMax: return static_cast<std::int64_t>(device_current(cfg_.device).i_max_num);
+        case kRegAin1: return ain_[0];
+        case kRegAin2: return ain_[1];
         case kRegSpeedActual: {
             const double num = motor_.pulse_velocity() / unitek_num_to_counts_per_s(1.0, ramps_locked());
             return static_cast<std::int64_t>(std::llround(std::clamp(num, -kFull, kFull)));
@@ -484,7 +500,7 @@ std::int64_t UnitekSim::current_limit_locked() const {
     send(out_frames)
 
 void UnitekSim::set_hardware_enable(bool on) {
-    UNITEK_SIM_LOCKED(hw_enable_ = on; apply_enable_locked());
+    UNITEK_SIM_LOCKED(hw_enable_ = on; apply_enable_locked(); if (on) analog_speed_locked());
 }
 
 void UnitekSim::force_limit(int direction, std::optional<bool> active) {
@@ -494,6 +510,20 @@ void UnitekSim::force_limit(int direction, std::optional<bool> active) {
         // A limit switch stops a motion towards it (the drive's own limit reaction).
         if (active.value_or(false) && motor_.moving() && motor_.pulse_velocity() * direction > 0) motor_.halt();
     });
+}
+
+void UnitekSim::set_analog_input(int channel, double volts) {
+    if (channel != 1 && channel != 2) throw InvalidArgument("unitek sim analog input: 1 (AIN1) or 2 (AIN2)");
+    const std::int64_t num = analog_command_num(volts);
+    UNITEK_SIM_LOCKED(ain_[channel - 1] = num; analog_speed_locked());
+}
+
+void UnitekSim::analog_speed_locked() {
+    // The analog input is the speed command when NDrive selects it; like SPEED_CMD,
+    // it takes effect while the drive is enabled.
+    if (cfg_.analog_command == 0 || !(status_locked() & kStatusEna)) return;
+    activity_ = Activity::Speed;
+    speed_locked(static_cast<double>(ain_[cfg_.analog_command - 1]), 1.0);
 }
 
 void UnitekSim::set_calibrated(bool on) { UNITEK_SIM_LOCKED(calibrated_ = on); }

@@ -56,6 +56,7 @@ struct SimConfig {
     std::string device = "DS 205/405";             // §6.1 current table row
     std::optional<std::int64_t> motor_i_max_num;   // the motor's peak current limit (num); nullopt = the device's
     std::uint16_t btr = kDefaultBtr;               // NDrive CAN-Setup NBT (§3.1): not changeable over CAN (B-U21)
+    int analog_command = 0;  // the speed command's source (an NDrive setting): 0 = the bus, 1 = AIN1, 2 = AIN2
     void validate() const;           // InvalidArgument naming the field
 };
 
@@ -102,6 +103,9 @@ public:
     // MODE write that enables the drive clears the errors (this sim's reading: how
     // NDrive clears an error is not in 002).  Warning bits (16-31) only show.
     void force_error(std::uint32_t bits);
+    // The voltage on AIN1/AIN2 (+/- 10 V): reads as 2949 num/V (0xD5/0xD6); with
+    // analog_command = that input, it is the speed command (10 V = 29490 = 90 % N max).
+    void set_analog_input(int channel, double volts);
     void power_cycle();  // EEPROM values back, RAM values lost, cyclic/events off, motor stopped
 
     // ---- introspection ----
@@ -163,6 +167,8 @@ private:
     bool calibrated_;
     std::optional<bool> icns_forced_;
     std::uint32_t err_warn_ = 0;  // 0x8F
+    std::int64_t ain_[2] = {0, 0};  // num
+    void analog_speed_locked();
     std::optional<bool> limit_forced_[2];  // [0] minus, [1] plus
     Activity activity_ = Activity::Idle;
     std::uint32_t last_status_ = 0;

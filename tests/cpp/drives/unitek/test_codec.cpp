@@ -1,6 +1,7 @@
 // UNITEK codec and register table against the 002 manual (worked examples, §4-§6).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "motorbus/drives/unitek/codec.hpp"
@@ -161,4 +162,12 @@ TEST(UnitekCodec, SmallerOfMotorAndDeviceCurrentLimit) {  // §6.1
     EXPECT_THROW(effective_current_limit_num(ds205, -1), InvalidArgument);
     EXPECT_THROW(device_current("DS 999"), InvalidArgument);
     EXPECT_EQ(kCurrentCommandMax, 511);
+}
+
+TEST(UnitekCodec, AnalogCommandTenVoltsIs29490) {  // §6.1, B-U18
+    EXPECT_EQ(analog_command_num(10.0), 29490);
+    EXPECT_EQ(analog_command_num(-10.0), -29490);
+    EXPECT_EQ(analog_command_num(1.0), 2949);
+    EXPECT_THROW(analog_command_num(10.01), InvalidArgument);
+    EXPECT_THROW(analog_command_num(std::nan("")), InvalidArgument);
 }
