@@ -421,8 +421,20 @@ def test_profile_velocity_polarity_inputs_latch_and_delta_through_the_transport(
             assert _read(bus, 0x2008) == 2
             latched = _read(bus, 0x2009, 2, signed=True)
             assert 0 < latched <= at
+            # 2009h:01 the pulse counter at the same instant (in counts too while StepNLoop is on).
+            assert abs(_read(bus, 0x2009, 1, signed=True) - latched) <= 2
             assert _read(bus, 0x60FD) & (1 << 17)                       # DI2 = 60FDh bit 17
             sim.set_input(2, False)
+            # A new 60FFh in the same direction changes the speed on the fly: no stop on the way.
+            _ok(bus, 0x60FF, 0, 6000, 4)
+            deadline = time.monotonic() + 3
+            while (v := _read(bus, 0x606C, signed=True)) != 6000:
+                assert v >= 4000 and time.monotonic() < deadline, v
+                time.sleep(0.005)
+            _ok(bus, 0x60FF, 0, 4000, 4)
+            while (v := _read(bus, 0x606C, signed=True)) != 4000:
+                assert v >= 4000 and time.monotonic() < deadline, v
+                time.sleep(0.005)
             # Velocity polarity (607Eh bit 6): the same motion shown negative.
             _ok(bus, 0x607E, 0, 0x40, 1)
             assert _read(bus, 0x606C, signed=True) == -4000
@@ -507,5 +519,109 @@ def test_state_machine_motor_power_quick_stop_and_set_points_through_the_transpo
             _ok(bus, 0x6040, 0, 0x07, 2)
             _ok(bus, 0x6040, 0, 0x00, 2)                                # T6: disable voltage
             assert _state(bus) & 0x4F == 0x40 and _read(bus, 0x2004, 1) == 0
+        finally:
+            bus.shutdown()
+
+
+def _ramp_slope(bus, low: float, high: float, timeout: float) -> float:
+    """counts/s per s between the first samples of 606Ch above `low` and above `high`."""
+    t_low = v_low = None
+    deadline = time.monotonic() + timeout
+    while True:
+        t0 = time.monotonic()
+        v = _read(bus, 0x606C, signed=True)
+        t = (t0 + time.monotonic()) / 2
+        if t_low is None and v > low:
+            t_low, v_low = t, v
+        elif t_low is not None and v > high:
+            return (v - v_low) / (t - t_low)
+        assert t < deadline, v
+        time.sleep(0.01)
+
+
+@pytest.mark.parametrize("acc_ms, slope", [(1000, 19900.0), (30000, 1000.0)])
+def test_acceleration_is_a_time_clamped_by_appendix_a(acc_ms, slope):
+    # 6082h 100 -> 6081h/60FFh 20000 counts/s in 6083h ms: 1 s gives 19 900 counts/s per s; 30 000 ms
+    # exceeds Table A.0's maximum for HSPD 20 000 (delta 1000 -> 19 900 ms): the write is kept and
+    # the move ramps in 19 900 ms, 1000 counts/s per s (unclamped it would be 663).
+    with SimBench([f"{KIND}:{NODE}"], sim_options={KIND: {"plus_limit": 4e6}}) as bench:
+        bus = _bus(bench)
+        try:
+            _ok(bus, 0x6083, 0, acc_ms, 4)
+            assert _read(bus, 0x6083) == acc_ms                         # the value is kept
+            _enable(bus, 3)
+            _ok(bus, 0x60FF, 0, 20000, 4)
+            low, high = (3000, 15000) if acc_ms == 1000 else (400, 1300)
+            assert _ramp_slope(bus, low, high, 5) == pytest.approx(slope, rel=0.1)
+            _ok(bus, 0x6040, 0, 0x02, 2)                                # quick stop
+        finally:
+            bus.shutdown()
+
+
+def test_end_velocity_is_the_start_and_stop_speed_of_a_move():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        bus = _bus(bench)
+        try:
+            for index, value in ((0x6081, 6000), (0x6082, 3000), (0x6083, 300), (0x6084, 300)):
+                _ok(bus, index, 0, value, 4)
+            _enable(bus, 1)
+            _ok(bus, 0x607A, 0, 3000, 4)
+            _ok(bus, 0x6040, 0, 0x1F, 2)
+            seen = []
+            deadline = time.monotonic() + 5
+            while not (_state(bus) & 0x0400 and _read(bus, 0x6064, signed=True) == 3000):
+                seen.append(_read(bus, 0x606C, signed=True))
+                assert time.monotonic() < deadline
+            moving = [v for v in seen if v]
+            assert moving and min(moving) >= 3000 and max(moving) <= 6000, (min(moving), max(moving))
+        finally:
+            bus.shutdown()
+
+
+def test_a_mode_written_while_moving_takes_over_once_idle_and_homing_35():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        sim = bench.sims[(KIND, str(NODE))]
+        bus = _bus(bench)
+        try:
+            for index, value in ((0x6081, 8000), (0x6083, 20), (0x6084, 20)):
+                _ok(bus, index, 0, value, 4)
+            _enable(bus, 1)
+            _ok(bus, 0x607A, 0, 4000, 4)
+            _ok(bus, 0x6040, 0, 0x1F, 2)
+            _ok(bus, 0x6060, 0, 6, 1)                                   # homing, while moving
+            assert _read(bus, 0x6061) == 1
+            deadline = time.monotonic() + 5
+            while _read(bus, 0x6061) != 6:
+                assert time.monotonic() < deadline
+                time.sleep(0.01)
+            assert _read(bus, 0x6064, signed=True) == 4000
+            # Method 35: this position is home, no motion.
+            at = sim.physical_position
+            _ok(bus, 0x6098, 0, 35, 1)
+            _ok(bus, 0x6040, 0, 0x0F, 2)
+            _ok(bus, 0x6040, 0, 0x1F, 2)
+            assert _state(bus) & 0x3400 == 0x1400
+            assert _read(bus, 0x6064, signed=True) == 0 and sim.physical_position == at
+        finally:
+            bus.shutdown()
+
+
+def test_stepnloop_off_positions_are_pulses():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        sim = bench.sims[(KIND, str(NODE))]
+        bus = _bus(bench)
+        try:
+            _ok(bus, 0x2001, 1, 0, 4)                                   # StepNLoop off
+            assert _read(bus, 0x2003) == 12                             # N/A
+            for index, value in ((0x6081, 8000), (0x6083, 20), (0x6084, 20)):
+                _ok(bus, index, 0, value, 4)
+            _enable(bus, 1)
+            _ok(bus, 0x607A, 0, 3200, 4)                                # 3200 pulses = one revolution
+            _ok(bus, 0x6040, 0, 0x1F, 2)
+            deadline = time.monotonic() + 5
+            while _read(bus, 0x6064, signed=True) != 3200:
+                assert time.monotonic() < deadline
+                time.sleep(0.01)
+            assert sim.physical_position == pytest.approx(3200, abs=1)
         finally:
             bus.shutdown()
