@@ -625,3 +625,56 @@ def test_stepnloop_off_positions_are_pulses():
             assert sim.physical_position == pytest.approx(3200, abs=1)
         finally:
             bus.shutdown()
+
+
+@pytest.mark.parametrize("profile_type", [0, 1])
+def test_motion_profile_type_shapes_the_ramp(profile_type):
+    # 100 -> 20000 counts/s in 1000 ms.  Trapezoid: 2000 is reached at 0.10 s, 10000 at 0.50 s (ratio
+    # 0.19); S-curve (6086h = 1, SCV): the ramp starts gently, 2000 at ~0.22 s of ~0.50 s (ratio ~0.44).
+    with SimBench([f"{KIND}:{NODE}"], sim_options={KIND: {"plus_limit": 4e6}}) as bench:
+        bus = _bus(bench)
+        try:
+            _ok(bus, 0x6086, 0, profile_type, 2)
+            _ok(bus, 0x6083, 0, 1000, 4)
+            _enable(bus, 3)
+            t0 = time.monotonic()
+            _ok(bus, 0x60FF, 0, 20000, 4)
+            t1 = t2 = None
+            while t2 is None:
+                v = _read(bus, 0x606C, signed=True)
+                t = time.monotonic()
+                if t1 is None and v > 2000:
+                    t1 = t
+                if v > 10000:
+                    t2 = t
+                assert t - t0 < 5, v
+            ratio = (t1 - t0) / (t2 - t0)
+            assert (ratio > 0.32) if profile_type else (ratio < 0.28), ratio
+            _ok(bus, 0x6040, 0, 0x02, 2)
+        finally:
+            bus.shutdown()
+
+
+def test_idle_current_after_the_idle_time():
+    with SimBench([f"{KIND}:{NODE}"]) as bench:
+        bus = _bus(bench)
+        try:
+            _ok(bus, 0x2004, 2, 1400, 2)                                # run
+            _ok(bus, 0x2004, 3, 400, 2)                                 # idle
+            _ok(bus, 0x2004, 4, 1500, 2)                                # idle time, ms
+            for index, value in ((0x6081, 8000), (0x6083, 20), (0x6084, 20)):
+                _ok(bus, index, 0, value, 4)
+            _enable(bus, 1)
+            _ok(bus, 0x607A, 0, 800, 4)
+            _ok(bus, 0x6040, 0, 0x1F, 2)
+            deadline = time.monotonic() + 5
+            while not _state(bus) & 0x0400 or _read(bus, 0x606C, signed=True) != 0:
+                assert time.monotonic() < deadline
+            stopped = time.monotonic()
+            assert _read(bus, 0x2004, 1) == 1400                        # still the run current
+            while _read(bus, 0x2004, 1) != 400:
+                assert time.monotonic() < deadline + 5
+                time.sleep(0.02)
+            assert time.monotonic() - stopped >= 1.4
+        finally:
+            bus.shutdown()
