@@ -539,8 +539,12 @@ def _ramp_slope(bus, low: float, high: float, timeout: float) -> float:
         time.sleep(0.01)
 
 
-@pytest.mark.parametrize("acc_ms, slope", [(1000, 19900.0), (30000, 1000.0)])
-def test_acceleration_is_a_time_clamped_by_appendix_a(acc_ms, slope):
+@pytest.mark.parametrize("acc_ms, speed, low_speed, window, slope", [
+    (1000, 20000, 100, (3000, 15000), 19900.0),
+    (30000, 20000, 100, (400, 1300), 1000.0),              # E-A12: 20 000 / 100 -> 19 900 ms
+    (30000, 900000, 1000, (20000, 80000), 899000 / 23.05),  # E-A12: 900 000 / 1000 -> 23 050 ms
+])
+def test_acceleration_is_a_time_clamped_by_appendix_a(acc_ms, speed, low_speed, window, slope):
     # 6082h 100 -> 6081h/60FFh 20000 counts/s in 6083h ms: 1 s gives 19 900 counts/s per s; 30 000 ms
     # exceeds Table A.0's maximum for HSPD 20 000 (delta 1000 -> 19 900 ms): the write is kept and
     # the move ramps in 19 900 ms, 1000 counts/s per s (unclamped it would be 663).
@@ -548,11 +552,11 @@ def test_acceleration_is_a_time_clamped_by_appendix_a(acc_ms, slope):
         bus = _bus(bench)
         try:
             _ok(bus, 0x6083, 0, acc_ms, 4)
+            _ok(bus, 0x6082, 0, low_speed, 4)
             assert _read(bus, 0x6083) == acc_ms                         # the value is kept
             _enable(bus, 3)
-            _ok(bus, 0x60FF, 0, 20000, 4)
-            low, high = (3000, 15000) if acc_ms == 1000 else (400, 1300)
-            assert _ramp_slope(bus, low, high, 5) == pytest.approx(slope, rel=0.1)
+            _ok(bus, 0x60FF, 0, speed, 4)
+            assert _ramp_slope(bus, *window, 5) == pytest.approx(slope, rel=0.1)
             _ok(bus, 0x6040, 0, 0x02, 2)                                # quick stop
         finally:
             bus.shutdown()
