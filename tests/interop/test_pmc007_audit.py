@@ -146,6 +146,7 @@ def served():
     with SimBench([f"pmc007:{NODE}"], bus=f"virtual:pmc007-audit-{time.monotonic_ns()}") as bench:
         srv = bench.can.servers[0]
         bus = can.Bus(interface="socketcand", host=srv.host, port=srv.port, channel="can0")
+        drain(bus, 0.3)  # the boot-up may still be on its way: no test should take it for a later one
         try:
             yield bench.sims[("pmc007", str(NODE))], bus, (srv.host, srv.port)
         finally:
@@ -524,3 +525,206 @@ def test_every_row_reads_refuses_stores_and_resets_as_the_table_says(co_node):
     for r in order:
         if r["storage"] == "rom":
             assert _read(node, r) == STORED[(r["index"], r["sub"])], (hex(r["index"]), r["sub"])
+
+
+# ---- behaviours through python-can (B-P04 ... B-P46 where the tests above do not) ----------
+
+def signed32(v: int) -> int:
+    return v - (1 << 32) if v & 0x80000000 else v
+
+
+def wait_idle(bus, timeout: float = 5.0) -> None:
+    deadline = time.monotonic() + timeout
+    while read(bus, 0x6001) & 0x08:
+        assert time.monotonic() < deadline, "still busy"
+        time.sleep(0.05)
+
+
+def test_sdo_abort_selection_block_refused_and_dlc_8_only(served):
+    sim, bus, _ = served
+    assert exchange(bus, frame("40 00 21 00 00 00 00 00")) == frame("80 00 21 00 00 00 02 06")  # 06020000
+    assert exchange(bus, frame("40 00 60 01 00 00 00 00")) == frame("80 00 60 01 11 00 09 06")  # 06090011
+    assert write_abort(bus, 0x6006, 0, 600, 4) == 0x06070012                                  # too long
+    assert write_abort(bus, 0x6006, 0, 60, 1) == 0x06070013                                   # too short
+    assert write_abort(bus, 0x6003, 0, 32001, 4) == 0x06090031
+    assert write_abort(bus, 0x6003, 0, -32001, 4) == 0x06090032
+    assert exchange(bus, frame("A0 08 10 00 7F 00 00 00")) == frame("80 08 10 00 01 00 04 05")  # B-P05
+    bus.send(can.Message(arbitration_id=SDO_TX, data=frame("40 06 60 00"), is_extended_id=False))
+    assert [m for m in drain(bus, 0.4) if m.arbitration_id == SDO_RX] == []                    # B-P06
+    assert read(bus, 0x6006) == 400
+
+
+def test_motion_rules_step_absolute_sign_stop_enable(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x6003, 0, -4000, 4)          # B-P16 / E-P19: negative speed counts down
+    write_ok(bus, 0x6004, 0, 100, 4)
+    wait_idle(bus)
+    assert signed32(read(bus, 0x600C)) == -100
+    write_ok(bus, 0x6003, 0, 4000, 4)
+    write_ok(bus, 0x601C, 0, 200, 4)            # B-P18: absolute target
+    wait_idle(bus)
+    assert read(bus, 0x600C) == 200 and read(bus, 0x601C) == 200
+    write_ok(bus, 0x6003, 0, 1000, 4)
+    write_ok(bus, 0x6004, 0, 100000, 4)
+    assert read(bus, 0x6001) & 0x08             # B-P09
+    write_ok(bus, 0x6004, 0, 5, 4)              # B-P07: ignored while busy, acknowledged
+    assert read(bus, 0x6004) == 100000
+    write_ok(bus, 0x6020, 0, 0, 1)              # B-P14: immediate stop
+    assert read(bus, 0x6001) & 0x08 == 0
+    write_ok(bus, 0x600C, 0, 1000, 4)           # B-P15: the counter is not rescaled by 600Ah
+    write_ok(bus, 0x600A, 0, 16, 2)
+    assert read(bus, 0x600C) == 1000
+    write_ok(bus, 0x600E, 0, 0, 1)              # B-P20: released, step commands refused
+    assert write_abort(bus, 0x6004, 0, 10, 4) == 0x08000022
+    write_ok(bus, 0x600E, 0, 1, 1)
+    sim.inject_error(0x02)                      # B-P19: errors cleared before motion
+    assert write_abort(bus, 0x6004, 0, 10, 4) == 0x08000022
+    write_ok(bus, 0x6000, 0, 0x02, 1)
+    write_ok(bus, 0x6004, 0, 10, 4)
+    wait_idle(bus)
+    assert read(bus, 0x600C) == 1010
+
+
+def test_stall_external_stop_debounce_and_gpio(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x6017, 0, 0x64E6, 2)         # B-P21: threshold 0x64 arms detection (E-P17 row)
+    write_ok(bus, 0x601B, 0, 1, 1)              # stop on stall
+    write_ok(bus, 0x6003, 0, 1000, 4)
+    write_ok(bus, 0x6004, 0, 100000, 4)
+    drain(bus, 0.05)
+    sim.set_jammed(True)
+    time.sleep(0.2)
+    assert read(bus, 0x6001) & 0x0C == 0x04     # stall latched, stopped
+    assert any(bytes(m.data[:2]) == frame("00 FF") for m in drain(bus, 0.2) if m.arbitration_id == EMCY)
+    sim.set_jammed(False)
+    write_ok(bus, 0x6001, 0, 0x04, 1)
+    # B-P22 / B-P23: EXT2 on the rising edge, 601Ah = 100 ms: a shorter glitch is ignored.
+    write_ok(bus, 0x600F, 1, 0x02, 1)
+    write_ok(bus, 0x600F, 2, 0x02, 1)
+    sim.set_input(8, False)                     # low: not the selected edge
+    time.sleep(0.2)
+    sim.set_input(8, True)                      # rising: counts after 100 ms stable...
+    sim.set_input(8, False)                     # ...back within it: a glitch
+    time.sleep(0.3)
+    assert read(bus, 0x6001) & 0x02 == 0
+    sim.set_input(8, True)
+    time.sleep(0.3)
+    assert read(bus, 0x6001) & 0x02
+    # B-P24: 6012h bit = 1 for a low level; outputs (6011h:01) driven by 6012h writes.
+    assert read(bus, 0x6012) & 0x0100 == 0      # EXT2 is high
+    sim.set_input(8, False)
+    write_ok(bus, 0x6011, 1, 0x0003, 2)
+    write_ok(bus, 0x6012, 0, 0x0002, 2)         # GPIO2 low, GPIO1 high
+    assert read(bus, 0x6012) & 0x0103 == 0x0102
+    assert sim.gpio_value & 0x3 == 0x2
+
+
+def test_nmt_states_node_id_heartbeat_and_pdo_rules(served):
+    sim, bus, _ = served
+    drain(bus, 0.2)                             # the boot-up (00) if it is still on its way
+    write_ok(bus, 0x1017, 0, 100, 2)            # B-P29: heartbeat 7F in PRE-OPERATIONAL
+    hb = wait_for(bus, HEARTBEAT)
+    assert hb is not None and bytes(hb.data) == b"\x7f"
+    nmt(bus, 0x02)                              # B-P26: STOPPED: no SDO, heartbeat 04
+    drain(bus, 0.15)
+    hb = wait_for(bus, HEARTBEAT)
+    assert hb is not None and bytes(hb.data) == b"\x04"
+    assert exchange(bus, frame("40 00 10 00 00 00 00 00"), timeout=0.4) is None
+    nmt(bus, 0x80)
+    assert read(bus, 0x1000) == 0
+    write_ok(bus, 0x1017, 0, 0, 2)
+    assert write_abort(bus, 0x1A00, 1, 0x60040020, 4) == 0x06040041   # B-P31: 6004h not mappable
+    assert write_abort(bus, 0x1800, 2, 241, 1) == 0x06090030          # B-P33
+    assert write_abort(bus, 0x1800, 2, 252, 1) == 0x06090030          # RTR-only types: no RTR
+    write_ok(bus, 0x1800, 2, 254, 1)
+    # B-P27 / B-P36: a new node-ID is served from reset communication on; unsaved, reset node
+    # brings the flash value back.
+    write_ok(bus, 0x2002, 0, 6, 1)
+    assert read(bus, 0x2002) == 6
+    drain(bus, 0.05)
+    nmt(bus, 0x82)
+    boot = wait_for(bus, 0x706)
+    assert boot is not None and bytes(boot.data) == b"\x00"
+    bus.send(can.Message(arbitration_id=0x606, data=frame("40 14 10 00 00 00 00 00"), is_extended_id=False))
+    reply = wait_for(bus, 0x586)
+    assert reply is not None and bytes(reply.data) == frame("43 14 10 00 86 00 00 00")  # EMCY id moved
+    nmt(bus, 0x81, node=6)
+    boot = wait_for(bus, HEARTBEAT)
+    assert boot is not None and bytes(boot.data) == b"\x00"
+    assert read(bus, 0x2002) == 5
+
+
+def _word(op: int, option: int = 0, data: int = 0) -> int:
+    # The spec's reading of the word (§1.10 [P]): opcode 31-24, option 23-20, data 19-0.
+    return op << 24 | option << 20 | data
+
+
+ROT, MIC, DIR, EXTEN, FREE, CLR2, CLR1, VSET, ACC, TRIG, CNTI, CNTC, JMP, JNE, JEQ, WAIT, OUT, CMP, \
+    RESET_EN, PAUSE_EN = range(1, 21)
+PROGRAM = [
+    _word(CLR1), _word(CLR2),                   # 0-1: the latched EXT1/EXT2 would refuse ROT
+    _word(MIC, 0, 16), _word(ACC, 0, 5), _word(DIR, 0, 1), _word(VSET, 0, 4000),   # 2-5
+    _word(CNTC),                                # 6
+    _word(ROT, 0, 200), _word(WAIT, 1, 0), _word(CNTI), _word(CMP, 1, 3), _word(JNE, 0, 7),  # 7-11: 3 x 200
+    _word(OUT, 3, 1),                           # 12: GPO3 low (GPI1/GPI2 are the RESET/PAUSE inputs)
+    _word(EXTEN, 0, 1), _word(TRIG, 0, 2), _word(FREE, 0, 0),   # 13-15
+    _word(JEQ, 0, 18), _word(DIR, 0, 0),        # 16-17: flag 1 (CMP): 17 skipped
+    _word(JMP, 0, 20), _word(DIR, 0, 0),        # 18-19: 19 skipped
+    _word(RESET_EN, 1, 0), _word(PAUSE_EN, 1, 0),   # 20-21: GPI1 low = restart at 0, GPI2 low = pause
+]
+
+
+def test_offline_program_every_instruction_over_sdo(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x601A, 0, 0, 2)              # no debounce: input edges count at once
+    write_ok(bus, 0x600F, 1, 0x03, 1)           # latch EXT1 and EXT2 (falling edges)...
+    sim.set_input(7, False)
+    sim.set_input(8, False)
+    sim.set_input(7, True)
+    sim.set_input(8, True)
+    write_ok(bus, 0x600F, 1, 0x00, 1)           # ...and disable them: the latches stay
+    assert read(bus, 0x6001) & 0x03 == 0x03
+    # B-P42: the manual's SDO sequence; B-P41: 100 instructions at most.
+    write_ok(bus, 0x6018, 2, 0, 1)
+    for i, w in enumerate(PROGRAM):
+        write_ok(bus, 0x6019, 1, i, 1)
+        write_ok(bus, 0x6019, 2, w, 4)
+    write_ok(bus, 0x6018, 1, len(PROGRAM), 1)
+    assert write_abort(bus, 0x6018, 1, 101, 1) in (0x06090030, 0x06090031)
+    for i, w in enumerate(PROGRAM):             # read back word by word
+        write_ok(bus, 0x6019, 1, i, 1)
+        assert read(bus, 0x6019, 2) == w
+    write_ok(bus, 0x6019, 3, 1, 1)              # to flash
+    write_ok(bus, 0x6018, 2, 1, 1)              # run now
+    deadline = time.monotonic() + 5
+    while sim.program_running and time.monotonic() < deadline:
+        time.sleep(0.05)
+    wait_idle(bus)
+    assert read(bus, 0x600C) == 600             # ROT/WAIT/CNTI/CMP/JNE: three moves of 200 (B-P43, B-P44)
+    assert read(bus, 0x600A) == 16 and read(bus, 0x6008) == 5           # MIC, ACC
+    assert read(bus, 0x6002) == 1 and read(bus, 0x6003) == 4000         # DIR (17, 19 skipped), VSET
+    assert read(bus, 0x600F, 1) == 0x03 and read(bus, 0x600F, 2) == 0x02  # EXTEN, TRIG
+    assert read(bus, 0x6005) == 0 and read(bus, 0x6001) & 0x03 == 0     # FREE; CLR1, CLR2
+    assert read(bus, 0x6012) & 0x07 == 0x04     # OUT 3,1: GPO3 low (B-P46)
+    # B-P45: GPI1 low restarts at 0 (RESET_EN); GPI2 low pauses (PAUSE_EN) after the move in flight.
+    sim.set_input(0, False)
+    sim.set_input(1, False)
+    time.sleep(0.6)
+    wait_idle(bus)
+    assert read(bus, 0x600C) == 800             # one move of 200, then paused
+    sim.set_input(1, True)
+    sim.set_input(1, False)                     # a second pulse resumes
+    deadline = time.monotonic() + 5
+    while sim.program_running and time.monotonic() < deadline:
+        time.sleep(0.05)
+    wait_idle(bus)
+    assert read(bus, 0x600C) == 1200
+    # B-P41: saved with 6018h:02 = 1 by 2007h = 2, the program runs at power-up.
+    write_ok(bus, 0x2007, 0, 2, 1)
+    sim.power_cycle()
+    assert wait_for(bus, HEARTBEAT) is not None
+    deadline = time.monotonic() + 5
+    while sim.program_running and time.monotonic() < deadline:
+        time.sleep(0.05)
+    wait_idle(bus)
+    assert read(bus, 0x600C) == 600
