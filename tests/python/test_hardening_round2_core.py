@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import math
+import os
 import random
 import resource
 import subprocess
@@ -60,7 +61,6 @@ def _in_thread(fn):
 # ---------------------------------------------------------------------------
 # item 4: link loss and close() end a transfer in flight
 
-@pytest.mark.threaded
 @pytest.mark.parametrize("timeout", [30.0, math.inf])
 @pytest.mark.parametrize("block", [False, True])
 def test_sdo_transfer_ends_with_linkdown_when_the_server_is_killed(timeout, block):
@@ -85,7 +85,6 @@ def test_sdo_transfer_ends_with_linkdown_when_the_server_is_killed(timeout, bloc
         served.close()
 
 
-@pytest.mark.threaded
 def test_sdo_transfer_ends_with_closederror_when_the_bus_is_closed_from_another_thread():
     bus = motorbus.open_bus(f"virtual:{_hub('close')}")
     sdo = SdoClient(bus, 9, timeout=math.inf)
@@ -105,7 +104,6 @@ def _cia402_bench():
                             "axis": {"z": {"kind": "cia402", "bus": "can0", "address": 5}}}, sim=True)
 
 
-@pytest.mark.threaded
 def test_a_poller_asking_by_sdo_ends_with_linkdown_when_the_server_dies():
     bench = _cia402_bench()
     try:
@@ -172,7 +170,6 @@ def test_block_uploads_under_bit_flips_return_exact_data_or_raise(rate):
 # ---------------------------------------------------------------------------
 # item 6 (issue 22): two clients, one node, one pair of COB-IDs, through socketcand
 
-@pytest.mark.threaded
 def test_two_clients_on_one_node_through_socketcand_each_get_their_own_answers():
     name = _hub("two")
     dev = motorbus.open_bus(f"virtual:{name}")
@@ -220,7 +217,6 @@ def test_two_clients_on_one_node_through_socketcand_each_get_their_own_answers()
 # ---------------------------------------------------------------------------
 # item 8: a second capturing Poller gets fresh samples
 
-@pytest.mark.threaded
 def test_a_second_capturing_poller_on_a_cia402_sim_gets_fresh_samples():
     with _cia402_bench() as bench:
         z = bench["z"]
@@ -272,7 +268,8 @@ def test_127_simulated_nodes_keep_bounded_receive_queues():
         print(f"\n[127 nodes] {frames} frames each: RSS +{grown:.1f} MB")
         # Unbounded they held 127 x 6000 frames (~60 MB); capped, 127 x 1024 (~10 MB).
         assert all(b.counters.rx_dropped == frames - 1024 for b in buses)
-        assert grown < 40, f"RSS grew {grown:.1f} MB"
+        if "asan" not in os.environ.get("LD_PRELOAD", ""):   # ASan's quarantine keeps freed blocks
+            assert grown < 40, f"RSS grew {grown:.1f} MB"
         # recv() still works on such a bus: the newest frames were kept.
         got = buses[0].recv_many(10_000, timeout=0)
         assert len(got) == 1024 and got[-1].data == (frames - 1).to_bytes(4, "little")
