@@ -728,3 +728,100 @@ def test_offline_program_every_instruction_over_sdo(served):
         time.sleep(0.05)
     wait_idle(bus)
     assert read(bus, 0x600C) == 600
+
+
+# ---- the position-mode profile over SDO, on a simulated clock (B-P11, B-P13, E-P15) ---------
+# Gear g = the ramp's average acceleration (pps², 003 §4.5.12): from the start speed 6006h to
+# 6003h in (6003h - 6006h) / gear seconds, covering the mean speed times that time.
+
+GEARS = {1: 77440, 2: 48410, 3: 27170, 4: 21510, 5: 14080, 6: 10460, 7: 6915, 8: 5210}
+
+
+@pytest.fixture
+def clocked():
+    from motorbus import _core as core
+    clock = core.SimClock(1_000_000_000)
+    with SimBench([f"pmc007:{NODE}"], bus=f"virtual:pmc007-audit-clk-{time.monotonic_ns()}",
+                  clock=clock) as bench:
+        srv = bench.can.servers[0]
+        bus = can.Bus(interface="socketcand", host=srv.host, port=srv.port, channel="can0")
+        drain(bus, 0.3)
+        try:
+            yield bench.sims[("pmc007", str(NODE))], bus, clock
+        finally:
+            _backlog.pop(id(bus), None)
+            bus.shutdown()
+
+
+def at(sim, clock, bus, t0: int, seconds: float) -> int:
+    clock.set(t0 + int(seconds * 1e9))
+    sim.poll()
+    return signed32(read(bus, 0x600C))
+
+
+@pytest.mark.parametrize("gear", sorted(GEARS))
+def test_position_move_start_speed_gear_ramps_cruise_and_end(clocked, gear):
+    sim, bus, clock = clocked
+    a = GEARS[gear]
+    write_ok(bus, 0x6006, 0, 400, 2)            # start speed (factory 400)
+    write_ok(bus, 0x6007, 0, 0, 2)              # stop speed
+    write_ok(bus, 0x6008, 0, gear, 1)
+    write_ok(bus, 0x6009, 0, gear, 1)
+    write_ok(bus, 0x6003, 0, 4000, 4)
+    t_up, d_up = 3600 / a, (400 + 4000) / 2 * 3600 / a
+    t_down, d_down = 4000 / a, 4000 / 2 * 4000 / a
+    steps = 20000
+    t_cruise = (steps - d_up - d_down) / 4000
+    t0 = clock.now()                            # the clock stands still while the command is sent
+    write_ok(bus, 0x6004, 0, steps, 4)
+    assert abs(at(sim, clock, bus, t0, t_up) - d_up) <= 0.01 * d_up + 2          # the ramp: gear and 6006h
+    p1 = at(sim, clock, bus, t0, t_up + 0.5)
+    p2 = at(sim, clock, bus, t0, t_up + 1.0)
+    assert abs((p2 - p1) - 2000) <= 2                                           # cruise at 6003h
+    end = t_up + t_cruise + t_down
+    at(sim, clock, bus, t0, end - 0.05)
+    assert read(bus, 0x6001) & 0x08                                             # still decelerating
+    assert at(sim, clock, bus, t0, end + 0.05) == steps
+    assert read(bus, 0x6001) & 0x08 == 0
+
+
+def test_speed_mode_ramps_up_and_decelerates_with_the_6009h_gear(clocked):
+    sim, bus, clock = clocked
+    write_ok(bus, 0x6008, 0, 8, 1)
+    write_ok(bus, 0x6009, 0, 6, 1)
+    write_ok(bus, 0x6003, 0, -4000, 4)          # B-P12: the sign is the direction
+    t0 = clock.now()
+    write_ok(bus, 0x6005, 0, 1, 1)              # runs at the 6003h in force
+    t_up = 3600 / GEARS[8]
+    p1 = at(sim, clock, bus, t0, t_up + 1.0)
+    p2 = at(sim, clock, bus, t0, t_up + 2.0)
+    assert p2 - p1 == -4000
+    t1 = clock.now()
+    write_ok(bus, 0x6005, 0, 0, 1)              # speed -> position: decelerates with 6009h
+    t_down = 4000 / GEARS[6]
+    at(sim, clock, bus, t1, t_down - 0.05)
+    assert read(bus, 0x6001) & 0x08
+    p3 = at(sim, clock, bus, t1, t_down + 0.05)
+    assert read(bus, 0x6001) & 0x08 == 0
+    assert abs((p2 - p3) - 4000 / 2 * t_down) <= 0.01 * 4000 / 2 * t_down + 2
+
+
+# ---- B-P34: an event TPDO never more often than its inhibit time -----------------------------
+
+def test_event_tpdo_respects_the_inhibit_time(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x1800, 1, 0x185, 4)
+    write_ok(bus, 0x1800, 2, 255, 1)
+    write_ok(bus, 0x1800, 3, 5000, 2)           # 500 ms in 100 us units (C-P08)
+    write_ok(bus, 0x1A00, 0, 1, 1)
+    write_ok(bus, 0x1A00, 1, 0x600C0020, 4)     # 600Ch: changes on every step
+    nmt(bus, 0x01)
+    write_ok(bus, 0x6003, 0, 2000, 4)
+    write_ok(bus, 0x6004, 0, 100000, 4)
+    got = [m for m in drain(bus, 1.8) if m.arbitration_id == 0x185]
+    write_ok(bus, 0x6020, 0, 0, 1)
+    assert 2 <= len(got) <= 5, len(got)
+    gaps = [b.timestamp - a.timestamp for a, b in zip(got, got[1:])]
+    assert min(gaps) >= 0.3, gaps               # 500 ms apart at the sender (receive jitter allowed)
+    values = [int.from_bytes(m.data, "little") for m in got]
+    assert values == sorted(values) and len(set(values)) == len(values)
