@@ -633,6 +633,13 @@ def test_nmt_states_node_id_heartbeat_and_pdo_rules(served):
     nmt(bus, 0x80)
     assert read(bus, 0x1000) == 0
     write_ok(bus, 0x1017, 0, 0, 2)
+    # B-P29 consumer [P]: node 1 watched at 100 ms; its heartbeat stops: EMCY 8130h, no state change.
+    write_ok(bus, 0x1016, 1, 0x00010064, 4)
+    bus.send(can.Message(arbitration_id=0x701, data=[0x05], is_extended_id=False))
+    lost = [m for m in drain(bus, 0.8) if m.arbitration_id == EMCY]
+    assert [bytes(m.data[:2]) for m in lost] == [frame("30 81")], lost
+    write_ok(bus, 0x1016, 1, 0, 4)
+    assert read(bus, 0x1000) == 0               # still PRE-OPERATIONAL: SDO answered
     assert write_abort(bus, 0x1A00, 1, 0x60040020, 4) == 0x06040041   # B-P31: 6004h not mappable
     assert write_abort(bus, 0x1800, 2, 241, 1) == 0x06090030          # B-P33
     assert write_abort(bus, 0x1800, 2, 252, 1) == 0x06090030          # RTR-only types: no RTR
@@ -825,3 +832,19 @@ def test_event_tpdo_respects_the_inhibit_time(served):
     assert min(gaps) >= 0.3, gaps               # 500 ms apart at the sender (receive jitter allowed)
     values = [int.from_bytes(m.data, "little") for m in got]
     assert values == sorted(values) and len(set(values)) == len(values)
+
+
+def test_rot_does_not_wait_for_the_end_of_its_move(served):
+    # B-P43: ROT starts the rotation and the next instruction runs at once: a second ROT
+    # finds the motor busy and is ignored (B-P07), unless a WAIT 1,0 separates them.
+    sim, bus, _ = served
+    write_ok(bus, 0x6003, 0, 4000, 4)
+    for i, w in enumerate([_word(ROT, 0, 200), _word(ROT, 0, 200)]):
+        write_ok(bus, 0x6019, 1, i, 1)
+        write_ok(bus, 0x6019, 2, w, 4)
+    write_ok(bus, 0x6018, 1, 2, 1)
+    write_ok(bus, 0x6018, 2, 1, 1)
+    time.sleep(0.3)
+    wait_idle(bus)
+    assert read(bus, 0x600C) == 200
+    assert not sim.program_running
