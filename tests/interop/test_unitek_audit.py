@@ -77,13 +77,11 @@ def bench():
 
 # ---- item 15: the EEPROM keeps every writable register -----------------------------------
 
-WRITES = [  # (REGID, value, signed): every writable register of the served table
+WRITES = [  # (REGID, value, signed): the manual's writable registers with a readable value
     (0x35, 500, False),        # ACC ramp (ex 6)
     (0x52, 0x0012, False),     # event mask: the limit switches (ex 10-1)
     (0x31, 3277, True),        # SPEED_CMD 10 % (ex 3)
     (0x90, 16380, True),       # TORQUE_CMD 50 % (ex 5)
-    (0x24, 100, False),        # I_MAX (NDrive list)
-    (0x26, -77, True),         # I_CMD (NDrive list)
 ]
 
 
@@ -132,6 +130,20 @@ def test_eeprom_store_keeps_every_writable_register(bench, level):
     assert int.from_bytes(ev[0][1:5], "little") & Status.LIM_PLUS
     # Stored set-points read back but start nothing at power-up.
     assert sim.speed_num == 0
+
+
+def test_eeprom_store_keeps_the_current_registers_too(bench):
+    sim, peer = bench
+    send(peer, [0x24, *le16(100)])                 # I_MAX (NDrive list)
+    send(peer, [0x26, *le16(-77)])                 # I_CMD (NDrive list)
+    send(peer, [0x84, 0x00, 0x00])
+    send(peer, [0x24, *le16(50)])
+    send(peer, [0x26, *le16(5)])
+    settle(sim, 5)
+    sim.power_cycle()
+    assert read(peer, 0x24) == 100
+    assert read(peer, 0x26, signed=True) == -77
+    assert read(peer, 0x20, signed=True) == -77    # within both limits
 
 
 def test_a_power_cycle_without_a_store_keeps_the_factory_values(bench):
@@ -247,10 +259,10 @@ def test_a_node_at_another_bit_rate_is_silent_and_deaf():
     with SimBench(["unitek:0x201"], bitrate=250000) as b:
         sim, peer = b.sims[("unitek", "0x201")], peer_of(b)
         try:
-            assert sim.bus_bit_rate == 250000
             send(peer, [0x3D, 0x40, 0x00])
             send(peer, [0x35, 0xF4, 0x01])
             assert frames(peer, 0.4) == []
+            assert sim.bus_bit_rate == 250000
             end = time.monotonic() + 2
             while sim.counters.bit_rate_mismatch < 2:
                 assert time.monotonic() < end
