@@ -34,7 +34,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoCaptureSource', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'PollGroup', 'PollSource', 'PollStats', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekCaptureSource', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_poll_source', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_poll_source', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'sdo_poll_source', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_capture_source', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_poll_source', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoCaptureSource', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'PollGroup', 'PollSource', 'PollStats', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekCaptureSource', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_poll_source', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_poll_source', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'sdo_poll_source', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_analog_command_num', 'unitek_bit_rate_for_btr', 'unitek_bit_timings', 'unitek_btr_for_bit_rate', 'unitek_capture_source', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_effective_current_limit_num', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_poll_source', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -3761,6 +3761,11 @@ class DmacSim(LineDevice):
     """
     A simulated DMAC module (a LineDevice: serve it with PtyLineServer). Device time runs on `clock` (a SimClock in tests); nothing runs in the background.
     """
+    @staticmethod
+    def chain_ultrasync(modules: collections.abc.Sequence[DmacSim]) -> None:
+        """
+        Wire IN6/OUT1 of these modules into one UltraSYNC chain (5.11), before serving them: with #INTERPOL_MODE:=-1 a segment ends when it is finished on every chained module.
+        """
     def __init__(self, clock: Clock = None, address: typing.SupportsInt | typing.SupportsIndex = 0, model: str = 'DMAC34-1', request_terminator: bytes = b'\r', reply_terminator: bytes = b'\r\n', supply_voltage: typing.SupportsInt | typing.SupportsIndex = 32000, baudrate: typing.SupportsInt | typing.SupportsIndex = 38400, positive_end_switch: typing.SupportsFloat | typing.SupportsIndex | None = None, negative_end_switch: typing.SupportsFloat | typing.SupportsIndex | None = None, end_switch_active_low: bool = False, reference_switch: typing.SupportsFloat | typing.SupportsIndex | None = None) -> None:
         ...
     def inject_error(self, bit: typing.SupportsInt | typing.SupportsIndex) -> None:
@@ -3783,6 +3788,10 @@ class DmacSim(LineDevice):
         ...
     def set_input(self, n: typing.SupportsInt | typing.SupportsIndex, active: bool) -> None:
         ...
+    def set_speed_limit(self, inc_per_s: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        """
+        A mechanical limit (friction, a brake): an interpolation segment faster than this (increments/s) lasts |offset|/limit instead of #INTERPOL_TIME. 0 = none.
+        """
     def set_supply_voltage(self, mv: typing.SupportsInt | typing.SupportsIndex) -> None:
         """
         Supply voltage in mV; outside the model's range latches undervoltage/overvoltage and stops the motor.
@@ -4570,6 +4579,9 @@ class UnitekClient:
         ...
 class UnitekSimCounters:
     @property
+    def bit_rate_mismatch(self) -> int:
+        ...
+    @property
     def cyclic_refused(self) -> int:
         ...
     @property
@@ -4597,7 +4609,7 @@ class UnitekSim:
     """
     A simulated UNITEK servo on the register protocol (see sim.hpp).
     """
-    def __init__(self, clock: Clock, rx_id: typing.SupportsInt | typing.SupportsIndex = 513, tx_id: typing.SupportsInt | typing.SupportsIndex = 385, n_max_rpm: typing.SupportsFloat | typing.SupportsIndex = 3000.0, acc_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0, dec_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0, position_control: bool = True, speed_control: bool = True, calibrated: bool = False, tol_num: typing.SupportsInt | typing.SupportsIndex = 64, minus_limit_num: typing.SupportsFloat | typing.SupportsIndex | None = -6553600.0, plus_limit_num: typing.SupportsFloat | typing.SupportsIndex | None = 6553600.0, torque_continuous_num: typing.SupportsInt | typing.SupportsIndex = 32767, dummy: typing.SupportsInt | typing.SupportsIndex = 0, table: UnitekRegisterTable | None = None) -> None:
+    def __init__(self, clock: Clock, rx_id: typing.SupportsInt | typing.SupportsIndex = 513, tx_id: typing.SupportsInt | typing.SupportsIndex = 385, n_max_rpm: typing.SupportsFloat | typing.SupportsIndex = 3000.0, acc_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0, dec_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0, position_control: bool = True, speed_control: bool = True, calibrated: bool = False, tol_num: typing.SupportsInt | typing.SupportsIndex = 64, minus_limit_num: typing.SupportsFloat | typing.SupportsIndex | None = -6553600.0, plus_limit_num: typing.SupportsFloat | typing.SupportsIndex | None = 6553600.0, torque_continuous_num: typing.SupportsInt | typing.SupportsIndex = 32767, dummy: typing.SupportsInt | typing.SupportsIndex = 0, table: UnitekRegisterTable | None = None, device: str = 'DS 205/405', motor_i_max_num: typing.SupportsInt | typing.SupportsIndex | None = None, btr: typing.SupportsInt | typing.SupportsIndex = 16421, analog_command: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
     def attach(self, bus: Bus) -> None:
         ...
@@ -4629,12 +4641,26 @@ class UnitekSim:
         """
         emit every frame due by the clock's now; returns the next due time (ns, -1 none)
         """
+    def set_analog_input(self, channel: typing.SupportsInt | typing.SupportsIndex, volts: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        """
+        AIN1/AIN2 (+/- 10 V, 2949 num/V); the speed command when analog_command names the input
+        """
     def set_calibrated(self, on: bool) -> None:
         ...
     def set_hardware_enable(self, on: bool) -> None:
         ...
     def value(self, regid: typing.SupportsInt | typing.SupportsIndex) -> int:
         ...
+    @property
+    def bit_rate(self) -> float:
+        """
+        bit/s of its BTR (§3.1 table)
+        """
+    @property
+    def bus_bit_rate(self) -> float:
+        """
+        bit/s of the bus it is attached to (0: none modelled)
+        """
     @property
     def counters(self) -> UnitekSimCounters:
         ...
@@ -4910,6 +4936,18 @@ def time_decode(frame: Frame) -> typing.Any:
     """
 def time_encode(unix_ms: typing.SupportsInt | typing.SupportsIndex) -> Frame:
     ...
+def unitek_analog_command_num(volts: typing.SupportsFloat | typing.SupportsIndex) -> int:
+    """
+    §6.1: the num of an analog command (10 V = 29490)
+    """
+def unitek_bit_rate_for_btr(btr: typing.SupportsInt | typing.SupportsIndex) -> float:
+    ...
+def unitek_bit_timings() -> list:
+    """
+    §3.1: bit rate (kbit/s), BTR setting value, longest line (m)
+    """
+def unitek_btr_for_bit_rate(bit_rate: typing.SupportsFloat | typing.SupportsIndex) -> int:
+    ...
 def unitek_capture_source(client: UnitekClient, regids: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], interval_ms: typing.SupportsInt | typing.SupportsIndex, max_age: typing.Any = None) -> UnitekCaptureSource:
     """
     Subscribes each register every interval_ms (unless it already transmits) and captures it; max_age (s, default 3 intervals + 2 ms): older data counts as stale.
@@ -4926,6 +4964,10 @@ def unitek_decode_to_drive(data: typing.Any) -> tuple[int, int, int]:
     """
 def unitek_device_currents() -> list:
     ...
+def unitek_effective_current_limit_num(device: str, motor_limit_num: typing.SupportsInt | typing.SupportsIndex) -> int:
+    """
+    §6.1: the smaller of the motor's and the device's peak current (num)
+    """
 def unitek_encode_reply(regid: typing.SupportsInt | typing.SupportsIndex, raw: typing.SupportsInt | typing.SupportsIndex, bits: typing.SupportsInt | typing.SupportsIndex = 16, dummy: typing.SupportsInt | typing.SupportsIndex = 0) -> bytes:
     ...
 def unitek_encode_request(regid: typing.SupportsInt | typing.SupportsIndex, interval: typing.SupportsInt | typing.SupportsIndex) -> bytes:
