@@ -848,3 +848,15 @@ def test_rot_does_not_wait_for_the_end_of_its_move(served):
     wait_idle(bus)
     assert read(bus, 0x600C) == 200
     assert not sim.program_running
+
+
+def test_run_one_instruction_and_clear_the_error_history(served):
+    sim, bus, _ = served
+    write_ok(bus, 0x6019, 1, 4, 1)              # 6019h:05 = 1 runs the word at the pointer (B-P42)
+    write_ok(bus, 0x6019, 2, _word(MIC, 0, 32), 4)
+    write_ok(bus, 0x6019, 5, 1, 2)
+    assert read(bus, 0x600A) == 32 and read(bus, 0x6019, 5) == 0
+    sim.inject_error(0x20)                      # 1003h logs 4200h; writing 0 to 1003h:00 clears it
+    assert read(bus, 0x1003, 0) == 1 and read(bus, 0x1003, 1) == 0x4200
+    write_ok(bus, 0x1003, 0, 0, 1)
+    assert read(bus, 0x1003, 0) == 0 and read(bus, 0x1003, 1) == 0
