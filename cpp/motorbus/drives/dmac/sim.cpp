@@ -273,17 +273,21 @@ void DmacSim::catch_up_locked() {
     // A module with nothing evolving jumps to now on its own (the chain only ever
     // releases modules that interpolate, which are never idle).
     const auto& ms = chain_->members;
+    std::vector<std::int64_t> target;  // read once: a real clock moves on while this loop runs
+    for (auto* m : ms) target.push_back(m->target_ms());
     for (;;) {
         Nanos next = std::numeric_limits<Nanos>::max();
-        for (auto* m : ms) {
-            if (m->now_ms_ >= m->target_ms()) continue;
-            if (m->idle_locked()) m->catch_up_self_locked(m->target_ms());
+        for (std::size_t i = 0; i < ms.size(); ++i) {
+            DmacSim* m = ms[i];
+            if (m->now_ms_ >= target[i]) continue;
+            if (m->idle_locked()) m->catch_up_self_locked(target[i]);
             else next = std::min(next, m->tick_time() + kNsPerMs);
         }
         if (next == std::numeric_limits<Nanos>::max()) return;
-        for (auto* m : ms)
-            if (m->now_ms_ < m->target_ms() && !m->idle_locked() && m->tick_time() + kNsPerMs <= next)
-                m->tick_locked();
+        for (std::size_t i = 0; i < ms.size(); ++i) {
+            DmacSim* m = ms[i];
+            if (m->now_ms_ < target[i] && !m->idle_locked() && m->tick_time() + kNsPerMs <= next) m->tick_locked();
+        }
         // IN6/OUT1: a segment ends when it is finished on every module in UltraSYNC.
         bool any = false, all_done = true;
         for (auto* m : ms)
