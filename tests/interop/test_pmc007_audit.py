@@ -292,6 +292,7 @@ def test_12_any_cob_id_may_be_configured(served):
     assert read(bus, 0x1800, 1) == 0x120
     write_ok(bus, 0x1400, 1, 0x5F0, 4)          # RPDO1 in the SDO range 0x581-0x5FF
     assert read(bus, 0x1400, 1) == 0x5F0
+    assert [m for m in drain(bus, 0.3) if m.arbitration_id == 0x120] == []   # B-P26: no PDO in PRE-OPERATIONAL
     nmt(bus, 0x01)
     m = wait_for(bus, 0x120)
     assert m is not None and bytes(m.data) == b"\x00"

@@ -3,6 +3,7 @@
 // a SimClock advanced by the test.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -163,6 +164,43 @@ TEST_F(SimFixture, AbortSelection) {
     EXPECT_EQ(abort_of([&] { sdo->write_u8(0x2007, 0, 4); }), 0x06090030u);
     EXPECT_EQ(sdo->read_u8(0x2007, 0), 0);
     EXPECT_EQ(sdo->read_string(0x1008, 0), "PMC007 (motorbus sim)");  // segmented upload
+    // Issue 23 #12: value sets answer 06090030, a mapping count above 8 06040042.
+    EXPECT_EQ(abort_of([&] { sdo->write_u8(0x1003, 0, 8); }), 0x06090030u);
+    EXPECT_EQ(abort_of([&] { sdo->write_u16(0x600A, 0, 512); }), 0x06090030u);
+    EXPECT_EQ(abort_of([&] { sdo->write_u8(0x6020, 0, 1); }), 0x06090030u);
+    EXPECT_EQ(abort_of([&] { sdo->write_u8(0x1A00, 0, 9); }), 0x06040042u);
+    EXPECT_EQ(abort_of([&] { sdo->write_u16(0x6021, 0, 700); }), 0x06090030u);
+    sdo->write_u8(0x6019, 1, 100);  // #13: the pointer reaches 100
+    EXPECT_EQ(sdo->read_u8(0x6019, 1), 100);
+}
+
+// Issue 23 #6, #10, #12: no RTR answer, any COB-ID, SYNC on the 1005h COB-ID.
+TEST_F(SimFixture, PdoRtrNeverSyncOnItsCobIdAnyCobId) {
+    sdo->write_u32(0x1800, 1, 0x120);  // CiA 301 restricted range: accepted
+    sdo->write_u8(0x1800, 2, 1);       // every SYNC
+    sdo->write_u8(0x1A00, 0, 1);
+    sdo->write_u32(0x1A00, 1, 0x60010008);
+    std::atomic<int> tpdos{0};
+    auto sub = host->subscribe(can::Filter{0x120, 0x7FF}, [&](const can::Frame& f) {
+        if (!f.rtr) ++tpdos;
+    });
+    host->send(can::Frame::make(0, std::vector<std::uint8_t>{0x01, 5}));
+    std::this_thread::sleep_for(50ms);
+    can::Frame rtr;
+    rtr.id = 0x120;
+    rtr.rtr = true;
+    rtr.len = 1;
+    host->send(rtr);
+    std::this_thread::sleep_for(100ms);
+    EXPECT_EQ(tpdos.load(), 0);
+    sdo->write_u32(0x1005, 0, 0x81);
+    host->send(can::Frame::make(0x080, std::span<const std::uint8_t>{}));
+    std::this_thread::sleep_for(100ms);
+    EXPECT_EQ(tpdos.load(), 0);
+    host->send(can::Frame::make(0x081, std::span<const std::uint8_t>{}));
+    for (int i = 0; i < 100 && tpdos.load() == 0; ++i) std::this_thread::sleep_for(5ms);
+    EXPECT_EQ(tpdos.load(), 1);
+    host->unsubscribe(sub);
 }
 
 // ---- motion --------------------------------------------------------------------------------
@@ -422,6 +460,9 @@ TEST_F(SimFixture, EmcyHistoryAndBootloader) {
     for (int i = 0; i < 100 && !sim->in_bootloader(); ++i) std::this_thread::sleep_for(5ms);
     EXPECT_TRUE(sim->in_bootloader());
     canopen::SdoClient quick(*host, 5, {.timeout = 100ms});
+    EXPECT_THROW(quick.read_u8(0x6001, 0), canopen::SdoTimeout);
+    host->send(can::Frame::make(0, std::vector<std::uint8_t>{0x01, 5}));  // #8: NMT start changes nothing
+    host->send(can::Frame::make(0, std::vector<std::uint8_t>{0x80, 0}));
     EXPECT_THROW(quick.read_u8(0x6001, 0), canopen::SdoTimeout);
     sim->power_cycle();
     EXPECT_FALSE(sim->in_bootloader());
