@@ -279,3 +279,15 @@ def test_a_node_at_another_bit_rate_is_silent_and_deaf():
             assert sim.counters.bit_rate_mismatch == 0
         finally:
             peer.shutdown()
+
+
+def test_python_api_of_the_tables():
+    from motorbus.drives import unitek
+
+    assert unitek.BIT_TIMINGS[1] == (500, 0x4025, 70)
+    assert unitek.btr_for_bit_rate(1_000_000) == 0x4002
+    assert unitek.bit_rate_for_btr(0x4425) == 100_000
+    assert unitek.current_limit_num("DS 412", 300) == 230
+    assert unitek.CURRENT_COMMAND_MAX == 511
+    with pytest.raises(_core.InvalidArgument, match="0x4002"):
+        unitek.btr_for_bit_rate(615_000)

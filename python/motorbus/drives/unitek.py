@@ -57,7 +57,8 @@ from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, 
 from ..registry import DrivePlugin, PollSpec
 
 __all__ = ["FrameError", "UnknownRegister", "CyclicLimit", "Reg", "Status", "ModeBit", "Unitek", "UnitekDrive", "UnitekSim", "Stream", "PLUGIN", "make_sim",
-           "open", "builtin_registers", "load_registers", "ndrive_registers", "REVOLUTIONS"]
+           "open", "builtin_registers", "load_registers", "ndrive_registers", "REVOLUTIONS", "BIT_TIMINGS",
+           "btr_for_bit_rate", "bit_rate_for_btr", "current_limit_num", "CURRENT_COMMAND_MAX"]
 
 #: Typed errors (also motorbus._core.Unitek*).
 FrameError = _core.UnitekFrameError          # a frame breaking the protocol; .byte, .data
@@ -69,6 +70,28 @@ FULL_SCALE = 32767
 #: User units of revolutions for open_drive(..., units=REVOLUTIONS).
 REVOLUTIONS = Units("rev", 1.0 / COUNTS_PER_REV)
 _NDRIVE_TOML = Path(__file__).with_name("unitek_ndrive.toml")
+
+#: §3.1: (bit rate in kbit/s, NDrive's BTR setting value, longest line in m).  The bit rate is
+#: set in NDrive's CAN-Setup, not over CAN: open the bus at the drive's rate.
+BIT_TIMINGS = tuple((r["kbit_s"], r["btr"], r["max_line_m"]) for r in _core.unitek_bit_timings())
+#: §6.1: the current command range, "+/- 9 bit".
+CURRENT_COMMAND_MAX = 511
+
+
+def btr_for_bit_rate(bit_rate: float) -> int:
+    """The BTR setting of a bit rate (bit/s); InvalidArgument naming the table's five."""
+    return _core.unitek_btr_for_bit_rate(bit_rate)
+
+
+def bit_rate_for_btr(btr: int) -> float:
+    """The bit rate (bit/s) of a BTR setting value; InvalidArgument naming the table's five."""
+    return _core.unitek_bit_rate_for_btr(btr)
+
+
+def current_limit_num(device: str, motor_limit_num: int) -> int:
+    """§6.1 "the smaller value is effective": the peak current (num) a ``device`` ("DS 205/405",
+    "DS 412", "DS 420") delivers with a motor limit of ``motor_limit_num``."""
+    return _core.unitek_effective_current_limit_num(device, motor_limit_num)
 
 
 class Reg(enum.IntEnum):
