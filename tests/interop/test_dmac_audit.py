@@ -178,3 +178,33 @@ def test_power_off_freewheel_speed_is_measured_too():
         s = value(ask(ser, "03READ #SPEED"))
         assert s == pytest.approx(-30000 / 2.718281828, rel=0.01)
         assert ask(ser, "03READ #PROFILE_SPEED") == b"03#PSP=+0\r\n"
+
+
+def test_ultrasync_through_the_native_client():
+    """motorbus's DmacClient on the same pty: set_interpolation(mode=-1) and synchro."""
+    from motorbus.drives.dmac import DmacClient, open_line, synchro
+
+    clock = SimClock()
+    x, y = make_sim("00", clock=clock), make_sim("01", clock=clock)
+    chain_ultrasync([x, y])
+    y.set_speed_limit(5000)
+    with PtyLineServer([x, y]) as server:
+        link = open_line(server.slave_path, timeout=0.5)
+        cx, cy = DmacClient(link, address=0), DmacClient(link, address=1)
+        try:
+            for c in (cx, cy):
+                c.brake(False)
+            for c in (cx, cy):
+                c.set_interpolation(100, 64, -1)
+                assert c.read("#INTERPOL_MODE") == -1
+                c.move_interpol(1000)
+                c.move_interpol(1000)
+            synchro(link, "INTERPOL")
+            assert cx.position == 0                  # a query: the line has processed the broadcast
+            clock.advance(150 * MS)
+            assert (cx.position, cy.position) == (1000, 750)
+            clock.advance(300 * MS)
+            assert (cx.position, cy.position) == (2000, 2000)
+        finally:
+            cx.close()
+            cy.close()
