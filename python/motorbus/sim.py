@@ -93,7 +93,8 @@ def serve_line(spec: str, baud: int = 0, clock: Any = None, store_dir: Optional[
     if plugin.transport != "serial":
         raise _core.InvalidArgument(f"drive spec {spec!r}: {plugin.kind} is a {plugin.transport} drive, not serial")
     drives = [make_sim(plugin.kind, a, clock=clock, store_dir=store_dir, **options) for a in addresses]
-    # A kind may wire the modules of one line together (the DMAC's IN6/OUT1 UltraSYNC chain).
+    # A kind may wire the modules of one line together (e.g. a synchronisation chain on their I/Os):
+    # its module's optional wire_line(drives) does it.
     wire = getattr(sys.modules.get(plugin.make_sim.__module__), "wire_line", None)
     if wire is not None:
         wire(drives)
