@@ -51,7 +51,30 @@ def main() -> None:
     opts = {"bitrate": a.bitrate} if a.bitrate else {}
     dev = motorbus.open_bus(name, **opts)
     host = motorbus.open_bus(name, **opts)
-    sims = [pmc007.make_sim(n, bus=dev) for n in range(1, a.nodes + 1)]
+    sims = [pmc007.make_sim(n) for n in range(1, a.nodes + 1)]
+    if a.bitrate and a.bitrate != 125000:
+        # A simulated PMC007 talks only at its 2003h baud (factory 125 kbit/s), like a real one:
+        # set it as on a real bench -- on a bus without wire time: node-ID (2002h) and baud,
+        # saved (2007h = 2), NMT reset node; then onto the bus at the new rate.
+        bauds = {20e3: 0, 25e3: 1, 50e3: 2, 100e3: 3, 125e3: 4, 250e3: 5, 500e3: 6, 800e3: 7, 1e6: 8}
+        if a.bitrate not in bauds:
+            raise SystemExit(f"--bitrate {a.bitrate:g}: a PMC007 baud (003 §4.3.2): {sorted(bauds)}")
+        with motorbus.open_bus(name + "-setup") as sb, motorbus.open_bus(name + "-setup") as sh:
+            for n, sim in enumerate(sims, 1):
+                sim.attach(sb)
+                setup = _core.SdoClient(sh, n, timeout=2.0)
+                setup.download(0x2002, 0, bytes([n]))
+                setup.download(0x2003, 0, bytes([bauds[a.bitrate]]))
+                setup.download(0x2007, 0, bytes([2]))
+                sh.send(_core.Frame(0, bytes([0x81, n])))
+                deadline = time.monotonic() + 2
+                while sim.active_baud_index != bauds[a.bitrate]:
+                    if time.monotonic() > deadline:
+                        raise SystemExit(f"node {n}: baud index still {sim.active_baud_index} after NMT reset")
+                    time.sleep(0.001)
+                sim.close()
+    for sim in sims:
+        sim.attach(dev)
     for n in range(1, a.nodes + 1):
         sdo = _core.SdoClient(host, n, timeout=2.0)
         sdo.download(0x1800, 1, (0x180 + n).to_bytes(4, "little"))

@@ -138,7 +138,7 @@ void Pmc007Sim::attach(can::Bus& bus) {
         std::lock_guard lock(m_);
         attaching_ = false;
         bus_ = nullptr;
-        gate_.reset();
+        if (gate_) old_gates_.push_back(std::move(gate_));  // `n` still holds it
         throw;
     }
     std::lock_guard lock(m_);
@@ -305,10 +305,12 @@ void Pmc007Sim::close() {
     }
     if (n) n->close();
     sv = {};  // destroyed without the lock (they unsubscribe from the bus)
-    std::unique_ptr<can::BitRateGate> gate;
+    // Closed, not freed: retired nodes and services unsubscribe from it when they go.
+    can::BitRateGate* gate = nullptr;
     {
         std::lock_guard lock(m_);
-        gate = std::move(gate_);
+        gate = gate_.get();
+        if (gate_) old_gates_.push_back(std::move(gate_));
     }
     if (gate) gate->close();
 }

@@ -200,6 +200,8 @@ private:
     motion::MotorModel motor_;
     mutable std::recursive_mutex m_;
     std::unique_ptr<can::BitRateGate> gate_;  // bus_ while attached: the 2003h baud must match the wire's
+    // Gates of earlier attachments, closed; declared before retired_ so that they outlive it.
+    std::vector<std::unique_ptr<can::BitRateGate>> old_gates_;
     can::Bus* bus_ = nullptr;
     std::unique_ptr<canopen::LocalNode> node_;
     std::shared_ptr<canopen::PdoService> pdo_;
