@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 import os
-import random
 import resource
 import subprocess
 import sys
@@ -30,8 +29,7 @@ import pytest
 
 import motorbus
 from motorbus import Bench, Poller, _core
-from motorbus.canopen import (LocalNode, ObjectDictionary, SdoAbortError, SdoClient, SdoProtocolError,
-                              SdoTimeout)
+from motorbus.canopen import LocalNode, ObjectDictionary, SdoClient
 from motorbus.socketcand import open_socketcand
 
 from test_hardening_bindings import _interrupt_child
@@ -123,48 +121,8 @@ def test_a_poller_asking_by_sdo_ends_with_linkdown_when_the_server_dies():
 
 
 # ---------------------------------------------------------------------------
-# item 5: block uploads under bit flips never return wrong data
-
-@pytest.mark.parametrize("rate", [0.02, 0.10])
-def test_block_uploads_under_bit_flips_return_exact_data_or_raise(rate):
-    name = _hub("flip")
-    dev = motorbus.open_bus(f"virtual:{name}")
-    host = motorbus.open_bus(f"virtual:{name}")
-    od = ObjectDictionary()
-    od.add_variable(0x2000, "U32", "u32", "rw", default=0)
-    od.add_variable(0x2001, "Blob", "DOMAIN", "rw", max_size=64)
-    node = LocalNode(dev, 4, od, sdo_timeout=0.05, send_boot_up=False)
-    rng = random.Random(f"flip-{rate}")
-    dev.set_faults(corrupt_probability=rate, seed=rng.randrange(1 << 30))
-    host.set_faults(corrupt_probability=rate, seed=rng.randrange(1 << 30))
-    sdo = SdoClient(host, 4, timeout=0.05)
-    transfers = 1500
-    outcome = {"ok": 0, "wrong": 0, "raised": 0}
-    wrong = []
-    try:
-        for i in range(transfers):
-            if i % 2:
-                index, value = 0x2000, rng.getrandbits(32).to_bytes(4, "little")
-            else:
-                index, value = 0x2001, rng.randbytes(rng.randint(1, 64))
-            od[index].value = value if index == 0x2001 else int.from_bytes(value, "little")
-            try:
-                got = sdo.upload(index, 0, block=True)
-            except (SdoAbortError, SdoTimeout, SdoProtocolError):
-                outcome["raised"] += 1
-                continue
-            if got == value:
-                outcome["ok"] += 1
-            else:
-                outcome["wrong"] += 1
-                wrong.append((hex(index), value.hex(), got.hex()))
-        print(f"\n[block uploads, bit flips {rate:.0%}] {transfers} transfers: {outcome}")
-        assert wrong == [], wrong[:5]
-        assert outcome["ok"] > transfers // 4   # the injector did not simply break every transfer
-    finally:
-        node.close()
-        host.close()
-        dev.close()
+# item 5: block uploads under bit flips never return wrong data — one test, with its bounded and
+# soak sizes: tests/reliability/test_sdo_faults.py::test_block_uploads_under_bit_flips_never_return_wrong_values
 
 
 # ---------------------------------------------------------------------------
