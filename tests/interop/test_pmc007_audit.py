@@ -635,12 +635,17 @@ def test_nmt_states_node_id_heartbeat_and_pdo_rules(served):
     assert read(bus, 0x1000) == 0
     write_ok(bus, 0x1017, 0, 0, 2)
     # B-P29 consumer [P]: node 1 watched at 100 ms; its heartbeat stops: EMCY 8130h, no state change.
-    write_ok(bus, 0x1016, 1, 0x00010064, 4)
+    write_ok(bus, 0x1016, 1, 0x000101F4, 4)     # node 1, 500 ms
     bus.send(can.Message(arbitration_id=0x701, data=[0x05], is_extended_id=False))
-    lost = [m for m in drain(bus, 0.8) if m.arbitration_id == EMCY]
-    assert [bytes(m.data[:2]) for m in lost] == [frame("30 81")], lost
-    write_ok(bus, 0x1016, 1, 0, 4)
+    lost = [m for m in drain(bus, 1.2) if m.arbitration_id == EMCY]
+    assert [bytes(m.data[:3]) for m in lost] == [frame("30 81 11")], lost   # 1001h: communication error
+    assert read(bus, 0x1001) == 0x11
     assert read(bus, 0x1000) == 0               # still PRE-OPERATIONAL: SDO answered
+    bus.send(can.Message(arbitration_id=0x701, data=[0x05], is_extended_id=False))   # back: 0000h
+    back = [m for m in drain(bus, 0.1) if m.arbitration_id == EMCY]
+    write_ok(bus, 0x1016, 1, 0, 4)              # no longer watched (before it is lost again)
+    assert bytes(back[0].data) == bytes(8), back
+    assert read(bus, 0x1001) == 0
     assert write_abort(bus, 0x1A00, 1, 0x60040020, 4) == 0x06040041   # B-P31: 6004h not mappable
     assert write_abort(bus, 0x1800, 2, 241, 1) == 0x06090030          # B-P33
     assert write_abort(bus, 0x1800, 2, 252, 1) == 0x06090030          # RTR-only types: no RTR

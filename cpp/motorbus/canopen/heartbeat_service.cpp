@@ -80,9 +80,13 @@ void HeartbeatService::apply_consumers() {
 
 void HeartbeatService::lost(std::uint8_t n) {
     (void)n;
-    try {
-        node_.send(encode_emcy(node_.node_id(), 0x8130, 0x11));  // N10
-    } catch (const Error&) {
+    if (on_emcy) {
+        on_emcy(0x8130);  // N10, through the device
+    } else {
+        try {
+            node_.send(encode_emcy(node_.node_id(), 0x8130, 0x11));  // N10
+        } catch (const Error&) {
+        }
     }
     // 0x1029:1 communication error behaviour (CiA 301 default 0: to PRE-OPERATIONAL).
     std::uint64_t behaviour = options_.error_behaviour_without_1029;

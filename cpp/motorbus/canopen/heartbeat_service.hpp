@@ -38,6 +38,10 @@ public:
     // Called on the node's worker thread (Lost) or the bus thread (others).
     CallbackSlot<void(std::uint8_t node)> on_lost;
     std::function<void(std::uint8_t node, HeartbeatEvent ev, NodeState state)> on_event;
+    // The EMCY of a lost heartbeat (N10, code 0x8130), for a device that sends its EMCY
+    // itself (its own error register, inhibit time, history).  Empty: the service sends
+    // it from the node with error register 0x11.  Called on the node's worker thread.
+    std::function<void(std::uint16_t code)> on_emcy;
     NodeHealth health(std::uint8_t node) const { return consumer_.health(node); }
     std::uint64_t heartbeats_sent() const;
 

@@ -160,6 +160,12 @@ Pmc007Sim::Services Pmc007Sim::make_services(canopen::LocalNode& n) {
     // 1016h consumers: the manual documents no reaction to a lost heartbeat: EMCY 8130h only [P].
     sv.hb = canopen::HeartbeatService::attach(
         n, {.consumer_entries = 3, .producer_ms = 0, .error_behaviour_without_1029 = 1});
+    // B-P30: every EMCY goes out through the device (1001h in byte 2, 1015h, 1003h).
+    sv.pdo->on_emcy = [this](std::uint16_t code, bool active) { comm_error(code, active); };
+    sv.hb->on_emcy = [this](std::uint16_t code) { comm_error(code, true); };
+    sv.hb->on_event = [this](std::uint8_t, canopen::HeartbeatEvent ev, canopen::NodeState) {
+        if (ev == canopen::HeartbeatEvent::Back || ev == canopen::HeartbeatEvent::Started) comm_error(0x8130, false);
+    };
     sv.ticker = std::make_shared<Ticker>(*this);
     n.add_service(sv.ticker);
     return sv;
@@ -171,14 +177,31 @@ void Pmc007Sim::schedule_node_id_switch() {
     std::lock_guard lock(m_);
     if (!node_ || u(0x2002) == node_id_) return;
     if (renode_.joinable()) {
-        if (!renode_done_) return;  // one switch at a time
-        renode_.join();             // finished: reaping it does not wait
+        if (!renode_done_) {
+            // One switch at a time: the running one looks again when it is done (a reset
+            // that reached the new node while the old one was still closing).
+            renode_again_ = true;
+            return;
+        }
+        renode_.join();  // finished: reaping it does not wait
     }
-    const auto id = static_cast<std::uint8_t>(u(0x2002));
     renode_done_ = false;
-    renode_ = std::thread([this, id] {
-        switch_node_id(id);
-        renode_done_ = true;
+    renode_again_ = false;
+    renode_ = std::thread([this] {
+        for (;;) {
+            std::uint8_t id = 0;
+            {
+                std::lock_guard l(m_);
+                renode_again_ = false;
+                id = static_cast<std::uint8_t>(u(0x2002));
+            }
+            if (id != node_id_) switch_node_id(id);
+            std::lock_guard l(m_);
+            if (!renode_again_) {
+                renode_done_ = true;
+                return;
+            }
+        }
     });
 }
 
@@ -469,6 +492,7 @@ void Pmc007Sim::load_power_up(bool cold) {
         ram_program_ = flash_program_;
         emcy_queue_.clear();
         emcy_error_ = false;
+        comm_errors_.clear();
     }
     t_publishing = true;  // values below are loaded, not "changed by the host"
     for (const auto& [r, var, flash] : power_up_) {
@@ -802,6 +826,7 @@ std::uint8_t Pmc007Sim::error_register_locked() const {
     if (errors_ & (err::kAoc | err::kBoc)) er |= 0x02;
     if (errors_ & err::kUvlo) er |= 0x04;
     if (errors_ & err::kTsd) er |= 0x08;
+    if (!comm_errors_.empty()) er |= 0x11;  // communication error [CiA]
     return er;
 }
 
@@ -845,9 +870,24 @@ void Pmc007Sim::flush_emcy_locked() {
     }
 }
 
+void Pmc007Sim::comm_error(std::uint16_t code, bool active) {
+    {
+        std::lock_guard lock(m_);
+        if (active) {
+            comm_errors_.insert(code);
+            emcy_locked(code);
+        } else if (comm_errors_.erase(code)) {
+            emcy_if_cleared_locked();
+        }
+    }
+    publish();
+}
+
 void Pmc007Sim::emcy_if_cleared_locked() {
-    // B-P30 [P]: EMCY 0000h when every error is clear again (6000h and the 6001h latches).
-    if (emcy_error_ && errors_ == 0 && (latched_ & (st::kExt1 | st::kExt2 | st::kStall | st::kExt3)) == 0) {
+    // B-P30 [P]: EMCY 0000h when every error is clear again (6000h, the 6001h latches and
+    // the communication errors).
+    if (emcy_error_ && errors_ == 0 && comm_errors_.empty() &&
+        (latched_ & (st::kExt1 | st::kExt2 | st::kStall | st::kExt3)) == 0) {
         emcy_error_ = false;
         emcy_locked(0x0000);
     }

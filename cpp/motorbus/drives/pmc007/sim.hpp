@@ -27,6 +27,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <utility>
@@ -174,6 +175,8 @@ private:
     void input_edge_locked(int bit, bool high, Nanos t);
     void level_change_locked(int bit, bool high, Nanos t);
     void emcy_locked(std::uint16_t code);
+    // An EMCY of the PDO engine or the heartbeat consumer (a communication error) comes and goes.
+    void comm_error(std::uint16_t code, bool active);
     // EMCY 0000h once every signalled condition (6000h errors, 6001h latches) is clear.
     void emcy_if_cleared_locked();
     // Queued EMCY frames whose 1015h inhibit time has passed go out.
@@ -211,6 +214,7 @@ private:
     std::thread renode_;
     std::thread boot_;  // takes the node off the bus on entering the bootloader
     std::atomic<bool> renode_done_{false};
+    bool renode_again_ = false;  // a switch was asked for while one ran (under m_)
     std::vector<std::shared_ptr<void>> retired_;  // replaced nodes/services: their OD listeners stay valid
 
     std::map<std::pair<std::uint16_t, std::uint8_t>, canopen::Bytes> flash_;
@@ -257,6 +261,9 @@ private:
     // EMCY frames raised inside the 1015h inhibit time: sent when it has passed (B-P30).
     std::deque<can::Frame> emcy_queue_;
     bool emcy_error_ = false;  // an error EMCY was sent and no 0000h since
+    // Communication errors signalled by the PDO engine / heartbeat consumer (EMCY code ->
+    // active): 1001h bit 4 (and bit 0) while any is active.
+    std::set<std::uint16_t> comm_errors_;
     std::atomic<std::uint16_t> cpr_{500};
     // Offline program execution.
     bool running_ = false, paused_ = false, flag_ = false;
