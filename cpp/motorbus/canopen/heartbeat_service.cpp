@@ -12,12 +12,15 @@ HeartbeatService::~HeartbeatService() = default;
 
 std::shared_ptr<HeartbeatService> HeartbeatService::attach(LocalNode& node, HeartbeatServiceOptions options) {
     std::shared_ptr<HeartbeatService> s(new HeartbeatService(node, options));
-    s->install();
+    s->install(s);
     node.add_service(s);
     return s;
 }
 
-void HeartbeatService::install() {
+void HeartbeatService::install(const std::weak_ptr<HeartbeatService>& self) {
+    // The dictionary outlives this service (a simulator closes its node and keeps its
+    // dictionary, then writes it again at a power cycle): its hooks hold the service
+    // weakly and leave the values alone once the service is gone.
     auto& od = node_.od();
     if (!od.find(0x1017, 0))
         od.add_variable({.index = 0x1017, .name = "Producer heartbeat time", .type = DataType::Unsigned16,
@@ -32,10 +35,12 @@ void HeartbeatService::install() {
     }
     auto producer = od.at(0x1017, 0);
     period_ns_ = Nanos(producer->get_u64()) * 1'000'000;
-    producer->set_write_hook([this](const Variable&, std::span<const std::uint8_t> d) -> std::uint32_t {
-        std::lock_guard l(m_);
-        period_ns_ = Nanos(d[0] | (d.size() > 1 ? d[1] << 8 : 0)) * 1'000'000;
-        next_ = -1;
+    producer->set_write_hook([self](const Variable&, std::span<const std::uint8_t> d) -> std::uint32_t {
+        auto s = self.lock();
+        if (!s) return 0;
+        std::lock_guard l(s->m_);
+        s->period_ns_ = Nanos(d[0] | (d.size() > 1 ? d[1] << 8 : 0)) * 1'000'000;
+        s->next_ = -1;
         return 0;
     });
     auto obj = od.object(0x1016);
@@ -43,15 +48,19 @@ void HeartbeatService::install() {
         if (sub == 0) continue;
         if (entries_.size() < sub) entries_.resize(sub, 0);
         entries_[sub - 1] = static_cast<std::uint32_t>(var->get_u64());
-        var->set_write_hook([this](const Variable& v, std::span<const std::uint8_t> d) -> std::uint32_t {
+        var->set_write_hook([self](const Variable& v, std::span<const std::uint8_t> d) -> std::uint32_t {
+            auto s = self.lock();
+            if (!s) return 0;
             std::uint32_t value = 0;
             for (std::size_t i = 0; i < d.size() && i < 4; ++i) value |= std::uint32_t(d[i]) << (8 * i);
-            std::lock_guard l(m_);
-            if (auto code = validate_consumer_entry(entries_, v.subindex(), value)) return code;
-            entries_[v.subindex() - 1] = value;
+            std::lock_guard l(s->m_);
+            if (auto code = validate_consumer_entry(s->entries_, v.subindex(), value)) return code;
+            s->entries_[v.subindex() - 1] = value;
             return 0;
         });
-        var->add_change_listener([this](const Variable&) { apply_consumers(); });
+        var->add_change_listener([self](const Variable&) {
+            if (auto s = self.lock()) s->apply_consumers();
+        });
     }
     consumer_.on_event = [this](std::uint8_t n, HeartbeatEvent ev, NodeState st) {
         if (ev == HeartbeatEvent::Lost)

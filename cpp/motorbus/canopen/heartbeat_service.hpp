@@ -51,7 +51,7 @@ public:
 
 private:
     HeartbeatService(LocalNode& node, HeartbeatServiceOptions options);
-    void install();
+    void install(const std::weak_ptr<HeartbeatService>& self);
     void apply_consumers();
     void lost(std::uint8_t node);
     LocalNode& node_;

@@ -93,15 +93,18 @@ std::shared_ptr<PdoService> PdoService::attach(LocalNode& node, PdoServiceOption
 
 void PdoService::install(const std::weak_ptr<PdoService>& self) {
     auto& od = node_.od();
-    auto* eng = engine_.get();
-    auto hook = [eng, self](const Variable& var, std::span<const std::uint8_t> data) {
-        const std::uint32_t code = eng->write(var.index(), var.subindex(), data);
+    auto* eng = engine_.get();   // listeners and the subscription below end with the service
+    // The dictionary outlives this service (see HeartbeatService::install): the hooks
+    // hold it weakly and take the values as plain data once it is gone.
+    auto hook = [self](const Variable& var, std::span<const std::uint8_t> data) -> std::uint32_t {
+        auto service = self.lock();
+        if (!service) return 0;
+        const std::uint32_t code = service->engine_->write(var.index(), var.subindex(), data);
         // A PDO (re)configured while OPERATIONAL (CiA 301: invalidate, map,
         // validate) must be scheduled now: the node runs this service's timer
         // only at the deadline it last returned -- none for a PDO that was
         // invalid -- so it used to stay silent until the next NMT change.
-        if (code == 0)
-            if (auto s = self.lock()) s->wake_node();
+        if (code == 0) service->wake_node();
         return code;
     };
     auto ensure = [&](std::uint16_t index, const char* name, bool tpdo, bool map, unsigned n) {

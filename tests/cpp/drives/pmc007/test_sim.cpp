@@ -548,3 +548,21 @@ TEST(Pmc007SimReset, ResetToNewReadsAsAFreshSim) {
     used.power_cycle();
     EXPECT_EQ(used.od().at(0x601A, 0)->get(), fresh.od().at(0x601A, 0)->get());
 }
+
+// A closed simulator keeps its dictionary: a power cycle (or a write) after close()
+// reaches the heartbeat and PDO hooks of services that are gone (a use-after-free
+// under ASan before the hooks held their service weakly).
+TEST(Pmc007SimLifetime, PowerCycleAfterCloseTouchesNoClosedService) {
+    SimClock clock{1'000'000'000};
+    auto dev = can::open_virtual("pmc007-lifetime");
+    auto sim = std::make_unique<Pmc007Sim>(5, clock);
+    sim->attach(*dev);
+    sim->close();
+    sim->power_cycle();                                          // reloads 1016h/1017h/PDO values
+    const std::uint8_t period[2] = {0x64, 0x00};
+    EXPECT_EQ(sim->od().at(0x1017, 0)->remote_write(period), 0u);   // a write through the hooks
+    EXPECT_EQ(sim->od().at(0x1800, 5)->remote_write(period), 0u);
+    EXPECT_EQ(sim->od().at(0x1017, 0)->get_u64(), 0x64u);
+    sim->attach(*dev);                                           // and it serves again
+    sim->close();
+}
