@@ -11,6 +11,9 @@ import pytest
 NOT_THREADED = {
     "test_demo", "test_examples", "test_cli_bus_serve", "test_sim_serve_pyserial",  # subprocesses
     "test_motion", "test_motion_ruckig", "test_frame",  # no threads
+    # The command line and the served twin, run as child processes; the client paths they
+    # reach are the in-process outcome tests' (test_outcomes_*), which do run under ASan.
+    "test_cli", "test_cli_outcomes", "test_sim_serve_bench", "test_move_outcomes",
 }
 
 

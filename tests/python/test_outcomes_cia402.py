@@ -10,6 +10,7 @@ identity object of the generic simulator, write-only 6060h, and no simulator lea
 from __future__ import annotations
 
 import gc
+import os
 import threading
 import time
 
@@ -402,7 +403,8 @@ def test_no_simulator_outlives_its_bench(tmp_path):
         grown = rss_kb() - rss0
     finally:
         bus.close()
-    assert grown < 4000, f"{grown} KB for 100 simulators (was ~16 000 KB with the cycle)"
+    if "asan" not in os.environ.get("LD_PRELOAD", ""):   # ASan's quarantine keeps freed blocks
+        assert grown < 4000, f"{grown} KB for 100 simulators (was ~16 000 KB with the cycle)"
 
     # The case: whole simulated benches opened and closed.
     p = tmp_path / "b.toml"
