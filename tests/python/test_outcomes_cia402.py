@@ -417,4 +417,5 @@ def test_no_simulator_outlives_its_bench(tmp_path):
         motorbus.Bench.load(p, sim=True).close()
     assert alive() == before
     grown = rss_kb() - rss0
-    assert grown < 4000, f"{grown} KB for 100 simulated benches"
+    if "asan" not in os.environ.get("LD_PRELOAD", ""):
+        assert grown < 4000, f"{grown} KB for 100 simulated benches"
