@@ -44,8 +44,11 @@ build: deps
 cpp-test: build
 	ctest --test-dir $(BUILD) --output-on-failure
 
+# Two workers (pytest-xdist), a module per worker at a time: most tests wait on simulated
+# motion and transports, so two halve the wall time on a 2-core machine.
+PYTEST_WORKERS ?= 2
 py-test: build
-	$(PY) -m pytest -q -p no:cacheprovider
+	$(PY) -m pytest -q -p no:cacheprovider -n $(PYTEST_WORKERS) --dist loadfile
 
 # C++ suites and the threaded Python tests under ASan+UBSan; C++ suites under TSan.
 sanitize: deps

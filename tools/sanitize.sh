@@ -30,9 +30,15 @@ cp build/asan/_core*.so "$stage/motorbus/"
 SITE=$("$PY" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 ASAN_RT=$(clang -print-file-name=libclang_rt.asan-x86_64.so)
 [ -f "$ASAN_RT" ] || ASAN_RT=$(find /usr/lib/llvm-*/lib/clang -name 'libclang_rt.asan-x86_64.so' | head -1)
+# Two pytest-xdist workers, each started with -S too (a wrapper: xdist's own workers
+# would load the site .pth files and import the editable, unsanitized package).
+PY_ABS="$(cd "$(dirname "$(command -v "$PY")")" && pwd)/$(basename "$PY")"   # the venv's, not resolved
+printf '#!/bin/sh\nexec %s -S "$@"\n' "$PY_ABS" > "$stage/python-S"
+chmod +x "$stage/python-S"
 LD_PRELOAD="$ASAN_RT" ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 PYTHONPATH="$stage:$SITE" \
-  "$PY" -S -m pytest -q -p no:cacheprovider -m threaded tests/python tests/interop
+  "$PY" -S -m pytest -q -p no:cacheprovider -m threaded --dist loadfile \
+  --tx "${PYTEST_WORKERS:-2}*popen//python=$stage/python-S" tests/python tests/interop
 
 echo "== C++ suites under TSan (clang)"
 LAUNCHER=(); command -v ccache >/dev/null && LAUNCHER=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
