@@ -141,11 +141,15 @@ void Pmc007Sim::attach(can::Bus& bus) {
         if (gate_) old_gates_.push_back(std::move(gate_));  // `n` still holds it
         throw;
     }
+    install_node(std::move(n), std::move(sv));
+}
+
+void Pmc007Sim::install_node(std::unique_ptr<canopen::LocalNode> n, Services sv) {
     std::lock_guard lock(m_);
     node_ = std::move(n);
-    pdo_ = sv.pdo;
-    hb_ = sv.hb;
-    ticker_ = sv.ticker;
+    pdo_ = std::move(sv.pdo);
+    hb_ = std::move(sv.hb);
+    ticker_ = std::move(sv.ticker);
     attaching_ = false;
 }
 
@@ -281,12 +285,7 @@ void Pmc007Sim::serve_again() {
         attaching_ = false;
         return;
     }
-    std::lock_guard lock(m_);
-    node_ = std::move(n);
-    pdo_ = sv.pdo;
-    hb_ = sv.hb;
-    ticker_ = sv.ticker;
-    attaching_ = false;
+    install_node(std::move(n), std::move(sv));
 }
 
 void Pmc007Sim::enter_bootloader() {

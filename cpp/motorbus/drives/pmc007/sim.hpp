@@ -161,6 +161,8 @@ private:
         std::shared_ptr<canopen::NodeService> ticker;
     };
     Services make_services(canopen::LocalNode& n);
+    // Takes `n` and its services as the node on the bus (under m_), ending an attach.
+    void install_node(std::unique_ptr<canopen::LocalNode> n, Services sv);
     canopen::LocalNodeOptions node_options();
     void publish();
     void load_power_up(bool cold);
