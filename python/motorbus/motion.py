@@ -1,4 +1,5 @@
-"""Motion profiles: plan, preview and sample moves the way each drive makes them.
+"""Motion profiles: plan, preview and sample moves (the generic planners; each vendor's own
+profile model is in its module, ``motorbus.drives.<vendor>``).
 
 Planners return a :class:`Profile`; ``Profile.sample(n)`` gives an ``n x 5`` numpy
 array (t, p, v, a, j) ready to plot, and ``Profile.step_times()`` the exact
@@ -16,77 +17,50 @@ from typing import Optional, Sequence
 import numpy as np
 
 from ._core import (  # noqa: F401
-    ARCUS_MAX_MOVE_DISTANCE,
-    ArcusHoming,
-    ArcusHomingOptions,
-    ArcusMotion,
-    ArcusProfileParams,
     Cia402Homing,
     Cia402HomingParams,
     Cia402ProfileParams,
     Cia402ProfilePosition,
+    InvalidArgument,
+    LimitExceeded,
+    Limits,
+    MotionState,
     MotorConfig,
     MotorEvent,
     MotorEventKind,
     MotorModel,
-    Pmc007ProfileParams,
-    SwitchConfig,
-    UnitekRampParams,
-    cia402_position_profile,
-    cia402_quick_stop_profile,
-    cia402_velocity_profile,
-    pmc007_convert_position,
-    pmc007_gear_acceleration,
-    pmc007_microsteps,
-    pmc007_position_profile,
-    pmc007_speed_profile,
-    unitek_speed_profile,
-    ArcusSpeedWindow,
-    DmacMotion,
-    InvalidArgument,
-    DmacProfileParams,
-    LimitExceeded,
-    Limits,
-    MotionState,
     Profile,
     RampShape,
     SnlActivity,
     SnlConfig,
     StepNLoop,
-    arcus_check_strict,
-    arcus_effective,
-    arcus_max_acc_ms,
-    arcus_speed_windows,
-    arcus_window_for_hspd,
-    arcus_window_for_sspdm,
-    dmac_position_profile,
-    dmac_ramp_time,
-    dmac_speed_profile,
+    SwitchConfig,
+    cia402_position_profile,
+    cia402_quick_stop_profile,
+    cia402_velocity_profile,
     jerk_limited_durations,
     plan_jerk_limited,
     plan_jerk_limited_velocity,
     plan_straight_line,
     plan_synchronized,
     plan_synchronized_jerk_limited,
-    synchronized_jerk_limited_durations,
     plan_trapezoid,
     plan_velocity,
     split_interpolation,
+    synchronized_jerk_limited_durations,
 )
 
+# Only what every drive can use lives here: planners, profiles, steps, multi-axis,
+# the motor model, StepNLoop and the CiA 402 profile/homing (a standard, not a vendor).
+# A vendor's own profile model (and anything named after its protocol) is in its
+# module, motorbus.drives.<vendor>, which imports it from _core itself.
 __all__ = [
-    "ArcusHoming", "ArcusHomingOptions", "Cia402Homing", "Cia402HomingParams", "Cia402ProfileParams",
-    "Cia402ProfilePosition", "MotorConfig", "MotorEvent", "MotorEventKind", "MotorModel", "Pmc007ProfileParams", "SwitchConfig",
-    "UnitekRampParams", "cia402_position_profile", "cia402_quick_stop_profile", "cia402_velocity_profile",
-    "pmc007_convert_position", "pmc007_gear_acceleration", "pmc007_microsteps", "pmc007_position_profile",
-    "pmc007_speed_profile", "unitek_speed_profile",
-    "ARCUS_MAX_MOVE_DISTANCE", "ArcusMotion", "ArcusProfileParams", "ArcusSpeedWindow", "DmacMotion",
-    "DmacProfileParams", "LimitExceeded", "Limits", "MotionState", "Profile", "RampShape", "SnlActivity", "SnlConfig",
-    "StepNLoop", "arcus_check_strict", "arcus_effective", "arcus_max_acc_ms", "arcus_speed_windows",
-    "arcus_window_for_hspd", "arcus_window_for_sspdm", "dmac_position_profile", "dmac_ramp_time",
-    "dmac_speed_profile", "jerk_limited_durations", "plan", "plan_jerk_limited", "plan_jerk_limited_velocity", "plan_straight_line",
-    "plan_synchronized", "plan_synchronized_jerk_limited", "synchronized_jerk_limited_durations", "plan_trapezoid", "plan_velocity", "sample", "split_interpolation", "step_times",
-    "dmac_interpolation",
+    "Cia402Homing", "Cia402HomingParams", "Cia402ProfileParams", "Cia402ProfilePosition", "LimitExceeded",
+    "Limits", "MotionState", "MotorConfig", "MotorEvent", "MotorEventKind", "MotorModel", "Profile", "RampShape",
+    "SnlActivity", "SnlConfig", "StepNLoop", "SwitchConfig", "cia402_position_profile", "cia402_quick_stop_profile",
+    "cia402_velocity_profile", "jerk_limited_durations", "plan", "plan_jerk_limited", "plan_jerk_limited_velocity",
+    "plan_straight_line", "plan_synchronized", "plan_synchronized_jerk_limited", "plan_trapezoid", "plan_velocity",
+    "sample", "split_interpolation", "step_times", "synchronized_jerk_limited_durations",
 ]
 
 _SHAPES = {"trapezoid": RampShape.TRAPEZOID, "s_curve": RampShape.SCURVE, "scurve": RampShape.SCURVE,
@@ -129,13 +103,3 @@ def step_times(profile: Profile, t0_ns: int = 0) -> tuple[np.ndarray, np.ndarray
     """Exact step times (int64 ns) and directions (int8, +1/-1) for a profile in steps."""
     return profile.step_times(t0_ns)
 
-
-def dmac_interpolation(start: Sequence[float], target: Sequence[float], limits: Sequence[Limits],
-                       period_ms: int = 100, straight_line: bool = True) -> np.ndarray:
-    """Plan a synchronised multi-axis move and split it into DMAC MOVE_INTERPOL offsets.
-
-    Returns an int64 array ``[segment, axis]`` whose column sums reach ``target - start``.
-    """
-    planner = plan_straight_line if straight_line else plan_synchronized
-    axes = planner(list(map(float, start)), list(map(float, target)), list(limits))
-    return np.asarray(split_interpolation(axes, int(period_ms)), dtype=np.int64).reshape(-1, len(start))

@@ -325,14 +325,13 @@ def test_real_time_sim_and_wait_idle():
 
 
 def test_typed_records_and_phase_enum():
-    from motorbus import motion
-    from motorbus.drives.arcus import ArcusCommandInfo, ArcusPhase
+    from motorbus.drives.arcus import ArcusCommandInfo, ArcusMotion, ArcusPhase, ArcusProfileParams
 
     rows = {c.name: c for c in core.arcus_commands()}
     assert isinstance(rows["HSPD"], ArcusCommandInfo)
     assert rows["HSPD"].query and rows["HSPD"].set and not rows["HSPD"].action
     assert rows["DI"].indexed == 6
-    a = motion.ArcusMotion(motion.ArcusProfileParams(hspd=1000, lspd=100, acc_ms=100, dec_ms=100))
+    a = ArcusMotion(ArcusProfileParams(hspd=1000, lspd=100, acc_ms=100, dec_ms=100))
     assert a.phase(0.0) == ArcusPhase.IDLE
     a.move(0, 1000)
     assert [a.phase(t) for t in (0.05, 0.5, a.profile.duration - 0.05)] == [

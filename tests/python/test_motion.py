@@ -6,6 +6,7 @@ import pytest
 import motorbus
 
 from motorbus import motion
+from motorbus.drives import arcus, dmac, pmc007, unitek
 
 
 def test_plan_trapezoid_and_sample():
@@ -45,43 +46,43 @@ def test_limit_exceeded_names_limit():
 
 
 def test_arcus_appendix_a_examples():
-    assert motion.arcus_max_acc_ms(20000, 100) == pytest.approx(19900)
-    assert motion.arcus_window_for_hspd(900000).number == 7
-    assert motion.arcus_max_acc_ms(900000, 1000) == pytest.approx(23050, abs=2)
-    params, window, notes = motion.arcus_effective(motion.ArcusProfileParams(hspd=1000, lspd=5, acc_ms=0.5))
+    assert arcus.arcus_max_acc_ms(20000, 100) == pytest.approx(19900)
+    assert arcus.arcus_window_for_hspd(900000).number == 7
+    assert arcus.arcus_max_acc_ms(900000, 1000) == pytest.approx(23050, abs=2)
+    params, window, notes = arcus.arcus_effective(arcus.ArcusProfileParams(hspd=1000, lspd=5, acc_ms=0.5))
     assert (params.lspd, params.acc_ms, window) == (10, 2, 1)
     assert len(notes) == 2
 
 
 def test_arcus_motion_on_the_fly():
-    a = motion.ArcusMotion(motion.ArcusProfileParams(hspd=1000, lspd=100, acc_ms=100))
+    a = arcus.ArcusMotion(arcus.ArcusProfileParams(hspd=1000, lspd=100, acc_ms=100))
     assert a.move(0, 10000) == ""
     assert a.move(0, 300000) == "?Index out of Range"
     a.move(0, 10000)
     assert a.change_target(5.0, 1000) == ""
     assert a.profile.end_position == 1000
     assert a.change_speed(1.0, 20000) in ("?Speed out of range", "")
-    idle = motion.ArcusMotion()
+    idle = arcus.ArcusMotion()
     assert idle.change_target(0.0, 5) == "?Motor is not moving"
 
 
 def test_dmac_half_second_example():
-    p = motion.DmacProfileParams(high_speed=60000, accel_time_ms=1000)
-    assert motion.dmac_ramp_time(p, 0, 30000) == pytest.approx(0.5)
-    d = motion.DmacMotion(p)
+    p = dmac.DmacProfileParams(high_speed=60000, accel_time_ms=1000)
+    assert dmac.dmac_ramp_time(p, 0, 30000) == pytest.approx(0.5)
+    d = dmac.DmacMotion(p)
     d.move_to(0.0, 100000)
     assert d.profile.end_position == 100000
     with pytest.raises(motion.LimitExceeded):
-        motion.DmacProfileParams(high_speed=500000)
+        dmac.DmacProfileParams(high_speed=500000)
 
 
 def test_dmac_interpolation_sums_reach_targets():
     lim = [motion.Limits(5000, 20000)] * 3
-    segs = motion.dmac_interpolation([0, 0, 0], [10000, -3333, 7], lim, period_ms=50)
+    segs = dmac.dmac_interpolation([0, 0, 0], [10000, -3333, 7], lim, period_ms=50)
     assert segs.shape[1] == 3
     assert segs.sum(axis=0).tolist() == [10000, -3333, 7]
     with pytest.raises(motion.LimitExceeded) as e:
-        motion.dmac_interpolation([0], [10], lim[:1], period_ms=1)
+        dmac.dmac_interpolation([0], [10], lim[:1], period_ms=1)
     assert e.value.limit == "#INTERPOL_TIME"
 
 
@@ -105,16 +106,16 @@ def test_stepnloop_from_python():
 
 
 def test_pmc007_cia402_unitek_models():
-    assert motion.pmc007_gear_acceleration(1) == 77440
-    p = motion.pmc007_position_profile(motion.MotionState(), 20000,
-                                       motion.Pmc007ProfileParams(speed=5610, accel_gear=8, decel_gear=8))
+    assert pmc007.pmc007_gear_acceleration(1) == 77440
+    p = pmc007.pmc007_position_profile(motion.MotionState(), 20000,
+                                       pmc007.Pmc007ProfileParams(speed=5610, accel_gear=8, decel_gear=8))
     assert p.end_position == 20000
     c = motion.Cia402ProfilePosition(motion.Cia402ProfileParams(1000, 10000, 10000))
     assert c.new_setpoint(0.0, 5000)
     assert c.new_setpoint(1.0, 0)
     assert not c.new_setpoint(1.5, 7)
     assert c.profile.end_position == 0
-    u = motion.unitek_speed_profile(motion.MotionState(), 3277, motion.UnitekRampParams(3000, 1000, 500), 1.0)
+    u = unitek.unitek_speed_profile(motion.MotionState(), 3277, unitek.UnitekRampParams(3000, 1000, 500), 1.0)
     assert u.final_velocity == pytest.approx(3277 / 32767 * 3000 / 60 * 65536)
     with pytest.raises(motion.LimitExceeded):
         motion.Cia402ProfileParams(motion_profile_type=5)
@@ -130,8 +131,8 @@ def test_motor_model_and_homing_on_sim_clock():
     m = motion.MotorModel(clk, cfg)
     events = []
     m.add_listener(events.append)
-    h = motion.ArcusHoming(m, motion.ArcusProfileParams(hspd=3200, lspd=100, acc_ms=100),
-                           motion.ArcusHomingOptions(rz=True))
+    h = arcus.ArcusHoming(m, arcus.ArcusProfileParams(hspd=3200, lspd=100, acc_ms=100),
+                           arcus.ArcusHomingOptions(rz=True))
     h.start("H", 1)
     for _ in range(1000):
         if not h.running:
@@ -159,7 +160,7 @@ def test_shapes_and_arrays_for_plotting():
     assert a.max() == pytest.approx(2000, rel=1e-3)  # same ramp time: peak = 2x average
     with pytest.raises(ValueError):
         motion.plan(1, max_velocity=1, max_acceleration=1, shape="square")
-    arc = motion.ArcusMotion(motion.ArcusProfileParams(hspd=1000, lspd=100, acc_ms=100))
+    arc = arcus.ArcusMotion(arcus.ArcusProfileParams(hspd=1000, lspd=100, acc_ms=100))
     arc.move(0, 5000)
     arr = motion.sample(arc.profile, 200)
     assert arr["v"][1] >= 100  # starts from LSPD
