@@ -19,8 +19,16 @@ from typing import Any, Optional, Union
 
 from .. import _core, _stop_at_exit
 from .._core import ArcusClientBase, ArcusClientCounters, ArcusCommandInfo, ArcusPhase, ArcusSim  # noqa: F401  (re-exported)
+# The DMX-CAN's profile model (manual 000, Appendix A) and homing engine, with the motion
+# library's generic pieces in motorbus.motion: re-exported here, the vendor's own module.
+from .._core import (ARCUS_MAX_MOVE_DISTANCE, ArcusHoming, ArcusHomingOptions, ArcusMotion,  # noqa: F401
+                     ArcusProfileParams, ArcusSpeedWindow, arcus_check_strict, arcus_effective, arcus_max_acc_ms,
+                     arcus_speed_windows, arcus_window_for_hspd, arcus_window_for_sspdm)
 
 __all__ = [
+    "ARCUS_MAX_MOVE_DISTANCE", "ArcusHoming", "ArcusHomingOptions", "ArcusMotion", "ArcusProfileParams",
+    "ArcusSpeedWindow", "arcus_check_strict", "arcus_effective", "arcus_max_acc_ms", "arcus_speed_windows",
+    "arcus_window_for_hspd", "arcus_window_for_sspdm",
     "ArcusClient",
     "ArcusClientCounters",
     "ArcusCommandInfo",

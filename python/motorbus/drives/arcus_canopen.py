@@ -27,6 +27,7 @@ import time
 from typing import Any, Optional, Union
 
 from .. import _core
+from .._core import ArcusMotion, ArcusProfileParams  # the DMX-CAN's profile model
 from ..canopen.cia402 import Cia402, Controlword, OpMode
 from ..drive import (Capability, DriveStatus, LimitReached, MoveFaulted, MoveStalled, ParamInfo, Params, StopReason,
                      Units)
@@ -537,16 +538,14 @@ def plan_move(drive: Any, start: float, target: float) -> Any:
     registers: 6081h = HSPD, 6082h = LSPD (at most 6081h), 6083h/6084h = ACC/DEC (ms),
     6086h = 1 S-curve.  The StepNLoop ratio has no CANopen object: the factory
     3200 pulses per 4000 counts (0.8) with 2001h:01 on."""
-    from .. import motion
-
     native = drive.native
     hspd = max(float(native.read(0x6081)), 1.0)
     lspd = min(max(float(native.read(0x6082)), 1.0), hspd)
     snl = bool(native.read(0x2001, 1))
-    params = motion.ArcusProfileParams(hspd=hspd, lspd=lspd, acc_ms=max(float(native.read(0x6083)), 1.0),
-                                       dec_ms=max(float(native.read(0x6084)), 1.0), edec=False,
-                                       scv=native.read(0x6086) == 1, snl_ratio=0.8 if snl else 1.0)
-    model = motion.ArcusMotion(params)
+    params = ArcusProfileParams(hspd=hspd, lspd=lspd, acc_ms=max(float(native.read(0x6083)), 1.0),
+                                dec_ms=max(float(native.read(0x6084)), 1.0), edec=False,
+                                scv=native.read(0x6086) == 1, snl_ratio=0.8 if snl else 1.0)
+    model = ArcusMotion(params)
     error = model.move(float(start), float(target))
     if error:
         raise _core.InvalidArgument(f"arcus-canopen plan_move {start} -> {target}: the model refuses: {error}")

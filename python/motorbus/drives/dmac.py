@@ -27,6 +27,10 @@ import contextlib
 from typing import Any, Iterable, Iterator, Optional, Sequence
 
 from .. import _core, _stop_at_exit
+# The DMAC's profile model (#ACCEL_TIME/#DECEL_TIME, the closed-loop approach at #LOW_SPEED):
+# the vendor's own module re-exports it (motorbus.motion keeps the generic planners).
+from .._core import (DmacMotion, DmacProfileParams, dmac_position_profile, dmac_ramp_time,  # noqa: F401
+                     dmac_speed_profile)
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFailed, MoveFaulted, MoveInterrupted,
                      MoveTimedOut, ParamInfo, Params, StopReason)
 from ..registry import DrivePlugin
@@ -207,6 +211,12 @@ __all__ = [
     "make_sim",
     "open_line",
     "parse_read_reply",
+    "dmac_interpolation",
+    "DmacMotion",
+    "DmacProfileParams",
+    "dmac_position_profile",
+    "dmac_ramp_time",
+    "dmac_speed_profile",
     "status_names",
     "stream_interpolation",
     "synchro",
@@ -413,6 +423,24 @@ def stream_interpolation(axes: Sequence[DmacClient], segments: Iterable[Sequence
     """
     return _core.dmac_stream_interpolation(list(axes), [list(map(int, s)) for s in segments],
                                            interpol_time_ms, fifo_size, sleep, backoff)
+def dmac_interpolation(start: Sequence[float], target: Sequence[float], limits: Sequence["_core.Limits"],
+                       period_ms: int = 100, straight_line: bool = True) -> Any:
+    """Plan a synchronised multi-axis move and split it into MOVE_INTERPOL offsets.
+
+    Returns an int64 numpy array ``[segment, axis]`` whose column sums reach
+    ``target - start``: the ``segments`` :func:`stream_interpolation` sends, one
+    row per ``period_ms`` (``#INTERPOL_TIME``).  The planning is the motion
+    library's (``motorbus.motion.plan_straight_line`` / ``plan_synchronized``).
+    """
+    import numpy as np
+
+    from .. import motion
+
+    planner = motion.plan_straight_line if straight_line else motion.plan_synchronized
+    axes = planner(list(map(float, start)), list(map(float, target)), list(limits))
+    return np.asarray(motion.split_interpolation(axes, int(period_ms)), dtype=np.int64).reshape(-1, len(start))
+
+
 
 
 SIM_OPTIONS = ("model", "supply_voltage", "baudrate", "request_terminator", "reply_terminator",

@@ -34,13 +34,18 @@ import time
 from typing import Any, Callable, Iterable, Optional, Union
 
 from .. import _core
+# The PMC007's profile model (start/stop speeds, gear table, microstepping): the vendor's own module
+# re-exports it (motorbus.motion keeps the generic planners).
+from .._core import (Pmc007ProfileParams, pmc007_convert_position, pmc007_gear_acceleration,  # noqa: F401
+                     pmc007_microsteps, pmc007_position_profile, pmc007_speed_profile)
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, MoveStalled,
                      ParamInfo, Params, StopReason, Units)
 from ..registry import DrivePlugin
 
 __all__ = ["ControllerStatus", "ErrorStatus", "Pmc007", "Pmc007Drive", "PLUGIN", "make_sim", "open", "OBJECTS",
            "EDS_PATH", "assemble", "disassemble", "BAUD_RATES", "GEAR_ACCELERATION", "STALL_EXAMPLES",
-           "ABORT_DEVICE_STATE"]
+           "ABORT_DEVICE_STATE", "Pmc007ProfileParams", "pmc007_convert_position",
+           "pmc007_gear_acceleration", "pmc007_microsteps", "pmc007_position_profile", "pmc007_speed_profile"]
 
 #: The EDS shipped with the package (generated from the table the simulator uses).
 EDS_PATH = os.path.join(os.path.dirname(__file__), "pmc007.eds")
@@ -934,10 +939,10 @@ def plan_move(drive: Any, start: float, target: float) -> Any:
 
     p = drive.params
     speed = abs(float(p["0x6003"])) or float(p["0x6006"])
-    params = motion.Pmc007ProfileParams(speed=speed, start_speed=float(p["0x6006"]), stop_speed=float(p["0x6007"]),
-                                        accel_gear=int(p["0x6008"]), decel_gear=int(p["0x6009"]),
-                                        microstepping=int(p["0x600A"]))
-    return motion.pmc007_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
+    params = Pmc007ProfileParams(speed=speed, start_speed=float(p["0x6006"]), stop_speed=float(p["0x6007"]),
+                                 accel_gear=int(p["0x6008"]), decel_gear=int(p["0x6009"]),
+                                 microstepping=int(p["0x600A"]))
+    return pmc007_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
 
 PLUGIN = DrivePlugin(
     kind="pmc007",
