@@ -1,15 +1,14 @@
-"""``motorbus demo --tour``: the transports one at a time, no hardware.
+"""``motorbus demo --tour``: the transports under the drives, one at a time, no hardware.
 
-(``motorbus demo`` itself is the bench demo in ``bench_demo.py``.)
+(``motorbus demo`` itself is the bench demo in ``bench_demo.py``: every registered drive
+kind, serial and CAN, simulated and driven through the Drive API — discover, home, a
+coordinated move, polling, candump logs, a plot.  The tour shows what those drives stand
+on, with no drive kind in it, so it names no vendor.)
 
-1. Serial: an RS-485 line (pty) with two Arcus DMX-CAN drives and an RS-232
-   line with a Midi DMAC, served by ``motorbus sim serve`` in a child process
-   and driven by the typed clients — the same path as a real bench.
-2. Motion: the Arcus profile model predicts the move the simulated drive makes.
-3. CAN: a virtual bus served over SLCAN (a pty) and socketcand (TCP) by
+1. CAN: a virtual bus served over SLCAN (a pty) and socketcand (TCP) by
    ``motorbus bus serve``; python-can clients on both exchange frames, and a
    recorder writes the traffic as a candump log.
-4. CANopen: a simulated node on a virtual bus served over socketcand, read and
+2. CANopen: a simulated node on a virtual bus served over socketcand, read and
    written by the SDO client (expedited, segmented, block), its dictionary
    exported as EDS.
 """
@@ -21,7 +20,6 @@ import subprocess
 import sys
 import tempfile
 import time
-from typing import Any
 
 from . import _core
 
@@ -51,51 +49,6 @@ def _stop(proc: subprocess.Popen) -> None:
         proc.wait(10)
     except subprocess.TimeoutExpired:
         proc.kill()
-
-
-def serial_bench(quick: bool) -> None:
-    from . import motion
-    from .drives.arcus import ArcusClient, open_line
-    from .drives.dmac import DmacClient
-
-    _title("serial drives: `motorbus sim serve --pty --drive arcus:01,02 --drive dmac:00`")
-    proc = _spawn("sim", "serve", "--pty", "--drive", "arcus:01,02", "--drive", "dmac:00")
-    try:
-        (arcus_spec, arcus_pty), (dmac_spec, dmac_pty) = _served_lines(proc, 2)
-        print(f"  {arcus_spec} on {arcus_pty} (RS-485 multi-drop), {dmac_spec} on {dmac_pty}")
-
-        line = open_line(arcus_pty, baud=115200, timeout=0.5)
-        with ArcusClient(line, "01") as x, ArcusClient(line, "02") as y:
-            target = 2000 if quick else 8000
-            for d in (x, y):
-                d.enable()
-                d.high_speed = 10000
-                d.acceleration = 100
-                d.deceleration = 100
-            model = motion.ArcusMotion(motion.ArcusProfileParams(hspd=10000, lspd=100, acc_ms=100, dec_ms=100,
-                                                                 snl_ratio=0.8))
-            model.move(0, target)
-            print(f"  Arcus model predicts X{target}: {model.profile.duration:.3f} s")
-            t0 = time.monotonic()
-            x.move(target)
-            y.move(-target // 2)
-            x.wait_idle(timeout=10)
-            y.wait_idle(timeout=10)
-            took = time.monotonic() - t0
-            print(f"  @01 X{target} -> EX={x.encoder} PX={x.position} in {took:.3f} s (wall, incl. polling)")
-            print(f"  @02 X{-target // 2} -> EX={y.encoder} status={y.status!r} SLS={y.snl_status!r}")
-
-        with DmacClient(dmac_pty, "00", baud=38400) as m:  # opens (and closes) the line itself
-            m.brake(False)  # a DMAC34 starts with its brake applied (factory BRAKE ON)
-            m.set_profile(high_speed=60000, accel_ms=100, decel_ms=100)
-            goal = 5000 if quick else 20000
-            m.move_to(goal)
-            pos = m.wait_idle(timeout=10)
-            print(f"  DMAC 00 MOVE_TO {goal} -> #POSITION={pos}, status {m.status}")
-            v = m.request_version()
-            print(f"  DMAC 00 version: {v.product} v{v.version}.{v.release} ({v.code}, {v.model}), serial {v.serial}")
-    finally:
-        _stop(proc)
 
 
 def can_bench(quick: bool, workdir: str) -> None:
@@ -153,10 +106,9 @@ def canopen_bench(quick: bool, workdir: str) -> None:
     _title("CANopen: a simulated node served over socketcand, read by the SDO client")
     od = canopen.ObjectDictionary()
     od.add_variable(0x1000, "Device type", "u32", "ro", default=0x00040192)
-    od.add_variable(0x1008, "Manufacturer device name", "VISIBLE_STRING", "const", default="PMC007 (simulated)")
+    od.add_variable(0x1008, "Manufacturer device name", "VISIBLE_STRING", "const", default="motorbus node (simulated)")
     od.add_record(0x1018, "Identity object")
     od.add_member(0x1018, 1, "Vendor-ID", "u32", "ro", default=0x000000AB)
-    od.add_variable(0x6001, "Controller status", "u8", "ro", default=8)
     od.add_variable(0x2003, "Baud index", "u8", "rw", low=0, high=8, default=4)
     od.add_variable(0x1F50, "Program", "DOMAIN", "rw", max_size=256 * 1024)
     with open_bus("virtual:co-demo") as node_side, open_bus("virtual:co-demo") as server_side:
@@ -167,7 +119,6 @@ def canopen_bench(quick: bool, workdir: str) -> None:
                 sdo = canopen.SdoClient(remote, 5, timeout=1.0)
                 print(f"  node 5 over socketcand 127.0.0.1:{server.port}: device type 0x{sdo.read_u32(0x1000):08X}, "
                       f"name {sdo.read_string(0x1008)!r}, vendor 0x{sdo.read_u32(0x1018, 1):X}")
-                print(f"  0x6001 controller status = {sdo.read_u8(0x6001)} (PMC007 manual: 8 = busy)")
                 sdo.write_u8(0x2003, 0, 7)
                 print(f"  wrote baud index 7 (800 kbit/s); node now holds {od[0x2003].value}")
                 try:
@@ -192,9 +143,8 @@ def canopen_bench(quick: bool, workdir: str) -> None:
 
 def tour(quick: bool = False) -> int:
     """``motorbus demo --tour``: the transports one by one."""
-    print("motorbus demo --tour: the transports one by one (ptys, TCP on 127.0.0.1)")
+    print("motorbus demo --tour: the transports under the drives one by one (a pty, TCP on 127.0.0.1)")
     with tempfile.TemporaryDirectory(prefix="motorbus-demo-") as workdir:
-        serial_bench(quick)
         can_bench(quick, workdir)
         canopen_bench(quick, workdir)
     print("\ndemo finished")
