@@ -179,16 +179,20 @@ void Pmc007Sim::schedule_node_id_switch() {
     // Called on the bus thread in the middle of the NMT reset: the node cannot be
     // replaced from there, so a helper thread does it once the reset is over.
     std::lock_guard lock(m_);
-    if (!node_ || u(0x2002) == node_id_) return;
+    if (!node_) return;
     if (renode_.joinable()) {
         if (!renode_done_) {
-            // One switch at a time: the running one looks again when it is done (a reset
-            // that reached the new node while the old one was still closing).
+            // One switch at a time: the running one looks again when it is done.  This
+            // comes before comparing with node_id_, which a running switch has not
+            // updated yet: the new node answers (boot-up, SDO, NMT) from its constructor
+            // on, so a reset can reach it while node_id_ still holds the old ID, and
+            // "2002h == node_id_" would then wrongly read as "nothing to do".
             renode_again_ = true;
             return;
         }
         renode_.join();  // finished: reaping it does not wait
     }
+    if (u(0x2002) == node_id_) return;
     renode_done_ = false;
     renode_again_ = false;
     renode_ = std::thread([this] {

@@ -47,11 +47,11 @@ struct SimFixture : ::testing::Test {
     std::string hub = "pmc007-" + std::to_string(reinterpret_cast<std::uintptr_t>(this));
     std::shared_ptr<can::VirtualBus> dev = can::open_virtual(hub);
     std::shared_ptr<can::VirtualBus> host = can::open_virtual(hub);
-    std::unique_ptr<Pmc007Sim> sim;
+    std::unique_ptr<Sim> sim;
     std::unique_ptr<canopen::SdoClient> sdo;
 
     void SetUp() override {
-        sim = std::make_unique<Pmc007Sim>(5, clock);
+        sim = std::make_unique<Sim>(5, clock);
         sim->attach(*dev);
         sdo = std::make_unique<canopen::SdoClient>(*host, 5);
     }
@@ -416,6 +416,29 @@ TEST_F(SimFixture, NodeIdTakesEffectAtResetCommunication) {
     EXPECT_EQ(sdo->read_u8(0x2002, 0), 5);
 }
 
+// B-P36 again, with the reset node sent the instant the new node's boot-up is on
+// the bus: the new LocalNode answers from its constructor on, before the switch
+// has finished, so the reset reaches it while the simulator still counts itself
+// as node 5.  It used to take "2002h (5) == my ID (5)" for nothing to do and stay
+// on 9; the switch must look again and come back to 5 (once seen under ASan).
+TEST_F(SimFixture, ResetNodeRightAfterTheNewBootUpSwitchesBack) {
+    sdo->write_u8(0x2002, 0, 9);
+    std::atomic<bool> booted{false};
+    // Sent from inside the delivery of the boot-up: on the thread still building the
+    // new node, so the reset always lands before that thread has finished the switch.
+    auto sub = host->subscribe_id(0x709, false, [&](const can::Frame& f) {
+        if (f.len != 1 || f.data[0] != 0 || booted.exchange(true)) return;
+        host->send(can::Frame::make(0, std::vector<std::uint8_t>{0x81, 9}));  // flash still says 5
+    });
+    host->send(can::Frame::make(0, std::vector<std::uint8_t>{0x82, 5}));
+    for (int i = 0; i < 400 && !booted; ++i) std::this_thread::sleep_for(5ms);
+    host->unsubscribe(sub);
+    EXPECT_TRUE(booted.load());
+    for (int i = 0; i < 400 && sim->node_id() != 5; ++i) std::this_thread::sleep_for(5ms);
+    EXPECT_EQ(sim->node_id(), 5);
+    EXPECT_EQ(sdo->read_u8(0x2002, 0), 5);
+}
+
 // B-P45: RESET_EN jumps to its target on a low pulse of GPI1 and stops the
 // rotation; PAUSE_EN toggles pause on GPI2 without stopping an issued rotation.
 TEST_F(SimFixture, ResetAndPauseInputs) {
@@ -488,15 +511,15 @@ TEST_F(SimFixture, LostConsumerHeartbeatOnlyEmcy) {
     EXPECT_TRUE(sim->busy());
 }
 
-// Pmc007SimOptions::store_path: the flash outlives the simulator object.
+// SimOptions::store_path: the flash outlives the simulator object.
 TEST(Pmc007Store, FlashSurvivesANewSimulator) {
     const std::string path = ::testing::TempDir() + "pmc007-store-test.flash";
     std::remove(path.c_str());
     SimClock clock;
-    Pmc007SimOptions o;
+    SimOptions o;
     o.store_path = path;
     {
-        Pmc007Sim sim(5, clock, o);
+        Sim sim(5, clock, o);
         auto& od = sim.od();
         std::uint8_t v[2] = {0x2C, 0x01};  // 300
         ASSERT_EQ(od.at(0x6006, 0)->remote_write(std::span(v, 2)), 0u);
@@ -509,7 +532,7 @@ TEST(Pmc007Store, FlashSurvivesANewSimulator) {
         std::uint8_t v2[2] = {0xF4, 0x01};  // 500, not saved
         ASSERT_EQ(od.at(0x6006, 0)->remote_write(std::span(v2, 2)), 0u);
     }
-    Pmc007Sim again(5, clock, o);
+    Sim again(5, clock, o);
     EXPECT_EQ(again.od().at(0x6006, 0)->get_u64(), 300u);
     EXPECT_EQ(again.flash_program(), std::vector<std::uint32_t>{0x01000C80u});
     std::remove(path.c_str());
@@ -519,7 +542,7 @@ TEST(Pmc007Store, FlashSurvivesANewSimulator) {
 // the state read as on a sim newly built at the same time.
 TEST(Pmc007SimReset, ResetToNewReadsAsAFreshSim) {
     SimClock clock{1'000'000'000};
-    Pmc007Sim used(5, clock);
+    Sim used(5, clock);
     auto write = [&](std::uint16_t i, std::uint8_t s, std::vector<std::uint8_t> d) {
         canopen::VariablePtr v;
         ASSERT_EQ(used.od().lookup(i, s, v), 0);
@@ -535,7 +558,7 @@ TEST(Pmc007SimReset, ResetToNewReadsAsAFreshSim) {
     used.poll();
     ASSERT_NE(used.error_status(), 0);
     used.reset_to_new();
-    Pmc007Sim fresh(5, clock);
+    Sim fresh(5, clock);
     for (const auto& r : pmc007_od_rows())
         EXPECT_EQ(used.od().at(r.index, r.sub)->get(), fresh.od().at(r.index, r.sub)->get())
             << std::hex << r.index << ":" << int(r.sub);
@@ -555,7 +578,7 @@ TEST(Pmc007SimReset, ResetToNewReadsAsAFreshSim) {
 TEST(Pmc007SimLifetime, PowerCycleAfterCloseTouchesNoClosedService) {
     SimClock clock{1'000'000'000};
     auto dev = can::open_virtual("pmc007-lifetime");
-    auto sim = std::make_unique<Pmc007Sim>(5, clock);
+    auto sim = std::make_unique<Sim>(5, clock);
     sim->attach(*dev);
     sim->close();
     sim->power_cycle();                                          // reloads 1016h/1017h/PDO values
