@@ -14,10 +14,6 @@ NOT_THREADED = {
     # The command line and the served twin, run as child processes; the client paths they
     # reach are the in-process outcome tests' (test_outcomes_*), which do run under ASan.
     "test_cli", "test_cli_outcomes", "test_sim_serve_bench", "test_move_outcomes",
-    # Out of the ASan re-run until a race is found: once under ASan the PMC007 twin sent no
-    # boot-up within 3 s after a reset node that switches its node-ID back (not an ASan report;
-    # the test runs in the plain stage as before).
-    "test_pmc007_audit",
 }
 
 
