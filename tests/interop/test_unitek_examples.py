@@ -3,7 +3,8 @@ with python-can as the client of a socketcand-served simulator (no motorbus code
 the client side), and motorbus's own client's frames captured on the bus by python-can.
 
 Vectors: tests/data/unitek/seed_examples.json (a copy of the shared seed vectors, with
-the DESIGN.md errata corrected: ex 6 `35 E8 03`, ex 4 DLC 5, ex 9 ids 0x201/0x181)."""
+the manual's errata corrected, as docs/drives/unitek.md lists them: ex 6 `35 E8 03`, ex 4 DLC 5,
+ex 9 ids 0x201/0x181)."""
 from __future__ import annotations
 
 import json

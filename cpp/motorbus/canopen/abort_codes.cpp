@@ -47,7 +47,8 @@ const std::vector<AbortEntry>& abort_table() {
 }
 
 const char* abort_text(std::uint32_t code) {
-    // PMC007 misprints (DESIGN.md): decode them as the CiA codes they stand for.
+    // Codes a device manual misprints (docs/canopen.md, "Abort codes"): decode them as
+    // the CiA codes they stand for.
     switch (code) {
         case 0x05030004: code = 0x05040004; break;
         case 0x05030005: code = 0x05040005; break;

@@ -44,8 +44,9 @@ constexpr std::uint32_t kNoData = 0x08000024;
 }  // namespace abort_code
 
 // The CiA 301 text for `code`, or nullptr when the code is not in the table.
-// The PMC007 manual misprints a few codes (05030004/05030005 for the CiA
-// 05040004/05040005, 0606001x for 0607001x): those decode to the CiA text.
+// A device manual misprints a few codes (05030004/05030005 for the CiA
+// 05040004/05040005, 0606001x for 0607001x; docs/canopen.md): those decode to
+// the CiA text.
 const char* abort_text(std::uint32_t code);
 // "0x06020000 Object does not exist in the object dictionary" (or "... unknown abort code").
 std::string describe_abort(std::uint32_t code);

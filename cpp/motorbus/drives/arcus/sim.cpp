@@ -112,7 +112,7 @@ void Sim::boot() {
     s.flash.br = options_.bit_rate;
     if (options_.comm_type == 2) {
         // A unit set up for CANopen: the CANopen tables' defaults (Tables 8.11,
-        // 8.21; DESIGN.md follows them for the CANopen persona).
+        // 8.21, where the ASCII persona follows Table 7.11; docs/drives/arcus.md).
         s.flash.slt = 10;
         s.flash.curr = 1500;
         s.flash.curi = 500;
@@ -372,7 +372,8 @@ std::string Sim::handle(const Request& req) {
 
     if (pc->op == Op::Set) {
         if (name == "DN") {
-            // DMC05, DMK05 or 05: the address is the two digits (DESIGN.md).
+            // DMC05, DMK05 or 05: the manual writes the name all three ways; the
+            // address is the two digits (docs/drives/arcus.md, readings).
             std::string_view t = pc->text_value;
             if (t.size() == 5 && (t.substr(0, 3) == "DMC" || t.substr(0, 3) == "DMK")) t.remove_prefix(3);
             auto a = t.size() == 2 ? parse_int(t) : std::nullopt;

@@ -35,8 +35,9 @@ struct CommandRejected : DriveFault {
     std::uint32_t error;
 };
 
-// Line settings of the DMAC (the manual does not name them; DESIGN.md: CR
-// after requests, CR LF after replies).
+// Line settings of the DMAC: the manual does not name them, so CR after
+// requests, CR LF after replies (docs/drives/dmac.md, "Where the manual is
+// ambiguous"); both configurable.
 serial::LineOptions default_line_options();
 
 struct Status {

@@ -4,7 +4,8 @@
 // Frame:  [aa][:n ]CMD [args][, CMD [args]]...      (aa = 00..63, absent = global)
 // Reply:  aa#MNEMONIC[.bit]=+123 | =h0000007B | =b00000000 00000000 00000000 01111011
 // Readings the project follows where the manual contradicts itself: see
-// DESIGN.md (bits numbered 1..32 from the LSB, sign always emitted on replies).
+// docs/drives/dmac.md, "Where the manual is ambiguous" (bits numbered 1..32
+// from the LSB, sign always emitted on replies).
 #pragma once
 #include <array>
 #include <cstdint>
