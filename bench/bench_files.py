@@ -35,7 +35,7 @@ def emit(**row: Any) -> None:
 
 
 def serial_sweep(reply_timeout: float) -> None:
-    plugins = [p for p in registry.drive_plugins().values() if p.transport == "serial" and p.probe]
+    plugins = [p for p in registry.drive_plugins().values() if p.transport == "serial" and p.provides("probe")]
     empty = _core.PtyLineServer([], 9600)
     try:
         t = time.perf_counter()

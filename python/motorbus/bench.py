@@ -827,8 +827,8 @@ class Bench:
                       timeout: Optional[float] = None) -> StartReport:
         """Starts moves on several axes together and reports how closely.
 
-        Axes of one kind sharing a line or bus whose plugin offers a drive-level
-        synchronised start (``DrivePlugin.synchronised_start``: DMAC ``SYNCHRO``)
+        Axes of one kind sharing a line or bus whose Drive class offers a drive-level
+        synchronised start (``Drive.synchronised_start``: DMAC ``SYNCHRO``)
         start on the drives' own trigger: their offsets are 0 by construction (one
         broadcast).  The others get a software start: commands back to back, each
         axis starting when its own command arrives; their offsets are measured
@@ -850,10 +850,10 @@ class Bench:
             (d.move_by if relative else d.move_to)(targets[name], velocity=velocity, wait=False)
 
         for (kind, line, bus), names in groups.items():
-            sync = registry.drive_plugin(kind).synchronised_start
-            if sync is not None and len(names) > 1:
+            cls = registry.drive_plugin(kind)
+            if cls.provides("synchronised_start") and len(names) > 1:
                 link = self.lines[line] if line else self.buses[bus]
-                with sync(link, [drives[n] for n in names]) as how:
+                with cls.synchronised_start(link, [drives[n] for n in names]) as how:
                     for n in names:
                         command(n)
                 now = time.perf_counter()

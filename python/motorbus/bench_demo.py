@@ -75,7 +75,7 @@ def _discover(bench: Bench) -> tuple[list[tuple[str, str, str, str]], list[str]]
             got = f"{f.kind} {f.identity.get('model', '')}".strip() if f else "nothing"
         else:   # the line is the bench's own: ask this axis's address with the kind's identity probe
             try:
-                ident = plugin.probe(bench.lines[cfg.line], cfg.address) if plugin.probe else None
+                ident = plugin.probe(bench.lines[cfg.line], cfg.address) if plugin.provides("probe") else None
             except _core.MotorbusError as e:   # the demo goes on: the table says what the probe met
                 ident, got = None, f"nothing ({type(e).__name__})"
             else:
@@ -156,12 +156,12 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
         starts = {n: d.position for n, d in movers.items()}
         plans = {}
         for n, d in movers.items():
-            if registry.drive_plugin(d.kind).plan_move is not None:
+            if type(d).provides("plan_move"):
                 try:
                     plans[n] = plot.planned(d, starts[n], targets[n])
                 except _core.MotorbusError as e:   # the kind's model refuses these settings: no plan line
                     _say(f"  {n}: no planned profile ({e})")
-        pollable = {n: d for n, d in movers.items() if registry.drive_plugin(d.kind).poll_fields is not None}
+        pollable = {n: d for n, d in movers.items() if type(d).provides("poll_fields")}
 
         _say(f"\n== coordinated move, polled at {RATE_HZ:g} Hz, CAN traffic recorded")
         candump = os.path.join(out, "demo_can.log")

@@ -1,7 +1,7 @@
 """Find the drives connected to serial lines and CAN buses, and write a bench file.
 
 ``discover(lines=["/dev/ttyUSB0"], buses=["socketcand:10.0.0.5:29536/can0"])`` asks
-every registered kind's probe (``DrivePlugin.probe`` / ``canopen_match``):
+every registered kind's probe (its Drive class's ``probe`` / ``canopen_match``):
 
 * a serial line: for each serial kind, each of its ``probe_bauds``, each of its
   ``probe_addresses``, the kind's identity query (Arcus ``ID``/``VER``, DMAC
@@ -111,9 +111,10 @@ def discover(lines: Sequence[str] = (), buses: Sequence[Any] = (), *, kinds: Opt
         if unknown:
             raise _core.InvalidArgument(f"discover kinds: unknown {unknown} (registered: {', '.join(plugins)})")
         plugins = {k: p for k, p in plugins.items() if k in kinds}
-    serial = [p for p in plugins.values() if p.transport == "serial" and p.probe]
-    canopen = [p for p in plugins.values() if p.transport == "can" and p.canopen_match]
-    can_probes = [p for p in plugins.values() if p.transport == "can" and p.probe and not p.canopen_match]
+    serial = [p for p in plugins.values() if p.transport == "serial" and p.provides("probe")]
+    canopen = [p for p in plugins.values() if p.transport == "can" and p.provides("canopen_match")]
+    can_probes = [p for p in plugins.values()
+                  if p.transport == "can" and p.provides("probe") and not p.provides("canopen_match")]
     # Work units for the bar: one per (line, kind, baud, address), one per CANopen scan and CAN probe.
     total = sum(len(p.probe_bauds or (p.default_baud,)) * len(p.probe_addresses) for p in serial) * len(lines)
     total += len(buses) * ((1 if canopen else 0) + sum(len(p.probe_addresses) for p in can_probes))

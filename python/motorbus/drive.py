@@ -29,6 +29,7 @@ from __future__ import annotations
 import abc
 import dataclasses
 import enum
+import inspect
 import logging
 import math
 import time
@@ -309,9 +310,36 @@ class Drive(abc.ABC):
     """One motor axis, whatever its vendor.  See the module doc.
 
     Subclasses set ``kind``, ``capabilities`` and implement the ``_`` methods in
-    native units; ``native`` is the vendor client they wrap."""
+    native units; ``native`` is the vendor client they wrap.
+
+    A kind's subclass is also its plugin: the ``motorbus.drive`` entry point names
+    it (as python-can's ``can.interface`` names a bus class), its class attributes
+    below say what the kind is, and the registry's consumers (``open_drive``, the
+    simulators, discovery, benches, the Poller, plots) call its hooks: classmethods
+    for what comes before a drive is open (``open``, ``make_sim``, ``check_address``,
+    ``probe``, ``canopen_match``, ``store_options``, ``synchronised_start``,
+    ``sim_faults``), methods for what acts on an open one (``poll_fields``,
+    ``capture_fields``, ``plan_move``).  An optional capability is a hook the kind
+    overrides (``provides(hook)`` says which); the defaults say the kind lacks it."""
 
     kind: str = "?"
+    #: One line for ``motorbus kinds`` and ``drive_kinds()``.
+    description: str = ""
+    #: ``"serial"`` (a line, shared by drives of one kind: RS-485 multi-drop) or
+    #: ``"can"`` (a node on a CAN bus); the registry refuses anything else.
+    transport: str = ""
+    #: The address a bench file or a test uses when it names none.
+    default_address: str = ""
+    #: Serial only: the framing (request/reply terminators, max line) a line server
+    #: and a LineLink need, as keyword arguments of both.
+    line_settings: Optional[dict] = None
+    #: Serial only: the line's baud rate unless a bench file says otherwise.
+    default_baud: int = 0
+    #: The keyword options ``make_sim`` takes (``sim serve`` and bench files pass them through).
+    sim_options: tuple = ()
+    #: What a discovery sweep tries (``probe``): addresses, and bauds on a serial line.
+    probe_addresses: tuple = ()
+    probe_bauds: tuple = ()
     capabilities: frozenset = frozenset()
     #: The drive stops by itself when the link to this host is lost.
     has_watchdog: bool = False
@@ -322,6 +350,99 @@ class Drive(abc.ABC):
     #: How far from its target (native units) a move may come to rest and still count as
     #: arrived, when the kind does not read it from the drive (``_in_position_window``).
     in_position_window: float = 0.0
+
+    # ---- the plugin: hooks of the kind (classmethods) and of an open drive -------------
+    @classmethod
+    def open(cls, *, line: Any = None, bus: Any = None, address: str, units: Optional[Units] = None,
+             **options: Any) -> "Drive":
+        """The kind's Drive on an open LineLink/port (``line``, serial kinds) or Bus/spec
+        (``bus``, CAN kinds) at a canonical ``address`` (``open_drive`` checks both first)."""
+        raise _core.InvalidArgument(f"drive kind {cls.kind!r} cannot be opened (its class has no open())")
+
+    @classmethod
+    def make_sim(cls, address: Any, clock: Any = None, **options: Any) -> Any:
+        """A simulated drive.  Serial: a LineDevice for a PtyLineServer.  CAN: an object
+        with ``attach(bus)`` and ``close()`` (``make_sim(..., bus=bus)`` attaches at once)."""
+        raise _core.InvalidArgument(f"drive kind {cls.kind!r} has no simulator")
+
+    @classmethod
+    def check_address(cls, text: Any) -> str:
+        """The canonical form of an address, or InvalidArgument naming the problem.  The
+        default takes any non-empty text without spaces; kinds check their own notation."""
+        if not isinstance(text, (str, int)) or isinstance(text, bool) or not str(text).strip() \
+                or any(c.isspace() for c in str(text).strip()):
+            raise _core.InvalidArgument(f"{cls.kind} address: non-empty text without spaces, not {text!r}")
+        return str(text).strip()
+
+    @classmethod
+    def store_options(cls, store_dir: str, address: str) -> dict:
+        """The ``make_sim`` options that keep a served drive's stored parameters in
+        ``store_dir`` (``sim serve --store-dir``); none by default."""
+        return {}
+
+    @classmethod
+    def wire_line(cls, sims: list) -> None:
+        """``sim serve``: wires the simulated drives of one served line together (a
+        synchronisation chain on their I/Os), before the line is served; nothing by default."""
+
+    @classmethod
+    def probe(cls, link: Any, address: str) -> Optional[dict]:
+        """Discovery (it never moves a motor nor writes a parameter): asks one address for
+        its identity (``{"model", "firmware", "serial"}``, what the protocol gives) over a
+        LineLink framed with ``line_settings`` (serial) or a Bus (CAN kinds that are not
+        CANopen); None when nothing answers.  Default: the kind cannot be probed."""
+        return None
+
+    @classmethod
+    def canopen_match(cls, node: Any) -> int:
+        """CANopen kinds: a score for a node the CANopen scan found (``NodeInfo``: device
+        type, vendor id, product code...), 0 = not this kind; the highest score names the
+        node's kind."""
+        return 0
+
+    @classmethod
+    def synchronised_start(cls, link: Any, drives: Any) -> Any:
+        """A drive-level synchronised start for drives of this kind sharing ``link``: a
+        context manager (its value: one word saying how); moves commanded inside it start
+        together when it exits (``Bench.move_together``)."""
+        raise _core.InvalidArgument(f"drive kind {cls.kind!r} has no drive-level synchronised start")
+
+    @classmethod
+    def sim_faults(cls) -> dict:
+        """Faults the kind's simulator can be given for robustness tests (the pytest
+        plugin's ``sim_faults`` fixture, ``sim serve``'s ``fault``): ``{name: fault(sim,
+        **options)}``, each provoking what its name says on one simulated drive (a limit
+        switch trips, the rotor stalls, the supply drops...).  Names are the kind's own."""
+        return {}
+
+    def poll_fields(self, fields: tuple) -> "registry.PollSpec":
+        """What ``motorbus.Poller`` reads from this drive on its C++ poll thread, for
+        field names among "position", "velocity", "status" (InvalidArgument for a field
+        the kind cannot give)."""
+        raise _core.InvalidArgument(f"{self.kind}: this drive kind cannot be polled")
+
+    def capture_fields(self, fields: tuple, period: float) -> "registry.PollSpec":
+        """For kinds whose drive can push its data (CANopen TPDOs, cyclic registers): sets
+        the drive to transmit ``fields`` about every ``period`` s and returns a capture
+        source (``stamped=True``) that takes what arrives instead of asking."""
+        raise _core.InvalidArgument(f"{self.kind}: this drive kind cannot push its data")
+
+    def plan_move(self, start: float, target: float) -> Any:
+        """The kind's own profile model of a position move: a ``motion.Profile`` in native
+        units, t = 0 at the command, from the drive's current speed/ramp parameters
+        (``motorbus.plot.planned``, ``motorbus demo``)."""
+        raise _core.InvalidArgument(f"drive kind {self.kind!r} has no profile model (plan_move)")
+
+    @classmethod
+    def provides(cls, hook: str) -> bool:
+        """True when the kind overrides ``hook`` (one of ``HOOKS``): an optional
+        capability its consumers offer only where it exists."""
+        if hook not in HOOKS:
+            raise _core.InvalidArgument(f"Drive.provides: a hook among {', '.join(HOOKS)}, not {hook!r}")
+        def function(attr: Any) -> Any:     # a classmethod's function (a kind may restore the default)
+            return getattr(attr, "__func__", attr)
+
+        return function(inspect.getattr_static(cls, hook)) is not function(Drive.__dict__[hook])
 
     def __init__(self, native: Any, *, units: Optional[Units] = None, on_error: StopHow = "stop",
                  on_exit: StopHow = "stop", close_native: Optional[Callable[[], None]] = None) -> None:
@@ -780,6 +901,11 @@ class Drive(abc.ABC):
         return f"<{type(self).__name__} {self.kind} {state}, units={self._units.name}>"
 
 
+#: The plugin hooks a kind may override (``Drive.provides``).
+HOOKS = ("open", "make_sim", "check_address", "store_options", "wire_line", "probe", "canopen_match", "synchronised_start",
+         "sim_faults", "poll_fields", "capture_fields", "plan_move")
+
+
 def open_drive(kind: str, *, line: Any = None, bus: Any = None, address: Union[str, int],
                units: Optional[Units] = None, **options: Any) -> Drive:
     """Opens a drive of a registered ``kind`` (``motorbus.drive_kinds()`` lists them).
@@ -792,14 +918,14 @@ def open_drive(kind: str, *, line: Any = None, bus: Any = None, address: Union[s
       for CANopen: see docs/drives/<vendor>.md);
     * ``options``: the vendor's (``on_error``, ``on_exit``, timeouts...).
     """
-    plugin = registry.drive_plugin(kind)
+    cls = registry.drive_plugin(kind)
     # An integer means that integer for every kind (a CAN id 0x201 is 513, not "513" read
     # as hex text by a kind that writes its ids in hex); text is the vendor's own notation.
     is_int = isinstance(address, int) and not isinstance(address, bool)
-    canonical = plugin.check_address(address if is_int else str(address).strip())
-    if plugin.transport == "serial":
+    canonical = cls.check_address(address if is_int else str(address).strip())
+    if cls.transport == "serial":
         if line is None or bus is not None:
             raise _core.InvalidArgument(f"open_drive({kind!r}): a serial drive takes line=, not bus=")
     elif bus is None or line is not None:
         raise _core.InvalidArgument(f"open_drive({kind!r}): a CAN drive takes bus=, not line=")
-    return plugin.open(line=line, bus=bus, address=canonical, units=units, **options)
+    return cls.open(line=line, bus=bus, address=canonical, units=units, **options)

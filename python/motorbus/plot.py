@@ -56,16 +56,13 @@ def planned(drive: Any, start: float, target: float, n: int = 1000) -> dict[str,
     """The move ``start`` -> ``target`` (user units) as the drive's kind plans it,
     sampled: ``{"t", "p", "v"}`` in seconds and user units, t = 0 at the command.
 
-    The profile model is the kind's own (``DrivePlugin.plan_move``, fed with
+    The profile model is the kind's own (``Drive.plan_move``, fed with
     the drive's current speed and ramp parameters); InvalidArgument for a kind
     that has none."""
-    from .registry import drive_plugin
-
-    plugin = drive_plugin(drive.kind)
-    if plugin.plan_move is None:
+    if not type(drive).provides("plan_move"):
         raise _core.InvalidArgument(f"plot.planned: drive kind {drive.kind!r} has no profile model (plan_move)")
     scale = float(drive.units.scale)
-    prof = plugin.plan_move(drive, start / scale, target / scale)
+    prof = drive.plan_move(start / scale, target / scale)
     s = prof.sample(max(2, int(n)))
     return {"t": s[:, 0], "p": s[:, 1] * scale, "v": s[:, 2] * scale}
 

@@ -11,12 +11,12 @@ Axes are grouped by transport (a serial line, a CAN bus): one C++ thread per
 group reads every axis of the group each period, on an absolute schedule
 (deadline k at t0 + k / rate_hz, shared by all groups), timestamps the sample
 and writes it into a preallocated ring, without the GIL.  Each drive kind says
-what to read through its plugin's ``poll_fields`` (registry.PollSpec); this
+what to read through its Drive class's ``poll_fields`` (registry.PollSpec); this
 module converts the native readings to the axis's user units (``drive.units``)
 with numpy, never per sample in Python.
 
 Where a drive pushes its data (CANopen TPDOs, a register protocol's cyclic
-transmissions: the kinds whose plugin has ``capture_fields``, listed in
+transmissions: the kinds whose Drive class has ``capture_fields``, listed in
 docs/poller.md), the poller captures instead of asking
 (``mode="auto"``, the default): the drive kind sets the drive to transmit the
 fields about every period, the bus receive thread keeps the latest values, and
@@ -45,7 +45,6 @@ from typing import Any, Iterable, Optional, Union
 import numpy as np
 
 from . import _core
-from .registry import drive_plugin
 
 __all__ = ["Poller", "FIELDS", "load_frame"]
 
@@ -92,7 +91,7 @@ class Poller:
     * ``candump``: a path; the CAN traffic of CAN groups is recorded there as a
       candump log while polling (``name.log`` -> ``name-2.log`` for a second bus);
     * ``mode``: ``"auto"`` (default: capture what the drive pushes where its
-      kind can push, i.e. its plugin has ``capture_fields`` — TPDOs on the
+      kind can push, i.e. its Drive class has ``capture_fields`` — TPDOs on the
       event timer, cyclic registers — and ask the others), ``"capture"`` (every axis captured; an
       axis whose kind cannot push is an InvalidArgument) or ``"ask"`` (always
       ask, one request per field per sample).  ``modes`` says per axis;
@@ -174,18 +173,17 @@ class Poller:
             self.start()
 
     def _spec(self, name: str, drive: Any, fields: tuple, mode: str) -> Any:
-        plugin = drive_plugin(drive.kind)
-        can_capture = plugin.capture_fields is not None
+        can_capture = type(drive).provides("capture_fields")
         if mode == "capture" and not can_capture:
             raise _core.InvalidArgument(f"Poller mode 'capture': axis {name!r} ({drive.kind}) cannot push its data; "
                                         f"use mode='auto' to ask it instead")
         if mode != "ask" and can_capture:
             self.modes[name] = "capture"
-            return plugin.capture_fields(drive, fields, self.period_ns / 1e9)
-        if plugin.poll_fields is None:
+            return drive.capture_fields(fields, self.period_ns / 1e9)
+        if not type(drive).provides("poll_fields"):
             raise _core.InvalidArgument(f"Poller: axis {name!r} ({drive.kind}): this drive kind cannot be polled")
         self.modes[name] = "ask"
-        return plugin.poll_fields(drive, fields)
+        return drive.poll_fields(fields)
 
     def _close_sources(self) -> None:
         for g in self._groups:

@@ -169,7 +169,7 @@ def identify(bench: Any) -> dict[str, dict]:
         entry: dict = {"kind": cfg.kind, "address": cfg.address,
                        "where": f"line {cfg.line}" if cfg.line else f"bus {cfg.bus}"}
         try:
-            if plugin.canopen_match is not None:
+            if plugin.provides("canopen_match"):
                 from .canopen import scan_network
 
                 node = int(cfg.address, 0)
@@ -181,7 +181,7 @@ def identify(bench: Any) -> dict[str, dict]:
                     entry.update(_canopen_strings(bench.buses[cfg.bus], node))
                 else:
                     entry["identity"] = "no answer"
-            elif plugin.probe is not None:
+            elif plugin.provides("probe"):
                 link = bench.lines[cfg.line] if cfg.line else bench.buses[cfg.bus]
                 entry.update(plugin.probe(link, cfg.address) or {"identity": "no answer"})
             else:
@@ -400,7 +400,7 @@ class SimFaults:
     """Fault injection on the simulated twin (the ``sim_faults`` fixture).
 
     * ``offered(axis)``: the faults that axis's simulator has (its kind's
-      ``DrivePlugin.sim_faults``); ``inject(axis, name, **options)`` provokes one;
+      ``Drive.sim_faults()``); ``inject(axis, name, **options)`` provokes one;
     * bus and line faults, owned by the bench: ``spoil_frames(bus=None, drop=0.0,
       corrupt=0.0, delay=0.0, drop_every=0, seed=...)`` on a simulated bus (both
       directions), ``cut_line(line)`` / ``cut_bus(bus)`` end the served transport.
@@ -414,14 +414,14 @@ class SimFaults:
         from . import registry
 
         self._bench[axis]  # names the axes when this one does not exist
-        return sorted(registry.drive_plugin(self._bench.config[axis].kind).sim_faults or {})
+        return sorted(registry.drive_plugin(self._bench.config[axis].kind).sim_faults())
 
     def inject(self, axis: str, fault: str, **options: Any) -> None:
         from . import _core, registry
 
         self._bench[axis]
         kind = self._bench.config[axis].kind
-        faults = registry.drive_plugin(kind).sim_faults or {}
+        faults = registry.drive_plugin(kind).sim_faults()
         if fault not in faults:
             raise _core.InvalidArgument(f"sim_faults: the {kind} simulator (axis {axis!r}) has no fault {fault!r} "
                                         f"(it has: {', '.join(sorted(faults)) or 'none'})")

@@ -2,7 +2,10 @@
 
 Two entry-point groups, read once and lazily (as python-can reads ``can.interface``):
 
-* ``motorbus.drive``: ``<kind> = "package.module:PLUGIN"``, a :class:`DrivePlugin`;
+* ``motorbus.drive``: ``<kind> = "package.module:SomeDrive"``, the kind's
+  :class:`motorbus.Drive` subclass (as python-can's ``can.interface`` names a bus
+  class): its class attributes say what the kind is, its methods and
+  classmethods are the kind's hooks (docs/plugins.md);
 * ``motorbus.bus``: ``<scheme> = "package.module:SCHEME"``, a :class:`BusScheme`.
 
 motorbus declares its own vendors and schemes in its ``pyproject.toml`` exactly
@@ -14,11 +17,14 @@ from __future__ import annotations
 import threading
 from dataclasses import dataclass
 from importlib import metadata
-from typing import Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 from . import _core
 
-__all__ = ["DRIVE_GROUP", "BUS_GROUP", "DrivePlugin", "PollSpec", "BusScheme", "drive_plugin", "drive_plugins",
+if TYPE_CHECKING:
+    from .drive import Drive
+
+__all__ = ["DRIVE_GROUP", "BUS_GROUP", "PollSpec", "BusScheme", "drive_plugin", "drive_plugins",
            "drive_kinds", "bus_scheme", "bus_schemes", "parse_drive_spec"]
 
 DRIVE_GROUP = "motorbus.drive"
@@ -27,7 +33,7 @@ BUS_GROUP = "motorbus.bus"
 
 @dataclass(frozen=True)
 class PollSpec:
-    """What a drive kind's ``poll_fields(drive, fields)`` gives :class:`motorbus.Poller`.
+    """What a drive's ``poll_fields(fields)`` gives :class:`motorbus.Poller`.
 
     * ``source``: a ``_core.PollSource`` (built on the kind's native C++ client)
       that reads the fields, in the order asked, on the poll thread;
@@ -50,83 +56,6 @@ class PollSpec:
     bus: Any = None
     stamped: bool = False
     close: Optional[Callable[[], None]] = None
-
-
-@dataclass(frozen=True)
-class DrivePlugin:
-    """What a vendor module exports as ``PLUGIN``.
-
-    * ``transport``: ``"serial"`` (a line, shared by drives of one kind: RS-485
-      multi-drop) or ``"can"`` (a node on a CAN bus).
-    * ``open(*, line, bus, address, units, **options) -> Drive``: the Drive adapter.
-    * ``make_sim(address, clock=None, **options)``: a simulated drive.  Serial:
-      a LineDevice for a PtyLineServer.  CAN: an object with ``attach(bus)`` and
-      ``close()`` (``make_sim(..., bus=bus)`` attaches at once).
-    * ``line_settings``: serial only, the framing (request/reply terminators,
-      max line) a line server and a LineLink need.
-    * ``check_address(text) -> str``: the canonical form of an address, or
-      InvalidArgument naming the problem.
-    * Discovery (``motorbus.discover``; it never moves a motor nor writes a
-      parameter): ``probe(link, address) -> dict | None`` asks one address for
-      its identity (``{"model": ..., "firmware": ..., "serial": ...}``, what the
-      protocol gives) over a LineLink framed with ``line_settings`` (serial) or
-      a Bus (CAN kinds that are not CANopen); ``probe_addresses`` and
-      ``probe_bauds`` are what a sweep tries.  CANopen kinds set
-      ``canopen_match(node) -> int`` instead: a score for a node found by the
-      CANopen scan (``NodeInfo``: device type, vendor id, product code...), 0 =
-      not this kind; the highest score names the node's kind.
-    * ``synchronised_start(link, drives)``, ``sim_faults``: see the fields' comments.
-    * ``poll_fields(drive, fields) -> PollSpec``: see the field's comment.
-    """
-
-    kind: str
-    description: str
-    transport: str
-    open: Callable[..., Any]
-    make_sim: Callable[..., Any]
-    check_address: Callable[[str], str]
-    default_address: str
-    line_settings: Optional[dict] = None
-    default_baud: int = 0
-    sim_options: tuple = ()
-    #: Options make_sim takes per served drive from ``sim serve --store-dir``: a
-    #: function (store_dir, address) -> dict of options.
-    store_options: Optional[Callable[[str, str], dict]] = None
-    probe: Optional[Callable[..., Optional[dict]]] = None
-    probe_addresses: tuple = ()
-    probe_bauds: tuple = ()
-    canopen_match: Optional[Callable[[Any], int]] = None
-    #: A drive-level synchronised start for axes of this kind sharing one link:
-    #: ``synchronised_start(link, drives)`` is a context manager; moves commanded
-    #: inside it start together when it exits (``Bench.move_together`` uses it).
-    synchronised_start: Optional[Callable[..., Any]] = None
-    #: Faults the kind's simulator can be given for robustness tests (the pytest
-    #: plugin's ``sim_faults`` fixture): ``{name: fault(sim, **options)}``, each
-    #: provoking what its name says on one simulated drive (a limit switch trips,
-    #: the rotor stalls, the supply drops...).  Names are the kind's own; the
-    #: fixture lists them when asked for one the kind does not have.
-    sim_faults: Optional[dict] = None
-    #: What ``motorbus.Poller`` reads from an open Drive of this kind on its C++
-    #: poll thread: ``poll_fields(drive, fields) -> PollSpec`` for a tuple of
-    #: field names among "position", "velocity", "status" (InvalidArgument for a
-    #: field the kind cannot give).  None: the kind cannot be polled.
-    poll_fields: Optional[Callable[..., "PollSpec"]] = None
-    #: The kind's own profile model for a position move of an open Drive:
-    #: ``plan_move(drive, start, target) -> motion.Profile`` in native units,
-    #: t = 0 at the command, from the drive's current speed/ramp parameters
-    #: (``motorbus.plot.planned``, ``motorbus demo``).  None: no model.
-    plan_move: Optional[Callable[..., Any]] = None
-    #: For kinds whose drive can push its data (CANopen TPDOs, cyclic registers):
-    #: ``capture_fields(drive, fields, period) -> PollSpec`` (period in s) sets the
-    #: drive to transmit the fields about every period and returns a capture
-    #: source (``stamped=True``) that takes what arrives instead of asking.
-    #: None: the kind can only be asked (``poll_fields``).
-    capture_fields: Optional[Callable[..., "PollSpec"]] = None
-
-    def __post_init__(self) -> None:
-        if self.transport not in ("serial", "can"):
-            raise _core.InvalidArgument(f"drive plugin {self.kind!r}: transport 'serial' or 'can', "
-                                        f"not {self.transport!r}")
 
 
 @dataclass(frozen=True)
@@ -185,15 +114,22 @@ def register(group: str, name: str, obj: Any) -> None:
         _cache[group][name] = obj
 
 
-def drive_plugin(kind: str) -> DrivePlugin:
-    plugin = _resolve(DRIVE_GROUP, kind, "drive kind")
-    if not isinstance(plugin, DrivePlugin):
-        raise _core.InvalidArgument(f"drive kind {kind!r}: its entry point is not a motorbus.registry.DrivePlugin")
-    return plugin
+def drive_plugin(kind: str) -> "type[Drive]":
+    """The :class:`motorbus.Drive` subclass registered as ``kind`` (its entry point loaded)."""
+    from .drive import Drive
+
+    cls = _resolve(DRIVE_GROUP, kind, "drive kind")
+    if not (isinstance(cls, type) and issubclass(cls, Drive)):
+        raise _core.InvalidArgument(f"drive kind {kind!r}: its entry point is not a motorbus.Drive subclass "
+                                    f"(it is {cls!r})")
+    if cls.transport not in ("serial", "can"):
+        raise _core.InvalidArgument(f"drive kind {kind!r} ({cls.__qualname__}): transport 'serial' or 'can', "
+                                    f"not {cls.transport!r}")
+    return cls
 
 
-def drive_plugins() -> dict[str, DrivePlugin]:
-    """Every registered drive kind, loaded (imports each vendor module)."""
+def drive_plugins() -> "dict[str, type[Drive]]":
+    """Every registered drive kind's Drive subclass, loaded (imports each vendor module)."""
     return {kind: drive_plugin(kind) for kind in sorted(_load(DRIVE_GROUP))}
 
 
@@ -213,8 +149,8 @@ def bus_schemes() -> dict[str, BusScheme]:
     return {name: bus_scheme(name) for name in sorted(_load(BUS_GROUP))}
 
 
-def parse_drive_spec(spec: str) -> tuple[DrivePlugin, list[str]]:
-    """``"<kind>:01,02"`` -> (that kind's plugin, ["01", "02"]); InvalidArgument naming the problem."""
+def parse_drive_spec(spec: str) -> "tuple[type[Drive], list[str]]":
+    """``"<kind>:01,02"`` -> (that kind's Drive subclass, ["01", "02"]); InvalidArgument naming the problem."""
     kind, sep, addrs = spec.partition(":")
     if not sep or not addrs:
         raise _core.InvalidArgument(f"drive spec {spec!r}: expected KIND:ADDR[,ADDR...], e.g. cia402:5")

@@ -55,7 +55,7 @@ def make_sim(kind: str, address: str, clock: Any = None, store_dir: Optional[str
     """One simulated drive of a registered kind (not served)."""
     plugin = registry.drive_plugin(kind)
     address = plugin.check_address(str(address))
-    if store_dir is not None and plugin.store_options is not None:
+    if store_dir is not None:
         options = {**plugin.store_options(store_dir, address), **options}
     return plugin.make_sim(address, clock=clock, **options)
 
@@ -93,11 +93,8 @@ def serve_line(spec: str, baud: int = 0, clock: Any = None, store_dir: Optional[
     if plugin.transport != "serial":
         raise _core.InvalidArgument(f"drive spec {spec!r}: {plugin.kind} is a {plugin.transport} drive, not serial")
     drives = [make_sim(plugin.kind, a, clock=clock, store_dir=store_dir, **options) for a in addresses]
-    # A kind may wire the modules of one line together (e.g. a synchronisation chain on their I/Os):
-    # its module's optional wire_line(drives) does it.
-    wire = getattr(sys.modules.get(plugin.make_sim.__module__), "wire_line", None)
-    if wire is not None:
-        wire(drives)
+    # A kind may wire the modules of one line together (e.g. a synchronisation chain on their I/Os).
+    plugin.wire_line(drives)
     server = _core.PtyLineServer(devices=drives, baud=baud)
     server.enforce_baud = strict_baud
     return ServedLine(label=spec, server=server, drives=drives)
@@ -348,7 +345,7 @@ class BenchTwin:
         """The axis's simulator as ``Bench(sim=True)`` makes it (its errors name the
         option and the file's line), attached to ``attach()`` for a CAN kind."""
         plugin = registry.drive_plugin(a.kind)
-        if store_dir is not None and plugin.store_options is not None:
+        if store_dir is not None:
             a = dataclasses.replace(a, sim={**plugin.store_options(store_dir, a.address), **a.sim})
         bench_make = getattr(self._parsed, "_make_sim", None)
         if bench_make is not None:
@@ -403,12 +400,12 @@ class BenchTwin:
 
     def faults(self, axis: str) -> list[str]:
         """The fault names the axis's simulator offers (its kind's ``sim_faults``)."""
-        return sorted(registry.drive_plugin(self._axis(axis).kind).sim_faults or {})
+        return sorted(registry.drive_plugin(self._axis(axis).kind).sim_faults())
 
     def inject(self, axis: str, name: str, **options: Any) -> None:
         """Calls the axis kind's ``sim_faults[name](sim, **options)`` on its simulator."""
         kind = self._axis(axis).kind
-        faults = registry.drive_plugin(kind).sim_faults or {}
+        faults = registry.drive_plugin(kind).sim_faults()
         if name not in faults:
             raise _core.InvalidArgument(f"the {kind} simulator (axis {axis!r}) has no fault {name!r} "
                                         f"(it has: {', '.join(sorted(faults)) or 'none'})")

@@ -298,7 +298,7 @@ def test_a_move_stopped_by_a_limit_fails_the_status_with_limit_reached(bench, mo
     drive.params["0x6081"] = 500              # slow: the limit closes while it moves
     RE(ensure_connected(z))
     start = drive.position
-    faults = registry.drive_plugin("cia402").sim_faults
+    faults = registry.drive_plugin("cia402").sim_faults()
     timer = threading.Timer(0.3, faults["limit"], args=(bench.sims["cia402"],), kwargs={"direction": 1})
     try:
         timer.start()

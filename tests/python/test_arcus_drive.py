@@ -47,7 +47,7 @@ def served():
 
 def test_plugin_descriptor():
     p = registry.drive_plugin("arcus")
-    assert p is arcus.PLUGIN
+    assert p is arcus.ArcusDrive
     assert (p.kind, p.transport, p.default_address, p.default_baud) == ("arcus", "serial", "01", 9600)
     assert p.line_settings == arcus.LINE_SETTINGS
     assert set(p.sim_options) >= {"eo_boot", "snl", "home", "plus_limit", "store_path"}
@@ -214,7 +214,7 @@ def test_params_read_write_describe_and_refusals(served):
 
 
 def test_store_keeps_stored_params_over_a_power_cycle(tmp_path):
-    opts = arcus.PLUGIN.store_options(str(tmp_path), "01")
+    opts = arcus.ArcusDrive.store_options(str(tmp_path), "01")
     s = Served(**opts)
     try:
         with s.open() as d:

@@ -39,7 +39,7 @@ _SERVER = textwrap.dedent("""
                 continue
             sim = bench.sims[(words[1], words[2])]
             if words[0] == "FAULT":
-                faults = registry.drive_plugin(words[1]).sim_faults
+                faults = registry.drive_plugin(words[1]).sim_faults()
                 faults[words[3]](sim, **json.loads(words[4] if len(words) > 4 else "{}"))
                 print("ok", flush=True)
 """)
@@ -159,7 +159,7 @@ def test_a_stop_from_another_process_exits_10(served):
 
 
 def test_a_drive_fault_during_the_move_exits_12_with_the_code(served):
-    names = motorbus.registry.drive_plugin("cia402").sim_faults
+    names = motorbus.registry.drive_plugin("cia402").sim_faults()
     name = "fault" if "fault" in names else "drive_fault"
     mover = start("move", served.path, "z", "150", "--velocity", "20", "--json")
     assert mover.stderr.readline().startswith("z: moving to 150 mm")
@@ -213,7 +213,7 @@ LIMIT_KINDS = {
 
 
 @pytest.mark.parametrize("kind", [k for k in sorted(LIMIT_KINDS)
-                                  if "limit" in (motorbus.registry.drive_plugin(k).sim_faults or {})])
+                                  if "limit" in motorbus.registry.drive_plugin(k).sim_faults()])
 def test_every_kind_a_limit_during_a_move_exits_11(tmp_path, kind):
     address, scale, options, velocity = LIMIT_KINDS[kind]
     serial = motorbus.registry.drive_plugin(kind).transport == "serial"

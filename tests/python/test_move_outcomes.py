@@ -100,7 +100,7 @@ def wait_until_moving(axis, away_from: float, deadline: float = 5.0) -> None:
 @pytest.mark.parametrize("kind", KINDS)
 def test_a_move_ends_at_its_target_or_raises_why(served, kind, outcome):
     plugin = registry.drive_plugin(kind)
-    faults = plugin.sim_faults or {}
+    faults = plugin.sim_faults()
     if outcome in INJECTED and INJECTED[outcome][0] not in faults:
         pytest.skip(f"the {kind} simulator cannot produce {outcome!r} (its docs page says how a move ends there)")
     if outcome == "stop_other_process" and plugin.transport == "serial":

@@ -35,7 +35,7 @@ class Served:
         self.host, self.port = srv.host, srv.port
         self.spec = f"socketcand:{srv.host}:{srv.port}/can0"
         self.sim = self.bench.sims[(kind, address)]
-        self.faults = registry.drive_plugin(kind).sim_faults
+        self.faults = registry.drive_plugin(kind).sim_faults()
         self.drive = motorbus.open_drive(kind, bus=self.spec, address=address, **open_options)
 
     def later(self, seconds: float, fn, *args, **kw) -> threading.Timer:

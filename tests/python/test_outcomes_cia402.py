@@ -36,7 +36,7 @@ class Rig:
         self.sim = bench.sims[(kind, self.address)]
         srv = bench.can.servers[0]
         self.spec = f"socketcand:{srv.host}:{srv.port}/can0"
-        self.faults = registry.drive_plugin(kind).sim_faults
+        self.faults = registry.drive_plugin(kind).sim_faults()
         self.drive = motorbus.open_drive(kind, bus=self.spec, address=self.address)
 
     def inject(self, name: str, **options) -> None:
@@ -335,8 +335,8 @@ def test_homing_into_a_fault_raises_move_faulted_with_the_code(rig):
 
 
 def test_sim_faults_have_the_standard_names_and_keep_the_old_ones():
-    assert {"limit", "fault", "stall", "stop_input", "drive_fault"} <= set(registry.drive_plugin("cia402").sim_faults)
-    assert {"limit", "stall", "trip_limit"} <= set(registry.drive_plugin("arcus-canopen").sim_faults)
+    assert {"limit", "fault", "stall", "stop_input", "drive_fault"} <= set(registry.drive_plugin("cia402").sim_faults())
+    assert {"limit", "stall", "trip_limit"} <= set(registry.drive_plugin("arcus-canopen").sim_faults())
 
 
 def test_the_generic_simulator_has_the_identity_object():

@@ -38,7 +38,7 @@ class Rig:
             sim_options.setdefault("eo_boot", True)
         self.line = serve_line(f"{kind}:{self.address}", **sim_options)
         self.sim = self.line.drives[0]
-        self.faults = plugin.sim_faults
+        self.faults = plugin.sim_faults()
         self.drive = motorbus.open_drive(kind, line=self.line.pty_path, address=self.address, units=units)
         d = self.drive
         if kind == "arcus":
@@ -256,7 +256,7 @@ def test_arcus_stall_raises_move_stalled_with_the_sls_text(rig):
 
 @pytest.mark.parametrize("kind,absent", [("arcus", ("fault", "stop_input")), ("dmac", ("stall", "stop_input"))])
 def test_outcomes_a_kind_cannot_produce_have_no_injection(kind, absent):
-    faults = registry.drive_plugin(kind).sim_faults
+    faults = registry.drive_plugin(kind).sim_faults()
     assert "limit" in faults
     for name in absent:
         assert name not in faults

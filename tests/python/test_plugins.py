@@ -43,10 +43,15 @@ def test_in_tree_kinds_are_declared_as_entry_points_like_any_plugin():
     text = (ROOT / "pyproject.toml").read_text()
     # A kind may carry a hyphen ("arcus-canopen", the CANopen persona of "arcus");
     # its module is the same name with "_" (a Python identifier).
-    declared = re.findall(r'^([\w-]+) = "motorbus\.drives\.(\w+):PLUGIN"$', text, re.MULTILINE)
-    assert declared and all(k.replace("-", "_") == m for k, m in declared)
+    # The entry point names the kind's Drive subclass (as python-can's names a bus class).
+    declared = re.findall(r'^([\w-]+) = "motorbus\.drives\.(\w+):(\w+Drive)"$', text, re.MULTILINE)
+    assert declared and all(k.replace("-", "_") == m for k, m, _ in declared)
     kinds = motorbus.drive_kinds()
-    assert set(kinds) == {k for k, _ in declared}
+    assert set(kinds) == {k for k, _, _ in declared}
+    for k, _, cls in declared:
+        plugin = registry.drive_plugin(k)
+        assert issubclass(plugin, motorbus.Drive) and plugin.__name__ == cls and plugin.kind == k
+        assert plugin.transport in ("serial", "can") and plugin.description == kinds[k]
     assert all(isinstance(d, str) and d and "\n" not in d for d in kinds.values())
     schemes = registry.bus_schemes()
     assert {"virtual", "slcan", "socketcand", "socketcan"} <= set(schemes)
@@ -65,10 +70,12 @@ def test_a_plugin_registered_at_run_time_is_served_by_sim_serve_code():
     """What an out-of-tree package gets: its kind is listed, opened and served with no change here."""
     from motorbus.drives import cia402
 
-    plugin = registry.DrivePlugin(kind="mykind", description="a test kind", transport="can",
-                                  open=cia402.open, make_sim=cia402.make_sim,
-                                  check_address=cia402.PLUGIN.check_address, default_address="3")
-    registry.register(registry.DRIVE_GROUP, "mykind", plugin)
+    class MyKindDrive(cia402.Cia402Drive):     # a kind is a Drive subclass; it inherits the hooks
+        kind = "mykind"
+        description = "a test kind"
+        default_address = "3"
+
+    registry.register(registry.DRIVE_GROUP, "mykind", MyKindDrive)
     try:
         assert motorbus.drive_kinds()["mykind"] == "a test kind"
         from motorbus.sim import SimBench

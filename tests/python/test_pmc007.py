@@ -154,7 +154,7 @@ def test_make_sim_refuses_unknown_options_and_bad_nodes():
         pmc007.make_sim(5, colour="red")
     with pytest.raises(motorbus.InvalidArgument, match="1..127"):
         pmc007.make_sim(128)
-    assert pmc007.PLUGIN.check_address(" 7 ") == "7"
+    assert pmc007.Pmc007Drive.check_address(" 7 ") == "7"
 
 
 def test_rpdo_and_numpy_tpdo_stream(rig):

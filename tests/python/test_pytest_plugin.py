@@ -209,7 +209,7 @@ def test_sim_faults_vocabulary_per_kind_and_bench_faults(pytester, every_kind):
         def test_offered_is_the_kinds_vocabulary(bench, sim_faults):
             for name in bench.axes:
                 kind = bench.config[name].kind
-                assert sim_faults.offered(name) == sorted(registry.drive_plugin(kind).sim_faults)
+                assert sim_faults.offered(name) == sorted(registry.drive_plugin(kind).sim_faults())
                 assert sim_faults.offered(name), kind
 
         def test_unknown_fault_lists_what_the_simulator_offers(sim_faults):

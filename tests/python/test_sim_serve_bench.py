@@ -184,7 +184,7 @@ def test_pytest_runs_against_the_served_twin(served, tmp_path):
 def test_control_names_faults_and_refuses_bad_ones(served):
     for axis in MOVES:
         kind = served.command("axes").split(f"{axis}=")[1].split()[0]
-        assert served.faults(axis) == sorted(registry.drive_plugin(kind).sim_faults or {})
+        assert served.faults(axis) == sorted(registry.drive_plugin(kind).sim_faults())
     with pytest.raises(InvalidArgument, match=r"no axis 'w'.*axes: x, y, rot"):
         served.inject("w", "stall")
     with pytest.raises(InvalidArgument, match=r"the arcus simulator \(axis 'x'\) has no fault 'melt' \(it has: "):
@@ -206,7 +206,7 @@ def test_served_bench_from_a_dict_of_every_kind():
     with ServedBench(data) as served:
         assert {c.split("=")[0] for c in served.command("axes").split()} == set(data["axis"])
         for axis, table in data["axis"].items():
-            assert served.faults(axis) == sorted(registry.drive_plugin(table["kind"]).sim_faults or {})
+            assert served.faults(axis) == sorted(registry.drive_plugin(table["kind"]).sim_faults())
         status = read_bench(served.bench_file, lambda b: {n: d.status for n, d in b.axes.items()})
         assert set(status) == set(data["axis"]) and not any(s.moving or s.fault for s in status.values())
 

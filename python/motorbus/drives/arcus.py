@@ -51,7 +51,6 @@ __all__ = [
     "ArcusMotorDisabled",
     "HOME_METHODS",
     "DEFAULT_HOME_METHOD",
-    "PLUGIN",
     "check_address",
     "open_line",
     "STOP_WAYS",
@@ -292,7 +291,7 @@ def make_sim(address: Union[str, int] = "01", clock: Optional["_core.Clock"] = N
     LINE_SETTINGS (requests end with CR, replies with NUL).
     """
     known = {"response_type", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
-             "start_position", "tick"}  # = _SIM_OPTIONS
+             "start_position", "tick"}  # = ArcusDrive.sim_options but store_path
     unknown = set(options) - known
     if unknown:
         raise _core.InvalidArgument(f"arcus sim options: unknown {sorted(unknown)}; known {sorted(known)}")
@@ -302,7 +301,6 @@ def make_sim(address: Union[str, int] = "01", clock: Optional["_core.Clock"] = N
 # ---- the motorbus.Drive adapter ------------------------------------------------------------------
 
 from .. import drive as _drive  # noqa: E402  (after the client: the adapter is built on it)
-from ..registry import DrivePlugin  # noqa: E402
 
 #: home() methods: the manual's homing commands (Figures 7.2-7.6).
 HOME_METHODS = ("H+", "H-", "HL+", "HL-", "L+", "L-", "Z+", "Z-", "ZH+", "ZH-")
@@ -458,6 +456,17 @@ class ArcusDrive(_drive.Drive):
     capabilities = frozenset({_drive.Capability.POSITION, _drive.Capability.VELOCITY, _drive.Capability.HOMING,
                               _drive.Capability.ENCODER, _drive.Capability.STORE})
     has_watchdog = False
+
+    # the plugin (motorbus.registry): what the kind is
+    description = "Arcus DMX-CAN integrated stepper, ASCII over RS-232/RS-485 (StepNLoop closed loop)"
+    transport = "serial"
+    default_address = "01"
+    line_settings = LINE_SETTINGS
+    default_baud = 9600
+    sim_options = ("response_type", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
+                   "start_position", "tick", "store_path")
+    probe_addresses = tuple(f"{a:02d}" for a in range(1, 100))   # DN 01-99
+    probe_bauds = (9600, 19200, 38400, 57600, 115200)              # the DB settings
 
     def __init__(self, native: ArcusClient, **kw: Any) -> None:
         super().__init__(native, **kw)
@@ -663,41 +672,87 @@ class ArcusDrive(_drive.Drive):
     def _close(self) -> None:
         self.native.close()
 
+    # ---- the plugin's hooks (motorbus.registry) ------------------------------------------
+    @classmethod
+    def open(cls, *, line: Any, bus: Any = None, address: str = "01", units: Optional[_drive.Units] = None,
+             baud: int = 9600, timeout: Optional[float] = None, on_error: Optional[str] = "stop",
+             on_exit: Optional[str] = "stop", query_retries: int = 1) -> "ArcusDrive":
+        """``line`` is a path (opened here, closed with the drive) or a shared LineLink."""
+        if bus is not None:
+            raise _core.InvalidArgument("arcus: a serial drive takes line=, not bus=")
+        if line is None:
+            raise _core.InvalidArgument("arcus: line= (a port path or a LineLink) is required")
+        # The Drive applies on_error/on_exit; the client itself stays quiet.
+        native = ArcusClient(line, address, baud=baud, timeout=timeout, on_error=None, on_exit=None,
+                             query_retries=query_retries)
+        try:
+            return cls(native, units=units, on_error=on_error, on_exit=on_exit)
+        except BaseException:
+            native.close()
+            raise
+
+    @classmethod
+    def make_sim(cls, address: Union[str, int] = "01", clock: Optional["_core.Clock"] = None,
+                 **options: Any) -> Any:
+        return make_sim(address, clock, **options)
+
+    @classmethod
+    def check_address(cls, text: Any) -> str:
+        return check_address(text)
+
+    @classmethod
+    def store_options(cls, store_dir: str, address: str) -> dict:
+        return {"store_path": os.path.join(store_dir, f"arcus-{address}.store")}
+
+    @classmethod
+    def probe(cls, line: "_core.LineLink", address: str) -> Optional[dict]:
+        """Discovery: the product id and firmware of the drive at `address`, or None.
+        Reads only (ID, VER): never moves the motor nor writes a parameter."""
+        client = ArcusClient(line, address, on_error=None, on_exit=None, query_retries=0)
+        try:
+            return {"model": client.id, "firmware": client.version}
+        finally:
+            client.close()   # a shared LineLink stays open
+
+    @classmethod
+    def sim_faults(cls) -> dict:
+        return dict(SIM_FAULTS)
+
+    def poll_fields(self, fields: Any) -> "PollSpec":
+        """motorbus.Poller: EX (PX with StepNLoop off), PS and MST queried by a client of
+        the poll thread's own on the drive's line.  PS is a speed (>= 0): the polled
+        velocity has no sign, unlike Drive.velocity (which adds the move's direction)."""
+        from ..registry import PollSpec
+
+        queries = {"position": "EX" if self._snl else "PX", "velocity": "PS", "status": "MST"}
+        names = []
+        for f in fields:
+            if f not in queries:
+                raise _core.InvalidArgument(f"arcus poll field {f!r}: this kind gives {', '.join(queries)}")
+            names.append(queries[f])
+        link = self.native.link
+        source = _core.arcus_poll_source(link, self.native.address, names)
+        return PollSpec(source=source, scales=(1.0,) * len(names), transport=link)
+
+    def plan_move(self, start: float, target: float) -> Any:
+        """The move as the DMX-CAN makes it (its profile model, ``ArcusMotion``: jump to
+        LSPD, ramp in ACC ms, cruise at HSPD, DEC with EDEC, S-curve with SCV), in the
+        drive's position unit (encoder counts with StepNLoop on, pulses off)."""
+        p = self.params
+        hspd, lspd = float(p["HSPD"]), float(p["LSPD"])
+        params = ArcusProfileParams(hspd=hspd, lspd=min(lspd, hspd), acc_ms=float(p["ACC"]),
+                                    dec_ms=float(p["DEC"]), edec=bool(p["EDEC"]), scv=bool(p["SCV"]),
+                                    snl_ratio=float(p["SLR"]) if self._snl else 1.0)
+        model = ArcusMotion(params)
+        error = model.move(float(start), float(target))
+        if error:
+            raise _core.InvalidArgument(f"arcus plan_move {start} -> {target}: the drive would answer {error}")
+        return model.profile
+
 
 def check_address(text: str) -> str:
     """'1', '01', 'DMC01' -> '01'; InvalidArgument naming the problem."""
     return f"{_address(text):02d}"
-
-
-def open_drive(*, line: Any, bus: Any = None, address: str = "01", units: Optional[_drive.Units] = None,
-               baud: int = 9600, timeout: Optional[float] = None, on_error: Optional[str] = "stop",
-               on_exit: Optional[str] = "stop", query_retries: int = 1) -> ArcusDrive:
-    """The plugin's ``open``: ``line`` is a path (opened here, closed with the drive) or a shared LineLink."""
-    if bus is not None:
-        raise _core.InvalidArgument("arcus: a serial drive takes line=, not bus=")
-    if line is None:
-        raise _core.InvalidArgument("arcus: line= (a port path or a LineLink) is required")
-    # The Drive applies on_error/on_exit; the client itself stays quiet.
-    native = ArcusClient(line, address, baud=baud, timeout=timeout, on_error=None, on_exit=None,
-                         query_retries=query_retries)
-    try:
-        return ArcusDrive(native, units=units, on_error=on_error, on_exit=on_exit)
-    except BaseException:
-        native.close()
-        raise
-
-
-_SIM_OPTIONS = ("response_type", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
-                "start_position", "tick")
-
-def probe(line: "_core.LineLink", address: str) -> Optional[dict]:
-    """Discovery: the product id and firmware of the drive at `address`, or None.
-    Reads only (ID, VER): never moves the motor nor writes a parameter."""
-    client = ArcusClient(line, address, on_error=None, on_exit=None, query_retries=0)
-    try:
-        return {"model": client.id, "firmware": client.version}
-    finally:
-        client.close()   # a shared LineLink stays open
 
 
 def _limit_fault(sim: ArcusSim, direction: Any = 1) -> None:
@@ -719,58 +774,3 @@ SIM_FAULTS = {
     # the names of earlier releases
     "trip_limit": lambda sim, direction=-1: _limit_fault(sim, direction),
 }
-
-
-def poll_fields(drive: ArcusDrive, fields: Any) -> "PollSpec":
-    """motorbus.Poller: EX (PX with StepNLoop off), PS and MST queried by a client of
-    the poll thread's own on the drive's line.  PS is a speed (>= 0): the polled
-    velocity has no sign, unlike Drive.velocity (which adds the move's direction)."""
-    from ..registry import PollSpec
-
-    queries = {"position": "EX" if drive._snl else "PX", "velocity": "PS", "status": "MST"}
-    names = []
-    for f in fields:
-        if f not in queries:
-            raise _core.InvalidArgument(f"arcus poll field {f!r}: this kind gives {', '.join(queries)}")
-        names.append(queries[f])
-    link = drive.native.link
-    source = _core.arcus_poll_source(link, drive.native.address, names)
-    return PollSpec(source=source, scales=(1.0,) * len(names), transport=link)
-
-
-def plan_move(drive: ArcusDrive, start: float, target: float) -> Any:
-    """The move as the DMX-CAN makes it (its profile model, ``ArcusMotion``: jump to
-    LSPD, ramp in ACC ms, cruise at HSPD, DEC with EDEC, S-curve with SCV), in the
-    drive's position unit (encoder counts with StepNLoop on, pulses off)."""
-    from .. import motion
-
-    p = drive.params
-    hspd, lspd = float(p["HSPD"]), float(p["LSPD"])
-    params = motion.ArcusProfileParams(hspd=hspd, lspd=min(lspd, hspd), acc_ms=float(p["ACC"]),
-                                       dec_ms=float(p["DEC"]), edec=bool(p["EDEC"]), scv=bool(p["SCV"]),
-                                       snl_ratio=float(p["SLR"]) if drive._snl else 1.0)
-    model = motion.ArcusMotion(params)
-    error = model.move(float(start), float(target))
-    if error:
-        raise _core.InvalidArgument(f"arcus plan_move {start} -> {target}: the drive would answer {error}")
-    return model.profile
-
-PLUGIN = DrivePlugin(
-    kind="arcus",
-    description="Arcus DMX-CAN integrated stepper, ASCII over RS-232/RS-485 (StepNLoop closed loop)",
-    transport="serial",
-    open=open_drive,
-    make_sim=make_sim,
-    check_address=check_address,
-    default_address="01",
-    line_settings=LINE_SETTINGS,
-    default_baud=9600,
-    sim_options=_SIM_OPTIONS + ("store_path",),
-    store_options=lambda store_dir, address: {"store_path": os.path.join(store_dir, f"arcus-{address}.store")},
-    probe=probe,
-    probe_addresses=tuple(f"{a:02d}" for a in range(1, 100)),   # DN 01-99
-    probe_bauds=(9600, 19200, 38400, 57600, 115200),              # the DB settings
-    sim_faults=SIM_FAULTS,
-    poll_fields=poll_fields,
-    plan_move=plan_move,
-)

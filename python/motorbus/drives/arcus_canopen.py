@@ -29,14 +29,13 @@ from typing import Any, Optional, Union
 from .. import _core
 from .._core import ArcusMotion, ArcusProfileParams  # the DMX-CAN's profile model
 from ..canopen.cia402 import Cia402, Controlword, OpMode
-from ..drive import (Capability, DriveStatus, LimitReached, MoveFaulted, MoveStalled, ParamInfo, Params, StopReason,
-                     Units)
-from ..registry import DrivePlugin
+from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveStalled, ParamInfo, Params,
+                     StopReason, Units)
 from . import arcus as _arcus
-from .cia402 import Cia402Drive, poll_fields as _cia402_poll_fields
+from .cia402 import Cia402Drive
 
 __all__ = ["ArcusCanopen", "ArcusCanopenDrive", "ArcusCanopenSim", "ArcusHomingMethod", "BitRate",
-           "CommType", "SnlStatus", "OBJECTS", "PLUGIN", "make_sim", "open"]
+           "CommType", "SnlStatus", "OBJECTS", "make_sim"]
 
 # (index, sub, name, type, access, default, low, high, unit, persists): the OD the
 # simulator serves (Table 10.1), from the C++ table.
@@ -369,6 +368,84 @@ class ArcusCanopenDrive(Cia402Drive):
                               Capability.STORE})
     has_watchdog = False
 
+    # ---- the plugin (motorbus.registry): what the kind is, and its hooks -------------------
+    # (poll_fields is Cia402Drive's: 6064h, 606Ch and 6041h by SDO, as for any CiA 402 drive.)
+    description = "Arcus DMX-CAN integrated stepper, CANopen CiA DSP-402 by SDO (the CAN persona of 'arcus')"
+    transport = "can"
+    default_address = "1"
+    sim_options = _SIM_OPTIONS
+    # Not offered by this persona (Cia402Drive's would be inherited): the SYNC start
+    # and the TPDO capture were never validated against the DMX-CAN's manual.
+    synchronised_start = classmethod(Drive.synchronised_start.__func__)
+    capture_fields = Drive.capture_fields
+
+    @classmethod
+    def open(cls, *, line: Any = None, bus: Any = None, address: str = "1", units: Optional[Units] = None,
+             timeout: float = 1.0, on_error: Optional[str] = "quick_stop",
+             on_exit: Optional[str] = "quick_stop") -> "ArcusCanopenDrive":
+        """``open_drive("arcus-canopen", bus=..., address=1)``."""
+        from ..bus import open_bus
+
+        if line is not None:
+            raise _core.InvalidArgument("arcus-canopen: a CAN drive takes bus=, not line= (the ASCII persona is "
+                                        "'arcus')")
+        if bus is None:
+            raise _core.InvalidArgument("arcus-canopen: bus= (a bus or a bus address) is required")
+        owns = isinstance(bus, str)
+        b = open_bus(bus) if owns else bus
+        try:
+            host = ArcusCanopen(b, int(_check_node(address)), timeout=timeout, on_error=None, on_exit=None)
+            drive = cls(host, units=units, on_error=on_error, on_exit=on_exit,
+                        close_native=b.close if owns else None)
+        except Exception:
+            if owns:
+                b.close()
+            raise
+        return drive
+
+    @classmethod
+    def make_sim(cls, address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, **options: Any) -> Any:
+        return make_sim(address, clock, **options)
+
+    @classmethod
+    def check_address(cls, text: Any) -> str:
+        return _check_node(text)
+
+    @classmethod
+    def store_options(cls, store_dir: str, address: str) -> dict:
+        import os
+
+        return {"store_path": os.path.join(store_dir, f"arcus-canopen-{address}.store")}
+
+    @classmethod
+    def canopen_match(cls, node: Any) -> int:
+        # Discovery: profile 402 with the identity Table 10.1 gives (vendor 0, revision 112)
+        # beats the generic cia402 match; any other 402 node stays cia402.
+        return 5 if node.profile == 402 and not node.vendor_id and node.revision == 112 else 0
+
+    @classmethod
+    def sim_faults(cls) -> dict:
+        return dict(SIM_FAULTS)
+
+    def plan_move(self, start: float, target: float) -> Any:
+        """The move as this persona makes it: the DMX-CAN's own profile model
+        (``ArcusMotion``) loaded from the CiA 402 objects as the drive loads its ASCII
+        registers: 6081h = HSPD, 6082h = LSPD (at most 6081h), 6083h/6084h = ACC/DEC (ms),
+        6086h = 1 S-curve.  The StepNLoop ratio has no CANopen object: the factory
+        3200 pulses per 4000 counts (0.8) with 2001h:01 on."""
+        native = self.native
+        hspd = max(float(native.read(0x6081)), 1.0)
+        lspd = min(max(float(native.read(0x6082)), 1.0), hspd)
+        snl = bool(native.read(0x2001, 1))
+        params = ArcusProfileParams(hspd=hspd, lspd=lspd, acc_ms=max(float(native.read(0x6083)), 1.0),
+                                    dec_ms=max(float(native.read(0x6084)), 1.0), edec=False,
+                                    scv=native.read(0x6086) == 1, snl_ratio=0.8 if snl else 1.0)
+        model = ArcusMotion(params)
+        error = model.move(float(start), float(target))
+        if error:
+            raise _core.InvalidArgument(f"arcus-canopen plan_move {start} -> {target}: the model refuses: {error}")
+        return model.profile
+
     def _refused(self, what: str) -> None:
         state = self.native.state
         if state != "OPERATION ENABLED":
@@ -498,29 +575,6 @@ class ArcusCanopenDrive(Cia402Drive):
         raise _core.InvalidArgument("arcus-canopen: the DMX-CAN documents no heartbeat; it has no watchdog")
 
 
-def open(*, line: Any = None, bus: Any = None, address: str = "1", units: Optional[Units] = None,
-         timeout: float = 1.0, on_error: Optional[str] = "quick_stop",
-         on_exit: Optional[str] = "quick_stop") -> ArcusCanopenDrive:  # noqa: A001 - the plugin's verb
-    """``open_drive("arcus-canopen", bus=..., address=1)``."""
-    from ..bus import open_bus
-
-    if line is not None:
-        raise _core.InvalidArgument("arcus-canopen: a CAN drive takes bus=, not line= (the ASCII persona is 'arcus')")
-    if bus is None:
-        raise _core.InvalidArgument("arcus-canopen: bus= (a bus or a bus address) is required")
-    owns = isinstance(bus, str)
-    b = open_bus(bus) if owns else bus
-    try:
-        host = ArcusCanopen(b, int(_check_node(address)), timeout=timeout, on_error=None, on_exit=None)
-        drive = ArcusCanopenDrive(host, units=units, on_error=on_error, on_exit=on_exit,
-                                  close_native=b.close if owns else None)
-    except Exception:
-        if owns:
-            b.close()
-        raise
-    return drive
-
-
 # The same drive as 'arcus' behind its CAN front end: the same faults.
 # Standard names ("limit", "stall") and the older alias; the DMX-CAN has no other fault
 # (no 603Fh: its errors are the limit and StepNLoop ones) and no stop input.
@@ -531,45 +585,6 @@ SIM_FAULTS = {
     "stall": lambda sim: sim.set_blocked(True),
     "trip_limit": lambda sim, direction=-1: sim.force_limit(int(direction), True),
 }
-
-def plan_move(drive: Any, start: float, target: float) -> Any:
-    """The move as this persona makes it: the DMX-CAN's own profile model
-    (``ArcusMotion``) loaded from the CiA 402 objects as the drive loads its ASCII
-    registers: 6081h = HSPD, 6082h = LSPD (at most 6081h), 6083h/6084h = ACC/DEC (ms),
-    6086h = 1 S-curve.  The StepNLoop ratio has no CANopen object: the factory
-    3200 pulses per 4000 counts (0.8) with 2001h:01 on."""
-    native = drive.native
-    hspd = max(float(native.read(0x6081)), 1.0)
-    lspd = min(max(float(native.read(0x6082)), 1.0), hspd)
-    snl = bool(native.read(0x2001, 1))
-    params = ArcusProfileParams(hspd=hspd, lspd=lspd, acc_ms=max(float(native.read(0x6083)), 1.0),
-                                dec_ms=max(float(native.read(0x6084)), 1.0), edec=False,
-                                scv=native.read(0x6086) == 1, snl_ratio=0.8 if snl else 1.0)
-    model = ArcusMotion(params)
-    error = model.move(float(start), float(target))
-    if error:
-        raise _core.InvalidArgument(f"arcus-canopen plan_move {start} -> {target}: the model refuses: {error}")
-    return model.profile
-
-PLUGIN = DrivePlugin(
-    kind="arcus-canopen",
-    description="Arcus DMX-CAN integrated stepper, CANopen CiA DSP-402 by SDO (the CAN persona of 'arcus')",
-    transport="can",
-    open=open,
-    make_sim=make_sim,
-    check_address=_check_node,
-    default_address="1",
-    sim_options=_SIM_OPTIONS,
-    store_options=lambda store_dir, address: {"store_path": __import__("os").path.join(
-        store_dir, f"arcus-canopen-{address}.store")},
-    # Discovery: profile 402 with the identity Table 10.1 gives (vendor 0, revision 112)
-    # beats the generic cia402 match; any other 402 node stays cia402.
-    canopen_match=lambda node: 5 if node.profile == 402 and not node.vendor_id and node.revision == 112 else 0,
-    sim_faults=SIM_FAULTS,
-    # 6064h, 606Ch and 6041h by SDO, as for any CiA 402 drive.
-    poll_fields=_cia402_poll_fields,
-    plan_move=plan_move,
-)
 
 
 def object_dictionary() -> "_core.ObjectDictionary":

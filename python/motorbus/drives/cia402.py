@@ -38,9 +38,8 @@ from .. import _core
 from ..canopen.cia402 import Cia402, Cia402Device, Controlword, OpMode
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, MoveStalled,
                      ParamInfo, Params, StopReason, Units)
-from ..registry import DrivePlugin
 
-__all__ = ["Cia402Drive", "Cia402Sim", "ERROR_CODES", "PLUGIN", "SYNC_START_RPDO", "make_sim", "open", "OBJECTS",
+__all__ = ["Cia402Drive", "Cia402Sim", "ERROR_CODES", "SYNC_START_RPDO", "make_sim", "OBJECTS",
            "error_text", "synchronised_start"]
 
 # Statusword bits the simulator drives itself (the state bits come from Cia402Device).
@@ -703,6 +702,83 @@ class Cia402Drive(Drive):
                               Capability.WATCHDOG})
     has_watchdog = True
 
+    # ---- the plugin (motorbus.registry): what the kind is, and its hooks -------------------
+    description = "any CiA 402 drive on CANopen (profile position, profile velocity, homing); simulated generically"
+    transport = "can"
+    default_address = "1"
+    sim_options = ("steps_per_rev", "home", "minus_limit", "plus_limit", "heartbeat_ms", "start_position")
+
+    @classmethod
+    def open(cls, *, line: Any = None, bus: Any = None, address: str, units: Optional[Units] = None,
+             timeout: float = 1.0, on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop",
+             watchdog: Optional[dict] = None) -> "Cia402Drive":
+        """``open_drive("cia402", bus=..., address=5)``.  ``watchdog={"host_node": 127, "period": 0.1}``
+        arms the drive's heartbeat consumer at once (see Cia402.start_watchdog)."""
+        from ..bus import open_bus
+
+        owns = isinstance(bus, str)
+        b = open_bus(bus) if owns else bus
+        try:
+            host = Cia402(b, int(address), timeout=timeout, on_error=None, on_exit=None)
+            drive = cls(host, units=units, on_error=on_error, on_exit=on_exit,
+                        close_native=b.close if owns else None)
+        except Exception:
+            if owns:
+                b.close()
+            raise
+        if watchdog:
+            drive.start_watchdog(**watchdog)
+        return drive
+
+    @classmethod
+    def make_sim(cls, address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, **options: Any) -> Any:
+        return make_sim(address, clock, **options)
+
+    @classmethod
+    def check_address(cls, text: Any) -> str:
+        return _check_node(text)
+
+    @classmethod
+    def canopen_match(cls, node: Any) -> int:
+        # Any node whose device type (0x1000) names profile 402; vendor kinds score higher.
+        return 1 if node.profile == 402 else 0
+
+    @classmethod
+    def synchronised_start(cls, bus: _core.Bus, drives: Sequence["Cia402Drive"]) -> Any:
+        return synchronised_start(bus, drives)
+
+    @classmethod
+    def sim_faults(cls) -> dict:
+        return dict(SIM_FAULTS)
+
+    def poll_fields(self, fields: Sequence[str]) -> Any:
+        """motorbus.Poller: 6064h/606Ch/6041h by SDO through the drive's own client."""
+        from ..canopen.poll import CIA402_POLL_OBJECTS, sdo_poll_spec
+
+        return sdo_poll_spec(self.kind, self._sdo, self.native.bus, fields, CIA402_POLL_OBJECTS)
+
+    def capture_fields(self, fields: Sequence[str], period: float) -> Any:
+        """motorbus.Poller, capturing: 6064h/606Ch/6041h mapped into TPDO 1 (and 2 when
+        they pass 64 bits), sent on the event timer every period (whole ms, >= 1)."""
+        from ..canopen.poll import CIA402_POLL_OBJECTS, tpdo_capture_spec
+
+        if self.native.bus is None:
+            raise _core.InvalidArgument(f"{self.kind} capture: the drive's SDO client has no bus to listen on")
+        return tpdo_capture_spec(self.kind, self._sdo, self.native.bus, self.native.node, fields,
+                                 CIA402_POLL_OBJECTS, period)
+
+    def plan_move(self, start: float, target: float) -> Any:
+        """Profile position mode as CiA 402 defines it: 6081h velocity, 6083h/6084h
+        accelerations, 6086h ramp shape (0 linear, 1 sin²), 607Fh cap; increments."""
+        from .. import motion
+
+        p = self.params
+        params = motion.Cia402ProfileParams(
+            profile_velocity=float(p["0x6081"]), profile_acceleration=float(p["0x6083"]),
+            profile_deceleration=float(p["0x6084"]), motion_profile_type=int(p["0x6086"]),
+            max_profile_velocity=float(p["0x607F"]) if "0x607F" in p else 0.0)
+        return motion.cia402_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
+
     def __init__(self, host: Cia402, *, units: Optional[Units] = None, on_error: Optional[str] = "quick_stop",
                  on_exit: Optional[str] = "quick_stop", close_native=None) -> None:
         super().__init__(host, units=units, on_error=on_error, on_exit=on_exit, close_native=close_native)
@@ -1103,28 +1179,6 @@ def synchronised_start(bus: _core.Bus, drives: Sequence[Cia402Drive]) -> Iterato
         d._release_sync_start(started=True)
 
 
-def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Units] = None,
-         timeout: float = 1.0, on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop",
-         watchdog: Optional[dict] = None) -> Cia402Drive:  # noqa: A001 - the plugin's verb
-    """``open_drive("cia402", bus=..., address=5)``.  ``watchdog={"host_node": 127, "period": 0.1}``
-    arms the drive's heartbeat consumer at once (see Cia402.start_watchdog)."""
-    from ..bus import open_bus
-
-    owns = isinstance(bus, str)
-    b = open_bus(bus) if owns else bus
-    try:
-        host = Cia402(b, int(address), timeout=timeout, on_error=None, on_exit=None)
-        drive = Cia402Drive(host, units=units, on_error=on_error, on_exit=on_exit,
-                            close_native=b.close if owns else None)
-    except Exception:
-        if owns:
-            b.close()
-        raise
-    if watchdog:
-        drive.start_watchdog(**watchdog)
-    return drive
-
-
 # Faults the simulator can be given (the pytest plugin's sim_faults fixture).
 # The standard names ("limit", "fault", "stall", "stop_input") and the older alias.
 SIM_FAULTS = {
@@ -1138,49 +1192,3 @@ SIM_FAULTS = {
     "stop_input": lambda sim: sim.set_stop_input(True),
     "drive_fault": lambda sim, code=0x5441: sim.inject_fault(int(code)),
 }
-
-def poll_fields(drive: Cia402Drive, fields: Sequence[str]):
-    """motorbus.Poller: 6064h/606Ch/6041h by SDO through the drive's own client."""
-    from ..canopen.poll import CIA402_POLL_OBJECTS, sdo_poll_spec
-
-    return sdo_poll_spec(drive.kind, drive._sdo, drive.native.bus, fields, CIA402_POLL_OBJECTS)
-
-
-def plan_move(drive: Cia402Drive, start: float, target: float) -> Any:
-    """Profile position mode as CiA 402 defines it: 6081h velocity, 6083h/6084h
-    accelerations, 6086h ramp shape (0 linear, 1 sin²), 607Fh cap; increments."""
-    from .. import motion
-
-    p = drive.params
-    params = motion.Cia402ProfileParams(profile_velocity=float(p["0x6081"]), profile_acceleration=float(p["0x6083"]),
-                                        profile_deceleration=float(p["0x6084"]),
-                                        motion_profile_type=int(p["0x6086"]), max_profile_velocity=float(p["0x607F"]) if "0x607F" in p else 0.0)
-    return motion.cia402_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
-def capture_fields(drive: Cia402Drive, fields: Sequence[str], period: float):
-    """motorbus.Poller, capturing: 6064h/606Ch/6041h mapped into TPDO 1 (and 2 when
-    they pass 64 bits), sent on the event timer every period (whole ms, >= 1)."""
-    from ..canopen.poll import CIA402_POLL_OBJECTS, tpdo_capture_spec
-
-    if drive.native.bus is None:
-        raise _core.InvalidArgument(f"{drive.kind} capture: the drive's SDO client has no bus to listen on")
-    return tpdo_capture_spec(drive.kind, drive._sdo, drive.native.bus, drive.native.node, fields,
-                             CIA402_POLL_OBJECTS, period)
-
-
-PLUGIN = DrivePlugin(
-    kind="cia402",
-    description="any CiA 402 drive on CANopen (profile position, profile velocity, homing); simulated generically",
-    transport="can",
-    open=open,
-    make_sim=make_sim,
-    check_address=_check_node,
-    default_address="1",
-    sim_options=("steps_per_rev", "home", "minus_limit", "plus_limit", "heartbeat_ms", "start_position"),
-    # Any node whose device type (0x1000) names profile 402; vendor kinds score higher.
-    canopen_match=lambda node: 1 if node.profile == 402 else 0,
-    synchronised_start=synchronised_start,
-    sim_faults=SIM_FAULTS,
-    poll_fields=poll_fields,
-    plan_move=plan_move,
-    capture_fields=capture_fields,
-)

@@ -33,7 +33,6 @@ from .._core import (DmacMotion, DmacProfileParams, dmac_position_profile, dmac_
                      dmac_speed_profile)
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFailed, MoveFaulted, MoveInterrupted,
                      MoveTimedOut, ParamInfo, Params, StopReason)
-from ..registry import DrivePlugin
 
 DmacSim = _core.DmacSim
 DmacSimState = _core.DmacSimState
@@ -201,7 +200,6 @@ __all__ = [
     "HomingLimitReached",
     "HomingTimedOut",
     "LINE_SETTINGS",
-    "PLUGIN",
     "UnknownCommand",
     "XON_ERROR",
     "chain_ultrasync",
@@ -547,6 +545,16 @@ class DmacDrive(Drive):
     #: 1.2.1): one increment, the module having no in-position window to read.
     in_position_window = 1.0
 
+    # the plugin (motorbus.registry): what the kind is
+    description = "Midi Ingénierie DMAC17/23/34 brushless modules, ASCII protocol over RS-232/RS-485"
+    transport = "serial"
+    default_address = DEFAULT_ADDRESS
+    line_settings = LINE_SETTINGS
+    default_baud = DEFAULT_BAUD
+    sim_options = SIM_OPTIONS
+    probe_addresses = tuple(f"{a:02d}" for a in range(64))   # 00-63
+    probe_bauds = BAUDRATES
+
     def __init__(self, native: DmacClient, **kwargs: Any) -> None:
         super().__init__(native, **kwargs)
         self._homed = False
@@ -856,29 +864,76 @@ class DmacDrive(Drive):
             raise _core.InvalidArgument(f"dmac: position {x:g} increments is outside int32")
         return n
 
+    # ---- the plugin's hooks (motorbus.registry) ------------------------------------------
+    @classmethod
+    def open(cls, *, line: Any, bus: Any = None, address: str = DEFAULT_ADDRESS, units: Any = None,
+             baud: int = DEFAULT_BAUD, timeout: Optional[float] = None, on_error: Optional[str] = "stop",
+             on_exit: Optional[str] = "stop", sleep: Any = None) -> "DmacDrive":
+        if bus is not None:
+            raise _core.InvalidArgument("dmac: a serial drive takes line=, not bus=")
+        # The adapter owns the safety words: the client does nothing at exit itself.
+        client = DmacClient(line, check_address(str(address)), baud=baud, timeout=timeout, sleep=sleep,
+                            on_error=None, on_exit=None)
+        return cls(client, units=units, on_error=on_error, on_exit=on_exit, close_native=client.close)
 
-def _open(*, line: Any, bus: Any = None, address: str = DEFAULT_ADDRESS, units: Any = None,
-          baud: int = DEFAULT_BAUD, timeout: Optional[float] = None, on_error: Optional[str] = "stop",
-          on_exit: Optional[str] = "stop", sleep: Any = None) -> DmacDrive:
-    if bus is not None:
-        raise _core.InvalidArgument("dmac: a serial drive takes line=, not bus=")
-    # The adapter owns the safety words: the client does nothing at exit itself.
-    client = DmacClient(line, check_address(str(address)), baud=baud, timeout=timeout, sleep=sleep,
-                        on_error=None, on_exit=None)
-    return DmacDrive(client, units=units, on_error=on_error, on_exit=on_exit, close_native=client.close)
+    @classmethod
+    def make_sim(cls, address: Any = "00", clock: Any = None, **options: Any) -> DmacSim:
+        return make_sim(address, clock, **options)
 
+    @classmethod
+    def check_address(cls, text: Any) -> str:
+        return check_address(text)
 
-def probe(line: "_core.LineLink", address: str) -> Optional[dict]:
-    """Discovery: REQUEST_VERSION of the module at `address`, or None.  Reads only."""
-    client = DmacClient(line, address=int(address), verify=False, on_error=None, on_exit=None)
-    try:
-        # Presence first, on the link's short reply timeout (the sweep's cost per
-        # empty address); the long REQUEST_VERSION banner only where a module is.
-        client.raw(f"{int(address):02d}READ #STATUS", True)
-        v = client.request_version()
-        return {"model": v.model, "firmware": f"v{v.version}.{v.release}", "serial": v.serial}
-    finally:
-        client.close()
+    @classmethod
+    def wire_line(cls, sims: Sequence[DmacSim]) -> None:
+        wire_line(sims)
+
+    @classmethod
+    def synchronised_start(cls, link: Any, drives: Sequence[Any]) -> Any:
+        return synchronised_start(link, drives)
+
+    @classmethod
+    def probe(cls, line: "_core.LineLink", address: str) -> Optional[dict]:
+        """Discovery: REQUEST_VERSION of the module at `address`, or None.  Reads only."""
+        client = DmacClient(line, address=int(address), verify=False, on_error=None, on_exit=None)
+        try:
+            # Presence first, on the link's short reply timeout (the sweep's cost per
+            # empty address); the long REQUEST_VERSION banner only where a module is.
+            client.raw(f"{int(address):02d}READ #STATUS", True)
+            v = client.request_version()
+            return {"model": v.model, "firmware": f"v{v.version}.{v.release}", "serial": v.serial}
+        finally:
+            client.close()
+
+    @classmethod
+    def sim_faults(cls) -> dict:
+        return dict(SIM_FAULTS)
+
+    def poll_fields(self, fields: Any) -> "PollSpec":
+        """motorbus.Poller: #POSITION, #SPEED and #STATUS (hex) read by a client of the poll
+        thread's own on the drive's line.  Each READ waits the module's #LINE_DELAY (3 ms
+        from the factory): a DMAC line polls at tens of Hz."""
+        from ..registry import PollSpec
+
+        reads = {"position": ("POSITION", 1.0), "velocity": ("SPEED", 1.0 / _SPEED_PER_INC_S),
+                 "status": ("STATUS", 1.0)}
+        for f in fields:
+            if f not in reads:
+                raise _core.InvalidArgument(f"dmac poll field {f!r}: this kind gives {', '.join(reads)}")
+        n = self.native
+        source = _core.dmac_poll_source(n.link, n.address, [reads[f][0] for f in fields], baud=n.baud,
+                                        timeout=n.timeout)
+        return PollSpec(source=source, scales=tuple(reads[f][1] for f in fields), transport=n.link)
+
+    def plan_move(self, start: float, target: float) -> Any:
+        """A DMAC position move (its profile model: #ACCEL_TIME/#DECEL_TIME to and from
+        #HIGH_SPEED, the closed-loop approach at #LOW_SPEED, S_CURVE), in increments."""
+        from .. import motion
+
+        p = self.params
+        params = DmacProfileParams(high_speed=int(p["#HIGH_SPEED"]), low_speed=int(p["#LOW_SPEED"]),
+                                   accel_time_ms=int(p["#ACCEL_TIME"]), decel_time_ms=int(p["#DECEL_TIME"]))
+        return dmac_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
 
 
 def _sim_model_is_dmac34(sim: DmacSim) -> bool:
@@ -922,51 +977,3 @@ SIM_FAULTS = {
     # a sensor ("cpu", "driver" or "motor") heats (0.1 degC): past its threshold a thermal fault latches
     "overheat": lambda sim, sensor="motor", tenths_c=900: sim.set_temperature(str(sensor), int(tenths_c)),
 }
-
-
-def poll_fields(drive: "DmacDrive", fields: Any) -> "PollSpec":
-    """motorbus.Poller: #POSITION, #SPEED and #STATUS (hex) read by a client of the poll
-    thread's own on the drive's line.  Each READ waits the module's #LINE_DELAY (3 ms
-    from the factory): a DMAC line polls at tens of Hz."""
-    from ..registry import PollSpec
-
-    reads = {"position": ("POSITION", 1.0), "velocity": ("SPEED", 1.0 / _SPEED_PER_INC_S), "status": ("STATUS", 1.0)}
-    for f in fields:
-        if f not in reads:
-            raise _core.InvalidArgument(f"dmac poll field {f!r}: this kind gives {', '.join(reads)}")
-    n = drive.native
-    source = _core.dmac_poll_source(n.link, n.address, [reads[f][0] for f in fields], baud=n.baud,
-                                    timeout=n.timeout)
-    return PollSpec(source=source, scales=tuple(reads[f][1] for f in fields), transport=n.link)
-
-
-def plan_move(drive: "DmacDrive", start: float, target: float) -> Any:
-    """A DMAC position move (its profile model: #ACCEL_TIME/#DECEL_TIME to and from
-    #HIGH_SPEED, the closed-loop approach at #LOW_SPEED, S_CURVE), in increments."""
-    from .. import motion
-
-    p = drive.params
-    params = motion.DmacProfileParams(high_speed=int(p["#HIGH_SPEED"]), low_speed=int(p["#LOW_SPEED"]),
-                                      accel_time_ms=int(p["#ACCEL_TIME"]), decel_time_ms=int(p["#DECEL_TIME"]))
-    return motion.dmac_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
-
-PLUGIN = DrivePlugin(
-    kind="dmac",
-    description="Midi Ingénierie DMAC17/23/34 brushless modules, ASCII protocol over RS-232/RS-485",
-    transport="serial",
-    open=_open,
-    make_sim=make_sim,
-    check_address=check_address,
-    default_address=DEFAULT_ADDRESS,
-    line_settings=LINE_SETTINGS,
-    default_baud=DEFAULT_BAUD,
-    sim_options=SIM_OPTIONS,
-    store_options=None,
-    synchronised_start=synchronised_start,
-    probe=probe,
-    probe_addresses=tuple(f"{a:02d}" for a in range(64)),   # 00-63
-    probe_bauds=BAUDRATES,
-    sim_faults=SIM_FAULTS,
-    poll_fields=poll_fields,
-    plan_move=plan_move,
-)

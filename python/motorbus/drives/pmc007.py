@@ -40,9 +40,8 @@ from .._core import (Pmc007ProfileParams, pmc007_convert_position, pmc007_gear_a
                      pmc007_microsteps, pmc007_position_profile, pmc007_speed_profile)
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, MoveStalled,
                      ParamInfo, Params, StopReason, Units)
-from ..registry import DrivePlugin
 
-__all__ = ["ControllerStatus", "ErrorStatus", "Pmc007", "Pmc007Drive", "PLUGIN", "make_sim", "open", "OBJECTS",
+__all__ = ["ControllerStatus", "ErrorStatus", "Pmc007", "Pmc007Drive", "make_sim", "OBJECTS",
            "EDS_PATH", "assemble", "disassemble", "BAUD_RATES", "GEAR_ACCELERATION", "STALL_EXAMPLES",
            "ABORT_DEVICE_STATE", "Pmc007ProfileParams", "pmc007_convert_position",
            "pmc007_gear_acceleration", "pmc007_microsteps", "pmc007_position_profile", "pmc007_speed_profile"]
@@ -600,6 +599,93 @@ class Pmc007Drive(Drive):
     has_watchdog = False
     in_position_window = 0.0
 
+    # ---- the plugin (motorbus.registry): what the kind is, and its hooks -------------------
+    description = "CQPUSI PMC007 integrated stepper on CANopen (CiA 301)"
+    transport = "can"
+    default_address = "5"
+    sim_options = ("steps_per_rev", "pull_out_speed", "ext1_switch", "store_path", "vendor_id", "product_code",
+                   "revision", "serial")
+
+    @classmethod
+    def open(cls, *, line: Any = None, bus: Any = None, address: str, units: Optional[Units] = None,
+             timeout: float = 1.0, on_error: Optional[str] = "stop", on_exit: Optional[str] = "stop",
+             home_speed: int = 2000, ext_limits: Optional[dict] = None) -> "Pmc007Drive":
+        """``open_drive("pmc007", bus=..., address=5)``; ``ext_limits={"ext2": +1}``: external stop
+        inputs wired as limit switches (their stop is then LimitReached, not MoveInterrupted)."""
+        from ..bus import open_bus
+
+        owns = isinstance(bus, str)
+        b = open_bus(bus) if owns else bus
+        try:
+            native = Pmc007(b, int(_check_node(address)), timeout=timeout, on_error=None, on_exit=None)
+            drive = cls(native, units=units, on_error=on_error, on_exit=on_exit,
+                        close_native=b.close if owns else None, home_speed=home_speed, ext_limits=ext_limits)
+        except Exception:
+            if owns:
+                b.close()
+            raise
+        return drive
+
+    @classmethod
+    def make_sim(cls, address: Union[str, int] = "5", clock: Any = None, **options: Any) -> Any:
+        return make_sim(address, clock, **options)
+
+    @classmethod
+    def check_address(cls, text: Any) -> str:
+        return _check_node(text)
+
+    @classmethod
+    def store_options(cls, store_dir: str, address: str) -> dict:
+        return {"store_path": os.path.join(store_dir, f"pmc007-{address}.flash")}
+
+    @classmethod
+    def canopen_match(cls, node: Any) -> int:
+        # Discovery: the manual gives the PMC007 no device type and no identity (1000h 0,
+        # no vendor), so a node reporting device type 0 and no vendor is taken for one (the
+        # simulator's product code 7 makes it surer); weak, but the only mark the manual
+        # leaves.  A CiA 402 drive reports its profile instead.
+        if node.device_type != 0 or node.vendor_id:
+            return 0
+        return 3 if node.product_code == 7 else 2 if not node.product_code else 0
+
+    @classmethod
+    def sim_faults(cls) -> dict:
+        return dict(SIM_FAULTS)
+
+    def poll_fields(self, fields: Any) -> Any:
+        """motorbus.Poller: 600Ch (position) and the controller status by SDO.  The
+        PMC007 has no actual-speed object (the Drive measures it over a window), so
+        "velocity" is refused: differentiate the polled position instead."""
+        from ..canopen.poll import sdo_poll_spec
+
+        native = self.native
+        return sdo_poll_spec(self.kind, native.sdo, native.bus, fields, _poll_objects())
+
+    def capture_fields(self, fields: Any, period: float) -> Any:
+        """motorbus.Poller, capturing: 600Ch and the controller status (6001h), both
+        PDO-mappable, in TPDO 1 on the event timer, written with the manual's sequence
+        (App.3 §11.2: the PDO changed in place)."""
+        from ..canopen.poll import tpdo_capture_spec
+
+        native = self.native
+        if native.bus is None:
+            raise _core.InvalidArgument("pmc007 capture: the drive's SDO client has no bus to listen on")
+        return tpdo_capture_spec(self.kind, native.sdo, native.bus, native.node, fields, _poll_objects(), period,
+                                 procedure="direct")
+
+    def plan_move(self, start: float, target: float) -> Any:
+        """A PMC007 position move (its profile model): run speed |6003h| (the start
+        speed 6006h when 0), start/stop speeds 6006h/6007h, gears 6008h/6009h,
+        microstepping 600Ah; steps."""
+        from .. import motion
+
+        p = self.params
+        speed = abs(float(p["0x6003"])) or float(p["0x6006"])
+        params = Pmc007ProfileParams(speed=speed, start_speed=float(p["0x6006"]), stop_speed=float(p["0x6007"]),
+                                     accel_gear=int(p["0x6008"]), decel_gear=int(p["0x6009"]),
+                                     microstepping=int(p["0x600A"]))
+        return pmc007_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
+
     def __init__(self, native: Pmc007, *, units: Optional[Units] = None, on_error: Optional[str] = "stop",
                  on_exit: Optional[str] = "stop", close_native=None, home_speed: int = 2000,
                  ext_limits: Optional[dict] = None) -> None:
@@ -842,26 +928,6 @@ def _check_ext_limits(ext_limits: Optional[dict]) -> dict:
     return out
 
 
-def open(*, line: Any = None, bus: Any = None, address: str, units: Optional[Units] = None,
-         timeout: float = 1.0, on_error: Optional[str] = "stop", on_exit: Optional[str] = "stop",
-         home_speed: int = 2000, ext_limits: Optional[dict] = None) -> Pmc007Drive:  # noqa: A001
-    """``open_drive("pmc007", bus=..., address=5)``; ``ext_limits={"ext2": +1}``: external stop
-    inputs wired as limit switches (their stop is then LimitReached, not MoveInterrupted)."""
-    from ..bus import open_bus
-
-    owns = isinstance(bus, str)
-    b = open_bus(bus) if owns else bus
-    try:
-        native = Pmc007(b, int(_check_node(address)), timeout=timeout, on_error=None, on_exit=None)
-        drive = Pmc007Drive(native, units=units, on_error=on_error, on_exit=on_exit,
-                            close_native=b.close if owns else None, home_speed=home_speed, ext_limits=ext_limits)
-    except Exception:
-        if owns:
-            b.close()
-        raise
-    return drive
-
-
 def _sim_stall(sim: Any) -> None:
     """The rotor jams and the drive detects it: an open-loop PMC007 sees a stall only with
     stall detection set up (6017h threshold != 0), so a sim without it gets the manual's
@@ -900,69 +966,9 @@ SIM_FAULTS = {
     # any error-status bits (ErrorStatus), e.g. 0x20 = over-temperature shutdown
     "error": lambda sim, bits=1: sim.inject_error(int(bits)),
 }
-def poll_fields(drive: "Pmc007Drive", fields: Any):
-    """motorbus.Poller: 600Ch (position) and the controller status by SDO.  The
-    PMC007 has no actual-speed object (the Drive measures it over a window), so
-    "velocity" is refused: differentiate the polled position instead."""
-    from ..canopen.poll import sdo_poll_spec
-
-    native = drive.native
-    return sdo_poll_spec(drive.kind, native.sdo, native.bus, fields, _poll_objects())
-
-
 def _poll_objects() -> dict:
     objects = {}
     for field, name in (("position", "motor_position"), ("status", "controller_status")):
         row = OBJECTS[name]
         objects[field] = (row["index"], row["sub"], row["type"].lower(), 1.0)
     return objects
-
-
-def capture_fields(drive: "Pmc007Drive", fields: Any, period: float):
-    """motorbus.Poller, capturing: 600Ch and the controller status (6001h), both
-    PDO-mappable, in TPDO 1 on the event timer, written with the manual's sequence
-    (App.3 §11.2: the PDO changed in place)."""
-    from ..canopen.poll import tpdo_capture_spec
-
-    native = drive.native
-    if native.bus is None:
-        raise _core.InvalidArgument("pmc007 capture: the drive's SDO client has no bus to listen on")
-    return tpdo_capture_spec(drive.kind, native.sdo, native.bus, native.node, fields, _poll_objects(), period,
-                             procedure="direct")
-
-
-def plan_move(drive: Any, start: float, target: float) -> Any:
-    """A PMC007 position move (its profile model): run speed |6003h| (the start
-    speed 6006h when 0), start/stop speeds 6006h/6007h, gears 6008h/6009h,
-    microstepping 600Ah; steps."""
-    from .. import motion
-
-    p = drive.params
-    speed = abs(float(p["0x6003"])) or float(p["0x6006"])
-    params = Pmc007ProfileParams(speed=speed, start_speed=float(p["0x6006"]), stop_speed=float(p["0x6007"]),
-                                 accel_gear=int(p["0x6008"]), decel_gear=int(p["0x6009"]),
-                                 microstepping=int(p["0x600A"]))
-    return pmc007_position_profile(motion.MotionState(float(start), 0.0, 0.0, 0.0), float(target), params)
-
-PLUGIN = DrivePlugin(
-    kind="pmc007",
-    description="CQPUSI PMC007 integrated stepper on CANopen (CiA 301)",
-    transport="can",
-    open=open,
-    make_sim=make_sim,
-    check_address=_check_node,
-    default_address="5",
-    sim_options=("steps_per_rev", "pull_out_speed", "ext1_switch", "store_path", "vendor_id", "product_code",
-                 "revision", "serial"),
-    store_options=lambda store_dir, address: {"store_path": os.path.join(store_dir, f"pmc007-{address}.flash")},
-    # Discovery: the manual gives the PMC007 no device type and no identity (1000h 0,
-    # no vendor), so a node reporting device type 0 and no vendor is taken for one (the
-    # simulator's product code 7 makes it surer); weak, but the only mark the manual
-    # leaves.  A CiA 402 drive reports its profile instead.
-    canopen_match=lambda node: (0 if node.device_type != 0 or node.vendor_id else
-                                3 if node.product_code == 7 else 2 if not node.product_code else 0),
-    sim_faults=SIM_FAULTS,
-    poll_fields=poll_fields,
-    plan_move=plan_move,
-    capture_fields=capture_fields,
-)

@@ -56,10 +56,10 @@ from .. import _core
 from .._core import UnitekRampParams, unitek_speed_profile  # noqa: F401
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, ParamInfo, Params,
                      StopReason, Units)
-from ..registry import DrivePlugin, PollSpec
+from ..registry import PollSpec
 
-__all__ = ["FrameError", "UnknownRegister", "CyclicLimit", "Reg", "Status", "ModeBit", "Unitek", "UnitekDrive", "UnitekSim", "Stream", "PLUGIN", "make_sim",
-           "open", "builtin_registers", "load_registers", "ndrive_registers", "REVOLUTIONS", "BIT_TIMINGS",
+__all__ = ["FrameError", "UnknownRegister", "CyclicLimit", "Reg", "Status", "ModeBit", "Unitek", "UnitekDrive", "UnitekSim", "Stream", "make_sim",
+           "builtin_registers", "load_registers", "ndrive_registers", "REVOLUTIONS", "BIT_TIMINGS",
            "btr_for_bit_rate", "bit_rate_for_btr", "current_limit_num", "CURRENT_COMMAND_MAX", "UnitekRampParams",
            "unitek_speed_profile"]
 
@@ -651,6 +651,13 @@ class UnitekDrive(Drive):
     capabilities = frozenset({Capability.POSITION, Capability.VELOCITY, Capability.HOMING, Capability.TORQUE,
                               Capability.STORE, Capability.ENCODER})
     has_watchdog = False
+
+    # the plugin (motorbus.registry): what the kind is
+    description = "UNITEK BAMOCAR/BAMOBIL/DS servo on its CAN register protocol (REGID, not CANopen)"
+    transport = "can"
+    default_address = "0x201"
+    sim_options = _SIM_OPTIONS
+    probe_addresses = tuple(f"0x{i:03X}" for i in range(0x201, 0x280))   # the receive-id range
     #: Seconds a move may show no motion before a still motor counts as at rest (a
     #: stop that came before the motor got going); a drive showing why it stopped, or
     #: Tol at the target, is at rest at once.
@@ -872,39 +879,74 @@ class UnitekDrive(Drive):
     def _close(self) -> None:
         self.native.close()
 
+    # ---- the plugin's hooks (motorbus.registry) ------------------------------------------
+    @classmethod
+    def open(cls, *, line: Any = None, bus: Any = None, address: Union[str, int] = "0x201",
+             units: Optional[Units] = None, timeout: float = 0.2, on_error: Optional[str] = "stop",
+             on_exit: Optional[str] = "stop", tx_id: Optional[int] = None, registers: Any = None,
+             n_max_rpm: float = 3000.0, device: str = "DS 205/405", tol_num: float = 64) -> "UnitekDrive":
+        """``open_drive("unitek", bus=..., address="0x201")``; ``tol_num``: the drive's Tol window
+        (num), the in-position window a move is judged by."""
+        from ..bus import open_bus
 
-def open(*, line: Any = None, bus: Any = None, address: Union[str, int] = "0x201",  # noqa: A001 - the plugin's verb
-         units: Optional[Units] = None, timeout: float = 0.2, on_error: Optional[str] = "stop",
-         on_exit: Optional[str] = "stop", tx_id: Optional[int] = None, registers: Any = None,
-         n_max_rpm: float = 3000.0, device: str = "DS 205/405", tol_num: float = 64) -> UnitekDrive:
-    """``open_drive("unitek", bus=..., address="0x201")``; ``tol_num``: the drive's Tol window
-    (num), the in-position window a move is judged by."""
-    from ..bus import open_bus
+        if bus is None:
+            raise _core.InvalidArgument("unitek: a CAN drive needs bus=")
+        owns = isinstance(bus, str)
+        b = open_bus(bus) if owns else bus
+        try:
+            native = Unitek(b, int(check_address(address), 16), tx_id, timeout=timeout, registers=registers,
+                            n_max_rpm=n_max_rpm, device=device, on_error=None, on_exit=None)
+            drive = cls(native, units=units, on_error=on_error, on_exit=on_exit,
+                        close_native=b.close if owns else None, tol_num=tol_num)
+        except Exception:
+            if owns:
+                b.close()
+            raise
+        return drive
 
-    if bus is None:
-        raise _core.InvalidArgument("unitek: a CAN drive needs bus=")
-    owns = isinstance(bus, str)
-    b = open_bus(bus) if owns else bus
-    try:
-        native = Unitek(b, int(check_address(address), 16), tx_id, timeout=timeout, registers=registers,
-                        n_max_rpm=n_max_rpm, device=device, on_error=None, on_exit=None)
-        drive = UnitekDrive(native, units=units, on_error=on_error, on_exit=on_exit,
-                            close_native=b.close if owns else None, tol_num=tol_num)
-    except Exception:
-        if owns:
-            b.close()
-        raise
-    return drive
+    @classmethod
+    def make_sim(cls, address: Union[str, int] = "0x201", clock: Any = None, **options: Any) -> "UnitekSim":
+        return make_sim(address, clock, **options)
 
+    @classmethod
+    def check_address(cls, text: Any) -> str:
+        return check_address(text)
 
-def probe(bus: Any, address: str) -> Optional[dict]:
-    """Discovery: reads KERN_STATUS once from the drive on receive id `address` (the
-    documented registers name no model or firmware).  Reads only; starts no stream."""
-    client = Unitek(bus, int(check_address(address), 16), timeout=0.05, on_error=None, on_exit=None)
-    try:
-        return {"kern_status": f"0x{client.read(Reg.KERN_STATUS):04X}"}
-    finally:
-        client.close()
+    @classmethod
+    def store_options(cls, store_dir: str, address: str) -> dict:
+        return {"store_path": str(Path(store_dir) / f"unitek-{address}.eeprom.json")}
+
+    @classmethod
+    def probe(cls, bus: Any, address: str) -> Optional[dict]:
+        """Discovery: reads KERN_STATUS once from the drive on receive id `address` (the
+        documented registers name no model or firmware).  Reads only; starts no stream."""
+        client = Unitek(bus, int(check_address(address), 16), timeout=0.05, on_error=None, on_exit=None)
+        try:
+            return {"kern_status": f"0x{client.read(Reg.KERN_STATUS):04X}"}
+        finally:
+            client.close()
+
+    @classmethod
+    def sim_faults(cls) -> dict:
+        return dict(SIM_FAULTS)
+
+    def poll_fields(self, fields: Sequence[str]) -> PollSpec:
+        """motorbus.Poller, asking: POS_IST/SPEED_IST/KERN_STATUS read (3D REGID 00) each sample."""
+        regids, scales = _poll_rows(self, fields)
+        source = _core.unitek_poll_source(self.native._core, regids)
+        return PollSpec(source=source, scales=scales, transport=self.native.bus, bus=self.native.bus)
+
+    def capture_fields(self, fields: Sequence[str], period: float) -> PollSpec:
+        """motorbus.Poller, capturing: the drive transmits each register cyclically
+        (``3D REGID t``, t = the poll period in whole ms, 1..254) and each sample takes
+        the latest value.  A register the user already streams keeps its interval; the
+        transmissions started here stop when the Poller stops.  At most 8 registers
+        transmit cyclically per drive (CyclicLimit beyond)."""
+        regids, scales = _poll_rows(self, fields)
+        interval_ms = min(254, max(1, int(round(period * 1000))))
+        source = _core.unitek_capture_source(self.native._core, regids, interval_ms)
+        return PollSpec(source=source, scales=scales, transport=self.native.bus, bus=self.native.bus,
+                        stamped=True, close=source.close)
 
 
 # ---- motorbus.Poller ---------------------------------------------------------------
@@ -923,26 +965,6 @@ def _poll_rows(drive: UnitekDrive, fields: Sequence[str]) -> tuple[list[int], tu
     return regids, tuple(scales)
 
 
-def poll_fields(drive: UnitekDrive, fields: Sequence[str]) -> PollSpec:
-    """motorbus.Poller, asking: POS_IST/SPEED_IST/KERN_STATUS read (3D REGID 00) each sample."""
-    regids, scales = _poll_rows(drive, fields)
-    source = _core.unitek_poll_source(drive.native._core, regids)
-    return PollSpec(source=source, scales=scales, transport=drive.native.bus, bus=drive.native.bus)
-
-
-def capture_fields(drive: UnitekDrive, fields: Sequence[str], period: float) -> PollSpec:
-    """motorbus.Poller, capturing: the drive transmits each register cyclically
-    (``3D REGID t``, t = the poll period in whole ms, 1..254) and each sample takes
-    the latest value.  A register the user already streams keeps its interval; the
-    transmissions started here stop when the Poller stops.  At most 8 registers
-    transmit cyclically per drive (CyclicLimit beyond)."""
-    regids, scales = _poll_rows(drive, fields)
-    interval_ms = min(254, max(1, int(round(period * 1000))))
-    source = _core.unitek_capture_source(drive.native._core, regids, interval_ms)
-    return PollSpec(source=source, scales=scales, transport=drive.native.bus, bus=drive.native.bus,
-                    stamped=True, close=source.close)
-
-
 # Faults the simulator can be given (the pytest plugin's sim_faults fixture): the standard
 # names ("limit", "fault") and this kind's own.  No "stall" (a servo: no stall detection on
 # this protocol) and no "stop_input" (002 documents no stop input; the RUN input is
@@ -957,20 +979,3 @@ SIM_FAULTS = {
     # the hardware enable (RUN) input drops: the power stage switches off
     "enable_off": lambda sim: sim.set_hardware_enable(False),
 }
-
-PLUGIN = DrivePlugin(
-    kind="unitek",
-    description="UNITEK BAMOCAR/BAMOBIL/DS servo on its CAN register protocol (REGID, not CANopen)",
-    transport="can",
-    open=open,
-    make_sim=make_sim,
-    check_address=check_address,
-    default_address="0x201",
-    sim_options=_SIM_OPTIONS,
-    store_options=lambda store_dir, address: {"store_path": str(Path(store_dir) / f"unitek-{address}.eeprom.json")},
-    probe=probe,
-    probe_addresses=tuple(f"0x{i:03X}" for i in range(0x201, 0x280)),   # the receive-id range
-    sim_faults=SIM_FAULTS,
-    poll_fields=poll_fields,
-    capture_fields=capture_fields,
-)
