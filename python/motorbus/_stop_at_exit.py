@@ -2,7 +2,7 @@
 interpreter exits with them still open, and when the process is ended by
 SIGTERM or SIGHUP.
 
-Every drive client (Arcus, DMAC, CiA 402) registers itself with :func:`track`
+Every drive client (serial or CAN) registers itself with :func:`track`
 when it opens and :func:`untrack` when it closes; at exit each one still
 tracked has its ``_stop_at_exit()`` called (best effort: a link that is
 already gone must not stop the others).  Weak references: a client that was

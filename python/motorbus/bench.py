@@ -8,11 +8,11 @@
     port = "/dev/ttyUSB0"
     baud = 9600
     [axis.x]
-    kind = "arcus"
+    kind = "..."                                 # a serial kind (`motorbus drives` lists them)
     line = "rs485"
     address = 1
     units = { name = "mm", scale = 0.0025 }
-    params = { HSPD = 10000, ACC = 100 }         # the vendor's own parameter names
+    params = { ... }                             # the kind's own parameter names (docs/drives/)
     [axis.z]
     kind = "cia402"
     bus = "can0"
@@ -273,7 +273,7 @@ class StartReport:
     axis's (0 for the first; axes started by their drives' own trigger share one
     offset); ``skew`` = the largest offset.  ``method``: "software" (commands sent
     back to back, each axis starting when its own command arrives), the drives'
-    own method ("DMAC SYNCHRO TOP"), or both joined by " + "."""
+    own method (as their kind names it: a broadcast trigger), or both joined by " + "."""
 
     method: str
     offsets: dict
@@ -828,7 +828,7 @@ class Bench:
         """Starts moves on several axes together and reports how closely.
 
         Axes of one kind sharing a line or bus whose Drive class offers a drive-level
-        synchronised start (``Drive.synchronised_start``: DMAC ``SYNCHRO``)
+        synchronised start (``Drive.synchronised_start``, e.g. a broadcast trigger)
         start on the drives' own trigger: their offsets are 0 by construction (one
         broadcast).  The others get a software start: commands back to back, each
         axis starting when its own command arrives; their offsets are measured
@@ -1011,9 +1011,9 @@ _MAX_STORE_BYTES = 1 << 20
 
 def _store_file_verdict(path: str, st: os.stat_result) -> str:
     """"" when ``path`` is a store file written by a motorbus simulator (or empty), else
-    what it is.  The formats: lines ``NAME=INTEGER`` (flash of the Arcus simulators),
-    lines ``rom IIII SS HEX`` / ``program ...`` / ``position N`` (object store of the
-    PMC007 simulator), a JSON object of register -> integer (EEPROM of the UNITEK simulator)."""
+    what it is.  The formats the in-tree simulators write: lines ``NAME=INTEGER`` (a
+    flash), lines ``rom IIII SS HEX`` / ``program ...`` / ``position N`` (a CANopen
+    object store), a JSON object of register -> integer (an EEPROM)."""
     if not stat.S_ISREG(st.st_mode):
         return f"is not a regular file (a {_file_type(st.st_mode)})"
     if st.st_size > _MAX_STORE_BYTES:

@@ -76,8 +76,8 @@ def exit_codes_text() -> str:
 
 
 #: The largest position or speed, in native units, a command line may ask for: every
-#: kind's position and speed registers are 32-bit (CiA 402 0x607A/0x6081, Arcus, DMAC,
-#: PMC007, UNITEK), so a larger value cannot be what was meant.
+#: in-tree kind's position and speed registers are 32-bit (CiA 402 0x607A/0x6081 and the
+#: vendors' own), so a larger value cannot be what was meant.
 NATIVE_MAX = 2 ** 31 - 1
 
 

@@ -4,13 +4,13 @@
 every registered kind's probe (its Drive class's ``probe`` / ``canopen_match``):
 
 * a serial line: for each serial kind, each of its ``probe_bauds``, each of its
-  ``probe_addresses``, the kind's identity query (Arcus ``ID``/``VER``, DMAC
-  ``REQUEST_VERSION``...).  One missing address costs one reply timeout (plus the
+  ``probe_addresses``, the kind's identity query (its ``probe``: an identity or
+  version request).  One missing address costs one reply timeout (plus the
   query's wire time at that rate), so a full sweep is bounded by kinds x bauds x
   addresses x timeout.  A line stops being swept at the first rate and kind that
   answered (one protocol at one rate per line).  Requests sent at a wrong rate
-  reach the drives as garbage; some latch that as an error (a DMAC sets its
-  #ERROR syntax bit): ``clear_faults()`` acknowledges it;
+  reach the drives as garbage; some latch that as an error (a syntax error
+  bit): ``clear_faults()`` acknowledges it;
 * a CAN bus: one CANopen scan (boot-up and heartbeat listening plus SDO 0x1000
   and 0x1018 on nodes 1-127, answered in parallel) whose nodes go to the
   CANopen kinds' ``canopen_match``; then the probes of CAN kinds that are not

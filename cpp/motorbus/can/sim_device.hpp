@@ -15,7 +15,7 @@
 //                 destructor calls it.  Then attach() may be called again (to
 //                 the same bus or another one), with the device's state kept.
 //   attached()    whether it is on a bus (a device that took itself off the
-//                 bus, e.g. a PMC007 in its bootloader, may still count as
+//                 bus, e.g. a node sitting in its bootloader, may still count as
 //                 attached: the bus is kept for its next power-up).
 //   describe()    "<kind> sim <address>", for error messages and logs, so that
 //                 a message about one of 100 simulated nodes says which.
@@ -59,7 +59,7 @@ public:
     // Off the bus; idempotent.  Not from the device's own callbacks (see above).
     virtual void close() = 0;
     virtual bool attached() const = 0;
-    // "<kind> sim <address>", e.g. "pmc007 sim node 5".
+    // "<kind> sim <address>", e.g. "cia402 sim node 5".
     virtual std::string describe() const = 0;
     // Power off and on again (see above).
     virtual void power_cycle() = 0;

@@ -88,8 +88,8 @@ struct VariableSpec {
     // round-trips.  Empty when the default is a plain literal.
     std::string default_expr{};
     // A second size a remote write may carry (0 = none), for a device whose manual
-    // lists an object with two sizes (PMC007 6020h: UNSIGNED8 in one table,
-    // UNSIGNED32 in another).  Such a write is narrowed or widened to the type's
+    // lists an object with two sizes (one manual gives an object UNSIGNED8 in one
+    // table and UNSIGNED32 in another).  Such a write is narrowed or widened to the type's
     // size first (bytes beyond it must be zero: 0x06090031 otherwise).
     std::size_t alt_size = 0;
 };

@@ -142,8 +142,8 @@ enum class PdoProcedure {
     // set sub0, enable.  Works on every conforming device.
     Cia301,
     // Writes in the order COB-ID, parameters, sub0 = n, entries, without the
-    // disable/enable steps: devices such as the PMC007 document exactly this
-    // sequence (manual appendix 3) and accept it.
+    // disable/enable steps: some devices' manuals document exactly this
+    // sequence, and those devices accept it.
     Direct,
 };
 const char* to_string(PdoProcedure p);                                 // "cia301", "direct"

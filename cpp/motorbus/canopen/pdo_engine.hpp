@@ -96,8 +96,8 @@ struct PdoEngineOptions {
     unsigned tpdo_count = 4;
     unsigned max_mapped = 8;  // highest mapping sub-index (<= 64)
     // true: the CiA 301 procedure is enforced (P8/P9: no change while valid).
-    // false: changes while valid are accepted and take effect at once, as the
-    // PMC007 does for its documented configuration sequence.
+    // false: changes while valid are accepted and take effect at once, as a
+    // device whose manual documents the direct configuration sequence does.
     bool strict = true;
     std::uint32_t sync_cob_id = 0x080;
     std::uint8_t sync_overflow = 0;   // 0x1019

@@ -1,6 +1,6 @@
 // The homing engine: what every drive's homing shares (the result vocabulary, the
 // search ramp) and the CiA 402 methods. Vendor homing lives with its vendor
-// (drives/arcus/homing.hpp).
+// (drives/<vendor>/homing.hpp).
 //
 // CiA 402 (methods 7, 11, 17, 18, 19, 20, 33, 34, 35), with 6099h:01 speed
 // during search for switch, 6099h:02 speed during search for zero, 609Ah

@@ -39,8 +39,8 @@ namespace motorbus::motion {
 
 // A switch at a physical position.  Home: active for lo <= p <= hi.  Minus
 // limit: active for p <= position.  Plus limit: active for p >= position.
-// active_low: the electrical input reads 0 when the switch is active (the
-// DMX-CAN default polarity).
+// active_low: the electrical input reads 0 when the switch is active (a
+// common factory polarity).
 struct SwitchConfig {
     bool present = false;
     double lo = 0, hi = 0;  // home window / limit position (use lo for limits)
@@ -54,11 +54,11 @@ struct SwitchConfig {
 enum class Switch { Home, MinusLimit, PlusLimit };
 
 struct MotorConfig {
-    double steps_per_rev = 3200;   // DMX-CAN: 16 microsteps x 200
-    double counts_per_rev = 4000;  // DMX-CAN: 1000 lines, quadrature
+    double steps_per_rev = 3200;   // 16 microsteps x 200 full steps
+    double counts_per_rev = 4000;  // a 1000-line encoder, quadrature
     double index_position = 0;     // physical steps of one Z index (repeats each rev)
     double index_width_steps = 0.8;  // Z is high within [index, index + width)
-    // The motor has a Z index channel.  A drive that reads none (PMC007) says
+    // The motor has a Z index channel.  A drive that reads none says
     // false: no IndexPulse events, whose search would otherwise end a step of the
     // integration at every revolution of a long move.
     bool index_channel = true;

@@ -27,7 +27,7 @@ enum class RampShape {
     Trapezoid,  // constant acceleration in each ramp
     SCurve,     // same ramp times and distances as Trapezoid, but the acceleration
                 // rises and falls linearly within each ramp (triangular accel, peak = 2x
-                // the trapezoid's): the reading of Arcus SCV=1 and DMAC S_CURVE ON
+                // the trapezoid's): how the drives' S-curve settings are read
     Sin2        // same ramp times and distances, acceleration a_peak sin^2(pi t/T)
                 // (CiA 402 6086h = 1; callers halve the acceleration to keep the peak)
 };

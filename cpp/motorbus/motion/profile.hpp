@@ -5,7 +5,7 @@
 // Time is in seconds (double) measured from the start of the profile; position
 // is in whatever unit the producer documents (steps, encoder counts, 1/10000
 // rev...).  Each segment is either a cubic (constant jerk) or the exponential
-// approach a closed position loop makes (DMAC's last 0.1 turn).  Velocity may
+// approach a closed position loop makes (a servo's last approach to target).  Velocity may
 // jump between segments (a stepper's start/stop speed), position never does.
 #pragma once
 #include <Eigen/Core>

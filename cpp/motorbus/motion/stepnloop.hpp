@@ -1,4 +1,4 @@
-// StepNLoop: the DMX-CAN's closed-loop position verification (000 manual,
+// StepNLoop: a stepper drive's closed-loop position verification (000 manual,
 // "StepNLoop Closed Loop Control", Tables 7.5-7.7, Objects 2001h-2003h,
 // Table 8.14) as a reusable state machine.  It holds no clock and moves no
 // motor: the owner reports what happens (a move starts, a delta sample, a
@@ -50,7 +50,7 @@ struct SnlConfig {
     std::uint32_t error_range = 1000;  // SLE
     std::uint32_t max_attempts = 10;   // SLA
     std::uint32_t idle_tolerance = 5;  // SLM
-    // Step/encoder ratio (SLR): pulses per encoder count; DMX-CAN 3200/4000.
+    // Step/encoder ratio (SLR): pulses per encoder count; factory 3200/4000.
     double ratio = 0.8;
     static SnlConfig ascii_defaults() { return {}; }        // Table 7.11
     static SnlConfig canopen_defaults() {                   // Table 8.11

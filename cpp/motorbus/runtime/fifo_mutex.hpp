@@ -3,8 +3,8 @@
 // std::mutex lets the thread that has just unlocked take it again at once, so a
 // loop of critical sections with nothing in between — a poller reading a slow
 // line back to back, always behind its deadlines — can keep another thread out
-// for as long as it runs (a user's command waited 0.9 s behind a 1 kHz DMAC
-// poll).  Here each waiter takes a ticket and is served in turn, so a waiter
+// for as long as it runs (a user's command waited 0.9 s behind a 1 kHz poll
+// of a serial drive).  Here each waiter takes a ticket and is served in turn, so a waiter
 // waits for at most the holders that came before it.  BasicLockable: use it
 // with std::lock_guard / std::unique_lock.  Not recursive.
 #pragma once

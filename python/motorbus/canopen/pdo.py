@@ -26,7 +26,7 @@ Entry = Union[Tuple[int, int, int], Tuple[int, int, int, bool]]
 
 PdoReceiver = _core.PdoReceiver
 #: PdoService(local_node, strict=True): the PDO engine of a served LocalNode.
-#: strict=False accepts parameter changes while a PDO is valid (as the PMC007 does).
+#: strict=False accepts parameter changes while a PDO is valid (as some devices do).
 PdoService = _core.PdoService
 PdoSender = _core.PdoSender
 PdoConfig = _core.PdoConfig
@@ -90,7 +90,7 @@ def configure_pdo(sdo, node: int, *, tpdo: Optional[int] = None, rpdo: Optional[
                   procedure: "str | _core.PdoProcedure" = "cia301") -> None:
     """Write a PDO's parameters and mapping. procedure='cia301' (PdoProcedure.CIA301) disables the PDO,
     clears the mapping, writes the entries and re-enables it; 'direct' writes in
-    the order devices such as the PMC007 document, without those steps."""
+    the order some devices' manuals document, without those steps."""
     if (tpdo is None) == (rpdo is None):
         raise _core.InvalidArgument("configure_pdo: give exactly one of tpdo= or rpdo=")
     _core.pdo_write_config(sdo, node, tpdo is not None, tpdo if tpdo is not None else rpdo,
