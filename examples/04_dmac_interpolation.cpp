@@ -18,8 +18,8 @@ int main() {
     auto clock = std::make_shared<SimClock>();
     dmac::SimOptions o0, o1;
     o1.address = 1;
-    auto a = std::make_shared<dmac::DmacSim>(clock, o0);
-    auto b = std::make_shared<dmac::DmacSim>(clock, o1);
+    auto a = std::make_shared<dmac::Sim>(clock, o0);
+    auto b = std::make_shared<dmac::Sim>(clock, o1);
     serial::PtyLineServer server({a, b});
     auto link = std::make_shared<serial::LineLink>(serial::open_port(server.slave_path(), 0),
                                                    dmac::default_line_options());
@@ -28,7 +28,7 @@ int main() {
     dmac::ClientOptions c0, c1;
     c0.sleep = c1.sleep = sleep;
     c1.address = 1;
-    dmac::DmacClient x(link, c0), y(link, c1);
+    dmac::Client x(link, c0), y(link, c1);
     x.brake(false);  // DMAC34: the factory brake is ON (annex 7.1)
     y.brake(false);
 

@@ -13,7 +13,7 @@ using namespace motorbus;
 int main() {
     SimClock clock(0);
     auto device_bus = can::open_virtual("pmc007-example"), host_bus = can::open_virtual("pmc007-example");
-    pmc007::Pmc007Sim sim(5, clock);
+    pmc007::Sim sim(5, clock);
     sim.attach(*device_bus);
     canopen::SdoClient sdo(*host_bus, 5);
 

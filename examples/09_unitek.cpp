@@ -15,11 +15,11 @@ int main() {
     SimClock clock;
     auto sim_bus = can::open_virtual("unitek-example");
     auto bus = can::open_virtual("unitek-example");
-    UnitekSim sim(clock);
+    Sim sim(clock);
     sim.attach(*sim_bus);
     ClientOptions o;
     o.clock = &clock;
-    UnitekClient drive(*bus, sim_default_table(), o);
+    Client drive(*bus, sim_default_table(), o);
 
     std::printf("KERN_STATUS 0x%04llX\n", static_cast<unsigned long long>(drive.read(kRegStatus)));
     drive.write(kRegAccRamp, 1000);  // 35 E8 03 (example 6)

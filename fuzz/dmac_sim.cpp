@@ -30,7 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // End-stop switches on the axis, so HARD_ENDS stops at switch edges get fuzzed too.
     options.positive_end_switch = motion::SwitchConfig{true, 20000, 0, false};
     options.negative_end_switch = motion::SwitchConfig{true, -20000, 0, data_len_odd(size)};
-    DmacSim sim(clock, options);
+    Sim sim(clock, options);
     std::string_view in(reinterpret_cast<const char*>(data), size);
     std::size_t start = 0;
     std::size_t lines = 0;

@@ -49,8 +49,8 @@ private:
     Nanos now_ = kStart;
 };
 
-Pmc007SimOptions options() {
-    Pmc007SimOptions o;
+SimOptions options() {
+    SimOptions o;
     o.ext1_switch = std::make_pair(-1e6, -1000.0);
     o.tick_ns = 1'000'000;  // coarse steps keep long moves cheap (as in the Arcus and DMAC targets)
     return o;
@@ -59,7 +59,7 @@ Pmc007SimOptions options() {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     static RewindableClock clock;
-    static Pmc007Sim sim(5, clock, options());
+    static Sim sim(5, clock, options());
     clock.rewind();
     sim.reset_to_new();
     auto& od = sim.od();

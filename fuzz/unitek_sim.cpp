@@ -25,7 +25,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // named registers) was a fifth of the run time.  The sim gets a copy.
     static const RegisterTable table = sim_default_table();
     SimClock clock;
-    UnitekSim sim(clock, {}, table);
+    Sim sim(clock, {}, table);
     std::size_t sent = 0;
     bool bad = false;
     sim.set_output([&](const can::Frame& f) {

@@ -1,4 +1,4 @@
-// DMAC command-to-reply round trip on a pty from C++: DmacClient::read(#POSITION)
+// DMAC command-to-reply round trip on a pty from C++: Client::read(#POSITION)
 // against the simulator served by PtyLineServer, unthrottled and paced at
 // 115200 baud.  The reference, in the same run and on the same server, is a
 // plain pyserial loop (python3 subprocess) sending the same request.
@@ -41,7 +41,7 @@ Stat run_ours(const std::string& path, int n) {
     auto opts = default_line_options();
     opts.reply_timeout = std::chrono::seconds(1);
     auto link = std::make_shared<serial::LineLink>(port, opts);
-    DmacClient c(link, {.address = 0});
+    Client c(link, {.address = 0});
     for (int i = 0; i < 50; ++i) c.position();
     std::vector<double> t;
     t.reserve(static_cast<std::size_t>(n));
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
     const int n = argc > 1 ? std::max(10, std::atoi(argv[1])) : 2000;
     std::printf("DMAC '00READ #POSITION' round trip from C++, %d requests each (median / p99, us)\n", n);
     for (unsigned baud : {0u, 115200u}) {
-        auto sim = std::make_shared<DmacSim>(std::make_shared<RealClock>(), SimOptions{});
+        auto sim = std::make_shared<Sim>(std::make_shared<RealClock>(), SimOptions{});
         serial::PtyLineServer server({sim}, baud);
         Stat ours = run_ours(server.slave_path(), n);
         Stat ref;

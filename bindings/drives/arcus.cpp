@@ -133,68 +133,68 @@ void bind_arcus_motion(py::module_& m) {
     m.def("arcus_window_for_hspd", &arcus_window_for_hspd, py::arg("hspd_pps"), py::return_value_policy::copy);
     m.def("arcus_window_for_sspdm", &arcus_window_for_sspdm, py::arg("sspdm"), py::return_value_policy::copy);
     m.def("arcus_max_acc_ms", &arcus_max_acc_ms, py::arg("hspd_pps"), py::arg("lspd_pps"));
-    py::class_<ArcusProfileParams>(m, "ArcusProfileParams")
+    py::class_<ProfileParams>(m, "ArcusProfileParams")
         .def(py::init([](double hspd, double lspd, double acc_ms, double dec_ms, bool edec, bool scv, double ratio) {
-                 return ArcusProfileParams{hspd, lspd, acc_ms, dec_ms, edec, scv, ratio};
+                 return ProfileParams{hspd, lspd, acc_ms, dec_ms, edec, scv, ratio};
              }),
              py::arg("hspd") = 1000.0, py::arg("lspd") = 100.0, py::arg("acc_ms") = 300.0, py::arg("dec_ms") = 300.0,
              py::arg("edec") = false, py::arg("scv") = false, py::arg("snl_ratio") = 1.0)
-        .def_readwrite("hspd", &ArcusProfileParams::hspd)
-        .def_readwrite("lspd", &ArcusProfileParams::lspd)
-        .def_readwrite("acc_ms", &ArcusProfileParams::acc_ms)
-        .def_readwrite("dec_ms", &ArcusProfileParams::dec_ms)
-        .def_readwrite("edec", &ArcusProfileParams::edec)
-        .def_readwrite("scv", &ArcusProfileParams::scv)
-        .def_readwrite("snl_ratio", &ArcusProfileParams::snl_ratio);
-    m.def("arcus_effective", [](const ArcusProfileParams& p) {
+        .def_readwrite("hspd", &ProfileParams::hspd)
+        .def_readwrite("lspd", &ProfileParams::lspd)
+        .def_readwrite("acc_ms", &ProfileParams::acc_ms)
+        .def_readwrite("dec_ms", &ProfileParams::dec_ms)
+        .def_readwrite("edec", &ProfileParams::edec)
+        .def_readwrite("scv", &ProfileParams::scv)
+        .def_readwrite("snl_ratio", &ProfileParams::snl_ratio);
+    m.def("arcus_effective", [](const ProfileParams& p) {
         auto e = arcus_effective(p);
         return py::make_tuple(e.params, e.window ? e.window->number : 0, e.adjustments);
     }, py::arg("params"), "(effective params, window number, [adjustments]) after Appendix A.");
     m.def("arcus_check_strict", &arcus_check_strict, py::arg("params"));
     m.attr("ARCUS_MAX_MOVE_DISTANCE") = kArcusMaxMoveDistance;
-    py::enum_<ArcusPhase>(m, "ArcusPhase", "Where an ArcusMotion is in its move (MST bits 0..2).")
-        .value("IDLE", ArcusPhase::Idle)
-        .value("ACCEL", ArcusPhase::Accel)
-        .value("CONST", ArcusPhase::Const, "at constant speed")
-        .value("DECEL", ArcusPhase::Decel);
-    py::class_<ArcusMotion>(m, "ArcusMotion")
-        .def(py::init<ArcusProfileParams, int>(), py::arg("params") = ArcusProfileParams{}, py::arg("sspdm") = 0)
-        .def("set_params", [](ArcusMotion& a, const ArcusProfileParams& p) { return a.set_params(p).params; })
-        .def("set_sspdm", &ArcusMotion::set_sspdm)
-        .def_property_readonly("effective", [](const ArcusMotion& a) { return a.effective().params; })
-        .def("move", [](ArcusMotion& a, double pos, double target) { return arcus_reply_text(a.move(pos, target)); },
+    py::enum_<Phase>(m, "ArcusPhase", "Where an ArcusMotion is in its move (MST bits 0..2).")
+        .value("IDLE", Phase::Idle)
+        .value("ACCEL", Phase::Accel)
+        .value("CONST", Phase::Const, "at constant speed")
+        .value("DECEL", Phase::Decel);
+    py::class_<Motion>(m, "ArcusMotion")
+        .def(py::init<ProfileParams, int>(), py::arg("params") = ProfileParams{}, py::arg("sspdm") = 0)
+        .def("set_params", [](Motion& a, const ProfileParams& p) { return a.set_params(p).params; })
+        .def("set_sspdm", &Motion::set_sspdm)
+        .def_property_readonly("effective", [](const Motion& a) { return a.effective().params; })
+        .def("move", [](Motion& a, double pos, double target) { return arcus_reply_text(a.move(pos, target)); },
              py::arg("position"), py::arg("target"), "X: returns '' or the drive's error reply.")
-        .def("jog", [](ArcusMotion& a, double pos, int dir) { return arcus_reply_text(a.jog(pos, dir)); })
+        .def("jog", [](Motion& a, double pos, int dir) { return arcus_reply_text(a.jog(pos, dir)); })
         .def("change_target",
-             [](ArcusMotion& a, double t, double target) { return arcus_reply_text(a.change_target(t, target)); },
+             [](Motion& a, double t, double target) { return arcus_reply_text(a.change_target(t, target)); },
              py::arg("t"), py::arg("target"))
         .def("change_speed",
-             [](ArcusMotion& a, double t, double v) { return arcus_reply_text(a.change_speed(t, v)); },
+             [](Motion& a, double t, double v) { return arcus_reply_text(a.change_speed(t, v)); },
              py::arg("t"), py::arg("hspd"))
-        .def("stop", &ArcusMotion::stop, py::arg("t"))
-        .def("abort", &ArcusMotion::abort, py::arg("t"))
-        .def_property_readonly("profile", &ArcusMotion::profile, py::return_value_policy::copy)
-        .def("moving", &ArcusMotion::moving, py::arg("t"))
-        .def("phase", &ArcusMotion::phase, py::arg("t"), "The ArcusPhase at time t (MST bits 0..2).");
+        .def("stop", &Motion::stop, py::arg("t"))
+        .def("abort", &Motion::abort, py::arg("t"))
+        .def_property_readonly("profile", &Motion::profile, py::return_value_policy::copy)
+        .def("moving", &Motion::moving, py::arg("t"))
+        .def("phase", &Motion::phase, py::arg("t"), "The ArcusPhase at time t (MST bits 0..2).");
 
-    py::class_<ArcusHomingOptions>(m, "ArcusHomingOptions")
-        .def(py::init([](double hca, double lca, bool rz) { return ArcusHomingOptions{hca, lca, rz}; }),
+    py::class_<HomingOptions>(m, "ArcusHomingOptions")
+        .def(py::init([](double hca, double lca, bool rz) { return HomingOptions{hca, lca, rz}; }),
              py::arg("hca") = 0.0, py::arg("lca") = 1000.0, py::arg("rz") = false);
-    py::class_<ArcusHoming>(m, "ArcusHoming")
-        .def(py::init<MotorModel&, ArcusProfileParams, ArcusHomingOptions>(), py::arg("motor"), py::arg("params"),
-             py::arg("options") = ArcusHomingOptions{}, py::keep_alive<1, 2>())
-        .def("start", [](ArcusHoming& h, const std::string& method, int dir) {
-            static const std::pair<const char*, ArcusHoming::Method> map[] = {
-                {"H", ArcusHoming::Method::H}, {"HL", ArcusHoming::Method::HL}, {"L", ArcusHoming::Method::L},
-                {"Z", ArcusHoming::Method::Z}, {"ZH", ArcusHoming::Method::ZH}};
+    py::class_<Homing>(m, "ArcusHoming")
+        .def(py::init<MotorModel&, ProfileParams, HomingOptions>(), py::arg("motor"), py::arg("params"),
+             py::arg("options") = HomingOptions{}, py::keep_alive<1, 2>())
+        .def("start", [](Homing& h, const std::string& method, int dir) {
+            static const std::pair<const char*, Homing::Method> map[] = {
+                {"H", Homing::Method::H}, {"HL", Homing::Method::HL}, {"L", Homing::Method::L},
+                {"Z", Homing::Method::Z}, {"ZH", Homing::Method::ZH}};
             for (const auto& [n, mm] : map)
                 if (method == n) return h.start(mm, dir);
             throw InvalidArgument("ArcusHoming.start: method is H, HL, L, Z or ZH, not '" + method + "'");
         }, py::arg("method"), py::arg("direction"))
-        .def("abort", &ArcusHoming::abort)
-        .def_property_readonly("running", &ArcusHoming::running)
-        .def_property_readonly("result", [](const ArcusHoming& h) { return static_cast<int>(h.result()); })
-        .def_property_readonly("snl_status", &ArcusHoming::snl_status);
+        .def("abort", &Homing::abort)
+        .def_property_readonly("running", &Homing::running)
+        .def_property_readonly("result", [](const Homing& h) { return static_cast<int>(h.result()); })
+        .def_property_readonly("snl_status", &Homing::snl_status);
 }
 }  // namespace
 

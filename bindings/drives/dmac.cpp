@@ -1,4 +1,4 @@
-// Bindings for cpp/motorbus/drives/dmac: DmacSim (a LineDevice), DmacClient,
+// Bindings for cpp/motorbus/drives/dmac: Sim (a LineDevice), Client,
 // the global SYNCHRO commands, interpolation streaming and a few codec helpers.
 #include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
@@ -61,8 +61,8 @@ std::function<void(Duration)> sleep_arg(const py::object& f) {
 }
 
 template <class T>
-std::function<void(DmacClient&, T)> dmac_setter(void (DmacClient::*f)(T)) {
-    return [f](DmacClient& c, T v) {
+std::function<void(Client&, T)> dmac_setter(void (Client::*f)(T)) {
+    return [f](Client& c, T v) {
         py::gil_scoped_release nogil;
         (c.*f)(v);
     };
@@ -75,32 +75,32 @@ namespace {
 void bind_dmac_motion(py::module_& m) {
     using namespace motorbus::motion;
     // ---- DMAC ------------------------------------------------------------------
-    py::class_<DmacProfileParams>(m, "DmacProfileParams")
+    py::class_<ProfileParams>(m, "DmacProfileParams")
         .def(py::init([](std::int32_t hs, std::int32_t ls, std::int32_t ati, std::int32_t dti, bool sc) {
-                 DmacProfileParams p{hs, ls, ati, dti, sc};
+                 ProfileParams p{hs, ls, ati, dti, sc};
                  p.validate();
                  return p;
              }),
              py::arg("high_speed") = 60000, py::arg("low_speed") = 6000, py::arg("accel_time_ms") = 1000,
              py::arg("decel_time_ms") = 1000, py::arg("s_curve") = false)
-        .def_readwrite("high_speed", &DmacProfileParams::high_speed)
-        .def_readwrite("low_speed", &DmacProfileParams::low_speed)
-        .def_readwrite("accel_time_ms", &DmacProfileParams::accel_time_ms)
-        .def_readwrite("decel_time_ms", &DmacProfileParams::decel_time_ms)
-        .def_readwrite("s_curve", &DmacProfileParams::s_curve);
+        .def_readwrite("high_speed", &ProfileParams::high_speed)
+        .def_readwrite("low_speed", &ProfileParams::low_speed)
+        .def_readwrite("accel_time_ms", &ProfileParams::accel_time_ms)
+        .def_readwrite("decel_time_ms", &ProfileParams::decel_time_ms)
+        .def_readwrite("s_curve", &ProfileParams::s_curve);
     m.def("dmac_ramp_time", &dmac_ramp_time, py::arg("params"), py::arg("v_from"), py::arg("v_to"));
     m.def("dmac_position_profile", &dmac_position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
     m.def("dmac_speed_profile", &dmac_speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
           py::arg("hold") = 0.0);
-    py::class_<DmacMotion>(m, "DmacMotion")
-        .def(py::init<DmacProfileParams, double>(), py::arg("params") = DmacProfileParams{}, py::arg("position") = 0.0)
-        .def("set_params", &DmacMotion::set_params)
-        .def("move_to", &DmacMotion::move_to, py::arg("t"), py::arg("target"))
-        .def("move_on", &DmacMotion::move_on, py::arg("t"), py::arg("offset"))
-        .def("move_speed", &DmacMotion::move_speed, py::arg("t"), py::arg("speed"))
-        .def("stop", &DmacMotion::stop, py::arg("t"))
-        .def_property_readonly("profile", &DmacMotion::profile, py::return_value_policy::copy)
-        .def("moving", &DmacMotion::moving, py::arg("t"));
+    py::class_<Motion>(m, "DmacMotion")
+        .def(py::init<ProfileParams, double>(), py::arg("params") = ProfileParams{}, py::arg("position") = 0.0)
+        .def("set_params", &Motion::set_params)
+        .def("move_to", &Motion::move_to, py::arg("t"), py::arg("target"))
+        .def("move_on", &Motion::move_on, py::arg("t"), py::arg("offset"))
+        .def("move_speed", &Motion::move_speed, py::arg("t"), py::arg("speed"))
+        .def("stop", &Motion::stop, py::arg("t"))
+        .def_property_readonly("profile", &Motion::profile, py::return_value_policy::copy)
+        .def("moving", &Motion::moving, py::arg("t"));
 
 }
 }  // namespace
@@ -178,7 +178,7 @@ void bind_dmac(py::module_& m) {
         .field("fifo_count", &SimState::fifo_count, "interpolation segments queued")
         .field("interpolating", &SimState::interpolating)
         .field("power", &SimState::power, "the motor is powered");
-    py::class_<DmacSim, serial::LineDevice, std::shared_ptr<DmacSim>>(
+    py::class_<Sim, serial::LineDevice, std::shared_ptr<Sim>>(
         m, "DmacSim",
         "A simulated DMAC module (a LineDevice: serve it with PtyLineServer). Device time runs on `clock` "
         "(a SimClock in tests); nothing runs in the background.")
@@ -204,48 +204,48 @@ void bind_dmac(py::module_& m) {
                      o.negative_end_switch = motion::SwitchConfig{true, *negative_end_switch, 0, end_switch_active_low};
                  if (reference_switch)
                      o.reference_switch = motion::SwitchConfig{true, *reference_switch, 1e15, false};
-                 return std::make_shared<DmacSim>(std::move(clock), o);
+                 return std::make_shared<Sim>(std::move(clock), o);
              }),
              py::arg("clock") = nullptr, py::arg("address") = 0, py::arg("model") = "DMAC34-1",
              py::arg("request_terminator") = py::bytes("\r"), py::arg("reply_terminator") = py::bytes("\r\n"),
              py::arg("supply_voltage") = 32000, py::arg("baudrate") = 38400,
              py::arg("positive_end_switch") = py::none(), py::arg("negative_end_switch") = py::none(),
              py::arg("end_switch_active_low") = false, py::arg("reference_switch") = py::none())
-        .def("poll", &DmacSim::poll, py::call_guard<py::gil_scoped_release>(), "Catch up with the clock.")
-        .def("state", &DmacSim::state, py::call_guard<py::gil_scoped_release>(), "A DmacSimState snapshot.")
-        .def("read", [](DmacSim& s, const std::string& var) { return s.read(var_arg(var)); }, py::arg("variable"),
+        .def("poll", &Sim::poll, py::call_guard<py::gil_scoped_release>(), "Catch up with the clock.")
+        .def("state", &Sim::state, py::call_guard<py::gil_scoped_release>(), "A DmacSimState snapshot.")
+        .def("read", [](Sim& s, const std::string& var) { return s.read(var_arg(var)); }, py::arg("variable"),
              py::call_guard<py::gil_scoped_release>())
-        .def_property_readonly("address", &DmacSim::address)
-        .def_property_readonly("baudrate", &DmacSim::baudrate)
-        .def_property_readonly("reply_terminator", [](const DmacSim& s) { return py::bytes(s.options().reply_terminator); })
-        .def("sequence_line", &DmacSim::sequence_line, py::arg("n"))
-        .def("set_input", &DmacSim::set_input, py::arg("n"), py::arg("active"), py::call_guard<py::gil_scoped_release>())
-        .def("set_analog", &DmacSim::set_analog, py::arg("channel"), py::arg("mv"))
-        .def("set_supply_voltage", &DmacSim::set_supply_voltage, py::arg("mv"), py::call_guard<py::gil_scoped_release>(),
+        .def_property_readonly("address", &Sim::address)
+        .def_property_readonly("baudrate", &Sim::baudrate)
+        .def_property_readonly("reply_terminator", [](const Sim& s) { return py::bytes(s.options().reply_terminator); })
+        .def("sequence_line", &Sim::sequence_line, py::arg("n"))
+        .def("set_input", &Sim::set_input, py::arg("n"), py::arg("active"), py::call_guard<py::gil_scoped_release>())
+        .def("set_analog", &Sim::set_analog, py::arg("channel"), py::arg("mv"))
+        .def("set_supply_voltage", &Sim::set_supply_voltage, py::arg("mv"), py::call_guard<py::gil_scoped_release>(),
              "Supply voltage in mV; outside the model's range latches undervoltage/overvoltage and stops the motor.")
-        .def("set_temperature", [](DmacSim& s, const std::string& which, std::int32_t tenths) {
-                 DmacSim::Sensor w;
-                 if (which == "cpu") w = DmacSim::Sensor::Cpu;
-                 else if (which == "driver") w = DmacSim::Sensor::Driver;
-                 else if (which == "motor") w = DmacSim::Sensor::Motor;
+        .def("set_temperature", [](Sim& s, const std::string& which, std::int32_t tenths) {
+                 Sim::Sensor w;
+                 if (which == "cpu") w = Sim::Sensor::Cpu;
+                 else if (which == "driver") w = Sim::Sensor::Driver;
+                 else if (which == "motor") w = Sim::Sensor::Motor;
                  else throw InvalidArgument("sensor: '" + which + "' is not 'cpu', 'driver' or 'motor'");
                  py::gil_scoped_release nogil;
                  s.set_temperature(w, tenths);
              }, py::arg("sensor"), py::arg("tenths_c"),
              "Temperature in 0.1 degC; CPU > 120 degC or driver/motor > 85 degC latches a thermal fault.")
-        .def("inject_error", &DmacSim::inject_error, py::arg("bit"), py::call_guard<py::gil_scoped_release>(),
+        .def("inject_error", &Sim::inject_error, py::arg("bit"), py::call_guard<py::gil_scoped_release>(),
              "Sets an #ERROR bit; fault bits 2..5 also stop the motor as the real fault does.")
-        .def("physical_outputs", &DmacSim::physical_outputs, py::call_guard<py::gil_scoped_release>())
-        .def("power_cycle", &DmacSim::power_cycle, py::call_guard<py::gil_scoped_release>())
-        .def_static("chain_ultrasync", &DmacSim::chain_ultrasync, py::arg("modules"),
+        .def("physical_outputs", &Sim::physical_outputs, py::call_guard<py::gil_scoped_release>())
+        .def("power_cycle", &Sim::power_cycle, py::call_guard<py::gil_scoped_release>())
+        .def_static("chain_ultrasync", &Sim::chain_ultrasync, py::arg("modules"),
                     "Wire IN6/OUT1 of these modules into one UltraSYNC chain (5.11), before serving them: "
                     "with #INTERPOL_MODE:=-1 a segment ends when it is finished on every chained module.")
-        .def("set_speed_limit", &DmacSim::set_speed_limit, py::arg("inc_per_s"),
+        .def("set_speed_limit", &Sim::set_speed_limit, py::arg("inc_per_s"),
              py::call_guard<py::gil_scoped_release>(),
              "A mechanical limit (friction, a brake): an interpolation segment faster than this "
              "(increments/s) lasts |offset|/limit instead of #INTERPOL_TIME. 0 = none.")
-        .def_property_readonly("lines_handled", &DmacSim::lines_handled)
-        .def_property_readonly("lines_rejected", &DmacSim::lines_rejected);
+        .def_property_readonly("lines_handled", &Sim::lines_handled)
+        .def_property_readonly("lines_rejected", &Sim::lines_rejected);
 
     // ---- client --------------------------------------------------------------------
     Record<ClientCounters>(m, "DmacClientCounters", "DmacClient counters (DmacClient.counters), read-only.")
@@ -253,7 +253,7 @@ void bind_dmac(py::module_& m) {
         .field("stray_lines", &ClientCounters::stray_lines, "lines that were not the awaited reply (late, misrouted)")
         .field("xon_errors", &ClientCounters::xon_errors, "MOVE_INTERPOL refused: FIFO full")
         .field("device_resets", &ClientCounters::device_resets, "version banners seen unsolicited");
-    using C = DmacClient;
+    using C = Client;
     auto rel = py::call_guard<py::gil_scoped_release>();
     // Readings and simple settings are properties (the native facade convention).
     auto ro = [](auto f) {

@@ -19,9 +19,9 @@ namespace {
 struct ClockHolder {
     std::shared_ptr<Clock> clock;
 };
-struct BoundSim : ClockHolder, Pmc007Sim {
-    BoundSim(std::shared_ptr<Clock> c, std::uint8_t node, Pmc007SimOptions o)
-        : ClockHolder{c ? std::move(c) : std::make_shared<RealClock>()}, Pmc007Sim(node, *clock, o) {}
+struct BoundSim : ClockHolder, Sim {
+    BoundSim(std::shared_ptr<Clock> c, std::uint8_t node, SimOptions o)
+        : ClockHolder{c ? std::move(c) : std::make_shared<RealClock>()}, Sim(node, *clock, o) {}
 };
 
 const char* type_code(canopen::DataType t) {
@@ -49,20 +49,20 @@ void bind_pmc007(py::module_& m) {
     m.def("pmc007_microsteps", &pmc007_microsteps, py::arg("setting"));
     m.def("pmc007_convert_position", &pmc007_convert_position, py::arg("position"), py::arg("from_setting"),
           py::arg("to_setting"));
-    py::class_<Pmc007ProfileParams>(m, "Pmc007ProfileParams")
+    py::class_<ProfileParams>(m, "Pmc007ProfileParams")
         .def(py::init([](double speed, double start_speed, double stop_speed, int ag, int dg, int micro) {
-                 Pmc007ProfileParams p{speed, start_speed, stop_speed, ag, dg, micro};
+                 ProfileParams p{speed, start_speed, stop_speed, ag, dg, micro};
                  p.validate();
                  return p;
              }),
              py::arg("speed") = 1000.0, py::arg("start_speed") = 400.0, py::arg("stop_speed") = 0.0,
              py::arg("accel_gear") = 0, py::arg("decel_gear") = 0, py::arg("microstepping") = 0)
-        .def_readwrite("speed", &Pmc007ProfileParams::speed)
-        .def_readwrite("start_speed", &Pmc007ProfileParams::start_speed)
-        .def_readwrite("stop_speed", &Pmc007ProfileParams::stop_speed)
-        .def_readwrite("accel_gear", &Pmc007ProfileParams::accel_gear)
-        .def_readwrite("decel_gear", &Pmc007ProfileParams::decel_gear)
-        .def_readwrite("microstepping", &Pmc007ProfileParams::microstepping);
+        .def_readwrite("speed", &ProfileParams::speed)
+        .def_readwrite("start_speed", &ProfileParams::start_speed)
+        .def_readwrite("stop_speed", &ProfileParams::stop_speed)
+        .def_readwrite("accel_gear", &ProfileParams::accel_gear)
+        .def_readwrite("decel_gear", &ProfileParams::decel_gear)
+        .def_readwrite("microstepping", &ProfileParams::microstepping);
     m.def("pmc007_position_profile", &pmc007_position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
     m.def("pmc007_speed_profile", &pmc007_speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
           py::arg("hold") = 0.0);
@@ -120,7 +120,7 @@ void bind_pmc007(py::module_& m) {
                          std::uint32_t serial) {
                  if (node_id < 1 || node_id > 127)
                      throw InvalidArgument("pmc007 sim: node-ID must be 1..127, not " + std::to_string(node_id));
-                 Pmc007SimOptions o;
+                 SimOptions o;
                  o.steps_per_rev = steps_per_rev;
                  o.pull_out_speed = pull_out_speed;
                  o.ext1_switch = ext1_switch;

@@ -61,7 +61,7 @@ std::shared_ptr<py::function> hold(py::function f) {
 struct ClientHolder {
     std::shared_ptr<can::Bus> bus;
     std::shared_ptr<Clock> clock;
-    std::unique_ptr<UnitekClient> client;
+    std::unique_ptr<Client> client;
     ~ClientHolder() {
         if (Py_IsInitialized() && PyGILState_Check()) {
             py::gil_scoped_release nogil;
@@ -75,7 +75,7 @@ struct ClientHolder {
 struct SimHolder {
     std::shared_ptr<Clock> clock;
     std::shared_ptr<can::Bus> bus;
-    std::unique_ptr<UnitekSim> sim;
+    std::unique_ptr<Sim> sim;
     ~SimHolder() {
         if (Py_IsInitialized() && PyGILState_Check()) {
             py::gil_scoped_release nogil;
@@ -122,16 +122,16 @@ void bind_unitek(py::module_& m) {
     py_errors::translate<FrameError, fill_frame_error>(m.attr("UnitekFrameError"));
 
     // ---- profile (existing) ----
-    py::class_<UnitekRampParams>(m, "UnitekRampParams")
+    py::class_<RampParams>(m, "UnitekRampParams")
         .def(py::init([](double nmax, double acc, double dec) {
-                 UnitekRampParams p{nmax, acc, dec};
+                 RampParams p{nmax, acc, dec};
                  p.validate();
                  return p;
              }),
              py::arg("n_max_rpm") = 3000.0, py::arg("acc_ramp_ms") = 1000.0, py::arg("dec_ramp_ms") = 1000.0)
-        .def_readwrite("n_max_rpm", &UnitekRampParams::n_max_rpm)
-        .def_readwrite("acc_ramp_ms", &UnitekRampParams::acc_ramp_ms)
-        .def_readwrite("dec_ramp_ms", &UnitekRampParams::dec_ramp_ms);
+        .def_readwrite("n_max_rpm", &RampParams::n_max_rpm)
+        .def_readwrite("acc_ramp_ms", &RampParams::acc_ramp_ms)
+        .def_readwrite("dec_ramp_ms", &RampParams::dec_ramp_ms);
     m.def("unitek_speed_profile", &unitek_speed_profile, py::arg("start"), py::arg("speed_num"), py::arg("params"),
           py::arg("hold") = 0.0);
 
@@ -317,7 +317,7 @@ void bind_unitek(py::module_& m) {
                  h->bus = bus;
                  h->clock = clock;
                  py::gil_scoped_release nogil;
-                 h->client = std::make_unique<UnitekClient>(*bus, table ? *table : RegisterTable::builtin(), o);
+                 h->client = std::make_unique<Client>(*bus, table ? *table : RegisterTable::builtin(), o);
                  return h;
              }),
              py::arg("bus"), py::arg("rx_id") = kDefaultRxId, py::arg("tx_id") = kDefaultTxId,
@@ -438,7 +438,7 @@ void bind_unitek(py::module_& m) {
                  c.analog_command = analog_command;
                  auto h = std::make_unique<SimHolder>();
                  h->clock = clock;
-                 h->sim = std::make_unique<UnitekSim>(*clock, c, table ? *table : sim_default_table());
+                 h->sim = std::make_unique<Sim>(*clock, c, table ? *table : sim_default_table());
                  return h;
              }),
              py::arg("clock"), py::arg("rx_id") = kDefaultRxId, py::arg("tx_id") = kDefaultTxId,

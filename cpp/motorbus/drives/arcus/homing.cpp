@@ -11,14 +11,14 @@ using namespace motorbus::motion;
 
 // ---- DMX-CAN -------------------------------------------------------------------
 
-ArcusHoming::ArcusHoming(MotorModel& motor, ArcusProfileParams params, Options opt)
+Homing::Homing(MotorModel& motor, ProfileParams params, Options opt)
     : motor_(motor), params_(arcus_effective(params).params), opt_(opt) {
     listener_ = motor_.add_listener([this](const MotorEvent& e) { on_event(e); });
 }
 
-ArcusHoming::~ArcusHoming() { motor_.remove_listener(listener_); }
+Homing::~Homing() { motor_.remove_listener(listener_); }
 
-int ArcusHoming::snl_status() const {
+int Homing::snl_status() const {
     switch (method_) {
         case Method::Z: return static_cast<int>(SnlStatus::ZHoming);
         // Homing while it looks for the switch, Z-Homing once it looks for the index.
@@ -29,21 +29,21 @@ int ArcusHoming::snl_status() const {
 }
 
 namespace {
-double arcus_accel(const ArcusProfileParams& p) {
+double arcus_accel(const ProfileParams& p) {
     return std::max(p.hspd - p.lspd, 1e-9) / (p.acc_ms / 1000.0);
 }
-double arcus_decel(const ArcusProfileParams& p) {
+double arcus_decel(const ProfileParams& p) {
     return std::max(p.hspd - p.lspd, 1e-9) / ((p.edec ? p.dec_ms : p.acc_ms) / 1000.0);
 }
 }  // namespace
 
-void ArcusHoming::jog(int direction, double speed) {
+void Homing::jog(int direction, double speed) {
     const RampShape shape = params_.scv ? RampShape::SCurve : RampShape::Trapezoid;
     motor_.command(ramp_and_hold(motor_.pulse_position(), motor_.pulse_velocity(), direction * speed,
                                  arcus_accel(params_), shape, params_.lspd));
 }
 
-void ArcusHoming::decel_stop(Nanos) {
+void Homing::decel_stop(Nanos) {
     // Ramp down to LSPD, then stop (a jump from LSPD to 0).
     const double v = motor_.pulse_velocity();
     Profile tail(State{motor_.pulse_position(), v, 0, 0});
@@ -59,7 +59,7 @@ void ArcusHoming::decel_stop(Nanos) {
     motor_.command(tail);
 }
 
-void ArcusHoming::run(double target, double, bool) {
+void Homing::run(double target, double, bool) {
     const RampShape shape = params_.scv ? RampShape::SCurve : RampShape::Trapezoid;
     Profile p = arcus_stepper_profile(State{motor_.pulse_position(), motor_.pulse_velocity(), 0, 0}, target,
                                       params_.hspd, params_.lspd, arcus_accel(params_), arcus_decel(params_), shape);
@@ -70,7 +70,7 @@ void ArcusHoming::run(double target, double, bool) {
     motor_.command(p);
 }
 
-void ArcusHoming::run_at(double target, double speed) {
+void Homing::run_at(double target, double speed) {
     const RampShape shape = params_.scv ? RampShape::SCurve : RampShape::Trapezoid;
     Profile p = arcus_stepper_profile(State{motor_.pulse_position(), motor_.pulse_velocity(), 0, 0}, target, speed,
                                       speed, arcus_accel(params_), arcus_decel(params_), shape);
@@ -81,7 +81,7 @@ void ArcusHoming::run_at(double target, double speed) {
     motor_.command(p);
 }
 
-void ArcusHoming::start(Method m, int direction) {
+void Homing::start(Method m, int direction) {
     motor_.update();
     method_ = m;
     dir_ = direction >= 0 ? 1 : -1;
@@ -105,26 +105,26 @@ void ArcusHoming::start(Method m, int direction) {
     else if (m != Method::Z && m != Method::L && motor_.home_active()) now_event(K::HomeOn);
 }
 
-void ArcusHoming::abort() {
+void Homing::abort() {
     if (result_ != HomingResult::Running) return;
     motor_.halt();
     result_ = HomingResult::Aborted;
 }
 
-void ArcusHoming::stop() {
+void Homing::stop() {
     if (result_ != HomingResult::Running) return;
     decel_stop(motor_.time());
     result_ = HomingResult::Aborted;
 }
 
-void ArcusHoming::set_zero() {
+void Homing::set_zero() {
     motor_.set_pulse_position(0);
     if (opt_.zero_encoder) motor_.set_encoder(0);
 }
 
 // The home switch was found while searching (H, HL): zero the counter there,
 // decelerate to LSPD and stop; stage 1 waits for the end of that ramp.
-void ArcusHoming::zero_and_decelerate(const MotorEvent& e) {
+void Homing::zero_and_decelerate(const MotorEvent& e) {
     set_zero();
     decel_stop(e.t);
     stage_ = 1;
@@ -133,13 +133,13 @@ void ArcusHoming::zero_and_decelerate(const MotorEvent& e) {
 }
 
 // The routine ends where the motor is now: stop at once, that point is zero.
-void ArcusHoming::stop_at_zero() {
+void Homing::stop_at_zero() {
     motor_.halt();
     set_zero();
     finish(HomingResult::Done);
 }
 
-void ArcusHoming::finish(HomingResult r) {
+void Homing::finish(HomingResult r) {
     if (r == HomingResult::Done && opt_.final_target && stage_ != kFinalStage) {
         // Zero found: on to the home offset (CANopen 607Ch), then zero there.
         motor_.halt();
@@ -154,7 +154,7 @@ void ArcusHoming::finish(HomingResult r) {
     stage_ = -1;
 }
 
-void ArcusHoming::on_event(const MotorEvent& e) {
+void Homing::on_event(const MotorEvent& e) {
     using K = MotorEvent::Kind;
     if (result_ != HomingResult::Running) return;
     const bool limit_ahead = (e.kind == K::PlusLimitOn && e.direction > 0) || (e.kind == K::MinusLimitOn && e.direction < 0);

@@ -27,7 +27,9 @@
 
 namespace motorbus::arcus {
 
-struct ArcusHomingOptions {
+struct HomingOptions;
+using ArcusHomingOptions = HomingOptions;  // issue 24's old name, while parallel edits land (removed after)
+struct HomingOptions {
     double hca = 0;      // HCA, pulses
     double lca = 1000;   // LCA, pulses (factory 1000)
     bool rz = false;     // RZ: return to zero after H/HL
@@ -46,14 +48,16 @@ struct ArcusHomingOptions {
     bool backoff_at_lspd = false;
 };
 
-class ArcusHoming {
+class Homing;
+using ArcusHoming = Homing;  // issue 24's old name, while parallel edits land (removed after)
+class Homing {
 public:
     enum class Method { H, HL, L, Z, ZH };
-    using Options = ArcusHomingOptions;
-    ArcusHoming(MotorModel& motor, ArcusProfileParams params, Options opt = {});
-    ~ArcusHoming();
-    ArcusHoming(const ArcusHoming&) = delete;
-    ArcusHoming& operator=(const ArcusHoming&) = delete;
+    using Options = HomingOptions;
+    Homing(MotorModel& motor, ProfileParams params, Options opt = {});
+    ~Homing();
+    Homing(const Homing&) = delete;
+    Homing& operator=(const Homing&) = delete;
 
     // Starts homing now (motor.time()); direction +1 or -1.
     void start(Method m, int direction);
@@ -67,7 +71,7 @@ public:
 
 private:
     MotorModel& motor_;
-    ArcusProfileParams params_;
+    ProfileParams params_;
     Options opt_;
     Method method_ = Method::H;
     int dir_ = 1;

@@ -56,11 +56,11 @@ double arcus_max_acc_ms(double hspd_pps, double lspd_pps) {
     return (hspd_pps - lspd_pps) / w.delta * 1000.0;
 }
 
-double ArcusEffective::accel() const {
+double Effective::accel() const {
     const double dv = std::max(params.hspd - params.lspd, 1e-9);
     return dv / (params.acc_ms / 1000.0);
 }
-double ArcusEffective::decel() const {
+double Effective::decel() const {
     const double dv = std::max(params.hspd - params.lspd, 1e-9);
     return dv / ((params.edec ? params.dec_ms : params.acc_ms) / 1000.0);
 }
@@ -80,14 +80,14 @@ void clamp_time(double& ms, const char* name, const ArcusSpeedWindow& w, double 
 }
 }  // namespace
 
-ArcusEffective arcus_effective(const ArcusProfileParams& req) {
+Effective arcus_effective(const ProfileParams& req) {
     if (!std::isfinite(req.hspd) || !std::isfinite(req.lspd) || !std::isfinite(req.acc_ms) ||
         !std::isfinite(req.dec_ms) || !std::isfinite(req.snl_ratio))
         throw InvalidArgument("Arcus profile: parameters must be finite");
     if (!(req.snl_ratio > 0)) throw LimitExceeded("SLR", req.snl_ratio, 0, "ratio must be positive");
     if (!(req.acc_ms > 0)) throw LimitExceeded("ACC", req.acc_ms, 0, "must be positive");
     if (req.edec && !(req.dec_ms > 0)) throw LimitExceeded("DEC", req.dec_ms, 0, "must be positive");
-    ArcusEffective e;
+    Effective e;
     e.params = req;
     // With StepNLoop on, speeds are in encoder counts/s: the windows are in PPS.
     const double hspd_pps = req.hspd * req.snl_ratio;
@@ -107,7 +107,7 @@ ArcusEffective arcus_effective(const ArcusProfileParams& req) {
     return e;
 }
 
-void arcus_check_strict(const ArcusProfileParams& req) {
+void arcus_check_strict(const ProfileParams& req) {
     const double hspd_pps = req.hspd * req.snl_ratio;
     const auto& w = arcus_window_for_hspd(hspd_pps);
     const std::string win = "speed window " + std::to_string(w.number);
@@ -141,26 +141,26 @@ Profile arcus_stepper_profile(const State& start, double target, double hspd, do
     return detail::stepper_profile(start, target, hspd, accel, decel, lspd, lspd, shape);
 }
 
-ArcusMotion::ArcusMotion(ArcusProfileParams params, int sspdm) {
+Motion::Motion(ProfileParams params, int sspdm) {
     set_params(params);
     set_sspdm(sspdm);
 }
 
-const ArcusEffective& ArcusMotion::set_params(const ArcusProfileParams& params) {
+const Effective& Motion::set_params(const ProfileParams& params) {
     eff_ = arcus_effective(params);
     return eff_;
 }
 
-void ArcusMotion::set_sspdm(int sspdm) {
+void Motion::set_sspdm(int sspdm) {
     (void)arcus_window_for_sspdm(sspdm);
     sspdm_ = sspdm;
 }
 
-static RampShape ArcusMotion_shape(const ArcusEffective& e) {
+static RampShape ArcusMotion_shape(const Effective& e) {
     return e.params.scv ? RampShape::SCurve : RampShape::Trapezoid;
 }
 
-ArcusReply ArcusMotion::move(double position, double target) {
+ArcusReply Motion::move(double position, double target) {
     if (!std::isfinite(position) || !std::isfinite(target)) return ArcusReply::MoveTooFar;
     if (std::fabs(target - position) > static_cast<double>(kArcusMaxMoveDistance)) return ArcusReply::MoveTooFar;
     hspd_now_ = eff_.params.hspd;
@@ -172,7 +172,7 @@ ArcusReply ArcusMotion::move(double position, double target) {
     return ArcusReply::Ok;
 }
 
-ArcusReply ArcusMotion::jog(double position, int direction) {
+ArcusReply Motion::jog(double position, int direction) {
     const double s = direction >= 0 ? 1.0 : -1.0;
     hspd_now_ = eff_.params.hspd;
     Profile p(State{position, 0, 0, 0});
@@ -196,9 +196,9 @@ ArcusReply ArcusMotion::jog(double position, int direction) {
     return ArcusReply::Ok;
 }
 
-bool ArcusMotion::moving(double t) const { return !profile_.empty() && t >= 0 && t < profile_.duration(); }
+bool Motion::moving(double t) const { return !profile_.empty() && t >= 0 && t < profile_.duration(); }
 
-ArcusReply ArcusMotion::change_target(double t, double new_target) {
+ArcusReply Motion::change_target(double t, double new_target) {
     if (!target_move_ || !moving(t)) return ArcusReply::MotorNotMoving;
     if (!std::isfinite(new_target)) return ArcusReply::MoveTooFar;
     const State st = profile_.at(t);
@@ -212,7 +212,7 @@ ArcusReply ArcusMotion::change_target(double t, double new_target) {
     return ArcusReply::Ok;
 }
 
-ArcusReply ArcusMotion::change_speed(double t, double new_hspd) {
+ArcusReply Motion::change_speed(double t, double new_hspd) {
     if (eff_.params.scv) return ArcusReply::ScvOn;
     if (!moving(t) || !std::isfinite(new_hspd) || new_hspd <= 0) return ArcusReply::BadSspd;
     const auto& w = arcus_window_for_sspdm(sspdm_);
@@ -243,7 +243,7 @@ ArcusReply ArcusMotion::change_speed(double t, double new_hspd) {
     return ArcusReply::Ok;
 }
 
-void ArcusMotion::stop(double t) {
+void Motion::stop(double t) {
     if (!moving(t)) return;
     const State st = profile_.at(t);
     Profile tail(State{st.p, st.v, 0, 0});
@@ -260,7 +260,7 @@ void ArcusMotion::stop(double t) {
     target_ = end;
 }
 
-void ArcusMotion::abort(double t) {
+void Motion::abort(double t) {
     if (!moving(t)) return;
     const double p = profile_.at(t).p;
     Profile head = profile_.truncated(t);
@@ -271,12 +271,12 @@ void ArcusMotion::abort(double t) {
     target_ = p;
 }
 
-ArcusPhase ArcusMotion::phase(double t) const {
-    if (!moving(t)) return ArcusPhase::Idle;
+Phase Motion::phase(double t) const {
+    if (!moving(t)) return Phase::Idle;
     const State st = profile_.at(t);
     const double acc = st.a != 0 ? st.a : st.j;
-    if (acc == 0 || st.v == 0) return ArcusPhase::Const;
-    return (acc > 0) == (st.v > 0) ? ArcusPhase::Accel : ArcusPhase::Decel;
+    if (acc == 0 || st.v == 0) return Phase::Const;
+    return (acc > 0) == (st.v > 0) ? Phase::Accel : Phase::Decel;
 }
 
 }  // namespace motorbus::arcus

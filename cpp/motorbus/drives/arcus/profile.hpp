@@ -48,7 +48,9 @@ double arcus_max_acc_ms(double hspd_pps, double lspd_pps);
 // Largest distance a single X move may cover (incremental or absolute).
 inline constexpr std::int64_t kArcusMaxMoveDistance = 262143;
 
-struct ArcusProfileParams {
+struct ProfileParams;
+using ArcusProfileParams = ProfileParams;  // issue 24's old name, while parallel edits land (removed after)
+struct ProfileParams {
     // The manual gives no factory HSPD/LSPD/ACC; these are the model's defaults.
     double hspd = 1000;     // PPS
     double lspd = 100;      // PPS
@@ -61,8 +63,10 @@ struct ArcusProfileParams {
 
 // The parameters the drive actually uses after Appendix A's automatic
 // adjustment, and what was adjusted (one human-readable line per change).
-struct ArcusEffective {
-    ArcusProfileParams params;
+struct Effective;
+using ArcusEffective = Effective;  // issue 24's old name, while parallel edits land (removed after)
+struct Effective {
+    ProfileParams params;
     const ArcusSpeedWindow* window = nullptr;
     std::vector<std::string> adjustments;
     double accel() const;  // PPS/s (average over the ramp for S-curve)
@@ -72,10 +76,10 @@ struct ArcusEffective {
 // [min ACC, max ACC] of HSPD's window (min wins when the window leaves no
 // room), LSPD is raised to the window's minimum and lowered to HSPD.  Throws
 // LimitExceeded for HSPD outside 1..6 000 000 PPS or non-positive ACC/DEC.
-ArcusEffective arcus_effective(const ArcusProfileParams& requested);
+Effective arcus_effective(const ProfileParams& requested);
 // Strict variant for tools that want to refuse instead of adjust: throws
 // LimitExceeded naming the first parameter outside its window's range.
-void arcus_check_strict(const ArcusProfileParams& requested);
+void arcus_check_strict(const ProfileParams& requested);
 
 // Answers the drive gives to on-the-fly commands (Table 11.1).
 enum class ArcusReply {
@@ -90,19 +94,22 @@ enum class ArcusReply {
 const char* arcus_reply_text(ArcusReply r);  // the drive's reply string, "" for Ok
 
 // Motor status bits 0..2 of MST during a move.
-enum class ArcusPhase { Idle, Accel, Const, Decel };
+enum class Phase { Idle, Accel, Const, Decel };
+using ArcusPhase = Phase;  // issue 24's old name, while parallel edits land (removed after)
 
 // The profile of one DMX-CAN axis across moves and on-the-fly changes.
 // Position continuity: every command starts from the state at its time.
-class ArcusMotion {
+class Motion;
+using ArcusMotion = Motion;  // issue 24's old name, while parallel edits land (removed after)
+class Motion {
 public:
-    explicit ArcusMotion(ArcusProfileParams params = {}, int sspdm = 0);
+    explicit Motion(ProfileParams params = {}, int sspdm = 0);
 
     // Parameters for the next move (the drive ignores changes mid-move except
     // through SSPD).  Returns the effective (adjusted) set.
-    const ArcusEffective& set_params(const ArcusProfileParams& params);
+    const Effective& set_params(const ProfileParams& params);
     void set_sspdm(int sspdm);  // 0..9; throws LimitExceeded otherwise
-    const ArcusEffective& effective() const { return eff_; }
+    const Effective& effective() const { return eff_; }
     int sspdm() const { return sspdm_; }
 
     // X: a target move from rest at `position`, as a new profile starting at
@@ -128,10 +135,10 @@ public:
     bool moving(double t) const;  // a move is running at t (t in [0, duration))
     bool target_move() const { return target_move_; }
     double target() const { return target_; }
-    ArcusPhase phase(double t) const;
+    Phase phase(double t) const;
 
 private:
-    ArcusEffective eff_;
+    Effective eff_;
     int sspdm_ = 0;
     Profile profile_;
     bool target_move_ = false;
@@ -141,7 +148,7 @@ private:
     double hspd_now_ = 0;  // high speed of the running move (after SSPD)
 };
 
-// The core of ArcusMotion, exposed for reuse: a stepper profile from `start`
+// The core of Motion, exposed for reuse: a stepper profile from `start`
 // (p, signed v) to `target` with start/stop speed `lspd` (magnitude), cruise
 // `hspd`, ramps `accel`/`decel` (PPS/s).  Ends with a jump LSPD -> 0.
 Profile arcus_stepper_profile(const State& start, double target, double hspd, double lspd,

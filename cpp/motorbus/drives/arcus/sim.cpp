@@ -294,11 +294,11 @@ std::string Sim::handle(const Request& req) {
         e.check_limit_at_start(e.physical_direction(dir), now);
         return ok;
     };
-    auto home = [&](ArcusHoming::Method method, int dir) -> std::string {
+    auto home = [&](Homing::Method method, int dir) -> std::string {
         if (refuse_in_error()) return std::string(error_text(ErrorCode::StateError));
         if (disabled()) return ok;
         s.idle_current_motion = false;
-        using M = ArcusHoming::Method;
+        using M = Homing::Method;
         s.snl.begin(method == M::Z   ? motion::SnlActivity::ZHome
                     : method == M::L ? motion::SnlActivity::LimitHome
                                      : motion::SnlActivity::Home);
@@ -612,7 +612,7 @@ std::string Sim::handle(const Request& req) {
         s.user_do &= ~std::int64_t{2};
         return ok;
     }
-    using M = ArcusHoming::Method;
+    using M = Homing::Method;
     if (name == "J+") return jog(1);
     if (name == "J-") return jog(-1);
     if (name == "H+") return home(M::H, 1);

@@ -119,14 +119,14 @@ struct Sim::State {
     std::unique_ptr<motion::MotorModel> motor;
     // X, J, T, SSPD, STOP: the profile model; the motor runs its profile
     // while arcus_profile is true.
-    ArcusMotion arcus{ArcusProfileParams{}};
+    Motion arcus{ProfileParams{}};
     bool arcus_profile = false;
     // H, HL, L, Z, ZH (declared after the motor: destroyed before it).
-    std::unique_ptr<ArcusHoming> homing;
+    std::unique_ptr<Homing> homing;
     int homing_listener = 0;  // runs after the homing's own listener
     int home_direction = 1;   // physical direction of the search
     // Set by the CANopen front end for the homing it is about to start (607Ch):
-    // see ArcusHomingOptions.  Consumed by start_homing.
+    // see HomingOptions.  Consumed by start_homing.
     std::optional<double> home_final_target;
     bool home_backoff_lspd = false;
 
@@ -183,8 +183,8 @@ public:
     // An unpowered (EO=0) or blocked rotor stays put while the pulses go out.
     void apply_jam() { m().set_jammed(s.blocked || !s.eo); }
 
-    ArcusProfileParams profile_params(double hspd_override = -1) const {
-        ArcusProfileParams ap;
+    ProfileParams profile_params(double hspd_override = -1) const {
+        ProfileParams ap;
         ap.snl_ratio = snl_on() ? slr() : 1.0;
         // arcus_effective refuses speeds outside 1..6 000 000 PPS; the sim
         // validates HSPD/LSPD itself, so only clamp what unit conversion moved.
@@ -224,21 +224,21 @@ public:
     }
 
     // MST bits 0..2.
-    ArcusPhase phase() const {
-        if (!m().moving()) return ArcusPhase::Idle;
+    Phase phase() const {
+        if (!m().moving()) return Phase::Idle;
         if (s.arcus_profile) return s.arcus.phase(arcus_time());
         const double v = m().pulse_velocity(), a = m().commanded_acceleration() * (steps_per_unit() > 0 ? 1 : -1);
-        if (v * a > 0) return ArcusPhase::Accel;
-        if (v * a < 0) return ArcusPhase::Decel;
-        return ArcusPhase::Const;
+        if (v * a > 0) return Phase::Accel;
+        if (v * a < 0) return Phase::Decel;
+        return Phase::Const;
     }
 
     std::int64_t mst() const {
         std::int64_t v = 0;
         const auto ph = phase();
-        if (ph == ArcusPhase::Const) v |= 1;
-        if (ph == ArcusPhase::Accel) v |= 2;
-        if (ph == ArcusPhase::Decel) v |= 4;
+        if (ph == Phase::Const) v |= 1;
+        if (ph == Phase::Accel) v |= 2;
+        if (ph == Phase::Decel) v |= 4;
         if (m().home_active()) v |= 8;
         if (m().minus_limit_active()) v |= 16;
         if (m().plus_limit_active()) v |= 32;
@@ -348,9 +348,9 @@ public:
             case K::MinusLimitOn: {
                 const int side = e.kind == K::PlusLimitOn ? 1 : -1;
                 if (e.direction != side) break;
-                // Limit homing runs onto its limit on purpose: ArcusHoming backs off.
+                // Limit homing runs onto its limit on purpose: Homing backs off.
                 if (s.job == Job::Home && s.homing && s.homing->running() &&
-                    s.homing->method() == ArcusHoming::Method::L && side == s.home_direction)
+                    s.homing->method() == Homing::Method::L && side == s.home_direction)
                     break;
                 limit_stop(side, e.t);
                 break;
@@ -382,7 +382,7 @@ public:
         }
     }
 
-    // Runs after ArcusHoming's listener.
+    // Runs after Homing's listener.
     void after_homing_event(const motion::MotorEvent& e) {
         if (s.job == Job::Home && s.homing && !s.homing->running()) end_homing(e.t);
     }
@@ -395,10 +395,10 @@ public:
         end_job(t);
     }
 
-    void start_homing(ArcusHoming::Method method, int dir, Nanos now) {
+    void start_homing(Homing::Method method, int dir, Nanos now) {
         if (s.homing) s.homing.reset();
         if (s.homing_listener) m().remove_listener(s.homing_listener);
-        ArcusHomingOptions ho;
+        HomingOptions ho;
         ho.hca = static_cast<double>(s.hca);
         ho.lca = static_cast<double>(s.cfg.lca);
         ho.rz = s.rz != 0;
@@ -407,7 +407,7 @@ public:
         ho.backoff_at_lspd = s.home_backoff_lspd;
         s.home_final_target.reset();
         s.home_backoff_lspd = false;
-        s.homing = std::make_unique<ArcusHoming>(m(), profile_params(), ho);
+        s.homing = std::make_unique<Homing>(m(), profile_params(), ho);
         State* sp = &s;
         const SimOptions* op = &o;
         s.homing_listener =

@@ -31,7 +31,7 @@ serial::LineOptions default_line_options() {
     return o;
 }
 
-DmacClient::DmacClient(std::shared_ptr<serial::LineLink> link, ClientOptions options)
+Client::Client(std::shared_ptr<serial::LineLink> link, ClientOptions options)
     : link_(std::move(link)), options_(std::move(options)) {
     if (!link_) throw InvalidArgument("DmacClient: link is null");
     if (options_.address < 0 || options_.address > kMaxAddress)
@@ -42,19 +42,19 @@ DmacClient::DmacClient(std::shared_ptr<serial::LineLink> link, ClientOptions opt
                               " is not 9600, 19200, 38400 or 115200");
 }
 
-int DmacClient::check_family(int n, int count, const char* name) {
+int Client::check_family(int n, int count, const char* name) {
     if (n < 1 || n > count)
         throw InvalidArgument(std::string(name) + "n: n=" + std::to_string(n) + " is outside 1.." +
                               std::to_string(count));
     return n;
 }
 
-void DmacClient::sleep(Duration d) {
+void Client::sleep(Duration d) {
     if (options_.sleep) options_.sleep(d);
     else interruptible_sleep_for(d);  // an interruption point (Ctrl-C) on every poll
 }
 
-Duration DmacClient::reply_wait() const {
+Duration Client::reply_wait() const {
     const Duration base = options_.timeout.value_or(link_->options().reply_timeout);
     // 10 bits a character; a request and its reply of up to 256 characters each.
     const Duration wire = std::chrono::nanoseconds(2LL * static_cast<long long>(kMaxFrame) * 10 *
@@ -62,7 +62,7 @@ Duration DmacClient::reply_wait() const {
     return base + kMaxLineDelay + wire;
 }
 
-std::string DmacClient::frame(std::string_view command) const {
+std::string Client::frame(std::string_view command) const {
     std::string f = address_prefix(options_.address);
     f += command;
     if (f.size() > kMaxFrame)
@@ -70,7 +70,7 @@ std::string DmacClient::frame(std::string_view command) const {
     return f;
 }
 
-std::string DmacClient::await(const std::string& request,
+std::string Client::await(const std::string& request,
                               const std::function<bool(std::string_view)>& match, bool send_only) {
     ++counters_.transactions;
     if (send_only) {
@@ -91,7 +91,7 @@ std::string DmacClient::await(const std::string& request,
     throw ProtocolError("DMAC: no valid reply to '" + request + "' (got '" + first + "')", bytes_of(first));
 }
 
-ReadReply DmacClient::read_reply(const std::string& request, Var v, int bit) {
+ReadReply Client::read_reply(const std::string& request, Var v, int bit) {
     const std::string prefix = address_prefix(options_.address) + var_info(v).mnemonic;
     std::optional<ReadReply> got;
     await(request, [&](std::string_view line) {
@@ -112,7 +112,7 @@ ReadReply DmacClient::read_reply(const std::string& request, Var v, int bit) {
 }
 
 // ---- generic ------------------------------------------------------------------------
-void DmacClient::command(std::string_view cmd) {
+void Client::command(std::string_view cmd) {
     if (!options_.verify) {
         await(frame(cmd), nullptr, true);
         return;
@@ -141,17 +141,17 @@ void DmacClient::command(std::string_view cmd) {
     throw CommandRejected(what, err);
 }
 
-std::int32_t DmacClient::read(Var v, Radix r) {
+std::int32_t Client::read(Var v, Radix r) {
     std::string req = encode_read(options_.address, v, r);
     return read_reply(req, v, 0).value;
 }
 
-bool DmacClient::read_bit(Var v, int bit) {
+bool Client::read_bit(Var v, int bit) {
     if (bit < 1 || bit > 32) throw InvalidArgument("bit: " + std::to_string(bit) + " is outside 1..32");
     return read_reply(encode_read(options_.address, v, Radix::Dec, bit), v, bit).value != 0;
 }
 
-void DmacClient::write(Var v, std::int32_t value) {
+void Client::write(Var v, std::int32_t value) {
     const VarInfo& vi = var_info(v);
     if (vi.read_only) throw InvalidArgument(vi.name + " is read-only");
     if (value < vi.min || value > vi.max)
@@ -160,14 +160,14 @@ void DmacClient::write(Var v, std::int32_t value) {
     command(encode_write(kGlobal, v, value));
 }
 
-void DmacClient::write_bit(Var v, int bit, bool value) {
+void Client::write_bit(Var v, int bit, bool value) {
     const VarInfo& vi = var_info(v);
     if (vi.read_only) throw InvalidArgument(vi.name + " is read-only");
     if (bit < 1 || bit > 32) throw InvalidArgument("bit: " + std::to_string(bit) + " is outside 1..32");
     command(encode_write(kGlobal, v, value ? 1 : 0, bit));
 }
 
-std::string DmacClient::raw(std::string_view f, bool expect_reply) {
+std::string Client::raw(std::string_view f, bool expect_reply) {
     ++counters_.transactions;
     if (!expect_reply) {
         link_->send(f);
@@ -176,9 +176,9 @@ std::string DmacClient::raw(std::string_view f, bool expect_reply) {
     return link_->transact(f, options_.timeout);
 }
 
-void DmacClient::clear_error() { command("#ERROR:=0"); }
+void Client::clear_error() { command("#ERROR:=0"); }
 
-void DmacClient::set_profile(std::optional<std::int32_t> hs, std::optional<std::int32_t> ls,
+void Client::set_profile(std::optional<std::int32_t> hs, std::optional<std::int32_t> ls,
                              std::optional<std::int32_t> acc, std::optional<std::int32_t> dec) {
     // One frame: the module applies all of them before the next move.
     std::string f;
@@ -198,14 +198,14 @@ void DmacClient::set_profile(std::optional<std::int32_t> hs, std::optional<std::
     if (!f.empty()) command(f);
 }
 
-void DmacClient::set_soft_limits(std::int32_t negative, std::int32_t positive) {
+void Client::set_soft_limits(std::int32_t negative, std::int32_t positive) {
     if (negative > positive)
         throw InvalidArgument("soft limits: #NEGATIVE_END " + std::to_string(negative) + " is above #POSITIVE_END " +
                               std::to_string(positive));
     command(encode_write(kGlobal, Var::NegativeEnd, negative) + ", " + encode_write(kGlobal, Var::PositiveEnd, positive));
 }
 
-void DmacClient::set_interpolation(std::int32_t time_ms, std::int32_t fifo_size, std::int32_t mode) {
+void Client::set_interpolation(std::int32_t time_ms, std::int32_t fifo_size, std::int32_t mode) {
     auto check = [](Var v, std::int32_t x) {
         const VarInfo& vi = var_info(v);
         if (x < vi.min || x > vi.max)
@@ -220,7 +220,7 @@ void DmacClient::set_interpolation(std::int32_t time_ms, std::int32_t fifo_size,
             encode_write(kGlobal, Var::InterpolMode, mode));
 }
 
-bool DmacClient::is_dmac34() {
+bool Client::is_dmac34() {
     // Software codes H142/J142/K142 are the DMAC34 firmwares (4.19).
     if (!dmac34_) {
         const VersionInfo v = request_version();
@@ -229,7 +229,7 @@ bool DmacClient::is_dmac34() {
     return *dmac34_;
 }
 
-std::int32_t DmacClient::analog_input(int channel) {
+std::int32_t Client::analog_input(int channel) {
     if (channel != 1 && channel != 2)
         throw InvalidArgument("analog input: channel " + std::to_string(channel) + " is not 1 or 2");
     const bool d34 = is_dmac34();
@@ -237,16 +237,16 @@ std::int32_t DmacClient::analog_input(int channel) {
     return read(channel == 2 ? Var::InputA2 : d34 ? Var::InputA1 : Var::InputAnalog);
 }
 
-void DmacClient::set_analog_output(int channel, std::int32_t mv) {
+void Client::set_analog_output(int channel, std::int32_t mv) {
     if (channel != 1 && channel != 2)
         throw InvalidArgument("analog output: channel " + std::to_string(channel) + " is not 1 or 2");
     write(channel == 1 ? Var::OutputA1 : Var::OutputA2, mv);
 }
 
 // ---- commands -------------------------------------------------------------------------
-void DmacClient::move_to(std::int32_t p) { command("MOVE_TO " + std::to_string(p)); }
-void DmacClient::move_on(std::int32_t d) { command("MOVE_ON " + std::to_string(d)); }
-void DmacClient::move_speed(std::int32_t v) {
+void Client::move_to(std::int32_t p) { command("MOVE_TO " + std::to_string(p)); }
+void Client::move_on(std::int32_t d) { command("MOVE_ON " + std::to_string(d)); }
+void Client::move_speed(std::int32_t v) {
     if (v < -400000 || v > 400000)
         throw InvalidArgument("MOVE_SPEED: " + std::to_string(v) + " is outside -400000..400000 (0.01 rpm)");
     command("MOVE_SPEED " + std::to_string(v));
@@ -259,29 +259,29 @@ static const char* stop_arg(StopWhat w) {
         default: return "";
     }
 }
-void DmacClient::stop(StopWhat w) { command(std::string("STOP") + stop_arg(w)); }
-void DmacClient::halt(StopWhat w) { command(std::string("HALT") + stop_arg(w)); }
+void Client::stop(StopWhat w) { command(std::string("STOP") + stop_arg(w)); }
+void Client::halt(StopWhat w) { command(std::string("HALT") + stop_arg(w)); }
 
-void DmacClient::power(PowerMode m) {
+void Client::power(PowerMode m) {
     command(m == PowerMode::On ? "POWER ON" : m == PowerMode::Off ? "POWER OFF" : "POWER SC");
 }
-void DmacClient::brake(bool on) { command(on ? "BRAKE ON" : "BRAKE OFF"); }
-void DmacClient::hard_ends(EndStops e) {
+void Client::brake(bool on) { command(on ? "BRAKE ON" : "BRAKE OFF"); }
+void Client::hard_ends(EndStops e) {
     static const char* t[] = {"HARD_ENDS OFF", "HARD_ENDS ALL", "HARD_ENDS POS", "HARD_ENDS NEG"};
     command(t[static_cast<int>(e)]);
 }
-void DmacClient::soft_ends(bool on) { command(on ? "SOFT_ENDS ON" : "SOFT_ENDS OFF"); }
-void DmacClient::s_curve(bool on) { command(on ? "S_CURVE ON" : "S_CURVE OFF"); }
-void DmacClient::optimized_current(bool on) { command(on ? "OPTIMIZED_CURRENT ON" : "OPTIMIZED_CURRENT OFF"); }
-void DmacClient::inverse_polarity(Polarity p) {
+void Client::soft_ends(bool on) { command(on ? "SOFT_ENDS ON" : "SOFT_ENDS OFF"); }
+void Client::s_curve(bool on) { command(on ? "S_CURVE ON" : "S_CURVE OFF"); }
+void Client::optimized_current(bool on) { command(on ? "OPTIMIZED_CURRENT ON" : "OPTIMIZED_CURRENT OFF"); }
+void Client::inverse_polarity(Polarity p) {
     static const char* t[] = {"INVERSE_POLARITY OFF", "INVERSE_POLARITY ALL", "INVERSE_POLARITY IN",
                               "INVERSE_POLARITY OUT"};
     command(t[static_cast<int>(p)]);
 }
-void DmacClient::reference(bool on) { command(on ? "REFERENCE ON" : "REFERENCE OFF"); }
-void DmacClient::module_reset(bool factory) { command(factory ? "MODULE_RESET ALL" : "MODULE_RESET"); }
+void Client::reference(bool on) { command(on ? "REFERENCE ON" : "REFERENCE OFF"); }
+void Client::module_reset(bool factory) { command(factory ? "MODULE_RESET ALL" : "MODULE_RESET"); }
 
-void DmacClient::set_address(int a) {
+void Client::set_address(int a) {
     if (a < 0 || a > kMaxAddress) throw InvalidArgument("SET_ADDRESS: " + std::to_string(a) + " is outside 0..63");
     // The module answers under its new address, so send, follow, then verify there.
     await(frame("SET_ADDRESS " + std::to_string(a)), nullptr, true);
@@ -293,14 +293,14 @@ void DmacClient::set_address(int a) {
     }
 }
 
-void DmacClient::set_baudrate(int baud) {
+void Client::set_baudrate(int baud) {
     if (baud != 9600 && baud != 19200 && baud != 38400 && baud != 115200)
         throw InvalidArgument("SET_BAUDRATE: " + std::to_string(baud) + " is not 9600, 19200, 38400 or 115200");
     // Applied at once by the module: the caller changes the port speed next.
     await(frame("SET_BAUDRATE " + std::to_string(baud)), nullptr, true);
 }
 
-VersionInfo DmacClient::request_version() {
+VersionInfo Client::request_version() {
     std::optional<VersionInfo> v;
     await(frame("REQUEST_VERSION"), [&](std::string_view line) {
         v = parse_version(line);
@@ -309,7 +309,7 @@ VersionInfo DmacClient::request_version() {
     return *v;
 }
 
-std::int32_t DmacClient::wait_idle(Duration timeout, Duration poll) {
+std::int32_t Client::wait_idle(Duration timeout, Duration poll) {
     Duration waited{0};
     for (;;) {
         if (!status().busy()) return position();
@@ -323,7 +323,7 @@ std::int32_t DmacClient::wait_idle(Duration timeout, Duration poll) {
 }
 
 // ---- sequencer ----------------------------------------------------------------------------
-void DmacClient::upload_sequence(const std::vector<std::string>& lines, int first, bool verify_readback) {
+void Client::upload_sequence(const std::vector<std::string>& lines, int first, bool verify_readback) {
     if (first < 1 || first + static_cast<int>(lines.size()) - 1 > kSeqLines)
         throw InvalidArgument("sequence: lines " + std::to_string(first) + ".." +
                               std::to_string(first + static_cast<int>(lines.size()) - 1) + " exceed 1..500");
@@ -356,7 +356,7 @@ void DmacClient::upload_sequence(const std::vector<std::string>& lines, int firs
     }
 }
 
-std::string DmacClient::read_sequence_line(int n) {
+std::string Client::read_sequence_line(int n) {
     if (n < 1 || n > kSeqLines) throw InvalidArgument("READ_SEQ: line " + std::to_string(n) + " is outside 1..500");
     std::optional<SeqLineReply> got;
     await(frame("READ_SEQ " + std::to_string(n)), [&](std::string_view line) {
@@ -366,25 +366,25 @@ std::string DmacClient::read_sequence_line(int n) {
     return got->text;
 }
 
-std::vector<std::string> DmacClient::read_sequence(int first, int last) {
+std::vector<std::string> Client::read_sequence(int first, int last) {
     std::vector<std::string> out;
     for (int n = first; n <= last; ++n) out.push_back(read_sequence_line(n));
     return out;
 }
 
-void DmacClient::start_sequence(int line) {
+void Client::start_sequence(int line) {
     if (line < 1 || line > kSeqLines) throw InvalidArgument("START_SEQ: line " + std::to_string(line) + " is outside 1..500");
     command("START_SEQ " + std::to_string(line));
 }
 
-void DmacClient::step(std::optional<int> line) {
+void Client::step(std::optional<int> line) {
     if (line && (*line < 1 || *line > kSeqLines))
         throw InvalidArgument("STEP: line " + std::to_string(*line) + " is outside 1..500");
     command(line ? "STEP " + std::to_string(*line) : std::string("STEP"));
 }
 
 // ---- interpolation ---------------------------------------------------------------------------
-std::optional<int> DmacClient::move_interpol(std::int32_t offset) {
+std::optional<int> Client::move_interpol(std::int32_t offset) {
     const std::string req = frame("MOVE_INTERPOL " + std::to_string(offset)) + ", READ #INTERPOL_COUNT";
     const std::string prefix = address_prefix(options_.address) + "#ICO=";
     bool full = false;
@@ -415,7 +415,7 @@ void synchro(serial::LineLink& link, Keyword what) {
     }
 }
 
-StreamStats stream_interpolation(std::vector<DmacClient*> axes, const std::vector<std::vector<long long>>& segments,
+StreamStats stream_interpolation(std::vector<Client*> axes, const std::vector<std::vector<long long>>& segments,
                                  const StreamOptions& o) {
     if (axes.empty()) throw InvalidArgument("stream_interpolation: no axes");
     for (auto* a : axes)

@@ -91,9 +91,11 @@ struct ClientCounters {
     std::uint64_t device_resets = 0;    // version banners seen unsolicited
 };
 
-class DmacClient {
+class Client;
+using DmacClient = Client;  // issue 24's old name, while parallel edits land (removed after)
+class Client {
 public:
-    DmacClient(std::shared_ptr<serial::LineLink> link, ClientOptions options = {});
+    Client(std::shared_ptr<serial::LineLink> link, ClientOptions options = {});
 
     int address() const { return options_.address; }
     serial::LineLink& link() { return *link_; }
@@ -234,7 +236,7 @@ struct StreamStats {
 // Pre-fills every FIFO (same number of segments on each axis), starts all axes
 // with SYNCHRO INTERPOL, then keeps feeding them round-robin, backing off on
 // XON_ERROR, until every segment is queued.  Does not wait for the end of motion.
-StreamStats stream_interpolation(std::vector<DmacClient*> axes,
+StreamStats stream_interpolation(std::vector<Client*> axes,
                                  const std::vector<std::vector<long long>>& segments,
                                  const StreamOptions& options = {});
 

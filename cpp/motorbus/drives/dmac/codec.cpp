@@ -141,7 +141,7 @@ const std::vector<VarInfo>& vars() {
     return t;
 }
 
-constexpr CmdInfo kCmds[] = {
+constexpr CommandInfo kCmds[] = {
     {Cmd::Invalid, "", "", ""},
     {Cmd::Assign, ":=", ":=", ""},
     {Cmd::Brake, "BRAKE", "BRA", ""},
@@ -429,7 +429,7 @@ std::optional<Var> find_variable(std::string_view name) {
     return std::nullopt;
 }
 
-const CmdInfo& cmd_info(Cmd c) {
+const CommandInfo& cmd_info(Cmd c) {
     auto i = static_cast<std::size_t>(c);
     return kCmds[i < std::size(kCmds) ? i : 0];
 }

@@ -86,13 +86,15 @@ enum class Cmd : std::uint8_t {
     OptimizedCurrent, Power, Read, ReadSeq, Reference, Return, RequestVersion, SetAddress,
     SetBaudrate, SCurve, SoftEnds, StartSeq, Step, Stop, Synchro, Wait
 };
-struct CmdInfo {
+struct CommandInfo;
+using CmdInfo = CommandInfo;  // issue 24's old name, while parallel edits land (removed after)
+struct CommandInfo {
     Cmd cmd;
     std::string_view name;       // "MOVE_TO"
     std::string_view mnemonic;   // "MTO"
     std::string_view alt;        // second mnemonic ("RVE") or empty
 };
-const CmdInfo& cmd_info(Cmd c);
+const CommandInfo& cmd_info(Cmd c);
 std::optional<Cmd> find_command(std::string_view word);
 
 enum class Keyword : std::uint8_t { None, On, Off, Sc, All, Pos, Neg, In, Out, Mouv, Seq, Top, Interpol };

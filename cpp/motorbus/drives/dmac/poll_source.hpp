@@ -25,7 +25,7 @@ public:
     std::string describe() const override;
 
 private:
-    DmacClient client_;
+    Client client_;
     std::vector<Var> vars_;
     std::vector<Radix> radix_;
 };

@@ -18,15 +18,15 @@ void check_range(const char* name, double v, double lo, double hi) {
 }
 
 // Constant-acceleration magnitudes (increments/s^2); infinity for start-stop.
-double accel_of(const DmacProfileParams& p) {
+double accel_of(const ProfileParams& p) {
     const double hs = dmac_speed_to_inc_per_s(p.high_speed);
     return p.accel_time_ms > 0 ? hs / (p.accel_time_ms / 1000.0) : std::numeric_limits<double>::infinity();
 }
-double decel_of(const DmacProfileParams& p) {
+double decel_of(const ProfileParams& p) {
     const double hs = dmac_speed_to_inc_per_s(p.high_speed);
     return p.decel_time_ms > 0 ? hs / (p.decel_time_ms / 1000.0) : std::numeric_limits<double>::infinity();
 }
-RampShape shape_of(const DmacProfileParams& p) { return p.s_curve ? RampShape::SCurve : RampShape::Trapezoid; }
+RampShape shape_of(const ProfileParams& p) { return p.s_curve ? RampShape::SCurve : RampShape::Trapezoid; }
 
 // Appends the closed-loop approach from the current end position to target.
 void append_approach(Profile& prof, double target, double low_speed_inc) {
@@ -46,14 +46,14 @@ void append_approach(Profile& prof, double target, double low_speed_inc) {
 }
 }  // namespace
 
-void DmacProfileParams::validate() const {
+void ProfileParams::validate() const {
     check_range("#HIGH_SPEED", high_speed, 0, 400000);
     check_range("#LOW_SPEED", low_speed, 0, 400000);
     check_range("#ACCEL_TIME", accel_time_ms, 0, 12000);
     check_range("#DECEL_TIME", decel_time_ms, 0, 12000);
 }
 
-double dmac_ramp_time(const DmacProfileParams& p, double v_from, double v_to) {
+double dmac_ramp_time(const ProfileParams& p, double v_from, double v_to) {
     if (p.high_speed <= 0) return 0.0;
     const double hs = p.high_speed;
     const double ati = p.accel_time_ms / 1000.0, dti = p.decel_time_ms / 1000.0;
@@ -62,7 +62,7 @@ double dmac_ramp_time(const DmacProfileParams& p, double v_from, double v_to) {
     return dti * std::fabs(v_to - v_from) / hs;
 }
 
-Profile dmac_speed_profile(const State& start, double speed_001rpm, const DmacProfileParams& p, double hold) {
+Profile dmac_speed_profile(const State& start, double speed_001rpm, const ProfileParams& p, double hold) {
     p.validate();
     const double hs = p.high_speed;
     const double target = std::clamp(speed_001rpm, -hs, hs);
@@ -81,7 +81,7 @@ Profile dmac_speed_profile(const State& start, double speed_001rpm, const DmacPr
     return prof;
 }
 
-Profile dmac_position_profile(const State& start, double target, const DmacProfileParams& p) {
+Profile dmac_position_profile(const State& start, double target, const ProfileParams& p) {
     p.validate();
     if (!std::isfinite(target) || !std::isfinite(start.p) || !std::isfinite(start.v))
         throw InvalidArgument("DMAC move: position and velocity must be finite");
@@ -117,17 +117,17 @@ Profile dmac_position_profile(const State& start, double target, const DmacProfi
     return prof;
 }
 
-DmacMotion::DmacMotion(DmacProfileParams params, double position)
+Motion::Motion(ProfileParams params, double position)
     : params_(params), profile_(State{position, 0, 0, 0}), target_(std::llround(position)) {
     params_.validate();
 }
 
-void DmacMotion::set_params(const DmacProfileParams& p) {
+void Motion::set_params(const ProfileParams& p) {
     p.validate();
     params_ = p;
 }
 
-void DmacMotion::splice(double t, const Profile& tail) {
+void Motion::splice(double t, const Profile& tail) {
     if (!(t >= 0) || !std::isfinite(t)) throw InvalidArgument("DMAC command time must be finite and >= 0");
     Profile head = profile_.truncated(t);
     if (head.duration() < t) {
@@ -144,21 +144,21 @@ void DmacMotion::splice(double t, const Profile& tail) {
     target_reached_ = motion_end_;
 }
 
-void DmacMotion::move_to(double t, std::int64_t target) {
+void Motion::move_to(double t, std::int64_t target) {
     const State st = profile_.at(t);
     splice(t, dmac_position_profile(st, static_cast<double>(target), params_));
     speed_mode_ = false;
     target_ = target;
 }
 
-void DmacMotion::move_on(double t, std::int64_t offset) {
+void Motion::move_on(double t, std::int64_t offset) {
     // Relative to the current target when one is set, so chained MOVE_ON add up.
     const State st = profile_.at(t);
     const double base = speed_mode_ ? std::round(st.p) : static_cast<double>(target_);
     move_to(t, static_cast<std::int64_t>(base) + offset);
 }
 
-void DmacMotion::move_speed(double t, std::int32_t speed_001rpm) {
+void Motion::move_speed(double t, std::int32_t speed_001rpm) {
     const State st = profile_.at(t);
     Profile tail = dmac_speed_profile(st, speed_001rpm, params_, kSpeedHoldSeconds);
     splice(t, tail);
@@ -169,7 +169,7 @@ void DmacMotion::move_speed(double t, std::int32_t speed_001rpm) {
     speed_mode_ = true;
 }
 
-void DmacMotion::stop(double t) {
+void Motion::stop(double t) {
     const State st = profile_.at(t);
     Profile tail = dmac_speed_profile(st, 0, params_, 0.0);
     splice(t, tail);
@@ -177,6 +177,6 @@ void DmacMotion::stop(double t) {
     target_ = static_cast<std::int64_t>(std::llround(tail.final_state().p));
 }
 
-bool DmacMotion::moving(double t) const { return t < motion_end_; }
+bool Motion::moving(double t) const { return t < motion_end_; }
 
 }  // namespace motorbus::dmac

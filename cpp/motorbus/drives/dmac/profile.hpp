@@ -45,7 +45,9 @@ inline constexpr double dmac_inc_per_s_to_speed(double inc_per_s) {
     return inc_per_s * 6000.0 / kDmacIncrementsPerRev;
 }
 
-struct DmacProfileParams {  // factory values (MODULE_RESET ALL)
+struct ProfileParams;
+using DmacProfileParams = ProfileParams;  // issue 24's old name, while parallel edits land (removed after)
+struct ProfileParams {  // factory values (MODULE_RESET ALL)
     std::int32_t high_speed = 60000;  // 0.01 rpm, 0..400000
     std::int32_t low_speed = 6000;    // 0.01 rpm, 0..400000
     std::int32_t accel_time_ms = 1000;  // 0..12000
@@ -58,17 +60,19 @@ struct DmacProfileParams {  // factory values (MODULE_RESET ALL)
 // Time (s) the DMAC takes to change speed from v_from to v_to (0.01 rpm):
 // #ACCEL_TIME x |dv| / #HIGH_SPEED when the speed magnitude grows, DECEL when
 // it shrinks (the manual's 0.5 s example: ATI 1000, HS 60000, 0 -> 30000).
-double dmac_ramp_time(const DmacProfileParams& p, double v_from, double v_to);
+double dmac_ramp_time(const ProfileParams& p, double v_from, double v_to);
 
 // The profile of one DMAC axis across commands.  Each command at time t
 // (seconds on the profile's own time line, 0 = first command) replaces the
 // future with a plan starting from the state at t.
-class DmacMotion {
+class Motion;
+using DmacMotion = Motion;  // issue 24's old name, while parallel edits land (removed after)
+class Motion {
 public:
-    explicit DmacMotion(DmacProfileParams params = {}, double position = 0);
+    explicit Motion(ProfileParams params = {}, double position = 0);
 
-    void set_params(const DmacProfileParams& p);  // validates; applies to next command
-    const DmacProfileParams& params() const { return params_; }
+    void set_params(const ProfileParams& p);  // validates; applies to next command
+    const ProfileParams& params() const { return params_; }
 
     void move_to(double t, std::int64_t target);
     void move_on(double t, std::int64_t offset);
@@ -87,7 +91,7 @@ public:
     std::int64_t target() const { return target_; }
 
 private:
-    DmacProfileParams params_;
+    ProfileParams params_;
     Profile profile_;
     bool speed_mode_ = false;
     std::int64_t target_ = 0;
@@ -98,9 +102,9 @@ private:
 
 // The core position plan, exposed for reuse: from `start` to `target`
 // (increments) with the given parameters.
-Profile dmac_position_profile(const State& start, double target, const DmacProfileParams& p);
+Profile dmac_position_profile(const State& start, double target, const ProfileParams& p);
 // Velocity plan from `start` to `speed_001rpm`, then holding it for `hold` s.
-Profile dmac_speed_profile(const State& start, double speed_001rpm, const DmacProfileParams& p,
+Profile dmac_speed_profile(const State& start, double speed_001rpm, const ProfileParams& p,
                            double hold);
 
 }  // namespace motorbus::dmac

@@ -8,13 +8,13 @@
 
 namespace motorbus::dmac {
 
-struct DmacSim::Pending {
+struct Sim::Pending {
     Cmd kind;
     std::int32_t value;
 };
 
-struct DmacSim::Chain {
-    std::vector<DmacSim*> members;
+struct Sim::Chain {
+    std::vector<Sim*> members;
 };
 
 namespace {
@@ -106,7 +106,7 @@ std::string_view model_name(Model m) {
     return "DMAC34-1";
 }
 
-DmacSim::DmacSim(std::shared_ptr<Clock> clock, SimOptions options)
+Sim::Sim(std::shared_ptr<Clock> clock, SimOptions options)
     : clock_(std::move(clock)), options_(std::move(options)) {
     if (!clock_) clock_ = std::make_shared<RealClock>();
     if (options_.address < 0 || options_.address > kMaxAddress)
@@ -123,15 +123,15 @@ DmacSim::DmacSim(std::shared_ptr<Clock> clock, SimOptions options)
     reset_locked(true);
 }
 
-DmacSim::~DmacSim() {
+Sim::~Sim() {
     if (!chain_) return;
     std::lock_guard lock(*mutex_);
     auto& m = chain_->members;
     m.erase(std::remove(m.begin(), m.end(), this), m.end());
 }
 
-void DmacSim::chain_ultrasync(const std::vector<std::shared_ptr<DmacSim>>& modules) {
-    std::vector<DmacSim*> ms;
+void Sim::chain_ultrasync(const std::vector<std::shared_ptr<Sim>>& modules) {
+    std::vector<Sim*> ms;
     for (const auto& m : modules) {
         if (!m) throw InvalidArgument("DmacSim chain_ultrasync: a module is None");
         if (std::find(ms.begin(), ms.end(), m.get()) == ms.end()) ms.push_back(m.get());
@@ -152,7 +152,7 @@ void DmacSim::chain_ultrasync(const std::vector<std::shared_ptr<DmacSim>>& modul
     }
 }
 
-void DmacSim::set_speed_limit(double inc_per_s) {
+void Sim::set_speed_limit(double inc_per_s) {
     if (!std::isfinite(inc_per_s) || inc_per_s < 0)
         throw InvalidArgument("DmacSim speed limit: increments/s >= 0 (0 = none), not " + std::to_string(inc_per_s));
     std::lock_guard lock(*mutex_);
@@ -160,13 +160,13 @@ void DmacSim::set_speed_limit(double inc_per_s) {
     speed_limit_ = inc_per_s;
 }
 
-bool DmacSim::dmac34() const {
+bool Sim::dmac34() const {
     return options_.model == Model::Dmac34_1 || options_.model == Model::Dmac34_2;
 }
 
-std::uint32_t DmacSim::input_mask() const { return dmac34() ? 0x3FFu : 0x3Fu; }
+std::uint32_t Sim::input_mask() const { return dmac34() ? 0x3FFu : 0x3Fu; }
 
-std::uint32_t DmacSim::logical_inputs() const {
+std::uint32_t Sim::logical_inputs() const {
     // The end-stop switches are wired onto the same inputs a test can drive.
     std::uint32_t electrical = physical_inputs_;
     if (options_.positive_end_switch.present && axis_->plus_limit_input())
@@ -177,14 +177,14 @@ std::uint32_t DmacSim::logical_inputs() const {
     return (electrical ^ (invert_in_ ? input_mask() : 0u)) & input_mask();
 }
 
-bool DmacSim::var_available(Var v) const {
+bool Sim::var_available(Var v) const {
     // #INPUT_ANALOG is the DMAC17/23 name; a DMAC34 has #INPUT_A1/#INPUT_A2 (5.8, 7.2).
     if (v == Var::InputAnalog) return !dmac34();
     return dmac34() || !var_info(v).dmac34_only;
 }
 
-DmacProfileParams DmacSim::params() const {
-    DmacProfileParams p;
+ProfileParams Sim::params() const {
+    ProfileParams p;
     p.high_speed = vars_[static_cast<std::size_t>(Var::HighSpeed)];
     p.low_speed = vars_[static_cast<std::size_t>(Var::LowSpeed)];
     p.accel_time_ms = vars_[static_cast<std::size_t>(Var::AccelTime)];
@@ -194,40 +194,40 @@ DmacProfileParams DmacSim::params() const {
 }
 
 // ---- time -------------------------------------------------------------------
-double DmacSim::motion_t() const { return static_cast<double>(now_ms_ - motion_t0_ms_) / 1000.0; }
+double Sim::motion_t() const { return static_cast<double>(now_ms_ - motion_t0_ms_) / 1000.0; }
 
-Nanos DmacSim::tick_time() const { return epoch_ns_ + now_ms_ * kNsPerMs; }
+Nanos Sim::tick_time() const { return epoch_ns_ + now_ms_ * kNsPerMs; }
 
-double DmacSim::user_position() const {
+double Sim::user_position() const {
     const double counts = axis_->steps_to_counts(axis_->physical_position());
     return counts + static_cast<double>(axis_->encoder() - std::llround(counts));
 }
 
-std::int32_t DmacSim::position_locked() const { return wrap_i32(axis_->encoder()); }
+std::int32_t Sim::position_locked() const { return wrap_i32(axis_->encoder()); }
 
 // #SPEED: the rotor's measured speed, whoever drives it -- the power stage,
 // or nothing while it runs down after POWER OFF/SC, a fault or MODULE_RESET.
-std::int32_t DmacSim::speed_locked() const {
+std::int32_t Sim::speed_locked() const {
     return round_i32(dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->velocity())));
 }
 
 // #PROFILE_SPEED: "the computed speed of the module" (5.24): what its profile
 // (or interpolation segment) asks for; nothing while the power stage is off.
-std::int32_t DmacSim::profile_speed_locked() const {
+std::int32_t Sim::profile_speed_locked() const {
     if (coasting_ || seg_wait_) return 0;
     return round_i32(dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->commanded_velocity())));
 }
 
-bool DmacSim::moving_locked() const {
+bool Sim::moving_locked() const {
     return interpolating_ || (coasting_ && axis_->moving()) || motion_->moving(motion_t());
 }
 
 // BUSY: active until the target is reached (3.5.4) -- the target velocity in
 // velocity mode, the target position otherwise.  A rotor running down with
 // the power stage off has no target.
-bool DmacSim::busy_locked() const { return interpolating_ || (!coasting_ && motion_->busy(motion_t())); }
+bool Sim::busy_locked() const { return interpolating_ || (!coasting_ && motion_->busy(motion_t())); }
 
-void DmacSim::coast(double tau) {
+void Sim::coast(double tau) {
     const double v = axis_->velocity();  // increments/s
     interpolating_ = false;
     fifo_.clear();
@@ -250,20 +250,20 @@ void DmacSim::coast(double tau) {
     }
 }
 
-std::int64_t DmacSim::target_ms() const { return (clock_->now() - epoch_ns_) / kNsPerMs; }
+std::int64_t Sim::target_ms() const { return (clock_->now() - epoch_ns_) / kNsPerMs; }
 
-bool DmacSim::idle_locked() const {
+bool Sim::idle_locked() const {
     const bool timers = vars_[static_cast<std::size_t>(Var::Timer1)] ||
                         vars_[static_cast<std::size_t>(Var::Timer2)] ||
                         vars_[static_cast<std::size_t>(Var::Timer3)];
     return !seq_running_ && !timers && !moving_locked();
 }
 
-bool DmacSim::ultrasync_locked() const {
+bool Sim::ultrasync_locked() const {
     return chain_ && vars_[static_cast<std::size_t>(Var::InterpolMode)] == -1;
 }
 
-void DmacSim::catch_up_locked() {
+void Sim::catch_up_locked() {
     if (!chain_) {
         catch_up_self_locked(target_ms());
         return;
@@ -278,14 +278,14 @@ void DmacSim::catch_up_locked() {
     for (;;) {
         Nanos next = std::numeric_limits<Nanos>::max();
         for (std::size_t i = 0; i < ms.size(); ++i) {
-            DmacSim* m = ms[i];
+            Sim* m = ms[i];
             if (m->now_ms_ >= target[i]) continue;
             if (m->idle_locked()) m->catch_up_self_locked(target[i]);
             else next = std::min(next, m->tick_time() + kNsPerMs);
         }
         if (next == std::numeric_limits<Nanos>::max()) return;
         for (std::size_t i = 0; i < ms.size(); ++i) {
-            DmacSim* m = ms[i];
+            Sim* m = ms[i];
             if (m->now_ms_ < target[i] && !m->idle_locked() && m->tick_time() + kNsPerMs <= next) m->tick_locked();
         }
         // IN6/OUT1: a segment ends when it is finished on every module in UltraSYNC.
@@ -301,7 +301,7 @@ void DmacSim::catch_up_locked() {
     }
 }
 
-void DmacSim::catch_up_self_locked(std::int64_t target) {
+void Sim::catch_up_self_locked(std::int64_t target) {
     while (now_ms_ < target) {
         if (idle_locked()) {
             // Nothing evolves while idle: jump instead of ticking through it.
@@ -313,7 +313,7 @@ void DmacSim::catch_up_self_locked(std::int64_t target) {
     }
 }
 
-void DmacSim::tick_locked() {
+void Sim::tick_locked() {
     ++now_ms_;
     for (int i = 1; i <= 3; ++i) {
         auto& t = vars_[static_cast<std::size_t>(timer_var(i))];
@@ -364,20 +364,20 @@ void DmacSim::tick_locked() {
     }
 }
 
-void DmacSim::poll() {
+void Sim::poll() {
     std::lock_guard lock(*mutex_);
     catch_up_locked();
 }
 
 // ---- motion -----------------------------------------------------------------
-void DmacSim::restart_motion_at(double position) {
+void Sim::restart_motion_at(double position) {
     pos_offset_ = 0;
-    motion_ = std::make_unique<DmacMotion>(params(), position);
+    motion_ = std::make_unique<Motion>(params(), position);
     motion_t0_ms_ = now_ms_;
     position_mode_ = false;
 }
 
-void DmacSim::halt_motion() {
+void Sim::halt_motion() {
     coasting_ = false;
     interpolating_ = false;
     fifo_.clear();
@@ -387,9 +387,9 @@ void DmacSim::halt_motion() {
     restart_motion_at(user_position());
 }
 
-void DmacSim::command_axis() { axis_->command_from(motion_->profile(), motion_t(), tick_time()); }
+void Sim::command_axis() { axis_->command_from(motion_->profile(), motion_t(), tick_time()); }
 
-void DmacSim::next_segment_locked() {
+void Sim::next_segment_locked() {
     seg_wait_ = false;
     fifo_.pop_front();
     if (!fifo_.empty()) {
@@ -402,7 +402,7 @@ void DmacSim::next_segment_locked() {
     restart_motion_at(user_position());
 }
 
-void DmacSim::start_interp_segment() {
+void Sim::start_interp_segment() {
     // One FIFO entry: #INTERPOL_TIME ms at constant speed, ending exactly on its
     // offset -- or longer, at the speed a mechanical limit allows.
     const Segment& s = fifo_.front();
@@ -421,7 +421,7 @@ void DmacSim::start_interp_segment() {
 
 // Advances the axis to t, stopping it where the commanded motion would first
 // go beyond an enabled soft end-stop ("movement is stopped", manual 1.2.3).
-void DmacSim::advance_axis(Nanos t) {
+void Sim::advance_axis(Nanos t) {
     if (soft_ends_ && axis_->moving() && t > axis_->time()) {
         const motion::Profile& prof = axis_->profile();
         const double t_from = axis_->profile_time(axis_->time());
@@ -456,7 +456,7 @@ void DmacSim::advance_axis(Nanos t) {
     axis_->advance_to(t);
 }
 
-void DmacSim::on_axis_event(const motion::MotorEvent& e) {
+void Sim::on_axis_event(const motion::MotorEvent& e) {
     using K = motion::MotorEvent::Kind;
     if (e.kind == K::HomeOn || e.kind == K::HomeOff) {
         in5_changed_locked(wrap_i32(e.encoder));
@@ -473,7 +473,7 @@ void DmacSim::on_axis_event(const motion::MotorEvent& e) {
     }
 }
 
-bool DmacSim::start_move(Cmd kind, std::int32_t value) {
+bool Sim::start_move(Cmd kind, std::int32_t value) {
     if (brake_) {
         flag(error::kLimit);
         return false;
@@ -528,7 +528,7 @@ bool DmacSim::start_move(Cmd kind, std::int32_t value) {
     return true;
 }
 
-void DmacSim::update_end_flags() {
+void Sim::update_end_flags() {
     const double p = user_position();
     const auto pen = static_cast<double>(vars_[static_cast<std::size_t>(Var::PositiveEnd)]);
     const auto nen = static_cast<double>(vars_[static_cast<std::size_t>(Var::NegativeEnd)]);
@@ -543,7 +543,7 @@ void DmacSim::update_end_flags() {
 
 // At a tick: an end-stop already active stops motion towards it (an input
 // set from outside, or a move started beyond a soft end-stop).
-void DmacSim::check_end_stops() {
+void Sim::check_end_stops() {
     update_end_flags();
     if (!moving_locked()) return;
     const double v = axis_->commanded_velocity();
@@ -554,7 +554,7 @@ void DmacSim::check_end_stops() {
 }
 
 // ---- reset --------------------------------------------------------------------
-void DmacSim::reset_locked(bool factory) {
+void Sim::reset_locked(bool factory) {
     for (std::size_t i = 0; i < kVarCount; ++i) {
         const VarInfo& vi = var_info(static_cast<Var>(i));
         if (vi.read_only) continue;
@@ -597,14 +597,14 @@ void DmacSim::reset_locked(bool factory) {
     if (on_reset >= 1 && on_reset <= kSeqLines) seq_start(on_reset);
 }
 
-void DmacSim::power_cycle() {
+void Sim::power_cycle() {
     std::lock_guard lock(*mutex_);
     catch_up_locked();
     reset_locked(false);
 }
 
 // ---- variables ----------------------------------------------------------------
-std::uint32_t DmacSim::status_locked() {
+std::uint32_t Sim::status_locked() {
     update_end_flags();
     std::uint32_t s = 0;
     auto set = [&](int bit, bool on) {
@@ -640,7 +640,7 @@ std::uint32_t DmacSim::status_locked() {
     return s;
 }
 
-std::optional<std::int32_t> DmacSim::read_var_locked(Var v, int bit) {
+std::optional<std::int32_t> Sim::read_var_locked(Var v, int bit) {
     if (!var_available(v)) return std::nullopt;
     std::int32_t value;
     switch (v) {
@@ -665,7 +665,7 @@ std::optional<std::int32_t> DmacSim::read_var_locked(Var v, int bit) {
     return value;
 }
 
-int DmacSim::write_var_locked(Var v, int bit, std::int32_t value) {
+int Sim::write_var_locked(Var v, int bit, std::int32_t value) {
     const VarInfo& vi = var_info(v);
     if (!var_available(v) || vi.read_only) return error::kSyntax;
     if (bit) {
@@ -702,7 +702,7 @@ int DmacSim::write_var_locked(Var v, int bit, std::int32_t value) {
     }
 }
 
-std::optional<std::int32_t> DmacSim::eval_operand(const Operand& o) {
+std::optional<std::int32_t> Sim::eval_operand(const Operand& o) {
     std::int64_t v;
     if (o.is_var) {
         auto r = read_var_locked(o.var, o.bit);
@@ -719,7 +719,7 @@ std::optional<std::int32_t> DmacSim::eval_operand(const Operand& o) {
     return wrap_i32(v);
 }
 
-std::optional<std::int32_t> DmacSim::eval(const Expr& e) {
+std::optional<std::int32_t> Sim::eval(const Expr& e) {
     auto a = eval_operand(e.lhs);
     if (!a) return std::nullopt;
     if (e.op == Op::None) return a;
@@ -750,21 +750,21 @@ std::optional<std::int32_t> DmacSim::eval(const Expr& e) {
 }
 
 // ---- sequencer ------------------------------------------------------------------
-void DmacSim::seq_start(int line) {
+void Sim::seq_start(int line) {
     seq_running_ = true;
     line_ = line;
     call_stack_.clear();
     wait_ = WaitKind::None;
 }
 
-void DmacSim::seq_stop() {
+void Sim::seq_stop() {
     seq_running_ = false;
     line_ = 0;
     call_stack_.clear();
     wait_ = WaitKind::None;
 }
 
-void DmacSim::seq_execute_line(int n) {
+void Sim::seq_execute_line(int n) {
     if (n < 1 || n > kSeqLines) {
         seq_stop();
         return;
@@ -854,7 +854,7 @@ void DmacSim::seq_execute_line(int n) {
 }
 
 // ---- commands -------------------------------------------------------------------
-std::string DmacSim::execute_locked(const Command& c, bool from_sequencer, bool global) {
+std::string Sim::execute_locked(const Command& c, bool from_sequencer, bool global) {
     (void)global;
     const std::string& term = options_.reply_terminator;
     if (!from_sequencer && sequence_only(c.cmd)) {
@@ -1057,7 +1057,7 @@ std::string DmacSim::execute_locked(const Command& c, bool from_sequencer, bool 
     }
 }
 
-std::string DmacSim::handle_locked(std::string_view line) {
+std::string Sim::handle_locked(std::string_view line) {
     ++lines_handled_;
     Request req = parse_request(line);
     if (req.address_error) return "";
@@ -1104,7 +1104,7 @@ std::string DmacSim::handle_locked(std::string_view line) {
     return reply;
 }
 
-std::string DmacSim::on_line(std::string_view line) {
+std::string Sim::on_line(std::string_view line) {
     std::string reply;
     std::int32_t delay_us = 0;
     {
@@ -1127,7 +1127,7 @@ std::string DmacSim::on_line(std::string_view line) {
     return reply;
 }
 
-std::string DmacSim::on_overlong() {
+std::string Sim::on_overlong() {
     std::lock_guard lock(*mutex_);
     catch_up_locked();
     ++lines_rejected_;
@@ -1137,7 +1137,7 @@ std::string DmacSim::on_overlong() {
 }
 
 // ---- inspection -------------------------------------------------------------------
-SimState DmacSim::state() {
+SimState Sim::state() {
     std::lock_guard lock(*mutex_);
     catch_up_locked();
     SimState s;
@@ -1154,30 +1154,30 @@ SimState DmacSim::state() {
     return s;
 }
 
-std::int32_t DmacSim::read(Var v) {
+std::int32_t Sim::read(Var v) {
     std::lock_guard lock(*mutex_);
     catch_up_locked();
     return read_var_locked(v, 0).value_or(0);
 }
 
-int DmacSim::address() {
+int Sim::address() {
     std::lock_guard lock(*mutex_);
     return address_;
 }
 
-std::int32_t DmacSim::baudrate() {
+std::int32_t Sim::baudrate() {
     std::lock_guard lock(*mutex_);
     return baudrate_;
 }
 
-std::string DmacSim::sequence_line(int n) {
+std::string Sim::sequence_line(int n) {
     std::lock_guard lock(*mutex_);
     if (n < 1 || n > kSeqLines) return "";
     const auto& l = program_[static_cast<std::size_t>(n)];
     return l ? format_command(*l) : "";
 }
 
-void DmacSim::set_input(int n, bool active) {
+void Sim::set_input(int n, bool active) {
     if (n < 1 || n > 10) throw InvalidArgument("DmacSim input: " + std::to_string(n) + " is outside 1..10");
     std::lock_guard lock(*mutex_);
     catch_up_locked();
@@ -1187,7 +1187,7 @@ void DmacSim::set_input(int n, bool active) {
     check_end_stops();
 }
 
-void DmacSim::in5_changed_locked(std::int32_t position) {
+void Sim::in5_changed_locked(std::int32_t position) {
     const bool is = (logical_inputs() & bit_mask(5)) != 0;
     const bool rising = is && !in5_last_;
     in5_last_ = is;
@@ -1200,7 +1200,7 @@ void DmacSim::in5_changed_locked(std::int32_t position) {
     }
 }
 
-void DmacSim::set_analog(int channel, std::int32_t mv) {
+void Sim::set_analog(int channel, std::int32_t mv) {
     // One analog input on a DMAC17/23, two on a DMAC34 (1.2.1, 3.5.3).
     if (channel < 1 || channel > (dmac34() ? 2 : 1))
         throw InvalidArgument("DmacSim analog channel: " + std::to_string(channel) + " (a " +
@@ -1209,14 +1209,14 @@ void DmacSim::set_analog(int channel, std::int32_t mv) {
     analog_[channel] = mv;
 }
 
-void DmacSim::set_supply_voltage(std::int32_t mv) {
+void Sim::set_supply_voltage(std::int32_t mv) {
     std::lock_guard lock(*mutex_);
     catch_up_locked();
     options_.supply_voltage_mv = mv;
     check_supply_locked();
 }
 
-void DmacSim::set_temperature(Sensor which, std::int32_t tenths_c) {
+void Sim::set_temperature(Sensor which, std::int32_t tenths_c) {
     std::lock_guard lock(*mutex_);
     catch_up_locked();
     switch (which) {
@@ -1227,7 +1227,7 @@ void DmacSim::set_temperature(Sensor which, std::int32_t tenths_c) {
     check_supply_locked();
 }
 
-void DmacSim::inject_error(int bit) {
+void Sim::inject_error(int bit) {
     if (bit < 1 || bit > 32) throw InvalidArgument("DmacSim error bit: 1..32");
     std::lock_guard lock(*mutex_);
     catch_up_locked();
@@ -1235,7 +1235,7 @@ void DmacSim::inject_error(int bit) {
     else flag(bit);
 }
 
-void DmacSim::fault_locked(int bit) {
+void Sim::fault_locked(int bit) {
     const bool already = (error_ & bit_mask(bit)) != 0;
     flag(bit);
     if (already) return;
@@ -1247,7 +1247,7 @@ void DmacSim::fault_locked(int bit) {
     power_ = false;
 }
 
-void DmacSim::check_supply_locked() {
+void Sim::check_supply_locked() {
     const std::int32_t mv = options_.supply_voltage_mv;
     const std::int32_t under = dmac34() ? 20000 : 12000;
     const std::int32_t over = dmac34() ? 170000 : 49000;
@@ -1258,7 +1258,7 @@ void DmacSim::check_supply_locked() {
     if (hot) fault_locked(error::kThermal);
 }
 
-std::uint32_t DmacSim::physical_outputs() {
+std::uint32_t Sim::physical_outputs() {
     std::lock_guard lock(*mutex_);
     catch_up_locked();
     const std::uint32_t mask = dmac34() ? 0xFFu : 0x0Fu;
@@ -1269,12 +1269,12 @@ std::uint32_t DmacSim::physical_outputs() {
     return (logical ^ (invert_out_ ? mask : 0u)) & mask;
 }
 
-std::uint64_t DmacSim::lines_handled() {
+std::uint64_t Sim::lines_handled() {
     std::lock_guard lock(*mutex_);
     return lines_handled_;
 }
 
-std::uint64_t DmacSim::lines_rejected() {
+std::uint64_t Sim::lines_rejected() {
     std::lock_guard lock(*mutex_);
     return lines_rejected_;
 }

@@ -1,9 +1,9 @@
 // A DMAC module as a serial LineDevice: every variable with its stored or
-// volatile behaviour, the DMAC motion profile (DmacMotion), hard and
+// volatile behaviour, the DMAC motion profile (Motion), hard and
 // soft end-stops, the 500-line sequencer (one line per millisecond), the
 // interpolation FIFO and MODULE_RESET [ALL].
 //
-// The axis is a motion::MotorModel: DmacMotion plans, the model plays the plan
+// The axis is a motion::MotorModel: Motion plans, the model plays the plan
 // (and the interpolation segments); #POSITION is the model's encoder and
 // #SPEED its rotor speed.  One step = one count = one increment (1/10000 rev).
 // Hard end-stops are the model's +/- limit switches (SimOptions) or the
@@ -92,10 +92,12 @@ struct SimState {
     bool power = false;
 };
 
-class DmacSim : public serial::LineDevice {
+class Sim;
+using DmacSim = Sim;  // issue 24's old name, while parallel edits land (removed after)
+class Sim : public serial::LineDevice {
 public:
-    explicit DmacSim(std::shared_ptr<Clock> clock, SimOptions options = {});
-    ~DmacSim() override;
+    explicit Sim(std::shared_ptr<Clock> clock, SimOptions options = {});
+    ~Sim() override;
 
     // ---- LineDevice -------------------------------------------------------
     std::string on_line(std::string_view line) override;
@@ -137,7 +139,7 @@ public:
     // they are served: the modules then share one lock.  InvalidArgument for
     // fewer than two distinct modules, a module already chained, or modules on
     // different clocks.
-    static void chain_ultrasync(const std::vector<std::shared_ptr<DmacSim>>& modules);
+    static void chain_ultrasync(const std::vector<std::shared_ptr<Sim>>& modules);
     // A mechanical limit on the rotor (friction, a brake: the figure of 5.11):
     // an interpolation segment faster than `inc_per_s` lasts |offset| / inc_per_s
     // instead of #INTERPOL_TIME.  0 = none.
@@ -190,7 +192,7 @@ private:
     void check_end_stops();
     void update_end_flags();
     void reset_locked(bool factory);
-    DmacProfileParams params() const;
+    ProfileParams params() const;
 
     // sequencer
     void seq_start(int line);
@@ -224,7 +226,7 @@ private:
 
     // motion: the planner (its own time line from motion_t0_ms_) and the axis
     std::unique_ptr<motion::MotorModel> axis_;
-    std::unique_ptr<DmacMotion> motion_;
+    std::unique_ptr<Motion> motion_;
     std::int64_t motion_t0_ms_ = 0;
     bool position_mode_ = false;
     // #POSITION written during a move re-homes without disturbing it: the

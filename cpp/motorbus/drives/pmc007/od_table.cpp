@@ -172,7 +172,7 @@ const OdRow* pmc007_od_row(std::uint16_t index, std::uint8_t sub) {
     return nullptr;
 }
 
-std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id, const Pmc007Identity& identity) {
+std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id, const Identity& identity) {
     if (node_id == 0 || node_id > 127) throw InvalidArgument("pmc007: node-ID must be 1..127");
     auto od = std::make_shared<canopen::ObjectDictionary>();
     od->set_node_id(node_id);

@@ -44,15 +44,17 @@ const std::vector<OdRow>& pmc007_od_rows();
 // The row of (index, sub), or nullptr.
 const OdRow* pmc007_od_row(std::uint16_t index, std::uint8_t sub);
 // 1018h:01-04.  003 documents no identity: the EDS carries 0 (unknown); a simulator
-// reads the identity it was given (Pmc007SimOptions::identity).
-struct Pmc007Identity {
+// reads the identity it was given (SimOptions::identity).
+struct Identity;
+using Pmc007Identity = Identity;  // issue 24's old name, while parallel edits land (removed after)
+struct Identity {
     std::uint32_t vendor_id = 0;
     std::uint32_t product_code = 0;
     std::uint32_t revision = 0;
     std::uint32_t serial = 0;
 };
 // A dictionary with every row, defaults evaluated for `node_id` (1..127), 1018h from `identity`.
-std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id, const Pmc007Identity& identity = {});
+std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id, const Identity& identity = {});
 // The EDS text of that dictionary ($NODEID expressions kept).
 std::string pmc007_eds();
 

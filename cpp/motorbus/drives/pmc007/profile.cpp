@@ -24,7 +24,7 @@ double pmc007_convert_position(double position, int from_setting, int to_setting
     return position * pmc007_microsteps(to_setting) / pmc007_microsteps(from_setting);
 }
 
-void Pmc007ProfileParams::validate() const {
+void ProfileParams::validate() const {
     (void)pmc007_gear_acceleration(accel_gear);
     (void)pmc007_gear_acceleration(decel_gear);
     (void)pmc007_microsteps(microstepping);
@@ -33,7 +33,7 @@ void Pmc007ProfileParams::validate() const {
     if (!(speed > 0) || !std::isfinite(speed)) throw LimitExceeded("speed", speed, 0, "must be positive");
 }
 
-Profile pmc007_position_profile(const State& start, double target, const Pmc007ProfileParams& p) {
+Profile pmc007_position_profile(const State& start, double target, const ProfileParams& p) {
     p.validate();
     const double a = pmc007_gear_acceleration(p.accel_gear), d = pmc007_gear_acceleration(p.decel_gear);
     // Start/stop speeds above the running speed collapse onto it.
@@ -41,7 +41,7 @@ Profile pmc007_position_profile(const State& start, double target, const Pmc007P
     return detail::stepper_profile(State{start.p, start.v, 0, 0}, target, p.speed, a, d, vs, ve, RampShape::SCurve);
 }
 
-Profile pmc007_speed_profile(const State& start, double speed, const Pmc007ProfileParams& p, double hold) {
+Profile pmc007_speed_profile(const State& start, double speed, const ProfileParams& p, double hold) {
     p.validate();
     const double a = pmc007_gear_acceleration(p.accel_gear), d = pmc007_gear_acceleration(p.decel_gear);
     Profile prof(State{start.p, start.v, 0, 0});

@@ -30,7 +30,9 @@ int pmc007_microsteps(int setting);
 // position first, then convert): pos * new / old.
 double pmc007_convert_position(double position, int from_setting, int to_setting);
 
-struct Pmc007ProfileParams {
+struct ProfileParams;
+using Pmc007ProfileParams = ProfileParams;  // issue 24's old name, while parallel edits land (removed after)
+struct ProfileParams {
     double speed = 1000;           // pps, the running speed (speed mode / position moves)
     double start_speed = 400;      // 6006h, pps (factory 400)
     double stop_speed = 0;         // 6007h, pps (factory 0)
@@ -41,8 +43,8 @@ struct Pmc007ProfileParams {
 };
 
 // Step/absolute displacement command: from `start` to `target` (steps).
-Profile pmc007_position_profile(const State& start, double target, const Pmc007ProfileParams& p);
+Profile pmc007_position_profile(const State& start, double target, const ProfileParams& p);
 // Speed mode: ramp to `speed` (signed pps) from the start speed, hold `hold` s.
-Profile pmc007_speed_profile(const State& start, double speed, const Pmc007ProfileParams& p, double hold);
+Profile pmc007_speed_profile(const State& start, double speed, const ProfileParams& p, double hold);
 
 }  // namespace motorbus::pmc007

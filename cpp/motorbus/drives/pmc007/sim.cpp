@@ -31,7 +31,7 @@ bool valid_microstepping(std::int64_t v) {
 // The node's timer drives the sim in real time (PDOs, heartbeat-visible state).
 class Ticker : public canopen::NodeService {
 public:
-    explicit Ticker(Pmc007Sim& sim) : sim_(sim) {}
+    explicit Ticker(Sim& sim) : sim_(sim) {}
     Nanos on_timer(canopen::LocalNode&, Nanos now) override {
         sim_.poll();
         // 2 ms while something changes by itself (a move, a program, a debounce),
@@ -40,7 +40,7 @@ public:
     }
 
 private:
-    Pmc007Sim& sim_;
+    Sim& sim_;
 };
 
 // Objects whose value the device computes (published after every change).
@@ -49,7 +49,7 @@ constexpr std::pair<std::uint16_t, std::uint8_t> kLive[] = {
     {0x6004, 0}, {0x601C, 0}, {0x6020, 0}, {0x6019, 2}, {0x6019, 3}, {0x6019, 5}};
 }  // namespace
 
-Pmc007Sim::Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions options)
+Sim::Sim(std::uint8_t node_id, Clock& clock, SimOptions options)
     : node_id_(node_id), clock_(clock), opt_(options), od_(build_pmc007_od(node_id, options.identity)), motor_(clock, [&] {
           motion::MotorConfig c;
           c.steps_per_rev = options.steps_per_rev;
@@ -105,9 +105,9 @@ Pmc007Sim::Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions option
     load_power_up(true);
 }
 
-Pmc007Sim::~Pmc007Sim() { close(); }
+Sim::~Sim() { close(); }
 
-canopen::LocalNodeOptions Pmc007Sim::node_options() {
+canopen::LocalNodeOptions Sim::node_options() {
     canopen::LocalNodeOptions o;
     o.reset_restores_defaults = false;  // B-P27/B-P28: the device's own reset rules (on_reset)
     o.sdo_require_dlc8 = true;          // B-P06 [P]: SDO requests with DLC != 8 are ignored
@@ -119,7 +119,7 @@ canopen::LocalNodeOptions Pmc007Sim::node_options() {
 // Nodes and services are made and destroyed without the sim's lock held: their
 // threads call into the sim (hooks, timer) and would otherwise wait on it while
 // we wait on them.
-void Pmc007Sim::attach(can::Bus& bus) {
+void Sim::attach(can::Bus& bus) {
     {
         std::lock_guard lock(m_);
         if (node_ || attaching_)
@@ -144,7 +144,7 @@ void Pmc007Sim::attach(can::Bus& bus) {
     install_node(std::move(n), std::move(sv));
 }
 
-void Pmc007Sim::install_node(std::unique_ptr<canopen::LocalNode> n, Services sv) {
+void Sim::install_node(std::unique_ptr<canopen::LocalNode> n, Services sv) {
     std::lock_guard lock(m_);
     node_ = std::move(n);
     pdo_ = std::move(sv.pdo);
@@ -153,7 +153,7 @@ void Pmc007Sim::install_node(std::unique_ptr<canopen::LocalNode> n, Services sv)
     attaching_ = false;
 }
 
-Pmc007Sim::Services Pmc007Sim::make_services(canopen::LocalNode& n) {
+Sim::Services Sim::make_services(canopen::LocalNode& n) {
     Services sv;
     canopen::PdoServiceOptions po;
     po.strict = false;  // B-P32: the manual's sequence changes a valid PDO in place
@@ -175,7 +175,7 @@ Pmc007Sim::Services Pmc007Sim::make_services(canopen::LocalNode& n) {
     return sv;
 }
 
-void Pmc007Sim::schedule_node_id_switch() {
+void Sim::schedule_node_id_switch() {
     // Called on the bus thread in the middle of the NMT reset: the node cannot be
     // replaced from there, so a helper thread does it once the reset is over.
     std::lock_guard lock(m_);
@@ -213,7 +213,7 @@ void Pmc007Sim::schedule_node_id_switch() {
     });
 }
 
-void Pmc007Sim::switch_node_id(std::uint8_t new_id) {
+void Sim::switch_node_id(std::uint8_t new_id) {
     canopen::LocalNode* old = nullptr;
     {
         std::lock_guard lock(m_);
@@ -265,12 +265,12 @@ void Pmc007Sim::switch_node_id(std::uint8_t new_id) {
     retired_.push_back(std::shared_ptr<canopen::LocalNode>(std::move(gone)));
 }
 
-bool Pmc007Sim::attached() const {
+bool Sim::attached() const {
     std::lock_guard lock(m_);
     return node_ != nullptr || (bus_ != nullptr && !attaching_);  // in the bootloader: off the bus, still attached
 }
 
-void Pmc007Sim::serve_again() {
+void Sim::serve_again() {
     can::Bus* bus = nullptr;
     {
         std::lock_guard lock(m_);
@@ -292,7 +292,7 @@ void Pmc007Sim::serve_again() {
     install_node(std::move(n), std::move(sv));
 }
 
-void Pmc007Sim::enter_bootloader() {
+void Sim::enter_bootloader() {
     std::shared_ptr<canopen::LocalNode> n;
     Services sv;
     {
@@ -318,7 +318,7 @@ void Pmc007Sim::enter_bootloader() {
     });
 }
 
-void Pmc007Sim::close() {
+void Sim::close() {
     if (renode_.joinable() && renode_.get_id() != std::this_thread::get_id()) renode_.join();
     if (boot_.joinable() && boot_.get_id() != std::this_thread::get_id()) boot_.join();
     std::unique_ptr<canopen::LocalNode> n;
@@ -349,15 +349,15 @@ double baud_index_bps(int index) {
 
 // ---- values -------------------------------------------------------------------
 
-std::int64_t Pmc007Sim::u(std::uint16_t i, std::uint8_t s) const {
+std::int64_t Sim::u(std::uint16_t i, std::uint8_t s) const {
     auto v = od_->at(i, s);
     const Bytes b = v->get();
     return decode_le(b, v->type() == canopen::DataType::Integer32);
 }
 
-void Pmc007Sim::set(std::uint16_t i, std::uint8_t s, std::int64_t value) { set(od_->at(i, s), value); }
+void Sim::set(std::uint16_t i, std::uint8_t s, std::int64_t value) { set(od_->at(i, s), value); }
 
-void Pmc007Sim::set(const canopen::VariablePtr& v, std::int64_t value) {
+void Sim::set(const canopen::VariablePtr& v, std::int64_t value) {
     std::uint8_t b[8];  // every object set here is a number of at most 8 bytes
     const std::size_t n = std::min(v->size(), sizeof b);
     for (std::size_t k = 0; k < n; ++k) b[k] = static_cast<std::uint8_t>(std::uint64_t(value) >> (8 * k));
@@ -365,7 +365,7 @@ void Pmc007Sim::set(const canopen::VariablePtr& v, std::int64_t value) {
     if (!v->holds({b, n})) v->try_set({b, n});
 }
 
-void Pmc007Sim::publish() {
+void Sim::publish() {
     if (t_publishing) return;
     t_publishing = true;
     // Computed under the lock, stored after it: a store runs the objects' listeners.
@@ -408,7 +408,7 @@ void Pmc007Sim::publish() {
 
 // The store file: one line per ROM object "rom IIII SS hexbytes", "program w w ...",
 // "position n".  Unknown or malformed lines are skipped (a damaged file = factory values).
-void Pmc007Sim::write_store_locked() {
+void Sim::write_store_locked() {
     if (opt_.store_path.empty()) return;
     std::ostringstream out;
     for (const auto& [k, bytes] : flash_) {
@@ -434,7 +434,7 @@ void Pmc007Sim::write_store_locked() {
     std::rename(tmp.c_str(), opt_.store_path.c_str());
 }
 
-void Pmc007Sim::read_store() {
+void Sim::read_store() {
     if (opt_.store_path.empty()) return;
     std::ifstream f(opt_.store_path, std::ios::binary);
     if (!f) return;
@@ -469,7 +469,7 @@ void Pmc007Sim::read_store() {
     }
 }
 
-void Pmc007Sim::load_power_up(bool cold) {
+void Sim::load_power_up(bool cold) {
     std::uint16_t old_outputs = 0;
     {
         std::lock_guard lock(m_);
@@ -529,11 +529,11 @@ void Pmc007Sim::load_power_up(bool cold) {
     publish();
 }
 
-void Pmc007Sim::apply_sync_cob_id(const std::shared_ptr<canopen::PdoService>& pdo) {
+void Sim::apply_sync_cob_id(const std::shared_ptr<canopen::PdoService>& pdo) {
     if (pdo) pdo->engine().set_sync_cob_id(static_cast<std::uint32_t>(u(0x1005)));
 }
 
-void Pmc007Sim::power_cycle() {
+void Sim::power_cycle() {
     if (boot_.joinable() && boot_.get_id() != std::this_thread::get_id()) boot_.join();
     canopen::LocalNode* n;
     bool from_bootloader = false;
@@ -568,7 +568,7 @@ void Pmc007Sim::power_cycle() {
     }
 }
 
-void Pmc007Sim::reset_to_new() {
+void Sim::reset_to_new() {
     {
         std::lock_guard lock(m_);
         if (node_ || attaching_ || bus_)
@@ -592,7 +592,7 @@ void Pmc007Sim::reset_to_new() {
     load_power_up(true);
 }
 
-void Pmc007Sim::on_reset(canopen::NmtCommand c) {
+void Sim::on_reset(canopen::NmtCommand c) {
     if (c == canopen::NmtCommand::ResetNode) {
         load_power_up(false);  // B-P28: "re-enter power-on reset process"
     } else {
@@ -604,27 +604,27 @@ void Pmc007Sim::on_reset(canopen::NmtCommand c) {
 
 // ---- state --------------------------------------------------------------------------
 
-std::uint8_t Pmc007Sim::error_status() {
+std::uint8_t Sim::error_status() {
     std::lock_guard lock(m_);
     return errors_;
 }
 
-std::uint8_t Pmc007Sim::controller_status() {
+std::uint8_t Sim::controller_status() {
     std::lock_guard lock(m_);
     return static_cast<std::uint8_t>(latched_ | (motor_.moving() ? st::kBusy : 0));
 }
 
-std::int32_t Pmc007Sim::position() {
+std::int32_t Sim::position() {
     std::lock_guard lock(m_);
     return static_cast<std::int32_t>(std::llround(motor_.pulse_position()));
 }
 
-double Pmc007Sim::velocity() {
+double Sim::velocity() {
     std::lock_guard lock(m_);
     return motor_.moving() ? motor_.pulse_velocity() : 0.0;
 }
 
-bool Pmc007Sim::active() {
+bool Sim::active() {
     std::lock_guard lock(m_);
     if (motor_.moving() || running_ || bootloader_pending_ || !emcy_queue_.empty()) return true;
     for (const auto& p : pending_)
@@ -632,42 +632,42 @@ bool Pmc007Sim::active() {
     return false;
 }
 
-bool Pmc007Sim::busy() {
+bool Sim::busy() {
     std::lock_guard lock(m_);
     return motor_.moving();
 }
 
-bool Pmc007Sim::enabled() { return u(0x600E) == 1; }
+bool Sim::enabled() { return u(0x600E) == 1; }
 
-std::uint16_t Pmc007Sim::gpio_value() {
+std::uint16_t Sim::gpio_value() {
     std::lock_guard lock(m_);
     return static_cast<std::uint16_t>(~levels_ & 0x7FF);  // B-P24: 1 = low level
 }
 
-std::vector<std::uint32_t> Pmc007Sim::flash_program() {
+std::vector<std::uint32_t> Sim::flash_program() {
     std::lock_guard lock(m_);
     return flash_program_;
 }
-std::vector<std::uint32_t> Pmc007Sim::ram_program() {
+std::vector<std::uint32_t> Sim::ram_program() {
     std::lock_guard lock(m_);
     return ram_program_;
 }
-bool Pmc007Sim::program_running() {
+bool Sim::program_running() {
     std::lock_guard lock(m_);
     return running_;
 }
-std::uint32_t Pmc007Sim::program_pointer() {
+std::uint32_t Sim::program_pointer() {
     std::lock_guard lock(m_);
     return pc_;
 }
-std::uint32_t Pmc007Sim::program_counter_value() {
+std::uint32_t Sim::program_counter_value() {
     std::lock_guard lock(m_);
     return counter_;
 }
 
 // ---- time ---------------------------------------------------------------------------
 
-void Pmc007Sim::poll() {
+void Sim::poll() {
     bool to_bootloader = false;
     canopen::LocalNode* n = nullptr;
     {
@@ -687,7 +687,7 @@ void Pmc007Sim::poll() {
     if (to_bootloader && n) enter_bootloader();
 }
 
-void Pmc007Sim::update_locked() {
+void Sim::update_locked() {
     const Nanos now = clock_.now();
     // Debounced input edges in time order (B-P23): an edge counts once the level
     // has been stable for 601Ah ms.  The model advances at most one debounce time
@@ -723,7 +723,7 @@ void Pmc007Sim::update_locked() {
     run_program_locked(now);
 }
 
-void Pmc007Sim::level_change_locked(int bit, bool high, Nanos t) {
+void Sim::level_change_locked(int bit, bool high, Nanos t) {
     const bool was = (levels_ >> bit) & 1;
     if (was == high) return;
     levels_ = static_cast<std::uint16_t>(high ? levels_ | (1u << bit) : levels_ & ~(1u << bit));
@@ -737,7 +737,7 @@ void Pmc007Sim::level_change_locked(int bit, bool high, Nanos t) {
         pending_[bit] = Pending{t, high};
 }
 
-void Pmc007Sim::set_input(int bit, bool high) {
+void Sim::set_input(int bit, bool high) {
     if (bit < 0 || bit > 10) throw InvalidArgument("pmc007 sim: input bit must be 0..10, not " + std::to_string(bit));
     {
         std::lock_guard lock(m_);
@@ -748,7 +748,7 @@ void Pmc007Sim::set_input(int bit, bool high) {
     publish();
 }
 
-void Pmc007Sim::input_edge_locked(int bit, bool high, Nanos t) {
+void Sim::input_edge_locked(int bit, bool high, Nanos t) {
     // External stops (B-P22): EXT1 = port 7 / enable bit 0, EXT2 = port 8 / bit 1, EXT3 = ENC1 = port 9 / bit 4.
     int sel = -1;
     std::uint8_t latch = 0;
@@ -775,7 +775,7 @@ void Pmc007Sim::input_edge_locked(int bit, bool high, Nanos t) {
     if (bit == 1 && !high && pause_en_) paused_ = !paused_;
 }
 
-void Pmc007Sim::set_jammed(bool jammed) {
+void Sim::set_jammed(bool jammed) {
     {
         std::lock_guard lock(m_);
         update_locked();
@@ -786,7 +786,7 @@ void Pmc007Sim::set_jammed(bool jammed) {
     publish();
 }
 
-void Pmc007Sim::inject_error(std::uint8_t bits) {
+void Sim::inject_error(std::uint8_t bits) {
     {
         std::lock_guard lock(m_);
         update_locked();
@@ -804,7 +804,7 @@ void Pmc007Sim::inject_error(std::uint8_t bits) {
     publish();
 }
 
-void Pmc007Sim::on_motor_event(const motion::MotorEvent& e) {
+void Sim::on_motor_event(const motion::MotorEvent& e) {
     // Called from motor_.update() with m_ held.
     using K = motion::MotorEvent::Kind;
     if (e.kind == K::Stalled) {
@@ -822,7 +822,7 @@ void Pmc007Sim::on_motor_event(const motion::MotorEvent& e) {
     }
 }
 
-std::uint8_t Pmc007Sim::error_register_locked() const {
+std::uint8_t Sim::error_register_locked() const {
     // 1001h [CiA]: bit 0 generic, 1 current, 2 voltage, 3 temperature.
     std::uint8_t er = 0;
     if (errors_) er |= 0x01;
@@ -833,7 +833,7 @@ std::uint8_t Pmc007Sim::error_register_locked() const {
     return er;
 }
 
-void Pmc007Sim::emcy_locked(std::uint16_t code) {
+void Sim::emcy_locked(std::uint16_t code) {
     // 1003h history, newest first [CiA]: which errors the PMC007 logs is not documented;
     // the sim logs what it signals by EMCY (not the 0000h "all clear").
     if (code != 0) {
@@ -852,7 +852,7 @@ void Pmc007Sim::emcy_locked(std::uint16_t code) {
     flush_emcy_locked();
 }
 
-void Pmc007Sim::flush_emcy_locked() {
+void Sim::flush_emcy_locked() {
     // 1015h [CiA]: an EMCY inside the inhibit time is delayed until it has passed, not dropped.
     while (!emcy_queue_.empty()) {
         if (!node_ || node_->nmt_state() == NmtState::Stopped || node_->nmt_state() == NmtState::Initialising) {
@@ -873,7 +873,7 @@ void Pmc007Sim::flush_emcy_locked() {
     }
 }
 
-void Pmc007Sim::comm_error(std::uint16_t code, bool active) {
+void Sim::comm_error(std::uint16_t code, bool active) {
     {
         std::lock_guard lock(m_);
         if (active) {
@@ -886,7 +886,7 @@ void Pmc007Sim::comm_error(std::uint16_t code, bool active) {
     publish();
 }
 
-void Pmc007Sim::emcy_if_cleared_locked() {
+void Sim::emcy_if_cleared_locked() {
     // B-P30 [P]: EMCY 0000h when every error is clear again (6000h, the 6001h latches and
     // the communication errors).
     if (emcy_error_ && errors_ == 0 && comm_errors_.empty() &&
@@ -898,13 +898,13 @@ void Pmc007Sim::emcy_if_cleared_locked() {
 
 // ---- motion ------------------------------------------------------------------------
 
-bool Pmc007Sim::refused_locked() const {
+bool Sim::refused_locked() const {
     // B-P08, B-P19, B-P20.
     return errors_ != 0 || (latched_ & (st::kExt1 | st::kExt2 | st::kStall | st::kExt3)) != 0 || u(0x600E) != 1;
 }
 
-Pmc007ProfileParams Pmc007Sim::params_locked(double speed) const {
-    Pmc007ProfileParams p;
+ProfileParams Sim::params_locked(double speed) const {
+    ProfileParams p;
     p.speed = speed;
     p.start_speed = double(u(0x6006));
     p.stop_speed = double(u(0x6007));
@@ -914,7 +914,7 @@ Pmc007ProfileParams Pmc007Sim::params_locked(double speed) const {
     return p;
 }
 
-std::uint32_t Pmc007Sim::start_move_locked(std::int64_t delta) {
+std::uint32_t Sim::start_move_locked(std::int64_t delta) {
     if (delta == 0) return 0;
     double speed = std::fabs(double(u(0x6003)));
     if (speed <= 0) speed = double(u(0x6006));  // [P] no run speed set: the start speed
@@ -924,12 +924,12 @@ std::uint32_t Pmc007Sim::start_move_locked(std::int64_t delta) {
     return 0;
 }
 
-void Pmc007Sim::stop_now_locked() {
+void Sim::stop_now_locked() {
     motor_.halt();
     speed_mode_running_ = false;
 }
 
-std::uint32_t Pmc007Sim::on_write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> d) {
+std::uint32_t Sim::on_write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> d) {
     std::lock_guard lock(m_);
     update_locked();
     const auto* row = pmc007_od_row(index, sub);
@@ -1057,7 +1057,7 @@ std::uint32_t Pmc007Sim::on_write(std::uint16_t index, std::uint8_t sub, std::sp
     }
 }
 
-void Pmc007Sim::factory_reset_locked() {
+void Sim::factory_reset_locked() {
     // Every ROM object to its factory value in the working copy (C-P19: flash untouched).
     // The objects a service owns take it through that service: the heartbeat producer and
     // consumers through their write hooks, the PDO parameters by rebuilding the engine
@@ -1076,7 +1076,7 @@ void Pmc007Sim::factory_reset_locked() {
 
 // ---- offline program --------------------------------------------------------------
 
-void Pmc007Sim::run_program_locked(Nanos) {
+void Sim::run_program_locked(Nanos) {
     for (int guard = 0; guard < 1000 && running_ && !paused_; ++guard) {
         const auto count = static_cast<std::uint32_t>(u(0x6018, 1));
         if (pc_ >= count || pc_ >= ram_program_.size()) {
@@ -1087,7 +1087,7 @@ void Pmc007Sim::run_program_locked(Nanos) {
     }
 }
 
-bool Pmc007Sim::exec_locked(std::uint32_t word, bool single) {
+bool Sim::exec_locked(std::uint32_t word, bool single) {
     auto ins = decode(word);
     if (!ins) {  // [P] unknown opcode: the program faults, pointer unchanged
         running_ = false;

@@ -63,7 +63,9 @@ constexpr int kGpio1 = 0, kExt1 = 7, kExt2 = 8, kEnc1 = 9, kEnc2 = 10;
 inline constexpr std::uint32_t kAbortDeviceState = 0x08000022;
 inline constexpr std::uint32_t kAbortValueRange = 0x06090030;
 
-struct Pmc007SimOptions {
+struct SimOptions;
+using Pmc007SimOptions = SimOptions;  // issue 24's old name, while parallel edits land (removed after)
+struct SimOptions {
     double steps_per_rev = 200;  // full steps of the motor (1.8 degree)
     double pull_out_speed = 0;   // steps/s above which the rotor stalls (0 = never)
     // A switch wired to EXT1 (pulls it low while lo <= position <= hi), e.g. the
@@ -78,18 +80,20 @@ struct Pmc007SimOptions {
     // What 1018h reads (003 documents no identity): vendor 0 = none claimed (a CiA
     // vendor ID is assigned, not invented), product code 7 ("PMC007"), revision 1.0
     // (as 100Ah "SW1.0"), serial 1.  A bench can give each sim its own.
-    Pmc007Identity identity{0, 7, 0x00010000, 1};
+    Identity identity{0, 7, 0x00010000, 1};
 };
 
 // 2003h baud index -> bit/s (003 §4.3.2); -1 for an index outside 0..8.
 double baud_index_bps(int index);
 
-class Pmc007Sim {
+class Sim;
+using Pmc007Sim = Sim;  // issue 24's old name, while parallel edits land (removed after)
+class Sim {
 public:
-    Pmc007Sim(std::uint8_t node_id, Clock& clock, Pmc007SimOptions options = {});
-    ~Pmc007Sim();
-    Pmc007Sim(const Pmc007Sim&) = delete;
-    Pmc007Sim& operator=(const Pmc007Sim&) = delete;
+    Sim(std::uint8_t node_id, Clock& clock, SimOptions options = {});
+    ~Sim();
+    Sim(const Sim&) = delete;
+    Sim& operator=(const Sim&) = delete;
 
     // Serve on `bus` (boot-up sent); InvalidArgument if already attached.
     void attach(can::Bus& bus);
@@ -172,7 +176,7 @@ private:
     std::uint32_t start_move_locked(std::int64_t delta);
     bool refused_locked() const;
     void stop_now_locked();
-    Pmc007ProfileParams params_locked(double speed) const;
+    ProfileParams params_locked(double speed) const;
     void on_motor_event(const motion::MotorEvent& e);
     void input_edge_locked(int bit, bool high, Nanos t);
     void level_change_locked(int bit, bool high, Nanos t);
@@ -200,7 +204,7 @@ private:
     std::atomic<std::uint8_t> node_id_;
     std::atomic<std::uint8_t> baud_index_{4};
     Clock& clock_;
-    Pmc007SimOptions opt_;
+    SimOptions opt_;
     std::shared_ptr<canopen::ObjectDictionary> od_;
     motion::MotorModel motor_;
     mutable std::recursive_mutex m_;

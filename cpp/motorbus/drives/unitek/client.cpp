@@ -63,9 +63,9 @@ std::size_t RingBuffer::read(std::uint64_t& cursor, Nanos* t, std::int64_t* v, s
     return n;
 }
 
-// ---- UnitekClient ----------------------------------------------------------------------
+// ---- Client ----------------------------------------------------------------------
 
-UnitekClient::UnitekClient(can::Bus& bus, RegisterTable table, ClientOptions options)
+Client::Client(can::Bus& bus, RegisterTable table, ClientOptions options)
     : bus_(bus), table_(std::move(table)), opt_(options), rx_id_(options.rx_id) {
     if (opt_.rx_id < kRxIdMin || opt_.rx_id > kRxIdMax)
         throw InvalidArgument("unitek rx_id: 0x201..0x27F, not " + std::to_string(opt_.rx_id));
@@ -75,14 +75,14 @@ UnitekClient::UnitekClient(can::Bus& bus, RegisterTable table, ClientOptions opt
     sub_ = bus_.subscribe_id(opt_.tx_id, false, [this](const can::Frame& f) { on_frame(f); });
 }
 
-UnitekClient::~UnitekClient() {
+Client::~Client() {
     try {
         close();
     } catch (...) {
     }
 }
 
-void UnitekClient::close() {
+void Client::close() {
     if (closing_.exchange(true)) return;
     std::vector<std::uint8_t> regids;
     {
@@ -105,17 +105,17 @@ void UnitekClient::close() {
     cv_.notify_all();
 }
 
-void UnitekClient::add_register(Register r) {
+void Client::add_register(Register r) {
     std::lock_guard l(m_);
     table_.add(std::move(r));
 }
 
-void UnitekClient::send(const std::vector<std::uint8_t>& bytes) {
+void Client::send(const std::vector<std::uint8_t>& bytes) {
     if (closed_.load()) throw ClosedError("unitek client: closed");
     bus_.send(can::Frame::make(rx_id_.load(), bytes), opt_.timeout);
 }
 
-void UnitekClient::write(std::uint8_t regid, std::int64_t value) {
+void Client::write(std::uint8_t regid, std::int64_t value) {
     std::vector<std::uint8_t> bytes;
     {
         std::lock_guard l(m_);
@@ -129,12 +129,12 @@ void UnitekClient::write(std::uint8_t regid, std::int64_t value) {
     }
 }
 
-void UnitekClient::write_raw(std::uint8_t regid, std::int64_t value, int bits) {
+void Client::write_raw(std::uint8_t regid, std::int64_t value, int bits) {
     if (regid == kRegRead) throw InvalidArgument("unitek write_raw: 0x3D is the read request (use read/subscribe)");
     send(encode_write(regid, value, bits));
 }
 
-std::int64_t UnitekClient::read(std::uint8_t regid, std::optional<std::chrono::nanoseconds> timeout) {
+std::int64_t Client::read(std::uint8_t regid, std::optional<std::chrono::nanoseconds> timeout) {
     const auto limit = timeout.value_or(opt_.timeout);
     if (limit <= std::chrono::nanoseconds::zero()) throw InvalidArgument("unitek read timeout: must be positive");
     std::unique_lock l(m_);
@@ -160,7 +160,7 @@ std::int64_t UnitekClient::read(std::uint8_t regid, std::optional<std::chrono::n
     return last_value_[regid];
 }
 
-std::shared_ptr<Stream> UnitekClient::subscribe(std::uint8_t regid, int interval_ms, std::size_t capacity,
+std::shared_ptr<Stream> Client::subscribe(std::uint8_t regid, int interval_ms, std::size_t capacity,
                                                 SampleCallback callback) {
     auto bytes = encode_cyclic(regid, interval_ms);  // checks the interval first
     std::shared_ptr<Stream> s;
@@ -188,7 +188,7 @@ std::shared_ptr<Stream> UnitekClient::subscribe(std::uint8_t regid, int interval
     return s;
 }
 
-void UnitekClient::unsubscribe(std::uint8_t regid) {
+void Client::unsubscribe(std::uint8_t regid) {
     std::shared_ptr<Stream> s;
     {
         std::lock_guard l(m_);
@@ -201,60 +201,60 @@ void UnitekClient::unsubscribe(std::uint8_t regid) {
     send(encode_request(regid, kIntervalStop));
 }
 
-std::vector<std::shared_ptr<Stream>> UnitekClient::streams() const {
+std::vector<std::shared_ptr<Stream>> Client::streams() const {
     std::lock_guard l(m_);
     std::vector<std::shared_ptr<Stream>> out;
     for (auto& [id, s] : streams_) out.push_back(s);
     return out;
 }
 
-void UnitekClient::write_mode(std::uint16_t mode) { write(kRegMode, mode); }
+void Client::write_mode(std::uint16_t mode) { write(kRegMode, mode); }
 
-void UnitekClient::enable() { write_mode(static_cast<std::uint16_t>(mode() & ~kModeDisable)); }
-void UnitekClient::disable() { write_mode(static_cast<std::uint16_t>(mode() | kModeDisable)); }
+void Client::enable() { write_mode(static_cast<std::uint16_t>(mode() & ~kModeDisable)); }
+void Client::disable() { write_mode(static_cast<std::uint16_t>(mode() | kModeDisable)); }
 
-void UnitekClient::set_events(bool on, std::optional<std::uint16_t> mask) {
+void Client::set_events(bool on, std::optional<std::uint16_t> mask) {
     if (mask) write(kRegEventMask, *mask);
     const std::uint16_t m = mode();
     write_mode(static_cast<std::uint16_t>(on ? (m | kModeEvents) : (m & ~kModeEvents)));
 }
 
-void UnitekClient::on_status(StatusCallback cb) {
+void Client::on_status(StatusCallback cb) {
     std::lock_guard l(m_);
     status_cb_ = std::move(cb);
 }
 
-std::optional<std::uint32_t> UnitekClient::last_event_status() const {
+std::optional<std::uint32_t> Client::last_event_status() const {
     std::lock_guard l(m_);
     return last_status_;
 }
 
-std::uint64_t UnitekClient::events() const {
+std::uint64_t Client::events() const {
     std::lock_guard l(m_);
     return events_;
 }
 
-std::uint16_t UnitekClient::mode() const {
+std::uint16_t Client::mode() const {
     std::lock_guard l(m_);
     return mode_;
 }
 
-void UnitekClient::set_receive_id(std::uint32_t rx_id) {
+void Client::set_receive_id(std::uint32_t rx_id) {
     write(kRegRxId, rx_id);  // checks 0x201..0x27F
     rx_id_ = rx_id;
 }
 
-void UnitekClient::store_eeprom(int level) {
+void Client::store_eeprom(int level) {
     if (level != 0 && level != 1) throw InvalidArgument("unitek EEPROM level: 0 or 1, not " + std::to_string(level));
     write(kRegEeprom, level);
 }
 
-ClientCounters UnitekClient::counters() const {
+ClientCounters Client::counters() const {
     std::lock_guard l(m_);
     return counters_;
 }
 
-void UnitekClient::on_frame(const can::Frame& f) {
+void Client::on_frame(const can::Frame& f) {
     if (f.rtr || f.extended || (f.flags & can::kFlagLoopback)) return;
     const Nanos t = opt_.clock ? opt_.clock->now() : (f.timestamp_ns ? f.timestamp_ns : monotonic_ns());
     FromDrive d;

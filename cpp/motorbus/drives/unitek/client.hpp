@@ -76,12 +76,14 @@ struct ClientCounters {
     std::uint64_t callback_errors = 0;
 };
 
-class UnitekClient {
+class Client;
+using UnitekClient = Client;  // issue 24's old name, while parallel edits land (removed after)
+class Client {
 public:
-    UnitekClient(can::Bus& bus, RegisterTable table = RegisterTable::builtin(), ClientOptions options = {});
-    ~UnitekClient();
-    UnitekClient(const UnitekClient&) = delete;
-    UnitekClient& operator=(const UnitekClient&) = delete;
+    Client(can::Bus& bus, RegisterTable table = RegisterTable::builtin(), ClientOptions options = {});
+    ~Client();
+    Client(const Client&) = delete;
+    Client& operator=(const Client&) = delete;
 
     const RegisterTable& table() const { return table_; }
     void add_register(Register r);

@@ -14,7 +14,7 @@ std::string hex_id(std::uint32_t id) {
     return buf;
 }
 
-void check_regids(const UnitekClient& client, const std::vector<std::uint8_t>& regids, const char* what) {
+void check_regids(const Client& client, const std::vector<std::uint8_t>& regids, const char* what) {
     if (regids.empty()) throw InvalidArgument(std::string(what) + ": at least one register");
     for (auto r : regids) {
         const Register& reg = client.table().at(r);  // UnknownRegister
@@ -25,7 +25,7 @@ void check_regids(const UnitekClient& client, const std::vector<std::uint8_t>& r
 
 }  // namespace
 
-PollSource::PollSource(UnitekClient& client, std::vector<std::uint8_t> regids)
+PollSource::PollSource(Client& client, std::vector<std::uint8_t> regids)
     : client_(client), regids_(std::move(regids)) {
     check_regids(client_, regids_, "unitek poll source");
 }
@@ -36,7 +36,7 @@ void PollSource::read(double* out) {
 
 std::string PollSource::describe() const { return "unitek rx " + hex_id(client_.rx_id()); }
 
-CaptureSource::CaptureSource(UnitekClient& client, can::Bus& bus, std::vector<std::uint8_t> regids, int interval_ms,
+CaptureSource::CaptureSource(Client& client, can::Bus& bus, std::vector<std::uint8_t> regids, int interval_ms,
                              Nanos max_age_ns)
     : client_(client), bus_(bus), regids_(std::move(regids)), interval_ms_(interval_ms),
       t_(regids_.size()), v_(regids_.size()) {

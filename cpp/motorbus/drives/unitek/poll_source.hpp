@@ -1,4 +1,4 @@
-// Poll sources for UNITEK drives (motorbus.Poller), on the drive's own UnitekClient:
+// Poll sources for UNITEK drives (motorbus.Poller), on the drive's own Client:
 //
 // * PollSource asks: one `3D REGID 00` read per field each sample (the client
 //   matches the reply; a commanding thread's reads of other REGIDs interleave);
@@ -24,14 +24,14 @@ class PollSource final : public poll::Source {
 public:
     // `client` must outlive the source (the bindings keep it alive).
     // UnknownRegister / InvalidArgument for a register the table lacks or cannot read.
-    PollSource(UnitekClient& client, std::vector<std::uint8_t> regids);
+    PollSource(Client& client, std::vector<std::uint8_t> regids);
 
     std::size_t columns() const override { return regids_.size(); }
     void read(double* out) override;
     std::string describe() const override;
 
 private:
-    UnitekClient& client_;
+    Client& client_;
     std::vector<std::uint8_t> regids_;
 };
 
@@ -41,7 +41,7 @@ public:
     // transmits cyclically (a user's Stream: then its interval is kept and the
     // stream is left running at close()).  Data older than max_age_ns (default:
     // 3 intervals + 2 ms) counts as stale.  CyclicLimit past 8 cyclic registers.
-    CaptureSource(UnitekClient& client, can::Bus& bus, std::vector<std::uint8_t> regids, int interval_ms,
+    CaptureSource(Client& client, can::Bus& bus, std::vector<std::uint8_t> regids, int interval_ms,
                   Nanos max_age_ns = 0);
     ~CaptureSource() override;
 
@@ -57,7 +57,7 @@ public:
     Nanos max_age_ns() const { return max_age_; }
 
 private:
-    UnitekClient& client_;
+    Client& client_;
     can::Bus& bus_;
     std::vector<std::uint8_t> regids_;
     std::vector<std::shared_ptr<Stream>> streams_;

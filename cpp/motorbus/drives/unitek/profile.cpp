@@ -7,7 +7,7 @@
 
 namespace motorbus::unitek {
 
-void UnitekRampParams::validate() const {
+void RampParams::validate() const {
     if (!(n_max_rpm > 0) || !std::isfinite(n_max_rpm)) throw LimitExceeded("N max", n_max_rpm, 0, "must be positive");
     for (auto [name, v] : {std::pair{"ACC ramp (0x35)", acc_ramp_ms}, std::pair{"DEC ramp (0xED)", dec_ramp_ms}}) {
         if (v < 0 || !std::isfinite(v)) throw LimitExceeded(name, v, 0, "ms");
@@ -15,11 +15,11 @@ void UnitekRampParams::validate() const {
     }
 }
 
-double unitek_num_to_counts_per_s(double num, const UnitekRampParams& p) {
+double unitek_num_to_counts_per_s(double num, const RampParams& p) {
     return num / kUnitekFullScale * p.n_max_rpm / 60.0 * kUnitekCountsPerRev;
 }
 
-Profile unitek_speed_profile(const State& start, double speed_num, const UnitekRampParams& p, double hold) {
+Profile unitek_speed_profile(const State& start, double speed_num, const RampParams& p, double hold) {
     p.validate();
     if (!std::isfinite(speed_num)) throw InvalidArgument("UNITEK speed command must be finite");
     speed_num = std::clamp(speed_num, -kUnitekFullScale, kUnitekFullScale);

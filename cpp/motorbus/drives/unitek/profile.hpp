@@ -20,7 +20,9 @@ inline constexpr std::uint8_t kUnitekRegDecRamp = 0xED;
 inline constexpr double kUnitekCountsPerRev = 65536.0;
 inline constexpr double kUnitekFullScale = 32767.0;
 
-struct UnitekRampParams {
+struct RampParams;
+using UnitekRampParams = RampParams;  // issue 24's old name, while parallel edits land (removed after)
+struct RampParams {
     double n_max_rpm = 3000;   // N max: the speed of 32767 num
     double acc_ramp_ms = 1000; // register 0x35
     double dec_ramp_ms = 1000; // register 0xED
@@ -28,9 +30,9 @@ struct UnitekRampParams {
 };
 
 // num -> counts/s
-double unitek_num_to_counts_per_s(double num, const UnitekRampParams& p);
+double unitek_num_to_counts_per_s(double num, const RampParams& p);
 // The drive's ramp from start.v (counts/s) to the command `speed_num`, held for `hold` s.
 // |speed_num| is limited to 32767.
-Profile unitek_speed_profile(const State& start, double speed_num, const UnitekRampParams& p, double hold);
+Profile unitek_speed_profile(const State& start, double speed_num, const RampParams& p, double hold);
 
 }  // namespace motorbus::unitek

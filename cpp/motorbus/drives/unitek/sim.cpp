@@ -83,7 +83,7 @@ RegisterTable sim_default_table() {
 void SimConfig::validate() const {
     if (rx_id < kRxIdMin || rx_id > kRxIdMax) throw InvalidArgument("unitek sim rx_id: 0x201..0x27F");
     if (tx_id < kTxIdMin || tx_id > kTxIdMax) throw InvalidArgument("unitek sim tx_id: 0x181..0x1FF");
-    UnitekRampParams{n_max_rpm, acc_ramp_ms, dec_ramp_ms}.validate();
+    RampParams{n_max_rpm, acc_ramp_ms, dec_ramp_ms}.validate();
     if (tol_num < 0) throw InvalidArgument("unitek sim tol_num: >= 0");
     if (minus_limit_num && plus_limit_num && !(*minus_limit_num < *plus_limit_num))
         throw InvalidArgument("unitek sim limits: minus_limit_num must be below plus_limit_num");
@@ -101,7 +101,7 @@ void SimConfig::validate() const {
                               std::to_string(*motor_i_max_num));
 }
 
-UnitekSim::UnitekSim(Clock& clock, SimConfig cfg, RegisterTable table)
+Sim::Sim(Clock& clock, SimConfig cfg, RegisterTable table)
     : clock_(clock), cfg_((cfg.validate(), cfg)), table_(std::move(table)), motor_(clock, motor_config(cfg_)),
       rx_id_(cfg_.rx_id), calibrated_(cfg_.calibrated) {
     reset_ram_locked();
@@ -113,9 +113,9 @@ UnitekSim::UnitekSim(Clock& clock, SimConfig cfg, RegisterTable table)
     last_status_ = status_locked();
 }
 
-UnitekSim::~UnitekSim() { close(); }
+Sim::~Sim() { close(); }
 
-void UnitekSim::reset_ram_locked() {
+void Sim::reset_ram_locked() {
     for (const auto& r : table_.rows()) regs_[r.regid] = 0;
     regs_[kRegEventMask] = kDefaultEventMask;
     regs_[kRegCurrentLimit] =
@@ -126,7 +126,7 @@ void UnitekSim::reset_ram_locked() {
     activity_ = Activity::Idle;
 }
 
-void UnitekSim::attach(can::Bus& bus) {
+void Sim::attach(can::Bus& bus) {
     std::lock_guard l(m_);
     if (bus_ != nullptr) throw InvalidArgument("unitek sim: already attached");
     bus_ = &bus;
@@ -142,12 +142,12 @@ void UnitekSim::attach(can::Bus& bus) {
     timer_->start(clock_, [this](Nanos) { return service(); }, 10'000'000);
 }
 
-void UnitekSim::set_output(std::function<void(const can::Frame&)> out) {
+void Sim::set_output(std::function<void(const can::Frame&)> out) {
     std::lock_guard l(m_);
     out_ = std::move(out);
 }
 
-void UnitekSim::close() {
+void Sim::close() {
     if (timer_) timer_->stop();
     can::Bus* bus = nullptr;
     {
@@ -161,7 +161,7 @@ void UnitekSim::close() {
     out_ = nullptr;
 }
 
-void UnitekSim::send(const std::vector<can::Frame>& frames) {
+void Sim::send(const std::vector<can::Frame>& frames) {
     std::function<void(const can::Frame&)> out;
     {
         std::lock_guard l(m_);
@@ -181,16 +181,16 @@ void UnitekSim::send(const std::vector<can::Frame>& frames) {
 
 // ---- time ------------------------------------------------------------------------------
 
-motion::State UnitekSim::state_locked() {
+motion::State Sim::state_locked() {
     return motion::State{motor_.pulse_position(), motor_.pulse_velocity(), 0, 0};
 }
 
-UnitekRampParams UnitekSim::ramps_locked() const {
+RampParams Sim::ramps_locked() const {
     const auto acc = regs_.count(kRegAccRamp) ? static_cast<double>(regs_.at(kRegAccRamp)) : cfg_.acc_ramp_ms;
-    return UnitekRampParams{cfg_.n_max_rpm, acc, cfg_.dec_ramp_ms};
+    return RampParams{cfg_.n_max_rpm, acc, cfg_.dec_ramp_ms};
 }
 
-std::vector<can::Frame> UnitekSim::advance_locked(Nanos now) {
+std::vector<can::Frame> Sim::advance_locked(Nanos now) {
     std::vector<can::Frame> out;
     // Cyclic frames in time order; the motor is advanced to each frame's time so
     // the value is the one of that instant.
@@ -211,7 +211,7 @@ std::vector<can::Frame> UnitekSim::advance_locked(Nanos now) {
     return out;
 }
 
-void UnitekSim::limits_locked() {
+void Sim::limits_locked() {
     // The drive's limit reaction: a motion towards an active limit switch stops
     // (seen at the sim's evaluation times: at most one service period late).
     if (!motor_.moving()) return;
@@ -222,7 +222,7 @@ void UnitekSim::limits_locked() {
     }
 }
 
-Nanos UnitekSim::service() {
+Nanos Sim::service() {
     std::vector<can::Frame> out;
     Nanos next = -1;
     {
@@ -241,7 +241,7 @@ Nanos UnitekSim::service() {
 
 // ---- frames ------------------------------------------------------------------------------
 
-void UnitekSim::on_frame(const can::Frame& f) {
+void Sim::on_frame(const can::Frame& f) {
     std::vector<can::Frame> out;
     std::optional<std::map<std::uint8_t, std::int64_t>> stored;
     std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb;
@@ -287,7 +287,7 @@ void UnitekSim::on_frame(const can::Frame& f) {
     if (timer_) timer_->poke();
 }
 
-void UnitekSim::handle_locked(const ToDrive& t, std::vector<can::Frame>& out) {
+void Sim::handle_locked(const ToDrive& t, std::vector<can::Frame>& out) {
     if (!t.is_request()) {
         write_locked(t.regid, t.value, t.value_bits);
         return;
@@ -320,7 +320,7 @@ void UnitekSim::handle_locked(const ToDrive& t, std::vector<can::Frame>& out) {
     }
 }
 
-void UnitekSim::emit_reply_locked(std::uint8_t regid, std::vector<can::Frame>& out) {
+void Sim::emit_reply_locked(std::uint8_t regid, std::vector<can::Frame>& out) {
     const Register* r = table_.find(regid);
     if (r == nullptr) return;
     const std::int64_t v = value_locked(regid);
@@ -331,7 +331,7 @@ void UnitekSim::emit_reply_locked(std::uint8_t regid, std::vector<can::Frame>& o
     ++counters_.frames_out;
 }
 
-void UnitekSim::check_events_locked(std::vector<can::Frame>& out) {
+void Sim::check_events_locked(std::vector<can::Frame>& out) {
     const std::uint32_t st = status_locked();
     const std::uint32_t changed = st ^ last_status_;
     last_status_ = st;
@@ -346,7 +346,7 @@ void UnitekSim::check_events_locked(std::vector<can::Frame>& out) {
 
 // ---- writes ------------------------------------------------------------------------------
 
-void UnitekSim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
+void Sim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
     const Register* r = table_.find(regid);
     if (r == nullptr) {
         ++counters_.unknown;  // no NACK exists: ignored
@@ -419,13 +419,13 @@ void UnitekSim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
     }
 }
 
-void UnitekSim::speed_locked(double num, double ramp_scale) {
+void Sim::speed_locked(double num, double ramp_scale) {
     auto p = ramps_locked();
     p.acc_ramp_ms = std::min(p.acc_ramp_ms * ramp_scale, 32767.0);
     motor_.command(unitek_speed_profile(state_locked(), num, p, kHoldForever));
 }
 
-void UnitekSim::apply_enable_locked() {
+void Sim::apply_enable_locked() {
     if (!(status_locked() & kStatusEna) && motor_.moving()) {
         // The power stage is off: the sim stops the rotor where it is (no load model to coast).
         motor_.halt();
@@ -435,7 +435,7 @@ void UnitekSim::apply_enable_locked() {
 
 // ---- reads ---------------------------------------------------------------------------------
 
-std::uint32_t UnitekSim::status_locked() {
+std::uint32_t Sim::status_locked() {
     std::uint32_t s = 0;
     if (!(mode_ & kModeDisable) && hw_enable_ && !(err_warn_ & kErrorBits)) s |= kStatusEna;
     if (motor_.plus_limit_active()) s |= kStatusLimPlus;
@@ -453,7 +453,7 @@ std::uint32_t UnitekSim::status_locked() {
     return s;
 }
 
-std::int64_t UnitekSim::value_locked(std::uint8_t regid) {
+std::int64_t Sim::value_locked(std::uint8_t regid) {
     switch (regid) {
         case kRegStatus: return status_locked() & 0xFFFF;  // C-U02: 16 bits in a read reply
         case kRegErrWarn: return err_warn_;
@@ -482,7 +482,7 @@ std::int64_t UnitekSim::value_locked(std::uint8_t regid) {
     }
 }
 
-std::int64_t UnitekSim::current_limit_locked() const {
+std::int64_t Sim::current_limit_locked() const {
     const auto it = regs_.find(kRegCurrentLimit);
     return effective_current_limit_num(device_current(cfg_.device), it == regs_.end() ? 0 : it->second);
 }
@@ -499,11 +499,11 @@ std::int64_t UnitekSim::current_limit_locked() const {
     }                                                  \
     send(out_frames)
 
-void UnitekSim::set_hardware_enable(bool on) {
+void Sim::set_hardware_enable(bool on) {
     UNITEK_SIM_LOCKED(hw_enable_ = on; apply_enable_locked(); if (on) analog_speed_locked());
 }
 
-void UnitekSim::force_limit(int direction, std::optional<bool> active) {
+void Sim::force_limit(int direction, std::optional<bool> active) {
     if (direction != 1 && direction != -1) throw InvalidArgument("unitek sim force_limit: direction +1 or -1");
     UNITEK_SIM_LOCKED({
         motor_.force_switch(direction > 0 ? motion::Switch::PlusLimit : motion::Switch::MinusLimit, active);
@@ -512,13 +512,13 @@ void UnitekSim::force_limit(int direction, std::optional<bool> active) {
     });
 }
 
-void UnitekSim::set_analog_input(int channel, double volts) {
+void Sim::set_analog_input(int channel, double volts) {
     if (channel != 1 && channel != 2) throw InvalidArgument("unitek sim analog input: 1 (AIN1) or 2 (AIN2)");
     const std::int64_t num = analog_command_num(volts);
     UNITEK_SIM_LOCKED(ain_[channel - 1] = num; analog_speed_locked());
 }
 
-void UnitekSim::analog_speed_locked() {
+void Sim::analog_speed_locked() {
     // The analog input is the speed command when NDrive selects it; like SPEED_CMD,
     // it takes effect while the drive is enabled.
     if (cfg_.analog_command == 0 || !(status_locked() & kStatusEna)) return;
@@ -526,13 +526,13 @@ void UnitekSim::analog_speed_locked() {
     speed_locked(static_cast<double>(ain_[cfg_.analog_command - 1]), 1.0);
 }
 
-void UnitekSim::set_calibrated(bool on) { UNITEK_SIM_LOCKED(calibrated_ = on); }
+void Sim::set_calibrated(bool on) { UNITEK_SIM_LOCKED(calibrated_ = on); }
 
-void UnitekSim::force_icns(std::optional<bool> active) { UNITEK_SIM_LOCKED(icns_forced_ = active); }
+void Sim::force_icns(std::optional<bool> active) { UNITEK_SIM_LOCKED(icns_forced_ = active); }
 
-void UnitekSim::force_error(std::uint32_t bits) { UNITEK_SIM_LOCKED(err_warn_ |= bits; apply_enable_locked()); }
+void Sim::force_error(std::uint32_t bits) { UNITEK_SIM_LOCKED(err_warn_ |= bits; apply_enable_locked()); }
 
-void UnitekSim::power_cycle() {
+void Sim::power_cycle() {
     std::lock_guard l(m_);
     motor_.advance_to(std::max(clock_.now(), motor_.time()));
     motor_.halt();
@@ -546,72 +546,72 @@ void UnitekSim::power_cycle() {
     last_status_ = status_locked();
 }
 
-std::uint32_t UnitekSim::status() {
+std::uint32_t Sim::status() {
     std::lock_guard l(m_);
     motor_.advance_to(std::max(clock_.now(), motor_.time()));
     return status_locked();
 }
 
-std::int64_t UnitekSim::value(std::uint8_t regid) {
+std::int64_t Sim::value(std::uint8_t regid) {
     table_.at(regid);
     std::lock_guard l(m_);
     motor_.advance_to(std::max(clock_.now(), motor_.time()));
     return regid == kRegStatus ? status_locked() : value_locked(regid);
 }
 
-double UnitekSim::position_num() {
+double Sim::position_num() {
     std::lock_guard l(m_);
     motor_.advance_to(std::max(clock_.now(), motor_.time()));
     return motor_.pulse_position();
 }
 
-double UnitekSim::speed_num() {
+double Sim::speed_num() {
     std::lock_guard l(m_);
     motor_.advance_to(std::max(clock_.now(), motor_.time()));
     return motor_.pulse_velocity() / unitek_num_to_counts_per_s(1.0, ramps_locked());
 }
 
-double UnitekSim::bit_rate() const { return bit_timing_for_btr(cfg_.btr).bit_rate(); }
+double Sim::bit_rate() const { return bit_timing_for_btr(cfg_.btr).bit_rate(); }
 
-double UnitekSim::bus_bit_rate() const {
+double Sim::bus_bit_rate() const {
     std::lock_guard l(m_);
     return bus_bit_rate_;
 }
 
-std::uint32_t UnitekSim::rx_id() const {
+std::uint32_t Sim::rx_id() const {
     std::lock_guard l(m_);
     return rx_id_;
 }
 
-std::vector<std::pair<std::uint8_t, int>> UnitekSim::cyclic() const {
+std::vector<std::pair<std::uint8_t, int>> Sim::cyclic() const {
     std::lock_guard l(m_);
     std::vector<std::pair<std::uint8_t, int>> out;
     for (const auto& s : slots_) out.emplace_back(s.regid, static_cast<int>(s.period / 1'000'000));
     return out;
 }
 
-std::uint64_t UnitekSim::sent(std::uint8_t regid) const {
+std::uint64_t Sim::sent(std::uint8_t regid) const {
     std::lock_guard l(m_);
     auto it = sent_.find(regid);
     return it == sent_.end() ? 0 : it->second;
 }
 
-SimCounters UnitekSim::counters() const {
+SimCounters Sim::counters() const {
     std::lock_guard l(m_);
     return counters_;
 }
 
-void UnitekSim::on_eeprom_store(std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb) {
+void Sim::on_eeprom_store(std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb) {
     std::lock_guard l(m_);
     eeprom_cb_ = std::move(cb);
 }
 
-std::map<std::uint8_t, std::int64_t> UnitekSim::eeprom() const {
+std::map<std::uint8_t, std::int64_t> Sim::eeprom() const {
     std::lock_guard l(m_);
     return eeprom_;
 }
 
-void UnitekSim::load_eeprom(const std::map<std::uint8_t, std::int64_t>& values) {
+void Sim::load_eeprom(const std::map<std::uint8_t, std::int64_t>& values) {
     {
         std::lock_guard l(m_);
         for (const auto& [id, v] : values) {

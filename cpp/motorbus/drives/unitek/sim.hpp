@@ -75,12 +75,14 @@ struct SimCounters {
 // The sim's registers: the documented ones plus POS_IST (0x6D, actual position, 32-bit signed, read-only).
 RegisterTable sim_default_table();
 
-class UnitekSim {
+class Sim;
+using UnitekSim = Sim;  // issue 24's old name, while parallel edits land (removed after)
+class Sim {
 public:
-    UnitekSim(Clock& clock, SimConfig cfg = {}, RegisterTable table = sim_default_table());
-    ~UnitekSim();
-    UnitekSim(const UnitekSim&) = delete;
-    UnitekSim& operator=(const UnitekSim&) = delete;
+    Sim(Clock& clock, SimConfig cfg = {}, RegisterTable table = sim_default_table());
+    ~Sim();
+    Sim(const Sim&) = delete;
+    Sim& operator=(const Sim&) = delete;
 
     // Serve on `bus` (subscribes to the receive id, starts the timer thread).
     void attach(can::Bus& bus);
@@ -146,7 +148,7 @@ private:
     std::uint32_t status_locked();
     std::int64_t value_locked(std::uint8_t regid);
     motion::State state_locked();
-    UnitekRampParams ramps_locked() const;
+    RampParams ramps_locked() const;
     void send(const std::vector<can::Frame>& frames);
     void reset_ram_locked();
     std::int64_t current_limit_locked() const;

@@ -22,8 +22,8 @@ constexpr Nanos kMs = 1'000'000;
 constexpr Nanos kSec = 1'000'000'000;
 
 namespace {
-ArcusProfileParams homing_params() {
-    ArcusProfileParams p;
+ProfileParams homing_params() {
+    ProfileParams p;
     p.hspd = 3200;
     p.lspd = 100;
     p.acc_ms = 100;
@@ -31,11 +31,11 @@ ArcusProfileParams homing_params() {
 }
 }  // namespace
 
-TEST(ArcusHoming, HomeOnlyResetsAtSwitchThenDecelerates) {
+TEST(Homing, HomeOnlyResetsAtSwitchThenDecelerates) {
     SimClock clk;
     MotorModel m(clk, bench_cfg());
-    ArcusHoming h(m, homing_params());
-    h.start(ArcusHoming::Method::H, +1);
+    Homing h(m, homing_params());
+    h.start(Homing::Method::H, +1);
     EXPECT_EQ(h.snl_status(), 6);
     run_until_done(clk, m, [&] { return h.running(); });
     ASSERT_EQ(h.result(), HomingResult::Done);
@@ -43,53 +43,53 @@ TEST(ArcusHoming, HomeOnlyResetsAtSwitchThenDecelerates) {
     EXPECT_NEAR(m.pulse_position(), 165, 1e-3);
     EXPECT_NEAR(m.physical_position(), 5165, 1e-3);
 }
-TEST(ArcusHoming, HomeReturnToZero) {
+TEST(Homing, HomeReturnToZero) {
     SimClock clk;
     MotorModel m(clk, bench_cfg());
-    ArcusHomingOptions o;
+    HomingOptions o;
     o.rz = true;
-    ArcusHoming h(m, homing_params(), o);
-    h.start(ArcusHoming::Method::H, +1);
+    Homing h(m, homing_params(), o);
+    h.start(Homing::Method::H, +1);
     run_until_done(clk, m, [&] { return h.running(); });
     ASSERT_EQ(h.result(), HomingResult::Done);
     EXPECT_EQ(m.pulse_count(), 0);
     EXPECT_NEAR(m.physical_position(), 5000, 1e-3);
 }
-TEST(ArcusHoming, HighLowFindsSwitchFromSameSide) {
+TEST(Homing, HighLowFindsSwitchFromSameSide) {
     SimClock clk;
     MotorModel m(clk, bench_cfg());
-    ArcusHomingOptions o;
+    HomingOptions o;
     o.hca = 600;  // past the switch (400 wide) by 600 at high speed, back at low speed
-    ArcusHoming h(m, homing_params(), o);
-    h.start(ArcusHoming::Method::HL, +1);
+    Homing h(m, homing_params(), o);
+    h.start(Homing::Method::HL, +1);
     run_until_done(clk, m, [&] { return h.running(); });
     ASSERT_EQ(h.result(), HomingResult::Done);
     EXPECT_EQ(m.pulse_count(), 0);
     // Final approach in + at LSPD: stops on the low edge of the window.
     EXPECT_NEAR(m.physical_position(), 5000, 0.01);
 }
-TEST(ArcusHoming, LimitHoming) {
+TEST(Homing, LimitHoming) {
     SimClock clk;
     MotorModel m(clk, bench_cfg());
-    ArcusHoming h(m, homing_params());  // LCA 1000
-    h.start(ArcusHoming::Method::L, -1);
+    Homing h(m, homing_params());  // LCA 1000
+    h.start(Homing::Method::L, -1);
     EXPECT_EQ(h.snl_status(), 13);
     run_until_done(clk, m, [&] { return h.running(); });
     ASSERT_EQ(h.result(), HomingResult::Done);
     EXPECT_EQ(m.pulse_count(), 0);
     EXPECT_NEAR(m.physical_position(), -20000 + 1000, 0.01);
 }
-TEST(ArcusHoming, ZIndexAndHomeThenZ) {
+TEST(Homing, ZIndexAndHomeThenZ) {
     SimClock clk;
     MotorModel m(clk, bench_cfg());
-    ArcusHoming h(m, homing_params());
-    h.start(ArcusHoming::Method::Z, +1);
+    Homing h(m, homing_params());
+    h.start(Homing::Method::Z, +1);
     run_until_done(clk, m, [&] { return h.running(); });
     ASSERT_EQ(h.result(), HomingResult::Done);
     EXPECT_NEAR(m.physical_position(), 37, 0.01);
     EXPECT_EQ(m.pulse_count(), 0);
 
-    h.start(ArcusHoming::Method::ZH, +1);
+    h.start(Homing::Method::ZH, +1);
     EXPECT_EQ(h.snl_status(), 6);  // Homing while it looks for the switch...
     clk.advance(2000 * kMs);       // (the switch at 5000 is passed after ~1.6 s)
     m.update();
@@ -100,11 +100,11 @@ TEST(ArcusHoming, ZIndexAndHomeThenZ) {
     EXPECT_NEAR(m.physical_position(), 6437, 0.01);
     EXPECT_EQ(m.pulse_count(), 0);
 }
-TEST(ArcusHoming, LimitBeforeHomeIsLimitError) {
+TEST(Homing, LimitBeforeHomeIsLimitError) {
     SimClock clk;
     MotorModel m(clk, bench_cfg());
-    ArcusHoming h(m, homing_params());
-    h.start(ArcusHoming::Method::H, -1);  // home is the other way
+    Homing h(m, homing_params());
+    h.start(Homing::Method::H, -1);  // home is the other way
     run_until_done(clk, m, [&] { return h.running(); });
     EXPECT_EQ(h.result(), HomingResult::LimitError);
     EXPECT_NEAR(m.physical_position(), -20000, 0.01);
@@ -123,7 +123,7 @@ TEST(MotorModel, LongJogOnSimClockIsCheapAndExact) {
             home_t = e.t;
         }
     });
-    ArcusMotion a(ArcusProfileParams{3200, 100, 100, 100, false, false, 1.0});
+    Motion a(ProfileParams{3200, 100, 100, 100, false, false, 1.0});
     a.jog(0, 1);
     m.command(a.profile());
     clk.advance(3600 * kSec);  // one simulated hour of jogging
@@ -137,7 +137,7 @@ TEST(MotorModel, LongJogOnSimClockIsCheapAndExact) {
 TEST(MotorModel, ReviseKeepsTheTimeOriginAndDisplaceIsSlip) {
     SimClock clk;
     MotorModel m(clk);
-    ArcusMotion a;
+    Motion a;
     a.move(0, 2000);
     m.command(a.profile());
     clk.advance(500 * kMs);
@@ -156,21 +156,21 @@ TEST(MotorModel, ReviseKeepsTheTimeOriginAndDisplaceIsSlip) {
     EXPECT_EQ(m.encoder(), 1050);
     EXPECT_NEAR(m.slip(), -40, 1e-9);
 }
-TEST(ArcusHoming, HighLowGoesHcaPastTheSwitchEdge) {
+TEST(Homing, HighLowGoesHcaPastTheSwitchEdge) {
     // Figure 7.4 E: "The motor is now past the home input by the amount defined by
     // the home correction amount (HCA)" -- counted from where it leaves the switch,
     // even when the deceleration stopped inside the switch.
     SimClock clk;
     MotorModel m(clk, bench_cfg());
-    ArcusHomingOptions o;
+    HomingOptions o;
     o.hca = 300;
     o.zero_encoder = true;
-    ArcusHoming h(m, homing_params(), o);
+    Homing h(m, homing_params(), o);
     std::vector<double> stops;
     m.add_listener([&](const MotorEvent& e) {
         if (e.kind == MotorEvent::Kind::ProfileDone) stops.push_back(e.physical);
     });
-    h.start(ArcusHoming::Method::HL, +1);
+    h.start(Homing::Method::HL, +1);
     run_until_done(clk, m, [&] { return h.running(); });
     ASSERT_EQ(h.result(), HomingResult::Done);
     ASSERT_EQ(stops.size(), 2u);  // the deceleration inside the switch, the HCA move
@@ -180,15 +180,15 @@ TEST(ArcusHoming, HighLowGoesHcaPastTheSwitchEdge) {
     EXPECT_EQ(m.pulse_count(), 0);
     EXPECT_EQ(m.encoder(), 0);  // zero_encoder: EX follows PX
 }
-TEST(ArcusHoming, StartingOnTheSwitchFindsItAtOnce) {
+TEST(Homing, StartingOnTheSwitchFindsItAtOnce) {
     SimClock clk;
     MotorConfig c = bench_cfg();
     MotorModel m(clk, c);
     m.command(move_profile(0, 5100));
     clk.advance(5 * kSec);
     m.update();
-    ArcusHoming h(m, homing_params());
-    h.start(ArcusHoming::Method::H, +1);  // already on the home switch
+    Homing h(m, homing_params());
+    h.start(Homing::Method::H, +1);  // already on the home switch
     run_until_done(clk, m, [&] { return h.running(); });
     ASSERT_EQ(h.result(), HomingResult::Done);
     // Zeroed where it started, and stopped there: it was still at LSPD.
@@ -196,7 +196,7 @@ TEST(ArcusHoming, StartingOnTheSwitchFindsItAtOnce) {
     EXPECT_EQ(m.pulse_count(), 0);
     // On the limit it homes against: backs off by LCA at once.
     m.force_switch(Switch::MinusLimit, true);
-    h.start(ArcusHoming::Method::L, -1);
+    h.start(Homing::Method::L, -1);
     m.force_switch(Switch::MinusLimit, std::nullopt);
     const double from = m.physical_position();
     run_until_done(clk, m, [&] { return h.running(); });
@@ -216,7 +216,7 @@ TEST(MotorModel, MoveEndingExactlyOnTheIndexEdgeStillEnds) {
         done += e.kind == MotorEvent::Kind::ProfileDone;
         index += e.kind == MotorEvent::Kind::IndexPulse;
     });
-    ArcusMotion a;  // ends with a jump from LSPD to 0: the edge is reached at the very end
+    Motion a;  // ends with a jump from LSPD to 0: the edge is reached at the very end
     a.move(0, 1600);
     m.command(a.profile());
     clk.advance(5 * kSec);

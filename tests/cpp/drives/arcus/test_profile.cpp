@@ -55,7 +55,7 @@ TEST(ArcusAppendixA, WindowsAndMinimums) {
 }
 
 TEST(ArcusAppendixA, AutomaticAdjustment) {
-    ArcusProfileParams p;
+    ProfileParams p;
     p.hspd = 1000;
     p.lspd = 5;       // below window 1's minimum 10
     p.acc_ms = 0.5;   // below 2 ms
@@ -85,8 +85,8 @@ TEST(ArcusAppendixA, AutomaticAdjustment) {
 // ---- Arcus moves --------------------------------------------------------------------
 
 namespace {
-ArcusProfileParams base_params() {
-    ArcusProfileParams p;
+ProfileParams base_params() {
+    ProfileParams p;
     p.hspd = 1000;
     p.lspd = 100;
     p.acc_ms = 100;
@@ -94,8 +94,8 @@ ArcusProfileParams base_params() {
 }
 }  // namespace
 
-TEST(ArcusMotion, TrapezoidFromLspd) {
-    ArcusMotion m(base_params());
+TEST(Motion, TrapezoidFromLspd) {
+    Motion m(base_params());
     ASSERT_EQ(m.move(0, 10000), ArcusReply::Ok);
     const Profile& p = m.profile();
     // Jump to LSPD, ramp 100 -> 1000 in 0.1 s (55 pulses), cruise, ramp down, jump to 0.
@@ -105,35 +105,35 @@ TEST(ArcusMotion, TrapezoidFromLspd) {
     EXPECT_NEAR(p.duration(), 0.1 + (10000 - 110) / 1000.0 + 0.1, 1e-9);
     EXPECT_EQ(p.end_position(), 10000);
     EXPECT_NEAR(p.segments().back().end().v, 100.0, 1e-9);  // ends from LSPD
-    EXPECT_EQ(m.phase(0.05), ArcusPhase::Accel);
-    EXPECT_EQ(m.phase(5.0), ArcusPhase::Const);
-    EXPECT_EQ(m.phase(p.duration() - 0.05), ArcusPhase::Decel);
-    EXPECT_EQ(m.phase(p.duration() + 1), ArcusPhase::Idle);
+    EXPECT_EQ(m.phase(0.05), Phase::Accel);
+    EXPECT_EQ(m.phase(5.0), Phase::Const);
+    EXPECT_EQ(m.phase(p.duration() - 0.05), Phase::Decel);
+    EXPECT_EQ(m.phase(p.duration() + 1), Phase::Idle);
     auto st = step_times(p);
     EXPECT_EQ(st.size(), 10000u);
 }
 
-TEST(ArcusMotion, EdecUsesDec) {
+TEST(Motion, EdecUsesDec) {
     auto prm = base_params();
     prm.edec = true;
     prm.dec_ms = 200;
-    ArcusMotion m(prm);
+    Motion m(prm);
     m.move(0, 10000);
     const Profile& p = m.profile();
     // Decel ramp 1000 -> 100 over 0.2 s covers 110 pulses.
     EXPECT_NEAR(p.duration(), 0.1 + (10000 - 55 - 110) / 1000.0 + 0.2, 1e-9);
 }
 
-TEST(ArcusMotion, IncrementalLimit262143) {
-    ArcusMotion m(base_params());
+TEST(Motion, IncrementalLimit262143) {
+    Motion m(base_params());
     EXPECT_EQ(m.move(100000, 362143), ArcusReply::Ok);
     EXPECT_EQ(m.move(100000, 362144), ArcusReply::MoveTooFar);
     EXPECT_EQ(m.move(100000, -162143), ArcusReply::Ok);
     EXPECT_EQ(m.move(100000, -162144), ArcusReply::MoveTooFar);
 }
 
-TEST(ArcusMotion, OnTheFlyTargetAhead) {
-    ArcusMotion m(base_params());
+TEST(Motion, OnTheFlyTargetAhead) {
+    Motion m(base_params());
     m.move(0, 10000);
     ASSERT_EQ(m.change_target(2.0, 20000), ArcusReply::Ok);
     const Profile& p = m.profile();
@@ -143,8 +143,8 @@ TEST(ArcusMotion, OnTheFlyTargetAhead) {
     EXPECT_EQ(step_times(p).size(), 20000u);
 }
 
-TEST(ArcusMotion, OnTheFlyTargetAlreadyPassedReverses) {
-    ArcusMotion m(base_params());
+TEST(Motion, OnTheFlyTargetAlreadyPassedReverses) {
+    Motion m(base_params());
     m.move(0, 10000);
     const double pos_at_5 = m.profile().position(5.0);  // about 4945
     ASSERT_EQ(m.change_target(5.0, 1000), ArcusReply::Ok);
@@ -161,8 +161,8 @@ TEST(ArcusMotion, OnTheFlyTargetAlreadyPassedReverses) {
     EXPECT_EQ(net, 1000);
 }
 
-TEST(ArcusMotion, OnTheFlyTargetErrors) {
-    ArcusMotion m(base_params());
+TEST(Motion, OnTheFlyTargetErrors) {
+    Motion m(base_params());
     EXPECT_EQ(m.change_target(0, 10), ArcusReply::MotorNotMoving);
     m.move(0, 100);
     EXPECT_EQ(m.change_target(100.0, 10), ArcusReply::MotorNotMoving);  // finished
@@ -171,8 +171,8 @@ TEST(ArcusMotion, OnTheFlyTargetErrors) {
     EXPECT_STREQ(arcus_reply_text(ArcusReply::MotorNotMoving), "?Motor is not moving");
 }
 
-TEST(ArcusMotion, OnTheFlySpeed) {
-    ArcusMotion m(base_params(), 0);
+TEST(Motion, OnTheFlySpeed) {
+    Motion m(base_params(), 0);
     m.move(0, 100000);
     EXPECT_EQ(m.change_speed(1.0, 20000), ArcusReply::SpeedOutOfRange);  // SSPDM 0: 1..16K
     ASSERT_EQ(m.change_speed(1.0, 2000), ArcusReply::Ok);
@@ -182,15 +182,15 @@ TEST(ArcusMotion, OnTheFlySpeed) {
     EXPECT_EQ(p.end_position(), 100000);
     auto s = base_params();
     s.scv = true;
-    ArcusMotion sc(s);
+    Motion sc(s);
     sc.move(0, 10000);
     EXPECT_EQ(sc.change_speed(1.0, 500), ArcusReply::ScvOn);
-    ArcusMotion idle(base_params());
+    Motion idle(base_params());
     EXPECT_EQ(idle.change_speed(0, 500), ArcusReply::BadSspd);
 }
 
-TEST(ArcusMotion, JogSpeedChangeAndStop) {
-    ArcusMotion m(base_params());
+TEST(Motion, JogSpeedChangeAndStop) {
+    Motion m(base_params());
     m.jog(0, -1);
     EXPECT_NEAR(m.profile().velocity(1.0), -1000, 1e-9);
     ASSERT_EQ(m.change_speed(1.0, 500), ArcusReply::Ok);
@@ -202,11 +202,11 @@ TEST(ArcusMotion, JogSpeedChangeAndStop) {
     EXPECT_FALSE(m.moving(3.1));
 }
 
-TEST(ArcusMotion, SCurveSameDuration) {
+TEST(Motion, SCurveSameDuration) {
     auto s = base_params();
-    ArcusMotion t(s);
+    Motion t(s);
     s.scv = true;
-    ArcusMotion c(s);
+    Motion c(s);
     t.move(0, 5000);
     c.move(0, 5000);
     EXPECT_NEAR(t.profile().duration(), c.profile().duration(), 1e-9);
@@ -214,15 +214,15 @@ TEST(ArcusMotion, SCurveSameDuration) {
     EXPECT_EQ(c.profile().end_position(), 5000);
 }
 
-TEST(ArcusMotion, RandomOnTheFlyChangesEndOnTarget) {
+TEST(Motion, RandomOnTheFlyChangesEndOnTarget) {
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> u(0, 1);
     for (int i = 0; i < 500; ++i) {
-        ArcusProfileParams p;
+        ProfileParams p;
         p.hspd = 200 + 15000 * u(rng);
         p.lspd = 10 + 100 * u(rng);
         p.acc_ms = 2 + 500 * u(rng);
-        ArcusMotion m(p);
+        Motion m(p);
         const double target = std::round(-50000 + 100000 * u(rng));
         ASSERT_EQ(m.move(0, target), ArcusReply::Ok);
         const double t = m.profile().duration() * u(rng);
@@ -240,12 +240,12 @@ TEST(ArcusMotion, RandomOnTheFlyChangesEndOnTarget) {
 
 TEST(HostileNumbers, ArcusModel) {
     for (double x : motorbus::test::kValues) {
-        ArcusProfileParams a;
+        ProfileParams a;
         a.hspd = x;
         if (x != 1.0) {  // 1 PPS is the only valid HSPD among these
             EXPECT_THROW(arcus_effective(a), motorbus::InvalidArgument) << x;
         }
-        ArcusMotion m;
+        Motion m;
         const ArcusReply r = m.move(0, x);
         EXPECT_EQ(r, std::isfinite(x) && std::fabs(x) <= 262143 ? ArcusReply::Ok : ArcusReply::MoveTooFar) << x;
         EXPECT_TRUE(std::isfinite(m.profile().end_position()));
@@ -256,6 +256,6 @@ TEST(HostileNumbers, ArcusModel) {
         }
         EXPECT_TRUE(std::isfinite(m.profile().duration()));
     }
-    ArcusMotion ok;
+    Motion ok;
     EXPECT_EQ(ok.move(0, 1000), ArcusReply::Ok);
 }

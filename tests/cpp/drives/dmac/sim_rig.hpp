@@ -14,18 +14,18 @@ namespace motorbus::dmac::testing {
 
 struct Rig {
     std::shared_ptr<SimClock> clock = std::make_shared<SimClock>();
-    std::shared_ptr<DmacSim> sim;
+    std::shared_ptr<Sim> sim;
     // A DMAC34 starts with its brake applied (factory BRAKE ON, annex 7.1):
     // the rig releases it, as a user does before moving; released = false keeps it.
     explicit Rig(SimOptions o, bool released = true) {
-        sim = std::make_shared<DmacSim>(clock, o);
+        sim = std::make_shared<Sim>(clock, o);
         if (released) release_brake();
     }
     explicit Rig(int address = 0, Model model = Model::Dmac34_1, bool released = true) {
         SimOptions o;
         o.address = address;
         o.model = model;
-        sim = std::make_shared<DmacSim>(clock, o);
+        sim = std::make_shared<Sim>(clock, o);
         if (released) release_brake();
     }
     void release_brake() {

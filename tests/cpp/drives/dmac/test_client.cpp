@@ -17,27 +17,27 @@ namespace {
 struct Bench {
     std::shared_ptr<SimClock> clock = std::make_shared<SimClock>();
     std::shared_ptr<dmac_test::SimPort> port = std::make_shared<dmac_test::SimPort>();
-    std::vector<std::shared_ptr<DmacSim>> sims;
+    std::vector<std::shared_ptr<Sim>> sims;
     std::shared_ptr<serial::LineLink> link;
-    std::vector<std::unique_ptr<DmacClient>> clients;
+    std::vector<std::unique_ptr<Client>> clients;
 
     explicit Bench(std::vector<int> addresses = {0}, Duration timeout = 100ms) {
         auto opts = default_line_options();
         opts.reply_timeout = timeout;
         link = std::make_shared<serial::LineLink>(port, opts);
         for (int a : addresses) {
-            auto s = std::make_shared<DmacSim>(clock, SimOptions{.address = a});
+            auto s = std::make_shared<Sim>(clock, SimOptions{.address = a});
             s->on_line(address_prefix(a) + "BRAKE OFF");  // factory BRAKE ON (annex 7.1)
             sims.push_back(s);
             port->attach(s);
             ClientOptions co;
             co.address = a;
             co.sleep = [c = clock](Duration d) { c->advance(d.count()); };
-            clients.push_back(std::make_unique<DmacClient>(link, co));
+            clients.push_back(std::make_unique<Client>(link, co));
         }
     }
-    DmacClient& c(std::size_t i = 0) { return *clients[i]; }
-    DmacSim& sim(std::size_t i = 0) { return *sims[i]; }
+    Client& c(std::size_t i = 0) { return *clients[i]; }
+    Sim& sim(std::size_t i = 0) { return *sims[i]; }
     void ms(std::int64_t n) { clock->advance(n * 1'000'000); }
 };
 
@@ -49,7 +49,7 @@ std::size_t count(const std::string& hay, const std::string& needle) {
 
 }  // namespace
 
-TEST(DmacClient, TypedVariablesRoundTrip) {
+TEST(Client, TypedVariablesRoundTrip) {
     Bench b;
     auto& c = b.c();
     c.set_profile(20000, 3000, 500, 700);
@@ -85,7 +85,7 @@ TEST(DmacClient, TypedVariablesRoundTrip) {
               std::string::npos);
 }
 
-TEST(DmacClient, MoveToAndWaitIdleOnSimulatedTime) {
+TEST(Client, MoveToAndWaitIdleOnSimulatedTime) {
     Bench b;
     auto& c = b.c();
     c.move_to(200000);
@@ -96,7 +96,7 @@ TEST(DmacClient, MoveToAndWaitIdleOnSimulatedTime) {
     const auto t0 = b.clock->now();
     EXPECT_EQ(c.wait_idle(10s, 1ms), 200000);
     const double took_ms = static_cast<double>(b.clock->now() - t0) / 1e6;
-    DmacMotion ref;
+    Motion ref;
     ref.move_to(0, 200000);
     EXPECT_NEAR(took_ms, ref.profile().duration() * 1000, 2.0);
     c.move_on(-5000);  // the manual's MOVE_ON example: half a turn CCW
@@ -105,7 +105,7 @@ TEST(DmacClient, MoveToAndWaitIdleOnSimulatedTime) {
     EXPECT_EQ(c.position(), 0);
 }
 
-TEST(DmacClient, WaitIdleTimesOutInSimulatedTime) {
+TEST(Client, WaitIdleTimesOutInSimulatedTime) {
     Bench b;
     b.c().move_to(100000);  // 10 turns: busy for seconds (a MOVE_SPEED is idle once at speed)
     EXPECT_THROW(b.c().wait_idle(50ms, 10ms), TimeoutError);
@@ -114,7 +114,7 @@ TEST(DmacClient, WaitIdleTimesOutInSimulatedTime) {
     EXPECT_EQ(b.c().speed(), 0);
 }
 
-TEST(DmacClient, StatusAndErrorDecoding) {
+TEST(Client, StatusAndErrorDecoding) {
     Bench b;
     auto& c = b.c();
     c.s_curve(true);
@@ -140,7 +140,7 @@ TEST(DmacClient, StatusAndErrorDecoding) {
     EXPECT_FALSE(c.error().any());
 }
 
-TEST(DmacClient, RejectedCommandsRaiseTyped) {
+TEST(Client, RejectedCommandsRaiseTyped) {
     Bench b;
     auto& c = b.c();
     // A5: the module rejects an undefined command (bit 12) -> UnknownCommand.
@@ -160,7 +160,7 @@ TEST(DmacClient, RejectedCommandsRaiseTyped) {
     EXPECT_TRUE(c.error().bit(error::kThermal));
 }
 
-TEST(DmacClient, VersionAndAddressChange) {
+TEST(Client, VersionAndAddressChange) {
     Bench b({4});
     auto v = b.c().request_version();
     EXPECT_EQ(v.address, 4);
@@ -178,7 +178,7 @@ TEST(DmacClient, VersionAndAddressChange) {
     EXPECT_EQ(b.sim().baudrate(), 115200);
 }
 
-TEST(DmacClient, ModuleResetThroughTheClient) {
+TEST(Client, ModuleResetThroughTheClient) {
     Bench b;
     auto& c = b.c();
     c.set_user_var(1, 5);
@@ -191,7 +191,7 @@ TEST(DmacClient, ModuleResetThroughTheClient) {
     EXPECT_EQ(c.read(Var::NegativeEnd), -10000);
 }
 
-TEST(DmacClient, SequencerUploadReadBackStartStopStep) {
+TEST(Client, SequencerUploadReadBackStartStopStep) {
     Bench b;
     auto& c = b.c();
     c.upload_sequence({"MOVE_ON 10000", "WAIT 2000", "JUMP 1"});
@@ -219,7 +219,7 @@ TEST(DmacClient, SequencerUploadReadBackStartStopStep) {
     EXPECT_THROW(c.start_sequence(501), InvalidArgument);
 }
 
-TEST(DmacClient, SingleAxisInterpolationReportsXon) {
+TEST(Client, SingleAxisInterpolationReportsXon) {
     Bench b;
     auto& c = b.c();
     c.write(Var::InterpolFifosize, 2);
@@ -230,7 +230,7 @@ TEST(DmacClient, SingleAxisInterpolationReportsXon) {
     EXPECT_EQ(c.interpol_count(), 2);
 }
 
-TEST(DmacClient, StreamsAMultiAxisPathKeepingEveryFifoFed) {
+TEST(Client, StreamsAMultiAxisPathKeepingEveryFifoFed) {
     Bench b({0, 1, 2});
     // A straight line from (0,0,0) to (20000, -5000, 12000): 100 segments of 20 ms.
     std::vector<std::vector<long long>> segs(100, std::vector<long long>{200, -50, 120});
@@ -238,7 +238,7 @@ TEST(DmacClient, StreamsAMultiAxisPathKeepingEveryFifoFed) {
     so.interpol_time_ms = 20;
     so.fifo_size = 16;
     so.sleep = [c = b.clock](Duration d) { c->advance(d.count()); };
-    std::vector<DmacClient*> axes{&b.c(0), &b.c(1), &b.c(2)};
+    std::vector<Client*> axes{&b.c(0), &b.c(1), &b.c(2)};
     auto st = stream_interpolation(axes, segs, so);
     EXPECT_EQ(st.segments, segs.size());
     EXPECT_GT(st.xon_errors, 0u);          // back-pressure happened...
@@ -252,7 +252,7 @@ TEST(DmacClient, StreamsAMultiAxisPathKeepingEveryFifoFed) {
     EXPECT_EQ(b.sim(2).state().position, 12000);
 }
 
-TEST(DmacClient, SynchroTopStartsArmedAxesTogether) {
+TEST(Client, SynchroTopStartsArmedAxesTogether) {
     Bench b({0, 3});
     synchro(*b.link, Keyword::On);
     b.c(0).move_speed(4000);
@@ -267,14 +267,14 @@ TEST(DmacClient, SynchroTopStartsArmedAxesTogether) {
     EXPECT_EQ(b.sim(0).state().now_ms, b.sim(1).state().now_ms);
 }
 
-TEST(DmacClient, OverARealPtyWithTheLineServer) {
+TEST(Client, OverARealPtyWithTheLineServer) {
     auto clock = std::make_shared<SimClock>();
-    auto s0 = std::make_shared<DmacSim>(clock, SimOptions{.address = 0});
-    auto s1 = std::make_shared<DmacSim>(clock, SimOptions{.address = 1});
+    auto s0 = std::make_shared<Sim>(clock, SimOptions{.address = 0});
+    auto s1 = std::make_shared<Sim>(clock, SimOptions{.address = 1});
     serial::PtyLineServer server({s0, s1});
     auto port = serial::open_port(server.slave_path(), 115200);
     auto link = std::make_shared<serial::LineLink>(port, default_line_options());
-    DmacClient c0(link, {.address = 0}), c1(link, {.address = 1});
+    Client c0(link, {.address = 0}), c1(link, {.address = 1});
     c1.brake(false);
     c1.move_to(1234);
     clock->advance(5'000'000'000);
@@ -284,7 +284,7 @@ TEST(DmacClient, OverARealPtyWithTheLineServer) {
 }
 
 // ---- hostile peers (HOSTILE_INPUTS.md 2.9) -------------------------------------------------
-TEST(DmacClient, A1NoTerminatorTimesOutAndTheNextCommandWorks) {
+TEST(Client, A1NoTerminatorTimesOutAndTheNextCommandWorks) {
     Bench b;
     b.port->tamper = [](const std::string& req, const std::string& reply) {
         return req.find("#V7") != std::string::npos ? reply.substr(0, reply.size() - 2) : reply;
@@ -293,7 +293,7 @@ TEST(DmacClient, A1NoTerminatorTimesOutAndTheNextCommandWorks) {
     EXPECT_EQ(b.c().position(), 0);  // the partial line was flushed, not prefixed
 }
 
-TEST(DmacClient, A2NulInsideAReplyIsRejected) {
+TEST(Client, A2NulInsideAReplyIsRejected) {
     Bench b;
     b.port->tamper = [](const std::string&, const std::string&) { return std::string("00#POS=+1\0" "23\r\n", 14); };
     try {
@@ -304,7 +304,7 @@ TEST(DmacClient, A2NulInsideAReplyIsRejected) {
     }
 }
 
-TEST(DmacClient, A3OverlongReplyRaisesReplyTooLong) {
+TEST(Client, A3OverlongReplyRaisesReplyTooLong) {
     Bench b;
     b.port->tamper = [](const std::string&, const std::string&) { return "00#POS=+" + std::string(400, '1') + "\r\n"; };
     EXPECT_THROW(b.c().position(), serial::ReplyTooLong);
@@ -312,7 +312,7 @@ TEST(DmacClient, A3OverlongReplyRaisesReplyTooLong) {
     EXPECT_EQ(b.c().position(), 0);
 }
 
-TEST(DmacClient, A5QuestionMarkRaisesUnknownCommand) {
+TEST(Client, A5QuestionMarkRaisesUnknownCommand) {
     Bench b;
     b.port->tamper = [](const std::string&, const std::string&) { return std::string("?XYZ\r\n"); };
     EXPECT_THROW(b.c().position(), UnknownCommand);
@@ -320,7 +320,7 @@ TEST(DmacClient, A5QuestionMarkRaisesUnknownCommand) {
     EXPECT_EQ(b.c().position(), 0);
 }
 
-TEST(DmacClient, A6ReplyForAnotherParameterOrModuleIsRejected) {
+TEST(Client, A6ReplyForAnotherParameterOrModuleIsRejected) {
     Bench b;
     b.port->tamper = [](const std::string&, const std::string&) { return std::string("00#VEL=+5\r\n"); };
     EXPECT_THROW(b.c().position(), ProtocolError);
@@ -331,7 +331,7 @@ TEST(DmacClient, A6ReplyForAnotherParameterOrModuleIsRejected) {
     EXPECT_GE(b.c().counters().stray_lines, 3u);
 }
 
-TEST(DmacClient, A7NumericGarbageIsRejectedAndUnsignedIsAccepted) {
+TEST(Client, A7NumericGarbageIsRejectedAndUnsignedIsAccepted) {
     Bench b;
     for (std::string bad : {"00#POS=", "00#POS=+99999999999", "00#POS=1e3", "00#POS=+1 2", "00#POS=+12a"}) {
         b.port->tamper = [bad](const std::string&, const std::string&) { return bad + "\r\n"; };
@@ -341,14 +341,14 @@ TEST(DmacClient, A7NumericGarbageIsRejectedAndUnsignedIsAccepted) {
     EXPECT_EQ(b.c().position(), 12345);  // the manual's unsigned form
 }
 
-TEST(DmacClient, A8LateReplyIsFlushedBeforeTheNextRequest) {
+TEST(Client, A8LateReplyIsFlushedBeforeTheNextRequest) {
     Bench b;
     b.c().set_user_var(1, 42);
     b.port->inject("00#V1=+999\r\n");  // a late reply from a previous, timed-out request
     EXPECT_EQ(b.c().user_var(1), 42);
 }
 
-TEST(DmacClient, A10NoiseIsSkippedAndCounted) {
+TEST(Client, A10NoiseIsSkippedAndCounted) {
     Bench b;
     b.port->tamper = [](const std::string&, const std::string& reply) {
         return std::string("\xff\xff\x00\xfe\r\n", 6) + reply;
@@ -357,7 +357,7 @@ TEST(DmacClient, A10NoiseIsSkippedAndCounted) {
     EXPECT_EQ(b.c().counters().stray_lines, 1u);
 }
 
-TEST(DmacClient, A11OnlyTheConfiguredTerminatorEndsAReply) {
+TEST(Client, A11OnlyTheConfiguredTerminatorEndsAReply) {
     Bench b;
     for (std::string term : {std::string("\r"), std::string("\0", 1), std::string("\n\r")}) {
         b.port->tamper = [term](const std::string&, const std::string& reply) {
@@ -369,7 +369,7 @@ TEST(DmacClient, A11OnlyTheConfiguredTerminatorEndsAReply) {
     EXPECT_EQ(b.c().position(), 0);
 }
 
-TEST(DmacClient, A13UnsolicitedBannerIsDroppedAndFlagged) {
+TEST(Client, A13UnsolicitedBannerIsDroppedAndFlagged) {
     Bench b;
     b.port->tamper = [](const std::string&, const std::string& reply) {
         return "00EV v1.7 H142 \"MIDI-INGENIERIE_DMAC34-1_H142-10145_25/01/05_12/04/06\" PHASE:6A BOOT:v1.1\r\n" +
@@ -379,7 +379,7 @@ TEST(DmacClient, A13UnsolicitedBannerIsDroppedAndFlagged) {
     EXPECT_EQ(b.c().counters().device_resets, 1u);
 }
 
-TEST(DmacClient, A14MotionCommandIsNeverRetriedOnTimeout) {
+TEST(Client, A14MotionCommandIsNeverRetriedOnTimeout) {
     Bench b;
     b.port->tamper = [](const std::string& req, const std::string& reply) {
         return req.find("MOVE_TO") != std::string::npos ? std::string() : reply;
@@ -390,7 +390,7 @@ TEST(DmacClient, A14MotionCommandIsNeverRetriedOnTimeout) {
     EXPECT_TRUE(b.c().status().moving());  // the move did start: query, don't resend
 }
 
-TEST(DmacClient, StreamsAPlannedStraightLineSplitByTheMotionPackage) {
+TEST(Client, StreamsAPlannedStraightLineSplitByTheMotionPackage) {
     Bench b({0, 1});
     std::vector<motion::Limits> lim(2, motion::Limits{50000, 100000, 100000, 0});
     auto profiles = motion::plan_straight_line({0, 0}, {30000, -12000}, lim);
@@ -408,7 +408,7 @@ TEST(DmacClient, StreamsAPlannedStraightLineSplitByTheMotionPackage) {
     EXPECT_EQ(b.sim(1).state().position, -12000);
 }
 
-TEST(DmacClient, MoreTypedVariables) {
+TEST(Client, MoreTypedVariables) {
     Bench b;
     auto& c = b.c();
     c.set_torque_ratio(70);

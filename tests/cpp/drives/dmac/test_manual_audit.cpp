@@ -20,16 +20,16 @@ namespace {
 struct ClientBench {
     std::shared_ptr<SimClock> clock = std::make_shared<SimClock>();
     std::shared_ptr<dmac_test::SimPort> port = std::make_shared<dmac_test::SimPort>();
-    std::shared_ptr<DmacSim> sim;
+    std::shared_ptr<Sim> sim;
     std::shared_ptr<serial::LineLink> link;
-    std::unique_ptr<DmacClient> client;
+    std::unique_ptr<Client> client;
     explicit ClientBench(Model model = Model::Dmac34_1) {
-        sim = std::make_shared<DmacSim>(clock, SimOptions{.address = 0, .model = model});
+        sim = std::make_shared<Sim>(clock, SimOptions{.address = 0, .model = model});
         port->attach(sim);
         link = std::make_shared<serial::LineLink>(port, default_line_options());
         ClientOptions co;
         co.sleep = [c = clock](Duration d) { c->advance(d.count()); };
-        client = std::make_unique<DmacClient>(link, co);
+        client = std::make_unique<Client>(link, co);
         if (model == Model::Dmac34_1 || model == Model::Dmac34_2) client->brake(false);
     }
 };
@@ -87,13 +87,13 @@ TEST(DmacAudit, ClientReplyTimeoutAllowsTheLineDelay) {
     // Over a real pty: the reply comes #LINE_DELAY (3 ms) after the request,
     // later than the 1 ms the caller allows the module itself to answer.
     auto clock = std::make_shared<SimClock>();
-    auto sim = std::make_shared<DmacSim>(clock, SimOptions{});
+    auto sim = std::make_shared<Sim>(clock, SimOptions{});
     serial::PtyLineServer server({sim});
     auto link = std::make_shared<serial::LineLink>(serial::open_port(server.slave_path(), 38400),
                                                    default_line_options());
     ClientOptions co;
     co.timeout = 1ms;
-    DmacClient c(link, co);
+    Client c(link, co);
     EXPECT_EQ(c.read(Var::LineDelay), 3000);  // TimeoutError before
 }
 
@@ -132,13 +132,13 @@ TEST(DmacAudit, OvervoltageAndThermalFaultsPerModel) {
     r34.sim->set_supply_voltage(160000);
     EXPECT_EQ(r34.sim->state().error, 0u);
     r34.sim->set_supply_voltage(32000);
-    r34.sim->set_temperature(DmacSim::Sensor::Motor, 860);  // above 85 degC
+    r34.sim->set_temperature(Sim::Sensor::Motor, 860);  // above 85 degC
     EXPECT_TRUE(bit_set(r34.sim->state().error, error::kThermal));
     EXPECT_EQ(r34.val("00READ #MTE"), 860);
-    r34.sim->set_temperature(DmacSim::Sensor::Motor, 650);
+    r34.sim->set_temperature(Sim::Sensor::Motor, 650);
     r34.tx("00#ERROR:=0");
     EXPECT_EQ(r34.sim->state().error, 0u);
-    r34.sim->set_temperature(DmacSim::Sensor::Cpu, 1210);  // CPU above 120 degC
+    r34.sim->set_temperature(Sim::Sensor::Cpu, 1210);  // CPU above 120 degC
     EXPECT_TRUE(bit_set(r34.sim->state().error, error::kThermal));
 }
 
@@ -154,8 +154,8 @@ TEST(DmacAudit, ClientRefusesAMoveWhileAFaultIsLatched) {
 // ---- 4: a frame over 256 characters ----------------------------------------------------
 TEST(DmacAudit, OverlongFrameOnThePtySetsTheSyntaxBit) {
     auto clock = std::make_shared<SimClock>();
-    auto s0 = std::make_shared<DmacSim>(clock, SimOptions{.address = 0});
-    auto s1 = std::make_shared<DmacSim>(clock, SimOptions{.address = 1});
+    auto s0 = std::make_shared<Sim>(clock, SimOptions{.address = 0});
+    auto s1 = std::make_shared<Sim>(clock, SimOptions{.address = 1});
     serial::PtyLineServer server({s0, s1});
     auto link = std::make_shared<serial::LineLink>(serial::open_port(server.slave_path(), 38400),
                                                    default_line_options());
@@ -163,9 +163,9 @@ TEST(DmacAudit, OverlongFrameOnThePtySetsTheSyntaxBit) {
     ClientOptions co;
     co.address = 1;
     co.verify = false;
-    DmacClient c1(link, co);
+    Client c1(link, co);
     co.address = 0;
-    DmacClient c0(link, co);
+    Client c0(link, co);
     EXPECT_EQ(c1.error().raw, bit_mask(error::kSyntax));  // was 0: the line server's path lost it
     EXPECT_EQ(c0.error().raw, 0u);                         // addressed to 01 only
     EXPECT_EQ(c1.user_var(1), 0);                          // nothing of it ran

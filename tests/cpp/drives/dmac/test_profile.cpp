@@ -15,7 +15,7 @@ using namespace motorbus::dmac;
 
 TEST(Dmac, HalfSecondExample) {
     // #ACCEL_TIME 1000 ms, #HIGH_SPEED 60000 (600 rpm): MOVE_SPEED 30000 -> 0.5 s.
-    DmacProfileParams p;
+    ProfileParams p;
     p.accel_time_ms = 1000;
     p.high_speed = 60000;
     EXPECT_DOUBLE_EQ(dmac_ramp_time(p, 0, 30000), 0.5);
@@ -29,7 +29,7 @@ TEST(Dmac, HalfSecondExample) {
 }
 
 TEST(Dmac, MoveSpeedClampedToHighSpeed) {
-    DmacMotion m;
+    Motion m;
     m.move_speed(0, 400000);
     EXPECT_NEAR(m.profile().velocity(5.0), dmac_speed_to_inc_per_s(60000), 1e-9);
     EXPECT_TRUE(m.moving(100.0));
@@ -39,7 +39,7 @@ TEST(Dmac, MoveSpeedClampedToHighSpeed) {
 }
 
 TEST(Dmac, PositionMoveLowSpeedAtLastTenthTurn) {
-    DmacProfileParams p;  // factory: HS 60000, LS 6000, 1000 ms ramps
+    ProfileParams p;  // factory: HS 60000, LS 6000, 1000 ms ramps
     Profile prof = dmac_position_profile(State{}, 100000, p);
     EXPECT_EQ(prof.end_position(), 100000);
     const double t_via = prof.first_crossing(99000);
@@ -57,20 +57,20 @@ TEST(Dmac, PositionMoveLowSpeedAtLastTenthTurn) {
 }
 
 TEST(Dmac, ShortMoveIsApproachOnly) {
-    DmacProfileParams p;
+    ProfileParams p;
     Profile prof = dmac_position_profile(State{0, 0, 0, 0}, -500, p);
     EXPECT_EQ(prof.end_position(), -500);
     EXPECT_NEAR(prof.velocity(1e-9), -5000, 1e-3);
 }
 
 TEST(Dmac, MoveWhileMovingAndLimits) {
-    DmacMotion m;
+    Motion m;
     m.move_to(0, 200000);
     m.move_to(1.0, 0);  // reverse mid-move
     EXPECT_EQ(m.profile().end_position(), 0);
     m.move_on(m.profile().duration() + 1, -5000);  // the manual's MOVE_ON -5000: half a turn CCW
     EXPECT_EQ(m.profile().end_position(), -5000);
-    DmacProfileParams bad;
+    ProfileParams bad;
     bad.high_speed = 400001;
     try {
         bad.validate();
@@ -79,13 +79,13 @@ TEST(Dmac, MoveWhileMovingAndLimits) {
         EXPECT_EQ(e.limit, "#HIGH_SPEED");
         EXPECT_DOUBLE_EQ(e.excess(), 1.0);
     }
-    bad = DmacProfileParams{};
+    bad = ProfileParams{};
     bad.accel_time_ms = 12001;
     EXPECT_THROW(bad.validate(), LimitExceeded);
 }
 
 TEST(Dmac, SCurveSameTimes) {
-    DmacProfileParams p;
+    ProfileParams p;
     Profile t = dmac_position_profile(State{}, 50000, p);
     p.s_curve = true;
     Profile s = dmac_position_profile(State{}, 50000, p);
@@ -94,7 +94,7 @@ TEST(Dmac, SCurveSameTimes) {
 }
 
 TEST(Dmac, StartStopWithZeroRampTimes) {
-    DmacProfileParams p;
+    ProfileParams p;
     p.accel_time_ms = 0;
     p.decel_time_ms = 0;
     Profile prof = dmac_position_profile(State{}, 20000, p);
@@ -103,7 +103,7 @@ TEST(Dmac, StartStopWithZeroRampTimes) {
 }
 
 TEST(Dmac, MoveOnFromInitialPosition) {
-    DmacMotion m(DmacProfileParams{}, 500);
+    Motion m(ProfileParams{}, 500);
     m.move_on(0, 100);
     EXPECT_EQ(m.profile().end_position(), 600);
     EXPECT_EQ(m.target(), 600);
@@ -111,7 +111,7 @@ TEST(Dmac, MoveOnFromInitialPosition) {
 
 TEST(HostileNumbers, DmacModel) {
     for (double x : motorbus::test::kValues) {
-        motorbus::test::survives([&] { return dmac_position_profile(State{}, x, DmacProfileParams{}); });
-        motorbus::test::survives([&] { return dmac_speed_profile(State{}, x, DmacProfileParams{}, 1.0); });
+        motorbus::test::survives([&] { return dmac_position_profile(State{}, x, ProfileParams{}); });
+        motorbus::test::survives([&] { return dmac_speed_profile(State{}, x, ProfileParams{}, 1.0); });
     }
 }

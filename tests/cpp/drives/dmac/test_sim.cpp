@@ -12,7 +12,7 @@ using namespace motorbus::dmac;
 using motorbus::dmac::testing::Rig;
 
 // ---- the manual's examples, byte for byte (tests/vectors/seed_examples.json) -----
-TEST(DmacSim, SeedExamplesByteForByte) {
+TEST(Sim, SeedExamplesByteForByte) {
     Rig r0(0);
     EXPECT_EQ(r0.tx("00#ACCEL_TIME:=123"), "");
     EXPECT_EQ(r0.tx("00READ #ACCEL_TIME"), "00#ATI=+123\r\n");
@@ -60,7 +60,7 @@ TEST(DmacSim, SeedExamplesByteForByte) {
               "04EV v1.7 H142 \"MIDI-INGENIERIE_DMAC34-1_H142-10145_25/01/05_12/04/06\" PHASE:6A BOOT:v1.1\r\n");
 }
 
-TEST(DmacSim, MnemonicsAndFullNamesAreTheSameCommand) {
+TEST(Sim, MnemonicsAndFullNamesAreTheSameCommand) {
     Rig r;
     r.tx("00#HSP:=20000");
     EXPECT_EQ(r.tx("00REA #HIGH_SPEED"), "00#HSP=+20000\r\n");
@@ -72,7 +72,7 @@ TEST(DmacSim, MnemonicsAndFullNamesAreTheSameCommand) {
     EXPECT_EQ(r.val("00READ #POSITION"), 300);
 }
 
-TEST(DmacSim, ReadBitAndWriteBit) {
+TEST(Sim, ReadBitAndWriteBit) {
     Rig r;
     r.tx("00S_CURVE ON");
     EXPECT_EQ(r.tx("00READ #STATUS.12"), "00#STA.12=+1\r\n");
@@ -86,7 +86,7 @@ TEST(DmacSim, ReadBitAndWriteBit) {
 }
 
 // ---- variables: ranges, read-only, stored vs volatile, resets -------------------
-TEST(DmacSim, RangesAndReadOnlyFlagErrors) {
+TEST(Sim, RangesAndReadOnlyFlagErrors) {
     Rig r;
     r.tx("00#HIGH_SPEED:=400001");
     EXPECT_EQ(r.read(Var::HighSpeed), 60000);
@@ -110,7 +110,7 @@ TEST(DmacSim, RangesAndReadOnlyFlagErrors) {
     EXPECT_EQ(r.tx("00READ #CPU_TEMPERATURE"), "00#CTE=+520\r\n");
 }
 
-TEST(DmacSim, ModuleResetKeepsStoredVariablesAndClearsVolatileOnes) {
+TEST(Sim, ModuleResetKeepsStoredVariablesAndClearsVolatileOnes) {
     Rig r;
     r.tx("00#V1:=5, #M1:=7, #HIGH_SPEED:=20000, #OUTPUT:=3, #ACCEL_TIME:=500, #TIMER_1:=100");
     r.tx("00#INTERPOL_TIME:=50, SOFT_ENDS ON, HARD_ENDS ALL, S_CURVE ON, #POSITION:=1234");
@@ -152,7 +152,7 @@ TEST(DmacSim, ModuleResetKeepsStoredVariablesAndClearsVolatileOnes) {
     EXPECT_EQ(r.read(Var::LineDelay), 1000);
 }
 
-TEST(DmacSim, OnResetStartsTheSequencer) {
+TEST(Sim, OnResetStartsTheSequencer) {
     Rig r;
     r.tx("00OPEN_SEQ");
     r.tx("00:7 #V1:=#V1 + 1");
@@ -167,10 +167,10 @@ TEST(DmacSim, OnResetStartsTheSequencer) {
 }
 
 // ---- addressing -------------------------------------------------------------------------
-TEST(DmacSim, GlobalCommandsRunEverywhereButOnlyAddressZeroAnswers) {
+TEST(Sim, GlobalCommandsRunEverywhereButOnlyAddressZeroAnswers) {
     Rig a(0), b(1);
     b.clock = a.clock;
-    b.sim = std::make_shared<DmacSim>(a.clock, SimOptions{.address = 1});
+    b.sim = std::make_shared<Sim>(a.clock, SimOptions{.address = 1});
     EXPECT_EQ(a.tx("READ #POSITION"), "00#POS=+0\r\n");
     EXPECT_EQ(b.tx("READ #POSITION"), "");
     a.tx("#V3:=9");
@@ -183,14 +183,14 @@ TEST(DmacSim, GlobalCommandsRunEverywhereButOnlyAddressZeroAnswers) {
 }
 
 // ---- motion -----------------------------------------------------------------------------
-TEST(DmacSim, MoveToFollowsTheDmacProfileTimes) {
+TEST(Sim, MoveToFollowsTheDmacProfileTimes) {
     Rig r;
     r.tx("00MOVE_TO 200000");
     // 0 -> 100 inc/ms in #ACCEL_TIME (1 s): 50000 inc; 100 -> #LOW_SPEED (10 inc/ms)
     // in 0.9 s: 49500 inc; the last 1000 inc closed-loop: tau 100 ms, ends in
     // tau (ln 1000 + 1); the rest cruises at 100 inc/ms.
     const double expected_ms = 1000 + (200000 - 100500) / 100.0 + 900 + 100 * (std::log(1000.0) + 1);
-    DmacMotion ref;
+    Motion ref;
     ref.move_to(0, 200000);
     EXPECT_NEAR(ref.profile().duration() * 1000, expected_ms, 1.0);
     r.ms(1000);
@@ -205,7 +205,7 @@ TEST(DmacSim, MoveToFollowsTheDmacProfileTimes) {
     EXPECT_TRUE(bit_set(st, status::kPowerOn));  // moves force power on
 }
 
-TEST(DmacSim, PositionControlBitDuringTheLastTenthOfATurn) {
+TEST(Sim, PositionControlBitDuringTheLastTenthOfATurn) {
     Rig r;
     r.tx("00MOVE_TO 20000");
     bool seen_loop = false, seen_before = false;
@@ -226,7 +226,7 @@ TEST(DmacSim, PositionControlBitDuringTheLastTenthOfATurn) {
     EXPECT_EQ(r.read(Var::Position), 20000);
 }
 
-TEST(DmacSim, MoveSpeedRampIsProportionalToTheSpeedChange) {
+TEST(Sim, MoveSpeedRampIsProportionalToTheSpeedChange) {
     Rig r;
     r.tx("00MOVE_SPEED 30000");  // manual: ATI 1000, HSP 60000 -> 0.5 s
     r.ms(250);
@@ -245,7 +245,7 @@ TEST(DmacSim, MoveSpeedRampIsProportionalToTheSpeedChange) {
     EXPECT_EQ(r.val("00READ #SPEED"), 0);
 }
 
-TEST(DmacSim, HaltStopsAtOnce) {
+TEST(Sim, HaltStopsAtOnce) {
     Rig r;
     r.tx("00MOVE_SPEED 60000");
     r.ms(1500);
@@ -256,7 +256,7 @@ TEST(DmacSim, HaltStopsAtOnce) {
     EXPECT_EQ(r.read(Var::Position), p);
 }
 
-TEST(DmacSim, SoftEndStopsStopTheAxisAndOnlyAllowReverse) {
+TEST(Sim, SoftEndStopsStopTheAxisAndOnlyAllowReverse) {
     Rig r;
     r.tx("00SOFT_ENDS ON");
     r.tx("00MOVE_TO 20000");  // #POSITIVE_END = 10000
@@ -280,7 +280,7 @@ TEST(DmacSim, SoftEndStopsStopTheAxisAndOnlyAllowReverse) {
     EXPECT_TRUE(bit_set(static_cast<std::uint32_t>(r.read(Var::Status)), status::kSoftNegEnd));
 }
 
-TEST(DmacSim, HardEndStopsFollowInputsAndPolarity) {
+TEST(Sim, HardEndStopsFollowInputsAndPolarity) {
     Rig r(0, Model::Dmac23_1);  // IN1 = positive, IN2 = negative end-stop
     r.tx("00HARD_ENDS POS");
     r.tx("00MOVE_SPEED 6000");
@@ -309,9 +309,9 @@ TEST(DmacSim, HardEndStopsFollowInputsAndPolarity) {
     EXPECT_EQ(r.read(Var::Input), 0x3F & ~0x2);
 }
 
-TEST(DmacSim, SynchroOnArmsMovesUntilSynchroTop) {
+TEST(Sim, SynchroOnArmsMovesUntilSynchroTop) {
     auto clock = std::make_shared<SimClock>();
-    DmacSim a(clock, SimOptions{.address = 0}), b(clock, SimOptions{.address = 3});
+    Sim a(clock, SimOptions{.address = 0}), b(clock, SimOptions{.address = 3});
     a.on_line("00BRAKE OFF");  // factory BRAKE ON (annex 7.1)
     b.on_line("03BRAKE OFF");
     for (auto* s : {&a, &b}) s->on_line("SYNCHRO ON");
@@ -327,7 +327,7 @@ TEST(DmacSim, SynchroOnArmsMovesUntilSynchroTop) {
     EXPECT_EQ(b.state().speed, -12500);
 }
 
-TEST(DmacSim, PowerAndBrake) {
+TEST(Sim, PowerAndBrake) {
     Rig r;
     r.tx("00POWER ON");
     EXPECT_TRUE(r.sim->state().power);
@@ -343,7 +343,7 @@ TEST(DmacSim, PowerAndBrake) {
     EXPECT_TRUE(bit_set(r17.sim->state().error, error::kSyntax));
 }
 
-TEST(DmacSim, CaptureAndReferenceOnIn5) {
+TEST(Sim, CaptureAndReferenceOnIn5) {
     Rig r;
     r.tx("00REFERENCE ON");
     EXPECT_TRUE(bit_set(r.sim->state().status, status::kReference));
@@ -361,7 +361,7 @@ TEST(DmacSim, CaptureAndReferenceOnIn5) {
     EXPECT_EQ(r.read(Var::Capture), r.read(Var::Position));
 }
 
-TEST(DmacSim, OutputsWithAlternateFunctionsAndPolarity) {
+TEST(Sim, OutputsWithAlternateFunctionsAndPolarity) {
     Rig r(0, Model::Dmac23_1);
     r.tx("00#OUTPUT:=4");
     EXPECT_EQ(r.sim->physical_outputs(), 4u);  // not busy, no fault
@@ -377,7 +377,7 @@ TEST(DmacSim, OutputsWithAlternateFunctionsAndPolarity) {
 }
 
 // ---- sequencer -------------------------------------------------------------------------
-TEST(DmacSim, SequenceOneRevEveryTwoSeconds) {
+TEST(Sim, SequenceOneRevEveryTwoSeconds) {
     Rig r;
     for (auto l : {"OPEN_SEQ", "MOVE_ON 10000", "WAIT 2000", "JUMP 1", "CLOSE_SEQ"}) r.tx(std::string("00") + l);
     EXPECT_EQ(r.sim->sequence_line(1), "MON +10000");
@@ -400,7 +400,7 @@ TEST(DmacSim, SequenceOneRevEveryTwoSeconds) {
     EXPECT_EQ(r.read(Var::Line), 0);
 }
 
-TEST(DmacSim, SequenceOneLinePerMillisecond) {
+TEST(Sim, SequenceOneLinePerMillisecond) {
     Rig r;
     r.tx("00OPEN_SEQ");
     for (int i = 0; i < 10; ++i) r.tx("00#V1:=#V1 + 1");
@@ -415,7 +415,7 @@ TEST(DmacSim, SequenceOneLinePerMillisecond) {
     EXPECT_FALSE(r.sim->state().sequencer_running);  // ...until past line 500
 }
 
-TEST(DmacSim, SequenceExample1OutputFollowsSupplyVoltage) {
+TEST(Sim, SequenceExample1OutputFollowsSupplyVoltage) {
     Rig r;
     for (auto l : {"OPEN_SEQ", "IF #SUPPLY_VOLTAGE < 15000 JUMP 5", "IF #SUPPLY_VOLTAGE > 20000 JUMP 5",
                    "#OUTPUT.4:=1", "JUMP 1", "#OUTPUT.4:=0", "JUMP 1", "CLOSE_SEQ", "START_SEQ 1"})
@@ -430,7 +430,7 @@ TEST(DmacSim, SequenceExample1OutputFollowsSupplyVoltage) {
     EXPECT_EQ(r.read(Var::Output), 0);
 }
 
-TEST(DmacSim, SequenceExample2AnalogSpeedLoopWithMnemonics) {
+TEST(Sim, SequenceExample2AnalogSpeedLoopWithMnemonics) {
     Rig r(0, Model::Dmac23_1);
     for (auto l : {"OSE", ":50 #V1:=#IAN - 15000", "#V1:=#V1 * 5", "MSP #V1", "JRE -3", "CSE", "SSE 50"})
         r.tx(std::string("00") + l);
@@ -440,7 +440,7 @@ TEST(DmacSim, SequenceExample2AnalogSpeedLoopWithMnemonics) {
     EXPECT_EQ(r.sim->sequence_line(53), "JRE -3");
 }
 
-TEST(DmacSim, SequenceExample3InputsTriggerMoves) {
+TEST(Sim, SequenceExample3InputsTriggerMoves) {
     Rig r;
     for (auto l : {"OPEN_SEQ", "IF #INPUT.2 = 1 JUMP_REL +3", "IF #INPUT.3 = 1 JUMP_REL +4", "JUMP 1",
                    "MOVE_ON 10000", "JUMP_REL 2", "MOVE_ON -10000", "WAIT 0", "JUMP 1", "CLOSE_SEQ",
@@ -460,7 +460,7 @@ TEST(DmacSim, SequenceExample3InputsTriggerMoves) {
     EXPECT_EQ(r.read(Var::Position), 0);
 }
 
-TEST(DmacSim, SequenceExample4CallAndReturn) {
+TEST(Sim, SequenceExample4CallAndReturn) {
     Rig r;
     for (auto l : {"OPEN_SEQ", ":150 IF #INPUT.3 = 0 CALL 160", "IF #SUPPLY_VOLTAGE > 30000 CALL 160", "JUMP 0",
                    ":160 #POSITION:=0", "#V5:=#V5 + 1", "RETURN", "CLOSE_SEQ", "#POSITION:=777", "START_SEQ 150"})
@@ -471,7 +471,7 @@ TEST(DmacSim, SequenceExample4CallAndReturn) {
     EXPECT_FALSE(r.sim->state().sequencer_running);
 }
 
-TEST(DmacSim, CallsNestFiveLevelsDeep) {
+TEST(Sim, CallsNestFiveLevelsDeep) {
     Rig r;
     // Line k calls k+10; line 10+k is "CALL 10+k+1"...: a chain of `depth` calls.
     auto build = [&](int depth) {
@@ -509,7 +509,7 @@ TEST(DmacSim, CallsNestFiveLevelsDeep) {
     EXPECT_FALSE(deep.sim->state().sequencer_running);
 }
 
-TEST(DmacSim, WaitPositiveZeroAndNegative) {
+TEST(Sim, WaitPositiveZeroAndNegative) {
     Rig r;
     for (auto l : {"OPEN_SEQ", "MOVE_ON 10000", "WAIT 0", "#V1:=#POSITION", "MOVE_ON 100000", "WAIT -100",
                    "#V2:=#POSITION", "#V3:=#SPEED", "JUMP 0", "CLOSE_SEQ", "START_SEQ"})
@@ -523,7 +523,7 @@ TEST(DmacSim, WaitPositiveZeroAndNegative) {
     EXPECT_EQ(r.read(Var::Position), 110000);
 }
 
-TEST(DmacSim, TimersCountDownEveryMillisecond) {
+TEST(Sim, TimersCountDownEveryMillisecond) {
     Rig r;
     for (auto l : {"OPEN_SEQ", "#TIMER_2:=50", "IF #TIMER_2 != 0 JUMP_REL +0", "#V2:=1", "JUMP 0", "CLOSE_SEQ",
                    "START_SEQ"})
@@ -539,7 +539,7 @@ TEST(DmacSim, TimersCountDownEveryMillisecond) {
     EXPECT_EQ(r.read(timer_var(3)), 500);
 }
 
-TEST(DmacSim, OperatorsEvaluateOnInt32) {
+TEST(Sim, OperatorsEvaluateOnInt32) {
     Rig r;
     r.tx("00#V1:=7");
     r.tx("00#V2:=#V1 * -3");
@@ -570,7 +570,7 @@ TEST(DmacSim, OperatorsEvaluateOnInt32) {
     EXPECT_EQ(r.read(Var::Position), -7);
 }
 
-TEST(DmacSim, MemorizedVariablesSurviveResetUserVariablesDoNot) {
+TEST(Sim, MemorizedVariablesSurviveResetUserVariablesDoNot) {
     Rig r;
     r.tx("00#M2:=H100, #V13:=1234");
     r.sim->power_cycle();
@@ -578,7 +578,7 @@ TEST(DmacSim, MemorizedVariablesSurviveResetUserVariablesDoNot) {
     EXPECT_EQ(r.read(v_var(13)), 0);
 }
 
-TEST(DmacSim, StepExecutesOneLine) {
+TEST(Sim, StepExecutesOneLine) {
     Rig r;
     for (auto l : {"OPEN_SEQ", "#V1:=1", "#V1:=2", "#V1:=3", "CLOSE_SEQ"}) r.tx(std::string("00") + l);
     r.tx("00STEP 2");
@@ -590,7 +590,7 @@ TEST(DmacSim, StepExecutesOneLine) {
     EXPECT_FALSE(r.sim->state().sequencer_running);
 }
 
-TEST(DmacSim, EditModeStatusBitAndLiveOnlyCommands) {
+TEST(Sim, EditModeStatusBitAndLiveOnlyCommands) {
     Rig r;
     r.tx("00OPEN_SEQ");
     EXPECT_TRUE(bit_set(r.sim->state().status, status::kSeqEdit));
@@ -609,7 +609,7 @@ TEST(DmacSim, EditModeStatusBitAndLiveOnlyCommands) {
 }
 
 // ---- interpolation -----------------------------------------------------------------------
-TEST(DmacSim, InterpolationFifoAndXonError) {
+TEST(Sim, InterpolationFifoAndXonError) {
     Rig r;
     r.tx("#INTERPOL_FIFOSIZE:=4");
     r.tx("#INTERPOL_TIME:=100");
@@ -639,7 +639,7 @@ TEST(DmacSim, InterpolationFifoAndXonError) {
     EXPECT_EQ(r.read(Var::Position), 360);
 }
 
-TEST(DmacSim, StopInInterpolationEmptiesTheFifo) {
+TEST(Sim, StopInInterpolationEmptiesTheFifo) {
     Rig r;
     for (int i = 0; i < 10; ++i) r.tx("00MOVE_INTERPOL 1000");
     r.tx("SYNCHRO INTERPOL");
@@ -651,7 +651,7 @@ TEST(DmacSim, StopInInterpolationEmptiesTheFifo) {
 }
 
 // ---- hostile input (HOSTILE_INPUTS.md 2.9) --------------------------------------------------
-TEST(DmacSim, A15OverlongAndBinaryInputIsSilentAndResyncs) {
+TEST(Sim, A15OverlongAndBinaryInputIsSilentAndResyncs) {
     Rig r;
     EXPECT_EQ(r.sim->on_overlong(), "");
     std::string longline = "00READ #POSITION" + std::string(300, 'X');
@@ -665,7 +665,7 @@ TEST(DmacSim, A15OverlongAndBinaryInputIsSilentAndResyncs) {
     EXPECT_GE(r.sim->lines_rejected(), 3u);
 }
 
-TEST(DmacSim, A7GarbageNumbersInCommandsChangeNothing) {
+TEST(Sim, A7GarbageNumbersInCommandsChangeNothing) {
     Rig r;
     for (const char* bad : {"00MOVE_TO 1e3", "00MOVE_TO +99999999999", "00#V1:=", "00#V1:=1 2", "00MOVE_TO ",
                             "00#V1:=H", "00#V1:=B102", "00MOVE_TO 12,", "00#V1:=5, BOGUS", ",", "00:0 NOP", "00:501 NOP"}) {
@@ -678,7 +678,7 @@ TEST(DmacSim, A7GarbageNumbersInCommandsChangeNothing) {
     EXPECT_EQ(r.tx("00#ERROR:=0, READ #POS"), "00#POS=+0\r\n");
 }
 
-TEST(DmacSim, A10NoiseBetweenFramesDoesNotDisturbTheNext) {
+TEST(Sim, A10NoiseBetweenFramesDoesNotDisturbTheNext) {
     Rig r;
     EXPECT_EQ(r.tx(std::string(64, '\xff')), "");
     EXPECT_EQ(r.tx(std::string(64, '\0')), "");
@@ -686,23 +686,23 @@ TEST(DmacSim, A10NoiseBetweenFramesDoesNotDisturbTheNext) {
     EXPECT_EQ(r.tx("00READ #POS"), "00#POS=+0\r\n");
 }
 
-TEST(DmacSim, RejectsBadAddressBeforeAnything) {
+TEST(Sim, RejectsBadAddressBeforeAnything) {
     Rig r(7);
     r.tx("7MOVE_TO 5");   // one digit: a global frame that makes no sense
     EXPECT_TRUE(bit_set(r.sim->state().error, error::kSyntax));
-    EXPECT_THROW(DmacSim(r.clock, SimOptions{.address = 64}), InvalidArgument);
+    EXPECT_THROW(Sim(r.clock, SimOptions{.address = 64}), InvalidArgument);
 }
 
 // ---- issue 23 items 17, 18 -------------------------------------------------------------------
-TEST(DmacSim, UltraSyncChainedModulesEndEachSegmentTogether) {  // 5.11
+TEST(Sim, UltraSyncChainedModulesEndEachSegmentTogether) {  // 5.11
     auto clock = std::make_shared<SimClock>();
     SimOptions ox, oy;
     oy.address = 1;
-    auto x = std::make_shared<DmacSim>(clock, ox);
-    auto y = std::make_shared<DmacSim>(clock, oy);
-    DmacSim::chain_ultrasync({x, y});
-    EXPECT_THROW(DmacSim::chain_ultrasync({x, y}), InvalidArgument);  // already chained
-    EXPECT_THROW(DmacSim::chain_ultrasync({x}), InvalidArgument);
+    auto x = std::make_shared<Sim>(clock, ox);
+    auto y = std::make_shared<Sim>(clock, oy);
+    Sim::chain_ultrasync({x, y});
+    EXPECT_THROW(Sim::chain_ultrasync({x, y}), InvalidArgument);  // already chained
+    EXPECT_THROW(Sim::chain_ultrasync({x}), InvalidArgument);
     y->set_speed_limit(5000);  // braked: a 1000-increment segment takes 200 ms
     x->on_line("BRAKE OFF");
     y->on_line("BRAKE OFF");
@@ -732,7 +732,7 @@ TEST(DmacSim, UltraSyncChainedModulesEndEachSegmentTogether) {  // 5.11
     EXPECT_THROW(y->set_speed_limit(-1), InvalidArgument);
 }
 
-TEST(DmacSim, UltraSyncWithoutAChainTimesItsOwnSegments) {
+TEST(Sim, UltraSyncWithoutAChainTimesItsOwnSegments) {
     Rig r;
     r.sim->set_speed_limit(5000);
     r.tx("00#INTERPOL_MODE:=-1, #INTERPOL_TIME:=100, MOVE_INTERPOL 1000, MOVE_INTERPOL 1000");
@@ -741,7 +741,7 @@ TEST(DmacSim, UltraSyncWithoutAChainTimesItsOwnSegments) {
     EXPECT_EQ(r.read(Var::Position), 1250);  // nobody to wait for; the brake still slows it
 }
 
-TEST(DmacSim, ProfileSpeedIsNothingWhileTheRotorRunsDown) {  // 4.8, 5.24
+TEST(Sim, ProfileSpeedIsNothingWhileTheRotorRunsDown) {  // 4.8, 5.24
     Rig r;
     r.tx("00#ACCEL_TIME:=100, MOVE_SPEED 60000");
     r.ms(500);

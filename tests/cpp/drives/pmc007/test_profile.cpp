@@ -26,7 +26,7 @@ TEST(Pmc007, GearTableAndMicrostepping) {
     EXPECT_DOUBLE_EQ(pmc007_convert_position(1600, 16, 32), 3200);
 }
 TEST(Pmc007, SCurveWithStartAndStopSpeed) {
-    Pmc007ProfileParams p;
+    ProfileParams p;
     p.speed = 5610;
     p.start_speed = 400;
     p.stop_speed = 200;
@@ -43,7 +43,7 @@ TEST(Pmc007, SCurveWithStartAndStopSpeed) {
     EXPECT_NEAR(sp.velocity(sp.duration() - 0.5), -3000, 1e-9);
 }
 TEST(Pmc007, GearZeroIsStartStop) {
-    Pmc007ProfileParams p;
+    ProfileParams p;
     p.speed = 1000;
     Profile prof = pmc007_position_profile(State{}, 500, p);
     EXPECT_NEAR(prof.duration(), 0.5, 1e-12);
@@ -52,7 +52,7 @@ TEST(Pmc007, GearZeroIsStartStop) {
 
 TEST(HostileNumbers, Pmc007Model) {
     for (double x : motorbus::test::kValues) {
-        Pmc007ProfileParams pm;
+        ProfileParams pm;
         pm.speed = x;
         motorbus::test::survives([&] { return pmc007_position_profile(State{}, 100, pm); });
     }

@@ -24,17 +24,17 @@ int rig_no = 0;
 struct Rig {
     RealClock clock;
     std::shared_ptr<can::Bus> sim_bus, host_bus;
-    std::unique_ptr<UnitekSim> sim;
-    std::unique_ptr<UnitekClient> client;
+    std::unique_ptr<Sim> sim;
+    std::unique_ptr<Client> client;
     Rig() {
         const std::string name = "unitek-poll-" + std::to_string(rig_no++);
         sim_bus = can::open_virtual(name);
         host_bus = can::open_virtual(name);
-        sim = std::make_unique<UnitekSim>(clock);
+        sim = std::make_unique<Sim>(clock);
         sim->attach(*sim_bus);
         ClientOptions o;
         o.timeout = 500ms;
-        client = std::make_unique<UnitekClient>(*host_bus, sim_default_table(), o);
+        client = std::make_unique<Client>(*host_bus, sim_default_table(), o);
     }
     ~Rig() {
         client.reset();

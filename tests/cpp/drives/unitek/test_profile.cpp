@@ -10,7 +10,7 @@ using namespace motorbus::motion;
 using namespace motorbus::unitek;
 
 TEST(Unitek, RampFromAccRegister) {
-    UnitekRampParams p;
+    RampParams p;
     p.n_max_rpm = 3000;
     p.acc_ramp_ms = 1000;  // Example 6: 0x35 = 0x03E8
     p.dec_ramp_ms = 500;
@@ -27,7 +27,7 @@ TEST(Unitek, RampFromAccRegister) {
 
 TEST(HostileNumbers, UnitekModel) {
     for (double x : motorbus::test::kValues) {
-        UnitekRampParams u;
+        RampParams u;
         u.acc_ramp_ms = x;
         motorbus::test::survives([&] { return unitek_speed_profile(State{}, 1000, u, 0); });
     }

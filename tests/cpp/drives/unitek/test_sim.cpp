@@ -20,8 +20,8 @@ int rig_no = 0;
 struct Rig {
     SimClock clock{1'000'000'000};
     std::shared_ptr<can::Bus> sim_bus, host_bus, spy_bus;
-    std::unique_ptr<UnitekSim> sim;
-    std::unique_ptr<UnitekClient> client;
+    std::unique_ptr<Sim> sim;
+    std::unique_ptr<Client> client;
     std::mutex m;
     std::vector<can::Frame> seen;  // everything on the bus, as a third node sees it
 
@@ -34,12 +34,12 @@ struct Rig {
             std::lock_guard l(m);
             seen.push_back(f);
         });
-        sim = std::make_unique<UnitekSim>(clock, cfg);
+        sim = std::make_unique<Sim>(clock, cfg);
         sim->attach(*sim_bus);
         ClientOptions o;
         o.clock = &clock;
         o.timeout = 500ms;
-        client = std::make_unique<UnitekClient>(*host_bus, RegisterTable::builtin(), o);
+        client = std::make_unique<Client>(*host_bus, RegisterTable::builtin(), o);
     }
     ~Rig() {
         // The spy's receive thread writes `seen`, a member destroyed before spy_bus:
@@ -87,7 +87,7 @@ struct Rig {
 Bytes payload(const can::Frame& f) { return {f.data.begin(), f.data.begin() + f.len}; }
 }  // namespace
 
-TEST(UnitekSim, Example8ReadStatusOnce) {
+TEST(Sim, Example8ReadStatusOnce) {
     Rig r;
     EXPECT_EQ(r.client->read(kRegStatus), 0x0181);
     auto to = r.frames(0x201, 1);
@@ -98,7 +98,7 @@ TEST(UnitekSim, Example8ReadStatusOnce) {
     EXPECT_EQ(payload(from[0]), (Bytes{0x40, 0x81, 0x01, 0x00}));  // DLC 4, dummy 0x00
 }
 
-TEST(UnitekSim, WritesAreNeverAcknowledged) {  // B-U05
+TEST(Sim, WritesAreNeverAcknowledged) {  // B-U05
     Rig r;
     r.client->write(kRegSpeedCmd, 0);
     r.client->write(kRegAccRamp, 1000);
@@ -108,7 +108,7 @@ TEST(UnitekSim, WritesAreNeverAcknowledged) {  // B-U05
     EXPECT_EQ(r.frames(0x181, 1).size(), 1u);
 }
 
-TEST(UnitekSim, Example9CyclicEvery100ms) {
+TEST(Sim, Example9CyclicEvery100ms) {
     SimConfig c;
     c.acc_ramp_ms = 0;
     Rig r(c);
@@ -140,7 +140,7 @@ TEST(UnitekSim, Example9CyclicEvery100ms) {
     EXPECT_EQ(lost, 0u);
 }
 
-TEST(UnitekSim, EightCyclicAt1msFor10sNoLoss) {
+TEST(Sim, EightCyclicAt1msFor10sNoLoss) {
     Rig r;
     const std::uint8_t regs[8] = {kRegSpeedActual, kRegSpeedCmd, kRegAccRamp, kRegStatus,
                                   kRegEventMask, kRegPosDest, kRegTorqueCmd, kRegA8};
@@ -186,7 +186,7 @@ TEST(UnitekSim, EightCyclicAt1msFor10sNoLoss) {
     EXPECT_EQ(r.sim->counters().frames_out, before);
 }
 
-TEST(UnitekSim, NinthRegisterIgnoredBySim) {  // B-U08
+TEST(Sim, NinthRegisterIgnoredBySim) {  // B-U08
     Rig r;
     for (std::uint8_t id : {0x30, 0x31, 0x35, 0x40, 0x52, 0x6E, 0x90, 0xA8})
         r.host_bus->send(can::Frame::make(0x201, Bytes{0x3D, id, 0x0A}));
@@ -201,7 +201,7 @@ TEST(UnitekSim, NinthRegisterIgnoredBySim) {  // B-U08
     extra.name = "EXTRA";
     t.add(extra);
     SimClock clock;
-    UnitekSim sim(clock, {}, t);
+    Sim sim(clock, {}, t);
     std::vector<can::Frame> out;
     sim.set_output([&](const can::Frame& f) { out.push_back(f); });
     for (std::uint8_t id : {0x30, 0x31, 0x35, 0x40, 0x52, 0x6E, 0x90, 0xA8, 0x34})
@@ -217,9 +217,9 @@ TEST(UnitekSim, NinthRegisterIgnoredBySim) {  // B-U08
     EXPECT_EQ(sim.cyclic().size(), 8u);
 }
 
-TEST(UnitekSim, OnceOnACyclicRegisterKeepsTheStream) {  // B-U07
+TEST(Sim, OnceOnACyclicRegisterKeepsTheStream) {  // B-U07
     SimClock clock;
-    UnitekSim sim(clock);
+    Sim sim(clock);
     std::vector<can::Frame> out;
     sim.set_output([&](const can::Frame& f) { out.push_back(f); });
     sim.on_frame(can::Frame::make(0x201, Bytes{0x3D, 0x30, 0x0A}));  // every 10 ms, first at once
@@ -246,7 +246,7 @@ TEST(UnitekSim, OnceOnACyclicRegisterKeepsTheStream) {  // B-U07
     for (std::size_t i = 6; i < out.size(); ++i) EXPECT_EQ(out[i].timestamp_ns - out[i - 1].timestamp_ns, 20'000'000);
 }
 
-TEST(UnitekSim, Example10EventOnTol) {
+TEST(Sim, Example10EventOnTol) {
     Rig r;
     r.sim->set_calibrated(true);
     std::atomic<int> events{0};
@@ -280,7 +280,7 @@ TEST(UnitekSim, Example10EventOnTol) {
     EXPECT_EQ(r.frames(0x181, 2, 50ms).size(), 1u);
 }
 
-TEST(UnitekSim, DisableAndHardwareEnable) {  // ex 2, B-U11
+TEST(Sim, DisableAndHardwareEnable) {  // ex 2, B-U11
     Rig r;
     r.client->disable();
     EXPECT_EQ(payload(r.frames(0x201, 1).back()), (Bytes{0x51, 0x04, 0x00}));
@@ -295,7 +295,7 @@ TEST(UnitekSim, DisableAndHardwareEnable) {  // ex 2, B-U11
     EXPECT_EQ(r.sim->position_num(), 0.0);
 }
 
-TEST(UnitekSim, SpeedRampFollowsAcc) {  // ex 3, ex 6, B-U24
+TEST(Sim, SpeedRampFollowsAcc) {  // ex 3, ex 6, B-U24
     Rig r;
     r.client->write(kRegAccRamp, 1000);
     r.client->write(kRegSpeedCmd, 3277);  // 10 %: 100 ms of ramp
@@ -309,7 +309,7 @@ TEST(UnitekSim, SpeedRampFollowsAcc) {  // ex 3, ex 6, B-U24
     EXPECT_NEAR(r.sim->speed_num(), 0, 1e-6);
 }
 
-TEST(UnitekSim, PositionToPosDestWithTol) {  // ex 4
+TEST(Sim, PositionToPosDestWithTol) {  // ex 4
     Rig r;
     r.client->write(kRegAccRamp, 100);
     r.client->write(kRegPosDest, 3000000);
@@ -320,7 +320,7 @@ TEST(UnitekSim, PositionToPosDestWithTol) {  // ex 4
     EXPECT_TRUE(r.client->read(kRegStatus) & kStatusTol);
 }
 
-TEST(UnitekSim, TorqueAndContinuousCurrentLimit) {  // ex 5
+TEST(Sim, TorqueAndContinuousCurrentLimit) {  // ex 5
     SimConfig c;
     c.torque_continuous_num = 10000;
     Rig r(c);
@@ -334,7 +334,7 @@ TEST(UnitekSim, TorqueAndContinuousCurrentLimit) {  // ex 5
     EXPECT_FALSE(r.sim->status() & kStatusIcns);
 }
 
-TEST(UnitekSim, LimitSwitchStopsMotionTowardsIt) {
+TEST(Sim, LimitSwitchStopsMotionTowardsIt) {
     SimConfig c;
     c.plus_limit_num = 65536;
     c.acc_ramp_ms = 10;
@@ -347,7 +347,7 @@ TEST(UnitekSim, LimitSwitchStopsMotionTowardsIt) {
     EXPECT_LT(r.sim->position_num(), 65536 + 5000);
 }
 
-TEST(UnitekSim, ReceiveIdChangeAndEepromAcrossPowerCycle) {  // ex 1, ex 7, B-U12, B-U13
+TEST(Sim, ReceiveIdChangeAndEepromAcrossPowerCycle) {  // ex 1, ex 7, B-U12, B-U13
     Rig r;
     r.client->write(kRegAccRamp, 250);
     r.client->set_receive_id(0x210);
@@ -364,7 +364,7 @@ TEST(UnitekSim, ReceiveIdChangeAndEepromAcrossPowerCycle) {  // ex 1, ex 7, B-U1
     r.client.reset();
     ClientOptions o;
     o.clock = &r.clock;
-    r.client = std::make_unique<UnitekClient>(*r.host_bus, RegisterTable::builtin(), o);
+    r.client = std::make_unique<Client>(*r.host_bus, RegisterTable::builtin(), o);
     r.client->write(kRegAccRamp, 250);
     r.client->set_receive_id(0x210);
     r.client->store_eeprom(0);
@@ -376,9 +376,9 @@ TEST(UnitekSim, ReceiveIdChangeAndEepromAcrossPowerCycle) {  // ex 1, ex 7, B-U1
     EXPECT_THROW(r.client->store_eeprom(2), InvalidArgument);
 }
 
-TEST(UnitekSim, HostileFramesToTheDrive) {  // R1-R3, B-U20, B-U22
+TEST(Sim, HostileFramesToTheDrive) {  // R1-R3, B-U20, B-U22
     SimClock clock;
-    UnitekSim sim(clock);
+    Sim sim(clock);
     std::vector<can::Frame> out;
     sim.set_output([&](const can::Frame& f) { out.push_back(f); });
     for (std::size_t n = 0; n < 3; ++n) sim.on_frame(can::Frame::make(0x201, Bytes(n, 0x3D)));
@@ -404,7 +404,7 @@ TEST(UnitekSim, HostileFramesToTheDrive) {  // R1-R3, B-U20, B-U22
     EXPECT_EQ(sim.value(kRegPosDest), -1);
 }
 
-TEST(UnitekClient, HostileRepliesAreCountedNotUsed) {  // R1, R4
+TEST(Client, HostileRepliesAreCountedNotUsed) {  // R1, R4
     Rig r;
     auto fake = can::open_virtual("unitek-test-" + std::to_string(rig_no - 1));
     fake->send(can::Frame::make(0x181, Bytes{0x40, 0x81, 0x01}));         // DLC 3
@@ -424,7 +424,7 @@ TEST(UnitekClient, HostileRepliesAreCountedNotUsed) {  // R1, R4
     EXPECT_THROW(r.client->read(kRegMode), InvalidArgument);  // write-only
 }
 
-TEST(UnitekClient, CloseStopsItsStreams) {
+TEST(Client, CloseStopsItsStreams) {
     Rig r;
     r.client->subscribe(kRegSpeedActual, 10);
     r.client->subscribe(kRegStatus, 20);
@@ -436,15 +436,15 @@ TEST(UnitekClient, CloseStopsItsStreams) {
     EXPECT_THROW(r.client->write(kRegSpeedCmd, 0), ClosedError);
 }
 
-TEST(UnitekClient, ReadTimesOutWithoutADrive) {
+TEST(Client, ReadTimesOutWithoutADrive) {
     auto bus = can::open_virtual("unitek-lonely");
     ClientOptions o;
     o.timeout = 20ms;
-    UnitekClient c(*bus, RegisterTable::builtin(), o);
+    Client c(*bus, RegisterTable::builtin(), o);
     EXPECT_THROW(c.read(kRegStatus), TimeoutError);
 }
 
-TEST(UnitekClient, RingBufferReaderRacingTheWriter) {
+TEST(Client, RingBufferReaderRacingTheWriter) {
     // One writer (the bus thread), one reader: every sample comes out in order or is
     // counted lost; none is read twice.
     RingBuffer ring(64);
@@ -473,7 +473,7 @@ TEST(UnitekClient, RingBufferReaderRacingTheWriter) {
 
 namespace {
 // The value of the one reply to `3D regid 00` (16-bit, sign-extended when asked).
-std::int64_t ask(UnitekSim& sim, std::vector<can::Frame>& out, std::uint8_t regid, bool is_signed = false) {
+std::int64_t ask(Sim& sim, std::vector<can::Frame>& out, std::uint8_t regid, bool is_signed = false) {
     out.clear();
     sim.on_frame(can::Frame::make(sim.rx_id(), Bytes{0x3D, regid, 0x00}));
     EXPECT_EQ(out.size(), 1u);
@@ -484,9 +484,9 @@ std::int64_t ask(UnitekSim& sim, std::vector<can::Frame>& out, std::uint8_t regi
 }
 }  // namespace
 
-TEST(UnitekSim, EepromKeepsEveryWritableRegister) {  // B-U13, issue 23 item 15
+TEST(Sim, EepromKeepsEveryWritableRegister) {  // B-U13, issue 23 item 15
     SimClock clock;
-    UnitekSim sim(clock);
+    Sim sim(clock);
     std::vector<can::Frame> out;
     sim.set_output([&](const can::Frame& f) { out.push_back(f); });
     const std::vector<Bytes> writes = {{0x51, 0x14, 0x00}, {0x35, 0xF4, 0x01}, {0x52, 0x12, 0x00},
@@ -515,12 +515,12 @@ TEST(UnitekSim, EepromKeepsEveryWritableRegister) {  // B-U13, issue 23 item 15
     EXPECT_EQ(sim.speed_num(), 0.0);          // a stored set-point starts nothing
 }
 
-TEST(UnitekSim, CurrentCommandNineBitsAndTheSmallerLimit) {  // §6.1, B-U17, issue 23 item 16
+TEST(Sim, CurrentCommandNineBitsAndTheSmallerLimit) {  // §6.1, B-U17, issue 23 item 16
     SimClock clock;
     SimConfig cfg;
     cfg.device = "DS 412";
     cfg.motor_i_max_num = 120;
-    UnitekSim sim(clock, cfg);
+    Sim sim(clock, cfg);
     std::vector<can::Frame> out;
     sim.set_output([&](const can::Frame& f) { out.push_back(f); });
     EXPECT_EQ(ask(sim, out, kRegDeviceCurrentMax), 230);
@@ -536,13 +536,13 @@ TEST(UnitekSim, CurrentCommandNineBitsAndTheSmallerLimit) {  // §6.1, B-U17, is
     sim.set_hardware_enable(false);
     EXPECT_EQ(ask(sim, out, kRegCurrentActual, true), 0);  // power stage off: no current
     cfg.motor_i_max_num = 512;
-    EXPECT_THROW(UnitekSim(clock, cfg), InvalidArgument);
+    EXPECT_THROW(Sim(clock, cfg), InvalidArgument);
     cfg.motor_i_max_num.reset();
     cfg.device = "DS 999";
-    EXPECT_THROW(UnitekSim(clock, cfg), InvalidArgument);
+    EXPECT_THROW(Sim(clock, cfg), InvalidArgument);
 }
 
-TEST(UnitekSim, NodeAtAnotherBitRateHearsAndSendsNothing) {  // §3.1, B-U21, issue 23 item 16
+TEST(Sim, NodeAtAnotherBitRateHearsAndSendsNothing) {  // §3.1, B-U21, issue 23 item 16
     SimClock clock;
     can::VirtualOptions vo;
     vo.bitrate = 250000;
@@ -551,7 +551,7 @@ TEST(UnitekSim, NodeAtAnotherBitRateHearsAndSendsNothing) {  // §3.1, B-U21, is
     std::atomic<int> seen{0};
     host->subscribe(can::Filter{}, [&](const can::Frame&) { ++seen; });
     SimConfig cfg;  // BTR 0x4025: 500 kbit/s
-    UnitekSim sim(clock, cfg);
+    Sim sim(clock, cfg);
     sim.attach(*medium);
     EXPECT_EQ(sim.bus_bit_rate(), 250000);
     host->send(can::Frame::make(0x201, Bytes{0x3D, 0x40, 0x00}), 100ms);
@@ -564,7 +564,7 @@ TEST(UnitekSim, NodeAtAnotherBitRateHearsAndSendsNothing) {  // §3.1, B-U21, is
     EXPECT_EQ(seen.load(), 0);
     sim.close();
     cfg.btr = 0x405C;  // 250 k in NDrive
-    UnitekSim at250(clock, cfg);
+    Sim at250(clock, cfg);
     at250.attach(*medium);
     host->send(can::Frame::make(0x201, Bytes{0x3D, 0x40, 0x00}), 100ms);
     const auto end2 = std::chrono::steady_clock::now() + 2s;
@@ -572,5 +572,5 @@ TEST(UnitekSim, NodeAtAnotherBitRateHearsAndSendsNothing) {  // §3.1, B-U21, is
     EXPECT_EQ(seen.load(), 1);
     at250.close();
     cfg.btr = 0x4026;
-    EXPECT_THROW(UnitekSim(clock, cfg), InvalidArgument);
+    EXPECT_THROW(Sim(clock, cfg), InvalidArgument);
 }
