@@ -172,7 +172,7 @@ void check_node(int n, bool allow_zero) {
 
 }  // namespace
 
-void bind_canopen_services(py::module_& m) {
+static void bind_records(py::module_& m) {
     // ---- records: C++ structs, read-only --------------------------------------------
     py::class_<EmcyMessage>(m, "EmcyError", "One EMCY message as received (CiA 301).")
         .def_readonly("node", &EmcyMessage::node_id)
@@ -280,7 +280,9 @@ void bind_canopen_services(py::module_& m) {
             return "NodeInfo(node=" + std::to_string(r.node_id) + ", state='" + to_string(r.state) +
                    "', device_type=" + opt_hex(r.device_type) + ", vendor_id=" + opt_hex(r.vendor_id) + ")";
         });
+}
 
+static void bind_codecs(py::module_& m) {
     // ---- pure codecs --------------------------------------------------------
     // An enum.IntEnum (not py::enum_): it replaces the IntEnum motorbus.canopen.nmt
     // defined before, whose members are ints (== 0x01, usable as a byte).
@@ -346,7 +348,9 @@ void bind_canopen_services(py::module_& m) {
               if (!t) return py::none();
               return py::int_(t->to_unix_ms());
           }, py::arg("frame"), "Unix time in ms, or None.");
+}
 
+static void bind_nmt(py::module_& m) {
     // ---- NMT master -----------------------------------------------------------
     // Wrapped by motorbus.canopen.nmt.NmtMaster, which carries the docstrings.
     py::class_<NmtMaster, std::shared_ptr<NmtMaster>>(m, "NmtMaster")
@@ -406,7 +410,9 @@ void bind_canopen_services(py::module_& m) {
                  };
              }, py::arg("callback"))
         .def_property_readonly("foreign_commands_ignored", [](NmtMaster& b) { return b.foreign_commands_ignored(); });
+}
 
+static void bind_heartbeat(py::module_& m) {
     // ---- heartbeat --------------------------------------------------------------
     py::class_<HeartbeatConsumer, std::shared_ptr<HeartbeatConsumer>>(m, "HeartbeatConsumer",
         "Per-node heartbeat supervision: started / lost / back / reset / state events.")
@@ -475,7 +481,9 @@ void bind_canopen_services(py::module_& m) {
         .def_property_readonly("send_failures", [](HeartbeatProducer& b) { return b.send_failures(); },
                                "heartbeats the bus refused (closed, full, link down) while started")
         .def_property_readonly("sent", [](HeartbeatProducer& b) { return b.sent(); });
+}
 
+static void bind_emcy(py::module_& m) {
     // ---- EMCY -------------------------------------------------------------------
     py::class_<EmcyConsumer, std::shared_ptr<EmcyConsumer>>(m, "EmcyConsumer",
         "Collects EMCY messages: bounded history and active codes per node.")
@@ -533,7 +541,9 @@ void bind_canopen_services(py::module_& m) {
         .def_property_readonly("pending", [](EmcyProducer& b) { return b.pending(); })
         .def_property_readonly("sent", [](EmcyProducer& b) { return b.sent(); })
         .def_property_readonly("dropped", [](EmcyProducer& b) { return b.dropped(); });
+}
 
+static void bind_sync(py::module_& m) {
     // ---- SYNC -------------------------------------------------------------------
     py::class_<SyncProducer, std::shared_ptr<SyncProducer>>(m, "SyncProducer",
         "SYNC on a C++ thread; jitter() reports the period error statistics.")
@@ -554,7 +564,9 @@ void bind_canopen_services(py::module_& m) {
         .def_property_readonly("sent", [](SyncProducer& b) { return b.sent(); })
         .def("jitter", [](SyncProducer& b) { return b.jitter(); })
         .def("reset_stats", [](SyncProducer& b) { b.reset_stats(); });
+}
 
+static void bind_pdo(py::module_& m) {
     // ---- PDO ----------------------------------------------------------------------
     py::class_<PdoLayout>(m, "PdoLayout", "A compiled PDO mapping: bit-exact pack/unpack (CiA 301, little-endian).")
         .def(py::init([](const py::iterable& entries) {
@@ -680,7 +692,9 @@ void bind_canopen_services(py::module_& m) {
               }
               return c;
           }, py::arg("sdo"), py::arg("node"), py::arg("tpdo"), py::arg("number"));
+}
 
+static void bind_cia402(py::module_& m) {
     // ---- CiA 402 ------------------------------------------------------------------
     m.def("cia402_decode_statusword", [](std::uint16_t sw) { return std::string(to_string(decode_statusword(sw))); },
           py::arg("statusword"), "State name; 'UNKNOWN' for patterns outside the table.");
@@ -762,7 +776,9 @@ void bind_canopen_services(py::module_& m) {
         .def("set_status_bits", &Cia402Device::set_status_bits, py::arg("mask"), py::arg("value"))
         .def_property_readonly("last_error_code", &Cia402Device::last_error_code)
         .def_property_readonly("drive_enabled", &Cia402Device::drive_enabled);
+}
 
+static void bind_pdo_service(py::module_& m) {
     // ---- PDO engine on a LocalNode -----------------------------------------------------
     py::class_<PdoService, std::shared_ptr<PdoService>>(m, "PdoService",
         "The PDO engine of a LocalNode: 0x1400-0x1BFF in its dictionary, TPDOs/RPDOs on its bus.")
@@ -826,7 +842,9 @@ void bind_canopen_services(py::module_& m) {
                  PyCallable call(cb.cast<py::function>());
                  s.on_lost = [call](std::uint8_t n) { call(n); };
              }, py::arg("callback"), "callback(node) when a consumed heartbeat is lost (e.g. Cia402Device.loss_of_master).");
+}
 
+static void bind_scanner(py::module_& m) {
     // ---- scanner ------------------------------------------------------------------
     m.def("scan_network", [](BusPtr bus, int first, int last, double sdo_timeout, double listen, bool probe_sdo,
                              bool identity) {
@@ -863,4 +881,17 @@ void bind_canopen_services(py::module_& m) {
         .def_property_readonly("received", &PdoCaptureSource::received)
         .def_property_readonly("short_frames", &PdoCaptureSource::short_frames)
         .def("close", &PdoCaptureSource::close, py::call_guard<py::gil_scoped_release>(), "Stops listening.");
+}
+
+void bind_canopen_services(py::module_& m) {
+    bind_records(m);
+    bind_codecs(m);
+    bind_nmt(m);
+    bind_heartbeat(m);
+    bind_emcy(m);
+    bind_sync(m);
+    bind_pdo(m);
+    bind_cia402(m);
+    bind_pdo_service(m);
+    bind_scanner(m);
 }

@@ -39,7 +39,7 @@ py::array_t<double> vec_to_array(const std::vector<double>& v) {
 }
 }  // namespace
 
-void bind_motion(py::module_& m) {
+static void bind_planners(py::module_& m) {
     // ---- errors ----------------------------------------------------------------
     py_errors::add_error_classes(m, {{"LimitExceeded", {"InvalidArgument"},
         "A motion request beyond a limit: .limit names it, .requested/.allowed/.excess quantify it."}});
@@ -145,7 +145,9 @@ void bind_motion(py::module_& m) {
               return vec_to_array(jerk_limited_durations(std::span(cases.data(), cases.size())));
           },
           py::arg("cases"), "Rows: p0, v0, a0, target, vmax, amax, jmax; the duration of each row's plan.");
+}
 
+static void bind_stepnloop(py::module_& m) {
     // ---- StepNLoop -------------------------------------------------------------
     py::class_<SnlConfig>(m, "SnlConfig")
         .def(py::init<>())
@@ -180,7 +182,9 @@ void bind_motion(py::module_& m) {
         .def_property_readonly("status", [](const StepNLoop& s) { return static_cast<int>(s.status()); })
         .def_property_readonly("status_name", [](const StepNLoop& s) { return snl_status_name(s.status()); })
         .def_property_readonly("attempts", &StepNLoop::attempts);
+}
 
+static void bind_cia402_profiles(py::module_& m) {
     // ---- CiA 402 ------------------------------------------------
     py::class_<Cia402ProfileParams>(m, "Cia402ProfileParams")
         .def(py::init([](double v, double a, double d, double qs, int type, double vmax) {
@@ -215,7 +219,9 @@ void bind_motion(py::module_& m) {
         .def_property_readonly("profile", &Cia402ProfilePosition::profile, py::return_value_policy::copy)
         .def("target_reached", &Cia402ProfilePosition::target_reached, py::arg("t"))
         .def_property_readonly("setpoint_pending", &Cia402ProfilePosition::setpoint_pending);
+}
 
+static void bind_motor_model(py::module_& m) {
     // ---- motor model and homing -------------------------------------------------
     py::class_<SwitchConfig>(m, "SwitchConfig")
         .def(py::init([](bool present, double lo, double hi, bool active_low) { return SwitchConfig{present, lo, hi, active_low}; }),
@@ -310,4 +316,11 @@ void bind_motion(py::module_& m) {
         .def_property_readonly("error", &Cia402Homing::error)
         .def_property_readonly("result", [](const Cia402Homing& h) { return static_cast<int>(h.result()); })
         .def_static("supported", &Cia402Homing::supported);
+}
+
+void bind_motion(py::module_& m) {
+    bind_planners(m);
+    bind_stepnloop(m);
+    bind_cia402_profiles(m);
+    bind_motor_model(m);
 }

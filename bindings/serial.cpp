@@ -145,7 +145,7 @@ void fill_reply_too_long(py::object& exc, const ReplyTooLong& e) {
 }
 }  // namespace
 
-void bind_serial(py::module_& m) {
+static void bind_serial_records(py::module_& m) {
     // ReplyTooLong(ProtocolError): a distinct class so callers can catch it alone.
     py_errors::add_error_classes(m, {{"ReplyTooLong", {"ProtocolError"},
         "A reply exceeded max_line; it was discarded up to its terminator. .data holds its first bytes."}});
@@ -170,7 +170,9 @@ void bind_serial(py::module_& m) {
         .field("replies", &LineServerCounters::replies, "non-empty replies written")
         .field("device_errors", &LineServerCounters::device_errors, "a device broke its no-throw promise (reply dropped)")
         .field("dropped_replies", &LineServerCounters::dropped_replies, "the client stopped reading; reply not written");
+}
 
+static void bind_ports(py::module_& m) {
     py::class_<Port, std::shared_ptr<Port>>(m, "Port", R"doc(A bidirectional byte stream (a serial device or one side of a pty).
 
     write(data)                 blocks until all bytes are written; LinkDown if the peer is gone
@@ -278,7 +280,9 @@ void bind_serial(py::module_& m) {
     m.def("open_port", &open_port, py::arg("path"), py::arg("baud") = 0, py::call_guard<py::gil_scoped_release>(),
           "Opens a serial device at `baud` (0 = keep the current speed), or a line behind a serial gateway:\n"
           "'socket://host:port' (raw TCP, baud ignored) or 'rfc2217://host:port' (baud sent to the gateway).");
+}
 
+static void bind_line_link(py::module_& m) {
     py::class_<LineLink, std::shared_ptr<LineLink>>(m, "LineLink", R"doc(Request/reply line framing on a Port.
 
     LineLink(port, request_terminator="\r", reply_terminators=["\r\n"], max_line=256,
@@ -382,7 +386,9 @@ void bind_serial(py::module_& m) {
             for (const auto& t : l.options().reply_terminators) out.append(to_py(t));
             return out;
         });
+}
 
+static void bind_line_devices(py::module_& m) {
     py::class_<LineDevice, PyLineDevice, std::shared_ptr<LineDevice>>(
         m, "LineDevice",
         R"doc(A simulated serial device; subclass it (call super().__init__()).
@@ -452,4 +458,11 @@ void bind_serial(py::module_& m) {
                                "LineServerCounters (a snapshot)")
         .def("__enter__", [](py::object self) { return self; })
         .def("__exit__", [](PyLineServer& s, py::args) { s.close(); });
+}
+
+void bind_serial(py::module_& m) {
+    bind_serial_records(m);
+    bind_ports(m);
+    bind_line_link(m);
+    bind_line_devices(m);
 }

@@ -34,7 +34,7 @@ struct EventRecord {
 
 }  // namespace
 
-void bind_slcan(py::module_& m) {
+static void bind_slcan_records(py::module_& m) {
     Record<SlcanStats>(m, "SlcanStats", "SLCAN link statistics (SlcanBus.stats), read-only.")
         .field("acks", &SlcanStats::acks, "CR / z / Z answering a command")
         .field("nacks", &SlcanStats::nacks, "BEL answering a command (or unsolicited)")
@@ -98,7 +98,9 @@ void bind_slcan(py::module_& m) {
         .prop("rx_errors", [](const EventRecord& r) { return r.event.rx_errors; }, "STATE_REPORT")
         .prop("tx_errors", [](const EventRecord& r) { return r.event.tx_errors; }, "STATE_REPORT")
         .prop("text", [](const EventRecord& r) { return py::bytes(r.text); }, "the line's bytes (no terminator)");
+}
 
+static void bind_slcan_bus(py::module_& m) {
     py::class_<SlcanBus, Bus, std::shared_ptr<SlcanBus>>(
         m, "SlcanBus", "A CAN bus through an SLCAN (Lawicel) adapter on a serial port.")
         .def("flush_tx",
@@ -186,7 +188,9 @@ void bind_slcan(py::module_& m) {
             py::gil_scoped_release nogil;
             s.close();
         });
+}
 
+static void bind_slcan_codec(py::module_& m) {
     // Pure codec, for tests and fuzzing from Python.
     m.def("slcan_encode",
           [](const Frame& f, const py::object& timestamp_ms) {
@@ -220,4 +224,10 @@ void bind_slcan(py::module_& m) {
         .def_property_readonly("pending", &slcan::StreamDecoder::pending)
         .def_property_readonly("counters", &slcan::StreamDecoder::counters, py::return_value_policy::copy,
                                "SlcanDecoderCounters (a snapshot)");
+}
+
+void bind_slcan(py::module_& m) {
+    bind_slcan_records(m);
+    bind_slcan_bus(m);
+    bind_slcan_codec(m);
 }

@@ -34,7 +34,7 @@ Duration seconds_or(const py::object& t, const char* name, Duration none_value, 
 
 }  // namespace
 
-void bind_socketcand(py::module_& m) {
+static void bind_socketcand_bus(py::module_& m) {
     using socketcand::ParserStats;
     Record<ParserStats>(m, "SocketcandParserStats", "The socketcand parser's view (SocketcandBus.parser_stats), read-only.")
         .field("elements", &ParserStats::elements, "well-formed elements delivered")
@@ -115,7 +115,9 @@ void bind_socketcand(py::module_& m) {
         "Connect to a socketcand server and open CHANNEL in raw mode. keepalive: seconds between "
         "< echo > probes on an idle link (None = off); the link is declared down after "
         "keepalive_misses silent periods.");
+}
 
+static void bind_socketcand_server(py::module_& m) {
     py::class_<SocketcandServer, std::shared_ptr<SocketcandServer>>(
         m, "SocketcandServer",
         "Serve a motorbus Bus over TCP with the socketcand protocol (raw mode). Each client is a "
@@ -156,7 +158,9 @@ void bind_socketcand(py::module_& m) {
         .def("__repr__", [](const SocketcandServer& s) {
             return "SocketcandServer(" + s.host() + ":" + std::to_string(s.port()) + ")";
         });
+}
 
+static void bind_socketcan(py::module_& m) {
     py::class_<SocketCanBus, Bus, std::shared_ptr<SocketCanBus>>(
         m, "SocketCanBus", "A Linux AF_CAN raw socket (can0, vcan0, ...).");
 
@@ -186,4 +190,10 @@ void bind_socketcand(py::module_& m) {
               return py::str(*why);
           },
           "None when AF_CAN raw sockets work on this machine, else why not.");
+}
+
+void bind_socketcand(py::module_& m) {
+    bind_socketcand_bus(m);
+    bind_socketcand_server(m);
+    bind_socketcan(m);
 }
