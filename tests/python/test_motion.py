@@ -83,7 +83,14 @@ def test_dmac_interpolation_sums_reach_targets():
     assert segs.sum(axis=0).tolist() == [10000, -3333, 7]
     with pytest.raises(motion.LimitExceeded) as e:
         dmac.dmac_interpolation([0], [10], lim[:1], period_ms=1)
-    assert e.value.limit == "#INTERPOL_TIME"
+    assert (e.value.limit, e.value.requested, e.value.allowed) == ("#INTERPOL_TIME", 1, 2)
+    with pytest.raises(motion.LimitExceeded, match=r"#INTERPOL_TIME: requested 139 is outside 2\.\.138"):
+        dmac.dmac_interpolation([0], [10], lim[:1], period_ms=139)
+    # the generic splitter takes any period from 1 ms: the 2..138 ms range is the DMAC's
+    one = motion.plan_synchronized([0], [10], lim[:1])
+    assert sum(s[0] for s in motion.split_interpolation(one, 1)) == 10
+    with pytest.raises(motion.LimitExceeded):
+        motion.split_interpolation(one, 0)
 
 
 def test_synchronized_axes_finish_together():

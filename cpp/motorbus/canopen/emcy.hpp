@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
-#include "motorbus/canopen/timer_thread.hpp"
+#include "motorbus/runtime/timer_thread.hpp"
 #include "motorbus/runtime/callback_slot.hpp"
 #include "motorbus/runtime/clock.hpp"
 

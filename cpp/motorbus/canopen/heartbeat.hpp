@@ -14,7 +14,7 @@
 
 #include "motorbus/can/bus.hpp"
 #include "motorbus/canopen/nmt.hpp"
-#include "motorbus/canopen/timer_thread.hpp"
+#include "motorbus/runtime/timer_thread.hpp"
 #include "motorbus/runtime/callback_slot.hpp"
 #include "motorbus/runtime/clock.hpp"
 

@@ -1,5 +1,5 @@
 // Multi-axis planning: time-synchronised and straight-line moves, and the
-// split of a path into DMAC MOVE_INTERPOL segments.
+// split of a path into interpolation segments (integer offsets per period).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -83,8 +83,7 @@ std::vector<Profile> plan_straight_line(const std::vector<double>& start, const 
 }
 
 std::vector<std::vector<long long>> split_interpolation(const std::vector<Profile>& axes, int period_ms) {
-    if (period_ms < 2) throw LimitExceeded("#INTERPOL_TIME", period_ms, 2, "ms per segment");
-    if (period_ms > 138) throw LimitExceeded("#INTERPOL_TIME", period_ms, 138, "ms per segment");
+    if (period_ms < 1) throw LimitExceeded("period_ms", period_ms, 1, "ms per segment");
     if (axes.empty()) throw InvalidArgument("split_interpolation: no axes");
     double T = 0;
     for (const auto& a : axes) T = std::max(T, a.duration());

@@ -110,8 +110,9 @@ std::vector<Profile> plan_straight_line(const std::vector<double>& start,
                                         RampShape shape = RampShape::Trapezoid);
 
 // Split a multi-axis path (one profile per axis, positions in increments) into
-// DMAC MOVE_INTERPOL segments: integer offsets per period of `period_ms`
-// (#INTERPOL_TIME, 2..138 ms).  Offsets are the differences of the rounded
+// interpolation segments, as a drive's interpolated-position stream takes them:
+// integer offsets per period of `period_ms` (>= 1; the periods a drive accepts are
+// its own check, in its folder).  Offsets are the differences of the rounded
 // sampled positions, so their running sums track the path with at most half an
 // increment of error and reach every target exactly.  Result: [segment][axis].
 std::vector<std::vector<long long>> split_interpolation(const std::vector<Profile>& axes,

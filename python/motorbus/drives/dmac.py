@@ -434,6 +434,13 @@ def dmac_interpolation(start: Sequence[float], target: Sequence[float], limits: 
 
     from .. import motion
 
+    # The module's own range for #INTERPOL_TIME (the splitter takes any period from 1 ms).
+    rng = _core.dmac_variable("#INTERPOL_TIME")
+    if not rng.min <= period_ms <= rng.max:
+        bound = rng.min if period_ms < rng.min else rng.max
+        e = _core.LimitExceeded(f"#INTERPOL_TIME: requested {period_ms} is outside {rng.min}..{rng.max} (ms per segment)")
+        e.limit, e.requested, e.allowed, e.excess = "#INTERPOL_TIME", float(period_ms), float(bound), float(period_ms - bound)
+        raise e
     planner = motion.plan_straight_line if straight_line else motion.plan_synchronized
     axes = planner(list(map(float, start)), list(map(float, target)), list(limits))
     return np.asarray(motion.split_interpolation(axes, int(period_ms)), dtype=np.int64).reshape(-1, len(start))

@@ -137,7 +137,7 @@ void Sim::attach(can::Bus& bus) {
     };
     // All standard ids: the receive id can change at run time (0x68).
     sub_ = bus.subscribe(can::Filter{0, 0, false, true}, [this](const can::Frame& f) { on_frame(f); });
-    timer_ = std::make_unique<canopen::TimerThread>();
+    timer_ = std::make_unique<TimerThread>();
     // service() asks for 1 ms while something moves or events are on; idle, 10 ms is enough.
     timer_->start(clock_, [this](Nanos) { return service(); }, 10'000'000);
 }

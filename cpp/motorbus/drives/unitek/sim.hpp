@@ -31,11 +31,11 @@
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
-#include "motorbus/canopen/timer_thread.hpp"
 #include "motorbus/drives/unitek/codec.hpp"
 #include "motorbus/drives/unitek/profile.hpp"
 #include "motorbus/motion/motor_model.hpp"
 #include "motorbus/runtime/clock.hpp"
+#include "motorbus/runtime/timer_thread.hpp"
 
 namespace motorbus::unitek {
 
@@ -181,7 +181,7 @@ private:
     bool eeprom_dirty_ = false;
     can::Bus* bus_ = nullptr;
     can::SubscriptionId sub_ = 0;
-    std::unique_ptr<canopen::TimerThread> timer_;
+    std::unique_ptr<TimerThread> timer_;
 };
 
 }  // namespace motorbus::unitek

@@ -1,5 +1,5 @@
-// A stoppable timer thread for the services (heartbeat, EMCY inhibit, PDO
-// timers).  `tick(now)` does the work due at `now` and returns the next
+// A stoppable timer thread for periodic services (CANopen heartbeat, EMCY
+// inhibit, PDO timers; a simulated drive's cyclic transmissions).  `tick(now)` does the work due at `now` and returns the next
 // deadline (-1 = none).  It waits on its own condition variable rather than
 // Clock::sleep_until, because cancelling a shared clock would stop everyone.
 // On a simulated clock it re-checks every `sim_poll` of real time.
@@ -15,7 +15,7 @@
 
 #include "motorbus/runtime/clock.hpp"
 
-namespace motorbus::canopen {
+namespace motorbus {
 
 class TimerThread {
 public:
@@ -90,4 +90,4 @@ private:
     std::thread thread_;
 };
 
-}  // namespace motorbus::canopen
+}  // namespace motorbus
