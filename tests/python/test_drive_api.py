@@ -14,6 +14,7 @@ itself is the same for every kind.
 from __future__ import annotations
 
 import itertools
+import pathlib
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -93,11 +94,23 @@ KINDS = {
                    sim_options={"calibrated": True}),
     "pmc007": Kind("pmc007", "5", 0.01, fault=lambda sim, drive: sim.inject_error(1),  # UVLO
                    param="start_speed", value=500, jog=50.0, home="ext1", setup=_pmc007_setup),
+    # The out-of-tree test kind (tests/plugin_kind/): registered only while its package is on the path.
+    "toy": Kind("toy", "1", 0.01, fault=lambda sim, drive: sim.set_fault_input(True),
+                unfault=lambda sim: sim.set_fault_input(False), param="SPEED", value=6000, jog=50.0, home="here",
+                setup=lambda drive: drive.params.__setitem__("SPEED", 20000)),
 }
+#: Where the out-of-tree kinds' packages are (their entry points come with them).
+OUT_OF_TREE = {"toy": pathlib.Path(__file__).resolve().parents[1] / "plugin_kind" / "python"}
 
 
 @pytest.fixture(params=sorted(KINDS))
 def kind(request) -> Kind:
+    if request.param in OUT_OF_TREE:
+        if not hasattr(motorbus._core, "ToySim"):
+            pytest.skip("built without MOTORBUS_TESTS (the out-of-tree test kind's C++ is not in _core)")
+        monkeypatch = request.getfixturevalue("monkeypatch")
+        monkeypatch.syspath_prepend(str(OUT_OF_TREE[request.param]))
+        monkeypatch.setattr(motorbus.registry, "_cache", {})   # read the entry points again, with the package's
     return KINDS[request.param]
 
 
