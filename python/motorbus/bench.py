@@ -45,6 +45,7 @@ from typing import Any, Iterator, Mapping, Optional, Sequence
 from . import _core, registry
 from .bus import open_bus, parse_spec
 from .drive import Drive, DriveStatus, MoveFailed, Units
+from .stopping import STOP_WAYS, check_stop_way
 
 __all__ = ["Bench", "BenchFileError", "AxisConfig", "ParamDiff", "StartReport"]
 
@@ -415,10 +416,18 @@ class _Checker:
                 units = Units(str(u.get("name", "native")), float(scale))
             except _core.InvalidArgument as e:
                 raise self.fail(str(e), *path, "units") from None
+        options = self.table(t, "options", *path)
+        for key in ("on_error", "on_exit"):
+            # Checked with the file, before any line or bus is opened (stopping.py's words and message).
+            if key in options:
+                try:
+                    check_stop_way(options[key], key)
+                except _core.InvalidArgument as e:
+                    raise self.fail(str(e), *path, "options", key) from None
         return AxisConfig(name=name, kind=kind, address=address,
                           line=link if link_key == "line" else None, bus=link if link_key == "bus" else None,
                           units=units, params=self.table(t, "params", *path),
-                          options=self.table(t, "options", *path), sim=self.table(t, "sim", *path))
+                          options=options, sim=self.table(t, "sim", *path))
 
     def one_kind_per_line(self, axes: dict[str, AxisConfig], lines: dict) -> None:
         # Two axes answering to one address on one bus would both answer every request.
@@ -894,8 +903,10 @@ class Bench:
         return {name: d.status for name, d in self._axes.items()}
 
     def stop_all(self, how: str = "stop") -> list[tuple[str, BaseException]]:
-        """Stops every axis (``how``: "stop" or "quick_stop"); an axis that fails
-        does not keep the others from stopping.  Returns the failures."""
+        """Stops every axis (``how``: "stop", "quick_stop" or "disable"); an axis that
+        fails does not keep the others from stopping.  Returns the failures."""
+        # Checked before the getattr: any other word would call whatever method it names.
+        check_stop_way(how, "Bench.stop_all how", tuple(w for w in STOP_WAYS if w is not None))
         failures = []
         for name, d in self._axes.items():
             if d.closed:

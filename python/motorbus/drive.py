@@ -46,9 +46,9 @@ __all__ = ["open_drive", "Capability", "Drive", "DriveStatus", "ParamInfo", "Par
            "MoveFailed", "MoveInterrupted", "LimitReached", "MoveFaulted", "MoveStalled", "MoveTimedOut",
            "MoveOutcome", "StopReason"]
 
-#: The one safety vocabulary (on_error, on_exit).
-STOP_WAYS = ("stop", "quick_stop", "disable", None)
-StopHow = Optional[str]
+# The one safety vocabulary (on_error, on_exit) lives in stopping.py, said once for
+# the Drive, the native clients, bench files and the CLI; re-exported here.
+from .stopping import STOP_WAYS, StopHow, check_stop_way  # noqa: E402
 
 
 class Capability(enum.Enum):
@@ -446,9 +446,8 @@ class Drive(abc.ABC):
 
     def __init__(self, native: Any, *, units: Optional[Units] = None, on_error: StopHow = "stop",
                  on_exit: StopHow = "stop", close_native: Optional[Callable[[], None]] = None) -> None:
-        for name, how in (("on_error", on_error), ("on_exit", on_exit)):
-            if how not in STOP_WAYS:
-                raise _core.InvalidArgument(f"{name}: one of 'stop', 'quick_stop', 'disable' or None, not {how!r}")
+        check_stop_way(on_error, "on_error")
+        check_stop_way(on_exit, "on_exit")
         if units is None:
             units = Units()
         elif not isinstance(units, Units):
@@ -928,4 +927,9 @@ def open_drive(kind: str, *, line: Any = None, bus: Any = None, address: Union[s
             raise _core.InvalidArgument(f"open_drive({kind!r}): a serial drive takes line=, not bus=")
     elif bus is None or line is not None:
         raise _core.InvalidArgument(f"open_drive({kind!r}): a CAN drive takes bus=, not line=")
+    # The stop words before any line or bus is opened (the Drive checks them again, for
+    # kinds opened another way): a typo must not leave a link half-opened behind it.
+    for key in ("on_error", "on_exit"):
+        if key in options:
+            check_stop_way(options[key], key)
     return cls.open(line=line, bus=bus, address=canonical, units=units, **options)

@@ -17,6 +17,7 @@ import enum
 from typing import Optional
 
 from .. import _core, _stop_at_exit
+from ..stopping import check_stop_way
 
 __all__ = ["ABORT_CONNECTION_ACTIONS", "Cia402", "Cia402Device", "OpMode", "STATES",
            "decode_statusword", "Controlword", "next_step"]
@@ -80,9 +81,8 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
     def __init__(self, sdo, node: int, timeout: float = 2.0, poll: float = 0.005, *,
                  on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop",
                  bus: Optional[_core.Bus] = None) -> None:
-        for name, v in (("on_error", on_error), ("on_exit", on_exit)):
-            if v not in _HALTS:
-                raise _core.InvalidArgument(f"Cia402 {name}: 'quick_stop', 'disable' or None, not {v!r}")
+        check_stop_way(on_error, "Cia402 on_error", _HALTS)
+        check_stop_way(on_exit, "Cia402 on_exit", _HALTS)
         if isinstance(sdo, _core.Bus):
             # One SDO client for the state machine and the watchdog set-up: two
             # clients on one COB-ID would take each other's responses.
@@ -209,7 +209,9 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
             pass
 
 
-_HALTS = (None, "quick_stop", "disable")
+#: The stop words this host has (stopping.py's minus "stop": the controlword's own
+#: decelerated stop is a halt the Drive layer drives, not one the host applies on unwinding).
+_HALTS = ("quick_stop", "disable", None)
 
 
 #: The device-side state machine for simulators (C++ Cia402Device).

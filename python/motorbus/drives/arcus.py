@@ -18,6 +18,7 @@ import os
 from typing import Any, Optional, Union
 
 from .. import _core, _stop_at_exit
+from ..stopping import STOP_WAYS, check_stop_way  # noqa: F401  (STOP_WAYS re-exported: motorbus's, said once)
 from .._core import ArcusClientBase, ArcusClientCounters, ArcusCommandInfo, ArcusPhase, ArcusSim  # noqa: F401  (re-exported)
 # The DMX-CAN's profile model (manual 000, Appendix A) and homing engine, with the motion
 # library's generic pieces in motorbus.motion: re-exported here, the vendor's own module.
@@ -157,10 +158,6 @@ def open_line(port: Union[str, "os.PathLike[str]", "_core.Port"], *, baud: int =
                           max_line=_core.ARCUS_MAX_REPLY, reply_timeout=timeout, turnaround=turnaround)
 
 
-#: on_error / on_exit words, the same as motorbus.Drive's.
-STOP_WAYS = ("stop", "quick_stop", "disable", None)
-
-
 class ArcusClient(_stop_at_exit.StopsMotor, ArcusClientBase):
     """Typed client for one DMX-CAN.
 
@@ -186,9 +183,8 @@ class ArcusClient(_stop_at_exit.StopsMotor, ArcusClientBase):
     def __init__(self, line: Any, address: Union[int, str] = "01", *, baud: int = 9600,
                  timeout: Optional[float] = None, on_error: Optional[str] = "stop",
                  on_exit: Optional[str] = "stop", query_retries: int = 1):
-        for name, v in (("on_error", on_error), ("on_exit", on_exit)):
-            if v not in STOP_WAYS:
-                raise _core.InvalidArgument(f"{name}: one of 'stop', 'quick_stop', 'disable' or None, not {v!r}")
+        check_stop_way(on_error, "on_error")
+        check_stop_way(on_exit, "on_exit")
         number = _address(address)
         self._owned_port = None
         if isinstance(line, _core.LineLink):

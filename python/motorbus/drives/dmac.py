@@ -27,6 +27,7 @@ import contextlib
 from typing import Any, Iterable, Iterator, Optional, Sequence
 
 from .. import _core, _stop_at_exit
+from ..stopping import check_stop_way
 # The DMAC's profile model (#ACCEL_TIME/#DECEL_TIME, the closed-loop approach at #LOW_SPEED):
 # the vendor's own module re-exports it (motorbus.motion keeps the generic planners).
 from .._core import (DmacMotion, DmacProfileParams, dmac_position_profile, dmac_ramp_time,  # noqa: F401
@@ -221,9 +222,6 @@ __all__ = [
     "variable_info",
 ]
 
-_STOP_WAYS = ("stop", "quick_stop", "disable", None)
-
-
 def open_line(port: Any, *, baud: int = DEFAULT_BAUD, timeout: float = 0.5, turnaround: float = 0.0) -> Any:
     """A ``LineLink`` framed for the DMAC (CR / CR LF) on a path or an open ``Port``.
 
@@ -264,9 +262,8 @@ class DmacClient(_stop_at_exit.StopsMotor, _core.DmacClient):
     def __init__(self, line: Any, address: Any = 0, *, baud: int = DEFAULT_BAUD, timeout: Optional[float] = None,
                  verify: bool = True, sleep: Any = None, on_error: Optional[str] = "stop",
                  on_exit: Optional[str] = "stop") -> None:
-        for name, how in (("on_error", on_error), ("on_exit", on_exit)):
-            if how not in _STOP_WAYS:
-                raise _core.InvalidArgument(f"{name}: one of 'stop', 'quick_stop', 'disable' or None, not {how!r}")
+        check_stop_way(on_error, "on_error")
+        check_stop_way(on_exit, "on_exit")
         self._port = None
         if isinstance(line, str):
             from ..serial import open_port

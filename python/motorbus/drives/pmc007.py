@@ -34,6 +34,7 @@ import time
 from typing import Any, Callable, Iterable, Optional, Union
 
 from .. import _core
+from ..stopping import check_stop_way
 # The PMC007's profile model (start/stop speeds, gear table, microstepping): the vendor's own module
 # re-exports it (motorbus.motion keeps the generic planners).
 from .._core import (Pmc007ProfileParams, pmc007_convert_position, pmc007_gear_acceleration,  # noqa: F401
@@ -160,9 +161,8 @@ class Pmc007:
 
     def __init__(self, bus: Any, node: int = 5, timeout: float = 1.0, *, on_error: Optional[str] = "stop",
                  on_exit: Optional[str] = "stop") -> None:
-        for name, v in (("on_error", on_error), ("on_exit", on_exit)):
-            if v not in ("stop", "quick_stop", "disable", None):
-                raise _core.InvalidArgument(f"Pmc007 {name}: 'stop', 'quick_stop', 'disable' or None, not {v!r}")
+        check_stop_way(on_error, "on_error")
+        check_stop_way(on_exit, "on_exit")
         self._owns = isinstance(bus, str)
         if self._owns:
             from ..bus import open_bus

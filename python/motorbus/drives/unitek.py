@@ -52,6 +52,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
 
 from .. import _core
+from ..stopping import check_stop_way
 # The drive's speed ramps (ACC 0x35 / DEC 0xED): the vendor's own module re-exports the model.
 from .._core import UnitekRampParams, unitek_speed_profile  # noqa: F401
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, ParamInfo, Params,
@@ -322,9 +323,8 @@ class Unitek:
     def __init__(self, bus: Any, rx_id: int = 0x201, tx_id: Optional[int] = None, *, timeout: float = 0.2,
                  registers: Any = None, n_max_rpm: float = 3000.0, device: str = "DS 205/405",
                  clock: Any = None, on_error: Optional[str] = "stop", on_exit: Optional[str] = None) -> None:
-        for name, how in (("on_error", on_error), ("on_exit", on_exit)):
-            if how not in ("stop", "quick_stop", "disable", None):
-                raise _core.InvalidArgument(f"{name}: one of 'stop', 'quick_stop', 'disable' or None, not {how!r}")
+        check_stop_way(on_error, "on_error")
+        check_stop_way(on_exit, "on_exit")
         currents = {d["device"]: d for d in _core.unitek_device_currents()}
         if device not in currents:
             raise _core.InvalidArgument(f"unitek device: one of {sorted(currents)}, not {device!r}")
