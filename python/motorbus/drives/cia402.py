@@ -13,13 +13,13 @@ The adapter runs on the host-side CiA 402 state machine (``motorbus.canopen``'s
 link-loss watchdog: the host produces a heartbeat, the drive quick-stops when it
 stops arriving (``watchdog=`` option of :func:`open`).
 
-The simulator (:class:`Cia402Sim`, ``make_sim``) is a CiA 402 node as the
-profile describes it, built from the core's pieces: a LocalNode (SDO server,
-NMT slave, boot-up), a HeartbeatService (producer 0x1017, consumer 0x1016), the
-device state machine (Cia402Device), profile position / profile velocity / homing
-on a motor model with home and limit switches, and a PDO engine (RPDO/TPDO 1-4,
-SYNC; the motion objects are mappable).  ``motorbus sim serve --drive cia402:5``
-serves it over socketcand or SLCAN.
+The simulator (``make_sim``: the C++ ``Cia402Sim``, cpp/motorbus/drives/cia402/) is a
+CiA 402 node as the profile describes it, built from the core's pieces: a LocalNode
+(SDO server, NMT slave, boot-up), a HeartbeatService (producer 0x1017, consumer
+0x1016), a PdoService (RPDO/TPDO 1-4, SYNC; the motion objects are mappable) and the
+CiA 402 axis (canopen::Cia402Axis: state machine, profile position / profile velocity
+/ homing on a motor model with home and limit switches).  ``motorbus sim serve --drive
+cia402:5`` serves it over socketcand or SLCAN.
 
 Several CiA 402 axes on one bus start together on one SYNC (:func:`synchronised_start`,
 used by ``Bench.move_together``): each drive's set-point travels in a synchronous RPDO
@@ -29,9 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import struct
-import threading
 import time
-import weakref
 from typing import Any, Iterator, Optional, Sequence, Union
 
 from .. import _core
@@ -48,7 +46,6 @@ _SW_TARGET_REACHED = 1 << 10
 _SW_INTERNAL_LIMIT = 1 << 11
 _SW_BIT12 = 1 << 12   # PV: speed zero; HM: homing attained (bit 12 of PP is the set-point ack)
 _SW_BIT13 = 1 << 13   # HM: homing error; PP: following error
-_SIM_BITS = _SW_REMOTE | _SW_TARGET_REACHED | _SW_INTERNAL_LIMIT | _SW_BIT13
 _I32_MIN, _I32_MAX = -(1 << 31), (1 << 31) - 1
 
 _CW_NEW_SETPOINT = 1 << 4
@@ -101,24 +98,8 @@ OBJECTS = [
     (0x60FF, 0, "Target velocity", "I32", "rw", 0, None, None, "inc/s", False, "PV target"),
     (0x6502, 0, "Supported drive modes", "U32", "ro", 0b100101, None, None, "", False, "PP, PV, HM"),
 ]
-_PERSISTENT = {(row[0], row[1]) for row in OBJECTS if row[9]}
-# What the simulator lets PDOs carry: the process data of PP/PV (CiA 402's usual mappings).
-_MAPPABLE = {0x6040, 0x6041, 0x6060, 0x6061, 0x6064, 0x606C, 0x607A, 0x60FF}
 _SIZES = {"U8": 1, "I8": 1, "U16": 2, "I16": 2, "U32": 4, "I32": 4}
 _SAVE = int.from_bytes(b"save", "little")  # CiA 301 0x1010 signature
-
-
-def _weak_call(obj: Any, name: str) -> Any:
-    """A callback for C++ to keep that reaches ``obj`` through a weak reference.  A bound
-    method kept by the motor model, the object dictionary or the heartbeat service closes
-    a reference cycle through C++, which the garbage collector does not see: every
-    simulator (~164 KB) would then live until the process ends (issue 28)."""
-    ref = weakref.ref(obj)
-
-    def call(*args: Any) -> Any:
-        target = ref()
-        return None if target is None else getattr(target, name)(*args)
-    return call
 
 
 def _check_node(address: Union[str, int]) -> str:
@@ -132,446 +113,37 @@ def _check_node(address: Union[str, int]) -> str:
     return str(node)
 
 
-class Cia402Sim:
-    """A simulated CiA 402 drive (see the module doc).
-
-    Options: ``steps_per_rev`` (motor model, default 3200), ``home=(lo, hi)``
-    (home switch window in increments, default (1000, 1400)), ``minus_limit`` /
-    ``plus_limit`` (switch positions, default -100000 / 100000), ``heartbeat_ms``
-    (0x1017 at boot, default 0 = off, as CiA 301), ``start_position``.
-    Time comes from ``clock`` (a RealClock by default): the motion is evaluated
-    when the host looks (each SDO access), so a SimClock test advances the
-    clock and reads.
-
-    Test hooks: :meth:`inject_fault` (a fault with a 603Fh code), :meth:`force_limit`
-    (a limit switch closes), :meth:`jam` (the rotor blocks: a following error past
-    6065h faults the drive with 0x8611), :meth:`set_stop_input` (a quick-stop input,
-    60FDh bit 16)."""
-
-    def __init__(self, node_id: int, clock: Optional[_core.Clock] = None, *, steps_per_rev: float = 3200,
-                 home: tuple = (1000, 1400), minus_limit: Optional[float] = -100000,
-                 plus_limit: Optional[float] = 100000, heartbeat_ms: int = 0, start_position: float = 0) -> None:
-        self.node_id = int(_check_node(node_id))
-        self.clock = clock if clock is not None else _core.RealClock()
-        cfg = _core.MotorConfig()
-        cfg.steps_per_rev = float(steps_per_rev)
-        cfg.counts_per_rev = float(steps_per_rev)
-        cfg.home = _core.SwitchConfig(True, float(home[0]), float(home[1]), False)
-        cfg.minus_limit = _core.SwitchConfig(minus_limit is not None, float(minus_limit or 0), 0.0, False)
-        cfg.plus_limit = _core.SwitchConfig(plus_limit is not None, float(plus_limit or 0), 0.0, False)
-        self.motor = _core.MotorModel(self.clock, cfg)
-        if start_position:
-            self.motor.set_pulse_position(float(start_position))
-            self.motor.set_encoder(int(round(start_position)))
-        self.device = Cia402Device()
-        self._lock = threading.RLock()
-        self._values: dict[tuple[int, int], Any] = {}
-        self._stored: dict[tuple[int, int], Any] = {}
-        self._pp: Optional[Any] = None       # Cia402ProfilePosition of the running PP move
-        self._pp_t0 = 0
-        self._homing: Optional[Any] = None
-        self._activity = "idle"              # idle | pp | pv | homing | stopping
-        self._limit_hit = False
-        self._forced: dict[int, bool] = {1: False, -1: False}   # force_limit: +1 / -1 switch closed
-        self._soft_limit_side = 0       # the PP target was clipped to 607Dh on this side
-        self._following_error = False   # PP statusword bit 13 until the next set-point
-        self._slip0 = 0.0               # the rotor's lag when the current motion began
-        self._stop_input = False
-        self._heartbeat_ms = int(heartbeat_ms)
-        self.od = self._build_od()
-        self._values[(0x1018, 4)] = self.node_id
-        # Weak: a bound method kept by C++ would keep this simulator alive forever.
-        self.motor.add_listener(_weak_call(self, "_on_motor_event"))
-        self.node: Optional[_core.LocalNode] = None
-        self.heartbeat: Optional[_core.HeartbeatService] = None
-        self.lost_master = threading.Event()
-        self.pdo: Optional[_core.PdoService] = None
-        #: clock time (ns) of the last profile-position set-point the drive accepted
-        self.last_setpoint_ns: Optional[int] = None
-
-    # ---- serving ----------------------------------------------------------------------
-    def attach(self, bus: _core.Bus) -> "Cia402Sim":
-        """Serve this node on ``bus`` (boot-up is sent at once)."""
-        if self.node is not None:
-            raise _core.InvalidArgument(f"cia402 sim {self.node_id}: already attached")
-        self.node = _core.LocalNode(bus, self.node_id, self.od)
-        self.heartbeat = _core.HeartbeatService(self.node, consumer_entries=4, producer_ms=self._heartbeat_ms)
-        self.pdo = _core.PdoService(self.node, rpdos=4, tpdos=4)
-        self.heartbeat.set_lost_callback(_weak_call(self, "_master_lost"))
-        return self
-
-    def close(self) -> None:
-        with self._lock:
-            self.motor.halt()
-        if self.node is not None:
-            self.node.close()
-
-    # ---- test hooks ---------------------------------------------------------------------
-    def inject_fault(self, error_code: int = 0x5441) -> None:
-        """The drive detects a fault (default 0x5441: a CiA 402 "interlock" error): the
-        motor stops at once, the state machine goes to FAULT, 0x603F holds the code."""
-        with self._lock:
-            self._stop_now()
-            self.device.fault(int(error_code))
-            self.device.fault_reaction_done()
-            self._values[(0x603F, 0)] = int(error_code)
-            self._values[(0x1001, 0)] = 0x01
-
-    def force_limit(self, direction: int, active: bool = True) -> None:
-        """The +limit (``direction`` +1) or -limit (-1) switch closes (``active``) whatever
-        the position: a motion toward it stops at once (statusword bit 11, 60FDh bit 1 / 0),
-        as at a switch met at its place."""
-        if direction not in (1, -1):
-            raise _core.InvalidArgument(f"cia402 sim force_limit: direction +1 or -1, not {direction!r}")
-        with self._lock:
-            self._update()
-            self._forced[direction] = bool(active)
-            self._check_forced_limits()
-
-    def jam(self, jammed: bool = True) -> None:
-        """The rotor blocks (``jammed``): the demand runs on, the lag grows, and past the
-        following error window 6065h the drive faults with 0x8611 (statusword bit 13)."""
-        with self._lock:
-            self._update()
-            self.motor.set_jammed(bool(jammed))
-
-    def set_stop_input(self, active: bool = True) -> None:
-        """The drive's quick-stop input (60FDh bit 16 while active): its rising edge makes a
-        moving drive quick stop as a controlword Quick Stop would (605Ah decides the rest)."""
-        with self._lock:
-            self._update()
-            rising = bool(active) and not self._stop_input
-            self._stop_input = bool(active)
-            if rising and self.device.state == "OPERATION ENABLED":
-                self.device.on_controlword(int(Controlword.QUICK_STOP))
-                if self.device.state == "QUICK STOP ACTIVE":
-                    self._begin_quick_stop()
-                else:
-                    self._stop_now()
-
-    @property
-    def position(self) -> float:
-        with self._lock:
-            self.motor.update()
-            return self.motor.pulse_position
-
-    # ---- the object dictionary ----------------------------------------------------------
-    def _build_od(self) -> _core.ObjectDictionary:
-        od = _core.ObjectDictionary()
-        records = {i for (i, s, *_rest) in OBJECTS if s != 0}
-        for index in sorted(records):
-            name = {0x6099: "Homing speeds"}.get(index, f"0x{index:04X}")
-            od.add_record(index, name)
-        for (index, sub, name, dtype, access, default, low, high, *_rest) in OBJECTS:
-            self._values[(index, sub)] = default
-            kwargs = dict(access=access, default=default, pdo_mappable=index in _MAPPABLE)
-            if low is not None:
-                kwargs.update(low=low, high=high)
-            if index in records:
-                var = od.add_member(index, sub, name, dtype, **kwargs)
-            else:
-                var = od.add_variable(index, name, dtype, **kwargs)
-            if dtype in _SIZES:
-                var.set_read_hook(self._reader(index, sub, dtype))
-                if access != "ro":
-                    var.set_write_hook(self._writer(index, sub, dtype))
-        cw = od.add_variable(0x6040, "Controlword", "U16", default=0, pdo_mappable=True)
-        # The hooks reach this simulator weakly (see _weak_call): the OD is kept by C++.
-        ref = weakref.ref(self)
-
-        def on_controlword(var: Any, data: bytes) -> Optional[int]:
-            sim = ref()
-            return None if sim is None else sim._controlword(int.from_bytes(data, "little"))
-
-        def read_statusword(var: Any, current: bytes) -> Optional[bytes]:
-            sim = ref()
-            return None if sim is None else sim._statusword().to_bytes(2, "little")
-
-        def on_store(var: Any, data: bytes) -> Optional[int]:
-            sim = ref()
-            return None if sim is None else sim._store(int.from_bytes(data, "little"))
-        cw.set_write_hook(on_controlword)
-        sw = od.add_variable(0x6041, "Statusword", "U16", access="ro", default=0, pdo_mappable=True)
-        sw.set_read_hook(read_statusword)
-        od.add_record(0x1010, "Store parameters", array=True)
-        store = od.add_member(0x1010, 1, "Save all parameters", "U32", default=1)
-        store.set_write_hook(on_store)
-        return od
-
-    def _reader(self, index: int, sub: int, dtype: str):
-        size, signed = _SIZES[dtype], dtype.startswith("I")
-        ref = weakref.ref(self)   # the hook is kept by C++ (see _weak_call)
-
-        def read(var: Any, current: bytes) -> Optional[bytes]:
-            sim = ref()
-            return None if sim is None else int(sim._value(index, sub)).to_bytes(size, "little", signed=signed)
-        return read
-
-    def _writer(self, index: int, sub: int, dtype: str):
-        signed = dtype.startswith("I")
-        ref = weakref.ref(self)
-
-        def write(var: Any, data: bytes) -> Optional[int]:
-            sim = ref()
-            return None if sim is None else sim._write(index, sub, int.from_bytes(data, "little", signed=signed))
-        return write
-
-    def _value(self, index: int, sub: int) -> int:
-        with self._lock:
-            self._update()
-            if index == 0x6064:
-                return int(round(self.motor.pulse_position))
-            if index == 0x606C:
-                return int(round(self.motor.pulse_velocity))
-            if index in (0x6060, 0x6061):  # the mode asked for is the mode in effect
-                return self.device.mode
-            if index == 0x60FD:
-                m = self.motor
-                return ((m.minus_limit_active or self._forced[-1]) << 0) | ((m.plus_limit_active or self._forced[1]) << 1) \
-                    | (m.home_active << 2) | (self._stop_input << 16)
-            return int(self._values[(index, sub)])
-
-    def _write(self, index: int, sub: int, value: int) -> Optional[int]:
-        with self._lock:
-            self._update()
-            if index == 0x6060:
-                code = self.device.set_mode(value)
-                if code:
-                    return code
-                self._pp = None
-            elif index == 0x6007:
-                code = self.device.set_abort_connection_option(value)
-                if code:
-                    return code
-            elif index == 0x605A:
-                code = self.device.set_quick_stop_option(value)
-                if code:
-                    return code
-            elif index == 0x6098 and not _core.Cia402Homing.supported(value):
-                return 0x06090030  # value range of parameter exceeded
-            self._values[(index, sub)] = value
-            if index == 0x60FF and self._activity == "pv":
-                self._apply_velocity()
-        return None
-
-    def _store(self, signature: int) -> Optional[int]:
-        if signature != _SAVE:
-            return 0x08000020  # data cannot be stored (CiA 301: wrong signature)
-        with self._lock:
-            self._stored = {k: v for k, v in self._values.items() if k in _PERSISTENT}
-        return None
-
-    # ---- behaviour ------------------------------------------------------------------------
-    def _params(self) -> Any:
-        v = self._values
-        p = _core.Cia402ProfileParams(
-            profile_velocity=float(v[(0x6081, 0)]), profile_acceleration=float(v[(0x6083, 0)]),
-            profile_deceleration=float(v[(0x6084, 0)]), quick_stop_deceleration=float(v[(0x6085, 0)]),
-            motion_profile_type=int(v[(0x6086, 0)]))
-        return p
-
-    def _now_s(self) -> float:
-        return (self.clock.now() - self._pp_t0) / 1e9
-
-    def _state(self) -> Any:
-        return _core.MotionState(self.motor.pulse_position, self.motor.pulse_velocity, 0.0, 0.0)
-
-    def _controlword(self, value: int) -> Optional[int]:
-        with self._lock:
-            self._update()
-            before_cw = self.device.controlword
-            before = self.device.state
-            self.device.on_controlword(value)
-            after = self.device.state
-            if after != "OPERATION ENABLED":
-                if before == "OPERATION ENABLED" and after == "QUICK STOP ACTIVE":
-                    self._begin_quick_stop()
-                elif after not in ("QUICK STOP ACTIVE",):
-                    self._stop_now()  # power stage off: the motor stops where it is
-                return None
-            mode = self.device.mode
-            rising = bool(value & _CW_NEW_SETPOINT) and not (before_cw & _CW_NEW_SETPOINT)
-            if value & _CW_HALT:
-                if self._activity == "homing" and self._homing is not None:
-                    # A halted homing is over, not attained (CiA 402: bits 10/12/13 = 1/0/0).
-                    self._homing.abort()
-                    self._homing = None
-                if self.motor.moving and self._activity != "stopping":
-                    self._decelerate()
-                return None
-            if mode == OpMode.PROFILE_POSITION and rising:
-                self._new_setpoint(value)
-            elif mode == OpMode.PROFILE_VELOCITY:
-                self._activity = "pv"
-                self._apply_velocity()
-            elif mode == OpMode.HOMING and rising:
-                self._start_homing()
-        return None
-
-    def _new_setpoint(self, cw: int) -> None:
-        target = float(self._values[(0x607A, 0)])
-        if self._pp is None or not self.motor.moving or self._activity != "pp":
-            self._pp = _core.Cia402ProfilePosition(self._params(), self.motor.pulse_position)
-            self._pp_t0 = self.clock.now()
-        self.last_setpoint_ns = self.clock.now()
-        t = self._now_s()
-        self._pp.new_setpoint(t, target, relative=bool(cw & _CW_RELATIVE),
-                              change_immediately=bool(cw & _CW_IMMEDIATE))
-        # Software position limits (607Dh): a target beyond one is clipped to it (CiA 402),
-        # and the drive shows internal limit active (bit 11) once it stands there.
-        lo, hi = float(self._values[(0x607D, 1)]), float(self._values[(0x607D, 2)])
-        end = self._pp.profile.position(self._pp.profile.duration)
-        self._soft_limit_side = 1 if end > hi else -1 if end < lo else 0
-        if self._soft_limit_side:
-            self._pp.new_setpoint(t, hi if self._soft_limit_side > 0 else lo, change_immediately=True)
-        self.motor.command(self._pp.profile, start_ns=self._pp_t0)
-        self._activity = "pp"
-        self._limit_hit = False
-        self._following_error = False
-        self._check_forced_limits()
-
-    def _apply_velocity(self) -> None:
-        v = float(self._values[(0x60FF, 0)])
-        prof = _core.cia402_velocity_profile(self._state(), v, self._params(), 1e6)
-        self.motor.command(prof)
-        self._limit_hit = False
-
-    def _start_homing(self) -> None:
-        v = self._values
-        params = _core.Cia402HomingParams(method=int(v[(0x6098, 0)]), speed_switch=float(v[(0x6099, 1)]),
-                                          speed_zero=float(v[(0x6099, 2)]), acceleration=float(v[(0x609A, 0)]),
-                                          home_offset=float(v[(0x607C, 0)]))
-        self._homing = _core.Cia402Homing(self.motor, params)
-        self._homing.start()
-        self._activity = "homing"
-
-    def _decelerate(self) -> None:
-        prof = _core.cia402_velocity_profile(self._state(), 0.0, self._params(), 0.0)
-        self.motor.command(prof)
-        self._activity = "stopping"
-
-    def _begin_quick_stop(self) -> None:
-        if self._homing is not None:
-            self._homing.abort()
-            self._homing = None
-        if self.motor.moving:
-            self.motor.command(_core.cia402_quick_stop_profile(self._state(), self._params()))
-        self._activity = "quick_stop"
-
-    def _stop_now(self) -> None:
-        if self._homing is not None:
-            self._homing.abort()
-            self._homing = None
-        self.motor.halt()
-        self._activity = "idle"
-
-    def _on_motor_event(self, event: Any) -> None:
-        # Called from motor.update() (our lock is held).  A limit switch met while
-        # moving toward it stops the motor at once (CiA 402: internal limit active).
-        if self._activity == "homing":
-            return  # the homing methods use the switches themselves
-        kind, Kind = event.kind, _core.MotorEventKind
-        if (kind == Kind.MINUS_LIMIT_ON and event.direction < 0) or (kind == Kind.PLUS_LIMIT_ON and event.direction > 0):
-            self.motor.halt()
-            self._limit_hit = True
-            self._activity = "idle"
-
-    def _update(self) -> None:
-        self.motor.update()
-        self._check_forced_limits()
-        self._check_following_error()
-        if self._activity == "quick_stop" and not self.motor.moving:
-            self.device.motion_stopped()
-            self._activity = "idle"
-
-    def _check_forced_limits(self) -> None:
-        # A switch closed by force_limit stops a motion toward it, as one met at its place.
-        m = self.motor
-        if self._activity == "homing" or not m.moving:
-            return
-        v = m.commanded_velocity
-        for side in (1, -1):
-            if self._forced[side] and v * side > 0:
-                m.halt()
-                self._limit_hit = True
-                self._activity = "idle"
-                return
-
-    def _check_following_error(self) -> None:
-        # The rotor lags the demand by more than 6065h: stop, fault 0x8611 (following error),
-        # and report where the rotor is (the position a real drive's encoder shows).
-        # The lag counts from where it was when the motion began: steps a jam lost earlier
-        # are lost for good (an open-loop counter), not a following error of this motion.
-        m = self.motor
-        if not m.moving:
-            self._slip0 = m.slip
-            return
-        if abs(m.slip - self._slip0) <= float(self._values[(0x6065, 0)]):
-            return
-        rotor = m.pulse_position - (m.slip - self._slip0)
-        self._stop_now()
-        m.set_pulse_position(rotor)
-        m.set_encoder(int(round(rotor)))
-        self._following_error = True
-        self.device.fault(0x8611)
-        self.device.fault_reaction_done()
-        self._values[(0x603F, 0)] = 0x8611
-        self._values[(0x1001, 0)] = 0x01
-
-    def _statusword(self) -> int:
-        with self._lock:
-            self._update()
-            mode = self.device.mode
-            bits = _SW_REMOTE
-            if self._limit_hit or self.motor.minus_limit_active or self.motor.plus_limit_active \
-                    or (self._soft_limit_side and not self.motor.moving):
-                bits |= _SW_INTERNAL_LIMIT
-            if mode == OpMode.PROFILE_POSITION:
-                if not self.motor.moving:  # the set-point (and any buffered one) is played out
-                    bits |= _SW_TARGET_REACHED
-                if self._following_error:
-                    bits |= _SW_BIT13
-            elif mode == OpMode.PROFILE_VELOCITY:
-                target = float(self._values[(0x60FF, 0)])
-                if abs(self.motor.pulse_velocity - target) < 0.5 or not self.motor.moving:
-                    bits |= _SW_TARGET_REACHED
-            elif mode == OpMode.HOMING:
-                h = self._homing
-                if (h is None and not self.motor.moving) or (h is not None and h.result != 0):  # Running == 0
-                    bits |= _SW_TARGET_REACHED
-                if h is not None and h.error:
-                    bits |= _SW_BIT13
-            elif not self.motor.moving:
-                bits |= _SW_TARGET_REACHED
-            self.device.set_status_bits(_SIM_BITS, bits)
-            sw = self.device.statusword
-            if mode == OpMode.HOMING:
-                attained = self._homing is not None and self._homing.attained
-                # Bit 12 of homing mode is "homing attained", not the set-point acknowledge.
-                sw = (sw & ~_SW_BIT12) | (_SW_BIT12 if attained else 0)
-            return sw
-
-    def _master_lost(self, node: int) -> None:
-        with self._lock:
-            before = self.device.state
-            self.device.loss_of_master()
-            after = self.device.state
-            if after == "QUICK STOP ACTIVE":
-                self._begin_quick_stop()
-            elif after != before:
-                self._stop_now()
-        self.lost_master.set()
+# The simulator is C++ (cpp/motorbus/drives/cia402/sim.hpp): a LocalNode with a
+# HeartbeatService, a PdoService and a canopen::Cia402Axis on a motor model.
+Cia402Sim = _core.Cia402Sim
+_SIM_OPTIONS = ("steps_per_rev", "home", "minus_limit", "plus_limit", "heartbeat_ms", "start_position")
 
 
 def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, *,
-             bus: Optional[_core.Bus] = None, **options: Any) -> Cia402Sim:
-    """A simulated CiA 402 drive at node ``address``; attached to ``bus`` when given.
-    Options: see :class:`Cia402Sim`."""
-    known = {"steps_per_rev", "home", "minus_limit", "plus_limit", "heartbeat_ms", "start_position"}
-    unknown = set(options) - known
+             bus: Optional[_core.Bus] = None, **options: Any) -> Any:
+    """A simulated CiA 402 drive at node ``address`` (the C++ ``Cia402Sim``); attached to
+    ``bus`` when given.  Options: ``steps_per_rev`` (motor model, default 3200), ``home=(lo, hi)``
+    (home switch window in increments, default (1000, 1400)), ``minus_limit`` / ``plus_limit``
+    (switch positions, default -100000 / 100000, None = none), ``heartbeat_ms`` (1017h at boot,
+    default 0 = off), ``start_position``.  Test hooks: ``inject_fault``, ``force_limit``,
+    ``jam``, ``set_stop_input`` (docs/drives/cia402.md)."""
+    unknown = set(options) - set(_SIM_OPTIONS)
     if unknown:
-        raise _core.InvalidArgument(f"cia402 sim options: unknown {sorted(unknown)}; known {sorted(known)}")
-    sim = Cia402Sim(int(_check_node(address)), clock, **options)
+        raise _core.InvalidArgument(f"cia402 sim options: unknown {sorted(unknown)}; known {sorted(_SIM_OPTIONS)}")
+    if "home" in options:
+        home = options["home"]
+        try:
+            options["home"] = (float(home[0]), float(home[1]))
+        except (TypeError, ValueError, IndexError):
+            raise _core.InvalidArgument(f"cia402 sim option home: (lo, hi) in increments, not {home!r}") from None
+    for name in ("steps_per_rev", "start_position", "minus_limit", "plus_limit"):
+        value = options.get(name)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+            raise _core.InvalidArgument(f"cia402 sim option {name}: a number, not {value!r}")
+    hb = options.get("heartbeat_ms")
+    if hb is not None and (isinstance(hb, bool) or not isinstance(hb, int)):
+        raise _core.InvalidArgument(f"cia402 sim option heartbeat_ms: whole milliseconds, not {hb!r}")
+    sim = _core.Cia402Sim(int(_check_node(address)), clock, **options)
     if bus is not None:
         sim.attach(bus)
     return sim
