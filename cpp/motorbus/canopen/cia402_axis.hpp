@@ -10,8 +10,8 @@
 // A vendor's device keeps its own firmware and takes the pieces it shares with
 // every CiA 402 drive from here (Cia402SetPoints: the PP handshake and its
 // one-deep set-point buffer, the homing-mode bookkeeping) with hooks for what it
-// does its own way (drives/arcus/sim_canopen.cpp: limit and StepNLoop faults,
-// homing methods run by its ASCII firmware).
+// does its own way (its own latched faults, homing methods run by its own
+// firmware: the vendor folders' CANopen simulators).
 //
 // Time: the motion is evaluated when someone looks (every public call runs
 // MotorModel::update() first), so a SimClock test advances the clock and reads.
@@ -49,8 +49,8 @@ enum class SetPointAction {
 // How a vendor reads the set-point bits where CiA 402 leaves room.
 struct Cia402SetPointPolicy {
     // CiA 402: while a motion runs, bit 5 = 1 replaces it now and bit 5 = 0 waits
-    // for it (buffered).  The DMX-CAN (manual 000 C-A09) buffers a "set of
-    // set-points" only with bit 5 = 1 and ignores a set-point with bit 5 = 0.
+    // for it (buffered).  A drive may instead buffer a "set of set-points" only
+    // with bit 5 = 1 and ignore a set-point with bit 5 = 0 (its manual says which).
     bool buffer_on_bit5 = false;
 };
 
@@ -115,7 +115,7 @@ struct Cia402AxisHooks {
     // Homing methods 6098h accepts (default: motion::Cia402Homing::supported).
     std::function<bool(int method)> homing_supported;
     // A vendor's own latched errors as a 603Fh code (0 = none), checked whenever
-    // the axis is looked at: a code faults the drive (Arcus: limit / StepNLoop).
+    // the axis is looked at: a code faults the drive (e.g. a latched limit error).
     std::function<std::uint16_t()> vendor_fault;
 };
 
