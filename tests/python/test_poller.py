@@ -330,7 +330,8 @@ def test_a_push_that_stops_is_counted_stale_and_its_age_shows():
         with Poller({"u": u}, fields=("position",), rate_hz=200) as poller:
             time.sleep(0.15)
             before = poller.stats["u"]["stale"]
-            u.native._core.unsubscribe(int(motorbus.drives.unitek.Reg.POS_IST))   # the drive stops pushing
+            # The C++ client's own unsubscribe, behind the Python stream bookkeeping: the drive stops pushing.
+            motorbus._core.UnitekClient.unsubscribe(u.native, int(motorbus.drives.unitek.Reg.POS_IST))
             time.sleep(0.2)
         stats = poller.stats["u"]
         frame = poller.frame()

@@ -183,6 +183,25 @@ def test_with_block_stops_on_error(rig):
     assert not sim.status & Status.ENA
 
 
+def test_a_client_still_open_at_exit_is_stopped_with_on_exit(rig):
+    """The native client has the shape of every kind's: a subclass of the C++ client
+    (no forwarding layer) whose exit hook applies ``on_exit``, as ArcusClient's and
+    DmacClient's do."""
+    from motorbus import _stop_at_exit
+    drive, sim, clock, bus = rig
+    d = Unitek(bus, 0x201, clock=clock, on_exit="disable")
+    assert isinstance(d, _core.UnitekClient)
+    assert d in _stop_at_exit._live
+    d.speed_rpm = 100
+    settle(sim, bus)
+    assert sim.status & Status.ENA
+    d._stop_at_exit()                  # what the atexit hook and SIGTERM do to each live client
+    settle(sim, bus)
+    assert not sim.status & Status.ENA
+    d.close()
+    assert d not in _stop_at_exit._live
+
+
 def test_t_out_model_disables_a_silent_link():
     name = f"virtual:unitek-py-{next(_names)}"
     with motorbus.open_bus(name) as sim_bus, motorbus.open_bus(name) as host_bus:

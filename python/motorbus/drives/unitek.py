@@ -51,7 +51,7 @@ import time
 from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
 
-from .. import _core
+from .. import _core, _stop_at_exit
 from ..stopping import check_stop_way
 # The drive's speed ramps (ACC 0x35 / DEC 0xED): the vendor's own module re-exports the model.
 from .._core import UnitekRampParams, unitek_speed_profile  # noqa: F401
@@ -314,15 +314,19 @@ class Stream:
 
 # ---- the native client ------------------------------------------------------------------
 
-class Unitek:
-    """The register protocol of one drive (see the module doc).
+class Unitek(_stop_at_exit.StopsMotor, _core.UnitekClient):
+    """The register protocol of one drive (see the module doc): the C++
+    ``unitek::Client`` with registers by name or :class:`Reg`, values in physical
+    units, :class:`Status`/:class:`ModeBit` types and numpy streams.
 
-    ``on_error`` / ``on_exit`` ("stop", "quick_stop", "disable" or None) say what the
-    ``with`` block does to the motor when it ends by an exception / normally."""
+    ``on_error`` / ``on_exit``: "stop" and "quick_stop" (speed command 0: the drive
+    decelerates on its ramp; the protocol has no faster stop of its own), "disable"
+    (MODE bit 2) or None; applied when an exception leaves ``with`` and at
+    interpreter exit, as every native client does."""
 
     def __init__(self, bus: Any, rx_id: int = 0x201, tx_id: Optional[int] = None, *, timeout: float = 0.2,
                  registers: Any = None, n_max_rpm: float = 3000.0, device: str = "DS 205/405",
-                 clock: Any = None, on_error: Optional[str] = "stop", on_exit: Optional[str] = None) -> None:
+                 clock: Any = None, on_error: Optional[str] = "stop", on_exit: Optional[str] = "stop") -> None:
         check_stop_way(on_error, "on_error")
         check_stop_way(on_exit, "on_exit")
         currents = {d["device"]: d for d in _core.unitek_device_currents()}
@@ -337,30 +341,28 @@ class Unitek:
         else:
             table = registers
         rx = int(check_address(rx_id), 16)
+        super().__init__(bus, rx_id=rx, tx_id=_tx_for(rx) if tx_id is None else tx_id,
+                         timeout=timeout, table=table, clock=clock)
         #: the CAN bus the drive is on (the Poller groups axes by it)
         self.bus = bus
-        self._core = _core.UnitekClient(bus, rx_id=rx, tx_id=_tx_for(rx) if tx_id is None else tx_id,
-                                        timeout=timeout, table=table, clock=clock)
         self.on_error = on_error
         self.on_exit = on_exit
         self._streams: dict[int, Stream] = {}
         self._lock = threading.Lock()
+        self._open = True
+        _stop_at_exit.track(self)
 
-    # ---- registers ----
-    @property
-    def table(self) -> Any:
-        return self._core.table
-
+    # ---- registers (table, add_register, write_raw: the C++ client's) ----
     def register(self, reg: Union[int, str]) -> Any:
         return self.table[_regid(reg, self.table)]
 
     def write(self, reg: Union[int, str], value: int) -> None:
         """Writes ``value`` (num).  Never acknowledged by the drive (read back where it matters)."""
-        self._core.write(_regid(reg, self.table), value)
+        super().write(_regid(reg, self.table), value)
 
     def read(self, reg: Union[int, str], timeout: Optional[float] = None) -> int:
         """Reads once (``3D REGID 00``); TimeoutError when the drive does not answer."""
-        return self._core.read(_regid(reg, self.table), timeout)
+        return super().read(_regid(reg, self.table), timeout)
 
     def write_physical(self, reg: Union[int, str], value: float) -> None:
         """Writes ``value`` in the register's unit (rpm, rev, %, A, ms)."""
@@ -371,17 +373,14 @@ class Unitek:
         r = self.register(reg)
         return self.scalings.to_physical(r, self.read(r.regid, timeout))
 
-    def add_register(self, register: Any) -> None:
-        self._core.add_register(register)
-
-    # ---- cyclic ----
+    # ---- cyclic (cyclic: the C++ client's) ----
     def subscribe(self, reg: Union[int, str], interval_ms: int, capacity: int = 65536,
                   callback: Optional[Callable[[int, int, int], None]] = None) -> Stream:
         """Every ``interval_ms`` (1..254) into a numpy ring; ``callback(regid, t_ns, value)`` too if given
         (it runs on the bus thread and takes the GIL: keep it short, or use the ring alone).
         The 9th register raises UnitekCyclicLimit."""
         regid = _regid(reg, self.table)
-        core = self._core.subscribe(regid, interval_ms, capacity, callback)
+        core = super().subscribe(regid, interval_ms, capacity, callback)
         with self._lock:
             s = self._streams.get(regid)
             if s is None:
@@ -390,46 +389,29 @@ class Unitek:
 
     def unsubscribe(self, reg: Union[int, str]) -> None:
         regid = _regid(reg, self.table)
-        self._core.unsubscribe(regid)
+        super().unsubscribe(regid)
         with self._lock:
             self._streams.pop(regid, None)
 
-    @property
-    def cyclic(self) -> list:
-        return self._core.cyclic
-
-    # ---- MODE / events ----
-    def enable(self) -> None:
-        self._core.enable()
-
-    def disable(self) -> None:
-        self._core.disable()
-
-    def set_events(self, on: bool, mask: Optional[int] = None) -> None:
-        """MODE bit 4: KERN_STATUS is sent on every change of a bit the mask selects."""
-        self._core.set_events(on, mask)
-
+    # ---- MODE / events (enable, disable, set_events: the C++ client's) ----
     def on_status(self, callback: Optional[Callable[[Status, int], None]]) -> None:
         if callback is None:
-            self._core.on_status(None)
+            super().on_status(None)
         else:
-            self._core.on_status(lambda st, t: callback(Status(st), t))
+            super().on_status(lambda st, t: callback(Status(st), t))
 
     @property
     def last_event_status(self) -> Optional[Status]:
-        st = self._core.last_event_status
+        st = _core.UnitekClient.last_event_status.fget(self)
         return None if st is None else Status(st)
 
     @property
     def mode(self) -> ModeBit:
-        return ModeBit(self._core.mode)
+        return ModeBit(_core.UnitekClient.mode.fget(self))
 
     def set_receive_id(self, rx_id: int) -> None:
         """0x68: the drive listens on ``rx_id`` at once (persistent after store_eeprom)."""
-        self._core.set_receive_id(int(check_address(rx_id), 16))
-
-    def store_eeprom(self, level: int = 0) -> None:
-        self._core.store_eeprom(level)
+        super().set_receive_id(int(check_address(rx_id), 16))
 
     # ---- typed shortcuts ----
     @property
@@ -458,26 +440,21 @@ class Unitek:
         """Speed command 0: the drive decelerates on its ramp."""
         self.write(Reg.SPEED_CMD, 0)
 
-    rx_id = property(lambda self: self._core.rx_id)
-    tx_id = property(lambda self: self._core.tx_id)
-    counters = property(lambda self: self._core.counters)
-
     def close(self) -> None:
         """Stops every cyclic transmission this client started and lets go of the bus."""
-        self._core.close()
+        self._open = False
+        _stop_at_exit.untrack(self)
+        super().close()
 
-    def __enter__(self) -> "Unitek":
-        return self
+    def _stop_on_error(self) -> None:
+        self._halt(self.on_error)
 
-    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
-        how = self.on_error if exc_type is not None else self.on_exit
-        try:
-            if how in ("stop", "quick_stop"):
-                self.stop()
-            elif how == "disable":
-                self.disable()
-        finally:
-            self.close()
+    def _stop_at_exit(self) -> None:
+        self._halt(self.on_exit)
+
+    def _halt(self, how: Optional[str]) -> None:
+        if getattr(self, "_open", False):
+            _stop_at_exit.halt(how, self.stop, self.stop, self.disable)
 
 
 # ---- the simulator ------------------------------------------------------------------------
@@ -933,7 +910,7 @@ class UnitekDrive(Drive):
     def poll_fields(self, fields: Sequence[str]) -> PollSpec:
         """motorbus.Poller, asking: POS_IST/SPEED_IST/KERN_STATUS read (3D REGID 00) each sample."""
         regids, scales = _poll_rows(self, fields)
-        source = _core.unitek_poll_source(self.native._core, regids)
+        source = _core.unitek_poll_source(self.native, regids)
         return PollSpec(source=source, scales=scales, transport=self.native.bus, bus=self.native.bus)
 
     def capture_fields(self, fields: Sequence[str], period: float) -> PollSpec:
@@ -944,7 +921,7 @@ class UnitekDrive(Drive):
         transmit cyclically per drive (CyclicLimit beyond)."""
         regids, scales = _poll_rows(self, fields)
         interval_ms = min(254, max(1, int(round(period * 1000))))
-        source = _core.unitek_capture_source(self.native._core, regids, interval_ms)
+        source = _core.unitek_capture_source(self.native, regids, interval_ms)
         return PollSpec(source=source, scales=scales, transport=self.native.bus, bus=self.native.bus,
                         stamped=True, close=source.close)
 
