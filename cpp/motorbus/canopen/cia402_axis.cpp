@@ -30,7 +30,11 @@ SetPointAction Cia402SetPoints::on_controlword(std::uint16_t prev, std::uint16_t
     const bool rising = (cw & cw::kNewSetPoint) && !(prev & cw::kNewSetPoint);
     if (!rising) return SetPointAction::None;
     if (mode == OpMode::Homing) return SetPointAction::StartHoming;
-    if (mode != OpMode::ProfilePosition || !accept) return SetPointAction::None;
+    if (mode != OpMode::ProfilePosition) return SetPointAction::None;
+    if (!accept) {
+        ack_ = false;
+        return SetPointAction::None;
+    }
     const double value = target_position;
     const bool relative = cw & cw::kRelative;
     const bool bit5 = cw & cw::kChangeImmediately;
@@ -42,7 +46,10 @@ SetPointAction Cia402SetPoints::on_controlword(std::uint16_t prev, std::uint16_t
         return SetPointAction::Start;
     }
     // A motion runs: the set-point waits for it, one deep.
-    if ((policy_.buffer_on_bit5 && !bit5) || buffered_) return SetPointAction::Refuse;
+    if ((policy_.buffer_on_bit5 && !bit5) || buffered_) {
+        ack_ = false;
+        return SetPointAction::Refuse;
+    }
     target_ = relative ? target_ + value : value;  // relative to the set-point before it
     buffered_ = target_;
     ack_ = true;
@@ -331,10 +338,17 @@ void Cia402Axis::loss_of_master() {
     const Cia402State after = device_->state();
     if (after == before) return;
     setpoints_.reset();
-    if (after == Cia402State::QuickStopActive)
+    if (after == Cia402State::QuickStopActive) {
         begin_quick_stop();
-    else
-        stop_now();
+        return;
+    }
+    stop_now();
+    if (after == Cia402State::FaultReactionActive) {
+        // 6007h = 1: a fault (0x8130); the motor stopped at once, so the reaction is over.
+        device_->fault_reaction_done();
+        error_code_ = device_->last_error_code();
+        error_register_ = 0x11;  // generic + communication error
+    }
 }
 
 // ---- behaviour (m_ held) -----------------------------------------------------------------
@@ -368,7 +382,8 @@ void Cia402Axis::new_setpoint(std::uint16_t cw) {
     const double end = prof.position(prof.duration());
     soft_limit_side_ = end > hi ? 1 : (end < lo ? -1 : 0);
     if (soft_limit_side_) pp_->new_setpoint(t, soft_limit_side_ > 0 ? hi : lo, false, true);
-    motor_.command(pp_->profile(), pp_t0_);
+    // The planner keeps one time line from pp_t0_: join it where it is now.
+    motor_.command_from(pp_->profile(), t);
     activity_ = Activity::Pp;
     limit_hit_ = false;
     following_error_ = false;

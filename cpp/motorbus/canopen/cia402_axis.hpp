@@ -145,7 +145,7 @@ public:
     std::uint32_t digital_inputs();                 // 60FDh: bit 0 -limit, 1 +limit, 2 home, 16 stop input
     std::uint16_t error_code() const;               // 603Fh (the last fault's; kept after a reset)
     std::uint8_t error_register() const;            // 1001h
-    Cia402State state() const;
+    Cia402State state() const;                      // as last evaluated (statusword() evaluates)
     double pulse_position();                        // the motor's position, unrounded
 
     // ---- device events and test hooks ----
