@@ -259,6 +259,20 @@ void bind_canopen(py::module_& m) {
         .def_property("value", [](const Variable& v) { return value_to_py(v, v.get()); },
                       [](Variable& v, const py::object& o) { v.set(value_from_py(v, o)); },
                       "value as int/float/bool/str/bytes by type (local write: limits checked, no hooks)")
+        .def_property_readonly("value_range", [](const Variable& v) -> py::object {
+            auto r = v.value_range();
+            if (!r) return py::none();
+            return py::make_tuple(scalar_to_py(r->first), scalar_to_py(r->second));
+        }, "(low, high) a write may carry: the limits, else the integer type's range; None for other types")
+        // The codec of this entry's type, for hosts (a node's SDO access, a vendor profile):
+        // nothing outside the dictionary needs a table of type sizes.
+        .def("encode", [](const Variable& v, const py::object& o) { return to_bytes(value_from_py(v, o)); },
+             py::arg("value"), "The little-endian bytes of `value` as this entry's type (InvalidArgument if it "
+                               "does not fit the type; the limits are the device's to enforce).")
+        .def("decode", [](const Variable& v, const py::bytes& data) {
+            std::string s = data;
+            return value_to_py(v, Bytes(s.begin(), s.end()));
+        }, py::arg("data"), "The Python value of `data` as this entry's type (int, float, bool, str or bytes).")
         .def("reset", &Variable::reset_to_default)
         .def("set_write_hook", [](Variable& v, py::object f) {
             if (f.is_none()) return v.set_write_hook(nullptr);

@@ -1,6 +1,8 @@
 // Bindings for cpp/motorbus/drives/pmc007: the profile model, the object
 // dictionary table (the one source of the sim's OD and the shipped EDS), the
 // offline-program codec and the simulator.  Conversions and GIL release only.
+#include <cstdio>
+
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -24,24 +26,6 @@ struct BoundSim : ClockHolder, Sim {
         : ClockHolder{c ? std::move(c) : std::make_shared<RealClock>()}, Sim(node, *clock, o) {}
 };
 
-const char* type_code(canopen::DataType t) {
-    switch (t) {
-        case canopen::DataType::Unsigned8: return "U8";
-        case canopen::DataType::Unsigned16: return "U16";
-        case canopen::DataType::Unsigned32: return "U32";
-        case canopen::DataType::Integer32: return "I32";
-        case canopen::DataType::VisibleString: return "VISIBLE_STRING";
-        default: return "?";
-    }
-}
-const char* storage_name(Storage s) {
-    switch (s) {
-        case Storage::Rom: return "rom";
-        case Storage::Ram: return "ram";
-        case Storage::Const: return "const";
-    }
-    return "?";
-}
 }  // namespace
 
 void bind_pmc007(py::module_& m) {
@@ -68,47 +52,31 @@ void bind_pmc007(py::module_& m) {
           py::arg("hold") = 0.0);
 
     // ---- the object dictionary table ----
-    m.def(
-        "pmc007_od_rows",
-        [] {
-            py::list out;
-            for (const auto& r : pmc007_od_rows()) {
-                py::object def = r.text ? py::object(py::str(r.text)) : py::object(py::int_(r.def));
-                out.append(py::make_tuple(r.index, r.sub, r.name, r.parent ? py::object(py::str(r.parent)) : py::none(),
-                                          type_code(r.type), canopen::access_name(r.access), r.pdo,
-                                          storage_name(r.storage), def,
-                                          r.low ? py::object(py::int_(*r.low)) : py::none(),
-                                          r.high ? py::object(py::int_(*r.high)) : py::none()));
-            }
-            return out;
-        },
-        "Every object of the PMC007 dictionary: (index, sub, name, parent, type, access, pdo_mappable, storage, "
-        "default, low, high).");
+    // Handed up as the typed dictionary itself (canopen.ObjectDictionary: types, access,
+    // limits, defaults and the C++ codecs of each entry): the host profile (Pmc007)
+    // reads and writes by it; nothing about a type is said again in Python.
+    m.def("pmc007_object_dictionary", [](std::uint8_t node_id) { return build_pmc007_od(node_id); },
+          py::arg("node_id") = 5,
+          "The PMC007 dictionary (every row of the table), defaults evaluated for `node_id`.");
+    py::enum_<Storage>(m, "Pmc007Storage", "How an object behaves over reset node / power-up (B-P37).")
+        .value("ROM", Storage::Rom, "saved to flash by 2007h = 2, reloaded at reset node")
+        .value("RAM", Storage::Ram, "back to the default at reset node / power-up")
+        .value("CONST", Storage::Const, "never changes");
+    m.def("pmc007_storage", [](std::uint16_t index, std::uint8_t sub) {
+              const OdRow* r = pmc007_od_row(index, sub);
+              if (!r) {
+                  char where[16];
+                  std::snprintf(where, sizeof where, "%04Xh:%02X", index, sub);
+                  throw InvalidArgument(std::string("pmc007: no object ") + where);
+              }
+              return r->storage;
+          }, py::arg("index"), py::arg("subindex") = 0, "The table's storage class of one object (B-P37).");
     m.def("pmc007_eds", &pmc007_eds, "The EDS text generated from the table (node-ID as $NODEID).");
 
     // ---- offline program codec ----
     m.def("pmc007_assemble", [](const std::string& text) { return assemble(text); }, py::arg("text"),
           "Mnemonic text -> 32-bit words (the spec's reading of the encoding).");
     m.def("pmc007_disassemble", [](const std::vector<std::uint32_t>& w) { return disassemble(w); }, py::arg("words"));
-    m.def("pmc007_disassemble_word", &disassemble_word, py::arg("word"));
-    m.def(
-        "pmc007_encode",
-        [](const std::string& mnem, int option, std::int64_t data) {
-            auto op = opcode_from_mnemonic(mnem);
-            if (!op) throw InvalidArgument("pmc007 program: unknown instruction '" + mnem + "'");
-            if (option < 0 || option > 15) throw InvalidArgument("pmc007 program: option must be 0..15");
-            if (data < 0 || data > 0xFFFFF) throw InvalidArgument("pmc007 program: data must be 0..1048575");
-            return encode({*op, std::uint8_t(option), std::uint32_t(data)});
-        },
-        py::arg("mnemonic"), py::arg("option") = 0, py::arg("data") = 0);
-    m.def(
-        "pmc007_decode",
-        [](std::uint32_t word) -> py::object {
-            auto ins = decode(word);
-            if (!ins) return py::none();
-            return py::make_tuple(mnemonic(ins->op), ins->option, ins->data);
-        },
-        py::arg("word"), "(mnemonic, option, data), or None for an unknown opcode.");
 
     // ---- the simulator ----
     auto rel = py::call_guard<py::gil_scoped_release>();

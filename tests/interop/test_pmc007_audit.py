@@ -423,19 +423,28 @@ ACTIONS = {(0x2002, 0), (0x2003, 0), (0x2007, 0), (0x6000, 0), (0x6001, 0), (0x6
            (0x6018, 2), (0x6019, 3), (0x6019, 5), (0x601C, 0), (0x6020, 0), (0x1003, 0)}
 
 
+_TYPE = {_core.DataType.UNSIGNED8: "U8", _core.DataType.UNSIGNED16: "U16", _core.DataType.UNSIGNED32: "U32",
+         _core.DataType.INTEGER32: "I32", _core.DataType.VISIBLE_STRING: "VISIBLE_STRING"}
+
+
 def _rows():
+    """Every entry of the table (the typed dictionary the library hands up), as this audit reads them."""
+    od = _core.pmc007_object_dictionary(NODE)
     out = []
-    for (index, sub, name, parent, dtype, access, pdo, storage, default, low, high) in _core.pmc007_od_rows():
-        if index == 0x1018 and sub >= 1:
-            default = IDENTITY[sub]
-        elif (index, sub) == (0x1014, 0):
-            default = 0x80 + NODE
-        elif (index, sub) in ((0x1200, 1), (0x1200, 2)):
-            default = (0x600 if sub == 1 else 0x580) + NODE
-        elif sub == 1 and (0x1400 <= index <= 0x1403 or 0x1800 <= index <= 0x1803):
-            default = (0x200 if index < 0x1800 else 0x180) + 0x100 * (index & 3) + NODE
-        out.append(dict(index=index, sub=sub, name=name, type=dtype, access=access, storage=storage,
-                        default=default))
+    for index in od.indices():
+        for sub in od.subindices(index):
+            var = od[index, sub]
+            default = var.default
+            if index == 0x1018 and sub >= 1:
+                default = IDENTITY[sub]
+            elif (index, sub) == (0x1014, 0):
+                default = 0x80 + NODE
+            elif (index, sub) in ((0x1200, 1), (0x1200, 2)):
+                default = (0x600 if sub == 1 else 0x580) + NODE
+            elif sub == 1 and (0x1400 <= index <= 0x1403 or 0x1800 <= index <= 0x1803):
+                default = (0x200 if index < 0x1800 else 0x180) + 0x100 * (index & 3) + NODE
+            out.append(dict(index=index, sub=sub, name=var.name, type=_TYPE[var.data_type], access=var.access,
+                            storage=_core.pmc007_storage(index, sub).name.lower(), default=default))
     return out
 
 

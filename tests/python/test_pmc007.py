@@ -37,7 +37,7 @@ def advance(sim, clock, seconds: float) -> None:
 
 def test_every_object_has_a_name_and_resolves_every_way():
     assert len(pmc007.OBJECTS) == 210
-    assert len({(r["index"]) for r in pmc007.OBJECTS.values()}) == 73
+    assert len({v.index for v in pmc007.OBJECTS.values()}) == 73
     for form in ("start_speed", "Start speed", "0x6006", "6006h", "0x6006:00", (0x6006, 0), 0x6006):
         assert Pmc007.resolve(form) == "start_speed"
     assert Pmc007.resolve("0x600F:01") == "external_emergency_stop.enable"

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 
 #include "motorbus/errors.hpp"
 
@@ -104,6 +105,26 @@ std::uint32_t Variable::check_size_for_write(std::size_t n) const {
         return abort_code::kTooLong;
     }
     return 0;
+}
+
+std::optional<std::pair<Scalar, Scalar>> Variable::value_range() const {
+    const DataType t = spec_.type;
+    const std::size_t bits = 8 * type_size(t);
+    std::optional<Scalar> lo, hi;
+    if (t == DataType::Boolean) {
+        lo = std::uint64_t{0};
+        hi = std::uint64_t{1};
+    } else if (is_signed(t) && bits) {
+        lo = bits >= 64 ? std::numeric_limits<std::int64_t>::min() : -(std::int64_t{1} << (bits - 1));
+        hi = bits >= 64 ? std::numeric_limits<std::int64_t>::max() : (std::int64_t{1} << (bits - 1)) - 1;
+    } else if (is_unsigned(t) && bits) {
+        lo = std::uint64_t{0};
+        hi = bits >= 64 ? std::numeric_limits<std::uint64_t>::max() : (std::uint64_t{1} << bits) - 1;
+    }
+    if (spec_.low_limit) lo = spec_.low_limit;
+    if (spec_.high_limit) hi = spec_.high_limit;
+    if (!lo || !hi) return std::nullopt;
+    return std::pair{*lo, *hi};
 }
 
 std::uint32_t Variable::validate(std::span<const std::uint8_t> data) const {

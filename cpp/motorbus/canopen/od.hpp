@@ -142,6 +142,10 @@ public:
     // Only the checks of remote_write (no hook, no commit): used by the SDO server
     // to refuse a segmented/block download at initiate time, before buffering.
     std::uint32_t check_size_for_write(std::size_t size) const;
+    // The values a write may carry: the limits where set, else the whole range of an
+    // integer type (BOOLEAN 0..1); nullopt for reals, strings and domains.  What a
+    // host shows as an object's range without a table of type sizes of its own.
+    std::optional<std::pair<Scalar, Scalar>> value_range() const;
 
     // --- hooks (may be set at any time; calls use a snapshot) ---
     void set_read_hook(ReadHook h);

@@ -111,6 +111,10 @@ class NodeNmt:
     def send_command(self, command: int) -> None:
         self._m.send(command, self.node_id)
 
+    #: ``node.nmt(0x01)``: a command by its code (0x01 start, 0x02 stop, 0x80 pre-op,
+    #: 0x81 reset node, 0x82 reset communication), as send_command.
+    __call__ = send_command
+
     def wait_for_bootup(self, timeout: float = 10.0) -> None:
         """Waits for the node's next boot-up message; motorbus.TimeoutError if none comes."""
         if not self._m.wait_for_boot(self.node_id, timeout):

@@ -122,6 +122,8 @@ class PdoChannel:
         self.tpdo = tpdo
         self.number = number
         self.config: Optional[PdoConfig] = None
+        #: Receive time (s, the bus clock) of the latest TPDO, set before its callbacks run.
+        self.timestamp: Optional[float] = None
         self._rx: Optional[_core.PdoReceiver] = None
         self._tx: Optional[_core.PdoSender] = None
         self._callbacks: List[Callable[[Dict[Tuple[int, int], int]], None]] = []
@@ -173,16 +175,20 @@ class PdoChannel:
         with self._lock:
             if self._rx is None:
                 entries = self._entries()
-                rx = _core.PdoReceiver(self._node.network.bus, self.cob_id, entries)
+                rx = _core.PdoReceiver(self._node.bus, self.cob_id, entries)
                 self._keys = [(e[0], e[1]) for e in entries]
                 # The receiver keeps raw field bits; signed objects are sign-extended here.
                 self._signs = [(1 << (e[2] - 1)) if e[3] else 0 for e in entries]
-                rx.set_callback(lambda values, ts: self._dispatch(self._decode(values)))
+                rx.set_callback(self._on_receive)
                 self._rx = rx
             return self._rx
 
     def _decode(self, values: Sequence[int]) -> Dict[Tuple[int, int], int]:
         return {k: (v - 2 * s if s and v >= s else v) for k, v, s in zip(self._keys, values, self._signs)}
+
+    def _on_receive(self, values: Sequence[int], timestamp_ns: int) -> None:
+        self.timestamp = timestamp_ns / 1e9     # before the callbacks, which may read it
+        self._dispatch(self._decode(values))
 
     def _dispatch(self, values: Dict[Tuple[int, int], int]) -> None:
         for cb in list(self._callbacks):
@@ -192,6 +198,11 @@ class PdoChannel:
         """callback({(index, subindex): value}) on the bus thread for every TPDO received."""
         self._callbacks.append(callback)
         self._receiver()
+
+    def remove_callback(self, callback: Callable[[Dict[Tuple[int, int], int]], None]) -> None:
+        """Stops calling ``callback`` (given to add_callback); unknown callbacks are ignored."""
+        if callback in self._callbacks:
+            self._callbacks.remove(callback)
 
     @property
     def values(self) -> Dict[Tuple[int, int], int]:
@@ -212,7 +223,7 @@ class PdoChannel:
             raise _core.InvalidArgument(f"{self!r}: a TPDO is sent by the device (use add_callback)")
         with self._lock:
             if self._tx is None:
-                self._tx = _core.PdoSender(self._node.network.bus, self.cob_id, self._entries())
+                self._tx = _core.PdoSender(self._node.bus, self.cob_id, self._entries())
             tx = self._tx
         tx.send([int(v) for v in values], timeout)
 

@@ -66,7 +66,7 @@ class SdoVariable:
             except OverflowError:
                 raise _core.InvalidArgument(f"{self.name}: {value} does not fit {size} bytes") from None
         elif self._is_integer():
-            data = _core.encode_value(self.od.data_type, int(value))
+            data = self.od.encode(int(value))
         else:
             raise _core.InvalidArgument(
                 f"{self.name}: no integer data type known for {value!r}: pass bytes or write(value, size=)")
@@ -77,7 +77,7 @@ class SdoVariable:
         """The int for integer types (signed per the type), else the bytes; bytes without an OD."""
         data = self.read()
         if self._is_integer():
-            return int(_core.decode_value(self.od.data_type, data))
+            return int(self.od.decode(data))
         return data
 
     @raw.setter
@@ -87,18 +87,19 @@ class SdoVariable:
     @property
     def value(self):
         """Typed by the OD data type: int (signed or not), float, bool, str or bytes."""
-        return _core.decode_value(self._data_type("read"), self.read())
+        return self._typed("read").decode(self.read())
 
     @value.setter
     def value(self, v) -> None:
-        self._client.download(self.index, self.subindex, _core.encode_value(self._data_type("write"), v))
+        self._client.download(self.index, self.subindex, self._typed("write").encode(v))
 
-    def _data_type(self, what: str):
+    def _typed(self, what: str) -> Variable:
+        """The dictionary entry whose C++ codec gives and takes the value."""
         if self.od is None:
             raise _core.InvalidArgument(
                 f"{self.name}: .value needs the data type: give add_node() an EDS or ObjectDictionary "
                 f"(or use .raw to {what} bytes)")
-        return self.od.data_type
+        return self.od
 
 
 class SdoObject:

@@ -29,6 +29,7 @@ from typing import Any, Optional, Union
 from .. import _core
 from .._core import ArcusMotion, ArcusProfileParams  # the DMX-CAN's profile model
 from ..canopen.cia402 import Cia402, Controlword, OpMode
+from ..canopen.node import check_node_id
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveStalled, ParamInfo, Params,
                      StopReason, Units)
 from . import arcus as _arcus
@@ -41,7 +42,6 @@ __all__ = ["ArcusCanopen", "ArcusCanopenDrive", "ArcusCanopenSim", "ArcusHomingM
 # simulator serves (Table 10.1), from the C++ table.
 OBJECTS = [tuple(row) for row in _core.arcus_canopen_objects()]
 _BY_KEY = {(r[0], r[1]): r for r in OBJECTS}
-_SIZES = {"U8": 1, "I8": 1, "U16": 2, "I16": 2, "U32": 4, "I32": 4}
 
 _SW_INTERNAL_LIMIT = 1 << 11
 
@@ -84,31 +84,28 @@ SnlStatus = _arcus.SnlStatus
 
 
 def _check_node(address: Union[str, int]) -> str:
-    text = str(address).strip()
-    try:
-        node = int(text, 0)
-    except ValueError:
-        raise _core.InvalidArgument(f"arcus-canopen address: a node-ID 1..127 (200Ch), not {address!r}") from None
-    if not 1 <= node <= 127:
-        raise _core.InvalidArgument(f"arcus-canopen address: node-ID {node} is outside 1..127")
-    return str(node)
+    """The node-ID 1..127 (200Ch) as text (the CANopen layer's check)."""
+    return str(check_node_id(address, "arcus-canopen"))
 
 
-def _encode(row: tuple, value: int) -> bytes:
-    index, sub, name, dtype, access, default, low, high = row[:8]
+def _entry(index: int, sub: int) -> "_core.Variable":
+    """The typed dictionary entry of one object of Table 10.1 (its C++ codec encodes and decodes)."""
+    od = _dictionary()
+    if (index, sub) not in od:
+        raise _core.InvalidArgument(f"arcus-canopen: 0x{index:04X}:{sub:02X} is not in the object dictionary")
+    return od[index, sub]
+
+
+def _encode(var: "_core.Variable", value: int) -> bytes:
+    """The manual's range checked before anything is sent (the drive's answer to a value
+    outside it is a bare abort), then the entry's codec."""
+    where = f"arcus-canopen {var.name} (0x{var.index:04X}:{var.subindex:02X})"
     if not isinstance(value, int) or isinstance(value, bool):
-        raise _core.InvalidArgument(f"arcus-canopen {name} (0x{index:04X}:{sub:02X}): an integer, not {value!r}")
+        raise _core.InvalidArgument(f"{where}: an integer, not {value!r}")
+    low, high = var.value_range
     if not low <= value <= high:
-        raise _core.InvalidArgument(f"arcus-canopen {name} (0x{index:04X}:{sub:02X}): {value} is outside "
-                                    f"{low}..{high}")
-    return int(value).to_bytes(_SIZES[dtype], "little", signed=dtype.startswith("I"))
-
-
-def _decode(row: tuple, data: bytes) -> Any:
-    dtype = row[3]
-    if dtype == "VISIBLE_STRING":
-        return data.decode("latin-1")
-    return int.from_bytes(data, "little", signed=dtype.startswith("I"))
+        raise _core.InvalidArgument(f"{where}: {value} is outside {low}..{high}")
+    return var.encode(value)
 
 
 class ArcusCanopen(Cia402):
@@ -119,20 +116,15 @@ class ArcusCanopen(Cia402):
     (the drive knows no other transfer)."""
 
     def read(self, index: int, sub: int = 0) -> Any:
-        """One object of Table 10.1, decoded by its type."""
-        row = _BY_KEY.get((index, sub))
-        if row is None:
-            raise _core.InvalidArgument(f"arcus-canopen: 0x{index:04X}:{sub:02X} is not in the object dictionary")
-        return _decode(row, bytes(self.sdo.upload(index, sub)))
+        """One object of Table 10.1, decoded by its dictionary entry."""
+        return _entry(index, sub).decode(bytes(self.sdo.upload(index, sub)))
 
     def write(self, index: int, sub: int, value: int) -> None:
         """One writable object, range-checked against the manual before it is sent."""
-        row = _BY_KEY.get((index, sub))
-        if row is None:
-            raise _core.InvalidArgument(f"arcus-canopen: 0x{index:04X}:{sub:02X} is not in the object dictionary")
-        if row[4] not in ("rw", "wo"):
-            raise _core.InvalidArgument(f"arcus-canopen {row[2]} (0x{index:04X}:{sub:02X}) is read-only")
-        self.sdo.download(index, sub, _encode(row, value))
+        var = _entry(index, sub)
+        if var.access not in ("rw", "wo"):
+            raise _core.InvalidArgument(f"arcus-canopen {var.name} (0x{index:04X}:{sub:02X}) is read-only")
+        self.sdo.download(index, sub, _encode(var, value))
 
     # ---- Arcus objects (2000h-200Eh) ----
     def _prop(index: int, sub: int = 0, wrap: Any = None, doc: str = ""):  # noqa: N805 - class-body helper
@@ -502,9 +494,10 @@ class ArcusCanopenDrive(Cia402Drive):
             raise
         self.native.set_velocity(int(round(velocity)))
 
-    def _read(self, index: int, sub: int = 0) -> Any:
-        """One object, decoded, through the read that survives a second SDO client."""
-        return _decode(_BY_KEY[(index, sub)], self._upload(index, sub))
+    @staticmethod
+    def object_dictionary() -> "_core.ObjectDictionary":
+        """Table 10.1, typed: the CiA 402 adapter's reads and writes use its entries."""
+        return _dictionary()
 
     # _is_idle and _homing_done: the CiA 402 ones (at rest for any reason; a homing error
     # or a fault raises what _stop_reason below finds).
@@ -612,6 +605,17 @@ def object_dictionary() -> "_core.ObjectDictionary":
         else:
             od.add_variable(index, name, dt, **kwargs)
     return od
+
+
+_OD: Optional["_core.ObjectDictionary"] = None
+
+
+def _dictionary() -> "_core.ObjectDictionary":
+    """object_dictionary(), made once: the client's and the adapter's codecs (read only)."""
+    global _OD
+    if _OD is None:
+        _OD = object_dictionary()
+    return _OD
 
 
 def eds_text() -> str:

@@ -28,11 +28,12 @@ and every drive applies it on the same SYNC frame.
 from __future__ import annotations
 
 import contextlib
-import struct
 import time
 from typing import Any, Iterator, Optional, Sequence, Union
 
 from .. import _core
+from ..canopen.node import check_node_id
+from ..canopen.pdo import PdoMap, configure_pdo, read_pdo_config
 from ..canopen.cia402 import Cia402, Cia402Device, Controlword, OpMode
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, MoveStalled,
                      ParamInfo, Params, StopReason, Units)
@@ -98,19 +99,40 @@ OBJECTS = [
     (0x60FF, 0, "Target velocity", "I32", "rw", 0, None, None, "inc/s", False, "PV target"),
     (0x6502, 0, "Supported drive modes", "U32", "ro", 0b100101, None, None, "", False, "PP, PV, HM"),
 ]
-_SIZES = {"U8": 1, "I8": 1, "U16": 2, "I16": 2, "U32": 4, "I32": 4}
-_SAVE = int.from_bytes(b"save", "little")  # CiA 301 0x1010 signature
+_SAVE = 0x65766173  # CiA 301 1010h signature "save" (ASCII, little-endian)
+_OD: Optional["_core.ObjectDictionary"] = None
+
+
+def object_dictionary() -> "_core.ObjectDictionary":
+    """The objects table as a typed dictionary (``motorbus.canopen.ObjectDictionary``, C++),
+    with the three objects every CiA 402 drive has beside it (6040h, 6041h, 1010h:01).  The
+    adapter reads and writes each object with its entry's codec (``Variable.encode/decode``);
+    nothing is packed in Python."""
+    global _OD
+    if _OD is None:
+        od = _core.ObjectDictionary()
+        records = {row[0] for row in OBJECTS if row[1] != 0}
+        for index in sorted(records):
+            od.add_record(index, f"0x{index:04X}")
+        rows = [row[:8] for row in OBJECTS] + [(0x6040, 0, "Controlword", "U16", "rw", 0, None, None),
+                                               (0x6041, 0, "Statusword", "U16", "ro", 0, None, None),
+                                               (0x1010, 1, "Save all parameters", "U32", "rw", 1, None, None)]
+        for (index, sub, name, dtype, access, default, low, high) in rows:
+            if index in (0x1010,) and index not in records:
+                od.add_record(index, "Store parameters", array=True)
+                records.add(index)
+            kw = dict(access=access, low=low, high=high, default=default)
+            if index in records:
+                od.add_member(index, sub, name, dtype, **kw)
+            else:
+                od.add_variable(index, name, dtype, **kw)
+        _OD = od
+    return _OD
 
 
 def _check_node(address: Union[str, int]) -> str:
-    text = str(address).strip()
-    try:
-        node = int(text, 0)
-    except ValueError:
-        raise _core.InvalidArgument(f"cia402 address: a CANopen node-ID 1..127, not {address!r}") from None
-    if not 1 <= node <= 127:
-        raise _core.InvalidArgument(f"cia402 address: node-ID {node} is outside 1..127")
-    return str(node)
+    """The node-ID 1..127 as text (the CANopen layer's check)."""
+    return str(check_node_id(address, "cia402"))
 
 
 # The simulator is C++ (cpp/motorbus/drives/cia402/sim.hpp): a LocalNode with a
@@ -228,35 +250,27 @@ class Cia402Params(Params):
         return f"0x{index:04X}" + (f":{subindex:02X}" if subindex else "")
 
     def _info(self, name: str) -> Optional[ParamInfo]:
-        for (i, s, n, dtype, access, default, low, high, unit, persists, desc) in OBJECTS:
+        for (i, s, n, _dtype, access, default, _low, _high, unit, persists, *desc) in OBJECTS:
             if name == f"0x{i:04X}" + (f":{s:02X}" if s else ""):
-                kind = "str" if dtype == "VISIBLE_STRING" else "int"
-                if low is None and dtype in _SIZES:
-                    bits = 8 * _SIZES[dtype]
-                    low, high = ((-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if dtype.startswith("I")
-                                 else (0, (1 << bits) - 1))
-                return ParamInfo(name=name, type=kind, minimum=low, maximum=high, unit=unit, default=default,
-                                 persists=persists, writable=access != "ro", description=f"{n}: {desc}")
+                var = object_dictionary()[i, s]     # type and range: the typed entry's
+                low, high = var.value_range or (None, None)
+                return ParamInfo(name=name, type="str" if var.data_type == _core.DataType.VISIBLE_STRING else "int",
+                                 minimum=low, maximum=high, unit=unit, default=default, persists=persists,
+                                 writable=access != "ro", description=f"{n}: {desc[0]}" if desc else n)
         return None
 
-    def _where(self, info: ParamInfo) -> tuple[int, int, str]:
+    def _where(self, info: ParamInfo) -> "_core.Variable":
         idx, _, sub = info.name.partition(":")
-        index, subindex = int(idx, 16), int(sub, 16) if sub else 0
-        dtype = next(d for (i, s, _n, d, *_r) in OBJECTS if (i, s) == (index, subindex))
-        return index, subindex, dtype
+        return object_dictionary()[int(idx, 16), int(sub, 16) if sub else 0]
 
     def _read(self, info: ParamInfo) -> Any:
-        index, sub, dtype = self._where(info)
-        data = self._drive._sdo.upload(index, sub)
-        if dtype == "VISIBLE_STRING":
-            return data.decode("latin-1")
-        return int.from_bytes(data, "little", signed=dtype.startswith("I"))
+        var = self._where(info)
+        return var.decode(self._drive._sdo.upload(var.index, var.subindex))
 
     def _write(self, info: ParamInfo, value: Any) -> None:
-        index, sub, dtype = self._where(info)
-        self._drive._sdo.download(index, sub, int(value).to_bytes(_SIZES[dtype], "little",
-                                                                    signed=dtype.startswith("I")))
-        if index == 0x6067:
+        var = self._where(info)
+        self._drive._sdo.download(var.index, var.subindex, var.encode(int(value)))
+        if var.index == 0x6067:
             self._drive._window = None      # the cached position window is read again
 
 
@@ -360,7 +374,7 @@ class Cia402Drive(Drive):
         # (without the set-point bit) of the move held in the RPDO until then.
         self._sync_bus: Optional[_core.Bus] = None
         self._held_cw: Optional[int] = None
-        self._sync_rpdo_cob: Optional[int] = None
+        self._sync_rpdo: Optional[tuple] = None   # (COB-ID, PdoMap) of the synchronised-start RPDO
         self._homed = False                      # the last homing attained (sticky until the next)
         self._window: Optional[float] = None     # 6067h, read at the first judged move
         self._at_limit_since: Optional[float] = None
@@ -368,11 +382,17 @@ class Cia402Drive(Drive):
         self._homing_ran = False
 
     # ---- helpers ----
-    def _u32(self, index: int, value: float) -> None:
-        self._sdo.download(index, 0, int(round(value)).to_bytes(4, "little", signed=False))
+    #: The typed dictionary the adapter reads and writes by (a vendor kind gives its own).
+    object_dictionary = staticmethod(object_dictionary)
 
-    def _i32(self, index: int, value: float) -> None:
-        self._sdo.download(index, 0, int(round(value)).to_bytes(4, "little", signed=True))
+    def _read(self, index: int, sub: int = 0) -> Any:
+        """One object, decoded by its dictionary entry (C++ codec), through the read that
+        survives a second SDO client (_upload)."""
+        return self.object_dictionary()[index, sub].decode(self._upload(index, sub))
+
+    def _download(self, index: int, value: Any, sub: int = 0) -> None:
+        """One object, encoded by its dictionary entry (C++ codec)."""
+        self._sdo.download(index, sub, self.object_dictionary()[index, sub].encode(value))
 
     #: Attempts of one read when another SDO client on the node takes the reply.
     sdo_read_attempts = 5
@@ -396,10 +416,7 @@ class Cia402Drive(Drive):
         raise AssertionError("unreachable")
 
     def _statusword(self) -> int:
-        return int.from_bytes(self._upload(0x6041, 0), "little")
-
-    def _read_i32(self, index: int) -> int:
-        return int.from_bytes(self._upload(index, 0), "little", signed=True)
+        return int(self._read(0x6041))
 
     def _use_mode(self, mode: OpMode) -> None:
         if self._mode != mode:
@@ -420,8 +437,8 @@ class Cia402Drive(Drive):
     def _speed_for_this_move(self, velocity: Optional[float]) -> None:
         """velocity= is for this move only: 6081h is put back when the move ends."""
         if velocity is not None:
-            self._for_this_move(lambda: int.from_bytes(self._upload(0x6081, 0), "little"),
-                                lambda v: self._u32(0x6081, v), int(round(velocity)))
+            self._for_this_move(lambda: self._read(0x6081), lambda v: self._download(0x6081, int(round(v))),
+                                int(round(velocity)))
 
     def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
         self._use_mode(OpMode.PROFILE_POSITION)
@@ -444,10 +461,14 @@ class Cia402Drive(Drive):
         and the set-point edge must find the new target already written.  Starts the node
         (NMT): PDOs flow only in OPERATIONAL."""
         node = self.native.node
-        if self._sync_rpdo_cob is None:
-            _core.pdo_write_config(self._sdo, node, False, SYNC_START_RPDO, transmission_type=1,
-                                   mapping=[(0x607A, 0, 32), (0x6040, 0, 16)])
-            self._sync_rpdo_cob = _core.pdo_read_config(self._sdo, node, False, SYNC_START_RPDO).cob_id
+        if self._sync_rpdo is None:
+            # The PDO layer writes the mapping and packs the frames (sizes and signs from the entries).
+            entries = []
+            for index in (0x607A, 0x6040):
+                var = self.object_dictionary()[index, 0]
+                entries.append((index, 0, 8 * var.size, var.value_range[0] < 0))
+            configure_pdo(self._sdo, node, rpdo=SYNC_START_RPDO, transmission_type=1, mapping=entries)
+            self._sync_rpdo = (read_pdo_config(self._sdo, node, rpdo=SYNC_START_RPDO).cob_id, PdoMap(entries))
         bus.send(_core.nmt_encode(_core.NmtCommand.START, node))   # PDOs flow only in OPERATIONAL
         self._sync_bus = bus
 
@@ -455,7 +476,8 @@ class Cia402Drive(Drive):
         base = int(Controlword.ENABLE_OPERATION) | _CW_IMMEDIATE | (_CW_RELATIVE if relative else 0)
         # As in an SDO move: the previous acknowledge must have dropped for the edge to count.
         self.native.wait_statusword(_SW_BIT12, 0)
-        self._sync_bus.send(_core.Frame(self._sync_rpdo_cob, struct.pack("<iH", target, base | _CW_NEW_SETPOINT)))
+        cob, layout = self._sync_rpdo
+        self._sync_bus.send(_core.Frame(cob, layout.pack([target, base | _CW_NEW_SETPOINT])))
         self._held_cw = base
 
     def _release_sync_start(self, started: bool) -> None:
@@ -467,7 +489,8 @@ class Cia402Drive(Drive):
         if base is None:
             return
         if not started:
-            bus.send(_core.Frame(self._sync_rpdo_cob, struct.pack("<iH", self._read_i32(0x607A), base)))
+            cob, layout = self._sync_rpdo
+            bus.send(_core.Frame(cob, layout.pack([int(self._read(0x607A)), base])))
             return
         try:
             self.native.wait_statusword(_SW_BIT12, _SW_BIT12)
@@ -506,7 +529,7 @@ class Cia402Drive(Drive):
         if method is not None:
             if not isinstance(method, int) or not _core.Cia402Homing.supported(method):
                 raise _core.InvalidArgument(f"cia402 home: method 7, 11, 17-20 or 33-35, not {method!r}")
-            self._sdo.download(0x6098, 0, int(method).to_bytes(1, "little", signed=True))
+            self._download(0x6098, int(method))
         self._start_homing()
 
     def _start_homing(self) -> None:
@@ -554,12 +577,9 @@ class Cia402Drive(Drive):
             return self._velocity() == 0
         return False
 
-    def _read_u16(self, index: int) -> int:
-        return int.from_bytes(self._upload(index, 0), "little")
-
     def _controlword_now(self) -> int:
         """6040h as the drive holds it (another program may have written it)."""
-        return int.from_bytes(self._upload(0x6040, 0), "little")
+        return int(self._read(0x6040))
 
     #: Seconds a drive must stand still at an internal limit (bit 11) without showing
     #: target reached before it counts as at rest (a move leaving a limit starts at v = 0).
@@ -597,7 +617,7 @@ class Cia402Drive(Drive):
         FFFFFFFFh switches the drive's window off (CiA 402): then, as without 6067h, exactly."""
         if self._window is None:
             try:
-                window = int.from_bytes(self._upload(0x6067, 0), "little")
+                window = int(self._read(0x6067))
             except _core.SdoAbortError:
                 window = 0xFFFFFFFF
             self._window = self.in_position_window if window == 0xFFFFFFFF else float(window)
@@ -628,7 +648,7 @@ class Cia402Drive(Drive):
         state = _core.cia402_decode_statusword(sw)
         ours = self._move is not None and self._move.stopped_by is not None
         if state in ("FAULT", "FAULT REACTION ACTIVE"):
-            code = self._read_u16(0x603F)
+            code = int(self._read(0x603F))
             error = MoveStalled if code in STALL_CODES else MoveFaulted
             return StopReason(error, error_text(code), code=code)
         if self._mode == OpMode.PROFILE_POSITION and sw & _SW_BIT13:
@@ -652,8 +672,7 @@ class Cia402Drive(Drive):
     def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         """607Dh:01/02 (software position limits); the I32 extremes mean none."""
         try:
-            lo = int.from_bytes(self._upload(0x607D, 1), "little", signed=True)
-            hi = int.from_bytes(self._upload(0x607D, 2), "little", signed=True)
+            lo, hi = int(self._read(0x607D, 1)), int(self._read(0x607D, 2))
         except _core.SdoAbortError:
             return (None, None)      # the drive has no 607Dh
         if lo >= hi:
@@ -664,23 +683,23 @@ class Cia402Drive(Drive):
         self.native.fault_reset()
 
     def _store(self) -> None:
-        self._sdo.download(0x1010, 1, _SAVE.to_bytes(4, "little"))
+        self._download(0x1010, _SAVE, sub=1)
 
     def _position(self) -> float:
-        return float(self._read_i32(0x6064))
+        return float(self._read(0x6064))
 
     def _velocity(self) -> float:
-        return float(self._read_i32(0x606C))
+        return float(self._read(0x606C))
 
     def _digital_inputs(self) -> int:
         """60FDh (bit 0 negative limit, bit 1 positive limit)."""
-        return int.from_bytes(self._upload(0x60FD, 0), "little")
+        return int(self._read(0x60FD))
 
     def _status_text(self, state: str, mode: Optional[int], sw: int, fault: bool) -> str:
         """The status line; a vendor kind adds what its drive says beyond CiA 402."""
         text = f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}"
         if fault:
-            text += f", {error_text(self._read_u16(0x603F))}"
+            text += f", {error_text(int(self._read(0x603F)))}"
         return text
 
     def _status(self) -> DriveStatus:
@@ -692,7 +711,7 @@ class Cia402Drive(Drive):
         fault = state in ("FAULT", "FAULT REACTION ACTIVE")
         if mode is None:        # not set by this Drive yet: the mode in effect (6061h), for the text
             try:
-                mode = int.from_bytes(self._upload(0x6061, 0), "little", signed=True)
+                mode = int(self._read(0x6061))
                 OpMode(mode)
             except (_core.SdoAbortError, ValueError):
                 mode = None

@@ -9,11 +9,13 @@
         axis.params["start_speed"] = 600    # any object by name, "0x6006" or "6006h"
         axis.native.controller_status       # ControllerStatus.BUSY | ...
 
-The native client :class:`Pmc007` talks SDO through motorbus's CANopen stack
-(``_core.SdoClient``) and names every object of the manual's dictionary (the
-one table in ``cpp/motorbus/drives/pmc007/od_table.cpp``, exported as
-``_core.pmc007_od_rows()``; the EDS shipped next to this module is generated from
-the same table).  The simulator (:class:`~motorbus._core.Pmc007Sim`, ``make_sim``)
+The native client :class:`Pmc007` is a profile of the CANopen node facade, as
+canopen's ``BaseNode402`` is a ``RemoteNode``: a :class:`motorbus.canopen.RemoteNode`
+whose object dictionary is the C++ one of the device (``cpp/motorbus/drives/pmc007/od_table.cpp``,
+handed up typed by ``_core.pmc007_object_dictionary``; the EDS shipped next to this module
+is generated from the same table).  An object by name is an entry of that dictionary
+read and written through the node's SDO client with the entry's C++ codec; PDOs are
+the node's ``tpdo``/``rpdo`` channels (the C++ PDO engine packs and unpacks them).  The simulator (:class:`~motorbus._core.Pmc007Sim`, ``make_sim``)
 is C++: a LocalNode with that dictionary, heartbeat, PDOs, EMCY, motion on the
 motor model.
 
@@ -35,6 +37,9 @@ from typing import Any, Callable, Iterable, Optional, Union
 
 from .. import _core
 from ..stopping import check_stop_way
+from ..canopen.node import RemoteNode, check_node_id
+from ..canopen.pdo import PdoChannel
+from ..canopen.sdo import SdoVariable
 # The PMC007's profile model (start/stop speeds, gear table, microstepping): the vendor's own module
 # re-exports it (motorbus.motion keeps the generic planners).
 from .._core import (Pmc007ProfileParams, pmc007_convert_position, pmc007_gear_acceleration,  # noqa: F401
@@ -90,29 +95,30 @@ class ControllerStatus(enum.IntFlag):
     EXT3 = 1 << 4   # the spec's reading: EXT3 (ENC1) latch
 
 
-_SIZES = {"U8": 1, "U16": 2, "U32": 4, "I32": 4}
-
-
 def _snake(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_")
 
 
-def _build_objects() -> dict:
-    """name -> row; names are snake_case of the manual's object names ("start_speed"),
-    "<record>.<member>" for sub-indexed ones ("external_emergency_stop.enable")."""
+def _build_objects(od: "_core.ObjectDictionary") -> dict:
+    """Python name -> the dictionary's typed entry (``motorbus.canopen.Variable``); names
+    are snake_case of the manual's object names ("start_speed"), "<record>.<member>" for
+    sub-indexed ones ("external_emergency_stop.enable")."""
     out = {}
-    for (index, sub, name, parent, dtype, access, pdo, storage, default, low, high) in _core.pmc007_od_rows():
-        key = f"{_snake(parent)}.{_snake(name)}" if parent else _snake(name)
-        if key in out:  # repeated member names (1003h:01..07, 1016h:01..03)
-            key = f"{key}_{sub}"
-        out[key] = dict(index=index, sub=sub, name=name, parent=parent, type=dtype, access=access, pdo=pdo,
-                        storage=storage, default=default, low=low, high=high)
+    for index in od.indices():
+        record = _snake(od.object_name(index)) if od.object_code(index) != "VAR" else None
+        for sub in od.subindices(index):
+            var = od[index, sub]
+            key = f"{record}.{_snake(var.name)}" if record else _snake(var.name)
+            if key in out:  # repeated member names (1003h:01..07, 1016h:01..03)
+                key = f"{key}_{sub}"
+            out[key] = var
     return out
 
 
-#: Every object of the dictionary by its Python name (see _build_objects).
-OBJECTS = _build_objects()
-_BY_INDEX = {(r["index"], r["sub"]): k for k, r in OBJECTS.items()}
+#: Every object of the dictionary by its Python name (see _build_objects): the typed
+#: entries of the C++ table (data type, access, limits, default, encode/decode).
+OBJECTS = _build_objects(_core.pmc007_object_dictionary())
+_BY_INDEX = {(v.index, v.subindex): k for k, v in OBJECTS.items()}
 
 
 def assemble(text: str) -> list[int]:
@@ -126,24 +132,8 @@ def disassemble(words: Iterable[int]) -> str:
 
 
 def _check_node(address: Union[str, int]) -> str:
-    """The node-ID 1..127: an int means that integer; text is decimal or 0x hex."""
-    if isinstance(address, bool):
-        raise _core.InvalidArgument(f"pmc007 address: a CANopen node-ID 1..127, not {address!r}")
-    if isinstance(address, int):
-        node = address
-    else:
-        text = str(address).strip()
-        node = None
-        if len(text) <= 12:     # a 100 000-digit "address" is refused, not converted
-            try:
-                node = int(text, 0)
-            except ValueError:
-                node = int(text, 10) if text.isdigit() else None   # "05": decimal with a leading zero
-        if node is None:
-            raise _core.InvalidArgument(f"pmc007 address: a CANopen node-ID 1..127, not {address!r}")
-    if not 1 <= node <= 127:
-        raise _core.InvalidArgument(f"pmc007 address: node-ID {node} is outside 1..127")
-    return str(node)
+    """The node-ID 1..127 as text (the CANopen layer's check)."""
+    return str(check_node_id(address, "pmc007"))
 
 
 def _object_property(name: str, doc: str) -> property:
@@ -151,28 +141,30 @@ def _object_property(name: str, doc: str) -> property:
     return property(lambda self: int(self.read(name)), lambda self, value: self.write(name, value), doc=doc)
 
 
-class Pmc007:
-    """The native client: named SDO access to every object of one PMC007 node.
+class Pmc007(RemoteNode):
+    """The native client: a PMC007 profile of a CANopen node (``motorbus.canopen.RemoteNode``).
 
     ``Pmc007(bus, node=5)`` (a ``_core.Bus`` or ``motorbus.open_bus`` text).  Objects by
     name: ``drive["start_speed"]``, ``drive.read("0x6006")``, ``drive.write("6006h", 600)``;
-    properties for the common ones.  Safety words ``on_error``/``on_exit``
-    ("stop" = 6020h immediate stop, "disable" = 600Eh = 0, None) apply to ``with``."""
+    properties for the common ones.  Underneath is the node: ``object_dictionary`` (the
+    device's C++ table, typed), ``sdo`` (its SDO client), ``tpdo``/``rpdo``, ``nmt``.
+    Safety words ``on_error``/``on_exit`` ("stop" = 6020h immediate stop, "disable" =
+    600Eh = 0, None) apply to ``with``."""
 
     def __init__(self, bus: Any, node: int = 5, timeout: float = 1.0, *, on_error: Optional[str] = "stop",
                  on_exit: Optional[str] = "stop") -> None:
         check_stop_way(on_error, "on_error")
         check_stop_way(on_exit, "on_exit")
+        node_id = check_node_id(node, "pmc007")
         self._owns = isinstance(bus, str)
         if self._owns:
             from ..bus import open_bus
             bus = open_bus(bus)
-        self.bus = bus
-        self.node = int(_check_node(node))
-        self.sdo = _core.SdoClient(bus, self.node, timeout=timeout)
+        super().__init__(bus, node_id, _core.pmc007_object_dictionary(node_id), timeout)
+        self.node = node_id
         self.on_error, self.on_exit = on_error, on_exit
-        self._pdo_rx: dict = {}
-        self._rpdo_tx: dict = {}
+        self._vars: dict = {}       # Python name -> the node's SdoVariable (made on first use)
+        self._pdos: dict = {}       # COB-ID -> the PdoChannel this client configured on it
         self._closed = False
 
     # ---- objects by name ----
@@ -201,24 +193,25 @@ class Pmc007:
                 return key
         raise _core.InvalidArgument(f"pmc007: no object {name!r}")
 
+    def variable(self, name: Union[str, int, tuple]) -> SdoVariable:
+        """The node's SDO object for a name (any form :meth:`resolve` takes): ``.value``
+        reads and writes it with its dictionary entry's C++ codec."""
+        key = self.resolve(name)
+        var = self._vars.get(key)
+        if var is None:
+            index, sub = OBJECTS[key].index, OBJECTS[key].subindex
+            var = self._vars[key] = SdoVariable(self.sdo.client, index, sub, self.object_dictionary[index, sub])
+        return var
+
     def read(self, name: Union[str, int, tuple]) -> Union[int, str]:
-        row = OBJECTS[self.resolve(name)]
-        data = self.sdo.upload(row["index"], row["sub"])
-        if row["type"] == "VISIBLE_STRING":
-            return data.rstrip(b"\0").decode("latin-1")
-        return int.from_bytes(data, "little", signed=row["type"] == "I32")
+        return self.variable(name).value
 
     def write(self, name: Union[str, int, tuple], value: int) -> None:
-        row = OBJECTS[self.resolve(name)]
-        if row["type"] not in _SIZES:
-            raise _core.InvalidArgument(f"pmc007: {row['name']} is not writable")
-        signed = row["type"] == "I32"
-        bits = 8 * _SIZES[row["type"]]
-        lo, hi = (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if signed else (0, (1 << bits) - 1)
-        v = int(value)
-        if not lo <= v <= hi:
-            raise _core.InvalidArgument(f"pmc007: {row['name']} = {v} does not fit {row['type']}")
-        self.sdo.download(row["index"], row["sub"], v.to_bytes(_SIZES[row["type"]], "little", signed=signed))
+        var = self.variable(name)
+        if var.od.access == "const":
+            raise _core.InvalidArgument(f"pmc007: {var.od.name} is not writable")
+        # The entry's codec refuses a value its type cannot carry; the limits are the device's.
+        var.value = int(value)
 
     def __getitem__(self, name: Union[str, int, tuple]) -> Union[int, str]:
         return self.read(name)
@@ -306,10 +299,6 @@ class Pmc007:
     def bootloader(self) -> None:
         self.write("system_control", 1)
 
-    def nmt(self, command: int) -> None:
-        """NMT 0x000 [command, node]: 0x01 start, 0x02 stop, 0x80 pre-op, 0x81 reset node, 0x82 reset comm."""
-        self.bus.send(_core.Frame(0, bytes([int(command) & 0xFF, self.node])))
-
     # ---- offline program ----
     def upload_program(self, program: Union[str, Iterable[int]], *, to_flash: bool = True,
                        auto_run: Optional[bool] = None) -> list[int]:
@@ -349,27 +338,27 @@ class Pmc007:
     def start_program(self, on: bool = True) -> None:
         self.write("offline_programming_parameter_1.offline_automatic_operation", 1 if on else 0)
 
-    # ---- PDO ----
+    # ---- PDO: the node's tpdo/rpdo channels (C++ PDO engine), in the manual's order ----
+    def _mapping(self, items: Iterable[Union[str, tuple]]) -> list:
+        """(index, sub, bits) of each object, the size from its dictionary entry."""
+        out = []
+        for item in items:
+            v = OBJECTS[self.resolve(item)]
+            out.append((v.index, v.subindex, 8 * v.size))
+        return out
+
     def configure_tpdo(self, n: int, mapping: Iterable[Union[str, tuple]], *, cob_id: Optional[int] = None,
                        transmission_type: int = 255, inhibit_100us: int = 0, event_timer_ms: int = 0) -> int:
         """TPDO ``n`` (1..4) with the manual's sequence (App.3 §11.2): COB-ID, type, inhibit,
-        event timer, sub0 = count, then the entries.  Returns the COB-ID."""
+        event timer, sub0 = count, then the entries (``procedure="direct"`` of the PDO layer).
+        Returns the COB-ID."""
         if not 1 <= int(n) <= 4:
             raise _core.InvalidArgument(f"pmc007: TPDO number 1..4, not {n!r}")
-        comm, mp = 0x1800 + n - 1, 0x1A00 + n - 1
         cob = int(cob_id) if cob_id is not None else 0x180 + 0x100 * (n - 1) + self.node
-        self.sdo.download(comm, 1, cob.to_bytes(4, "little"))
-        self.sdo.download(comm, 2, int(transmission_type).to_bytes(1, "little"))
-        self.sdo.download(comm, 3, int(inhibit_100us).to_bytes(2, "little"))
-        self.sdo.download(comm, 5, int(event_timer_ms).to_bytes(2, "little"))
-        entries = []
-        for item in mapping:
-            row = OBJECTS[self.resolve(item)]
-            entries.append((row["index"] << 16) | (row["sub"] << 8) | (8 * _SIZES[row["type"]]))
-        self.sdo.download(mp, 0, bytes([len(entries)]))
-        for i, e in enumerate(entries, 1):
-            self.sdo.download(mp, i, e.to_bytes(4, "little"))
-        self._pdo_rx[cob] = entries
+        channel = self.tpdo[int(n)]
+        channel.configure(cob_id=cob, transmission_type=int(transmission_type), inhibit_100us=int(inhibit_100us),
+                          event_timer_ms=int(event_timer_ms), mapping=self._mapping(mapping), procedure="direct")
+        self._pdos[cob] = channel
         return cob
 
     def configure_rpdo(self, n: int, mapping: Iterable[Union[str, tuple]], *, cob_id: Optional[int] = None,
@@ -378,57 +367,45 @@ class Pmc007:
         writable mappable objects (6000h, 6001h, 600Ch, 6012h) can be mapped.  Returns the COB-ID."""
         if not 1 <= int(n) <= 4:
             raise _core.InvalidArgument(f"pmc007: RPDO number 1..4, not {n!r}")
-        comm, mp = 0x1400 + n - 1, 0x1600 + n - 1
         cob = int(cob_id) if cob_id is not None else 0x200 + 0x100 * (n - 1) + self.node
-        self.sdo.download(comm, 1, cob.to_bytes(4, "little"))
-        self.sdo.download(comm, 2, int(transmission_type).to_bytes(1, "little"))
-        entries = []
-        for item in mapping:
-            row = OBJECTS[self.resolve(item)]
-            entries.append((row["index"] << 16) | (row["sub"] << 8) | (8 * _SIZES[row["type"]]))
-        self.sdo.download(mp, 0, bytes([len(entries)]))
-        for i, e in enumerate(entries, 1):
-            self.sdo.download(mp, i, e.to_bytes(4, "little"))
-        self._rpdo_tx[cob] = entries
+        channel = self.rpdo[int(n)]
+        channel.configure(cob_id=cob, transmission_type=int(transmission_type), mapping=self._mapping(mapping),
+                          procedure="direct")
+        self._pdos[cob] = channel
         return cob
+
+    def _channel(self, cob_id: int, tpdo: bool) -> PdoChannel:
+        channel = self._pdos.get(int(cob_id))
+        if channel is None or channel.tpdo != tpdo:
+            raise _core.InvalidArgument(f"pmc007: {'TPDO' if tpdo else 'RPDO'} 0x{int(cob_id):X} was not "
+                                        "configured by this client")
+        return channel
 
     def send_rpdo(self, cob_id: int, values: dict) -> None:
         """One RPDO frame on ``cob_id`` (configured by configure_rpdo) with {object name: value}."""
-        entries = self._rpdo_tx.get(int(cob_id))
-        if entries is None:
-            raise _core.InvalidArgument(f"pmc007: RPDO 0x{cob_id:X} was not configured by this client")
-        data = b""
-        for e in entries:
-            key = _BY_INDEX[(e >> 16, (e >> 8) & 0xFF)]
-            if key not in values:
-                raise _core.InvalidArgument(f"pmc007: RPDO 0x{cob_id:X} needs a value for {key!r}")
-            data += int(values[key]).to_bytes((e & 0xFF) // 8, "little", signed=OBJECTS[key]["type"] == "I32")
-        self.bus.send(_core.Frame(int(cob_id), data))
+        channel = self._channel(cob_id, tpdo=False)
+        names = [_BY_INDEX[(index, sub)] for (index, sub, _bits) in channel.mapping]
+        missing = [k for k in names if k not in values]
+        if missing:
+            raise _core.InvalidArgument(f"pmc007: RPDO 0x{int(cob_id):X} needs a value for {missing[0]!r}")
+        channel.transmit([int(values[k]) for k in names])
 
     def tpdo_stream(self, cob_id: int, capacity: int = 100_000) -> "TpdoStream":
         """The TPDO's values as numpy arrays: a ring of ``capacity`` frames, one field per mapped
         object plus ``t`` (the frame's receive time, s).  ``stream.values()`` is a copy, oldest first."""
-        entries = self._pdo_rx.get(int(cob_id))
-        if entries is None:
-            raise _core.InvalidArgument(f"pmc007: TPDO 0x{cob_id:X} was not configured by this client")
-        return TpdoStream(self, int(cob_id), entries, int(capacity))
+        return TpdoStream(self._channel(cob_id, tpdo=True), int(capacity))
 
-    def on_tpdo(self, cob_id: int, callback: Callable[[dict], None]) -> int:
-        """Typed callback {object name: value} for every TPDO frame on ``cob_id``
-        (as configured by configure_tpdo).  Returns the subscription id."""
-        entries = self._pdo_rx.get(int(cob_id))
-        if entries is None:
-            raise _core.InvalidArgument(f"pmc007: TPDO 0x{cob_id:X} was not configured by this client")
+    def on_tpdo(self, cob_id: int, callback: Callable[[dict], None]) -> Callable[[dict], None]:
+        """Typed callback {object name: value} for every TPDO frame on ``cob_id`` (as
+        configured by configure_tpdo).  Returns what was added to the channel
+        (``self.tpdo[n].remove_callback(it)`` stops it)."""
+        channel = self._channel(cob_id, tpdo=True)
+        names = {(index, sub): _BY_INDEX[(index, sub)] for (index, sub, _bits) in channel.mapping}
 
-        def decode(frame: Any) -> None:
-            data, pos, out = bytes(frame.data), 0, {}
-            for e in entries:
-                key = _BY_INDEX[(e >> 16, (e >> 8) & 0xFF)]
-                size = (e & 0xFF) // 8
-                out[key] = int.from_bytes(data[pos:pos + size], "little", signed=OBJECTS[key]["type"] == "I32")
-                pos += size
-            callback(out)
-        return self.bus.subscribe(decode, int(cob_id), 0x7FF)
+        def by_name(values: dict) -> None:
+            callback({names[k]: v for k, v in values.items()})
+        channel.add_callback(by_name)
+        return by_name
 
     # ---- life ----
     def _halt(self, how: Optional[str]) -> None:
@@ -446,6 +423,7 @@ class Pmc007:
         if self._closed:
             return
         self._closed = True
+        super().close()             # the node's PDO receivers
         if self._owns:
             self.bus.close()
 
@@ -458,33 +436,32 @@ class Pmc007:
 
 
 class TpdoStream:
-    """numpy ring buffer of one TPDO's decoded values (see Pmc007.tpdo_stream); ``close()`` stops it."""
+    """numpy ring buffer of one TPDO's values (see Pmc007.tpdo_stream), fed by the node's
+    TPDO channel (decoded by the C++ PDO engine); ``close()`` stops it."""
 
-    _DTYPES = {"U8": "u1", "U16": "u2", "U32": "u4", "I32": "i4"}
-
-    def __init__(self, client: Pmc007, cob_id: int, entries: list, capacity: int) -> None:
+    def __init__(self, channel: PdoChannel, capacity: int) -> None:
         import numpy as np
 
         if capacity < 1:
             raise _core.InvalidArgument("pmc007: tpdo_stream capacity must be >= 1")
-        self._keys = [_BY_INDEX[(e >> 16, (e >> 8) & 0xFF)] for e in entries]
-        self._sizes = [(e & 0xFF) // 8 for e in entries]
-        fields = [("t", "f8")] + [(k, self._DTYPES[OBJECTS[k]["type"]]) for k in self._keys]
+        self._keys = [(index, sub) for (index, sub, _bits) in channel.mapping]
+        od = channel._node.object_dictionary
+        fields = [("t", "f8")]
+        for index, sub in self._keys:
+            var = od[index, sub]
+            # numpy's integer of the entry's size and sign (the entry says both).
+            fields.append((_BY_INDEX[(index, sub)], f"{'i' if var.value_range[0] < 0 else 'u'}{var.size}"))
         self.dtype = np.dtype(fields)
         self._buf = np.zeros(capacity, dtype=self.dtype)
         self._n = 0
         self._lock = threading.Lock()
-        self._client = client
-        self._sub = client.bus.subscribe(self._on_frame, cob_id, 0x7FF)
+        self._channel = channel
+        channel.add_callback(self._on_values)
 
-    def _on_frame(self, frame: Any) -> None:
-        data, pos = bytes(frame.data), 0
-        row = [frame.timestamp_ns / 1e9]
-        for k, size in zip(self._keys, self._sizes):
-            row.append(int.from_bytes(data[pos:pos + size], "little", signed=OBJECTS[k]["type"] == "I32"))
-            pos += size
+    def _on_values(self, values: dict) -> None:
+        row = (self._channel.timestamp, *(values[k] for k in self._keys))
         with self._lock:
-            self._buf[self._n % len(self._buf)] = tuple(row)
+            self._buf[self._n % len(self._buf)] = row
             self._n += 1
 
     def __len__(self) -> int:
@@ -505,9 +482,7 @@ class TpdoStream:
             return np.concatenate([self._buf[i:], self._buf[:i]])
 
     def close(self) -> None:
-        if self._sub is not None:
-            self._client.bus.unsubscribe(self._sub)
-            self._sub = None
+        self._channel.remove_callback(self._on_values)
 
 
 # ---- simulator -------------------------------------------------------------------------
@@ -550,18 +525,15 @@ class Pmc007Params(Params):
             return name
 
     def _info(self, name: str) -> Optional[ParamInfo]:
-        row = OBJECTS.get(name)
-        if row is None:
+        if name not in OBJECTS:
             return None
-        dtype = row["type"]
-        low, high = row["low"], row["high"]
-        if dtype in _SIZES and low is None:
-            bits = 8 * _SIZES[dtype]
-            low, high = ((-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if dtype == "I32" else (0, (1 << bits) - 1))
-        return ParamInfo(name=name, type="str" if dtype == "VISIBLE_STRING" else "int", minimum=low, maximum=high,
-                         default=row["default"], persists=row["storage"] == "rom",
-                         writable=row["access"] in ("rw", "wo"),
-                         description=f"{row['index']:04X}h:{row['sub']:02X} {row['name']}")
+        var = self._drive.native.variable(name).od     # the node's own entry (defaults for its node-ID)
+        low, high = var.value_range or (None, None)
+        return ParamInfo(name=name, type="str" if var.data_type == _core.DataType.VISIBLE_STRING else "int",
+                         minimum=low, maximum=high, default=var.default,
+                         persists=_core.pmc007_storage(var.index, var.subindex) == _core.Pmc007Storage.ROM,
+                         writable=var.access in ("rw", "wo"),
+                         description=f"{var.index:04X}h:{var.subindex:02X} {var.name}")
 
     def _read(self, info: ParamInfo) -> Any:
         return self._drive.native.read(info.name)
@@ -659,7 +631,7 @@ class Pmc007Drive(Drive):
         from ..canopen.poll import sdo_poll_spec
 
         native = self.native
-        return sdo_poll_spec(self.kind, native.sdo, native.bus, fields, _poll_objects())
+        return sdo_poll_spec(self.kind, native.sdo.client, native.bus, fields, _poll_objects())
 
     def capture_fields(self, fields: Any, period: float) -> Any:
         """motorbus.Poller, capturing: 600Ch and the controller status (6001h), both
@@ -670,7 +642,7 @@ class Pmc007Drive(Drive):
         native = self.native
         if native.bus is None:
             raise _core.InvalidArgument("pmc007 capture: the drive's SDO client has no bus to listen on")
-        return tpdo_capture_spec(self.kind, native.sdo, native.bus, native.node, fields, _poll_objects(), period,
+        return tpdo_capture_spec(self.kind, native.sdo.client, native.bus, native.node, fields, _poll_objects(), period,
                                  procedure="direct")
 
     def plan_move(self, start: float, target: float) -> Any:
@@ -967,8 +939,10 @@ SIM_FAULTS = {
     "error": lambda sim, bits=1: sim.inject_error(int(bits)),
 }
 def _poll_objects() -> dict:
+    """The poll layer's (index, sub, "i32"/"u8", scale) of each field, said by the entry."""
     objects = {}
     for field, name in (("position", "motor_position"), ("status", "controller_status")):
-        row = OBJECTS[name]
-        objects[field] = (row["index"], row["sub"], row["type"].lower(), 1.0)
+        var = OBJECTS[name]
+        sign = "i" if var.value_range[0] < 0 else "u"
+        objects[field] = (var.index, var.subindex, f"{sign}{8 * var.size}", 1.0)
     return objects
