@@ -10,6 +10,7 @@
 #include "motorbus/drives/pmc007/profile.hpp"
 #include "motorbus/drives/pmc007/program.hpp"
 #include "motorbus/drives/pmc007/sim.hpp"
+#include "../sim_device.hpp"
 
 namespace py = pybind11;
 using namespace motorbus;
@@ -17,14 +18,6 @@ using namespace motorbus::motion;
 using namespace motorbus::pmc007;
 
 namespace {
-// The clock must outlive the simulator that holds a reference to it.
-struct ClockHolder {
-    std::shared_ptr<Clock> clock;
-};
-struct BoundSim : ClockHolder, Sim {
-    BoundSim(std::shared_ptr<Clock> c, std::uint8_t node, SimOptions o)
-        : ClockHolder{c ? std::move(c) : std::make_shared<RealClock>()}, Sim(node, *clock, o) {}
-};
 
 }  // namespace
 
@@ -80,8 +73,9 @@ void bind_pmc007(py::module_& m) {
 
     // ---- the simulator ----
     auto rel = py::call_guard<py::gil_scoped_release>();
-    py::class_<BoundSim, std::shared_ptr<BoundSim>>(m, "Pmc007Sim",
-                                                    "A simulated CQPUSI PMC007 CANopen node (see sim.hpp).")
+    // attach / close / attached / describe / power_cycle: the SimulatedDevice base's.
+    py::class_<Sim, can::SimulatedDevice, std::shared_ptr<Sim>>(m, "Pmc007Sim",
+                                                              "A simulated CQPUSI PMC007 CANopen node (see sim.hpp).")
         .def(py::init([](int node_id, std::shared_ptr<Clock> clock, double steps_per_rev, double pull_out_speed,
                          std::optional<std::pair<double, double>> ext1_switch, std::string store_path,
                          std::uint32_t vendor_id, std::uint32_t product_code, std::uint32_t revision,
@@ -94,39 +88,37 @@ void bind_pmc007(py::module_& m) {
                  o.ext1_switch = ext1_switch;
                  o.store_path = std::move(store_path);
                  o.identity = {vendor_id, product_code, revision, serial};
-                 return std::make_shared<BoundSim>(std::move(clock), std::uint8_t(node_id), o);
+                 if (!clock) clock = std::make_shared<RealClock>();
+                 return py_helpers::make_sim<Sim>(std::uint8_t(node_id), std::move(clock), o);
              }),
              py::arg("node_id") = 5, py::arg("clock") = nullptr, py::arg("steps_per_rev") = 200.0,
              py::arg("pull_out_speed") = 0.0, py::arg("ext1_switch") = py::none(),
              py::arg("store_path") = "", py::arg("vendor_id") = 0u, py::arg("product_code") = 7u,
              py::arg("revision") = 0x00010000u, py::arg("serial") = 1u)
-        .def("attach", [](BoundSim& s, can::Bus& bus) { py::gil_scoped_release nogil; s.attach(bus); },
-             py::arg("bus"), py::keep_alive<1, 2>())
-        .def("close", &BoundSim::close, rel)
-        .def_property_readonly("attached", &BoundSim::attached)
-        .def("power_cycle", &BoundSim::power_cycle)
-        .def("poll", &BoundSim::poll, rel)
-        .def_property_readonly("node_id", &BoundSim::node_id)
-        .def_property_readonly("error_status", &BoundSim::error_status)
-        .def_property_readonly("controller_status", &BoundSim::controller_status)
-        .def_property_readonly("position", &BoundSim::position)
-        .def_property_readonly("velocity", &BoundSim::velocity)
-        .def_property_readonly("busy", &BoundSim::busy)
-        .def_property_readonly("enabled", &BoundSim::enabled)
-        .def_property_readonly("gpio_value", &BoundSim::gpio_value)
-        .def_property_readonly("active_baud_index", &BoundSim::active_baud_index)
-        .def_property_readonly("active_encoder_cpr", &BoundSim::active_encoder_cpr,
+        .def_property_readonly("last_error", &Sim::last_error,
+                               "why the last node-ID switch or return to the bus failed ('' if none did)")
+        .def("poll", &Sim::poll, rel)
+        .def_property_readonly("node_id", &Sim::node_id)
+        .def_property_readonly("error_status", &Sim::error_status)
+        .def_property_readonly("controller_status", &Sim::controller_status)
+        .def_property_readonly("position", &Sim::position)
+        .def_property_readonly("velocity", &Sim::velocity)
+        .def_property_readonly("busy", &Sim::busy)
+        .def_property_readonly("enabled", &Sim::enabled)
+        .def_property_readonly("gpio_value", &Sim::gpio_value)
+        .def_property_readonly("active_baud_index", &Sim::active_baud_index)
+        .def_property_readonly("active_encoder_cpr", &Sim::active_encoder_cpr,
                                "The encoder CPR in use: 6021h as it was at the last power-up or reset node (B-P40).")
-        .def_property_readonly("od", &BoundSim::od_ptr)
-        .def_property_readonly("flash_program", &BoundSim::flash_program)
-        .def_property_readonly("ram_program", &BoundSim::ram_program)
-        .def_property_readonly("program_running", &BoundSim::program_running)
-        .def_property_readonly("program_pointer", &BoundSim::program_pointer)
-        .def_property_readonly("program_counter", &BoundSim::program_counter_value)
-        .def_property_readonly("emcy_sent", &BoundSim::emcy_sent)
-        .def_property_readonly("in_bootloader", &BoundSim::in_bootloader)
-        .def("set_jammed", &BoundSim::set_jammed, py::arg("jammed"))
-        .def("set_input", &BoundSim::set_input, py::arg("bit"), py::arg("high"), rel,
+        .def_property_readonly("od", &Sim::od_ptr)
+        .def_property_readonly("flash_program", &Sim::flash_program)
+        .def_property_readonly("ram_program", &Sim::ram_program)
+        .def_property_readonly("program_running", &Sim::program_running)
+        .def_property_readonly("program_pointer", &Sim::program_pointer)
+        .def_property_readonly("program_counter", &Sim::program_counter_value)
+        .def_property_readonly("emcy_sent", &Sim::emcy_sent)
+        .def_property_readonly("in_bootloader", &Sim::in_bootloader)
+        .def("set_jammed", &Sim::set_jammed, py::arg("jammed"))
+        .def("set_input", &Sim::set_input, py::arg("bit"), py::arg("high"), rel,
              "Electrical level of input port `bit` (6012h bit 0..10; 7 EXT1, 8 EXT2, 9 ENC1/EXT3).")
-        .def("inject_error", &BoundSim::inject_error, py::arg("bits"), rel, "Latch 6000h error bits (EMCY sent).");
+        .def("inject_error", &Sim::inject_error, py::arg("bits"), rel, "Latch 6000h error bits (EMCY sent).");
 }

@@ -225,12 +225,12 @@ class ArcusCanopenSim:
 
     def attach(self, bus: _core.Bus) -> "ArcusCanopenSim":
         """Serve the CAN front end on ``bus`` (boot-up 0x700+n sent now when CAN is in effect)."""
-        self.core.attach_can(bus)
+        self.core.attach(bus)
         self.bus = bus
         return self
 
     def close(self) -> None:
-        self.core.detach_can()
+        self.core.close()
         self.bus = None
 
     def __getattr__(self, name: str) -> Any:  # test hooks: force_limit, power_cycle, positions...
