@@ -15,6 +15,7 @@ void bind_errors(py::module_& m);
 void bind_runtime(py::module_& m);
 void bind_poll(py::module_& m);
 void bind_can(py::module_& m);
+void bind_sim_device(py::module_& m);
 void bind_slcan(py::module_& m);
 void bind_socketcand(py::module_& m);
 void bind_serial(py::module_& m);
@@ -28,6 +29,7 @@ PYBIND11_MODULE(_core, m) {
     bind_runtime(m);
     bind_poll(m);
     bind_can(m);
+    bind_sim_device(m);  // before the vendors' simulators, which derive from it
     bind_slcan(m);
     bind_socketcand(m);
     bind_serial(m);

@@ -14,7 +14,7 @@ int main() {
     SimClock clock(0);
     auto device_bus = can::open_virtual("pmc007-example"), host_bus = can::open_virtual("pmc007-example");
     pmc007::Sim sim(5, clock);
-    sim.attach(*device_bus);
+    sim.attach(device_bus);
     canopen::SdoClient sdo(*host_bus, 5);
 
     sdo.write_i32(0x6003, 0, 1600);   // speed first: + sets direction 1

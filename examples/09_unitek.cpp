@@ -16,7 +16,7 @@ int main() {
     auto sim_bus = can::open_virtual("unitek-example");
     auto bus = can::open_virtual("unitek-example");
     Sim sim(clock);
-    sim.attach(*sim_bus);
+    sim.attach(sim_bus);
     ClientOptions o;
     o.clock = &clock;
     Client drive(*bus, sim_default_table(), o);

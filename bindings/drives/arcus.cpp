@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "sim_device.hpp"
 #include "errors.hpp"
 #include "motorbus/drives/arcus/client.hpp"
 #include "motorbus/drives/arcus/codec.hpp"
@@ -242,14 +243,18 @@ void bind_arcus(py::module_& m) {
         "(min, max) ACC in ms the drive accepts for HSPD/LSPD (Table A.0; max truncated to 10 ms like the "
         "manual's examples).");
 
-    py::class_<Sim, serial::LineDevice, std::shared_ptr<Sim>>(
-        m, "ArcusSim", "A simulated Arcus DMX-CAN answering ASCII lines (a LineDevice for PtyLineServer).")
+    // One drive, two faces: a LineDevice for its serial line, a SimulatedDevice (attach / close /
+    // attached / describe / power_cycle, the base's binding) for its CAN port.
+    py::class_<Sim, serial::LineDevice, can::SimulatedDevice, std::shared_ptr<Sim>>(
+        m, "ArcusSim",
+        "A simulated Arcus DMX-CAN: answers ASCII lines (a LineDevice for PtyLineServer) and, attached to a "
+        "CAN bus, CANopen (a SimulatedDevice).")
         .def(py::init([](std::shared_ptr<Clock> clock, int address, int response_type, const std::string& store_path,
                          bool eo_boot, bool snl, std::pair<double, double> home, std::optional<double> minus_limit,
                          std::optional<double> plus_limit, double z_position, double start_position, double tick,
                          int comm_type, int node_id, double store_time, double clear_time, int bit_rate) {
                  if (!clock) clock = std::make_shared<RealClock>();
-                 return std::make_shared<Sim>(clock, sim_options(address, response_type, store_path, eo_boot, snl,
+                 return py_helpers::make_sim<Sim>(clock, sim_options(address, response_type, store_path, eo_boot, snl,
                                                                   home, minus_limit, plus_limit, z_position,
                                                                   start_position, tick, comm_type, node_id,
                                                                   store_time, clear_time, bit_rate));
@@ -273,7 +278,6 @@ void bind_arcus(py::module_& m) {
             py::arg("line"), "One request line without CR -> the reply bytes (NUL included; b'' = silent).")
         .def_property_readonly("address", &Sim::address)
         .def_property_readonly("store_path", &Sim::store_path)
-        .def("power_cycle", &Sim::power_cycle, py::call_guard<py::gil_scoped_release>())
         .def("set_input", &Sim::set_input, py::arg("index"), py::arg("actuated"),
              py::call_guard<py::gil_scoped_release>(), "DI1..DI6 (DI2 is the latch input).")
         .def("force_home", &Sim::force_home, py::arg("actuated"), py::call_guard<py::gil_scoped_release>())
@@ -287,12 +291,9 @@ void bind_arcus(py::module_& m) {
         .def_property_readonly("motor_status", &Sim::motor_status)
         .def_property_readonly("snl_status", &Sim::snl_status)
         .def_property_readonly("busy", &Sim::busy)
-        // The CANopen front end (one drive, two front ends).
-        .def("attach_can", &Sim::attach_can, py::arg("bus"), py::call_guard<py::gil_scoped_release>(),
-             "Serve the CANopen persona on `bus` (answers while the communication type in effect is CAN).")
-        .def("detach_can", &Sim::detach_can, py::call_guard<py::gil_scoped_release>())
+        // The CANopen front end (one drive, two front ends): attach / close are the SimulatedDevice's.
         .def("on_can_frame", &Sim::on_can_frame, py::arg("frame"), py::call_guard<py::gil_scoped_release>(),
-             "One CAN frame in, the frames the drive answers out (what attach_can runs per frame).")
+             "One CAN frame in, the frames the drive answers out (what attach runs per frame).")
         .def_property_readonly("active_protocol", &Sim::active_protocol,
                                "Communication type in effect: 0 RS-232, 1 RS-485, 2 CAN (200Ah at the last boot).")
         .def_property_readonly("can_node_id", &Sim::can_node_id)

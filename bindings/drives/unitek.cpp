@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 
 #include "../common.hpp"
+#include "../sim_device.hpp"
 #include "../errors.hpp"
 #include "motorbus/drives/unitek/client.hpp"
 #include "motorbus/drives/unitek/codec.hpp"
@@ -68,20 +69,6 @@ struct ClientHolder {
             client.reset();
         } else {
             client.reset();
-        }
-    }
-};
-
-struct SimHolder {
-    std::shared_ptr<Clock> clock;
-    std::shared_ptr<can::Bus> bus;
-    std::unique_ptr<Sim> sim;
-    ~SimHolder() {
-        if (Py_IsInitialized() && PyGILState_Check()) {
-            py::gil_scoped_release nogil;
-            sim.reset();
-        } else {
-            sim.reset();
         }
     }
 };
@@ -408,7 +395,9 @@ void bind_unitek(py::module_& m) {
         .def_readonly("events_out", &SimCounters::events_out)
         .def_readonly("bit_rate_mismatch", &SimCounters::bit_rate_mismatch);
 
-    py::class_<SimHolder>(m, "UnitekSim", "A simulated UNITEK servo on the register protocol (see sim.hpp).")
+    // attach / close / attached / describe / power_cycle: the SimulatedDevice base's.
+    py::class_<Sim, can::SimulatedDevice, std::shared_ptr<Sim>>(
+        m, "UnitekSim", "A simulated UNITEK servo on the register protocol (see sim.hpp).")
         .def(py::init([](std::shared_ptr<Clock> clock, std::uint32_t rx_id, std::uint32_t tx_id, double n_max_rpm,
                          double acc_ramp_ms, double dec_ramp_ms, bool position_control, bool speed_control,
                          bool calibrated, std::int64_t tol_num, std::optional<double> minus_limit_num,
@@ -436,10 +425,7 @@ void bind_unitek(py::module_& m) {
                  if (btr < 0 || btr > 0xFFFF) throw InvalidArgument("unitek sim btr: a 16-bit BTR setting value");
                  c.btr = static_cast<std::uint16_t>(btr);
                  c.analog_command = analog_command;
-                 auto h = std::make_unique<SimHolder>();
-                 h->clock = clock;
-                 h->sim = std::make_unique<Sim>(*clock, c, table ? *table : sim_default_table());
-                 return h;
+                 return py_helpers::make_sim<Sim>(std::move(clock), c, table ? *table : sim_default_table());
              }),
              py::arg("clock"), py::arg("rx_id") = kDefaultRxId, py::arg("tx_id") = kDefaultTxId,
              py::arg("n_max_rpm") = 3000.0, py::arg("acc_ramp_ms") = 1000.0, py::arg("dec_ramp_ms") = 1000.0,
@@ -448,80 +434,66 @@ void bind_unitek(py::module_& m) {
              py::arg("plus_limit_num") = 100.0 * 65536, py::arg("torque_continuous_num") = 32767,
              py::arg("dummy") = 0, py::arg("table") = py::none(), py::arg("device") = "DS 205/405",
              py::arg("motor_i_max_num") = py::none(), py::arg("btr") = kDefaultBtr, py::arg("analog_command") = 0)
-        .def("attach", [](SimHolder& h, std::shared_ptr<can::Bus> bus) {
-            if (!bus) throw InvalidArgument("bus: None");
-            h.bus = bus;
+        .def("on_frame", [](Sim& h, const can::Frame& f) {
             py::gil_scoped_release nogil;
-            h.sim->attach(*bus);
-        }, py::arg("bus"))
-        .def("close", [](SimHolder& h) {
-            py::gil_scoped_release nogil;
-            h.sim->close();
-        })
-        .def("on_frame", [](SimHolder& h, const can::Frame& f) {
-            py::gil_scoped_release nogil;
-            h.sim->on_frame(f);
+            h.on_frame(f);
         }, py::arg("frame"))
-        .def("service", [](SimHolder& h) {
+        .def("service", [](Sim& h) {
             py::gil_scoped_release nogil;
-            return h.sim->service();
+            return h.service();
         }, "emit every frame due by the clock's now; returns the next due time (ns, -1 none)")
-        .def("set_hardware_enable", [](SimHolder& h, bool on) {
+        .def("set_hardware_enable", [](Sim& h, bool on) {
             py::gil_scoped_release nogil;
-            h.sim->set_hardware_enable(on);
+            h.set_hardware_enable(on);
         }, py::arg("on"))
-        .def("force_limit", [](SimHolder& h, int dir, std::optional<bool> a) {
+        .def("force_limit", [](Sim& h, int dir, std::optional<bool> a) {
             py::gil_scoped_release nogil;
-            h.sim->force_limit(dir, a);
+            h.force_limit(dir, a);
         }, py::arg("direction"), py::arg("active"))
-        .def("force_error", [](SimHolder& h, std::uint32_t bits) {
+        .def("force_error", [](Sim& h, std::uint32_t bits) {
             py::gil_scoped_release nogil;
-            h.sim->force_error(bits);
+            h.force_error(bits);
         }, py::arg("bits"), "latch NDrive error (0-15: power stage off) / warning (16-31) bits in 0x8F")
-        .def("set_analog_input", [](SimHolder& h, int channel, double volts) {
+        .def("set_analog_input", [](Sim& h, int channel, double volts) {
             py::gil_scoped_release nogil;
-            h.sim->set_analog_input(channel, volts);
+            h.set_analog_input(channel, volts);
         }, py::arg("channel"), py::arg("volts"),
            "AIN1/AIN2 (+/- 10 V, 2949 num/V); the speed command when analog_command names the input")
-        .def("set_calibrated", [](SimHolder& h, bool on) {
+        .def("set_calibrated", [](Sim& h, bool on) {
             py::gil_scoped_release nogil;
-            h.sim->set_calibrated(on);
+            h.set_calibrated(on);
         }, py::arg("on"))
-        .def("force_icns", [](SimHolder& h, std::optional<bool> a) {
+        .def("force_icns", [](Sim& h, std::optional<bool> a) {
             py::gil_scoped_release nogil;
-            h.sim->force_icns(a);
+            h.force_icns(a);
         }, py::arg("active"))
-        .def("power_cycle", [](SimHolder& h) {
-            py::gil_scoped_release nogil;
-            h.sim->power_cycle();
-        })
-        .def_property_readonly("status", [](SimHolder& h) { return h.sim->status(); })
-        .def("value", [](SimHolder& h, std::int64_t regid) { return h.sim->value(regid_arg(regid)); }, py::arg("regid"))
-        .def_property_readonly("position_num", [](SimHolder& h) { return h.sim->position_num(); })
-        .def_property_readonly("speed_num", [](SimHolder& h) { return h.sim->speed_num(); })
-        .def_property_readonly("rx_id", [](SimHolder& h) { return h.sim->rx_id(); })
-        .def_property_readonly("bit_rate", [](SimHolder& h) { return h.sim->bit_rate(); },
+        .def_property_readonly("status", [](Sim& h) { return h.status(); })
+        .def("value", [](Sim& h, std::int64_t regid) { return h.value(regid_arg(regid)); }, py::arg("regid"))
+        .def_property_readonly("position_num", [](Sim& h) { return h.position_num(); })
+        .def_property_readonly("speed_num", [](Sim& h) { return h.speed_num(); })
+        .def_property_readonly("rx_id", [](Sim& h) { return h.rx_id(); })
+        .def_property_readonly("bit_rate", [](Sim& h) { return h.bit_rate(); },
                                "bit/s of its BTR (§3.1 table)")
-        .def_property_readonly("bus_bit_rate", [](SimHolder& h) { return h.sim->bus_bit_rate(); },
+        .def_property_readonly("bus_bit_rate", [](Sim& h) { return h.bus_bit_rate(); },
                                "bit/s of the bus it is attached to (0: none modelled)")
-        .def_property_readonly("tx_id", [](SimHolder& h) { return h.sim->tx_id(); })
-        .def_property_readonly("cyclic", [](SimHolder& h) {
+        .def_property_readonly("tx_id", [](Sim& h) { return h.tx_id(); })
+        .def_property_readonly("cyclic", [](Sim& h) {
             std::vector<std::pair<int, int>> out;
-            for (auto [r, ms] : h.sim->cyclic()) out.emplace_back(r, ms);
+            for (auto [r, ms] : h.cyclic()) out.emplace_back(r, ms);
             return out;
         })
-        .def("sent", [](SimHolder& h, std::int64_t regid) { return h.sim->sent(regid_arg(regid)); }, py::arg("regid"))
-        .def_property_readonly("counters", [](SimHolder& h) { return h.sim->counters(); })
-        .def_property_readonly("n_max_rpm", [](SimHolder& h) { return h.sim->config().n_max_rpm; })
-        .def("eeprom", [](SimHolder& h) {
+        .def("sent", [](Sim& h, std::int64_t regid) { return h.sent(regid_arg(regid)); }, py::arg("regid"))
+        .def_property_readonly("counters", [](Sim& h) { return h.counters(); })
+        .def_property_readonly("n_max_rpm", [](Sim& h) { return h.config().n_max_rpm; })
+        .def("eeprom", [](Sim& h) {
             std::map<int, std::int64_t> out;
-            for (auto [k, v] : h.sim->eeprom()) out[k] = v;
+            for (auto [k, v] : h.eeprom()) out[k] = v;
             return out;
         })
-        .def("on_eeprom_store", [](SimHolder& h, const py::object& callback) {
-            if (callback.is_none()) return h.sim->on_eeprom_store(nullptr);
+        .def("on_eeprom_store", [](Sim& h, const py::object& callback) {
+            if (callback.is_none()) return h.on_eeprom_store(nullptr);
             auto f = hold(callback.cast<py::function>());
-            h.sim->on_eeprom_store([f](const std::map<std::uint8_t, std::int64_t>& values) {
+            h.on_eeprom_store([f](const std::map<std::uint8_t, std::int64_t>& values) {
                 if (py_helpers::interpreter_finalizing()) return;
                 py::gil_scoped_acquire gil;
                 try {
@@ -533,11 +505,11 @@ void bind_unitek(py::module_& m) {
                 }
             });
         }, py::arg("callback"), "callback(dict regid -> value) after each EEPROM store (0x84)")
-        .def("load_eeprom", [](SimHolder& h, const std::map<int, std::int64_t>& values) {
+        .def("load_eeprom", [](Sim& h, const std::map<int, std::int64_t>& values) {
             std::map<std::uint8_t, std::int64_t> in;
             for (auto [k, v] : values) in[regid_arg(k)] = v;
             py::gil_scoped_release nogil;
-            h.sim->load_eeprom(in);
+            h.load_eeprom(in);
         }, py::arg("values"));
 
     // Poll sources (motorbus.Poller) on this client: asking, or capturing cyclic transmissions.

@@ -41,7 +41,10 @@ bool BitRateGate::in_step() const {
     const double wire = medium_bit_rate();
     if (wire <= 0) return true;
     const double own = node_rate_();
-    return own <= 0 || std::fabs(own - wire) < 0.5;
+    // 0: the node models no bit rate of its own (follows the wire); < 0: a
+    // setting outside the device's table, which matches no wire.
+    if (own == 0) return true;
+    return own > 0 && std::fabs(own - wire) < 0.5;
 }
 
 void BitRateGate::do_send(const Frame& frame, Deadline deadline) {

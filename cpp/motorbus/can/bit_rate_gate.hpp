@@ -22,7 +22,8 @@ double medium_bit_rate(const Bus& bus);
 
 class BitRateGate final : public Bus {
 public:
-    // `node_bit_rate` is asked at every frame (bit/s; 0 = follows the wire): it
+    // `node_bit_rate` is asked at every frame (bit/s; 0 = follows the wire,
+    // < 0 = a setting that matches no wire): it
     // reads the node's own setting, which changes at its power cycles.  It runs
     // on the medium's receive thread and in send(): it must not block (read an
     // atomic).  `medium` must outlive the gate; `keep` may own it.

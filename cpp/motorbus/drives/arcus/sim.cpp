@@ -43,7 +43,7 @@ Sim::Sim(std::shared_ptr<Clock> clock, SimOptions options)
     clock_owner_ = std::move(clock);
 }
 
-Sim::~Sim() { detach_can(); }
+Sim::~Sim() { close(); }
 
 namespace {
 

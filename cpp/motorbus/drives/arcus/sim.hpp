@@ -1,6 +1,6 @@
 // Simulated Arcus DMX-CAN: one drive with two front ends.  On its ASCII line
 // (RS-232 point-to-point or RS-485 multi-drop) it is a LineDevice; attached to
-// a CAN bus (attach_can) it is a CiA DSP-402 node served by SDO (manual 000
+// a CAN bus (attach, the can::SimulatedDevice face) it is a CiA DSP-402 node served by SDO (manual 000
 // chapters 8 and 10, sim_canopen.cpp).  Which of the two answers is the stored
 // communication type (CM / 200Ah) read at power-up: a factory-fresh unit talks
 // RS-232, a unit stored as CAN answers on CAN and not on its serial line.  Answers every command of codec.hpp the way manual 000 says,
@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
+#include "motorbus/can/sim_device.hpp"
 #include "motorbus/can/frame.hpp"
 
 #include "motorbus/drives/arcus/codec.hpp"
@@ -82,7 +83,10 @@ const std::vector<CanopenObject>& canopen_objects();
 // 7 500k, 8 800k, 9 1M); 0 for any other code.
 double canopen_bit_rate_bps(int code);
 
-class Sim : public serial::LineDevice {
+// One object with both faces, as the real unit is one drive: a LineDevice for
+// its serial line (served by a serial::LineServer) and a can::SimulatedDevice
+// for its CAN port.  close() takes it off the CAN bus only.
+class Sim : public serial::LineDevice, public can::SimulatedDevice {
 public:
     Sim(Clock& clock, SimOptions options = {});
     // Shares ownership of the clock (bindings, servers that outlive the caller).
@@ -96,7 +100,7 @@ public:
 
     // ---- test hooks (all thread-safe) ----
     int address() const;               // address it currently answers on
-    void power_cycle();                // boot again from the store file
+    void power_cycle() override;       // boot again from the store file
     void set_input(int index, bool actuated);  // DI1..DI6; DI2 is the latch input
     // Forces a switch regardless of position (nullopt = follow the world).
     void force_home(std::optional<bool> actuated);
@@ -112,14 +116,19 @@ public:
     std::string store_path() const;
 
     // ---- the CANopen front end (sim_canopen.cpp) ----
-    // Serves the node on `bus` (kept alive until detach_can).  It answers only
+    // ---- the CAN face: can::SimulatedDevice ----
+    // Serves the node on `bus` (kept alive until close()).  It answers only
     // while the communication type in effect is CAN; the boot-up frame
     // 0x700+n [00] is sent now and at every power cycle.
-    void attach_can(std::shared_ptr<can::Bus> bus);
-    void detach_can();  // idempotent
+    void attach(std::shared_ptr<can::Bus> bus) override;
+    void close() override;  // off the CAN bus (idempotent); the serial face is unaffected
+    bool attached() const override;
+    std::string describe() const override;  // "arcus sim node <node-ID in effect>"
+    // 200Bh in effect, bit/s; -1 for a code outside Table 8.36 (matches no wire).
+    double node_bit_rate() const override;
     // One received frame in, the frames the drive answers out (SDO replies);
     // an NMT reset node power-cycles the drive (its boot-up is in the result).
-    // What attach_can runs for each frame; public for tests and the fuzzer.
+    // What attach runs for each frame; public for tests and the fuzzer.
     std::vector<can::Frame> on_can_frame(const can::Frame& frame);
     int active_protocol() const;  // communication type in effect: 0, 1 or 2
     int can_node_id() const;      // node-ID in effect (200Ch at the last boot)
@@ -143,7 +152,7 @@ private:
     // While set, the firmware runs a command at this (past) instant rather than
     // at clock.now(): a buffered set-point starts exactly where the previous move ended.
     std::optional<Nanos> at_;
-    std::mutex bus_mutex_;
+    mutable std::mutex bus_mutex_;
     std::shared_ptr<can::Bus> bus_;  // a can::BitRateGate on the attached bus
     std::atomic<int> bit_rate_code_{5};  // active_br, read by the gate on the bus thread
     std::vector<can::SubscriptionId> subs_;

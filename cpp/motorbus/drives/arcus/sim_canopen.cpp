@@ -158,17 +158,26 @@ double canopen_bit_rate_bps(int code) {
 
 // ---- serving ---------------------------------------------------------------------
 
-void Sim::attach_can(std::shared_ptr<can::Bus> medium) {
-    if (!medium) throw InvalidArgument("arcus sim attach: bus is null");
+double Sim::node_bit_rate() const {
+    const double r = canopen_bit_rate_bps(bit_rate_code_.load());  // atomic: asked on the bus thread
+    return r > 0 ? r : -1.0;
+}
+
+std::string Sim::describe() const { return "arcus sim node " + std::to_string(can_node_id()); }
+
+bool Sim::attached() const {
+    std::lock_guard lock(bus_mutex_);
+    return bus_ != nullptr;
+}
+
+void Sim::attach(std::shared_ptr<can::Bus> medium) {
+    if (!medium) throw InvalidArgument(describe() + " attach: bus is None");
     {
         std::lock_guard lock(bus_mutex_);
-        if (bus_) throw InvalidArgument("arcus sim attach: already attached to a bus");
+        if (bus_) throw already_attached();
         // The node hears and is heard only at its own bit rate (200Bh at the
         // last boot; issue 23 #4).  A code outside 1..9 matches no wire.
-        auto gate = std::make_shared<can::BitRateGate>(
-            *medium, [this] { const double r = canopen_bit_rate_bps(bit_rate_code_.load()); return r > 0 ? r : -1.0; },
-            medium);
-        std::shared_ptr<can::Bus> bus = gate;
+        std::shared_ptr<can::Bus> bus = gate_onto(std::move(medium));
         bus_ = bus;
         // Every SDO request id and NMT: the node-ID in effect changes at a power cycle.
         can::Filter sdo;
@@ -193,7 +202,7 @@ void Sim::attach_can(std::shared_ptr<can::Bus> medium) {
     if (boot_up) send_frames({*boot_up});
 }
 
-void Sim::detach_can() {
+void Sim::close() {
     std::shared_ptr<can::Bus> bus;
     std::vector<can::SubscriptionId> subs;
     {

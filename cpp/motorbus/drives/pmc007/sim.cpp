@@ -49,6 +49,15 @@ constexpr std::pair<std::uint16_t, std::uint8_t> kLive[] = {
     {0x6004, 0}, {0x601C, 0}, {0x6020, 0}, {0x6019, 2}, {0x6019, 3}, {0x6019, 5}};
 }  // namespace
 
+namespace {
+// LocalNode refuses a node-ID already served on the medium with this InvalidArgument
+// (LocalNode::claim_node_id): the one failure of a (re)start that is device behaviour.
+bool id_taken(const std::exception& e) {
+    return dynamic_cast<const InvalidArgument*>(&e) != nullptr &&
+           std::string_view(e.what()).find("is already served") != std::string_view::npos;
+}
+}  // namespace
+
 Sim::Sim(std::uint8_t node_id, Clock& clock, SimOptions options)
     : node_id_(node_id), clock_(clock), opt_(options), od_(build_pmc007_od(node_id, options.identity)), motor_(clock, [&] {
           motion::MotorConfig c;
@@ -105,7 +114,24 @@ Sim::Sim(std::uint8_t node_id, Clock& clock, SimOptions options)
     load_power_up(true);
 }
 
+Sim::Sim(std::uint8_t node_id, std::shared_ptr<Clock> clock, SimOptions options)
+    : Sim(node_id, clock ? *clock : throw InvalidArgument("pmc007 sim: clock is None"), std::move(options)) {
+    clock_owner_ = std::move(clock);
+}
+
 Sim::~Sim() { close(); }
+
+std::string Sim::describe() const { return "pmc007 sim node " + std::to_string(node_id_.load()); }
+
+std::string Sim::last_error() const {
+    std::lock_guard lock(m_);
+    return last_error_;
+}
+
+void Sim::record_node_error(const std::string& what) {
+    std::lock_guard lock(m_);
+    last_error_ = what;
+}
 
 canopen::LocalNodeOptions Sim::node_options() {
     canopen::LocalNodeOptions o;
@@ -119,14 +145,14 @@ canopen::LocalNodeOptions Sim::node_options() {
 // Nodes and services are made and destroyed without the sim's lock held: their
 // threads call into the sim (hooks, timer) and would otherwise wait on it while
 // we wait on them.
-void Sim::attach(can::Bus& bus) {
+void Sim::attach(std::shared_ptr<can::Bus> bus) {
     {
         std::lock_guard lock(m_);
-        if (node_ || attaching_)
-            throw InvalidArgument("pmc007 sim " + std::to_string(node_id_.load()) + ": already attached");
+        if (node_ || attaching_ || bus_) throw already_attached();
+        // The node hears and is heard only at its 2003h baud in effect (issue 23 #11);
+        // the gate owns the medium, so the caller need not keep it.
+        gate_ = gate_onto(std::move(bus));
         attaching_ = true;
-        // The node hears and is heard only at its 2003h baud in effect (issue 23 #11).
-        gate_ = std::make_unique<can::BitRateGate>(bus, [this] { return baud_index_bps(baud_index_.load()); });
         bus_ = gate_.get();
     }
     std::unique_ptr<canopen::LocalNode> n;
@@ -239,8 +265,13 @@ void Sim::switch_node_id(std::uint8_t new_id) {
     try {
         fresh = std::make_unique<canopen::LocalNode>(*bus_, new_id, od_, node_options());
         sv = make_services(*fresh);  // the new node is PRE-OPERATIONAL with its boot-up sent
-    } catch (const std::exception&) {
-        // The ID is taken on this bus: stay on the old one (and put the COB-IDs back).
+    } catch (const std::exception& e) {
+        // Stay on the old ID (and put the COB-IDs back).  An ID taken on this bus is
+        // the documented case; anything else is a fault: either way, last_error() says which.
+        record_node_error(id_taken(e) ? "pmc007 sim node " + std::to_string(old_id) + ": node-ID " +
+                                            std::to_string(new_id) + " is taken, stays on " + std::to_string(old_id)
+                                      : "pmc007 sim node " + std::to_string(old_id) + ": switching to node-ID " +
+                                            std::to_string(new_id) + " failed: " + e.what());
         od_->set_node_id(old_id);
         t_publishing = true;
         for (auto& [r, v] : moved) set(r->index, r->sub, (v & ~0x7FFLL) | (r->node_offset + old_id));
@@ -283,9 +314,13 @@ void Sim::serve_again() {
     try {
         n = std::make_unique<canopen::LocalNode>(*bus, node_id_.load(), od_, node_options());  // boot-up sent
         sv = make_services(*n);
-    } catch (const std::exception&) {
-        // [P] the ID is served by another node meanwhile: this one stays off the bus.
+    } catch (const std::exception& e) {
+        // [P] the ID is served by another node meanwhile: this one stays off the bus.  Any
+        // other failure too, but it is no device behaviour: last_error() tells them apart.
+        const std::string id = std::to_string(node_id_.load());
         std::lock_guard lock(m_);
+        last_error_ = id_taken(e) ? "pmc007 sim node " + id + ": node-ID " + id + " is taken, stays off the bus"
+                                  : "pmc007 sim node " + id + ": back on the bus failed: " + e.what();
         attaching_ = false;
         return;
     }

@@ -35,6 +35,7 @@
 
 #include "motorbus/can/bit_rate_gate.hpp"
 #include "motorbus/can/bus.hpp"
+#include "motorbus/can/sim_device.hpp"
 #include "motorbus/canopen/heartbeat_service.hpp"
 #include "motorbus/canopen/local_node.hpp"
 #include "motorbus/canopen/pdo_service.hpp"
@@ -63,8 +64,6 @@ constexpr int kGpio1 = 0, kExt1 = 7, kExt2 = 8, kEnc1 = 9, kEnc2 = 10;
 inline constexpr std::uint32_t kAbortDeviceState = 0x08000022;
 inline constexpr std::uint32_t kAbortValueRange = 0x06090030;
 
-struct SimOptions;
-using Pmc007SimOptions = SimOptions;  // issue 24's old name, while parallel edits land (removed after)
 struct SimOptions {
     double steps_per_rev = 200;  // full steps of the motor (1.8 degree)
     double pull_out_speed = 0;   // steps/s above which the rotor stalls (0 = never)
@@ -86,23 +85,32 @@ struct SimOptions {
 // 2003h baud index -> bit/s (003 §4.3.2); -1 for an index outside 0..8.
 double baud_index_bps(int index);
 
-class Sim;
-using Pmc007Sim = Sim;  // issue 24's old name, while parallel edits land (removed after)
-class Sim {
+class Sim : public can::SimulatedDevice {
 public:
     Sim(std::uint8_t node_id, Clock& clock, SimOptions options = {});
+    // Shares ownership of the clock (bindings, servers that outlive the caller).
+    Sim(std::uint8_t node_id, std::shared_ptr<Clock> clock, SimOptions options = {});
     ~Sim();
     Sim(const Sim&) = delete;
     Sim& operator=(const Sim&) = delete;
 
-    // Serve on `bus` (boot-up sent); InvalidArgument if already attached.
-    void attach(can::Bus& bus);
-    void close();
-    bool attached() const;
-
+    // ---- can::SimulatedDevice ----
+    // Serve on `bus` (kept alive until close(); boot-up sent) through a gate at
+    // the 2003h baud in effect; InvalidArgument if already attached.
+    void attach(std::shared_ptr<can::Bus> bus) override;
+    void close() override;
+    bool attached() const override;
+    std::string describe() const override;  // "pmc007 sim node <active node-ID>"
     // Power off and on again: flash reloaded, RAM defaults, position per 602Ah,
     // offline program auto-run, boot-up (when attached).
-    void power_cycle();
+    void power_cycle() override;
+    double node_bit_rate() const override { return baud_index_bps(baud_index_.load()); }
+    // Why the last node-ID switch or return to the bus (after the bootloader)
+    // failed, "" if none did.  These run on a helper thread, where an exception
+    // has nobody to reach: the node stays on its old ID (or off the bus) and
+    // the reason is kept here.  "node-ID N is taken" is the documented case (B-P36
+    // [P]); anything else is a simulator fault a test should see.
+    std::string last_error() const;
     // Back to the state of a sim newly built with the same options (flash from
     // the store file or factory values, programs empty, motor at rest at 0 with
     // the clock's now() as its time), without rebuilding the dictionary, the
@@ -203,14 +211,17 @@ private:
 
     std::atomic<std::uint8_t> node_id_;
     std::atomic<std::uint8_t> baud_index_{4};
+    std::shared_ptr<Clock> clock_owner_;  // set by the shared_ptr constructor
     Clock& clock_;
     SimOptions opt_;
     std::shared_ptr<canopen::ObjectDictionary> od_;
     motion::MotorModel motor_;
     mutable std::recursive_mutex m_;
-    std::unique_ptr<can::BitRateGate> gate_;  // bus_ while attached: the 2003h baud must match the wire's
+    std::shared_ptr<can::BitRateGate> gate_;  // bus_ while attached: the 2003h baud must match the wire's
     // Gates of earlier attachments, closed; declared before retired_ so that they outlive it.
-    std::vector<std::unique_ptr<can::BitRateGate>> old_gates_;
+    // (each owns its medium: a closed sim keeps the buses it served on alive until it goes, as retired
+    // nodes and services still name their gates)
+    std::vector<std::shared_ptr<can::BitRateGate>> old_gates_;
     can::Bus* bus_ = nullptr;
     std::unique_ptr<canopen::LocalNode> node_;
     std::shared_ptr<canopen::PdoService> pdo_;
@@ -220,6 +231,9 @@ private:
     std::thread renode_;
     std::thread boot_;  // takes the node off the bus on entering the bootloader
     std::atomic<bool> renode_done_{false};
+    std::string last_error_;  // under m_: see last_error()
+    // Records why a helper-thread (re)start of the node failed (see last_error()).
+    void record_node_error(const std::string& what);
     bool renode_again_ = false;  // a switch was asked for while one ran (under m_)
     std::vector<std::shared_ptr<void>> retired_;  // replaced nodes/services: their OD listeners stay valid
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <utility>
 
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/motion/planner.hpp"
@@ -113,7 +115,19 @@ Sim::Sim(Clock& clock, SimConfig cfg, RegisterTable table)
     last_status_ = status_locked();
 }
 
+Sim::Sim(std::shared_ptr<Clock> clock, SimConfig cfg, RegisterTable table)
+    : Sim(clock ? *clock : throw InvalidArgument("unitek sim: clock is None"), std::move(cfg), std::move(table)) {
+    clock_owner_ = std::move(clock);
+}
+
 Sim::~Sim() { close(); }
+
+std::string Sim::describe() const {
+    // The transmit id: constant (the receive id may change at run time) and the node's own on the bus.
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "unitek sim tx 0x%03X", static_cast<unsigned>(cfg_.tx_id));
+    return buf;
+}
 
 void Sim::reset_ram_locked() {
     for (const auto& r : table_.rows()) regs_[r.regid] = 0;
@@ -126,17 +140,18 @@ void Sim::reset_ram_locked() {
     activity_ = Activity::Idle;
 }
 
-void Sim::attach(can::Bus& bus) {
+void Sim::attach(std::shared_ptr<can::Bus> bus) {
     std::lock_guard l(m_);
-    if (bus_ != nullptr) throw InvalidArgument("unitek sim: already attached");
-    bus_ = &bus;
-    // A medium with a bit rate (a virtual hub with wire time) must share the node's.
-    if (const auto* v = dynamic_cast<const can::VirtualBus*>(&bus)) bus_bit_rate_ = v->bitrate();
-    out_ = [this](const can::Frame& f) {
-        if (bus_ != nullptr && !bus_->closed()) bus_->send(f, std::chrono::milliseconds(100));
+    if (gate_) throw already_attached();
+    // A medium with a bit rate (a virtual hub with wire time) must share the node's:
+    // the gate passes nothing either way otherwise (and counts it).
+    gate_ = gate_onto(std::move(bus));
+    // The gate itself, not `this`: a send racing close() finds a closed bus, never a freed one.
+    out_ = [gate = gate_](const can::Frame& f) {
+        if (!gate->closed()) gate->send(f, std::chrono::milliseconds(100));
     };
     // All standard ids: the receive id can change at run time (0x68).
-    sub_ = bus.subscribe(can::Filter{0, 0, false, true}, [this](const can::Frame& f) { on_frame(f); });
+    sub_ = gate_->subscribe(can::Filter{0, 0, false, true}, [this](const can::Frame& f) { on_frame(f); });
     timer_ = std::make_unique<TimerThread>();
     // service() asks for 1 ms while something moves or events are on; idle, 10 ms is enough.
     timer_->start(clock_, [this](Nanos) { return service(); }, 10'000'000);
@@ -149,25 +164,32 @@ void Sim::set_output(std::function<void(const can::Frame&)> out) {
 
 void Sim::close() {
     if (timer_) timer_->stop();
-    can::Bus* bus = nullptr;
+    std::shared_ptr<can::BitRateGate> gate;
+    can::SubscriptionId sub = 0;
     {
         std::lock_guard l(m_);
-        bus = bus_;
+        gate.swap(gate_);
+        sub = std::exchange(sub_, 0);
+        if (gate) out_ = nullptr;  // a set_output() sink stays: there was no bus
     }
-    if (bus != nullptr && sub_ != 0) bus->unsubscribe(sub_);
+    if (!gate) return;
+    // Outside the lock: unsubscribe waits for a running on_frame, which takes it.
+    if (sub != 0) gate->unsubscribe(sub);
+    gate->close();  // the gate only: the medium is the caller's
     std::lock_guard l(m_);
-    sub_ = 0;
-    bus_ = nullptr;
-    out_ = nullptr;
+    refused_before_ += gate->refused();
+}
+
+bool Sim::attached() const {
+    std::lock_guard l(m_);
+    return gate_ != nullptr;
 }
 
 void Sim::send(const std::vector<can::Frame>& frames) {
     std::function<void(const can::Frame&)> out;
     {
         std::lock_guard l(m_);
-        out = out_;
-        // A controller at another bit rate than the wire's puts nothing readable on it.
-        if (bus_bit_rate_ > 0 && bus_bit_rate_ != bit_timing_for_btr(cfg_.btr).bit_rate()) return;
+        out = out_;  // on a bus: the gate drops what a controller at another bit rate cannot put on the wire
     }
     if (!out) return;
     for (const auto& f : frames) {
@@ -247,11 +269,6 @@ void Sim::on_frame(const can::Frame& f) {
     std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb;
     {
         std::lock_guard l(m_);
-        if (bus_bit_rate_ > 0 && bus_bit_rate_ != bit_timing_for_btr(cfg_.btr).bit_rate()) {
-            // Another bit rate: the controller decodes nothing (it answers with error frames).
-            ++counters_.bit_rate_mismatch;
-            return;
-        }
         if (f.extended || f.rtr || f.is_fd() || (f.flags & can::kFlagError) || f.id != rx_id_) {
             // B-U20: the drive reads its own receive id only.  Our own transmit id
             // and every other node's traffic land here too (one subscription for all ids).
@@ -575,7 +592,7 @@ double Sim::bit_rate() const { return bit_timing_for_btr(cfg_.btr).bit_rate(); }
 
 double Sim::bus_bit_rate() const {
     std::lock_guard l(m_);
-    return bus_bit_rate_;
+    return gate_ ? gate_->medium_bit_rate() : 0.0;
 }
 
 std::uint32_t Sim::rx_id() const {
@@ -598,7 +615,10 @@ std::uint64_t Sim::sent(std::uint8_t regid) const {
 
 SimCounters Sim::counters() const {
     std::lock_guard l(m_);
-    return counters_;
+    SimCounters c = counters_;
+    // Another bit rate: the controller decodes nothing (it answers with error frames); the gate counts.
+    c.bit_rate_mismatch = refused_before_ + (gate_ ? gate_->refused() : 0);
+    return c;
 }
 
 void Sim::on_eeprom_store(std::function<void(const std::map<std::uint8_t, std::int64_t>&)> cb) {

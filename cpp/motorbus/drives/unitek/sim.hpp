@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "motorbus/can/bus.hpp"
+#include "motorbus/can/sim_device.hpp"
 #include "motorbus/drives/unitek/codec.hpp"
 #include "motorbus/drives/unitek/profile.hpp"
 #include "motorbus/motion/motor_model.hpp"
@@ -69,26 +70,33 @@ struct SimCounters {
     std::uint64_t cyclic_refused = 0;  // a 9th cyclic register
     std::uint64_t frames_out = 0;
     std::uint64_t events_out = 0;
-    std::uint64_t bit_rate_mismatch = 0;  // frames on a bus of another bit rate: not decoded (error frames)
+    // Frames on a bus of another bit rate: not decoded (error frames) or not heard (its own), counted
+    // by the bit-rate gate it attaches through, over every attachment.
+    std::uint64_t bit_rate_mismatch = 0;
 };
 
 // The sim's registers: the documented ones plus POS_IST (0x6D, actual position, 32-bit signed, read-only).
 RegisterTable sim_default_table();
 
-class Sim;
-using UnitekSim = Sim;  // issue 24's old name, while parallel edits land (removed after)
-class Sim {
+class Sim : public can::SimulatedDevice {
 public:
     Sim(Clock& clock, SimConfig cfg = {}, RegisterTable table = sim_default_table());
+    // Shares ownership of the clock (bindings, servers that outlive the caller).
+    Sim(std::shared_ptr<Clock> clock, SimConfig cfg = {}, RegisterTable table = sim_default_table());
     ~Sim();
     Sim(const Sim&) = delete;
     Sim& operator=(const Sim&) = delete;
 
-    // Serve on `bus` (subscribes to the receive id, starts the timer thread).
-    void attach(can::Bus& bus);
+    // ---- can::SimulatedDevice ----
+    // Serve on `bus` (kept alive until close()) through a gate at its BTR's bit
+    // rate: subscribes to every standard id, starts the timer thread.
+    void attach(std::shared_ptr<can::Bus> bus) override;
+    void close() override;
+    bool attached() const override;
+    std::string describe() const override;  // "unitek sim tx 0x181"
+    double node_bit_rate() const override { return bit_rate(); }
     // Output without a bus (fuzzing, unit tests): every frame the drive sends.
     void set_output(std::function<void(const can::Frame&)> out);
-    void close();
 
     // A frame seen on the bus (public for tests and fuzzing; not id-filtered by the caller).
     void on_frame(const can::Frame& f);
@@ -108,7 +116,7 @@ public:
     // The voltage on AIN1/AIN2 (+/- 10 V): reads as 2949 num/V (0xD5/0xD6); with
     // analog_command = that input, it is the speed command (10 V = 29490 = 90 % N max).
     void set_analog_input(int channel, double volts);
-    void power_cycle();  // EEPROM values back, RAM values lost, cyclic/events off, motor stopped
+    void power_cycle() override;  // EEPROM values back, RAM values lost, cyclic/events off, motor stopped
 
     // ---- introspection ----
     std::uint32_t status();
@@ -163,7 +171,6 @@ private:
     std::vector<Slot> slots_;
     std::map<std::uint8_t, std::uint64_t> sent_;
     std::uint32_t rx_id_;
-    double bus_bit_rate_ = 0;  // the attached medium's, 0 = none modelled
     std::uint16_t mode_ = 0;
     bool hw_enable_ = true;
     bool calibrated_;
@@ -179,7 +186,9 @@ private:
     std::function<void(const can::Frame&)> out_;
     std::function<void(const std::map<std::uint8_t, std::int64_t>&)> eeprom_cb_;
     bool eeprom_dirty_ = false;
-    can::Bus* bus_ = nullptr;
+    std::shared_ptr<can::BitRateGate> gate_;  // on the medium attach() was given, which it keeps alive
+    std::uint64_t refused_before_ = 0;       // the gates of earlier attachments refused this many
+    std::shared_ptr<Clock> clock_owner_;     // set by the shared_ptr constructor
     can::SubscriptionId sub_ = 0;
     std::unique_ptr<TimerThread> timer_;
 };

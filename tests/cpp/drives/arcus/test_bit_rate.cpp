@@ -54,7 +54,7 @@ TEST(ArcusBitRate, StoredRateTakesEffectAtThePowerCycleAndTheNodeMovesBuses) {
     motorbus::arcus::Sim sim(clock, o);
     auto node_side = hub("arcus-br-125", 125e3);
     auto host = hub("arcus-br-125", 125e3);
-    sim.attach_can(node_side);
+    sim.attach(node_side);
     ASSERT_TRUE(expect_id(*host, 0x701, 500ms));                       // boot-up at the factory 125k
     host->send(sdo(0x2F, 0x200B, 7));                                   // 500 kbit/s
     ASSERT_TRUE(expect_id(*host, 0x581, 500ms));
@@ -67,17 +67,17 @@ TEST(ArcusBitRate, StoredRateTakesEffectAtThePowerCycleAndTheNodeMovesBuses) {
     EXPECT_FALSE(expect_id(*host, 0x581, 300ms));
     EXPECT_EQ(sim.can_bit_rate(), 7);
 
-    sim.detach_can();
+    sim.close();
     auto fast_node = hub("arcus-br-500", 500e3);
     auto fast_host = hub("arcus-br-500", 500e3);
-    sim.attach_can(fast_node);
+    sim.attach(fast_node);
     ASSERT_TRUE(expect_id(*fast_host, 0x701, 500ms));
     fast_host->send(sdo(0x40, 0x200B));
     auto r = expect_id(*fast_host, 0x581, 500ms);
     ASSERT_TRUE(r);
     EXPECT_EQ(r->data[0], 0x4F);
     EXPECT_EQ(r->data[4], 7);
-    sim.detach_can();
+    sim.close();
 }
 
 TEST(ArcusBitRate, AGateOnABusWithoutWireTimePassesEverything) {

@@ -52,7 +52,7 @@ struct SimFixture : ::testing::Test {
 
     void SetUp() override {
         sim = std::make_unique<Sim>(5, clock);
-        sim->attach(*dev);
+        sim->attach(dev);
         sdo = std::make_unique<canopen::SdoClient>(*host, 5);
     }
     void TearDown() override {
@@ -579,13 +579,13 @@ TEST(Pmc007SimLifetime, PowerCycleAfterCloseTouchesNoClosedService) {
     SimClock clock{1'000'000'000};
     auto dev = can::open_virtual("pmc007-lifetime");
     auto sim = std::make_unique<Sim>(5, clock);
-    sim->attach(*dev);
+    sim->attach(dev);
     sim->close();
     sim->power_cycle();                                          // reloads 1016h/1017h/PDO values
     const std::uint8_t period[2] = {0x64, 0x00};
     EXPECT_EQ(sim->od().at(0x1017, 0)->remote_write(period), 0u);   // a write through the hooks
     EXPECT_EQ(sim->od().at(0x1800, 5)->remote_write(period), 0u);
     EXPECT_EQ(sim->od().at(0x1017, 0)->get_u64(), 0x64u);
-    sim->attach(*dev);                                           // and it serves again
+    sim->attach(dev);                                           // and it serves again
     sim->close();
 }

@@ -31,7 +31,7 @@ struct Rig {
         sim_bus = can::open_virtual(name);
         host_bus = can::open_virtual(name);
         sim = std::make_unique<Sim>(clock);
-        sim->attach(*sim_bus);
+        sim->attach(sim_bus);
         ClientOptions o;
         o.timeout = 500ms;
         client = std::make_unique<Client>(*host_bus, sim_default_table(), o);

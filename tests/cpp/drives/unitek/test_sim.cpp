@@ -35,7 +35,7 @@ struct Rig {
             seen.push_back(f);
         });
         sim = std::make_unique<Sim>(clock, cfg);
-        sim->attach(*sim_bus);
+        sim->attach(sim_bus);
         ClientOptions o;
         o.clock = &clock;
         o.timeout = 500ms;
@@ -552,7 +552,7 @@ TEST(Sim, NodeAtAnotherBitRateHearsAndSendsNothing) {  // §3.1, B-U21, issue 23
     host->subscribe(can::Filter{}, [&](const can::Frame&) { ++seen; });
     SimConfig cfg;  // BTR 0x4025: 500 kbit/s
     Sim sim(clock, cfg);
-    sim.attach(*medium);
+    sim.attach(medium);
     EXPECT_EQ(sim.bus_bit_rate(), 250000);
     host->send(can::Frame::make(0x201, Bytes{0x3D, 0x40, 0x00}), 100ms);
     const auto end = std::chrono::steady_clock::now() + 2s;
@@ -565,7 +565,7 @@ TEST(Sim, NodeAtAnotherBitRateHearsAndSendsNothing) {  // §3.1, B-U21, issue 23
     sim.close();
     cfg.btr = 0x405C;  // 250 k in NDrive
     Sim at250(clock, cfg);
-    at250.attach(*medium);
+    at250.attach(medium);
     host->send(can::Frame::make(0x201, Bytes{0x3D, 0x40, 0x00}), 100ms);
     const auto end2 = std::chrono::steady_clock::now() + 2s;
     while (seen.load() == 0 && std::chrono::steady_clock::now() < end2) std::this_thread::sleep_for(1ms);
