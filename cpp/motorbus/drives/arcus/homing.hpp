@@ -27,8 +27,6 @@
 
 namespace motorbus::arcus {
 
-struct HomingOptions;
-using ArcusHomingOptions = HomingOptions;  // issue 24's old name, while parallel edits land (removed after)
 struct HomingOptions {
     double hca = 0;      // HCA, pulses
     double lca = 1000;   // LCA, pulses (factory 1000)
@@ -48,8 +46,6 @@ struct HomingOptions {
     bool backoff_at_lspd = false;
 };
 
-class Homing;
-using ArcusHoming = Homing;  // issue 24's old name, while parallel edits land (removed after)
 class Homing {
 public:
     enum class Method { H, HL, L, Z, ZH };

@@ -48,8 +48,6 @@ double arcus_max_acc_ms(double hspd_pps, double lspd_pps);
 // Largest distance a single X move may cover (incremental or absolute).
 inline constexpr std::int64_t kArcusMaxMoveDistance = 262143;
 
-struct ProfileParams;
-using ArcusProfileParams = ProfileParams;  // issue 24's old name, while parallel edits land (removed after)
 struct ProfileParams {
     // The manual gives no factory HSPD/LSPD/ACC; these are the model's defaults.
     double hspd = 1000;     // PPS
@@ -63,8 +61,6 @@ struct ProfileParams {
 
 // The parameters the drive actually uses after Appendix A's automatic
 // adjustment, and what was adjusted (one human-readable line per change).
-struct Effective;
-using ArcusEffective = Effective;  // issue 24's old name, while parallel edits land (removed after)
 struct Effective {
     ProfileParams params;
     const ArcusSpeedWindow* window = nullptr;
@@ -95,12 +91,9 @@ const char* arcus_reply_text(ArcusReply r);  // the drive's reply string, "" for
 
 // Motor status bits 0..2 of MST during a move.
 enum class Phase { Idle, Accel, Const, Decel };
-using ArcusPhase = Phase;  // issue 24's old name, while parallel edits land (removed after)
 
 // The profile of one DMX-CAN axis across moves and on-the-fly changes.
 // Position continuity: every command starts from the state at its time.
-class Motion;
-using ArcusMotion = Motion;  // issue 24's old name, while parallel edits land (removed after)
 class Motion {
 public:
     explicit Motion(ProfileParams params = {}, int sspdm = 0);

@@ -91,8 +91,6 @@ struct ClientCounters {
     std::uint64_t device_resets = 0;    // version banners seen unsolicited
 };
 
-class Client;
-using DmacClient = Client;  // issue 24's old name, while parallel edits land (removed after)
 class Client {
 public:
     Client(std::shared_ptr<serial::LineLink> link, ClientOptions options = {});

@@ -86,8 +86,6 @@ enum class Cmd : std::uint8_t {
     OptimizedCurrent, Power, Read, ReadSeq, Reference, Return, RequestVersion, SetAddress,
     SetBaudrate, SCurve, SoftEnds, StartSeq, Step, Stop, Synchro, Wait
 };
-struct CommandInfo;
-using CmdInfo = CommandInfo;  // issue 24's old name, while parallel edits land (removed after)
 struct CommandInfo {
     Cmd cmd;
     std::string_view name;       // "MOVE_TO"

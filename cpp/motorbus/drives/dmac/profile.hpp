@@ -45,8 +45,6 @@ inline constexpr double dmac_inc_per_s_to_speed(double inc_per_s) {
     return inc_per_s * 6000.0 / kDmacIncrementsPerRev;
 }
 
-struct ProfileParams;
-using DmacProfileParams = ProfileParams;  // issue 24's old name, while parallel edits land (removed after)
 struct ProfileParams {  // factory values (MODULE_RESET ALL)
     std::int32_t high_speed = 60000;  // 0.01 rpm, 0..400000
     std::int32_t low_speed = 6000;    // 0.01 rpm, 0..400000
@@ -65,8 +63,6 @@ double dmac_ramp_time(const ProfileParams& p, double v_from, double v_to);
 // The profile of one DMAC axis across commands.  Each command at time t
 // (seconds on the profile's own time line, 0 = first command) replaces the
 // future with a plan starting from the state at t.
-class Motion;
-using DmacMotion = Motion;  // issue 24's old name, while parallel edits land (removed after)
 class Motion {
 public:
     explicit Motion(ProfileParams params = {}, double position = 0);

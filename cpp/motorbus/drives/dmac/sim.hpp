@@ -92,8 +92,6 @@ struct SimState {
     bool power = false;
 };
 
-class Sim;
-using DmacSim = Sim;  // issue 24's old name, while parallel edits land (removed after)
 class Sim : public serial::LineDevice {
 public:
     explicit Sim(std::shared_ptr<Clock> clock, SimOptions options = {});

@@ -45,8 +45,6 @@ const std::vector<OdRow>& pmc007_od_rows();
 const OdRow* pmc007_od_row(std::uint16_t index, std::uint8_t sub);
 // 1018h:01-04.  003 documents no identity: the EDS carries 0 (unknown); a simulator
 // reads the identity it was given (SimOptions::identity).
-struct Identity;
-using Pmc007Identity = Identity;  // issue 24's old name, while parallel edits land (removed after)
 struct Identity {
     std::uint32_t vendor_id = 0;
     std::uint32_t product_code = 0;

@@ -30,8 +30,6 @@ int pmc007_microsteps(int setting);
 // position first, then convert): pos * new / old.
 double pmc007_convert_position(double position, int from_setting, int to_setting);
 
-struct ProfileParams;
-using Pmc007ProfileParams = ProfileParams;  // issue 24's old name, while parallel edits land (removed after)
 struct ProfileParams {
     double speed = 1000;           // pps, the running speed (speed mode / position moves)
     double start_speed = 400;      // 6006h, pps (factory 400)

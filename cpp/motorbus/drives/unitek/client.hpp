@@ -76,8 +76,6 @@ struct ClientCounters {
     std::uint64_t callback_errors = 0;
 };
 
-class Client;
-using UnitekClient = Client;  // issue 24's old name, while parallel edits land (removed after)
 class Client {
 public:
     Client(can::Bus& bus, RegisterTable table = RegisterTable::builtin(), ClientOptions options = {});

@@ -20,8 +20,6 @@ inline constexpr std::uint8_t kUnitekRegDecRamp = 0xED;
 inline constexpr double kUnitekCountsPerRev = 65536.0;
 inline constexpr double kUnitekFullScale = 32767.0;
 
-struct RampParams;
-using UnitekRampParams = RampParams;  // issue 24's old name, while parallel edits land (removed after)
 struct RampParams {
     double n_max_rpm = 3000;   // N max: the speed of 32767 num
     double acc_ramp_ms = 1000; // register 0x35
