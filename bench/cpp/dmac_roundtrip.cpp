@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
         Stat ours = run_ours(server.slave_path(), n);
         Stat ref;
         const bool have_ref = run_pyserial(server.slave_path(), n, ref);
-        std::printf("%20s: motorbus C++ DmacClient %8.1f / %8.1f", baud ? "paced 115200 baud" : "unthrottled",
+        std::printf("%20s: motorbus C++ dmac::Client %8.1f / %8.1f", baud ? "paced 115200 baud" : "unthrottled",
                     ours.median_us, ours.p99_us);
         if (have_ref)
             std::printf("   pyserial loop %8.1f / %8.1f   ratio (pyserial/motorbus, median) %5.2f\n", ref.median_us,
