@@ -589,3 +589,19 @@ TEST(Pmc007SimLifetime, PowerCycleAfterCloseTouchesNoClosedService) {
     sim->attach(dev);                                           // and it serves again
     sim->close();
 }
+
+// B-P36 [P]: a node-ID written to 2002h that another node already serves on the bus
+// is not taken: the node stays on its old ID, and last_error() says why (it used to be
+// silence, and any other failure of the switch was silenced as "taken" too).
+TEST_F(SimFixture, NodeIdSwitchToATakenIdStaysAndSaysWhy) {
+    Sim other(9, clock);
+    other.attach(can::open_virtual(hub));
+    EXPECT_EQ(sim->last_error(), "");
+    sdo->write_u8(0x2002, 0, 9);
+    host->send(can::Frame::make(0, std::vector<std::uint8_t>{0x82, 5}));  // reset communication
+    for (int i = 0; i < 400 && sim->last_error().empty(); ++i) std::this_thread::sleep_for(5ms);
+    EXPECT_EQ(sim->last_error(), "pmc007 sim node 5: node-ID 9 is taken, stays on 5");
+    EXPECT_EQ(sim->node_id(), 5);
+    EXPECT_EQ(sdo->read_u8(0x2002, 0), 9);  // node 5 still answers; the RAM value stays what was written
+    other.close();
+}
