@@ -17,6 +17,17 @@ struct Sim::Chain {
     std::vector<Sim*> members;
 };
 
+// The sequencer (sequencer.cpp) runs its flow control itself and hands the
+// other commands of a line back to the module.
+struct Sim::SeqHost final : Sequencer::Host {
+    Sim& sim;
+    explicit SeqHost(Sim& s) : sim(s) {}
+    std::optional<std::int32_t> eval(const Expr& e) override { return sim.eval(e); }
+    void flag(int error_bit) override { sim.flag(error_bit); }
+    void execute(const Command& c) override { sim.execute_locked(c, true, false); }
+    bool moving() override { return sim.moving_locked(); }
+};
+
 namespace {
 
 constexpr std::int64_t kNsPerMs = 1'000'000;
@@ -114,7 +125,6 @@ Sim::Sim(std::shared_ptr<Clock> clock, SimOptions options)
                               " is outside 0..63");
     address_ = options_.address;
     baudrate_ = options_.baudrate;
-    program_.assign(kSeqLines + 1, std::nullopt);
     axis_ = std::make_unique<motion::MotorModel>(*clock_, axis_config(options_));
     epoch_ns_ = axis_->time();  // the model's time is the device's, tick for tick
     axis_->add_listener([this](const motion::MotorEvent& e) { on_axis_event(e); });
@@ -256,7 +266,7 @@ bool Sim::idle_locked() const {
     const bool timers = vars_[static_cast<std::size_t>(Var::Timer1)] ||
                         vars_[static_cast<std::size_t>(Var::Timer2)] ||
                         vars_[static_cast<std::size_t>(Var::Timer3)];
-    return !seq_running_ && !timers && !moving_locked();
+    return !seq_.running() && !timers && !moving_locked();
 }
 
 bool Sim::ultrasync_locked() const {
@@ -338,29 +348,9 @@ void Sim::tick_locked() {
         restart_motion_at(user_position());
     }
     check_end_stops();
-    if (seq_running_) {
-        switch (wait_) {
-            case WaitKind::Time:
-                if (now_ms_ < wait_until_ms_) return;
-                break;
-            case WaitKind::Motion:
-                if (moving_locked()) return;
-                break;
-            case WaitKind::MotionTimeout:
-                if (moving_locked() && now_ms_ < wait_until_ms_) return;
-                break;
-            case WaitKind::None:
-                break;
-        }
-        if (wait_ != WaitKind::None) {
-            wait_ = WaitKind::None;
-            line_ = resume_line_;
-            if (line_ < 1 || line_ > kSeqLines) {
-                seq_stop();
-                return;
-            }
-        }
-        seq_execute_line(line_);
+    if (seq_.running()) {
+        SeqHost host(*this);
+        seq_.tick(host, now_ms_);
     }
 }
 
@@ -578,11 +568,7 @@ void Sim::reset_locked(bool factory) {
     fifo_.clear();
     seg_elapsed_ms_ = 0;
     seg_wait_ = false;
-    edit_ = false;
-    seq_running_ = false;
-    line_ = 0;
-    call_stack_.clear();
-    wait_ = WaitKind::None;
+    seq_.reset();
     // "Motor is powered off and then stopped (short-circuited) until complete
     // stop" (4.8): a moving rotor runs down as under POWER SC.
     coast(kShortCircuitTau);
@@ -594,7 +580,7 @@ void Sim::reset_locked(bool factory) {
     first_reset_ = false;
     check_supply_locked();
     const std::int32_t on_reset = vars_[static_cast<std::size_t>(Var::OnReset)];
-    if (on_reset >= 1 && on_reset <= kSeqLines) seq_start(on_reset);
+    if (on_reset >= 1 && on_reset <= kSeqLines) seq_.start(on_reset);
 }
 
 void Sim::power_cycle() {
@@ -619,8 +605,8 @@ std::uint32_t Sim::status_locked() {
     set(status::kSCurve, s_curve_);
     set(status::kInputsInverted, invert_in_);
     set(status::kOutputsInverted, invert_out_);
-    set(status::kSeqRun, seq_running_);
-    set(status::kSeqEdit, edit_);
+    set(status::kSeqRun, seq_.running());
+    set(status::kSeqEdit, seq_.editing());
     set(status::kHardPosEnd, hard_pos_hit_);
     set(status::kHardNegEnd, hard_neg_hit_);
     set(status::kSoftPosEnd, soft_pos_hit_);
@@ -654,7 +640,7 @@ std::optional<std::int32_t> Sim::read_var_locked(Var v, int bit) {
         case Var::InputA1: value = analog_[1]; break;
         case Var::InputA2: value = analog_[2]; break;
         case Var::InterpolCount: value = static_cast<std::int32_t>(fifo_.size()); break;
-        case Var::Line: value = seq_running_ ? line_ : 0; break;
+        case Var::Line: value = seq_.line(); break;
         case Var::CpuTemperature: value = options_.cpu_temperature; break;
         case Var::DriverTemperature: value = options_.driver_temperature; break;
         case Var::MotorTemperature: value = options_.motor_temperature; break;
@@ -693,8 +679,8 @@ int Sim::write_var_locked(Var v, int bit, std::int32_t value) {
             check_supply_locked();
             return 0;
         case Var::Line:
-            if (value == 0) seq_stop();
-            else line_ = value;
+            if (value == 0) seq_.stop();
+            else seq_.set_line(value);
             return 0;
         default:
             vars_[static_cast<std::size_t>(v)] = value;
@@ -749,114 +735,18 @@ std::optional<std::int32_t> Sim::eval(const Expr& e) {
     return a;
 }
 
-// ---- sequencer ------------------------------------------------------------------
-void Sim::seq_start(int line) {
-    seq_running_ = true;
-    line_ = line;
-    call_stack_.clear();
-    wait_ = WaitKind::None;
-}
-
-void Sim::seq_stop() {
-    seq_running_ = false;
-    line_ = 0;
-    call_stack_.clear();
-    wait_ = WaitKind::None;
-}
-
-void Sim::seq_execute_line(int n) {
-    if (n < 1 || n > kSeqLines) {
-        seq_stop();
-        return;
-    }
-    line_ = n;
-    int next = n + 1;
-    const std::optional<Command>& slot = program_[static_cast<std::size_t>(n)];
-    auto jump_to = [&](Cmd kind, const Expr& target) -> bool {
-        auto t = eval(target);
-        if (!t) return false;
-        std::int64_t dest = *t;
-        if (kind == Cmd::JumpRel) dest = n + static_cast<std::int64_t>(*t);
-        if (kind == Cmd::Jump && dest == 0) {  // JUMP 0 ends the program
-            next = 0;
-            return true;
-        }
-        if (dest < 1 || dest > kSeqLines) {
-            flag(error::kLimit);
-            return false;
-        }
-        if (kind == Cmd::Call) {
-            if (call_stack_.size() >= 5) {  // five nested calls at most
-                flag(error::kLimit);
-                return false;
-            }
-            call_stack_.push_back(n + 1);
-        }
-        next = static_cast<int>(dest);
-        return true;
-    };
-    bool ok = true;
-    if (slot) {
-        const Command& c = *slot;
-        switch (c.cmd) {
-            case Cmd::Jump: case Cmd::JumpRel: case Cmd::Call:
-                ok = jump_to(c.cmd, c.expr);
-                break;
-            case Cmd::Return:
-                if (call_stack_.empty()) {
-                    flag(error::kSyntax);
-                    ok = false;
-                } else {
-                    next = call_stack_.back();
-                    call_stack_.pop_back();
-                }
-                break;
-            case Cmd::If: {
-                auto t = eval(c.expr);
-                if (!t) ok = false;
-                else if (*t != 0) ok = jump_to(c.jump, c.target);
-                break;
-            }
-            case Cmd::Wait: {
-                auto w = eval(c.expr);
-                if (!w || *w < -3600000 || *w > 3600000) {
-                    if (w) flag(error::kLimit);
-                    ok = false;
-                } else if (*w > 0) {
-                    wait_ = WaitKind::Time;
-                    wait_until_ms_ = now_ms_ + *w;
-                } else if (*w == 0) {
-                    wait_ = WaitKind::Motion;
-                } else {
-                    wait_ = WaitKind::MotionTimeout;
-                    wait_until_ms_ = now_ms_ - static_cast<std::int64_t>(*w);
-                }
-                break;
-            }
-            default:
-                execute_locked(c, true, false);
-                break;
-        }
-    }
-    // A failed flow-control line stops the program (the error bit says why).
-    if (!ok) {
-        seq_stop();
-        return;
-    }
-    if (!seq_running_) return;  // the line itself stopped the sequencer (STOP, HALT, #LINE:=0)
-    if (line_ != n) return;     // the line wrote #LINE: that is the next line
-    if (wait_ != WaitKind::None) {
-        resume_line_ = next;     // #LINE shows the WAIT line while it waits
-        return;
-    }
-    if (next < 1 || next > kSeqLines) seq_stop();
-    else line_ = next;
-}
-
 // ---- commands -------------------------------------------------------------------
+bool Sim::in_range(std::optional<std::int32_t> v, std::int64_t lo, std::int64_t hi) {
+    if (!v) return false;
+    if (*v < lo || *v > hi) {
+        flag(error::kLimit);
+        return false;
+    }
+    return true;
+}
+
 std::string Sim::execute_locked(const Command& c, bool from_sequencer, bool global) {
     (void)global;
-    const std::string& term = options_.reply_terminator;
     if (!from_sequencer && sequence_only(c.cmd)) {
         flag(error::kSyntax);
         return "";
@@ -865,46 +755,69 @@ std::string Sim::execute_locked(const Command& c, bool from_sequencer, bool glob
         flag(error::kSyntax);
         return "";
     }
-    auto arg = [&]() -> std::optional<std::int32_t> { return eval(c.expr); };
-    auto in_range = [&](std::optional<std::int32_t> v, std::int64_t lo, std::int64_t hi) {
-        if (!v) return false;
-        if (*v < lo || *v > hi) {
-            flag(error::kLimit);
-            return false;
-        }
-        return true;
-    };
     switch (c.cmd) {
-        case Cmd::Invalid:
-            flag(c.error_bit ? c.error_bit : error::kSyntax);
+        case Cmd::CloseSeq: case Cmd::OpenSeq: case Cmd::ReadSeq: case Cmd::StartSeq: case Cmd::Step:
+            return sequencer_command_locked(c);
+        case Cmd::Brake: case Cmd::Halt: case Cmd::Stop: case Cmd::MoveOn: case Cmd::MoveTo:
+        case Cmd::MoveSpeed: case Cmd::Power: case Cmd::Synchro:
+            motion_command_locked(c);
             return "";
-        case Cmd::Assign: {
-            auto v = arg();
-            if (!v) return "";
-            if (int e = write_var_locked(c.var, c.bit, *v)) flag(e);
+        default:
+            return setting_command_locked(c);
+    }
+}
+
+// OPEN_SEQ, CLOSE_SEQ, READ_SEQ, START_SEQ, STEP.
+std::string Sim::sequencer_command_locked(const Command& c) {
+    switch (c.cmd) {
+        case Cmd::CloseSeq:
+            seq_.close_editor();
+            return "";
+        case Cmd::OpenSeq:
+            seq_.open_editor();
+            return "";
+        case Cmd::ReadSeq: {
+            auto n = eval(c.expr);
+            if (!in_range(n, 1, kSeqLines)) return "";
+            const auto& l = seq_.program_line(*n);
+            return format_seq_reply(address_, *n, l ? format_command(*l) : "") + options_.reply_terminator;
+        }
+        case Cmd::StartSeq: {
+            std::optional<std::int32_t> n = 1;
+            if (c.has_arg) n = eval(c.expr);
+            if (in_range(n, 1, kSeqLines)) seq_.start(*n);
             return "";
         }
+        case Cmd::Step: {
+            std::optional<std::int32_t> n = seq_.step_default();
+            if (c.has_arg) n = eval(c.expr);
+            if (!in_range(n, 1, kSeqLines)) return "";
+            // Debug mode: one line now, the sequencer itself stays stopped.
+            SeqHost host(*this);
+            seq_.step(host, *n, now_ms_);
+            return "";
+        }
+        default:
+            flag(error::kSyntax);
+            return "";
+    }
+}
+
+// The commands that start, stop or power the motion; none answers.
+void Sim::motion_command_locked(const Command& c) {
+    switch (c.cmd) {
         case Cmd::Brake:
             if (!dmac34()) {
                 flag(error::kSyntax);
-                return "";
+                return;
             }
             brake_ = c.keyword == Keyword::On;
             if (brake_) halt_motion();
-            return "";
-        case Cmd::CloseSeq:
-            edit_ = false;
-            return "";
-        case Cmd::OpenSeq:
-            seq_stop();
-            for (auto& l : program_) l.reset();
-            edit_ = true;
-            edit_line_ = 1;
-            return "";
+            return;
         case Cmd::Halt:
             if (c.keyword != Keyword::Seq) halt_motion();
-            if (c.keyword != Keyword::Mouv) seq_stop();
-            return "";
+            if (c.keyword != Keyword::Mouv) seq_.stop();
+            return;
         case Cmd::Stop:
             if (c.keyword != Keyword::Seq) {
                 // In interpolation STOP is HALT and empties the FIFO.
@@ -915,8 +828,79 @@ std::string Sim::execute_locked(const Command& c, bool from_sequencer, bool glob
                     command_axis();
                 }
             }
-            if (c.keyword != Keyword::Mouv) seq_stop();
+            if (c.keyword != Keyword::Mouv) seq_.stop();
+            return;
+        case Cmd::MoveOn:
+        case Cmd::MoveTo:
+        case Cmd::MoveSpeed: {
+            auto v = eval(c.expr);
+            if (c.cmd == Cmd::MoveSpeed && !in_range(v, -400000, 400000)) return;
+            if (!v) return;
+            if (synchro_) pending_ = std::make_unique<Pending>(Pending{c.cmd, *v});
+            else start_move(c.cmd, *v);
+            return;
+        }
+        case Cmd::Power:
+            if (c.keyword == Keyword::On) {
+                if (!(error_ & kFaultBits)) power_ = true;
+            } else {
+                // OFF: no current, no torque -- the rotor freewheels; SC: the
+                // short-circuited coils brake it (low-speed resisting torque, 4.15).
+                coast(c.keyword == Keyword::Sc ? kShortCircuitTau : kFreewheelTau);
+                power_ = false;
+            }
+            return;
+        case Cmd::Synchro:
+            synchro_command_locked(c.keyword);
+            return;
+        default:
+            flag(error::kSyntax);
+            return;
+    }
+}
+
+void Sim::synchro_command_locked(Keyword k) {
+    switch (k) {
+        case Keyword::On: synchro_ = true; break;
+        case Keyword::Off:
+            synchro_ = false;
+            pending_.reset();
+            break;
+        case Keyword::Top:
+            if (pending_) {
+                Pending p = *pending_;
+                pending_.reset();
+                start_move(p.kind, p.value);
+            }
+            break;
+        case Keyword::Interpol:
+            if (!fifo_.empty() && !interpolating_) {
+                // Any other motion stops at once; the FIFO takes over.
+                axis_->halt();
+                restart_motion_at(user_position());
+                interpolating_ = true;
+                start_interp_segment();
+                power_ = true;
+                abnormal_stop_ = false;
+            }
+            break;
+        default: break;
+    }
+}
+
+// Variables, settings, READ, MOVE_INTERPOL and the module's own commands.
+std::string Sim::setting_command_locked(const Command& c) {
+    const std::string& term = options_.reply_terminator;
+    switch (c.cmd) {
+        case Cmd::Invalid:
+            flag(c.error_bit ? c.error_bit : error::kSyntax);
             return "";
+        case Cmd::Assign: {
+            auto v = eval(c.expr);
+            if (!v) return "";
+            if (int e = write_var_locked(c.var, c.bit, *v)) flag(e);
+            return "";
+        }
         case Cmd::HardEnds:
             hard_pos_ = c.keyword == Keyword::All || c.keyword == Keyword::Pos;
             hard_neg_ = c.keyword == Keyword::All || c.keyword == Keyword::Neg;
@@ -929,21 +913,11 @@ std::string Sim::execute_locked(const Command& c, bool from_sequencer, bool glob
             reset_locked(c.keyword == Keyword::All);
             return "";
         case Cmd::MoveInterpol: {
-            auto v = arg();
+            auto v = eval(c.expr);
             if (!v) return "";
             const auto cap = static_cast<std::size_t>(vars_[static_cast<std::size_t>(Var::InterpolFifosize)]);
             if (fifo_.size() >= cap) return std::string(1, kXonError);
             fifo_.push_back({*v, vars_[static_cast<std::size_t>(Var::InterpolTime)]});
-            return "";
-        }
-        case Cmd::MoveOn:
-        case Cmd::MoveTo:
-        case Cmd::MoveSpeed: {
-            auto v = arg();
-            if (c.cmd == Cmd::MoveSpeed && !in_range(v, -400000, 400000)) return "";
-            if (!v) return "";
-            if (synchro_) pending_ = std::make_unique<Pending>(Pending{c.cmd, *v});
-            else start_move(c.cmd, *v);
             return "";
         }
         case Cmd::Nop:
@@ -957,16 +931,6 @@ std::string Sim::execute_locked(const Command& c, bool from_sequencer, bool glob
         case Cmd::SoftEnds:
             soft_ends_ = c.keyword == Keyword::On;
             return "";
-        case Cmd::Power:
-            if (c.keyword == Keyword::On) {
-                if (!(error_ & kFaultBits)) power_ = true;
-            } else {
-                // OFF: no current, no torque -- the rotor freewheels; SC: the
-                // short-circuited coils brake it (low-speed resisting torque, 4.15).
-                coast(c.keyword == Keyword::Sc ? kShortCircuitTau : kFreewheelTau);
-                power_ = false;
-            }
-            return "";
         case Cmd::Read: {
             auto v = read_var_locked(c.var, c.bit);
             if (!v) {
@@ -974,12 +938,6 @@ std::string Sim::execute_locked(const Command& c, bool from_sequencer, bool glob
                 return "";
             }
             return format_read_reply(address_, c.var, c.bit, *v, c.radix) + term;
-        }
-        case Cmd::ReadSeq: {
-            auto n = arg();
-            if (!in_range(n, 1, kSeqLines)) return "";
-            const auto& l = program_[static_cast<std::size_t>(*n)];
-            return format_seq_reply(address_, *n, l ? format_command(*l) : "") + term;
         }
         case Cmd::Reference:
             reference_ = c.keyword == Keyword::On;
@@ -993,64 +951,17 @@ std::string Sim::execute_locked(const Command& c, bool from_sequencer, bool glob
                    term;
         }
         case Cmd::SetAddress: {
-            auto n = arg();
+            auto n = eval(c.expr);
             if (in_range(n, 0, kMaxAddress)) address_ = *n;
             return "";
         }
         case Cmd::SetBaudrate: {
-            auto n = arg();
+            auto n = eval(c.expr);
             if (!n) return "";
             if (*n != 9600 && *n != 19200 && *n != 38400 && *n != 115200) flag(error::kLimit);
             else baudrate_ = *n;
             return "";
         }
-        case Cmd::StartSeq: {
-            std::optional<std::int32_t> n = 1;
-            if (c.has_arg) n = arg();
-            if (in_range(n, 1, kSeqLines)) seq_start(*n);
-            return "";
-        }
-        case Cmd::Step: {
-            std::optional<std::int32_t> n = line_ ? line_ : 1;
-            if (c.has_arg) n = arg();
-            if (!in_range(n, 1, kSeqLines)) return "";
-            // Debug mode: one line now, the sequencer itself stays stopped.
-            seq_running_ = true;
-            seq_execute_line(*n);
-            const int next = wait_ != WaitKind::None ? resume_line_ : line_;
-            seq_running_ = false;
-            wait_ = WaitKind::None;
-            line_ = next;
-            return "";
-        }
-        case Cmd::Synchro:
-            switch (c.keyword) {
-                case Keyword::On: synchro_ = true; break;
-                case Keyword::Off:
-                    synchro_ = false;
-                    pending_.reset();
-                    break;
-                case Keyword::Top:
-                    if (pending_) {
-                        Pending p = *pending_;
-                        pending_.reset();
-                        start_move(p.kind, p.value);
-                    }
-                    break;
-                case Keyword::Interpol:
-                    if (!fifo_.empty() && !interpolating_) {
-                        // Any other motion stops at once; the FIFO takes over.
-                        axis_->halt();
-                        restart_motion_at(user_position());
-                        interpolating_ = true;
-                        start_interp_segment();
-                        power_ = true;
-                        abnormal_stop_ = false;
-                    }
-                    break;
-                default: break;
-            }
-            return "";
         default:
             flag(error::kSyntax);
             return "";
@@ -1065,20 +976,19 @@ std::string Sim::handle_locked(std::string_view line) {
     if (!global && req.address != address_) return "";
     bool rejected = false;
     std::string reply;
-    if (edit_) {
-        int at = req.seq_line ? req.seq_line : edit_line_;
+    if (seq_.editing()) {
+        int at = req.seq_line ? req.seq_line : seq_.edit_line();
         for (const Command& c : req.commands) {
             if (c.cmd == Cmd::Invalid) {
                 flag(c.error_bit);
                 rejected = true;
             } else if (live_only(c.cmd)) {
                 reply += execute_locked(c, false, global);
-            } else if (at > kSeqLines) {
+            } else if (!seq_.store(at, c)) {
                 flag(error::kLimit);
                 rejected = true;
             } else {
-                program_[static_cast<std::size_t>(at)] = c;
-                edit_line_ = ++at;
+                ++at;
             }
         }
     } else {
@@ -1146,8 +1056,8 @@ SimState Sim::state() {
     s.speed = speed_locked();
     s.status = status_locked();
     s.error = error_;
-    s.line = seq_running_ ? line_ : 0;
-    s.sequencer_running = seq_running_;
+    s.line = seq_.line();
+    s.sequencer_running = seq_.running();
     s.fifo_count = static_cast<int>(fifo_.size());
     s.interpolating = interpolating_;
     s.power = power_;
@@ -1173,7 +1083,7 @@ std::int32_t Sim::baudrate() {
 std::string Sim::sequence_line(int n) {
     std::lock_guard lock(*mutex_);
     if (n < 1 || n > kSeqLines) return "";
-    const auto& l = program_[static_cast<std::size_t>(n)];
+    const auto& l = seq_.program_line(n);
     return l ? format_command(*l) : "";
 }
 

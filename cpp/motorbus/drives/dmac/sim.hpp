@@ -35,6 +35,7 @@
 
 #include "motorbus/drives/dmac/codec.hpp"
 #include "motorbus/drives/dmac/profile.hpp"
+#include "motorbus/drives/dmac/sequencer.hpp"
 #include "motorbus/motion/motor_model.hpp"
 #include "motorbus/runtime/clock.hpp"
 #include "motorbus/serial/line_device.hpp"
@@ -157,6 +158,12 @@ private:
     void tick_locked();
     std::string handle_locked(std::string_view line);
     std::string execute_locked(const Command& c, bool from_sequencer, bool global);
+    std::string sequencer_command_locked(const Command& c);
+    void motion_command_locked(const Command& c);
+    void synchro_command_locked(Keyword k);
+    std::string setting_command_locked(const Command& c);
+    // v in lo..hi; out of it flags the limit error.  false for nullopt (already flagged).
+    bool in_range(std::optional<std::int32_t> v, std::int64_t lo, std::int64_t hi);
     void flag(int error_bit) { error_ |= bit_mask(error_bit); }
 
     std::optional<std::int32_t> read_var_locked(Var v, int bit);
@@ -191,11 +198,6 @@ private:
     void update_end_flags();
     void reset_locked(bool factory);
     ProfileParams params() const;
-
-    // sequencer
-    void seq_start(int line);
-    void seq_stop();
-    void seq_execute_line(int line);
 
     std::shared_ptr<Clock> clock_;
     SimOptions options_;
@@ -244,16 +246,9 @@ private:
     bool seg_wait_ = false;     // UltraSYNC: done, waiting for the chained modules
     double speed_limit_ = 0;    // inc/s, 0 = none
 
-    // sequencer
-    std::vector<std::optional<Command>> program_;  // index 1..500
-    bool edit_ = false;
-    int edit_line_ = 1;
-    bool seq_running_ = false;
-    int line_ = 0;                    // next line to execute (0 = stopped)
-    std::vector<int> call_stack_;
-    enum class WaitKind { None, Time, Motion, MotionTimeout } wait_ = WaitKind::None;
-    std::int64_t wait_until_ms_ = 0;
-    int resume_line_ = 0;             // line after the WAIT in progress
+    // sequencer (sequencer.hpp); SeqHost lends it this module's commands
+    struct SeqHost;
+    Sequencer seq_;
     bool first_reset_ = true;
 
     std::uint64_t lines_handled_ = 0, lines_rejected_ = 0;
