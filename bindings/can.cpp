@@ -67,7 +67,7 @@ Frame frame_from_py(std::uint32_t id, const py::object& data, bool extended, boo
 
 }  // namespace
 
-void bind_can(py::module_& m) {
+static void bind_frames(py::module_& m) {
     py::class_<Frame>(m, "Frame", "A CAN frame. Invalid fields are refused at construction.")
         .def(py::init(&frame_from_py), py::arg("id"), py::arg("data") = py::bytes(),
              py::arg("extended") = false, py::arg("rtr") = false, py::arg("dlc") = py::none())
@@ -102,7 +102,9 @@ void bind_can(py::module_& m) {
         .field("parse_errors", &BusCounters::parse_errors, "malformed input from the medium, discarded")
         .field("bus_errors", &BusCounters::bus_errors, "error frames / BEL / error states reported")
         .field("ignored", &BusCounters::ignored, "well-formed input not used (status lines etc.)");
+}
 
+static void bind_buses(py::module_& m) {
     py::class_<Bus, std::shared_ptr<Bus>>(m, "Bus", "A CAN bus endpoint (open one with open_bus).")
         .def("send",
              [](Bus& b, const Frame& f, const py::object& timeout) {
@@ -222,7 +224,9 @@ void bind_can(py::module_& m) {
              py::arg("receive_own") = false)
         .def("feed", &ExternalBus::feed, py::arg("frame"), py::call_guard<py::gil_scoped_release>())
         .def("feed_parse_error", &ExternalBus::feed_parse_error);
+}
 
+static void bind_logs(py::module_& m) {
     // ---- logs -------------------------------------------------------------
     py::class_<LogEntry>(m, "LogEntry", "One logged frame: time (s), channel, direction.")
         .def_readonly("frame", &LogEntry::frame)
@@ -266,4 +270,10 @@ void bind_can(py::module_& m) {
         return motorbus::py_helpers::blocking_call([&] { return play(bus, entries, speed); });  // Ctrl-C stops it
     }, py::arg("bus"), py::arg("entries"), py::arg("speed") = 1.0,
        "Replays entries onto bus: speed 1.0 = original timing, 0 = as fast as possible.");
+}
+
+void bind_can(py::module_& m) {
+    bind_frames(m);
+    bind_buses(m);
+    bind_logs(m);
 }
