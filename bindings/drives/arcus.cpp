@@ -7,6 +7,7 @@
 #include "common.hpp"
 #include "sim_device.hpp"
 #include "errors.hpp"
+#include "motorbus/drives/arcus/canopen_od.hpp"
 #include "motorbus/drives/arcus/client.hpp"
 #include "motorbus/drives/arcus/codec.hpp"
 #include "motorbus/drives/arcus/sim.hpp"
@@ -299,6 +300,9 @@ void bind_arcus(py::module_& m) {
         .def_property_readonly("can_node_id", &Sim::can_node_id)
         .def_property_readonly("can_bit_rate", &Sim::can_bit_rate);
 
+    m.def("arcus_canopen_object_dictionary", &canopen_object_dictionary,
+          "Table 10.1 as a typed canopen.ObjectDictionary (types, access, limits, defaults, codecs): what the "
+          "arcus-canopen client reads and writes by, and the source of the shipped EDS.");
     m.def("arcus_canopen_objects", [] {
         py::list out;
         for (const auto& o : canopen_objects())

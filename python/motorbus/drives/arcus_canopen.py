@@ -581,30 +581,11 @@ SIM_FAULTS = {
 
 
 def object_dictionary() -> "_core.ObjectDictionary":
-    """Table 10.1 as a motorbus ObjectDictionary (types, access, defaults, ranges), for
-    tools and for the EDS (:func:`eds_text`).  The simulator serves the same table."""
-    od = _core.ObjectDictionary()
-    records = sorted({r[0] for r in OBJECTS if r[1] != 0})
-    names = {0x1018: "Identity", 0x2001: "StepNLoop parameters", 0x2004: "Driver settings",
-             0x2009: "Latch positions", 0x6099: "Homing speeds"}
-    for index in records:
-        od.add_record(index, names.get(index, f"0x{index:04X}"))
-    for (index, sub, name, dtype, access, default, low, high, _unit, _persists) in OBJECTS:
-        if index in records and sub == 0:
-            continue  # the record's "number of entries" comes with the record
-        kwargs: dict = {"access": access}
-        if dtype == "VISIBLE_STRING":
-            kwargs["default"] = "DMC"
-        else:
-            kwargs["default"] = int(default)
-            if access in ("rw", "wo"):
-                kwargs.update(low=int(low), high=int(high))
-        dt = {"I8": "I8", "I16": "I16", "I32": "I32"}.get(dtype, dtype)
-        if index in records:
-            od.add_member(index, sub, name, dt, **kwargs)
-        else:
-            od.add_variable(index, name, dt, **kwargs)
-    return od
+    """Table 10.1 as a typed motorbus ObjectDictionary (types, access, defaults, ranges and the
+    C++ codec of each entry), built in C++ from the table the simulator serves
+    (``cpp/motorbus/drives/arcus/canopen_od.cpp``); the EDS (:func:`eds_text`) is generated
+    from it.  A fresh dictionary per call (tools may change its values)."""
+    return _core.arcus_canopen_object_dictionary()
 
 
 _OD: Optional["_core.ObjectDictionary"] = None
