@@ -201,7 +201,7 @@ TransferMode mode_of(bool block, bool segmented) {
 
 }  // namespace
 
-void bind_canopen(py::module_& m) {
+static void bind_errors_and_types(py::module_& m) {
     // ---- errors (the table of errors.hpp) ---------------------------------------
     py_errors::add_error_classes(m, {
         {"SdoAbortError", {"MotorbusError"},
@@ -236,7 +236,9 @@ void bind_canopen(py::module_& m) {
     for (unsigned c = 1; c <= 0x1B; ++c)
         if (is_known_type(static_cast<std::uint16_t>(c)))
             dt.value(type_name(static_cast<DataType>(c)), static_cast<DataType>(c));
+}
 
+static void bind_variable(py::module_& m) {
     // ---- variables and the dictionary --------------------------------------
     py::class_<Variable, std::shared_ptr<Variable>>(m, "Variable", "One object-dictionary entry.")
         .def_property_readonly("index", &Variable::index)
@@ -322,7 +324,9 @@ void bind_canopen(py::module_& m) {
                           type_name(v.type()), access_name(v.access()));
             return std::string(b) + " '" + v.name() + "'";
         });
+}
 
+static void bind_object_dictionary(py::module_& m) {
     py::class_<ObjectDictionary, std::shared_ptr<ObjectDictionary>>(m, "ObjectDictionary",
         "Objects addressed by (index, subindex) or by name ('Record.Member', '0x1018:1').")
         .def(py::init<>())
@@ -431,7 +435,9 @@ void bind_canopen(py::module_& m) {
               return to_bytes(value_from_py(t, value, std::string("value of type ") + type_name(t)));
           }, py::arg("data_type"), py::arg("value"),
           "The little-endian bytes of `value` as a CiA 301 type; InvalidArgument when it does not fit.");
+}
 
+static void bind_counters(py::module_& m) {
     // ---- counters: C++ structs, read-only -------------------------------------------
     py::class_<SdoClientCounters>(m, "SdoClientCounters", "Counters of one SDO client, across its transfers.")
         .def_readonly("transfers", &SdoClientCounters::transfers)
@@ -476,7 +482,9 @@ void bind_canopen(py::module_& m) {
                    ", sdo_while_stopped=" + u64s(c.sdo_while_stopped) + ", sdo=" +
                    py::repr(py::cast(c.sdo)).cast<std::string>() + ")";
         });
+}
 
+static void bind_sdo_client(py::module_& m) {
     // ---- SDO client --------------------------------------------------------------
     py::class_<SdoClient>(m, "SdoClient", "SDO client for one node (requests 0x600+n, responses 0x580+n).")
         .def(py::init([](can::Bus& bus, std::uint8_t node_id, double timeout, std::size_t max_transfer,
@@ -577,7 +585,9 @@ void bind_canopen(py::module_& m) {
           },
           py::arg("sdo"), py::arg("objects"), py::keep_alive<0, 1>(),
           "A PollSource uploading [(index, subindex, type)] each sample (type: 'i32', 'u16', ...).");
+}
 
+static void bind_local_node(py::module_& m) {
     // ---- LocalNode ---------------------------------------------------------------
     py::class_<LocalNode, LocalNodeHolder>(m, "LocalNode",
         "A node we serve: SDO server on 0x600+n/0x580+n, boot-up, NMT slave.")
@@ -622,4 +632,13 @@ void bind_canopen(py::module_& m) {
             py::gil_scoped_release nogil;
             n.close();
         });
+}
+
+void bind_canopen(py::module_& m) {
+    bind_errors_and_types(m);
+    bind_variable(m);
+    bind_object_dictionary(m);
+    bind_counters(m);
+    bind_sdo_client(m);
+    bind_local_node(m);
 }

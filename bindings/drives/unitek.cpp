@@ -96,7 +96,7 @@ py::tuple stream_read(StreamView& v, std::int64_t max) {
 
 }  // namespace
 
-void bind_unitek(py::module_& m) {
+static void bind_unitek_errors_and_profile(py::module_& m) {
     py_errors::add_error_classes(m, {
         {"UnitekFrameError", {"ProtocolError"},
          "A UNITEK frame that breaks the protocol (wrong DLC...); .byte is the 0-based index of the byte at fault, .data the frame."},
@@ -121,7 +121,9 @@ void bind_unitek(py::module_& m) {
         .def_readwrite("dec_ramp_ms", &RampParams::dec_ramp_ms);
     m.def("unitek_speed_profile", &unitek_speed_profile, py::arg("start"), py::arg("speed_num"), py::arg("params"),
           py::arg("hold") = 0.0);
+}
 
+static void bind_unitek_registers(py::module_& m) {
     // ---- register table ----
     py::enum_<Access>(m, "UnitekAccess")
         .value("RW", Access::ReadWrite).value("RO", Access::ReadOnly).value("WO", Access::WriteOnly);
@@ -239,8 +241,9 @@ void bind_unitek(py::module_& m) {
     m.def("unitek_analog_command_num", &analog_command_num, py::arg("volts"),
           "§6.1: the num of an analog command (10 V = 29490)");
     m.def("unitek_sim_default_table", &sim_default_table);
-    m.def("unitek_event_status_mask", &event_status_mask, py::arg("mask"));
+}
 
+static void bind_unitek_codec(py::module_& m) {
     // ---- codec ----
     m.def("unitek_encode_write", [](std::int64_t regid, std::int64_t value, int bits) {
         return to_bytes(encode_write(regid_arg(regid), value, bits));
@@ -249,9 +252,6 @@ void bind_unitek(py::module_& m) {
         if (interval < 0 || interval > 255) throw InvalidArgument("interval: 0 (once), 1..254 ms, 255 (stop)");
         return to_bytes(encode_request(regid_arg(regid), static_cast<std::uint8_t>(interval)));
     }, py::arg("regid"), py::arg("interval"));
-    m.def("unitek_encode_reply", [](std::int64_t regid, std::uint32_t raw, int bits, int dummy) {
-        return to_bytes(encode_reply(regid_arg(regid), raw, bits, static_cast<std::uint8_t>(dummy & 0xFF)));
-    }, py::arg("regid"), py::arg("raw"), py::arg("bits") = 16, py::arg("dummy") = 0);
     m.def("unitek_decode_to_drive", [](const py::object& data) {
         const auto t = decode_to_drive(bytes_of(data, "data"));
         return py::make_tuple(t.regid, t.value, t.value_bits);
@@ -260,7 +260,9 @@ void bind_unitek(py::module_& m) {
         const auto f = decode_from_drive(bytes_of(data, "data"));
         return py::make_tuple(f.regid, f.value, f.value_bits);
     }, py::arg("data"), "(regid, raw value, bits) of a frame from the drive; UnitekFrameError unless DLC 4 or 6");
+}
 
+static void bind_unitek_client(py::module_& m) {
     // ---- client ----
     py::class_<StreamView, std::shared_ptr<StreamView>>(m, "UnitekStream",
         "One cyclic register: a ring of (timestamp ns, value num) filled by the bus thread.")
@@ -382,7 +384,9 @@ void bind_unitek(py::module_& m) {
         .def_property_readonly("tx_id", [](const ClientHolder& h) { return h.client->tx_id(); })
         .def_property_readonly("counters", [](const ClientHolder& h) { return h.client->counters(); })
         .def("close", [](ClientHolder& h) { blocking_call([&] { h.client->close(); }); });
+}
 
+static void bind_unitek_sim(py::module_& m) {
     // ---- simulator ----
     py::class_<SimCounters>(m, "UnitekSimCounters")
         .def_readonly("frames_in", &SimCounters::frames_in)
@@ -511,7 +515,9 @@ void bind_unitek(py::module_& m) {
             py::gil_scoped_release nogil;
             h.load_eeprom(in);
         }, py::arg("values"));
+}
 
+static void bind_unitek_poll(py::module_& m) {
     // Poll sources (motorbus.Poller) on this client: asking, or capturing cyclic transmissions.
     auto regids_arg = [](const std::vector<std::int64_t>& ids) {
         std::vector<std::uint8_t> r;
@@ -541,4 +547,13 @@ void bind_unitek(py::module_& m) {
           py::keep_alive<0, 1>(),
           "Subscribes each register every interval_ms (unless it already transmits) and captures it; "
           "max_age (s, default 3 intervals + 2 ms): older data counts as stale.");
+}
+
+void bind_unitek(py::module_& m) {
+    bind_unitek_errors_and_profile(m);
+    bind_unitek_registers(m);
+    bind_unitek_codec(m);
+    bind_unitek_client(m);
+    bind_unitek_sim(m);
+    bind_unitek_poll(m);
 }
