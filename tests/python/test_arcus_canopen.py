@@ -538,7 +538,7 @@ def test_the_same_drive_api_script_through_both_personas_of_one_drive(tmp_path):
 
     with motorbus.open_bus("virtual:arcus-both") as sim_bus:
         sim = ac.make_sim(NODE, protocol="ascii", store_path=str(tmp_path / "flash"), bus=sim_bus, eo_boot=True)
-        pty = _core.PtyLineServer([sim.core], 0, None)
+        pty = _core.PtyLineServer([sim], 0, None)
         try:
             with motorbus.open_drive("arcus", line=pty.slave_path, address="01", units=units) as axis:
                 by_ascii = script(axis, "HL+", {"HSPD": 20000, "LSPD": 2000, "ACC": 20, "DEC": 20})

@@ -212,29 +212,11 @@ class ArcusCanopen(Cia402):
         self.home(None if method is None else int(method), timeout)
 
 
-class ArcusCanopenSim:
-    """One simulated DMX-CAN (``_core.ArcusSim``) served on a CAN bus.
-
-    ``core`` is the whole drive: the same object answers ASCII lines
-    (``core.on_line``, a LineDevice for the pty server) while its stored
-    communication type is RS-232/485, and SDO on the bus while it is CAN."""
-
-    def __init__(self, core: Any) -> None:
-        self.core = core
-        self.bus: Optional[_core.Bus] = None
-
-    def attach(self, bus: _core.Bus) -> "ArcusCanopenSim":
-        """Serve the CAN front end on ``bus`` (boot-up 0x700+n sent now when CAN is in effect)."""
-        self.core.attach(bus)
-        self.bus = bus
-        return self
-
-    def close(self) -> None:
-        self.core.close()
-        self.bus = None
-
-    def __getattr__(self, name: str) -> Any:  # test hooks: force_limit, power_cycle, positions...
-        return getattr(self.core, name)
+#: One simulated DMX-CAN: ``_core.ArcusSim`` itself, the whole drive in one object.  It is a
+#: ``SimulatedDevice`` (``attach(bus)`` serves its CAN front end, boot-up 0x700+n sent when CAN is in
+#: effect, and keeps the bus; ``close()``) and a ``LineDevice`` (``on_line``, for the pty server):
+#: it answers SDO while its stored communication type is CAN, ASCII lines while it is RS-232/485.
+ArcusCanopenSim = _core.ArcusSim
 
 
 _SIM_OPTIONS = ("protocol", "store_path", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
@@ -271,10 +253,9 @@ def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None
         options.setdefault("clear_time", SERVED_CLEAR_TIME)
     core = _core.ArcusSim(clock, address=int(ascii_address), node_id=node,
                           comm_type=2 if protocol == "canopen" else 0, **options)
-    sim = ArcusCanopenSim(core)
     if bus is not None:
-        sim.attach(bus)
-    return sim
+        core.attach(bus)
+    return core
 
 
 # ---- the Drive adapter ----------------------------------------------------------------
