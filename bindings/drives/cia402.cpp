@@ -40,6 +40,9 @@ void bind_cia402(py::module_& m) {
         return out;
     }, "The generic CiA 402 simulator's objects: (index, sub, name, type, access, default, low, high, unit, "
        "persists, description).");
+    m.def("cia402_object_dictionary", &object_dictionary, py::arg("node_id") = 1,
+          "The same objects as a typed canopen.ObjectDictionary (types, access, limits, defaults, codecs): what the "
+          "generic Drive adapter reads and writes by.");
 
     auto rel = py::call_guard<py::gil_scoped_release>();
     // attach / close / attached / describe / power_cycle: the SimulatedDevice base's.
@@ -47,7 +50,7 @@ void bind_cia402(py::module_& m) {
         "A simulated CiA 402 drive served by a LocalNode (see cpp/motorbus/drives/cia402/sim.hpp).")
         .def(py::init([](int node_id, std::shared_ptr<Clock> clock, double steps_per_rev,
                          std::pair<double, double> home, std::optional<double> minus_limit,
-                         std::optional<double> plus_limit, int heartbeat_ms, double start_position) {
+                         std::optional<double> plus_limit, std::uint16_t heartbeat_ms, double start_position) {
                  if (node_id < 1 || node_id > 127)
                      throw InvalidArgument("cia402 sim: node-ID " + std::to_string(node_id) + " is outside 1..127");
                  SimOptions o{steps_per_rev, home, minus_limit, plus_limit, heartbeat_ms, start_position};

@@ -158,8 +158,7 @@ Sim::~Sim() {
     }
 }
 
-void Sim::build_od() {
-    auto& od = *od_;
+void add_objects(canopen::ObjectDictionary& od, std::uint8_t node_id) {
     for (const auto& r : objects()) {
         if (r.sub != 0 && !od.object(r.index)) od.add_record(r.index, r.index == 0x6099 ? "Homing speeds" : [&] {
             char buf[8];
@@ -185,10 +184,36 @@ void Sim::build_od() {
         else
             od.add_variable(std::move(spec));
     }
-    od.at(0x1018, 4)->set_u64(node_id_);
+    od.at(0x1018, 4)->set_u64(node_id);
     od.add_record(0x1010, "Store parameters", canopen::ObjectCode::Array);
     od.add_member(0x1010, {.subindex = 1, .name = "Save all parameters", .type = DataType::Unsigned32,
                            .default_value = std::uint64_t{1}});
+}
+
+std::shared_ptr<canopen::ObjectDictionary> object_dictionary(std::uint8_t node_id) {
+    auto od = std::make_shared<canopen::ObjectDictionary>();
+    add_objects(*od, node_id);
+    return od;
+}
+
+void Sim::build_od() {
+    auto& od = *od_;
+    add_objects(od, node_id_);
+
+    // PDO mapping parameters as CiA 301 declares them: RECORDs (the PdoService adopts
+    // what exists and would make ARRAYs, whose length a master such as canopen's
+    // PdoMap.save() takes from sub-index 0 and then writes no entry at all).
+    for (std::uint16_t base : {std::uint16_t{0x1600}, std::uint16_t{0x1A00}})
+        for (std::uint16_t n = 0; n < 4; ++n) {
+            const std::uint16_t index = base + n;
+            od.add_record(index, base == 0x1600 ? "RPDO mapping parameter" : "TPDO mapping parameter");
+            od.add_member(index, {.subindex = 0, .name = "Number of mapped objects", .type = DataType::Unsigned8,
+                                  .access = Access::RW, .default_value = std::uint64_t{0}});
+            for (std::uint8_t sub = 1; sub <= 8; ++sub)
+                od.add_member(index, {.subindex = sub, .name = "Mapped object " + std::to_string(sub),
+                                      .type = DataType::Unsigned32, .access = Access::RW,
+                                      .default_value = std::uint64_t{0}});
+        }
 
     canopen::Cia402Axis& ax = *axis_;
     // What the axis computes, read when the host looks.
