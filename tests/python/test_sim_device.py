@@ -33,7 +33,11 @@ def _arcus():
     return sim, _core.Frame(0x603, bytes([0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])), 0x583
 
 
-@pytest.mark.parametrize("make", [_pmc007, _unitek, _arcus], ids=["pmc007", "unitek", "arcus"])
+def _cia402():
+    return _core.Cia402Sim(7), _core.Frame(0x607, bytes([0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])), 0x587
+
+
+@pytest.mark.parametrize("make", [_pmc007, _unitek, _arcus, _cia402], ids=["pmc007", "unitek", "arcus", "cia402"])
 def test_every_can_sim_is_one_simulated_device(make):
     sim, request, reply_id = make()
     assert isinstance(sim, _core.SimulatedDevice)
