@@ -104,29 +104,13 @@ _OD: Optional["_core.ObjectDictionary"] = None
 
 
 def object_dictionary() -> "_core.ObjectDictionary":
-    """The objects table as a typed dictionary (``motorbus.canopen.ObjectDictionary``, C++),
-    with the three objects every CiA 402 drive has beside it (6040h, 6041h, 1010h:01).  The
-    adapter reads and writes each object with its entry's codec (``Variable.encode/decode``);
-    nothing is packed in Python."""
+    """The objects the generic simulator serves, as the typed dictionary built in C++ from
+    its table (``_core.cia402_object_dictionary``: the rows plus 1010h:01): the adapter
+    reads and writes each object with its entry's codec (``Variable.encode/decode``);
+    nothing is packed in Python.  Made once, read only."""
     global _OD
     if _OD is None:
-        od = _core.ObjectDictionary()
-        records = {row[0] for row in OBJECTS if row[1] != 0}
-        for index in sorted(records):
-            od.add_record(index, f"0x{index:04X}")
-        rows = [row[:8] for row in OBJECTS] + [(0x6040, 0, "Controlword", "U16", "rw", 0, None, None),
-                                               (0x6041, 0, "Statusword", "U16", "ro", 0, None, None),
-                                               (0x1010, 1, "Save all parameters", "U32", "rw", 1, None, None)]
-        for (index, sub, name, dtype, access, default, low, high) in rows:
-            if index in (0x1010,) and index not in records:
-                od.add_record(index, "Store parameters", array=True)
-                records.add(index)
-            kw = dict(access=access, low=low, high=high, default=default)
-            if index in records:
-                od.add_member(index, sub, name, dtype, **kw)
-            else:
-                od.add_variable(index, name, dtype, **kw)
-        _OD = od
+        _OD = _core.cia402_object_dictionary()
     return _OD
 
 

@@ -59,6 +59,11 @@ struct ObjectRow {
     const char* text_default = nullptr;  // VISIBLE_STRING rows
 };
 const std::vector<ObjectRow>& objects();
+// objects() as a dictionary (records, limits, defaults, 1018h:04 = the node-ID, 1010h:01
+// store), no behaviour: the simulator serves it with its hooks added, and a host (the
+// generic Drive adapter) reads and writes by its typed entries.
+void add_objects(canopen::ObjectDictionary& od, std::uint8_t node_id);
+std::shared_ptr<canopen::ObjectDictionary> object_dictionary(std::uint8_t node_id = 1);
 
 // A can::SimulatedDevice: attach(bus) serves the node (boot-up sent; the bus is
 // kept alive until close()), close() takes it off (the motor halts where it is).
