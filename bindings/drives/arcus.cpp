@@ -7,6 +7,7 @@
 #include "common.hpp"
 #include "sim_device.hpp"
 #include "errors.hpp"
+#include "named_enum.hpp"
 #include "motorbus/drives/arcus/canopen_od.hpp"
 #include "motorbus/drives/arcus/client.hpp"
 #include "motorbus/drives/arcus/codec.hpp"
@@ -20,6 +21,9 @@ namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::arcus;
 using motorbus::py_helpers::Record;
+using motorbus::py_helpers::enum_arg;
+using motorbus::py_helpers::EnumOrName;
+using motorbus::py_helpers::named_enum;
 using motorbus::py_helpers::blocking_call;
 using motorbus::py_helpers::duration_arg;
 using motorbus::py_helpers::Forever;
@@ -200,7 +204,7 @@ void bind_arcus_motion(py::module_& m) {
 }
 }  // namespace
 
-void bind_arcus(py::module_& m) {
+static void bind_arcus_codec(py::module_& m) {
     bind_arcus_motion(m);
     register_errors(m);
 
@@ -243,7 +247,9 @@ void bind_arcus(py::module_& m) {
         py::arg("hspd"), py::arg("lspd"),
         "(min, max) ACC in ms the drive accepts for HSPD/LSPD (Table A.0; max truncated to 10 ms like the "
         "manual's examples).");
+}
 
+static void bind_arcus_sim(py::module_& m) {
     // One drive, two faces: a LineDevice for its serial line, a SimulatedDevice (attach / close /
     // attached / describe / power_cycle, the base's binding) for its CAN port.
     py::class_<Sim, serial::LineDevice, can::SimulatedDevice, std::shared_ptr<Sim>>(
@@ -311,7 +317,13 @@ void bind_arcus(py::module_& m) {
         return out;
     }, "The DMX-CAN object dictionary the simulator serves (Table 10.1): (index, sub, name, type, access, "
        "default, low, high, unit, persists) tuples.");
+}
 
+static void bind_arcus_client(py::module_& m) {
+    // The home command's method; ArcusClientBase.home takes it or its name ("HL").
+    named_enum<HomeMethod>(m, "ArcusHomeMethod", "The homing routines: H, HL, ZH, Z, L (Table 11.0; + or - is the direction).",
+                           "home method", {{"H", HomeMethod::H}, {"HL", HomeMethod::HL}, {"ZH", HomeMethod::ZH},
+                                           {"Z", HomeMethod::Z}, {"L", HomeMethod::L}});
     Record<ClientCounters>(m, "ArcusClientCounters", "ArcusClient counters (ArcusClient.counters), read-only.")
         .field("requests", &ClientCounters::requests)
         .field("timeouts", &ClientCounters::timeouts)
@@ -385,15 +397,8 @@ void bind_arcus(py::module_& m) {
         .def("clear_snl", &C::clear_snl, rel)
         .def(
             "home",
-            [](C& cl, const std::string& method, int direction) {
-                HomeMethod hm;
-                if (method == "H") hm = HomeMethod::H;
-                else if (method == "HL") hm = HomeMethod::HL;
-                else if (method == "ZH") hm = HomeMethod::ZH;
-                else if (method == "Z") hm = HomeMethod::Z;
-                else if (method == "L") hm = HomeMethod::L;
-                else throw InvalidArgument("home method: one of H, HL, ZH, Z, L");
-                if (direction != 1 && direction != -1) throw InvalidArgument("home direction: +1 or -1");
+            [](C& cl, const EnumOrName<HomeMethod>& method, int direction) {
+                const HomeMethod hm = enum_arg<HomeMethod>(method);
                 py::gil_scoped_release nogil;
                 cl.home(hm, direction);
             },
@@ -453,7 +458,9 @@ void bind_arcus(py::module_& m) {
         .def_property("baud_code", get(&C::baud_code), put(&C::set_baud_code))
         .def_property("can_bit_rate_code", get(&C::can_bit_rate_code), put(&C::set_can_bit_rate_code))
         .def_property("node_id", get(&C::node_id), put(&C::set_node_id));
+}
 
+static void bind_arcus_poll(py::module_& m) {
     // A PollSource querying `names` (e.g. ["EX", "PS", "MST"]) each sample, with a
     // client of its own on the drive's LineLink (motorbus.Poller).
     m.def("arcus_poll_source",
@@ -467,4 +474,11 @@ void bind_arcus(py::module_& m) {
           },
           py::arg("link"), py::arg("address"), py::arg("names"), py::arg("timeout") = py::none(),
           py::arg("query_retries") = 1);
+}
+
+void bind_arcus(py::module_& m) {
+    bind_arcus_codec(m);
+    bind_arcus_sim(m);
+    bind_arcus_client(m);
+    bind_arcus_poll(m);
 }

@@ -6,6 +6,7 @@
 
 #include "common.hpp"
 #include "errors.hpp"
+#include "named_enum.hpp"
 #include "motorbus/drives/dmac/client.hpp"
 #include "motorbus/drives/dmac/codec.hpp"
 #include "motorbus/drives/dmac/poll_source.hpp"
@@ -18,6 +19,10 @@ namespace py = pybind11;
 using namespace motorbus;
 using namespace motorbus::dmac;
 using motorbus::py_helpers::Record;
+using motorbus::py_helpers::enum_arg;
+using motorbus::py_helpers::EnumOrName;
+using motorbus::py_helpers::enum_method;
+using motorbus::py_helpers::named_enum;
 
 namespace {
 
@@ -26,32 +31,6 @@ Var var_arg(const std::string& name) {
     auto v = find_variable(name);
     if (!v) throw InvalidArgument("DMAC variable: '" + name + "' is not a DMAC variable name or mnemonic");
     return *v;
-}
-
-// A DmacRadix or its name ('dec'/'d', 'hex'/'h', 'bin'/'b').
-Radix radix_arg(const py::object& o) {
-    if (py::isinstance<Radix>(o)) return o.cast<Radix>();
-    if (!py::isinstance<py::str>(o)) throw InvalidArgument("radix: a DmacRadix or 'dec', 'hex', 'bin'");
-    auto r = o.cast<std::string>();
-    if (r == "dec" || r == "d" || r.empty()) return Radix::Dec;
-    if (r == "hex" || r == "h") return Radix::Hex;
-    if (r == "bin" || r == "b") return Radix::Bin;
-    throw InvalidArgument("radix: '" + r + "' is not 'dec', 'hex' or 'bin'");
-}
-
-StopWhat stop_arg(const std::string& w) {
-    if (w == "all") return StopWhat::All;
-    if (w == "movement" || w == "MOUV") return StopWhat::Movement;
-    if (w == "sequence" || w == "SEQ") return StopWhat::Sequence;
-    throw InvalidArgument("what: '" + w + "' is not 'all', 'movement' or 'sequence'");
-}
-
-Keyword synchro_arg(const std::string& w) {
-    if (w == "ON" || w == "on") return Keyword::On;
-    if (w == "OFF" || w == "off") return Keyword::Off;
-    if (w == "TOP" || w == "top") return Keyword::Top;
-    if (w == "INTERPOL" || w == "interpol") return Keyword::Interpol;
-    throw InvalidArgument("SYNCHRO: '" + w + "' is not ON, OFF, TOP or INTERPOL");
 }
 
 std::function<void(Duration)> sleep_arg(const py::object& f) {
@@ -109,7 +88,10 @@ namespace {
 void fill_rejected(py::object& exc, const CommandRejected& e) { exc.attr("error") = e.error; }
 }  // namespace
 
-void bind_dmac(py::module_& m) {
+static void bind_dmac_client_commands(py::class_<Client, std::shared_ptr<Client>>& cls);
+static void bind_dmac_streaming(py::module_& m);
+
+static void bind_dmac_codec(py::module_& m) {
     bind_dmac_motion(m);
     // ---- errors ---------------------------------------------------------------
     py_errors::add_error_classes(m, {
@@ -122,10 +104,28 @@ void bind_dmac(py::module_& m) {
     py_errors::translate<CommandRejected, fill_rejected>(m.attr("DmacCommandRejected"));
 
     // ---- codec helpers ---------------------------------------------------------------
-    py::enum_<Radix>(m, "DmacRadix", "How a DMAC value is written: +123, h0000007B or b00000000 ... 01111011.")
-        .value("DEC", Radix::Dec)
-        .value("HEX", Radix::Hex)
-        .value("BIN", Radix::Bin);
+    // The enums the client and the simulator take; each also accepts its names
+    // as strings, in any case (named_enum.hpp).
+    named_enum<Radix>(m, "DmacRadix", "How a DMAC value is written: +123, h0000007B or b00000000 ... 01111011.",
+                      "radix", {{"DEC", Radix::Dec}, {"HEX", Radix::Hex}, {"BIN", Radix::Bin}},
+                      {{"d", Radix::Dec}, {"", Radix::Dec}, {"h", Radix::Hex}, {"b", Radix::Bin}});
+    named_enum<StopWhat>(m, "DmacStopWhat", "What STOP / HALT stop: everything, the movement (MOUV) or the sequence (SEQ).",
+                         "what", {{"ALL", StopWhat::All}, {"MOVEMENT", StopWhat::Movement}, {"SEQUENCE", StopWhat::Sequence}},
+                         {{"MOUV", StopWhat::Movement}, {"SEQ", StopWhat::Sequence}});
+    named_enum<PowerMode>(m, "DmacPowerMode", "POWER ON, OFF (freewheel) or SC (short-circuited coils).", "POWER",
+                          {{"ON", PowerMode::On}, {"OFF", PowerMode::Off}, {"SC", PowerMode::ShortCircuit}});
+    named_enum<EndStops>(m, "DmacEndStops", "HARD_ENDS: which hard end-stop inputs stop the motor.", "HARD_ENDS",
+                         {{"OFF", EndStops::Off}, {"ALL", EndStops::All}, {"POS", EndStops::Positive},
+                          {"NEG", EndStops::Negative}});
+    named_enum<Polarity>(m, "DmacPolarity", "INVERSE_POLARITY: which of the inputs and outputs are inverted.",
+                         "INVERSE_POLARITY", {{"OFF", Polarity::Off}, {"ALL", Polarity::All}, {"IN", Polarity::Inputs},
+                                              {"OUT", Polarity::Outputs}});
+    // SYNCHRO's words (dmac_synchro refuses the other keywords).
+    named_enum<Keyword>(m, "DmacKeyword", "The keywords of the DMAC command language.", "SYNCHRO",
+                        {{"ON", Keyword::On}, {"OFF", Keyword::Off}, {"SC", Keyword::Sc}, {"ALL", Keyword::All},
+                         {"POS", Keyword::Pos}, {"NEG", Keyword::Neg}, {"IN", Keyword::In}, {"OUT", Keyword::Out},
+                         {"MOUV", Keyword::Mouv}, {"SEQ", Keyword::Seq}, {"TOP", Keyword::Top},
+                         {"INTERPOL", Keyword::Interpol}});
     Record<ReadReply>(m, "DmacReadReply", "One parsed 'aa#MNE[.bit]=value' reply (dmac_parse_read_reply), read-only.")
         .field("address", &ReadReply::address)
         .field("mnemonic", &ReadReply::mnemonic, "'#ATI'")
@@ -155,7 +155,7 @@ void bind_dmac(py::module_& m) {
         .field("revision_date", &VersionInfo::revision_date)
         .field("phase", &VersionInfo::phase, "'6A'")
         .field("boot", &VersionInfo::boot, "'v1.1'");
-    m.def("dmac_format_value", [](std::int32_t v, const py::object& r) { return format_value(v, radix_arg(r)); },
+    m.def("dmac_format_value", [](std::int32_t v, const EnumOrName<Radix>& r) { return format_value(v, enum_arg<Radix>(r)); },
           py::arg("value"), py::arg("radix") = Radix::Dec,
           "'+123', 'h0000007B' or 'b00000000 ... 01111011'; radix is a DmacRadix or 'dec'/'hex'/'bin'.");
     m.def(
@@ -165,8 +165,13 @@ void bind_dmac(py::module_& m) {
     m.def("dmac_error_names", [](std::uint32_t e) { return error_names(e); }, py::arg("error"));
     m.def("dmac_variable", [](const std::string& name) { return var_info(var_arg(name)); }, py::arg("name"),
           "The DmacVariableInfo of a variable, by full name or mnemonic ('#ACCEL_TIME', 'ATI').");
+}
 
+static void bind_dmac_sim(py::module_& m) {
     // ---- simulator -----------------------------------------------------------------
+    named_enum<Sim::Sensor>(m, "DmacSensor", "The temperature sensors of a module (DmacSim.set_temperature).",
+                            "sensor", {{"CPU", Sim::Sensor::Cpu}, {"DRIVER", Sim::Sensor::Driver},
+                                       {"MOTOR", Sim::Sensor::Motor}});
     Record<SimState>(m, "DmacSimState", "A snapshot of a DmacSim (DmacSim.state()), read-only.")
         .field("now_ms", &SimState::now_ms, "device time (ms)")
         .field("position", &SimState::position, "#POSITION (1/10000 rev)")
@@ -223,12 +228,8 @@ void bind_dmac(py::module_& m) {
         .def("set_analog", &Sim::set_analog, py::arg("channel"), py::arg("mv"))
         .def("set_supply_voltage", &Sim::set_supply_voltage, py::arg("mv"), py::call_guard<py::gil_scoped_release>(),
              "Supply voltage in mV; outside the model's range latches undervoltage/overvoltage and stops the motor.")
-        .def("set_temperature", [](Sim& s, const std::string& which, std::int32_t tenths) {
-                 Sim::Sensor w;
-                 if (which == "cpu") w = Sim::Sensor::Cpu;
-                 else if (which == "driver") w = Sim::Sensor::Driver;
-                 else if (which == "motor") w = Sim::Sensor::Motor;
-                 else throw InvalidArgument("sensor: '" + which + "' is not 'cpu', 'driver' or 'motor'");
+        .def("set_temperature", [](Sim& s, const EnumOrName<Sim::Sensor>& which, std::int32_t tenths) {
+                 const Sim::Sensor w = enum_arg<Sim::Sensor>(which);
                  py::gil_scoped_release nogil;
                  s.set_temperature(w, tenths);
              }, py::arg("sensor"), py::arg("tenths_c"),
@@ -246,7 +247,9 @@ void bind_dmac(py::module_& m) {
              "(increments/s) lasts |offset|/limit instead of #INTERPOL_TIME. 0 = none.")
         .def_property_readonly("lines_handled", &Sim::lines_handled)
         .def_property_readonly("lines_rejected", &Sim::lines_rejected);
+}
 
+static void bind_dmac_client(py::module_& m) {
     // ---- client --------------------------------------------------------------------
     Record<ClientCounters>(m, "DmacClientCounters", "DmacClient counters (DmacClient.counters), read-only.")
         .field("transactions", &ClientCounters::transactions)
@@ -263,9 +266,9 @@ void bind_dmac(py::module_& m) {
         };
     };
     auto wo = [](auto f) { return dmac_setter(f); };
-    py::class_<C, std::shared_ptr<C>>(m, "DmacClient",
-                                      "Typed DMAC commands over a LineLink (one client per module address).")
-        .def(py::init([](std::shared_ptr<serial::LineLink> link, int address, int baud, bool verify,
+    py::class_<C, std::shared_ptr<C>> cls(m, "DmacClient",
+                                          "Typed DMAC commands over a LineLink (one client per module address).");
+    cls.def(py::init([](std::shared_ptr<serial::LineLink> link, int address, int baud, bool verify,
                          const py::object& timeout, const py::object& sleep) {
                  ClientOptions o;
                  o.address = address;
@@ -289,9 +292,9 @@ void bind_dmac(py::module_& m) {
             return py::bytes(r);
         },
              py::arg("frame"), py::arg("expect_reply") = true)
-        .def("read", [](C& c, const std::string& v, const py::object& r) {
+        .def("read", [](C& c, const std::string& v, const EnumOrName<Radix>& r) {
                  Var var = var_arg(v);
-                 Radix rx = radix_arg(r);
+                 Radix rx = enum_arg<Radix>(r);
                  py::gil_scoped_release nogil;
                  return c.read(var, rx);
              }, py::arg("variable"), py::arg("radix") = Radix::Dec,
@@ -374,36 +377,33 @@ void bind_dmac(py::module_& m) {
         .def("memorized_var", &C::memorized_var, py::arg("n"), rel)
         .def("set_memorized_var", &C::set_memorized_var, py::arg("n"), py::arg("value"), rel)
         .def("timer", &C::timer, py::arg("n"), rel)
-        .def("set_timer", &C::set_timer, py::arg("n"), py::arg("ms"), rel)
-        .def("move_to", &C::move_to, py::arg("position"), rel)
+        .def("set_timer", &C::set_timer, py::arg("n"), py::arg("ms"), rel);
+    bind_dmac_client_commands(cls);
+}
+
+void bind_dmac(py::module_& m) {
+    bind_dmac_codec(m);
+    bind_dmac_sim(m);
+    bind_dmac_client(m);
+    bind_dmac_streaming(m);
+}
+
+// Motion, settings in keywords, sequences and interpolation.
+static void bind_dmac_client_commands(py::class_<Client, std::shared_ptr<Client>>& cls) {
+    using C = Client;
+    auto rel = py::call_guard<py::gil_scoped_release>();
+    cls.def("move_to", &C::move_to, py::arg("position"), rel)
         .def("move_on", &C::move_on, py::arg("offset"), rel)
         .def("move_speed", &C::move_speed, py::arg("speed"), rel)
-        .def("stop", [](C& c, const std::string& w) { c.stop(stop_arg(w)); }, py::arg("what") = "all", rel)
-        .def("halt", [](C& c, const std::string& w) { c.halt(stop_arg(w)); }, py::arg("what") = "all", rel)
-        .def("power", [](C& c, const std::string& mode) {
-            if (mode == "ON" || mode == "on") c.power(PowerMode::On);
-            else if (mode == "OFF" || mode == "off") c.power(PowerMode::Off);
-            else if (mode == "SC" || mode == "sc") c.power(PowerMode::ShortCircuit);
-            else throw InvalidArgument("POWER: '" + mode + "' is not ON, OFF or SC");
-        }, py::arg("mode"), rel)
+        .def("stop", enum_method(&C::stop), py::arg("what") = StopWhat::All)
+        .def("halt", enum_method(&C::halt), py::arg("what") = StopWhat::All)
+        .def("power", enum_method(&C::power), py::arg("mode"))
         .def("brake", &C::brake, py::arg("on"), rel)
-        .def("hard_ends", [](C& c, const std::string& w) {
-            if (w == "OFF" || w == "off") c.hard_ends(EndStops::Off);
-            else if (w == "ALL" || w == "all") c.hard_ends(EndStops::All);
-            else if (w == "POS" || w == "pos") c.hard_ends(EndStops::Positive);
-            else if (w == "NEG" || w == "neg") c.hard_ends(EndStops::Negative);
-            else throw InvalidArgument("HARD_ENDS: '" + w + "' is not OFF, ALL, POS or NEG");
-        }, py::arg("which"), rel)
+        .def("hard_ends", enum_method(&C::hard_ends), py::arg("which"))
         .def("soft_ends", &C::soft_ends, py::arg("on"), rel)
         .def("s_curve", &C::s_curve, py::arg("on"), rel)
         .def("optimized_current", &C::optimized_current, py::arg("on"), rel)
-        .def("inverse_polarity", [](C& c, const std::string& w) {
-            if (w == "OFF" || w == "off") c.inverse_polarity(Polarity::Off);
-            else if (w == "ALL" || w == "all") c.inverse_polarity(Polarity::All);
-            else if (w == "IN" || w == "in") c.inverse_polarity(Polarity::Inputs);
-            else if (w == "OUT" || w == "out") c.inverse_polarity(Polarity::Outputs);
-            else throw InvalidArgument("INVERSE_POLARITY: '" + w + "' is not OFF, ALL, IN or OUT");
-        }, py::arg("which"), rel)
+        .def("inverse_polarity", enum_method(&C::inverse_polarity), py::arg("which"))
         .def("reference", &C::reference, py::arg("on"), rel)
         .def("module_reset", &C::module_reset, py::arg("factory") = false, rel)
         .def("set_address", &C::set_address, py::arg("address"), rel)
@@ -426,9 +426,12 @@ void bind_dmac(py::module_& m) {
         .def("step", &C::step, py::arg("line") = py::none(), rel)
         .def("move_interpol", &C::move_interpol, py::arg("offset"), rel,
              "Queues one segment; returns the FIFO level, or None when the FIFO was full (XON_ERROR).");
+}
 
-    m.def("dmac_synchro", [](std::shared_ptr<serial::LineLink> link, const std::string& what) {
-        Keyword k = synchro_arg(what);
+static void bind_dmac_streaming(py::module_& m) {
+    using C = Client;
+    m.def("dmac_synchro", [](std::shared_ptr<serial::LineLink> link, const EnumOrName<Keyword>& what) {
+        Keyword k = enum_arg<Keyword>(what);
         py::gil_scoped_release nogil;
         synchro(*link, k);
     }, py::arg("link"), py::arg("what"), "Global SYNCHRO ON|OFF|TOP|INTERPOL (no reply).");

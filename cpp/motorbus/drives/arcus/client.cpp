@@ -233,7 +233,10 @@ void Client::stop() { expect_ok("STOP", transact("STOP", true)); }
 void Client::abort() { expect_ok("ABORT", transact("ABORT", true)); }
 void Client::clear() { action("CLR"); }
 void Client::clear_snl() { action("CLRS"); }
-void Client::home(HomeMethod method, int direction) { action(home_command(method, direction)); }
+void Client::home(HomeMethod method, int direction) {
+    if (direction != 1 && direction != -1) throw InvalidArgument("home direction: +1 or -1");
+    action(home_command(method, direction));
+}
 std::int64_t Client::home_correction() { return query("HCA"); }
 void Client::set_home_correction(std::int64_t steps) { set("HCA", steps); }
 bool Client::return_to_zero() { return query("RZ") != 0; }

@@ -109,7 +109,7 @@ public:
     void abort();                                // ABORT: immediately
     void clear();                                // CLR: limit and StepNLoop errors
     void clear_snl();                            // CLRS
-    void home(HomeMethod method, int direction);
+    void home(HomeMethod method, int direction);  // direction +1 or -1, else InvalidArgument
     std::int64_t home_correction();              // HCA
     void set_home_correction(std::int64_t steps);
     bool return_to_zero();                       // RZ
