@@ -183,6 +183,25 @@ def test_rpdo_and_numpy_tpdo_stream(rig):
         c.send_rpdo(rx, {})
 
 
+def test_a_client_still_open_at_exit_is_stopped_with_on_exit(rig):
+    """The native client has every kind's shape: the exit hook knows it and applies
+    ``on_exit`` (it used to apply on_exit when a ``with`` ended normally, and nothing at
+    interpreter exit); a closed client is forgotten."""
+    from motorbus import _stop_at_exit
+    sim, c, clock = rig
+    other = Pmc007(c.bus, 5, on_exit="disable")
+    assert other in _stop_at_exit._live
+    other.enable(True)
+    assert c.enabled
+    other._stop_at_exit()              # what the atexit hook and SIGTERM do to each live client
+    assert not c.enabled
+    other.close()
+    assert other not in _stop_at_exit._live
+    with Pmc007(c.bus, 5, on_exit="disable") as d:   # a normal end of `with` leaves the motor be
+        d.enable(True)
+    assert c.enabled
+
+
 def test_sim_serve_store_dir_keeps_the_flash(tmp_path):
     from motorbus.sim import make_sim as make_any_sim
     name = f"virtual:pmc007-py-store-{next(_names)}"

@@ -35,7 +35,7 @@ import threading
 import time
 from typing import Any, Callable, Iterable, Optional, Union
 
-from .. import _core
+from .. import _core, _stop_at_exit
 from ..stopping import check_stop_way
 from ..canopen.node import RemoteNode, check_node_id
 from ..canopen.pdo import PdoChannel
@@ -141,15 +141,16 @@ def _object_property(name: str, doc: str) -> property:
     return property(lambda self: int(self.read(name)), lambda self, value: self.write(name, value), doc=doc)
 
 
-class Pmc007(RemoteNode):
+class Pmc007(_stop_at_exit.StopsMotor, RemoteNode):
     """The native client: a PMC007 profile of a CANopen node (``motorbus.canopen.RemoteNode``).
 
     ``Pmc007(bus, node=5)`` (a ``_core.Bus`` or ``motorbus.open_bus`` text).  Objects by
     name: ``drive["start_speed"]``, ``drive.read("0x6006")``, ``drive.write("6006h", 600)``;
     properties for the common ones.  Underneath is the node: ``object_dictionary`` (the
     device's C++ table, typed), ``sdo`` (its SDO client), ``tpdo``/``rpdo``, ``nmt``.
-    Safety words ``on_error``/``on_exit`` ("stop" = 6020h immediate stop, "disable" =
-    600Eh = 0, None) apply to ``with``."""
+    Safety words ``on_error``/``on_exit`` ("stop" and "quick_stop" = 6020h immediate stop,
+    "disable" = 600Eh = 0, None): ``on_error`` when an exception leaves ``with``,
+    ``on_exit`` at interpreter exit, as every native client (``_stop_at_exit.StopsMotor``)."""
 
     def __init__(self, bus: Any, node: int = 5, timeout: float = 1.0, *, on_error: Optional[str] = "stop",
                  on_exit: Optional[str] = "stop") -> None:
@@ -166,6 +167,7 @@ class Pmc007(RemoteNode):
         self._vars: dict = {}       # Python name -> the node's SdoVariable (made on first use)
         self._pdos: dict = {}       # COB-ID -> the PdoChannel this client configured on it
         self._closed = False
+        _stop_at_exit.track(self)
 
     # ---- objects by name ----
     @staticmethod
@@ -408,31 +410,25 @@ class Pmc007(RemoteNode):
         return by_name
 
     # ---- life ----
+    def _stop_on_error(self) -> None:
+        self._halt(self.on_error)
+
+    def _stop_at_exit(self) -> None:
+        self._halt(self.on_exit)
+
     def _halt(self, how: Optional[str]) -> None:
-        if how is None:
-            return
-        try:
-            if how == "disable":
-                self.release()
-            else:
-                self.stop()
-        except _core.MotorbusError:
-            pass
+        if not self._closed:
+            # 6020h is already the immediate stop: "stop" and "quick_stop" are the same here.
+            _stop_at_exit.halt(how, self.stop, self.stop, self.release)
 
     def close(self) -> None:
         if self._closed:
             return
         self._closed = True
+        _stop_at_exit.untrack(self)
         super().close()             # the node's PDO receivers
         if self._owns:
             self.bus.close()
-
-    def __enter__(self) -> "Pmc007":
-        return self
-
-    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
-        self._halt(self.on_error if exc_type is not None else self.on_exit)
-        self.close()
 
 
 class TpdoStream:
