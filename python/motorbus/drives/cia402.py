@@ -55,50 +55,9 @@ _CW_RELATIVE = 1 << 6
 _CW_HALT = 1 << 8
 
 # (index, sub, name, type, access, default, low, high, unit, persists, description): the objects
-# the simulator serves and the adapter's params describe.  One table for both.
-OBJECTS = [
-    (0x1000, 0, "Device type", "U32", "ro", 0x00420192, None, None, "", False, "CiA 402 drive (servo + stepper)"),
-    (0x1001, 0, "Error register", "U8", "ro", 0, None, None, "", False, "CiA 301 error register"),
-    (0x1008, 0, "Manufacturer device name", "VISIBLE_STRING", "ro", "motorbus CiA 402 sim", None, None, "", False,
-     "device name"),
-    # Identity (CiA 301): vendor 0 = no CiA-assigned vendor (a simulator); serial = the node-ID (set per sim).
-    (0x1018, 1, "Vendor-ID", "U32", "ro", 0, None, None, "", False, "identity: vendor"),
-    (0x1018, 2, "Product code", "U32", "ro", 0x402, None, None, "", False, "identity: product"),
-    (0x1018, 3, "Revision number", "U32", "ro", 0x00010000, None, None, "", False, "identity: revision"),
-    (0x1018, 4, "Serial number", "U32", "ro", 0, None, None, "", False, "identity: serial (the node-ID)"),
-    (0x603F, 0, "Error code", "U16", "ro", 0, None, None, "", False, "last fault's CiA 402 error code"),
-    (0x6007, 0, "Abort connection option code", "I16", "rw", 1, 0, 3, "", True,
-     "what a lost master does: 1 fault, 2 disable voltage, 3 quick stop"),
-    (0x605A, 0, "Quick stop option code", "I16", "rw", 2, 0, 8, "", True, "quick stop reaction"),
-    (0x6060, 0, "Modes of operation", "I8", "rw", 0, None, None, "", False, "1 PP, 3 PV, 6 HM"),
-    (0x6061, 0, "Modes of operation display", "I8", "ro", 0, None, None, "", False, "the mode in effect"),
-    (0x6064, 0, "Position actual value", "I32", "ro", 0, None, None, "inc", False, "position"),
-    (0x6065, 0, "Following error window", "U32", "rw", 1000, 0, 0xFFFFFFFF, "inc", True,
-     "a larger lag of the rotor behind the demand is a following error (fault 0x8611)"),
-    (0x6067, 0, "Position window", "U32", "rw", 10, 0, 0xFFFFFFFF, "inc", True,
-     "a move within this of its target is at target"),
-    (0x606C, 0, "Velocity actual value", "I32", "ro", 0, None, None, "inc/s", False, "velocity"),
-    (0x607A, 0, "Target position", "I32", "rw", 0, None, None, "inc", False, "PP target"),
-    (0x607C, 0, "Home offset", "I32", "rw", 0, None, None, "inc", True, "position after homing"),
-    (0x607D, 1, "Min position limit", "I32", "rw", _I32_MIN, None, None, "inc", True,
-     "software position limit: PP targets below are clipped to it"),
-    (0x607D, 2, "Max position limit", "I32", "rw", _I32_MAX, None, None, "inc", True,
-     "software position limit: PP targets above are clipped to it"),
-    (0x6081, 0, "Profile velocity", "U32", "rw", 1000, 1, 10_000_000, "inc/s", True, "PP speed"),
-    (0x6083, 0, "Profile acceleration", "U32", "rw", 10000, 1, 100_000_000, "inc/s²", True, "PP/PV acceleration"),
-    (0x6084, 0, "Profile deceleration", "U32", "rw", 10000, 1, 100_000_000, "inc/s²", True, "PP/PV deceleration"),
-    (0x6085, 0, "Quick stop deceleration", "U32", "rw", 100000, 1, 100_000_000, "inc/s²", True,
-     "deceleration of a quick stop"),
-    (0x6086, 0, "Motion profile type", "I16", "rw", 0, 0, 1, "", True, "0 linear ramp, 1 sin² ramp"),
-    (0x6098, 0, "Homing method", "I8", "rw", 19, None, None, "", True, "7, 11, 17-20, 33-35 (sim default 19: home switch)"),
-    (0x6099, 1, "Speed during search for switch", "U32", "rw", 5000, 1, 10_000_000, "inc/s", True, "homing"),
-    (0x6099, 2, "Speed during search for zero", "U32", "rw", 1000, 1, 10_000_000, "inc/s", True, "homing"),
-    (0x609A, 0, "Homing acceleration", "U32", "rw", 20000, 1, 100_000_000, "inc/s²", True, "homing"),
-    (0x60FD, 0, "Digital inputs", "U32", "ro", 0, None, None, "", False,
-     "bit 0 negative limit, 1 positive, 2 home; bit 16 the simulator's quick-stop input"),
-    (0x60FF, 0, "Target velocity", "I32", "rw", 0, None, None, "inc/s", False, "PV target"),
-    (0x6502, 0, "Supported drive modes", "U32", "ro", 0b100101, None, None, "", False, "PP, PV, HM"),
-]
+# the simulator serves and the adapter's params describe -- one table, in C++
+# (cpp/motorbus/drives/cia402/sim.cpp ``objects()``); typed, it is object_dictionary().
+OBJECTS = [tuple(row) for row in _core.cia402_objects()]
 _SAVE = 0x65766173  # CiA 301 1010h signature "save" (ASCII, little-endian)
 _OD: Optional["_core.ObjectDictionary"] = None
 
