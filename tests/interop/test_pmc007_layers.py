@@ -133,6 +133,18 @@ def test_a_move_to_walked_down_to_the_wire_bytes(bench, tmp_path):
     assert frames[3][1][:4] == bytes([0x43, 0x03, 0x60, 0x00])     # 6003h read back: 4 bytes
 
 
+def test_cia402_and_arcus_canopen_adapters_read_and_write_by_typed_cpp_dictionaries():
+    from motorbus.drives import arcus_canopen, cia402
+    generic, arcus = cia402.Cia402Drive.object_dictionary(), arcus_canopen.ArcusCanopenDrive.object_dictionary()
+    assert isinstance(generic, ObjectDictionary) and isinstance(arcus, ObjectDictionary)
+    # The same rows as the C++ tables the simulators serve, typed by them.
+    assert {(r[0], r[1]) for r in cia402.OBJECTS} <= {(i, s) for i in generic.indices() for s in generic.subindices(i)}
+    assert generic[0x607A, 0].data_type == DataType.INTEGER32 and generic[0x607A, 0].encode(-1) == b"\xff" * 4
+    assert generic[0x6041, 0].decode(b"\x37\x06") == 0x0637
+    assert arcus[0x2004, 2].value_range == (100, 2500)             # Run current, mA: the table's range
+    assert arcus[0x6060, 0].access == "wo" and arcus[0x6060, 0].encode(-1) == b"\xff"
+
+
 VENDORS = ["pmc007.py", "cia402.py", "arcus_canopen.py"]
 
 
