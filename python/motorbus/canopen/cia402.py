@@ -201,12 +201,16 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
         # then applies 0x6007 too, should the stop above not have reached it.
 
     def _halt(self, how: Optional[str]) -> None:
-        if how is None or self._closed:
+        if self._closed:
             return
-        try:
-            self.write_controlword(int(Controlword.QUICK_STOP if how == "quick_stop" else Controlword.DISABLE_VOLTAGE))
-        except Exception:  # noqa: BLE001 - best effort while unwinding
-            pass
+
+        def quick_stop() -> None:
+            self.write_controlword(int(Controlword.QUICK_STOP))
+
+        def disable() -> None:
+            self.write_controlword(int(Controlword.DISABLE_VOLTAGE))
+        # The words' ladder is _stop_at_exit.halt's ("stop" is not one of this host's words).
+        _stop_at_exit.halt(how, quick_stop, quick_stop, disable)
 
 
 #: The stop words this host has (stopping.py's minus "stop": the controlword's own

@@ -298,15 +298,15 @@ class DmacClient(_stop_at_exit.StopsMotor, _core.DmacClient):
         self._apply(self.on_exit)
 
     def _apply(self, how: Optional[str]) -> None:
-        if how is None or not getattr(self, "_open", False):
+        if not getattr(self, "_open", False):
             return
-        cmd = {"stop": "STOP", "quick_stop": "HALT", "disable": "POWER OFF"}[how]
-        try:
+
+        def send(cmd: str) -> Any:
             # The command plus a READ, so we know the module took it; no error
             # checking that could itself raise while unwinding.
-            self.raw(f"{self.address:02d}{cmd}, READ #STATUS", expect_reply=True)
-        except Exception:  # the link may already be gone; nothing more to do
-            pass
+            return lambda: self.raw(f"{self.address:02d}{cmd}, READ #STATUS", expect_reply=True)
+        # The words' ladder is _stop_at_exit.halt's (a failed STOP falls back to HALT, then POWER OFF).
+        _stop_at_exit.halt(how, send("STOP"), send("HALT"), send("POWER OFF"))
 
     def __repr__(self) -> str:
         return f"DmacClient(address={self.address:02d})"
