@@ -34,7 +34,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoCaptureSource', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'PollGroup', 'PollSource', 'PollStats', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekCaptureSource', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_poll_source', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_poll_source', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'sdo_poll_source', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_analog_command_num', 'unitek_bit_rate_for_btr', 'unitek_bit_timings', 'unitek_btr_for_bit_rate', 'unitek_capture_source', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_effective_current_limit_num', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_poll_source', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoCaptureSource', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'PollGroup', 'PollSource', 'PollStats', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SimulatedDevice', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekCaptureSource', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_poll_source', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_poll_source', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'sdo_poll_source', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_analog_command_num', 'unitek_bit_rate_for_btr', 'unitek_bit_timings', 'unitek_btr_for_bit_rate', 'unitek_capture_source', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_effective_current_limit_num', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_poll_source', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -416,6 +416,38 @@ class Recorder:
     @property
     def count(self) -> int:
         ...
+class SimulatedDevice:
+    """
+    A simulated CAN device: attach(bus) serves it on a bus (kept alive until close()), close() takes it off (idempotent); attach again to serve it anew.  Also a context manager (closes on exit).
+    """
+    def __enter__(self) -> typing.Any:
+        ...
+    def __exit__(self, *args) -> None:
+        ...
+    def attach(self, bus: Bus) -> None:
+        """
+        Serve on `bus`; the simulator keeps it alive until close().  InvalidArgument if already attached.
+        """
+    def close(self) -> None:
+        """
+        Off the bus (idempotent); attach() may follow.
+        """
+    def describe(self) -> str:
+        """
+        '<kind> sim <address>', as errors name it.
+        """
+    def power_cycle(self) -> None:
+        """
+        Power off and on: stored settings take effect, volatile ones are lost.
+        """
+    @property
+    def attached(self) -> bool:
+        ...
+    @property
+    def node_bit_rate(self) -> float:
+        """
+        bit/s the simulated controller runs at (0: takes the wire's; < 0: matches no wire)
+        """
 class SlcanStats:
     """
     SLCAN link statistics (SlcanBus.stats), read-only.
@@ -3101,17 +3133,11 @@ class ArcusCommandInfo:
         """
         written to flash by STORE (Table 7.10)
         """
-class ArcusSim(LineDevice):
+class ArcusSim(LineDevice, SimulatedDevice):
     """
-    A simulated Arcus DMX-CAN answering ASCII lines (a LineDevice for PtyLineServer).
+    A simulated Arcus DMX-CAN: answers ASCII lines (a LineDevice for PtyLineServer) and, attached to a CAN bus, CANopen (a SimulatedDevice).
     """
     def __init__(self, clock: Clock = None, address: typing.SupportsInt | typing.SupportsIndex = 1, response_type: typing.SupportsInt | typing.SupportsIndex = 0, store_path: str = '', eo_boot: bool = False, snl: bool = True, home: tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex] = (8000.0, 8400.0), minus_limit: typing.SupportsFloat | typing.SupportsIndex | None = -400000.0, plus_limit: typing.SupportsFloat | typing.SupportsIndex | None = 400000.0, z_position: typing.SupportsFloat | typing.SupportsIndex = 1600.0, start_position: typing.SupportsFloat | typing.SupportsIndex = 0.0, tick: typing.SupportsFloat | typing.SupportsIndex = 0.0001, comm_type: typing.SupportsInt | typing.SupportsIndex = 0, node_id: typing.SupportsInt | typing.SupportsIndex = 1, store_time: typing.SupportsFloat | typing.SupportsIndex = 0.0, clear_time: typing.SupportsFloat | typing.SupportsIndex = 0.0, bit_rate: typing.SupportsInt | typing.SupportsIndex = 5) -> None:
-        ...
-    def attach_can(self, bus: Bus) -> None:
-        """
-        Serve the CANopen persona on `bus` (answers while the communication type in effect is CAN).
-        """
-    def detach_can(self) -> None:
         ...
     def disturb(self, steps: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
@@ -3121,14 +3147,12 @@ class ArcusSim(LineDevice):
         ...
     def on_can_frame(self, frame: Frame) -> list[Frame]:
         """
-        One CAN frame in, the frames the drive answers out (what attach_can runs per frame).
+        One CAN frame in, the frames the drive answers out (what attach runs per frame).
         """
     def on_line(self, line: typing.Any) -> bytes:
         """
         One request line without CR -> the reply bytes (NUL included; b'' = silent).
         """
-    def power_cycle(self) -> None:
-        ...
     def set_blocked(self, blocked: bool) -> None:
         ...
     def set_input(self, index: typing.SupportsInt | typing.SupportsIndex, actuated: bool) -> None:
@@ -4174,23 +4198,17 @@ class Pmc007ProfileParams:
     @stop_speed.setter
     def stop_speed(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
-class Pmc007Sim:
+class Pmc007Sim(SimulatedDevice):
     """
     A simulated CQPUSI PMC007 CANopen node (see sim.hpp).
     """
     def __init__(self, node_id: typing.SupportsInt | typing.SupportsIndex = 5, clock: Clock = None, steps_per_rev: typing.SupportsFloat | typing.SupportsIndex = 200.0, pull_out_speed: typing.SupportsFloat | typing.SupportsIndex = 0.0, ext1_switch: tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex] | None = None, store_path: str = '', vendor_id: typing.SupportsInt | typing.SupportsIndex = 0, product_code: typing.SupportsInt | typing.SupportsIndex = 7, revision: typing.SupportsInt | typing.SupportsIndex = 65536, serial: typing.SupportsInt | typing.SupportsIndex = 1) -> None:
-        ...
-    def attach(self, bus: Bus) -> None:
-        ...
-    def close(self) -> None:
         ...
     def inject_error(self, bits: typing.SupportsInt | typing.SupportsIndex) -> None:
         """
         Latch 6000h error bits (EMCY sent).
         """
     def poll(self) -> None:
-        ...
-    def power_cycle(self) -> None:
         ...
     def set_input(self, bit: typing.SupportsInt | typing.SupportsIndex, high: bool) -> None:
         """
@@ -4206,9 +4224,6 @@ class Pmc007Sim:
         """
         The encoder CPR in use: 6021h as it was at the last power-up or reset node (B-P40).
         """
-    @property
-    def attached(self) -> bool:
-        ...
     @property
     def busy(self) -> bool:
         ...
@@ -4233,6 +4248,11 @@ class Pmc007Sim:
     @property
     def in_bootloader(self) -> bool:
         ...
+    @property
+    def last_error(self) -> str:
+        """
+        why the last node-ID switch or return to the bus failed ('' if none did)
+        """
     @property
     def node_id(self) -> int:
         ...
@@ -4605,15 +4625,11 @@ class UnitekSimCounters:
     @property
     def unknown(self) -> int:
         ...
-class UnitekSim:
+class UnitekSim(SimulatedDevice):
     """
     A simulated UNITEK servo on the register protocol (see sim.hpp).
     """
     def __init__(self, clock: Clock, rx_id: typing.SupportsInt | typing.SupportsIndex = 513, tx_id: typing.SupportsInt | typing.SupportsIndex = 385, n_max_rpm: typing.SupportsFloat | typing.SupportsIndex = 3000.0, acc_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0, dec_ramp_ms: typing.SupportsFloat | typing.SupportsIndex = 1000.0, position_control: bool = True, speed_control: bool = True, calibrated: bool = False, tol_num: typing.SupportsInt | typing.SupportsIndex = 64, minus_limit_num: typing.SupportsFloat | typing.SupportsIndex | None = -6553600.0, plus_limit_num: typing.SupportsFloat | typing.SupportsIndex | None = 6553600.0, torque_continuous_num: typing.SupportsInt | typing.SupportsIndex = 32767, dummy: typing.SupportsInt | typing.SupportsIndex = 0, table: UnitekRegisterTable | None = None, device: str = 'DS 205/405', motor_i_max_num: typing.SupportsInt | typing.SupportsIndex | None = None, btr: typing.SupportsInt | typing.SupportsIndex = 16421, analog_command: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
-        ...
-    def attach(self, bus: Bus) -> None:
-        ...
-    def close(self) -> None:
         ...
     def eeprom(self) -> dict[int, int]:
         ...
@@ -4632,8 +4648,6 @@ class UnitekSim:
         callback(dict regid -> value) after each EEPROM store (0x84)
         """
     def on_frame(self, frame: Frame) -> None:
-        ...
-    def power_cycle(self) -> None:
         ...
     def sent(self, regid: typing.SupportsInt | typing.SupportsIndex) -> int:
         ...
