@@ -252,7 +252,7 @@ void LocalNode::on_sdo_frame(const can::Frame& f) {
     }
     {
         std::lock_guard lock(sdo_mutex_);
-        if (server_.handles_inline(f.payload())) {
+        if (options_.sdo_inline || server_.handles_inline(f.payload())) {
             // Mid-transfer frames are cheap and come back to back (block
             // sub-blocks), and a silent frame is followed at once by the next
             // request: a mailbox would add latency or drop them.

@@ -92,6 +92,11 @@ struct LocalNodeOptions {
     // DLC is not 8, for a device whose manual says so.  false = the CiA 301
     // lenience of SdoServerMachine (short frames parsed as far as they go).
     bool sdo_require_dlc8 = false;
+    // Serve every SDO request on the bus receive thread, as mid-transfer frames
+    // are, instead of through the worker's mailbox: for a device whose hooks are
+    // short and never block (a C++ simulator), it saves a thread hand-off per
+    // request.  false = the mailbox (a slow hook never stalls the bus; S18).
+    bool sdo_inline = false;
 };
 
 struct LocalNodeCounters {

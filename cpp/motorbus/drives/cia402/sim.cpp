@@ -326,6 +326,9 @@ void Sim::attach(std::shared_ptr<can::Bus> bus) {
 void Sim::serve(can::Bus& bus) {
     canopen::LocalNodeOptions o;
     o.on_reset = [this](canopen::NmtCommand) { publish_settings(); };
+    // The hooks are this file's C++ (the axis under its own lock, bounded work): the
+    // requests are served on the bus thread, without a hand-off to the node's worker.
+    o.sdo_inline = true;
     auto n = std::make_unique<canopen::LocalNode>(bus, node_id_, od_, o);
     auto hb = canopen::HeartbeatService::attach(
         *n, {.consumer_entries = 4, .producer_ms = static_cast<std::uint16_t>(options_.heartbeat_ms)});

@@ -1,0 +1,142 @@
+"""SDO expedited reads/s from the canopen package's client: against the generic C++ CiA 402
+simulator and against canopen's own LocalNode with the same dictionary (the EDS the
+simulator exports), in the same run; ratio printed.  Two transports, each the same for both
+servers:
+
+* ``virtual`` (as bench/pmc007_sdo.py): python-can's `virtual` interface; the simulator sits
+  behind motorbus's python-can bridge (a Python reader thread), the LocalNode behind its
+  Network's notifier thread.
+* ``socketcand``: the client talks socketcand (python-can's interface) to a motorbus
+  SocketcandServer on 127.0.0.1; the simulator is on the served bus itself (no Python on its
+  side), the LocalNode reaches its own server through python-can's socketcand interface too
+  (a Python program serving a node has no other way onto a served bus).
+
+    python bench/cia402_sdo.py [--seconds 3] [--object 0x6041] [--transport both]
+
+Both servers answer the same request (an expedited upload of 6041h, the statusword a master
+polls; --object picks another, e.g. 0x6081 a plain setting) to the same client code.  The
+simulator's statusword is computed when read (the motion is evaluated); the LocalNode's is
+a stored value.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import tempfile
+
+from helpers.timing import rate  # bench/helpers: shared by the benchmarks
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--seconds", type=float, default=3.0)
+    ap.add_argument("--object", type=lambda s: int(s, 0), default=0x6041)
+    ap.add_argument("--transport", choices=("virtual", "socketcand", "both"), default="both")
+    a = ap.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        for transport in ("virtual", "socketcand") if a.transport == "both" else (a.transport,):
+            (virtual if transport == "virtual" else socketcand)(a, os.path.join(tmp, "cia402.eds"))
+
+
+def report(transport: str, index: int, ours: tuple, ref: tuple) -> None:
+    print(f"[{transport}] canopen client -> motorbus cia402 sim : {ours[0]:9.0f} reads/s  median {ours[1]:6.1f} us  "
+          f"p99 {ours[2]:6.1f} us")
+    print(f"[{transport}] canopen client -> canopen LocalNode   : {ref[0]:9.0f} reads/s  median {ref[1]:6.1f} us  "
+          f"p99 {ref[2]:6.1f} us")
+    print(f"[{transport}] ratio (sim / canopen LocalNode)        : {ours[0] / ref[0]:.2f}x  "
+          f"(object 0x{index:04X}, load {os.getloadavg()[0]:.1f})")
+    print(json.dumps({"bench": "cia402_sdo", "transport": transport, "object": f"0x{index:04X}",
+                      "sim_reads_per_s": round(ours[0]), "localnode_reads_per_s": round(ref[0]),
+                      "ratio": round(ours[0] / ref[0], 3)}))
+
+
+def virtual(a: argparse.Namespace, eds: str) -> None:
+    import can
+    import canopen
+
+    import motorbus
+    from motorbus.drives import cia402
+
+    index = a.object
+
+    # 1. canopen's client -> the C++ cia402 sim, through motorbus's python-can bridge.
+    pc = can.Bus(interface="virtual", channel="bench-cia402-sdo")
+    bus = motorbus.open_bus(pc)
+    sim = cia402.make_sim(5, bus=bus)
+    with open(eds, "w") as f:
+        f.write(sim.od.to_eds(False))
+    net = canopen.Network()
+    net.connect(interface="virtual", channel="bench-cia402-sdo")
+    remote = net.add_node(5, eds)
+    expected = remote.sdo.upload(index, 0)
+    ours = rate(lambda: remote.sdo.upload(index, 0), a.seconds)
+    net.disconnect()
+    sim.close()
+    bus.close()
+
+    # 2. canopen's client -> canopen's LocalNode with the same EDS.
+    server, client = canopen.Network(), canopen.Network()
+    server.connect(interface="virtual", channel="bench-cia402-ref")
+    client.connect(interface="virtual", channel="bench-cia402-ref")
+    local = canopen.LocalNode(5, eds)
+    server.add_node(local)
+    remote = client.add_node(5, eds)
+    assert len(remote.sdo.upload(index, 0)) == len(expected)
+    ref = rate(lambda: remote.sdo.upload(index, 0), a.seconds)
+    client.disconnect()
+    server.disconnect()
+    report("virtual", index, ours, ref)
+
+
+def socketcand(a: argparse.Namespace, eds: str) -> None:
+    import can
+    import canopen
+
+    import motorbus
+    from motorbus import _core
+    from motorbus.drives import cia402
+
+    index = a.object
+
+    def connect(server: "_core.SocketcandServer") -> "canopen.Network":
+        net = canopen.Network(can.Bus(interface="socketcand", host=server.host, port=server.port, channel="can0"))
+        net.connect = lambda *args, **kw: None  # the bus is open already
+        net.notifier = can.Notifier(net.bus, net.listeners, 0.1)
+        return net
+
+    def disconnect(net: "canopen.Network") -> None:
+        net.notifier.stop()
+        net.bus.shutdown()
+
+    # 1. canopen's client -> the C++ cia402 sim on the served bus.
+    # Two endpoints of one virtual hub: the server's and the simulator's (an endpoint does not
+    # hear its own frames).
+    with motorbus.open_bus("virtual:bench-cia402-served") as hub, \
+            motorbus.open_bus("virtual:bench-cia402-served") as node_side:
+        sim = cia402.make_sim(5, bus=node_side)
+        with open(eds, "w") as f:
+            f.write(sim.od.to_eds(False))
+        with _core.SocketcandServer(hub, host="127.0.0.1", port=0, channel="can0") as server:
+            net = connect(server)
+            remote = net.add_node(5, eds)
+            expected = remote.sdo.upload(index, 0)
+            ours = rate(lambda: remote.sdo.upload(index, 0), a.seconds)
+            disconnect(net)
+        sim.close()
+
+    # 2. canopen's client -> canopen's LocalNode, itself a socketcand client of the server.
+    with motorbus.open_bus("virtual:bench-cia402-served-ref") as hub:
+        with _core.SocketcandServer(hub, host="127.0.0.1", port=0, channel="can0") as server:
+            node_net, client = connect(server), connect(server)
+            node_net.add_node(canopen.LocalNode(5, eds))
+            remote = client.add_node(5, eds)
+            assert len(remote.sdo.upload(index, 0)) == len(expected)
+            ref = rate(lambda: remote.sdo.upload(index, 0), a.seconds)
+            disconnect(client)
+            disconnect(node_net)
+    report("socketcand", index, ours, ref)
+
+
+if __name__ == "__main__":
+    main()
