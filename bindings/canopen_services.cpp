@@ -165,6 +165,16 @@ Cia402State cia402_state_of(const std::string& s) {
     throw InvalidArgument("CiA 402 state name not known: '" + s + "'");
 }
 
+// An int for a core function that range-checks it, narrowed to the core's
+// type: a value the type cannot hold becomes the type's maximum, which each
+// such check here refuses (SYNC counter 1-240, overflow 0 or 2-240, node range
+// 1-127), so the range is checked once, by the core, with its message.
+template <class U>
+U saturate(std::int64_t v) {
+    constexpr auto hi = std::numeric_limits<U>::max();
+    return v < 0 || v > static_cast<std::int64_t>(hi) ? hi : static_cast<U>(v);
+}
+
 void check_node(int n, bool allow_zero) {
     if (n < (allow_zero ? 0 : 1) || n > 127)
         throw InvalidArgument("node id " + std::to_string(n) + (allow_zero ? " is outside 0-127" : " is outside 1-127"));
@@ -336,10 +346,8 @@ static void bind_codecs(py::module_& m) {
           }, py::arg("frame"));
     m.def("emcy_code_text", &emcy_code_text, py::arg("code"));
     m.def("sync_encode", [](std::optional<int> counter, std::uint32_t cob_id) {
-              if (counter && (*counter < 1 || *counter > 240)) throw InvalidArgument("SYNC counter must be 1-240");
-              return encode_sync(counter ? std::optional<std::uint8_t>(static_cast<std::uint8_t>(*counter))
-                                         : std::nullopt,
-                                 cob_id);
+              return encode_sync(counter ? std::optional<std::uint8_t>(saturate<std::uint8_t>(*counter)) : std::nullopt,
+                                 cob_id);  // the core refuses a counter outside 1-240
           }, py::arg("counter") = py::none(), py::arg("cob_id") = kSyncCobId);
     m.def("time_encode", [](std::int64_t unix_ms) { return encode_time(TimeOfDay::from_unix_ms(unix_ms)); },
           py::arg("unix_ms"));
@@ -551,10 +559,8 @@ static void bind_sync(py::module_& m) {
                  not_none(bus, "bus");
                  const auto period_ns = duration_arg(period, "period");
                  if (period_ns.count() <= 0) throw InvalidArgument("period: a SYNC period must be > 0 s");
-                 if (overflow < 0 || overflow > 240) throw InvalidArgument("SYNC counter overflow must be 0 or 2-240");
-                 return make_service<SyncProducer>(bus, *bus, period_ns,
-                                                   static_cast<std::uint8_t>(overflow), cob_id);
-                 
+                 // The core refuses an overflow other than 0 or 2-240.
+                 return make_service<SyncProducer>(bus, *bus, period_ns, saturate<std::uint8_t>(overflow), cob_id);
              }), py::arg("bus"), py::arg("period"), py::arg("counter_overflow") = 0, py::arg("cob_id") = kSyncCobId)
         .def("start", [](SyncProducer& b, bool realtime) { b.start(realtime); }, py::arg("realtime") = false,
              "realtime=True asks for SCHED_FIFO; see realtime_granted.")
@@ -581,14 +587,9 @@ static void bind_pdo(py::module_& m) {
                  return l.offset(i);
              })
         .def("pack", [](const PdoLayout& l, const std::vector<std::int64_t>& values) {
-                 if (values.size() != l.size())
-                     throw InvalidArgument("PDO pack: " + std::to_string(values.size()) + " values for " +
-                                           std::to_string(l.size()) + " entries");
-                 std::uint64_t v[PdoLayout::kMaxEntries];
-                 for (std::size_t i = 0; i < values.size(); ++i) v[i] = static_cast<std::uint64_t>(values[i]);
-                 std::uint8_t out[8];
-                 const unsigned n = l.pack(v, out);
-                 return to_bytes(std::span<const std::uint8_t>(out, n));
+                 // The layout keeps each value's low bits: a negative one packs as its two's complement.
+                 const std::vector<std::uint64_t> v(values.begin(), values.end());
+                 return to_bytes(l.pack(v));  // the core refuses a wrong count
              }, py::arg("values"), "Values are ints (negative ones in two's complement of their width).")
         .def("pack_unsigned", [](const PdoLayout& l, const std::vector<std::uint64_t>& values) {
                  return to_bytes(l.pack(values));
@@ -849,10 +850,9 @@ static void bind_scanner(py::module_& m) {
     m.def("scan_network", [](BusPtr bus, int first, int last, double sdo_timeout, double listen, bool probe_sdo,
                              bool identity) {
               not_none(bus, "bus");
-              if (first < 1 || last > 127 || first > last) throw InvalidArgument("scan range must be within 1-127");
-              ScanOptions o;
-              o.first = static_cast<std::uint8_t>(first);
-              o.last = static_cast<std::uint8_t>(last);
+              ScanOptions o;  // the core refuses a range outside 1-127
+              o.first = saturate<std::uint8_t>(first);
+              o.last = saturate<std::uint8_t>(last);
               o.sdo_timeout = duration_arg(sdo_timeout, "sdo_timeout");
               o.listen = duration_arg(listen, "listen");
               o.probe_sdo = probe_sdo;

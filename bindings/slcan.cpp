@@ -197,8 +197,8 @@ static void bind_slcan_codec(py::module_& m) {
               std::optional<std::uint16_t> ts;
               if (!timestamp_ms.is_none()) {
                   auto v = arg_cast<unsigned>(timestamp_ms, "timestamp_ms", "an int 0-59999 or None");
-                  if (v > slcan::kMaxTimestamp) throw InvalidArgument("slcan timestamp: must be 0-59999 ms");
-                  ts = static_cast<std::uint16_t>(v);
+                  // Past 65535 it stays out of range: the core refuses more than 59999 ms.
+                  ts = static_cast<std::uint16_t>(std::min<unsigned>(v, std::numeric_limits<std::uint16_t>::max()));
               }
               return py::bytes(slcan::encode_frame(f, ts));
           },

@@ -217,9 +217,7 @@ static void bind_unitek_registers(py::module_& m) {
         return out;
     });
     m.def("unitek_continuous_current_num", [](const std::string& device, double amps) {
-        for (const auto& d : device_currents())
-            if (device == d.device) return continuous_current_num(d, amps);
-        throw InvalidArgument("unitek device: 'DS 205/405', 'DS 412' or 'DS 420', not '" + device + "'");
+        return continuous_current_num(device_current(device), amps);
     }, py::arg("device"), py::arg("amps"));
     m.def("unitek_effective_current_limit_num", [](const std::string& device, std::int64_t motor_limit_num) {
         return effective_current_limit_num(device_current(device), motor_limit_num);
