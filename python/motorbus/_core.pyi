@@ -34,7 +34,7 @@ from motorbus.canopen import SdoTimeout
 import numpy
 import numpy.typing
 import typing
-__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacMotion', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSim', 'DmacSimState', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoCaptureSource', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'PollGroup', 'PollSource', 'PollStats', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SimulatedDevice', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'TtyPort', 'UnitekAccess', 'UnitekCaptureSource', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_poll_source', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_poll_source', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_decode', 'pmc007_disassemble', 'pmc007_disassemble_word', 'pmc007_eds', 'pmc007_encode', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_od_rows', 'pmc007_position_profile', 'pmc007_speed_profile', 'read_log', 'scan_network', 'sdo_poll_source', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_analog_command_num', 'unitek_bit_rate_for_btr', 'unitek_bit_timings', 'unitek_btr_for_bit_rate', 'unitek_capture_source', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_effective_current_limit_num', 'unitek_encode_reply', 'unitek_encode_request', 'unitek_encode_write', 'unitek_event_status_mask', 'unitek_poll_source', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
+__all__: list[str] = ['ABORT_CODES', 'ARCUS_MAX_MOVE_DISTANCE', 'ARCUS_MAX_REPLY', 'ARCUS_MAX_REQUEST', 'ArcusBadSspd', 'ArcusClientBase', 'ArcusClientCounters', 'ArcusCommandInfo', 'ArcusEnableRs485', 'ArcusError', 'ArcusHomeMethod', 'ArcusHoming', 'ArcusHomingOptions', 'ArcusIndexOutOfRange', 'ArcusMotion', 'ArcusMotorNotMoving', 'ArcusMoving', 'ArcusPhase', 'ArcusProfileParams', 'ArcusScvOn', 'ArcusSim', 'ArcusSpeedOutOfRange', 'ArcusSpeedWindow', 'ArcusStateError', 'ArcusUnknownCommand', 'Bus', 'BusCounters', 'Cia402Device', 'Cia402Homing', 'Cia402HomingParams', 'Cia402Host', 'Cia402ProfileParams', 'Cia402ProfilePosition', 'Cia402Sim', 'Clock', 'ClosedError', 'DataType', 'DmacClient', 'DmacClientCounters', 'DmacCommandRejected', 'DmacEndStops', 'DmacKeyword', 'DmacMotion', 'DmacPolarity', 'DmacPowerMode', 'DmacProfileParams', 'DmacRadix', 'DmacReadReply', 'DmacSensor', 'DmacSim', 'DmacSimState', 'DmacStopWhat', 'DmacStreamStats', 'DmacUnknownCommand', 'DmacVariableInfo', 'DmacVersionInfo', 'DriveFault', 'EchoLineDevice', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'ExternalBus', 'Frame', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'InvalidArgument', 'JitterStats', 'LimitExceeded', 'Limits', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'LinkDown', 'LocalNode', 'LocalNodeCounters', 'LogEntry', 'LogFormat', 'MotionState', 'MotorConfig', 'MotorEvent', 'MotorEventKind', 'MotorModel', 'MotorbusError', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoCaptureSource', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'Pmc007ProfileParams', 'Pmc007Sim', 'Pmc007Storage', 'PollGroup', 'PollSource', 'PollStats', 'Port', 'Profile', 'ProtocolError', 'PtyLineServer', 'PtyPair', 'RampShape', 'RealClock', 'Recorder', 'ReplyTooLong', 'Rfc2217Port', 'SdoAbortError', 'SdoClient', 'SdoClientCounters', 'SdoProtocolError', 'SdoServerCounters', 'SdoTimeout', 'SimClock', 'SimulatedDevice', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SnlActivity', 'SnlConfig', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'StepNLoop', 'SwitchConfig', 'SyncProducer', 'TcpPort', 'TimeoutError', 'ToyClient', 'ToyLastStop', 'ToySim', 'ToyStatus', 'TtyPort', 'UnitekAccess', 'UnitekCaptureSource', 'UnitekClient', 'UnitekClientCounters', 'UnitekCyclicLimit', 'UnitekFrameError', 'UnitekQuantity', 'UnitekRampParams', 'UnitekRegister', 'UnitekRegisterTable', 'UnitekScalings', 'UnitekSim', 'UnitekSimCounters', 'UnitekStream', 'UnitekUnknownRegister', 'Variable', 'VirtualBus', 'abort_text', 'arcus_acc_range', 'arcus_build_request', 'arcus_canopen_object_dictionary', 'arcus_canopen_objects', 'arcus_check_strict', 'arcus_commands', 'arcus_effective', 'arcus_max_acc_ms', 'arcus_parse_reply', 'arcus_poll_source', 'arcus_speed_windows', 'arcus_window_for_hspd', 'arcus_window_for_sspdm', 'cia402_decode_statusword', 'cia402_next_step', 'cia402_object_dictionary', 'cia402_objects', 'cia402_position_profile', 'cia402_quick_stop_profile', 'cia402_velocity_profile', 'decode_value', 'dmac_error_names', 'dmac_format_value', 'dmac_parse_read_reply', 'dmac_poll_source', 'dmac_position_profile', 'dmac_ramp_time', 'dmac_speed_profile', 'dmac_status_names', 'dmac_stream_interpolation', 'dmac_synchro', 'dmac_variable', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'jerk_limited_durations', 'monotonic_ns', 'nmt_decode', 'nmt_encode', 'open_port', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'pdo_read_config', 'pdo_write_config', 'plan_jerk_limited', 'plan_jerk_limited_velocity', 'plan_straight_line', 'plan_synchronized', 'plan_synchronized_jerk_limited', 'plan_trapezoid', 'plan_velocity', 'play', 'pmc007_assemble', 'pmc007_convert_position', 'pmc007_disassemble', 'pmc007_eds', 'pmc007_gear_acceleration', 'pmc007_microsteps', 'pmc007_object_dictionary', 'pmc007_position_profile', 'pmc007_speed_profile', 'pmc007_storage', 'read_log', 'scan_network', 'sdo_poll_source', 'slcan_encode', 'socketcan_unavailable_reason', 'split_interpolation', 'sync_encode', 'synchronized_jerk_limited_durations', 'time_decode', 'time_encode', 'unitek_analog_command_num', 'unitek_bit_rate_for_btr', 'unitek_bit_timings', 'unitek_btr_for_bit_rate', 'unitek_capture_source', 'unitek_continuous_current_num', 'unitek_decode_from_drive', 'unitek_decode_to_drive', 'unitek_device_currents', 'unitek_effective_current_limit_num', 'unitek_encode_request', 'unitek_encode_write', 'unitek_poll_source', 'unitek_sim_default_table', 'unitek_speed_profile', 'wire_bits_worst_case']
 class Clock:
     def cancel(self) -> None:
         ...
@@ -1369,6 +1369,14 @@ class Variable:
         ...
     def add_change_listener(self, callback: collections.abc.Callable) -> int:
         ...
+    def decode(self, data: bytes) -> typing.Any:
+        """
+        The Python value of `data` as this entry's type (int, float, bool, str or bytes).
+        """
+    def encode(self, value: typing.Any) -> bytes:
+        """
+        The little-endian bytes of `value` as this entry's type (InvalidArgument if it does not fit the type; the limits are the device's to enforce).
+        """
     def remove_change_listener(self, handle: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     def reset(self) -> None:
@@ -1429,6 +1437,11 @@ class Variable:
     @value.setter
     def value(self, arg1: typing.Any) -> None:
         ...
+    @property
+    def value_range(self) -> typing.Any:
+        """
+        (low, high) a write may carry: the limits, else the integer type's range; None for other types
+        """
 class ObjectDictionary:
     """
     Objects addressed by (index, subindex) or by name ('Record.Member', '0x1018:1').
@@ -3194,6 +3207,66 @@ class ArcusSim(LineDevice, SimulatedDevice):
     @property
     def store_path(self) -> str:
         ...
+class ArcusHomeMethod:
+    """
+    The homing routines: H, HL, ZH, Z, L (Table 11.0; + or - is the direction).
+    
+    Members:
+    
+      H
+    
+      HL
+    
+      ZH
+    
+      Z
+    
+      L
+    """
+    H: typing.ClassVar[ArcusHomeMethod]
+    HL: typing.ClassVar[ArcusHomeMethod]
+    L: typing.ClassVar[ArcusHomeMethod]
+    Z: typing.ClassVar[ArcusHomeMethod]
+    ZH: typing.ClassVar[ArcusHomeMethod]
+    __members__: typing.ClassVar[dict[str, ArcusHomeMethod]]
+    @typing.overload
+    def __eq__(self, other: ArcusHomeMethod) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    @typing.overload
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @typing.overload
+    def __init__(self, name: str) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: ArcusHomeMethod) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
 class ArcusClientCounters:
     """
     ArcusClient counters (ArcusClient.counters), read-only.
@@ -3266,7 +3339,7 @@ class ArcusClientBase:
         ...
     def enable_latch(self, on: bool = True) -> None:
         ...
-    def home(self, method: str, direction: typing.SupportsInt | typing.SupportsIndex) -> None:
+    def home(self, method: ArcusHomeMethod | str, direction: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     def incremental_mode(self) -> None:
         ...
@@ -3505,6 +3578,56 @@ class ArcusClientBase:
     @property
     def version(self) -> str:
         ...
+class Cia402Sim(SimulatedDevice):
+    """
+    A simulated CiA 402 drive served by a LocalNode (see cpp/motorbus/drives/cia402/sim.hpp).
+    """
+    def __init__(self, node_id: typing.SupportsInt | typing.SupportsIndex, clock: Clock = None, *, steps_per_rev: typing.SupportsFloat | typing.SupportsIndex = 3200.0, home: tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex] = (1000.0, 1400.0), minus_limit: typing.SupportsFloat | typing.SupportsIndex | None = -100000.0, plus_limit: typing.SupportsFloat | typing.SupportsIndex | None = 100000.0, heartbeat_ms: typing.SupportsInt | typing.SupportsIndex = 0, start_position: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
+        ...
+    def force_limit(self, direction: typing.SupportsInt | typing.SupportsIndex, active: bool = True) -> None:
+        """
+        The +limit (+1) or -limit (-1) switch closes whatever the position: a motion toward it stops.
+        """
+    def inject_fault(self, error_code: typing.SupportsInt | typing.SupportsIndex = 21569) -> None:
+        """
+        The drive detects a fault (default 0x5441 interlock): the motor stops, FAULT, 603Fh holds the code.
+        """
+    def jam(self, jammed: bool = True) -> None:
+        """
+        The rotor blocks: past 6065h the drive faults with 0x8611 (statusword bit 13).
+        """
+    def set_stop_input(self, active: bool = True) -> None:
+        """
+        The quick-stop input (60FDh bit 16): its rising edge quick-stops a moving drive.
+        """
+    @property
+    def heartbeat(self) -> HeartbeatService:
+        ...
+    @property
+    def last_setpoint_ns(self) -> int | None:
+        """
+        Clock time (ns) of the last profile-position set-point the drive took, or None.
+        """
+    @property
+    def lost_master(self) -> bool:
+        """
+        True once the master's heartbeat was lost (6007h applied).
+        """
+    @property
+    def node_id(self) -> int:
+        ...
+    @property
+    def od(self) -> ObjectDictionary:
+        ...
+    @property
+    def pdo(self) -> PdoService:
+        ...
+    @property
+    def position(self) -> float:
+        ...
+    @property
+    def state(self) -> str:
+        ...
 class DmacProfileParams:
     s_curve: bool
     def __init__(self, high_speed: typing.SupportsInt | typing.SupportsIndex = 60000, low_speed: typing.SupportsInt | typing.SupportsIndex = 6000, accel_time_ms: typing.SupportsInt | typing.SupportsIndex = 1000, decel_time_ms: typing.SupportsInt | typing.SupportsIndex = 1000, s_curve: bool = False) -> None:
@@ -3579,12 +3702,319 @@ class DmacRadix:
         ...
     def __index__(self) -> int:
         ...
+    @typing.overload
     def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @typing.overload
+    def __init__(self, name: str) -> None:
         ...
     def __int__(self) -> int:
         ...
     @typing.overload
     def __ne__(self, other: DmacRadix) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class DmacStopWhat:
+    """
+    What STOP / HALT stop: everything, the movement (MOUV) or the sequence (SEQ).
+    
+    Members:
+    
+      ALL
+    
+      MOVEMENT
+    
+      SEQUENCE
+    """
+    ALL: typing.ClassVar[DmacStopWhat]
+    MOVEMENT: typing.ClassVar[DmacStopWhat]
+    SEQUENCE: typing.ClassVar[DmacStopWhat]
+    __members__: typing.ClassVar[dict[str, DmacStopWhat]]
+    @typing.overload
+    def __eq__(self, other: DmacStopWhat) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    @typing.overload
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @typing.overload
+    def __init__(self, name: str) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: DmacStopWhat) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class DmacPowerMode:
+    """
+    POWER ON, OFF (freewheel) or SC (short-circuited coils).
+    
+    Members:
+    
+      ON
+    
+      OFF
+    
+      SC
+    """
+    OFF: typing.ClassVar[DmacPowerMode]
+    ON: typing.ClassVar[DmacPowerMode]
+    SC: typing.ClassVar[DmacPowerMode]
+    __members__: typing.ClassVar[dict[str, DmacPowerMode]]
+    @typing.overload
+    def __eq__(self, other: DmacPowerMode) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    @typing.overload
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @typing.overload
+    def __init__(self, name: str) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: DmacPowerMode) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class DmacEndStops:
+    """
+    HARD_ENDS: which hard end-stop inputs stop the motor.
+    
+    Members:
+    
+      OFF
+    
+      ALL
+    
+      POS
+    
+      NEG
+    """
+    ALL: typing.ClassVar[DmacEndStops]
+    NEG: typing.ClassVar[DmacEndStops]
+    OFF: typing.ClassVar[DmacEndStops]
+    POS: typing.ClassVar[DmacEndStops]
+    __members__: typing.ClassVar[dict[str, DmacEndStops]]
+    @typing.overload
+    def __eq__(self, other: DmacEndStops) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    @typing.overload
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @typing.overload
+    def __init__(self, name: str) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: DmacEndStops) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class DmacPolarity:
+    """
+    INVERSE_POLARITY: which of the inputs and outputs are inverted.
+    
+    Members:
+    
+      OFF
+    
+      ALL
+    
+      IN
+    
+      OUT
+    """
+    ALL: typing.ClassVar[DmacPolarity]
+    IN: typing.ClassVar[DmacPolarity]
+    OFF: typing.ClassVar[DmacPolarity]
+    OUT: typing.ClassVar[DmacPolarity]
+    __members__: typing.ClassVar[dict[str, DmacPolarity]]
+    @typing.overload
+    def __eq__(self, other: DmacPolarity) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    @typing.overload
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @typing.overload
+    def __init__(self, name: str) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: DmacPolarity) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class DmacKeyword:
+    """
+    The keywords of the DMAC command language.
+    
+    Members:
+    
+      ON
+    
+      OFF
+    
+      SC
+    
+      ALL
+    
+      POS
+    
+      NEG
+    
+      IN
+    
+      OUT
+    
+      MOUV
+    
+      SEQ
+    
+      TOP
+    
+      INTERPOL
+    """
+    ALL: typing.ClassVar[DmacKeyword]
+    IN: typing.ClassVar[DmacKeyword]
+    INTERPOL: typing.ClassVar[DmacKeyword]
+    MOUV: typing.ClassVar[DmacKeyword]
+    NEG: typing.ClassVar[DmacKeyword]
+    OFF: typing.ClassVar[DmacKeyword]
+    ON: typing.ClassVar[DmacKeyword]
+    OUT: typing.ClassVar[DmacKeyword]
+    POS: typing.ClassVar[DmacKeyword]
+    SC: typing.ClassVar[DmacKeyword]
+    SEQ: typing.ClassVar[DmacKeyword]
+    TOP: typing.ClassVar[DmacKeyword]
+    __members__: typing.ClassVar[dict[str, DmacKeyword]]
+    @typing.overload
+    def __eq__(self, other: DmacKeyword) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    @typing.overload
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @typing.overload
+    def __init__(self, name: str) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: DmacKeyword) -> bool:
         ...
     @typing.overload
     def __ne__(self, other: typing.Any) -> bool:
@@ -3729,6 +4159,60 @@ class DmacVersionInfo:
         """
         1 in v1.7
         """
+class DmacSensor:
+    """
+    The temperature sensors of a module (DmacSim.set_temperature).
+    
+    Members:
+    
+      CPU
+    
+      DRIVER
+    
+      MOTOR
+    """
+    CPU: typing.ClassVar[DmacSensor]
+    DRIVER: typing.ClassVar[DmacSensor]
+    MOTOR: typing.ClassVar[DmacSensor]
+    __members__: typing.ClassVar[dict[str, DmacSensor]]
+    @typing.overload
+    def __eq__(self, other: DmacSensor) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    @typing.overload
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @typing.overload
+    def __init__(self, name: str) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: DmacSensor) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
 class DmacSimState:
     """
     A snapshot of a DmacSim (DmacSim.state()), read-only.
@@ -3820,7 +4304,7 @@ class DmacSim(LineDevice):
         """
         Supply voltage in mV; outside the model's range latches undervoltage/overvoltage and stops the motor.
         """
-    def set_temperature(self, sensor: str, tenths_c: typing.SupportsInt | typing.SupportsIndex) -> None:
+    def set_temperature(self, sensor: DmacSensor | str, tenths_c: typing.SupportsInt | typing.SupportsIndex) -> None:
         """
         Temperature in 0.1 degC; CPU > 120 degC or driver/motor > 85 degC latches a thermal fault.
         """
@@ -3881,11 +4365,11 @@ class DmacClient:
         ...
     def command(self, command: str) -> None:
         ...
-    def halt(self, what: str = 'all') -> None:
+    def halt(self, what: DmacStopWhat | str = ...) -> None:
         ...
-    def hard_ends(self, which: str) -> None:
+    def hard_ends(self, which: DmacEndStops | str) -> None:
         ...
-    def inverse_polarity(self, which: str) -> None:
+    def inverse_polarity(self, which: DmacPolarity | str) -> None:
         ...
     def memorized_var(self, n: typing.SupportsInt | typing.SupportsIndex) -> int:
         ...
@@ -3903,11 +4387,11 @@ class DmacClient:
         ...
     def optimized_current(self, on: bool) -> None:
         ...
-    def power(self, mode: str) -> None:
+    def power(self, mode: DmacPowerMode | str) -> None:
         ...
     def raw(self, frame: str, expect_reply: bool = True) -> bytes:
         ...
-    def read(self, variable: str, radix: typing.Any = ...) -> int:
+    def read(self, variable: str, radix: DmacRadix | str = ...) -> int:
         """
         READ a variable; radix is a DmacRadix or 'dec'/'hex'/'bin' (default DmacRadix.DEC).
         """
@@ -3959,7 +4443,7 @@ class DmacClient:
         ...
     def step(self, line: typing.SupportsInt | typing.SupportsIndex | None = None) -> None:
         ...
-    def stop(self, what: str = 'all') -> None:
+    def stop(self, what: DmacStopWhat | str = ...) -> None:
         ...
     def stop_sequence(self) -> None:
         ...
@@ -4197,6 +4681,56 @@ class Pmc007ProfileParams:
         ...
     @stop_speed.setter
     def stop_speed(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+class Pmc007Storage:
+    """
+    How an object behaves over reset node / power-up (B-P37).
+    
+    Members:
+    
+      ROM : saved to flash by 2007h = 2, reloaded at reset node
+    
+      RAM : back to the default at reset node / power-up
+    
+      CONST : never changes
+    """
+    CONST: typing.ClassVar[Pmc007Storage]
+    RAM: typing.ClassVar[Pmc007Storage]
+    ROM: typing.ClassVar[Pmc007Storage]
+    __members__: typing.ClassVar[dict[str, Pmc007Storage]]
+    @typing.overload
+    def __eq__(self, other: Pmc007Storage) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: Pmc007Storage) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
         ...
 class Pmc007Sim(SimulatedDevice):
     """
@@ -4713,6 +5247,145 @@ class UnitekCaptureSource(PollSource):
     @property
     def max_age(self) -> float:
         ...
+class ToyLastStop:
+    """
+    How the toy drive's last motion ended (STATUS? second word).
+    
+    Members:
+    
+      NONE
+    
+      TARGET
+    
+      STOP
+    
+      ABORT
+    
+      DISABLE
+    
+      FAULT
+    """
+    ABORT: typing.ClassVar[ToyLastStop]
+    DISABLE: typing.ClassVar[ToyLastStop]
+    FAULT: typing.ClassVar[ToyLastStop]
+    NONE: typing.ClassVar[ToyLastStop]
+    STOP: typing.ClassVar[ToyLastStop]
+    TARGET: typing.ClassVar[ToyLastStop]
+    __members__: typing.ClassVar[dict[str, ToyLastStop]]
+    @typing.overload
+    def __eq__(self, other: ToyLastStop) -> bool:
+        ...
+    @typing.overload
+    def __eq__(self, other: typing.Any) -> bool:
+        ...
+    def __getstate__(self) -> int:
+        ...
+    def __hash__(self) -> int:
+        ...
+    def __index__(self) -> int:
+        ...
+    def __init__(self, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __int__(self) -> int:
+        ...
+    @typing.overload
+    def __ne__(self, other: ToyLastStop) -> bool:
+        ...
+    @typing.overload
+    def __ne__(self, other: typing.Any) -> bool:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def __setstate__(self, state: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def __str__(self) -> str:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def value(self) -> int:
+        ...
+class ToyStatus:
+    """
+    STATUS? parsed, read-only.
+    """
+    @property
+    def enabled(self) -> bool:
+        ...
+    @property
+    def fault(self) -> bool:
+        ...
+    @property
+    def homed(self) -> bool:
+        ...
+    @property
+    def last_stop(self) -> ToyLastStop:
+        ...
+    @property
+    def moving(self) -> bool:
+        ...
+class ToySim(LineDevice):
+    """
+    A simulated toy stepper (a LineDevice: serve it with PtyLineServer); motion on a MotorModel.
+    """
+    def __init__(self, clock: Clock = None, address: typing.SupportsInt | typing.SupportsIndex = 1, speed: typing.SupportsFloat | typing.SupportsIndex = 4000.0, accel: typing.SupportsFloat | typing.SupportsIndex = 40000.0, start_position: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
+        ...
+    def set_fault_input(self, active: bool) -> None:
+        """
+        The drive's fault input (an overtemperature, say).
+        """
+    @property
+    def address(self) -> int:
+        ...
+    @property
+    def moving(self) -> bool:
+        ...
+    @property
+    def position(self) -> int:
+        """
+        Steps, caught up with the clock.
+        """
+class ToyClient:
+    """
+    The toy protocol on a LineLink, one address.
+    """
+    def __init__(self, link: LineLink, address: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def abort(self) -> None:
+        ...
+    def clear(self) -> None:
+        ...
+    def command(self, text: str) -> str:
+        ...
+    def disable(self) -> None:
+        ...
+    def enable(self) -> None:
+        ...
+    def get(self, name: str) -> float:
+        ...
+    def home(self) -> None:
+        ...
+    def jog(self, velocity: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    def move_to(self, target: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    def position(self) -> int:
+        ...
+    def set(self, name: str, value: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    def status(self) -> ToyStatus:
+        ...
+    def stop(self) -> None:
+        ...
+    def velocity(self) -> float:
+        ...
+    @property
+    def address(self) -> int:
+        ...
+    @property
+    def link(self) -> LineLink:
+        ...
 def abort_text(code: typing.SupportsInt | typing.SupportsIndex) -> typing.Any:
     """
     CiA 301 text for an SDO abort code (None if unknown).
@@ -4724,6 +5397,10 @@ def arcus_acc_range(hspd: typing.SupportsInt | typing.SupportsIndex, lspd: typin
 def arcus_build_request(address: typing.SupportsInt | typing.SupportsIndex, command: str) -> bytes:
     """
     b'@NN<command>\\r' (validated).
+    """
+def arcus_canopen_object_dictionary() -> ObjectDictionary:
+    """
+    Table 10.1 as a typed canopen.ObjectDictionary (types, access, limits, defaults, codecs): what the arcus-canopen client reads and writes by, and the source of the shipped EDS.
     """
 def arcus_canopen_objects() -> list:
     """
@@ -4759,6 +5436,14 @@ def cia402_decode_statusword(statusword: typing.SupportsInt | typing.SupportsInd
     """
 def cia402_next_step(from_state: str, to_state: str) -> typing.Any:
     ...
+def cia402_object_dictionary(node_id: typing.SupportsInt | typing.SupportsIndex = 1) -> ObjectDictionary:
+    """
+    The same objects as a typed canopen.ObjectDictionary (types, access, limits, defaults, codecs): what the generic Drive adapter reads and writes by.
+    """
+def cia402_objects() -> list:
+    """
+    The generic CiA 402 simulator's objects: (index, sub, name, type, access, default, low, high, unit, persists, description).
+    """
 def cia402_position_profile(start: MotionState, target: typing.SupportsFloat | typing.SupportsIndex, params: Cia402ProfileParams) -> Profile:
     ...
 def cia402_quick_stop_profile(start: MotionState, params: Cia402ProfileParams) -> Profile:
@@ -4771,7 +5456,7 @@ def decode_value(data_type: DataType, data: bytes) -> typing.Any:
     """
 def dmac_error_names(error: typing.SupportsInt | typing.SupportsIndex) -> list[str]:
     ...
-def dmac_format_value(value: typing.SupportsInt | typing.SupportsIndex, radix: typing.Any = ...) -> str:
+def dmac_format_value(value: typing.SupportsInt | typing.SupportsIndex, radix: DmacRadix | str = ...) -> str:
     """
     '+123', 'h0000007B' or 'b00000000 ... 01111011'; radix is a DmacRadix or 'dec'/'hex'/'bin'.
     """
@@ -4793,7 +5478,7 @@ def dmac_stream_interpolation(axes: collections.abc.Sequence[DmacClient], segmen
     """
     Streams segments[k][axis] to every axis, starting them with SYNCHRO INTERPOL.
     """
-def dmac_synchro(link: LineLink, what: str) -> None:
+def dmac_synchro(link: LineLink, what: DmacKeyword | str) -> None:
     """
     Global SYNCHRO ON|OFF|TOP|INTERPOL (no reply).
     """
@@ -4892,32 +5577,28 @@ def pmc007_assemble(text: str) -> list[int]:
     """
 def pmc007_convert_position(position: typing.SupportsFloat | typing.SupportsIndex, from_setting: typing.SupportsInt | typing.SupportsIndex, to_setting: typing.SupportsInt | typing.SupportsIndex) -> float:
     ...
-def pmc007_decode(word: typing.SupportsInt | typing.SupportsIndex) -> typing.Any:
-    """
-    (mnemonic, option, data), or None for an unknown opcode.
-    """
 def pmc007_disassemble(words: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]) -> str:
-    ...
-def pmc007_disassemble_word(word: typing.SupportsInt | typing.SupportsIndex) -> str:
     ...
 def pmc007_eds() -> str:
     """
     The EDS text generated from the table (node-ID as $NODEID).
     """
-def pmc007_encode(mnemonic: str, option: typing.SupportsInt | typing.SupportsIndex = 0, data: typing.SupportsInt | typing.SupportsIndex = 0) -> int:
-    ...
 def pmc007_gear_acceleration(gear: typing.SupportsInt | typing.SupportsIndex) -> float:
     ...
 def pmc007_microsteps(setting: typing.SupportsInt | typing.SupportsIndex) -> int:
     ...
-def pmc007_od_rows() -> list:
+def pmc007_object_dictionary(node_id: typing.SupportsInt | typing.SupportsIndex = 5) -> ObjectDictionary:
     """
-    Every object of the PMC007 dictionary: (index, sub, name, parent, type, access, pdo_mappable, storage, default, low, high).
+    The PMC007 dictionary (every row of the table), defaults evaluated for `node_id`.
     """
 def pmc007_position_profile(start: MotionState, target: typing.SupportsFloat | typing.SupportsIndex, params: Pmc007ProfileParams) -> Profile:
     ...
 def pmc007_speed_profile(start: MotionState, speed: typing.SupportsFloat | typing.SupportsIndex, params: Pmc007ProfileParams, hold: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> Profile:
     ...
+def pmc007_storage(index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex = 0) -> Pmc007Storage:
+    """
+    The table's storage class of one object (B-P37).
+    """
 def read_log(path: str) -> tuple[list[LogEntry], int]:
     """
     Reads a candump (.log) or ASC (.asc) file: (entries, bad_line_count).
@@ -4982,13 +5663,9 @@ def unitek_effective_current_limit_num(device: str, motor_limit_num: typing.Supp
     """
     §6.1: the smaller of the motor's and the device's peak current (num)
     """
-def unitek_encode_reply(regid: typing.SupportsInt | typing.SupportsIndex, raw: typing.SupportsInt | typing.SupportsIndex, bits: typing.SupportsInt | typing.SupportsIndex = 16, dummy: typing.SupportsInt | typing.SupportsIndex = 0) -> bytes:
-    ...
 def unitek_encode_request(regid: typing.SupportsInt | typing.SupportsIndex, interval: typing.SupportsInt | typing.SupportsIndex) -> bytes:
     ...
 def unitek_encode_write(regid: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex, bits: typing.SupportsInt | typing.SupportsIndex = 16) -> bytes:
-    ...
-def unitek_event_status_mask(mask: typing.SupportsInt | typing.SupportsIndex) -> int:
     ...
 def unitek_poll_source(client: UnitekClient, regids: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex]) -> PollSource:
     """
