@@ -16,7 +16,7 @@ constexpr std::uint32_t kAbortRange = 0x06090030;  // value range of parameter e
 // ---- Cia402SetPoints -----------------------------------------------------------------
 
 SetPointAction Cia402SetPoints::on_controlword(std::uint16_t prev, std::uint16_t cw, OpMode mode, bool idle,
-                                               bool accept, std::int32_t target_position, double position) {
+                                               bool accept, double target_position, double position) {
     if (!(cw & cw::kNewSetPoint)) ack_ = false;  // the acknowledge lasts while bit 4 does
     const bool halt = cw & cw::kHalt;
     if (halt && !(prev & cw::kHalt)) {

@@ -68,7 +68,7 @@ public:
     // caller starts what the action says (target() is absolute).  A Start the
     // caller cannot run is undone with refuse().
     SetPointAction on_controlword(std::uint16_t prev, std::uint16_t cw, OpMode mode, bool idle, bool accept,
-                                  std::int32_t target_position, double position);
+                                  double target_position, double position);
     // The running set-point was reached: the buffered one (if any) is due now.
     std::optional<double> take_buffered();
     void refuse() { ack_ = false; }

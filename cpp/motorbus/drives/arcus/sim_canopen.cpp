@@ -32,9 +32,6 @@ constexpr std::int64_t kI32Min = std::numeric_limits<std::int32_t>::min();
 constexpr std::int64_t kI32Max = std::numeric_limits<std::int32_t>::max();
 
 constexpr std::uint16_t kHalt = 1u << 8;
-constexpr std::uint16_t kNewSetPoint = 1u << 4;
-constexpr std::uint16_t kSetOfSetPoints = 1u << 5;
-constexpr std::uint16_t kRelative = 1u << 6;
 constexpr std::uint16_t kFaultReset = 1u << 7;
 
 int type_size(const char* type) {
@@ -283,7 +280,7 @@ std::vector<can::Frame> Sim::canopen_frame(const can::Frame& f, bool& reset) {
     const Nanos now = clock_.now();
     SimEngine e(s, options_);
     CanopenState& co = s.co;
-    if (co.state == CoState::OperationEnabled && co.active_mode == 1 && co.buffered && !(co.cw & kHalt) &&
+    if (co.state == CoState::OperationEnabled && co.active_mode == 1 && co.setpoints.buffered() && !(co.cw & kHalt) &&
         s.job == Job::Target && s.motor->moving()) {
         // A set of set-points: the buffered one starts the instant the running
         // move ends (B-A12), even when nobody looked at the drive then.
@@ -400,8 +397,8 @@ std::uint32_t Sim::od_read(std::uint16_t index, std::uint8_t sub, std::uint32_t&
             const bool oe = co.state == CoState::OperationEnabled;
             bool reached = idle, bit12 = false, bit13 = false;
             if (oe && co.active_mode == 1) {
-                reached = idle && !co.buffered;
-                bit12 = co.setpoint_ack;
+                reached = idle && !co.setpoints.buffered();
+                bit12 = co.setpoints.acknowledged();
                 bit13 = s.snl.in_error();  // following error: StepNLoop stall / range error
             } else if (oe && co.active_mode == 3) {
                 const double target = vel_sign * co.target_velocity;
@@ -530,7 +527,7 @@ std::uint32_t Sim::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t
             // In Operation enabled a new mode takes over only when the motor is idle (B-A10).
             if (co.state == CoState::OperationEnabled && !s.motor->moving() && s.job == Job::None) {
                 co.active_mode = co.mode;
-                co.setpoint_ack = co.buffered = false;
+                co.setpoints.reset();
                 co.homing_started = co.homing_attained = co.homing_error = false;
                 co.pv_pending = false;
             }
@@ -631,12 +628,13 @@ void Sim::controlword(std::uint16_t v) {
     auto enter_mode = [&] {
         co.state = CoState::OperationEnabled;
         co.active_mode = co.mode;
-        co.setpoint_ack = co.buffered = false;
+        co.setpoints.reset();
         co.homing_started = co.homing_attained = co.homing_error = false;
         co.pv_pending = false;  // PV runs on a 60FFh write or a halt release
     };
     auto exit_mode = [&] {
-        co.buffered = co.pv_pending = false;
+        co.setpoints.drop_buffered();
+        co.pv_pending = false;
         if (s.motor->moving()) command("STOP");
     };
     switch (co.state) {
@@ -668,13 +666,15 @@ void Sim::controlword(std::uint16_t v) {
                 // Immediate stop (ASCII ABORT), then Switch on disabled (B-A11).
                 command("ABORT");
                 command("EO=0");
-                co.buffered = co.pv_pending = false;
+                co.setpoints.drop_buffered();
+                co.pv_pending = false;
                 co.state = CoState::SwitchOnDisabled;
                 return;
             }
             if (disable_voltage) {
                 command("EO=0");
-                co.buffered = co.pv_pending = false;
+                co.setpoints.drop_buffered();
+                co.pv_pending = false;
                 co.state = CoState::SwitchOnDisabled;
                 return;
             }
@@ -695,45 +695,33 @@ void Sim::controlword(std::uint16_t v) {
             return;
     }
 
-    // Operation enabled: the mode's bits.
-    const bool halt = v & kHalt;
-    const bool halt_rising = halt && !(prev & kHalt);
-    const bool start_rising = (v & kNewSetPoint) && !(prev & kNewSetPoint);
-    if (!(v & kNewSetPoint)) co.setpoint_ack = false;
-    if (halt_rising) {
-        // Halt: decelerate to a stop in every mode (B-A09); a halted PP/homing move is not resumed.
-        co.buffered = false;
-        if (s.motor->moving()) command("STOP");
-        return;
-    }
-    if (co.active_mode == 3) {
-        if (!halt && (prev & kHalt)) co.pv_pending = true;  // resume at 60FFh
-        return;
-    }
-    if (halt || !start_rising) return;
+    // Operation enabled: the mode's bits, through the handshake every CiA 402 drive shares.
     const bool idle = !s.motor->moving() && s.job == Job::None;
-    if (co.active_mode == 1) {
-        if (errors_latched(s)) return;  // B-A31: not acknowledged
-        const double pos_sign = (s.cfg.cpol & 0x80) ? -1.0 : 1.0;
-        const double value = pos_sign * co.target_position;
-        if (!idle) {
-            // Set of set-points (bit 5 = 1): buffered, played after this move (C-A09).
-            if (!(v & kSetOfSetPoints) || co.buffered) return;
-            co.buffered = true;
-            co.buffered_target = (v & kRelative) ? co.buffered_target + value : value;
-            co.setpoint_ack = true;
+    const double pos_sign = (s.cfg.cpol & 0x80) ? -1.0 : 1.0;
+    const double from = static_cast<double>(SimEngine(s, options_).pulse());
+    const auto action = co.setpoints.on_controlword(prev, v, static_cast<canopen::OpMode>(co.active_mode), idle,
+                                                    !errors_latched(s),  // B-A31: not acknowledged
+                                                    pos_sign * co.target_position, from);
+    switch (action) {
+        case canopen::SetPointAction::Halt:
+            // Halt: decelerate to a stop in every mode (B-A09); a halted PP/homing move is not resumed.
+            if (s.motor->moving()) command("STOP");
+            return;
+        case canopen::SetPointAction::Resume:
+            co.pv_pending = true;  // PV resumes at 60FFh
+            return;
+        case canopen::SetPointAction::Start: {
+            // Idle: the set-point starts now (a relative one from where the axis is).
+            load_profile(s, co.profile_velocity, co.end_velocity, co.acceleration, co.deceleration);
+            const auto mm = s.inc_mode;
+            s.inc_mode = 0;
+            const bool ok = command(line("X", std::llround(co.setpoints.target()), "")) == "OK";
+            s.inc_mode = mm;
+            if (!ok) co.setpoints.refuse();
             return;
         }
-        const double from = static_cast<double>(SimEngine(s, options_).pulse());
-        const double target = (v & kRelative) ? from + value : value;
-        load_profile(s, co.profile_velocity, co.end_velocity, co.acceleration, co.deceleration);
-        const auto mm = s.inc_mode;
-        s.inc_mode = 0;
-        const bool ok = command(line("X", std::llround(target), "")) == "OK";
-        s.inc_mode = mm;
-        co.setpoint_ack = ok;
-        co.buffered_target = target;  // a relative buffered set-point adds to this one
-        return;
+        case canopen::SetPointAction::StartHoming: break;
+        default: return;  // Buffer (C-A09: played after this move), Refuse, None
     }
     if (co.active_mode == 6) {
         if (errors_latched(s) || !idle) return;
@@ -798,7 +786,8 @@ void Sim::canopen_service() {
     if (enabled && errors_latched(s)) {
         // A limit or StepNLoop error is a Fault until 200Dh clears it (B-A18, B-A22).
         co.state = CoState::Fault;
-        co.buffered = co.pv_pending = false;
+        co.setpoints.drop_buffered();
+        co.pv_pending = false;
         if (co.homing_started && !co.homing_attained) co.homing_error = true;
         return;
     }
@@ -807,7 +796,7 @@ void Sim::canopen_service() {
     if (idle && co.mode != co.active_mode) {
         // A 6060h written while the motor ran takes over once it is idle (B-A10).
         co.active_mode = co.mode;
-        co.setpoint_ack = co.buffered = false;
+        co.setpoints.reset();
         co.homing_started = co.homing_attained = co.homing_error = false;
         co.pv_pending = false;
         return;
@@ -818,12 +807,12 @@ void Sim::canopen_service() {
         co.homing_error = !ok && !(co.cw & kHalt);
     }
     if (!idle || (co.cw & kHalt)) return;
-    if (co.active_mode == 1 && co.buffered) {
-        co.buffered = false;
+    if (co.active_mode == 1 && co.setpoints.buffered()) {
+        const double target = *co.setpoints.take_buffered();
         load_profile(s, co.profile_velocity, co.end_velocity, co.acceleration, co.deceleration);
         const auto mm = s.inc_mode;
         s.inc_mode = 0;
-        command(line("X", std::llround(co.buffered_target), ""));
+        command(line("X", std::llround(target), ""));
         s.inc_mode = mm;
     }
     if (co.active_mode == 3 && co.pv_pending) {

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include "motorbus/canopen/cia402_axis.hpp"
 #include "motorbus/drives/arcus/homing.hpp"
 #include "motorbus/drives/arcus/profile.hpp"
 #include "motorbus/drives/arcus/sim.hpp"
@@ -80,11 +81,11 @@ struct CanopenState {
     std::uint8_t latch_enable = 0;
     std::uint8_t clear_error = 0, store = 0;  // 200Dh / 200Eh handshakes
     Nanos clear_until = 0, store_until = 0;
-    // Profile position: set-point acknowledge, the buffered set-point of a
-    // "set of set-points" (depth 1) and whether the last set-point's move ended.
-    bool setpoint_ack = false;
-    bool buffered = false;
-    double buffered_target = 0;  // absolute, in drive units
+    // Profile position: the set-point handshake every CiA 402 drive shares
+    // (acknowledge, the one-deep buffer of a "set of set-points", absolute
+    // targets in drive units), read as manual 000 C-A09 reads bit 5: a set-point
+    // while moving is buffered only with bit 5 = 1.
+    canopen::Cia402SetPoints setpoints{canopen::Cia402SetPointPolicy{.buffer_on_bit5 = true}};
     // Homing: started, attained, failed.
     bool homing_started = false, homing_attained = false, homing_error = false;
     // Profile velocity: run at 60FFh once the motor is idle (after a halt,
