@@ -1,12 +1,12 @@
 // C++ enums bound as py::enum_ that the Python API may also name with a string.
 //
-// The vendor clients take the manual's words ("ON", "sc", "MOUV"...) as well as
-// the enum members: the C++ enum is bound once with its names (named_enum), and
-// a function taking it declares its parameter as EnumOrName<E> (shown as
-// `DmacPowerMode | str`) and converts with enum_arg<E>.  The names are the
+// A native client may take a manual's words ("ON", "sc"...) as well as the enum
+// members: the C++ enum is bound once with its names (named_enum), and a
+// function taking it declares its parameter as EnumOrName<E> (shown as
+// `<Enum> | str` in the stubs) and converts with enum_arg<E>.  The names are the
 // bound enum's own, matched in any case, plus a few aliases; an unknown name
 // or another type raises InvalidArgument naming the argument and the choices.
-// The enum also converts by itself: DmacPowerMode("sc") is DmacPowerMode.SC.
+// The enum also converts by itself: <Enum>("on") is <Enum>.ON.
 #pragma once
 #include <pybind11/pybind11.h>
 #include <pybind11/typing.h>
