@@ -298,11 +298,13 @@ class ArcusCanopenParams(Params):
         r = self._row(name)
         if r is None:
             return None
-        index, sub, n, dtype, access, default, low, high, unit, persists = r
-        writable = access in ("rw", "wo")
-        return ParamInfo(name=name, type="str" if dtype == "VISIBLE_STRING" else "int",
-                         minimum=low if writable else None, maximum=high if writable else None, unit=unit,
-                         default=default, persists=bool(persists), writable=writable,
+        index, sub, n, _type, access, _default, _low, _high, unit, persists = r
+        var = _entry(index, sub)            # type, range, default: the typed entry's
+        writable = var.access in ("rw", "wo")
+        low, high = var.value_range if writable else (None, None)
+        return ParamInfo(name=name, type="str" if var.data_type == _core.DataType.VISIBLE_STRING else "int",
+                         minimum=low, maximum=high, unit=unit, default=var.default, persists=bool(persists),
+                         writable=writable,
                          description=f"{n} (write-only: the drive cannot read it back)" if access == "wo" else n)
 
     def _read(self, info: ParamInfo) -> Any:
