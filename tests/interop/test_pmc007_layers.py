@@ -133,6 +133,26 @@ def test_a_move_to_walked_down_to_the_wire_bytes(bench, tmp_path):
     assert frames[3][1][:4] == bytes([0x43, 0x03, 0x60, 0x00])     # 6003h read back: 4 bytes
 
 
+def test_the_client_is_a_node_profile_standing_on_its_bus(bench):
+    b, spec = bench
+    with motorbus.open_bus(spec) as bus, Pmc007(bus, NODE, on_error=None, on_exit=None) as c:
+        assert isinstance(c, motorbus.canopen.RemoteNode) and c.network is None and c.id == NODE
+        assert c.sdo["Start speed"].raw == 400                 # the node facade, by the table's names
+        assert c.variable("0x6006").od is c.object_dictionary[0x6006, 0]
+        cob = c.configure_tpdo(1, ["motor_position"], event_timer_ms=20)
+        assert c.tpdo[1].mapping == [(0x600C, 0, 32)] and c.tpdo[1].cob_id == cob == 0x180 + NODE
+        c.nmt(0x01)                                              # start: PDOs flow
+        c.write("motor_position", -5)
+        assert c.tpdo[1].wait_for_reception(2.0) == {(0x600C, 0): -5}   # signed, from the entry
+        with pytest.raises(motorbus.InvalidArgument, match="come with a Network"):
+            c.emcy
+    for good, node in ((5, 5), ("05", 5), ("0x7F", 127), (" 12 ", 12)):
+        assert motorbus.canopen.check_node_id(good, "x") == node
+    for bad in (0, 128, "node", True, "9" * 20):
+        with pytest.raises(motorbus.InvalidArgument, match="x address"):
+            motorbus.canopen.check_node_id(bad, "x")
+
+
 def test_cia402_and_arcus_canopen_adapters_read_and_write_by_typed_cpp_dictionaries():
     from motorbus.drives import arcus_canopen, cia402
     generic, arcus = cia402.Cia402Drive.object_dictionary(), arcus_canopen.ArcusCanopenDrive.object_dictionary()
