@@ -186,16 +186,15 @@ void bind_arcus_motion(py::module_& m) {
     py::class_<HomingOptions>(m, "ArcusHomingOptions")
         .def(py::init([](double hca, double lca, bool rz) { return HomingOptions{hca, lca, rz}; }),
              py::arg("hca") = 0.0, py::arg("lca") = 1000.0, py::arg("rz") = false);
+    named_enum<Homing::Method>(m, "ArcusHomingMethod", "The routines ArcusHoming runs on a MotorModel.",
+                               "ArcusHoming.start method", {{"H", Homing::Method::H}, {"HL", Homing::Method::HL},
+                                                            {"L", Homing::Method::L}, {"Z", Homing::Method::Z},
+                                                            {"ZH", Homing::Method::ZH}});
     py::class_<Homing>(m, "ArcusHoming")
         .def(py::init<MotorModel&, ProfileParams, HomingOptions>(), py::arg("motor"), py::arg("params"),
              py::arg("options") = HomingOptions{}, py::keep_alive<1, 2>())
-        .def("start", [](Homing& h, const std::string& method, int dir) {
-            static const std::pair<const char*, Homing::Method> map[] = {
-                {"H", Homing::Method::H}, {"HL", Homing::Method::HL}, {"L", Homing::Method::L},
-                {"Z", Homing::Method::Z}, {"ZH", Homing::Method::ZH}};
-            for (const auto& [n, mm] : map)
-                if (method == n) return h.start(mm, dir);
-            throw InvalidArgument("ArcusHoming.start: method is H, HL, L, Z or ZH, not '" + method + "'");
+        .def("start", [](Homing& h, const EnumOrName<Homing::Method>& method, int dir) {
+            h.start(enum_arg<Homing::Method>(method), dir);
         }, py::arg("method"), py::arg("direction"))
         .def("abort", &Homing::abort)
         .def_property_readonly("running", &Homing::running)

@@ -22,6 +22,7 @@ from motorbus import _core
     (_core.DmacSensor, "driver", "DRIVER"),
     (_core.DmacRadix, "h", "HEX"),
     (_core.ArcusHomeMethod, "zh", "ZH"),
+    (_core.ArcusHomingMethod, "hl", "HL"),
 ])
 def test_an_enum_takes_its_names(enum, name, member):
     assert enum(name) == getattr(enum, member)
