@@ -6,12 +6,16 @@ servers:
 * ``virtual`` (as bench/pmc007_sdo.py): python-can's `virtual` interface; the simulator sits
   behind motorbus's python-can bridge (a Python reader thread), the LocalNode behind its
   Network's notifier thread.
+* ``motorbus``: python-can's ``motorbus`` interface (``can.Bus(interface="motorbus",
+  channel="virtual:…")``, motorbus's C++ virtual hub behind python-can's API); the simulator
+  is another endpoint of the client's hub (no Python on its side), the LocalNode's Network
+  opens the same interface on a hub of its own.
 * ``socketcand``: the client talks socketcand (python-can's interface) to a motorbus
   SocketcandServer on 127.0.0.1; the simulator is on the served bus itself (no Python on its
   side), the LocalNode reaches its own server through python-can's socketcand interface too
   (a Python program serving a node has no other way onto a served bus).
 
-    python bench/cia402_sdo.py [--seconds 3] [--object 0x6041] [--transport both] [--rounds 6]
+    python bench/cia402_sdo.py [--seconds 3] [--object 0x6041] [--transport all] [--rounds 6]
 
 Both servers answer the same request (an expedited upload of 6041h, the statusword a master
 polls; --object picks another, e.g. 0x6081 a plain setting) to the same client code.  The
@@ -37,12 +41,13 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seconds", type=float, default=3.0, help="per server and transport")
     ap.add_argument("--object", type=lambda s: int(s, 0), default=0x6041)
-    ap.add_argument("--transport", choices=("virtual", "socketcand", "both"), default="both")
+    ap.add_argument("--transport", choices=("virtual", "motorbus", "socketcand", "all"), default="all")
     ap.add_argument("--rounds", type=int, default=6)
     a = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        for transport in ("virtual", "socketcand") if a.transport == "both" else (a.transport,):
-            (virtual if transport == "virtual" else socketcand)(a, os.path.join(tmp, "cia402.eds"))
+        for transport in ("virtual", "motorbus", "socketcand") if a.transport == "all" else (a.transport,):
+            {"virtual": virtual, "motorbus": motorbus_interface, "socketcand": socketcand}[transport](
+                a, os.path.join(tmp, "cia402.eds"))
 
 
 def alternate(a: argparse.Namespace, ours: Callable[[], object], ref: Callable[[], object]) -> tuple:
@@ -112,6 +117,37 @@ def virtual(a: argparse.Namespace, eds: str) -> None:
         sim.close()
         bus.close()
     report("virtual", index, ours, ref)
+
+
+def motorbus_interface(a: argparse.Namespace, eds: str) -> None:
+    import canopen
+
+    import motorbus
+    from motorbus.drives import cia402
+
+    index = a.object
+    nets: list = []
+
+    def network(channel: str) -> "canopen.Network":
+        net = canopen.Network()
+        net.connect(interface="motorbus", channel=channel)
+        nets.append(net)
+        return net
+
+    with motorbus.open_bus("virtual:bench-cia402-pycan") as node_side:
+        sim = cia402.make_sim(5, bus=node_side)
+        with open(eds, "w") as f:
+            f.write(sim.od.to_eds(False))
+        try:
+            to_sim = network("virtual:bench-cia402-pycan").add_node(5, eds)
+            network("virtual:bench-cia402-pycan-ref").add_node(canopen.LocalNode(5, eds))
+            to_ref = network("virtual:bench-cia402-pycan-ref").add_node(5, eds)
+            ours, ref = alternate(a, lambda: to_sim.sdo.upload(index, 0), lambda: to_ref.sdo.upload(index, 0))
+        finally:
+            for net in nets:
+                net.disconnect()
+            sim.close()
+    report("motorbus", index, ours, ref)
 
 
 def socketcand(a: argparse.Namespace, eds: str) -> None:
