@@ -39,7 +39,7 @@ std::string bytes_or_str(const py::handle& h, const char* what) {
     throw InvalidArgument(std::string(what) + ": expected str or bytes");
 }
 
-// One Python class per Table 11.1 reply, all subclasses of ArcusError(DriveFault).
+// One Python class per Table 11.1 reply, all subclasses of ReplyError(DriveFault).
 struct ReplyClass {
     ErrorCode code;
     const char* name;
@@ -74,7 +74,7 @@ void register_errors(py::module_& m) {
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);
-        } catch (const ArcusError& e) {
+        } catch (const ReplyError& e) {
             py::handle cls = g_arcus_error;
             for (std::size_t i = 0; i < std::size(kReplyClasses); ++i)
                 if (kReplyClasses[i].code == e.code) cls = g_reply_class[i];

@@ -67,9 +67,9 @@ void bind_dmac_motion(py::module_& m) {
         .def_readwrite("accel_time_ms", &ProfileParams::accel_time_ms)
         .def_readwrite("decel_time_ms", &ProfileParams::decel_time_ms)
         .def_readwrite("s_curve", &ProfileParams::s_curve);
-    m.def("dmac_ramp_time", &dmac_ramp_time, py::arg("params"), py::arg("v_from"), py::arg("v_to"));
-    m.def("dmac_position_profile", &dmac_position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
-    m.def("dmac_speed_profile", &dmac_speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
+    m.def("dmac_ramp_time", &ramp_time, py::arg("params"), py::arg("v_from"), py::arg("v_to"));
+    m.def("dmac_position_profile", &position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
+    m.def("dmac_speed_profile", &speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
           py::arg("hold") = 0.0);
     py::class_<Motion>(m, "DmacMotion")
         .def(py::init<ProfileParams, double>(), py::arg("params") = ProfileParams{}, py::arg("position") = 0.0)

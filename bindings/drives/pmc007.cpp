@@ -22,9 +22,9 @@ namespace {
 }  // namespace
 
 void bind_pmc007(py::module_& m) {
-    m.def("pmc007_gear_acceleration", &pmc007_gear_acceleration, py::arg("gear"));
-    m.def("pmc007_microsteps", &pmc007_microsteps, py::arg("setting"));
-    m.def("pmc007_convert_position", &pmc007_convert_position, py::arg("position"), py::arg("from_setting"),
+    m.def("pmc007_gear_acceleration", &gear_acceleration, py::arg("gear"));
+    m.def("pmc007_microsteps", &microsteps, py::arg("setting"));
+    m.def("pmc007_convert_position", &convert_position, py::arg("position"), py::arg("from_setting"),
           py::arg("to_setting"));
     py::class_<ProfileParams>(m, "Pmc007ProfileParams")
         .def(py::init([](double speed, double start_speed, double stop_speed, int ag, int dg, int micro) {
@@ -40,8 +40,8 @@ void bind_pmc007(py::module_& m) {
         .def_readwrite("accel_gear", &ProfileParams::accel_gear)
         .def_readwrite("decel_gear", &ProfileParams::decel_gear)
         .def_readwrite("microstepping", &ProfileParams::microstepping);
-    m.def("pmc007_position_profile", &pmc007_position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
-    m.def("pmc007_speed_profile", &pmc007_speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
+    m.def("pmc007_position_profile", &position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
+    m.def("pmc007_speed_profile", &speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
           py::arg("hold") = 0.0);
 
     // ---- the object dictionary table ----
@@ -56,7 +56,7 @@ void bind_pmc007(py::module_& m) {
         .value("RAM", Storage::Ram, "back to the default at reset node / power-up")
         .value("CONST", Storage::Const, "never changes");
     m.def("pmc007_storage", [](std::uint16_t index, std::uint8_t sub) {
-              const OdRow* r = pmc007_od_row(index, sub);
+              const OdRow* r = od_row(index, sub);
               if (!r) {
                   char where[16];
                   std::snprintf(where, sizeof where, "%04Xh:%02X", index, sub);
@@ -64,7 +64,7 @@ void bind_pmc007(py::module_& m) {
               }
               return r->storage;
           }, py::arg("index"), py::arg("subindex") = 0, "The table's storage class of one object (B-P37).");
-    m.def("pmc007_eds", &pmc007_eds, "The EDS text generated from the table (node-ID as $NODEID).");
+    m.def("pmc007_eds", &eds, "The EDS text generated from the table (node-ID as $NODEID).");
 
     // ---- offline program codec ----
     m.def("pmc007_assemble", [](const std::string& text) { return assemble(text); }, py::arg("text"),

@@ -119,7 +119,7 @@ static void bind_unitek_errors_and_profile(py::module_& m) {
         .def_readwrite("n_max_rpm", &RampParams::n_max_rpm)
         .def_readwrite("acc_ramp_ms", &RampParams::acc_ramp_ms)
         .def_readwrite("dec_ramp_ms", &RampParams::dec_ramp_ms);
-    m.def("unitek_speed_profile", &unitek_speed_profile, py::arg("start"), py::arg("speed_num"), py::arg("params"),
+    m.def("unitek_speed_profile", &speed_profile, py::arg("start"), py::arg("speed_num"), py::arg("params"),
           py::arg("hold") = 0.0);
 }
 

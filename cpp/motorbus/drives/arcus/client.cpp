@@ -98,7 +98,7 @@ std::string Client::transact(std::string_view command, bool idempotent) {
         }
         if (auto code = classify_error(reply.body)) {
             ++counters_.device_errors;
-            throw ArcusError(*code, reply.body, std::string(command));
+            throw ReplyError(*code, reply.body, std::string(command));
         }
         return reply.body;
     }

@@ -4,7 +4,7 @@
 // LineLink: that is an RS-485 line with up to 99 devices (LineLink serializes
 // transactions).  Every call blocks until the reply or the timeout and raises a
 // typed error: TimeoutError, ProtocolError (bytes the device never sends, a
-// reply for another address, a non-number where a number is due), ArcusError
+// reply for another address, a non-number where a number is due), ReplyError
 // (the device refused the command with a Table 11.1 reply).
 //
 // Motion commands are never retried after a timeout (a lost "OK" does not mean
@@ -51,7 +51,7 @@ public:
     ClientCounters counters() const { return counters_; }
 
     // ---- raw access -----------------------------------------------------------
-    // Sends `command` (without "@NN"), returns the reply body; throws ArcusError
+    // Sends `command` (without "@NN"), returns the reply body; throws ReplyError
     // for a refusal.  `idempotent` allows retries after a timeout.
     std::string command(std::string_view command, bool idempotent = false);
     // "@00<command>": every device acts, none replies.

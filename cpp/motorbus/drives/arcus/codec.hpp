@@ -69,8 +69,8 @@ std::string_view error_name(ErrorCode code);        // "Moving"
 std::optional<ErrorCode> classify_error(std::string_view body);
 
 // The controller refused a command with one of the replies of Table 11.1.
-struct ArcusError : DriveFault {
-    ArcusError(ErrorCode c, std::string reply_body, std::string request_cmd)
+struct ReplyError : DriveFault {
+    ReplyError(ErrorCode c, std::string reply_body, std::string request_cmd)
         : DriveFault("arcus: " + std::string(request_cmd) + " -> " + reply_body),
           code(c), reply(std::move(reply_body)), command(std::move(request_cmd)) {}
     ErrorCode code;

@@ -123,15 +123,15 @@ void arcus_check_strict(const ProfileParams& req) {
     if (req.edec) check("DEC", req.dec_ms);
 }
 
-const char* arcus_reply_text(ArcusReply r) {
+const char* arcus_reply_text(MotionReply r) {
     switch (r) {
-        case ArcusReply::Ok: return "";
-        case ArcusReply::MotorNotMoving: return "?Motor is not moving";
-        case ArcusReply::Moving: return "?Moving";
-        case ArcusReply::ScvOn: return "?SCV ON";
-        case ArcusReply::SpeedOutOfRange: return "?Speed out of range";
-        case ArcusReply::BadSspd: return "?Bad SSPD Command";
-        case ArcusReply::MoveTooFar: return "?Index out of Range";
+        case MotionReply::Ok: return "";
+        case MotionReply::MotorNotMoving: return "?Motor is not moving";
+        case MotionReply::Moving: return "?Moving";
+        case MotionReply::ScvOn: return "?SCV ON";
+        case MotionReply::SpeedOutOfRange: return "?Speed out of range";
+        case MotionReply::BadSspd: return "?Bad SSPD Command";
+        case MotionReply::MoveTooFar: return "?Index out of Range";
     }
     return "";
 }
@@ -160,19 +160,19 @@ static RampShape ArcusMotion_shape(const Effective& e) {
     return e.params.scv ? RampShape::SCurve : RampShape::Trapezoid;
 }
 
-ArcusReply Motion::move(double position, double target) {
-    if (!std::isfinite(position) || !std::isfinite(target)) return ArcusReply::MoveTooFar;
-    if (std::fabs(target - position) > static_cast<double>(kArcusMaxMoveDistance)) return ArcusReply::MoveTooFar;
+MotionReply Motion::move(double position, double target) {
+    if (!std::isfinite(position) || !std::isfinite(target)) return MotionReply::MoveTooFar;
+    if (std::fabs(target - position) > static_cast<double>(kArcusMaxMoveDistance)) return MotionReply::MoveTooFar;
     hspd_now_ = eff_.params.hspd;
     profile_ = arcus_stepper_profile(State{position, 0, 0, 0}, target, hspd_now_, eff_.params.lspd,
                                      eff_.accel(), eff_.decel(), ArcusMotion_shape(eff_));
     target_move_ = true;
     jogging_ = false;
     target_ = target;
-    return ArcusReply::Ok;
+    return MotionReply::Ok;
 }
 
-ArcusReply Motion::jog(double position, int direction) {
+MotionReply Motion::jog(double position, int direction) {
     const double s = direction >= 0 ? 1.0 : -1.0;
     hspd_now_ = eff_.params.hspd;
     Profile p(State{position, 0, 0, 0});
@@ -193,14 +193,14 @@ ArcusReply Motion::jog(double position, int direction) {
     target_move_ = false;
     jogging_ = true;
     jog_dir_ = static_cast<int>(s);
-    return ArcusReply::Ok;
+    return MotionReply::Ok;
 }
 
 bool Motion::moving(double t) const { return !profile_.empty() && t >= 0 && t < profile_.duration(); }
 
-ArcusReply Motion::change_target(double t, double new_target) {
-    if (!target_move_ || !moving(t)) return ArcusReply::MotorNotMoving;
-    if (!std::isfinite(new_target)) return ArcusReply::MoveTooFar;
+MotionReply Motion::change_target(double t, double new_target) {
+    if (!target_move_ || !moving(t)) return MotionReply::MotorNotMoving;
+    if (!std::isfinite(new_target)) return MotionReply::MoveTooFar;
     const State st = profile_.at(t);
     Profile tail = arcus_stepper_profile(st, new_target, hspd_now_, eff_.params.lspd, eff_.accel(), eff_.decel(),
                                          ArcusMotion_shape(eff_));
@@ -209,15 +209,15 @@ ArcusReply Motion::change_target(double t, double new_target) {
     head.finish(new_target, 0);
     profile_ = head;
     target_ = new_target;
-    return ArcusReply::Ok;
+    return MotionReply::Ok;
 }
 
-ArcusReply Motion::change_speed(double t, double new_hspd) {
-    if (eff_.params.scv) return ArcusReply::ScvOn;
-    if (!moving(t) || !std::isfinite(new_hspd) || new_hspd <= 0) return ArcusReply::BadSspd;
+MotionReply Motion::change_speed(double t, double new_hspd) {
+    if (eff_.params.scv) return MotionReply::ScvOn;
+    if (!moving(t) || !std::isfinite(new_hspd) || new_hspd <= 0) return MotionReply::BadSspd;
     const auto& w = arcus_window_for_sspdm(sspdm_);
     const double pps = new_hspd * eff_.params.snl_ratio;
-    if (pps < w.hspd_low || pps > w.hspd_high) return ArcusReply::SpeedOutOfRange;
+    if (pps < w.hspd_low || pps > w.hspd_high) return MotionReply::SpeedOutOfRange;
     const State st = profile_.at(t);
     // The ramp keeps the move's acceleration (PPS/s) fixed.
     const double accel = eff_.accel(), decel = eff_.decel();
@@ -240,7 +240,7 @@ ArcusReply Motion::change_speed(double t, double new_hspd) {
     head.append(tail);
     head.finish(target_move_ ? target_ : end_p, end_v);
     profile_ = head;
-    return ArcusReply::Ok;
+    return MotionReply::Ok;
 }
 
 void Motion::stop(double t) {

@@ -78,7 +78,7 @@ Effective arcus_effective(const ProfileParams& requested);
 void arcus_check_strict(const ProfileParams& requested);
 
 // Answers the drive gives to on-the-fly commands (Table 11.1).
-enum class ArcusReply {
+enum class MotionReply {
     Ok,
     MotorNotMoving,   // "?Motor is not moving": T while no target move runs
     Moving,           // "?Moving": a move command while outputting pulses
@@ -87,7 +87,7 @@ enum class ArcusReply {
     BadSspd,          // "?Bad SSPD Command": SSPD not usable (not moving, <= 0)
     MoveTooFar        // a move above 262143 pulses (the drive refuses it)
 };
-const char* arcus_reply_text(ArcusReply r);  // the drive's reply string, "" for Ok
+const char* arcus_reply_text(MotionReply r);  // the drive's reply string, "" for Ok
 
 // Motor status bits 0..2 of MST during a move.
 enum class Phase { Idle, Accel, Const, Decel };
@@ -108,18 +108,18 @@ public:
     // X: a target move from rest at `position`, as a new profile starting at
     // t = 0.  Refuses (MoveTooFar) a distance above 262143.  The simulator
     // answers "?Moving" itself when moving(t) is true.
-    ArcusReply move(double position, double target);
+    MotionReply move(double position, double target);
     // J+/J-: jog from rest at `position`.
-    ArcusReply jog(double position, int direction);
+    MotionReply jog(double position, int direction);
     // T at time t (seconds since the move started): change the target of the
     // running target move.  If the new target cannot be reached without
     // overshoot, or was already passed, the motor decelerates to LSPD, stops,
     // and moves back (the manual: "it will reverse direction").
-    ArcusReply change_target(double t, double new_target);
+    MotionReply change_target(double t, double new_target);
     // SSPD at time t: change the high speed of the running move (target move
     // or jog) to new_hspd using the move's ACC/DEC.  Checks SCV and the SSPDM
     // window.
-    ArcusReply change_speed(double t, double new_hspd);
+    MotionReply change_speed(double t, double new_hspd);
     // STOP: decelerate to LSPD, then stop.  ABORT: stop now.
     void stop(double t);
     void abort(double t);

@@ -564,7 +564,7 @@ std::uint32_t Sim::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t
                         const double pps = std::fabs(new_v) * (e.snl_on() ? e.slr() : 1.0);
                         if (pps >= 1 && pps <= 6'000'000) {
                             s.arcus.set_sspdm(arcus_window_for_hspd(pps).sspdm_first);
-                            if (s.arcus.change_speed(e.arcus_time(), std::fabs(new_v)) == ArcusReply::Ok) {
+                            if (s.arcus.change_speed(e.arcus_time(), std::fabs(new_v)) == MotionReply::Ok) {
                                 s.motor->revise(s.arcus.profile());
                                 changed = true;
                             }

@@ -244,7 +244,7 @@ std::string run_x(Cmd& c) {
     double target = s.inc_mode ? from + static_cast<double>(*c.v) : static_cast<double>(*c.v);
     if (std::abs(target - from) > static_cast<double>(kMaxIncrement)) return c.unknown();
     c.e.configure_arcus();
-    if (s.arcus.move(from, target) != ArcusReply::Ok) return c.unknown();
+    if (s.arcus.move(from, target) != MotionReply::Ok) return c.unknown();
     if (c.disabled()) return Cmd::ok();
     s.idle_current_motion = false;
     s.job = Job::Target;
@@ -268,7 +268,7 @@ std::string run_t(Cmd& c) {
     const double t = c.e.arcus_time();
     const double shift = s.arcus.profile().position(t) - c.m.pulse_position();
     auto r = s.arcus.change_target(t, static_cast<double>(*c.v) + shift);
-    if (r != ArcusReply::Ok) return arcus_reply_text(r);
+    if (r != MotionReply::Ok) return arcus_reply_text(r);
     c.m.revise(s.arcus.profile());
     return Cmd::ok();
 }
@@ -287,7 +287,7 @@ std::string run_sspd(Cmd& c) {
         return Cmd::error(ErrorCode::BadSspd);
     s.arcus.set_sspdm(static_cast<int>(s.sspdm));
     auto r = s.arcus.change_speed(c.e.arcus_time(), static_cast<double>(*c.v));
-    if (r != ArcusReply::Ok) return arcus_reply_text(r);
+    if (r != MotionReply::Ok) return arcus_reply_text(r);
     c.m.revise(s.arcus.profile());
     return Cmd::ok();
 }

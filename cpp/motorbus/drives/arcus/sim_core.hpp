@@ -303,7 +303,7 @@ public:
         s.idle_current_motion = dec.idle_current;
         s.job = Job::Correct;
         s.stopping = false;
-        if (s.arcus.move(from, target) == ArcusReply::Ok) command_arcus();
+        if (s.arcus.move(from, target) == MotionReply::Ok) command_arcus();
         if (!m().moving()) s.job = Job::None;
     }
 

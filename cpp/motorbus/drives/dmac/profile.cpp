@@ -19,11 +19,11 @@ void check_range(const char* name, double v, double lo, double hi) {
 
 // Constant-acceleration magnitudes (increments/s^2); infinity for start-stop.
 double accel_of(const ProfileParams& p) {
-    const double hs = dmac_speed_to_inc_per_s(p.high_speed);
+    const double hs = speed_to_inc_per_s(p.high_speed);
     return p.accel_time_ms > 0 ? hs / (p.accel_time_ms / 1000.0) : std::numeric_limits<double>::infinity();
 }
 double decel_of(const ProfileParams& p) {
-    const double hs = dmac_speed_to_inc_per_s(p.high_speed);
+    const double hs = speed_to_inc_per_s(p.high_speed);
     return p.decel_time_ms > 0 ? hs / (p.decel_time_ms / 1000.0) : std::numeric_limits<double>::infinity();
 }
 RampShape shape_of(const ProfileParams& p) { return p.s_curve ? RampShape::SCurve : RampShape::Trapezoid; }
@@ -34,14 +34,14 @@ void append_approach(Profile& prof, double target, double low_speed_inc) {
     const double err = std::fabs(target - p0);
     if (err == 0) return;
     const double s = target > p0 ? 1.0 : -1.0;
-    const double tau = kDmacApproachIncrements / low_speed_inc;
+    const double tau = kApproachIncrements / low_speed_inc;
     if (err > kApproachEndIncrements) {
         const double t_exp = tau * std::log(err / kApproachEndIncrements);
         prof.append_exp_approach(t_exp, target, tau);
     }
     // Last increment at the loop's speed for an error of one increment.
     const double rest = std::min(err, kApproachEndIncrements);
-    const double v_min = low_speed_inc * kApproachEndIncrements / kDmacApproachIncrements;
+    const double v_min = low_speed_inc * kApproachEndIncrements / kApproachIncrements;
     prof.append_jump(rest / v_min, s * v_min, 0, 0);
 }
 }  // namespace
@@ -53,7 +53,7 @@ void ProfileParams::validate() const {
     check_range("#DECEL_TIME", decel_time_ms, 0, 12000);
 }
 
-double dmac_ramp_time(const ProfileParams& p, double v_from, double v_to) {
+double ramp_time(const ProfileParams& p, double v_from, double v_to) {
     if (p.high_speed <= 0) return 0.0;
     const double hs = p.high_speed;
     const double ati = p.accel_time_ms / 1000.0, dti = p.decel_time_ms / 1000.0;
@@ -62,32 +62,32 @@ double dmac_ramp_time(const ProfileParams& p, double v_from, double v_to) {
     return dti * std::fabs(v_to - v_from) / hs;
 }
 
-Profile dmac_speed_profile(const State& start, double speed_001rpm, const ProfileParams& p, double hold) {
+Profile speed_profile(const State& start, double speed_001rpm, const ProfileParams& p, double hold) {
     p.validate();
     const double hs = p.high_speed;
     const double target = std::clamp(speed_001rpm, -hs, hs);
-    const double vt = dmac_speed_to_inc_per_s(target);
+    const double vt = speed_to_inc_per_s(target);
     Profile prof(State{start.p, start.v, 0, 0});
     double v = start.v;
     const RampShape shape = shape_of(p);
-    const double v_from = dmac_inc_per_s_to_speed(v);
+    const double v_from = inc_per_s_to_speed(v);
     if (v * vt < 0) {
-        detail::append_ramp(prof, -v, dmac_ramp_time(p, v_from, 0), shape);
+        detail::append_ramp(prof, -v, ramp_time(p, v_from, 0), shape);
         v = 0;
     }
-    detail::append_ramp(prof, vt - v, dmac_ramp_time(p, dmac_inc_per_s_to_speed(v), target), shape);
+    detail::append_ramp(prof, vt - v, ramp_time(p, inc_per_s_to_speed(v), target), shape);
     if (hold > 0) prof.append_jump(hold, vt, 0, 0);
     prof.finish(prof.final_state().p, vt);
     return prof;
 }
 
-Profile dmac_position_profile(const State& start, double target, const ProfileParams& p) {
+Profile position_profile(const State& start, double target, const ProfileParams& p) {
     p.validate();
     if (!std::isfinite(target) || !std::isfinite(start.p) || !std::isfinite(start.v))
         throw InvalidArgument("DMAC move: position and velocity must be finite");
-    const double hs = dmac_speed_to_inc_per_s(p.high_speed);
+    const double hs = speed_to_inc_per_s(p.high_speed);
     // The loop approaches at most at the cruise speed.
-    const double ls = std::min(dmac_speed_to_inc_per_s(p.low_speed), hs);
+    const double ls = std::min(speed_to_inc_per_s(p.low_speed), hs);
     if (!(ls > 0)) throw LimitExceeded("#LOW_SPEED", p.low_speed, 1, "a position move needs a non-zero approach speed");
     const double a = accel_of(p), d = decel_of(p);
     const RampShape shape = shape_of(p);
@@ -97,17 +97,17 @@ Profile dmac_position_profile(const State& start, double target, const ProfilePa
     const double x = std::fabs(x_signed);
     const double u = s * start.v;
     const double stop_to_ls = u > ls ? (u * u - ls * ls) / (2 * d) : 0.0;
-    if (start.v != 0 && (u < 0 || x <= kDmacApproachIncrements || stop_to_ls > x - kDmacApproachIncrements)) {
+    if (start.v != 0 && (u < 0 || x <= kApproachIncrements || stop_to_ls > x - kApproachIncrements)) {
         // Moving the wrong way, or too fast for this target: come to rest first.
         detail::append_ramp(prof, -start.v, std::fabs(start.v) / d, shape);
         const State rest{prof.final_state().p, 0, 0, 0};
-        Profile tail = dmac_position_profile(rest, target, p);
+        Profile tail = position_profile(rest, target, p);
         prof.append(tail);
         prof.finish(target, 0);
         return prof;
     }
-    if (x > kDmacApproachIncrements) {
-        const double via = target - s * kDmacApproachIncrements;
+    if (x > kApproachIncrements) {
+        const double via = target - s * kApproachIncrements;
         Profile head = detail::stepper_profile(State{start.p, start.v, 0, 0}, via, hs, a, d, 0.0, ls, shape);
         prof = head;
         prof.finish(via, s * ls);
@@ -146,7 +146,7 @@ void Motion::splice(double t, const Profile& tail) {
 
 void Motion::move_to(double t, std::int64_t target) {
     const State st = profile_.at(t);
-    splice(t, dmac_position_profile(st, static_cast<double>(target), params_));
+    splice(t, position_profile(st, static_cast<double>(target), params_));
     speed_mode_ = false;
     target_ = target;
 }
@@ -160,7 +160,7 @@ void Motion::move_on(double t, std::int64_t offset) {
 
 void Motion::move_speed(double t, std::int32_t speed_001rpm) {
     const State st = profile_.at(t);
-    Profile tail = dmac_speed_profile(st, speed_001rpm, params_, kSpeedHoldSeconds);
+    Profile tail = speed_profile(st, speed_001rpm, params_, kSpeedHoldSeconds);
     splice(t, tail);
     const double vt = tail.final_state().v;
     target_reached_ = t + (tail.duration() - kSpeedHoldSeconds);
@@ -171,7 +171,7 @@ void Motion::move_speed(double t, std::int32_t speed_001rpm) {
 
 void Motion::stop(double t) {
     const State st = profile_.at(t);
-    Profile tail = dmac_speed_profile(st, 0, params_, 0.0);
+    Profile tail = speed_profile(st, 0, params_, 0.0);
     splice(t, tail);
     speed_mode_ = false;
     target_ = static_cast<std::int64_t>(std::llround(tail.final_state().p));

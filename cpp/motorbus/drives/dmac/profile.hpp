@@ -35,14 +35,14 @@ namespace motorbus::dmac {
 // A vendor profile model is built from the generic motion pieces.
 using namespace motorbus::motion;
 
-inline constexpr double kDmacIncrementsPerRev = 10000.0;
-inline constexpr double kDmacApproachIncrements = 1000.0;  // 0.1 turn
+inline constexpr double kIncrementsPerRev = 10000.0;
+inline constexpr double kApproachIncrements = 1000.0;  // 0.1 turn
 // 0.01 rpm -> increments/s
-inline constexpr double dmac_speed_to_inc_per_s(double speed_001rpm) {
-    return speed_001rpm * kDmacIncrementsPerRev / 6000.0;
+inline constexpr double speed_to_inc_per_s(double speed_001rpm) {
+    return speed_001rpm * kIncrementsPerRev / 6000.0;
 }
-inline constexpr double dmac_inc_per_s_to_speed(double inc_per_s) {
-    return inc_per_s * 6000.0 / kDmacIncrementsPerRev;
+inline constexpr double inc_per_s_to_speed(double inc_per_s) {
+    return inc_per_s * 6000.0 / kIncrementsPerRev;
 }
 
 struct ProfileParams {  // factory values (MODULE_RESET ALL)
@@ -58,7 +58,7 @@ struct ProfileParams {  // factory values (MODULE_RESET ALL)
 // Time (s) the DMAC takes to change speed from v_from to v_to (0.01 rpm):
 // #ACCEL_TIME x |dv| / #HIGH_SPEED when the speed magnitude grows, DECEL when
 // it shrinks (the manual's 0.5 s example: ATI 1000, HS 60000, 0 -> 30000).
-double dmac_ramp_time(const ProfileParams& p, double v_from, double v_to);
+double ramp_time(const ProfileParams& p, double v_from, double v_to);
 
 // The profile of one DMAC axis across commands.  Each command at time t
 // (seconds on the profile's own time line, 0 = first command) replaces the
@@ -98,9 +98,9 @@ private:
 
 // The core position plan, exposed for reuse: from `start` to `target`
 // (increments) with the given parameters.
-Profile dmac_position_profile(const State& start, double target, const ProfileParams& p);
+Profile position_profile(const State& start, double target, const ProfileParams& p);
 // Velocity plan from `start` to `speed_001rpm`, then holding it for `hold` s.
-Profile dmac_speed_profile(const State& start, double speed_001rpm, const ProfileParams& p,
+Profile speed_profile(const State& start, double speed_001rpm, const ProfileParams& p,
                            double hold);
 
 }  // namespace motorbus::dmac

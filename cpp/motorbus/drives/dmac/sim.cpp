@@ -26,8 +26,8 @@ motion::MotorConfig axis_config(const SimOptions& o) {
     motion::MotorConfig c;
     // One step = one encoder count = one DMAC increment: every position the
     // firmware reports is the model's encoder as is.
-    c.steps_per_rev = kDmacIncrementsPerRev;
-    c.counts_per_rev = kDmacIncrementsPerRev;
+    c.steps_per_rev = kIncrementsPerRev;
+    c.counts_per_rev = kIncrementsPerRev;
     c.index_width_steps = 1;
     c.plus_limit = o.positive_end_switch;
     c.minus_limit = o.negative_end_switch;
@@ -175,14 +175,14 @@ std::int32_t Sim::position_locked() const { return wrap_i32(axis_->encoder()); }
 // #SPEED: the rotor's measured speed, whoever drives it -- the power stage,
 // or nothing while it runs down after POWER OFF/SC, a fault or MODULE_RESET.
 std::int32_t Sim::speed_locked() const {
-    return round_i32(dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->velocity())));
+    return round_i32(inc_per_s_to_speed(axis_->steps_to_counts(axis_->velocity())));
 }
 
 // #PROFILE_SPEED: "the computed speed of the module" (5.24): what its profile
 // (or interpolation segment) asks for; nothing while the power stage is off.
 std::int32_t Sim::profile_speed_locked() const {
     if (coasting_ || seg_wait_) return 0;
-    return round_i32(dmac_inc_per_s_to_speed(axis_->steps_to_counts(axis_->commanded_velocity())));
+    return round_i32(inc_per_s_to_speed(axis_->steps_to_counts(axis_->commanded_velocity())));
 }
 
 bool Sim::moving_locked() const {
@@ -574,7 +574,7 @@ std::uint32_t Sim::status_locked() {
     set(status::kMovement, moving);
     if (moving && position_mode_ && !interpolating_) {
         const double err = static_cast<double>(motion_->target() + pos_offset_) - user_position();
-        set(status::kPositionControl, std::fabs(err) <= kDmacApproachIncrements);
+        set(status::kPositionControl, std::fabs(err) <= kApproachIncrements);
     }
     set(status::kBusy, busy_locked());
     set(status::kReference, reference_);

@@ -161,13 +161,13 @@ std::vector<OdRow> make_rows() {
 }
 }  // namespace
 
-const std::vector<OdRow>& pmc007_od_rows() {
+const std::vector<OdRow>& od_rows() {
     static const std::vector<OdRow> rows = make_rows();
     return rows;
 }
 
-const OdRow* pmc007_od_row(std::uint16_t index, std::uint8_t sub) {
-    for (const auto& r : pmc007_od_rows())
+const OdRow* od_row(std::uint16_t index, std::uint8_t sub) {
+    for (const auto& r : od_rows())
         if (r.index == index && r.sub == sub) return &r;
     return nullptr;
 }
@@ -185,7 +185,7 @@ std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id,
     info.nr_rx_pdo = 4;
     info.nr_tx_pdo = 4;
     std::map<std::uint16_t, bool> made;
-    for (const auto& r : pmc007_od_rows()) {
+    for (const auto& r : od_rows()) {
         canopen::VariableSpec spec;
         spec.index = r.index;
         spec.subindex = r.sub;
@@ -228,7 +228,7 @@ std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id,
     return od;
 }
 
-std::string pmc007_eds() {
+std::string eds() {
     auto od = build_pmc007_od(5);
     return canopen::to_eds(*od);
 }

@@ -1,7 +1,7 @@
 // The PMC007's object dictionary (003 Appendix 1, §4.3-§4.9, with the
 // readings of the spec's §1.2/§1.3) as ONE table of rows.  The simulator's
 // dictionary (build_pmc007_od) and the EDS shipped with the package
-// (pmc007_eds, written to device.eds by the generator test) both come from
+// (eds, written to device.eds by the generator test) both come from
 // it, so the device a host talks to and the file it loads cannot disagree.
 #pragma once
 #include <cstdint>
@@ -40,9 +40,9 @@ struct OdRow {
 };
 
 // Every index:sub of the spec (73 indices, 210 entries), in index order.
-const std::vector<OdRow>& pmc007_od_rows();
+const std::vector<OdRow>& od_rows();
 // The row of (index, sub), or nullptr.
-const OdRow* pmc007_od_row(std::uint16_t index, std::uint8_t sub);
+const OdRow* od_row(std::uint16_t index, std::uint8_t sub);
 // 1018h:01-04.  003 documents no identity: the EDS carries 0 (unknown); a simulator
 // reads the identity it was given (SimOptions::identity).
 struct Identity {
@@ -54,6 +54,6 @@ struct Identity {
 // A dictionary with every row, defaults evaluated for `node_id` (1..127), 1018h from `identity`.
 std::shared_ptr<canopen::ObjectDictionary> build_pmc007_od(std::uint8_t node_id, const Identity& identity = {});
 // The EDS text of that dictionary ($NODEID expressions kept).
-std::string pmc007_eds();
+std::string eds();
 
 }  // namespace motorbus::pmc007

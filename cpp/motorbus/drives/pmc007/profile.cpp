@@ -7,43 +7,43 @@
 
 namespace motorbus::pmc007 {
 
-double pmc007_gear_acceleration(int gear) {
+double gear_acceleration(int gear) {
     if (gear < 0) throw LimitExceeded("acceleration gear (6008h/6009h)", gear, 0, "gears are 0..8");
     if (gear > 8) throw LimitExceeded("acceleration gear (6008h/6009h)", gear, 8, "gears are 0..8");
-    return gear == 0 ? std::numeric_limits<double>::infinity() : kPmc007GearAcceleration[static_cast<std::size_t>(gear)];
+    return gear == 0 ? std::numeric_limits<double>::infinity() : kGearAcceleration[static_cast<std::size_t>(gear)];
 }
 
-int pmc007_microsteps(int setting) {
+int microsteps(int setting) {
     if (setting == 0) return 1;
     for (int m = 2; m <= 256; m *= 2)
         if (setting == m) return m;
     throw LimitExceeded("microstepping (600Ah)", setting, setting > 256 ? 256 : 0, "0, 2, 4, 8, 16, 32, 64, 128 or 256");
 }
 
-double pmc007_convert_position(double position, int from_setting, int to_setting) {
-    return position * pmc007_microsteps(to_setting) / pmc007_microsteps(from_setting);
+double convert_position(double position, int from_setting, int to_setting) {
+    return position * microsteps(to_setting) / microsteps(from_setting);
 }
 
 void ProfileParams::validate() const {
-    (void)pmc007_gear_acceleration(accel_gear);
-    (void)pmc007_gear_acceleration(decel_gear);
-    (void)pmc007_microsteps(microstepping);
+    (void)gear_acceleration(accel_gear);
+    (void)gear_acceleration(decel_gear);
+    (void)microsteps(microstepping);
     if (start_speed < 0 || start_speed > 65535) throw LimitExceeded("start speed (6006h)", start_speed, start_speed < 0 ? 0 : 65535);
     if (stop_speed < 0 || stop_speed > 65535) throw LimitExceeded("stop speed (6007h)", stop_speed, stop_speed < 0 ? 0 : 65535);
     if (!(speed > 0) || !std::isfinite(speed)) throw LimitExceeded("speed", speed, 0, "must be positive");
 }
 
-Profile pmc007_position_profile(const State& start, double target, const ProfileParams& p) {
+Profile position_profile(const State& start, double target, const ProfileParams& p) {
     p.validate();
-    const double a = pmc007_gear_acceleration(p.accel_gear), d = pmc007_gear_acceleration(p.decel_gear);
+    const double a = gear_acceleration(p.accel_gear), d = gear_acceleration(p.decel_gear);
     // Start/stop speeds above the running speed collapse onto it.
     const double vs = std::min(p.start_speed, p.speed), ve = std::min(p.stop_speed, p.speed);
     return detail::stepper_profile(State{start.p, start.v, 0, 0}, target, p.speed, a, d, vs, ve, RampShape::SCurve);
 }
 
-Profile pmc007_speed_profile(const State& start, double speed, const ProfileParams& p, double hold) {
+Profile speed_profile(const State& start, double speed, const ProfileParams& p, double hold) {
     p.validate();
-    const double a = pmc007_gear_acceleration(p.accel_gear), d = pmc007_gear_acceleration(p.decel_gear);
+    const double a = gear_acceleration(p.accel_gear), d = gear_acceleration(p.decel_gear);
     Profile prof(State{start.p, start.v, 0, 0});
     double v = start.v;
     if (v * speed < 0) {  // reverse: slow down to the stop speed, stop, restart

@@ -18,17 +18,17 @@ namespace motorbus::pmc007 {
 // A vendor profile model is built from the generic motion pieces.
 using namespace motorbus::motion;
 
-inline constexpr std::array<double, 9> kPmc007GearAcceleration = {0,     77440, 48410, 27170, 21510,
+inline constexpr std::array<double, 9> kGearAcceleration = {0,     77440, 48410, 27170, 21510,
                                                                   14080, 10460, 6915,  5210};
 
 // pps^2 of a gear 1..8; infinity for gear 0 (no ramp).  Throws LimitExceeded outside 0..8.
-double pmc007_gear_acceleration(int gear);
+double gear_acceleration(int gear);
 // Microsteps per full step for a 600Ah value (0 -> 1); throws LimitExceeded
 // for values other than 0, 2, 4, ..., 256.
-int pmc007_microsteps(int setting);
+int microsteps(int setting);
 // Position count after changing the microstepping (the manual: read the
 // position first, then convert): pos * new / old.
-double pmc007_convert_position(double position, int from_setting, int to_setting);
+double convert_position(double position, int from_setting, int to_setting);
 
 struct ProfileParams {
     double speed = 1000;           // pps, the running speed (speed mode / position moves)
@@ -41,8 +41,8 @@ struct ProfileParams {
 };
 
 // Step/absolute displacement command: from `start` to `target` (steps).
-Profile pmc007_position_profile(const State& start, double target, const ProfileParams& p);
+Profile position_profile(const State& start, double target, const ProfileParams& p);
 // Speed mode: ramp to `speed` (signed pps) from the start speed, hold `hold` s.
-Profile pmc007_speed_profile(const State& start, double speed, const ProfileParams& p, double hold);
+Profile speed_profile(const State& start, double speed, const ProfileParams& p, double hold);
 
 }  // namespace motorbus::pmc007

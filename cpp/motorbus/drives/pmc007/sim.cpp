@@ -70,13 +70,13 @@ Sim::Sim(std::uint8_t node_id, Clock& clock, SimOptions options)
           return c;
       }()) {
     // Factory "flash": the defaults of every ROM object.
-    for (const auto& r : pmc007_od_rows())
+    for (const auto& r : od_rows())
         if (r.storage == Storage::Rom) flash_[{r.index, r.sub}] = od_->at(r.index, r.sub)->default_bytes();
     // What load_power_up() visits, looked up once (the keys of flash_ never change).
-    for (const auto& r : pmc007_od_rows())
+    for (const auto& r : od_rows())
         power_up_.push_back({&r, od_->at(r.index, r.sub),
                              r.storage == Storage::Rom ? &flash_.at({r.index, r.sub}) : nullptr});
-    for (const auto& r : pmc007_od_rows()) {
+    for (const auto& r : od_rows()) {
         const bool pdo_area = r.index >= 0x1400 && r.index <= 0x1BFF;
         if (pdo_area || r.index == 0x1016 || r.index == 0x1017) continue;  // the generic services own them
         auto var = od_->at(r.index, r.sub);
@@ -251,7 +251,7 @@ void Sim::switch_node_id(std::uint8_t new_id) {
     const std::uint8_t old_id = node_id_;
     // Predefined COB-IDs ($NODEID+...) follow the node-ID when they still hold the old default.
     std::vector<std::pair<const OdRow*, std::int64_t>> moved;
-    for (const auto& r : pmc007_od_rows())
+    for (const auto& r : od_rows())
         if (r.node_offset >= 0) {
             const std::int64_t cur = u(r.index, r.sub);
             if ((cur & 0x7FF) == r.node_offset + old_id) moved.push_back({&r, (cur & ~0x7FFLL) | (r.node_offset + new_id)});
@@ -955,7 +955,7 @@ std::uint32_t Sim::start_move_locked(std::int64_t delta) {
     if (speed <= 0) speed = double(u(0x6006));  // [P] no run speed set: the start speed
     if (speed <= 0) return 0;                   // [P] nothing to move with: accepted, no motion
     const motion::State s{motor_.pulse_position(), motor_.moving() ? motor_.pulse_velocity() : 0.0, 0, 0};
-    motor_.command(pmc007_position_profile(s, s.p + double(delta), params_locked(speed)));
+    motor_.command(position_profile(s, s.p + double(delta), params_locked(speed)));
     return 0;
 }
 
@@ -967,7 +967,7 @@ void Sim::stop_now_locked() {
 std::uint32_t Sim::on_write(std::uint16_t index, std::uint8_t sub, std::span<const std::uint8_t> d) {
     std::lock_guard lock(m_);
     update_locked();
-    const auto* row = pmc007_od_row(index, sub);
+    const auto* row = od_row(index, sub);
     const std::int64_t v = decode_le(d, row && row->type == canopen::DataType::Integer32);
     switch (index) {
         case 0x1003:
@@ -978,7 +978,7 @@ std::uint32_t Sim::on_write(std::uint16_t index, std::uint8_t sub, std::span<con
             if (v == 1) {
                 bootloader_pending_ = true;
             } else if (v == 2) {  // B-P37: every ROM object to flash
-                for (const auto& r : pmc007_od_rows())
+                for (const auto& r : od_rows())
                     if (r.storage == Storage::Rom) flash_[{r.index, r.sub}] = od_->at(r.index, r.sub)->get();
                 write_store_locked();
             } else if (v == 3) {  // B-P38 / C-P19: factory values into the working copy only
@@ -1009,7 +1009,7 @@ std::uint32_t Sim::on_write(std::uint16_t index, std::uint8_t sub, std::span<con
             if (u(0x6005) == 1) {  // B-P12 speed mode: run at the new speed
                 const motion::State s{motor_.pulse_position(), motor_.moving() ? motor_.pulse_velocity() : 0.0, 0, 0};
                 const double speed = double(v);
-                motor_.command(pmc007_speed_profile(s, speed, params_locked(std::max(1.0, std::fabs(speed))),
+                motor_.command(speed_profile(s, speed, params_locked(std::max(1.0, std::fabs(speed))),
                                                     speed == 0 ? 0.0 : 1e6));
                 speed_mode_running_ = v != 0;
             }
@@ -1031,7 +1031,7 @@ std::uint32_t Sim::on_write(std::uint16_t index, std::uint8_t sub, std::span<con
         case 0x6005:
             if (v == 0 && u(0x6005) == 1 && motor_.moving()) {      // speed -> position: decelerate
                 const motion::State s{motor_.pulse_position(), motor_.pulse_velocity(), 0, 0};
-                motor_.command(pmc007_speed_profile(s, 0.0, params_locked(std::max(1.0, std::fabs(s.v))), 0.0));
+                motor_.command(speed_profile(s, 0.0, params_locked(std::max(1.0, std::fabs(s.v))), 0.0));
                 speed_mode_running_ = false;
             }
             if (v == 1 && u(0x6005) == 0) {  // position -> speed: run at the current 6003h (B-P12)
@@ -1039,7 +1039,7 @@ std::uint32_t Sim::on_write(std::uint16_t index, std::uint8_t sub, std::span<con
                 if (speed != 0) {
                     if (refused_locked()) return kAbortDeviceState;  // B-P20: as a 6003h write would be
                     const motion::State s{motor_.pulse_position(), motor_.moving() ? motor_.pulse_velocity() : 0.0, 0, 0};
-                    motor_.command(pmc007_speed_profile(s, speed, params_locked(std::fabs(speed)), 1e6));
+                    motor_.command(speed_profile(s, speed, params_locked(std::fabs(speed)), 1e6));
                     speed_mode_running_ = true;
                 }
             }
@@ -1097,7 +1097,7 @@ void Sim::factory_reset_locked() {
     // The objects a service owns take it through that service: the heartbeat producer and
     // consumers through their write hooks, the PDO parameters by rebuilding the engine
     // from the dictionary (a zero mapping word is no value the engine's hooks accept).
-    for (const auto& r : pmc007_od_rows()) {
+    for (const auto& r : od_rows()) {
         if (r.storage != Storage::Rom) continue;
         auto var = od_->at(r.index, r.sub);
         if ((r.index == 0x1016 || r.index == 0x1017) && canopen::writable(r.access))

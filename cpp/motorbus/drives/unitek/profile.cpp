@@ -15,16 +15,16 @@ void RampParams::validate() const {
     }
 }
 
-double unitek_num_to_counts_per_s(double num, const RampParams& p) {
-    return num / kUnitekFullScale * p.n_max_rpm / 60.0 * kUnitekCountsPerRev;
+double num_to_counts_per_s(double num, const RampParams& p) {
+    return num / kFullScale * p.n_max_rpm / 60.0 * kCountsPerRev;
 }
 
-Profile unitek_speed_profile(const State& start, double speed_num, const RampParams& p, double hold) {
+Profile speed_profile(const State& start, double speed_num, const RampParams& p, double hold) {
     p.validate();
     if (!std::isfinite(speed_num)) throw InvalidArgument("UNITEK speed command must be finite");
-    speed_num = std::clamp(speed_num, -kUnitekFullScale, kUnitekFullScale);
-    const double full = unitek_num_to_counts_per_s(kUnitekFullScale, p);
-    const double vt = unitek_num_to_counts_per_s(speed_num, p);
+    speed_num = std::clamp(speed_num, -kFullScale, kFullScale);
+    const double full = num_to_counts_per_s(kFullScale, p);
+    const double vt = num_to_counts_per_s(speed_num, p);
     Profile prof(State{start.p, start.v, 0, 0});
     double v = start.v;
     auto ramp = [&](double from, double to, double ms) {

@@ -9,16 +9,17 @@
 #pragma once
 #include <cstdint>
 
+#include "motorbus/drives/unitek/codec.hpp"
 #include "motorbus/motion/profile.hpp"
 
 namespace motorbus::unitek {
 // A vendor profile model is built from the generic motion pieces.
 using namespace motorbus::motion;
 
-inline constexpr std::uint8_t kUnitekRegAccRamp = 0x35;
-inline constexpr std::uint8_t kUnitekRegDecRamp = 0xED;
-inline constexpr double kUnitekCountsPerRev = 65536.0;
-inline constexpr double kUnitekFullScale = 32767.0;
+// kRegAccRamp (0x35, documented) is the codec's; DEC_RAMP is NDrive's register list only.
+inline constexpr std::uint8_t kRegDecRamp = 0xED;
+inline constexpr double kCountsPerRev = 65536.0;
+inline constexpr double kFullScale = 32767.0;
 
 struct RampParams {
     double n_max_rpm = 3000;   // N max: the speed of 32767 num
@@ -28,9 +29,9 @@ struct RampParams {
 };
 
 // num -> counts/s
-double unitek_num_to_counts_per_s(double num, const RampParams& p);
+double num_to_counts_per_s(double num, const RampParams& p);
 // The drive's ramp from start.v (counts/s) to the command `speed_num`, held for `hold` s.
 // |speed_num| is limited to 32767.
-Profile unitek_speed_profile(const State& start, double speed_num, const RampParams& p, double hold);
+Profile speed_profile(const State& start, double speed_num, const RampParams& p, double hold);
 
 }  // namespace motorbus::unitek

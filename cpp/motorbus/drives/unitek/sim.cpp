@@ -16,8 +16,8 @@ constexpr double kHoldForever = 1.0e6;  // s: a speed command holds until the ne
 
 motion::MotorConfig motor_config(const SimConfig& c) {
     motion::MotorConfig m;
-    m.steps_per_rev = kUnitekCountsPerRev;  // a servo: the "steps" are the position num
-    m.counts_per_rev = kUnitekCountsPerRev;
+    m.steps_per_rev = kCountsPerRev;  // a servo: the "steps" are the position num
+    m.counts_per_rev = kCountsPerRev;
     if (c.minus_limit_num) m.minus_limit = {true, *c.minus_limit_num, 0, false, false};
     if (c.plus_limit_num) m.plus_limit = {true, *c.plus_limit_num, 0, false, false};
     m.tick_ns = 250'000;
@@ -424,7 +424,7 @@ void Sim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
             if (enabled) {
                 activity_ = Activity::Position;
                 const auto p = ramps_locked();
-                const double full = unitek_num_to_counts_per_s(kFull, p);
+                const double full = num_to_counts_per_s(kFull, p);
                 motion::Limits lim;
                 lim.max_velocity = full;
                 lim.max_acceleration = full / std::max(p.acc_ramp_ms, 1.0) * 1000.0;
@@ -439,7 +439,7 @@ void Sim::write_locked(std::uint8_t regid, std::uint32_t raw, int bits) {
 void Sim::speed_locked(double num, double ramp_scale) {
     auto p = ramps_locked();
     p.acc_ramp_ms = std::min(p.acc_ramp_ms * ramp_scale, 32767.0);
-    motor_.command(unitek_speed_profile(state_locked(), num, p, kHoldForever));
+    motor_.command(speed_profile(state_locked(), num, p, kHoldForever));
 }
 
 void Sim::apply_enable_locked() {
@@ -489,7 +489,7 @@ std::int64_t Sim::value_locked(std::uint8_t regid) {
         case kRegAin1: return ain_[0];
         case kRegAin2: return ain_[1];
         case kRegSpeedActual: {
-            const double num = motor_.pulse_velocity() / unitek_num_to_counts_per_s(1.0, ramps_locked());
+            const double num = motor_.pulse_velocity() / num_to_counts_per_s(1.0, ramps_locked());
             return static_cast<std::int64_t>(std::llround(std::clamp(num, -kFull, kFull)));
         }
         default: {
@@ -585,7 +585,7 @@ double Sim::position_num() {
 double Sim::speed_num() {
     std::lock_guard l(m_);
     motor_.advance_to(std::max(clock_.now(), motor_.time()));
-    return motor_.pulse_velocity() / unitek_num_to_counts_per_s(1.0, ramps_locked());
+    return motor_.pulse_velocity() / num_to_counts_per_s(1.0, ramps_locked());
 }
 
 double Sim::bit_rate() const { return bit_timing_for_btr(cfg_.btr).bit_rate(); }

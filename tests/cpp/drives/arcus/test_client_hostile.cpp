@@ -53,7 +53,7 @@ TEST(ArcusHostile, A5UnknownCommandIsTypedAndNotRetried) {
     try {
         b.c.command("FOO", /*idempotent=*/true);
         FAIL();
-    } catch (const ArcusError& e) {
+    } catch (const ReplyError& e) {
         EXPECT_EQ(e.code, ErrorCode::UnknownCommand);
         EXPECT_EQ(e.reply, "?FOO");
         EXPECT_EQ(e.command, "FOO");
@@ -65,7 +65,7 @@ TEST(ArcusHostile, A5UnknownCommandIsTypedAndNotRetried) {
     try {
         b.c.position();
         FAIL();
-    } catch (const ArcusError& e) {
+    } catch (const ReplyError& e) {
         EXPECT_EQ(e.code, ErrorCode::UnknownCommand);
     }
 }
@@ -174,7 +174,7 @@ TEST(ArcusHostile, RefusalsAreTypedForEveryTable11_1Reply) {
     auto code_of = [&](auto&& f) -> ErrorCode {
         try {
             f();
-        } catch (const ArcusError& e) {
+        } catch (const ReplyError& e) {
             return e.code;
         }
         ADD_FAILURE() << "no ArcusError";

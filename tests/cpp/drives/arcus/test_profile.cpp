@@ -96,7 +96,7 @@ ProfileParams base_params() {
 
 TEST(Motion, TrapezoidFromLspd) {
     Motion m(base_params());
-    ASSERT_EQ(m.move(0, 10000), ArcusReply::Ok);
+    ASSERT_EQ(m.move(0, 10000), MotionReply::Ok);
     const Profile& p = m.profile();
     // Jump to LSPD, ramp 100 -> 1000 in 0.1 s (55 pulses), cruise, ramp down, jump to 0.
     EXPECT_DOUBLE_EQ(p.velocity(1e-12), 100.0 + 9000.0 * 1e-12);
@@ -126,16 +126,16 @@ TEST(Motion, EdecUsesDec) {
 
 TEST(Motion, IncrementalLimit262143) {
     Motion m(base_params());
-    EXPECT_EQ(m.move(100000, 362143), ArcusReply::Ok);
-    EXPECT_EQ(m.move(100000, 362144), ArcusReply::MoveTooFar);
-    EXPECT_EQ(m.move(100000, -162143), ArcusReply::Ok);
-    EXPECT_EQ(m.move(100000, -162144), ArcusReply::MoveTooFar);
+    EXPECT_EQ(m.move(100000, 362143), MotionReply::Ok);
+    EXPECT_EQ(m.move(100000, 362144), MotionReply::MoveTooFar);
+    EXPECT_EQ(m.move(100000, -162143), MotionReply::Ok);
+    EXPECT_EQ(m.move(100000, -162144), MotionReply::MoveTooFar);
 }
 
 TEST(Motion, OnTheFlyTargetAhead) {
     Motion m(base_params());
     m.move(0, 10000);
-    ASSERT_EQ(m.change_target(2.0, 20000), ArcusReply::Ok);
+    ASSERT_EQ(m.change_target(2.0, 20000), MotionReply::Ok);
     const Profile& p = m.profile();
     EXPECT_EQ(p.end_position(), 20000);
     EXPECT_NEAR(p.velocity(9.0), 1000, 1e-9);  // still cruising past the old target
@@ -147,7 +147,7 @@ TEST(Motion, OnTheFlyTargetAlreadyPassedReverses) {
     Motion m(base_params());
     m.move(0, 10000);
     const double pos_at_5 = m.profile().position(5.0);  // about 4945
-    ASSERT_EQ(m.change_target(5.0, 1000), ArcusReply::Ok);
+    ASSERT_EQ(m.change_target(5.0, 1000), MotionReply::Ok);
     const Profile& p = m.profile();
     EXPECT_EQ(p.end_position(), 1000);
     // Decelerates to LSPD (0.1 s, 55 pulses), stops, then runs back.
@@ -163,19 +163,19 @@ TEST(Motion, OnTheFlyTargetAlreadyPassedReverses) {
 
 TEST(Motion, OnTheFlyTargetErrors) {
     Motion m(base_params());
-    EXPECT_EQ(m.change_target(0, 10), ArcusReply::MotorNotMoving);
+    EXPECT_EQ(m.change_target(0, 10), MotionReply::MotorNotMoving);
     m.move(0, 100);
-    EXPECT_EQ(m.change_target(100.0, 10), ArcusReply::MotorNotMoving);  // finished
+    EXPECT_EQ(m.change_target(100.0, 10), MotionReply::MotorNotMoving);  // finished
     m.jog(0, 1);
-    EXPECT_EQ(m.change_target(1.0, 10), ArcusReply::MotorNotMoving);    // not a target move
-    EXPECT_STREQ(arcus_reply_text(ArcusReply::MotorNotMoving), "?Motor is not moving");
+    EXPECT_EQ(m.change_target(1.0, 10), MotionReply::MotorNotMoving);    // not a target move
+    EXPECT_STREQ(arcus_reply_text(MotionReply::MotorNotMoving), "?Motor is not moving");
 }
 
 TEST(Motion, OnTheFlySpeed) {
     Motion m(base_params(), 0);
     m.move(0, 100000);
-    EXPECT_EQ(m.change_speed(1.0, 20000), ArcusReply::SpeedOutOfRange);  // SSPDM 0: 1..16K
-    ASSERT_EQ(m.change_speed(1.0, 2000), ArcusReply::Ok);
+    EXPECT_EQ(m.change_speed(1.0, 20000), MotionReply::SpeedOutOfRange);  // SSPDM 0: 1..16K
+    ASSERT_EQ(m.change_speed(1.0, 2000), MotionReply::Ok);
     const Profile& p = m.profile();
     // Same acceleration (9000 pps/s): 1000 -> 2000 takes 1/9 s.
     EXPECT_NEAR(p.velocity(1.0 + 1.0 / 9.0 + 0.01), 2000, 1e-9);
@@ -184,16 +184,16 @@ TEST(Motion, OnTheFlySpeed) {
     s.scv = true;
     Motion sc(s);
     sc.move(0, 10000);
-    EXPECT_EQ(sc.change_speed(1.0, 500), ArcusReply::ScvOn);
+    EXPECT_EQ(sc.change_speed(1.0, 500), MotionReply::ScvOn);
     Motion idle(base_params());
-    EXPECT_EQ(idle.change_speed(0, 500), ArcusReply::BadSspd);
+    EXPECT_EQ(idle.change_speed(0, 500), MotionReply::BadSspd);
 }
 
 TEST(Motion, JogSpeedChangeAndStop) {
     Motion m(base_params());
     m.jog(0, -1);
     EXPECT_NEAR(m.profile().velocity(1.0), -1000, 1e-9);
-    ASSERT_EQ(m.change_speed(1.0, 500), ArcusReply::Ok);
+    ASSERT_EQ(m.change_speed(1.0, 500), MotionReply::Ok);
     EXPECT_NEAR(m.profile().velocity(2.0), -500, 1e-9);
     m.stop(3.0);
     const Profile& p = m.profile();
@@ -224,10 +224,10 @@ TEST(Motion, RandomOnTheFlyChangesEndOnTarget) {
         p.acc_ms = 2 + 500 * u(rng);
         Motion m(p);
         const double target = std::round(-50000 + 100000 * u(rng));
-        ASSERT_EQ(m.move(0, target), ArcusReply::Ok);
+        ASSERT_EQ(m.move(0, target), MotionReply::Ok);
         const double t = m.profile().duration() * u(rng);
         const double t2 = std::round(-50000 + 100000 * u(rng));
-        if (m.change_target(t, t2) == ArcusReply::Ok) {
+        if (m.change_target(t, t2) == MotionReply::Ok) {
             EXPECT_EQ(m.profile().end_position(), t2);
             EXPECT_LE(m.profile().max_abs_velocity(), m.effective().params.hspd * (1 + 1e-9));
             auto st = step_times(m.profile());
@@ -246,16 +246,16 @@ TEST(HostileNumbers, ArcusModel) {
             EXPECT_THROW(arcus_effective(a), motorbus::InvalidArgument) << x;
         }
         Motion m;
-        const ArcusReply r = m.move(0, x);
-        EXPECT_EQ(r, std::isfinite(x) && std::fabs(x) <= 262143 ? ArcusReply::Ok : ArcusReply::MoveTooFar) << x;
+        const MotionReply r = m.move(0, x);
+        EXPECT_EQ(r, std::isfinite(x) && std::fabs(x) <= 262143 ? MotionReply::Ok : MotionReply::MoveTooFar) << x;
         EXPECT_TRUE(std::isfinite(m.profile().end_position()));
         m.move(0, 1000);
-        const ArcusReply rt = m.change_target(0.5, x);
+        const MotionReply rt = m.change_target(0.5, x);
         if (!std::isfinite(x)) {
-            EXPECT_EQ(rt, ArcusReply::MoveTooFar);
+            EXPECT_EQ(rt, MotionReply::MoveTooFar);
         }
         EXPECT_TRUE(std::isfinite(m.profile().duration()));
     }
     Motion ok;
-    EXPECT_EQ(ok.move(0, 1000), ArcusReply::Ok);
+    EXPECT_EQ(ok.move(0, 1000), MotionReply::Ok);
 }

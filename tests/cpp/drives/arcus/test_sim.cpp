@@ -157,7 +157,7 @@ TEST(ArcusSim, MovingErrors) {
     try {
         b.c.move(10);
         FAIL();
-    } catch (const ArcusError& e) {
+    } catch (const ReplyError& e) {
         EXPECT_EQ(e.code, ErrorCode::Moving);
         EXPECT_EQ(e.reply, "?Moving");
     }
@@ -203,7 +203,7 @@ TEST(ArcusSim, OnTheFlySpeedChange) {
     try {
         b.c.change_speed(2000);
         FAIL();
-    } catch (const ArcusError& e) {
+    } catch (const ReplyError& e) {
         EXPECT_EQ(e.code, ErrorCode::ScvOn);
     }
     b.c.set_s_curve(false);

@@ -18,20 +18,20 @@ TEST(Dmac, HalfSecondExample) {
     ProfileParams p;
     p.accel_time_ms = 1000;
     p.high_speed = 60000;
-    EXPECT_DOUBLE_EQ(dmac_ramp_time(p, 0, 30000), 0.5);
-    Profile s = dmac_speed_profile(State{}, 30000, p, 1.0);
+    EXPECT_DOUBLE_EQ(ramp_time(p, 0, 30000), 0.5);
+    Profile s = speed_profile(State{}, 30000, p, 1.0);
     EXPECT_NEAR(s.duration(), 1.5, 1e-12);
-    EXPECT_NEAR(s.velocity(0.5), dmac_speed_to_inc_per_s(30000), 1e-9);  // 300 rpm = 50000 inc/s
+    EXPECT_NEAR(s.velocity(0.5), speed_to_inc_per_s(30000), 1e-9);  // 300 rpm = 50000 inc/s
     EXPECT_NEAR(s.velocity(0.5), 50000, 1e-9);
     // Proportional in the other direction and for partial changes.
-    EXPECT_DOUBLE_EQ(dmac_ramp_time(p, 60000, 30000), 0.5);
-    EXPECT_DOUBLE_EQ(dmac_ramp_time(p, 30000, -30000), 1.0);
+    EXPECT_DOUBLE_EQ(ramp_time(p, 60000, 30000), 0.5);
+    EXPECT_DOUBLE_EQ(ramp_time(p, 30000, -30000), 1.0);
 }
 
 TEST(Dmac, MoveSpeedClampedToHighSpeed) {
     Motion m;
     m.move_speed(0, 400000);
-    EXPECT_NEAR(m.profile().velocity(5.0), dmac_speed_to_inc_per_s(60000), 1e-9);
+    EXPECT_NEAR(m.profile().velocity(5.0), speed_to_inc_per_s(60000), 1e-9);
     EXPECT_TRUE(m.moving(100.0));
     m.stop(10.0);
     EXPECT_NEAR(m.profile().duration(), 11.0, 1e-9);  // DECEL_TIME 1 s from HIGH_SPEED
@@ -40,11 +40,11 @@ TEST(Dmac, MoveSpeedClampedToHighSpeed) {
 
 TEST(Dmac, PositionMoveLowSpeedAtLastTenthTurn) {
     ProfileParams p;  // factory: HS 60000, LS 6000, 1000 ms ramps
-    Profile prof = dmac_position_profile(State{}, 100000, p);
+    Profile prof = position_profile(State{}, 100000, p);
     EXPECT_EQ(prof.end_position(), 100000);
     const double t_via = prof.first_crossing(99000);
     ASSERT_GT(t_via, 0);
-    EXPECT_NEAR(prof.velocity(t_via), dmac_speed_to_inc_per_s(6000), 1e-6);  // 10000 inc/s
+    EXPECT_NEAR(prof.velocity(t_via), speed_to_inc_per_s(6000), 1e-6);  // 10000 inc/s
     // Velocity proportional to the error inside the last 0.1 turn.
     const double t_half = prof.first_crossing(99500);
     EXPECT_NEAR(prof.velocity(t_half), 5000, 1e-6);
@@ -58,7 +58,7 @@ TEST(Dmac, PositionMoveLowSpeedAtLastTenthTurn) {
 
 TEST(Dmac, ShortMoveIsApproachOnly) {
     ProfileParams p;
-    Profile prof = dmac_position_profile(State{0, 0, 0, 0}, -500, p);
+    Profile prof = position_profile(State{0, 0, 0, 0}, -500, p);
     EXPECT_EQ(prof.end_position(), -500);
     EXPECT_NEAR(prof.velocity(1e-9), -5000, 1e-3);
 }
@@ -86,9 +86,9 @@ TEST(Dmac, MoveWhileMovingAndLimits) {
 
 TEST(Dmac, SCurveSameTimes) {
     ProfileParams p;
-    Profile t = dmac_position_profile(State{}, 50000, p);
+    Profile t = position_profile(State{}, 50000, p);
     p.s_curve = true;
-    Profile s = dmac_position_profile(State{}, 50000, p);
+    Profile s = position_profile(State{}, 50000, p);
     EXPECT_NEAR(t.duration(), s.duration(), 1e-9);
     EXPECT_EQ(s.end_position(), 50000);
 }
@@ -97,7 +97,7 @@ TEST(Dmac, StartStopWithZeroRampTimes) {
     ProfileParams p;
     p.accel_time_ms = 0;
     p.decel_time_ms = 0;
-    Profile prof = dmac_position_profile(State{}, 20000, p);
+    Profile prof = position_profile(State{}, 20000, p);
     EXPECT_EQ(prof.end_position(), 20000);
     EXPECT_NEAR(prof.velocity(1e-6), 100000, 1e-6);
 }
@@ -111,7 +111,7 @@ TEST(Dmac, MoveOnFromInitialPosition) {
 
 TEST(HostileNumbers, DmacModel) {
     for (double x : motorbus::test::kValues) {
-        motorbus::test::survives([&] { return dmac_position_profile(State{}, x, ProfileParams{}); });
-        motorbus::test::survives([&] { return dmac_speed_profile(State{}, x, ProfileParams{}, 1.0); });
+        motorbus::test::survives([&] { return position_profile(State{}, x, ProfileParams{}); });
+        motorbus::test::survives([&] { return speed_profile(State{}, x, ProfileParams{}, 1.0); });
     }
 }

@@ -103,8 +103,8 @@ TEST(DmacSimAxis, ReportedSpeedAndPositionFollowTheProfile) {
     r.tx("00MOVE_SPEED 12345");
     // ATI 1000 ms for 60000: 12345 is reached after 205.75 ms.
     r.ms(100);
-    const double a = dmac_speed_to_inc_per_s(60000);  // inc/s^2 with ATI = 1 s
-    EXPECT_EQ(r.read(Var::Speed), std::lround(dmac_inc_per_s_to_speed(a * 0.1)));
+    const double a = speed_to_inc_per_s(60000);  // inc/s^2 with ATI = 1 s
+    EXPECT_EQ(r.read(Var::Speed), std::lround(inc_per_s_to_speed(a * 0.1)));
     EXPECT_EQ(r.read(Var::Position), std::lround(a * 0.1 * 0.1 / 2));
     r.ms(200);
     EXPECT_EQ(r.read(Var::Speed), 12345);

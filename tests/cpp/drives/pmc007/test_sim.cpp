@@ -71,12 +71,12 @@ struct SimFixture : ::testing::Test {
 
 TEST(Pmc007Table, CountsOfTheSpec) {
     std::set<std::uint16_t> indices;
-    for (const auto& r : pmc007_od_rows()) indices.insert(r.index);
+    for (const auto& r : od_rows()) indices.insert(r.index);
     EXPECT_EQ(indices.size(), 73u);
-    EXPECT_EQ(pmc007_od_rows().size(), 210u);
+    EXPECT_EQ(od_rows().size(), 210u);
     // B-P31: mappable exactly 1001h, 1002h, 1003h:01-07, 1007h, 6000h, 6001h, 600Ch, 6012h.
     std::set<std::pair<int, int>> mappable;
-    for (const auto& r : pmc007_od_rows())
+    for (const auto& r : od_rows())
         if (r.pdo) mappable.insert({r.index, r.sub});
     EXPECT_EQ(mappable.size(), 14u);
     EXPECT_TRUE(mappable.count({0x6012, 0}));
@@ -86,7 +86,7 @@ TEST(Pmc007Table, CountsOfTheSpec) {
 // The shipped EDS is the generated one.  MOTORBUS_WRITE_EDS=1 regenerates it.
 TEST(Pmc007Table, ShippedEdsIsGenerated) {
     const std::string path = std::string(MOTORBUS_TEST_DATA) + "/../python/motorbus/drives/pmc007.eds";
-    const std::string text = pmc007_eds();
+    const std::string text = eds();
     if (const char* w = std::getenv("MOTORBUS_WRITE_EDS"); w && std::string(w) == "1") {
         std::ofstream(path, std::ios::binary) << text;
     }
@@ -559,7 +559,7 @@ TEST(Pmc007SimReset, ResetToNewReadsAsAFreshSim) {
     ASSERT_NE(used.error_status(), 0);
     used.reset_to_new();
     Sim fresh(5, clock);
-    for (const auto& r : pmc007_od_rows())
+    for (const auto& r : od_rows())
         EXPECT_EQ(used.od().at(r.index, r.sub)->get(), fresh.od().at(r.index, r.sub)->get())
             << std::hex << r.index << ":" << int(r.sub);
     EXPECT_EQ(used.error_status(), fresh.error_status());
