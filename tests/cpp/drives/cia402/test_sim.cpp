@@ -4,6 +4,8 @@
 // time is a SimClock advanced by the test.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <mutex>
 #include <set>
 #include <thread>
 
@@ -170,6 +172,24 @@ TEST_F(SimRig, ALostMasterHeartbeatAppliesTheAbortConnectionOption) {
     EXPECT_EQ(canopen::decode_statusword(statusword()), canopen::Cia402State::Fault);
     EXPECT_EQ(sdo->read_u16(0x603F, 0), 0x8130);
     EXPECT_EQ(sdo->read_u8(0x1001, 0), 0x11);
+}
+
+TEST_F(SimRig, RequestsAreServedOnTheBusThreadNotTheNodesWorker) {
+    // LocalNodeOptions::sdo_inline: a request is served on the thread the bus delivers it
+    // on (where the sim's endpoint runs its subscribers), not handed to the node's worker
+    // thread through its one-slot mailbox.
+    std::atomic<std::thread::id> served_on{}, delivered_on{};
+    const auto sub = dev->subscribe_id(0x605, false, [&](const can::Frame&) {
+        delivered_on = std::this_thread::get_id();
+    });
+    sim->od().at(0x1008, 0)->set_read_hook([&](const canopen::Variable&, canopen::Bytes&) -> std::uint32_t {
+        served_on = std::this_thread::get_id();
+        return 0;
+    });
+    EXPECT_EQ(sdo->read_string(0x1008, 0), "motorbus CiA 402 sim");
+    dev->unsubscribe(sub);
+    EXPECT_NE(served_on.load(), std::thread::id{});
+    EXPECT_EQ(served_on.load(), delivered_on.load());
 }
 
 TEST_F(SimRig, SimulatedDeviceContract) {
