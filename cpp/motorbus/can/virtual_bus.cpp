@@ -46,8 +46,15 @@ public:
         wire_cv_.notify_all();
     }
 
-    // Hands `f` to every endpoint but the sender, now.
+    // Hands `f` to every endpoint but the sender, now.  One frame at a time: on a
+    // wire every node sees the frames in one order, so a reply that an endpoint
+    // sends the moment it receives a request (its receive thread runs while this
+    // loop is still handing the request to the others) waits here until the
+    // request has reached everyone; without it a third endpoint (candump, a
+    // recorder) saw the reply before the request.  Recursive: a delivery that
+    // runs no callback never sends, but one that did must not deadlock.
     void deliver(const Frame& f, const VirtualBus* sender) {
+        std::lock_guard order(order_mutex_);
         std::vector<VirtualBus*> targets;
         {
             std::lock_guard lock(mutex_);
@@ -204,6 +211,7 @@ private:
     std::condition_variable wire_cv_, space_cv_, idle_cv_;
     std::vector<VirtualBus*> endpoints_;
     int delivering_ = 0;
+    std::recursive_mutex order_mutex_;  // one fan-out at a time (deliver)
     std::map<const VirtualBus*, std::deque<Pending>> tx_;
     std::priority_queue<Due, std::vector<Due>, std::greater<Due>> delayed_;
     std::uint64_t seq_ = 0;

@@ -34,6 +34,31 @@ TEST(VirtualBus, FramesReachEveryOtherEndpointNotTheSender) {
     EXPECT_EQ(b->counters().rx_frames, 1u);
 }
 
+// Every endpoint sees the frames in one order, as every node on a wire does: a
+// reply sent by a responder the moment it receives a request must not reach a
+// third endpoint (a candump, a recorder) before that request.  The hub used to
+// fan a frame out endpoint by endpoint with no lock, so a fast responder earlier
+// in the list could answer before the request had been handed to a later one.
+TEST(VirtualBus, AReplyNeverOvertakesItsRequestAtAThirdEndpoint) {
+    auto responder = open_virtual("t-order"), master = open_virtual("t-order"), tap = open_virtual("t-order");
+    auto sub = responder->subscribe_id(0x605, false, [&](const Frame& f) {
+        responder->send(fr(0x585, {f.data[0], f.data[1]}));
+    });
+    constexpr int kRounds = 3000;
+    for (int i = 0; i < kRounds; ++i) {
+        master->send(fr(0x605, {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8)}));
+        ASSERT_TRUE(master->recv(1s));
+    }
+    int misordered = 0;
+    for (int i = 0; i < kRounds; ++i) {
+        auto req = tap->recv(1s), rep = tap->recv(1s);
+        ASSERT_TRUE(req && rep);
+        if (req->id != 0x605 || rep->id != 0x585 || req->data[0] != rep->data[0]) ++misordered;
+    }
+    responder->unsubscribe(sub);
+    EXPECT_EQ(misordered, 0);
+}
+
 TEST(VirtualBus, HubsAreIsolatedByName) {
     auto a = open_virtual("t-iso-1"), b = open_virtual("t-iso-2");
     a->send(fr(1));
