@@ -14,6 +14,8 @@
 
 namespace motorbus::arcus {
 
+using canopen::Cia402State;
+
 namespace {
 
 // SDO abort codes (CiA 301 §7.2.4.3.17); manual 000 lists none (B-A02).
@@ -280,7 +282,7 @@ std::vector<can::Frame> Sim::canopen_frame(const can::Frame& f, bool& reset) {
     const Nanos now = clock_.now();
     SimEngine e(s, options_);
     CanopenState& co = s.co;
-    if (co.state == CoState::OperationEnabled && co.active_mode == 1 && co.setpoints.buffered() && !(co.cw & kHalt) &&
+    if (co.state() == Cia402State::OperationEnabled && co.active_mode == 1 && co.setpoints.buffered() && !(co.cw & kHalt) &&
         s.job == Job::Target && s.motor->moving()) {
         // A set of set-points: the buffered one starts the instant the running
         // move ends (B-A12), even when nobody looked at the drive then.
@@ -381,20 +383,11 @@ std::uint32_t Sim::od_read(std::uint16_t index, std::uint8_t sub, std::uint32_t&
         case 0x200E: v = co.store; break;
         case 0x6040: v = co.cw; break;
         case 0x6041: {
-            using canopen::Cia402State;
-            Cia402State st = Cia402State::SwitchOnDisabled;
-            switch (co.state) {
-                case CoState::SwitchOnDisabled: st = Cia402State::SwitchOnDisabled; break;
-                case CoState::ReadyToSwitchOn: st = Cia402State::ReadyToSwitchOn; break;
-                case CoState::SwitchedOn: st = Cia402State::SwitchedOn; break;
-                case CoState::OperationEnabled: st = Cia402State::OperationEnabled; break;
-                case CoState::QuickStopActive: st = Cia402State::QuickStopActive; break;
-                case CoState::Fault: st = Cia402State::Fault; break;
-            }
+            const Cia402State st = co.state();
             std::uint16_t w = canopen::statusword_bits(st) | canopen::sw::kRemote;
-            if (co.state != CoState::SwitchOnDisabled && co.state != CoState::Fault) w |= canopen::sw::kVoltageEnabled;
+            if (st != Cia402State::SwitchOnDisabled && st != Cia402State::Fault) w |= canopen::sw::kVoltageEnabled;
             const bool idle = !s.motor->moving() && s.job == Job::None;
-            const bool oe = co.state == CoState::OperationEnabled;
+            const bool oe = co.state() == Cia402State::OperationEnabled;
             bool reached = idle, bit12 = false, bit13 = false;
             if (oe && co.active_mode == 1) {
                 reached = idle && !co.setpoints.buffered();
@@ -421,7 +414,7 @@ std::uint32_t Sim::od_read(std::uint16_t index, std::uint8_t sub, std::uint32_t&
             v = w;
             break;
         }
-        case 0x6061: v = co.state == CoState::OperationEnabled ? co.active_mode : co.mode; break;
+        case 0x6061: v = co.state() == Cia402State::OperationEnabled ? co.active_mode : co.mode; break;
         case 0x6064: v = std::llround(pos_sign * static_cast<double>(e.snl_on() ? e.encoder() : e.pulse())); break;
         case 0x606C: v = std::llround(vel_sign * s.motor->pulse_velocity()); break;
         case 0x607A: v = co.target_position; break;
@@ -525,7 +518,7 @@ std::uint32_t Sim::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t
             if (v != 1 && v != 3 && v != 6) return kAbortRange;
             co.mode = static_cast<std::int8_t>(v);
             // In Operation enabled a new mode takes over only when the motor is idle (B-A10).
-            if (co.state == CoState::OperationEnabled && !s.motor->moving() && s.job == Job::None) {
+            if (co.state() == Cia402State::OperationEnabled && !s.motor->moving() && s.job == Job::None) {
                 co.active_mode = co.mode;
                 co.setpoints.reset();
                 co.homing_started = co.homing_attained = co.homing_error = false;
@@ -552,7 +545,7 @@ std::uint32_t Sim::od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t
         case 0x60FF: {
             const std::int32_t before = co.target_velocity;
             co.target_velocity = static_cast<std::int32_t>(v);
-            if (co.state == CoState::OperationEnabled && co.active_mode == 3 && !(co.cw & kHalt)) {
+            if (co.state() == Cia402State::OperationEnabled && co.active_mode == 3 && !(co.cw & kHalt)) {
                 const bool moving = s.motor->moving() || s.job != Job::None;
                 if (moving && before != co.target_velocity) {
                     // Same direction: change the speed on the fly (what ASCII SSPD does, in the
@@ -607,26 +600,22 @@ void Sim::controlword(std::uint16_t v) {
     CanopenState& co = s.co;
     const std::uint16_t prev = co.cw;
     co.cw = v;
-    const bool rising_fault_reset = (v & kFaultReset) && !(prev & kFaultReset);
-    if (co.state == CoState::Fault) {
-        // Transition 6 (Fault -> Switch on disabled, "recovers from the fault"):
+    using S = Cia402State;
+    const S before = co.state();
+    co.device->on_controlword(v);
+    const S after = co.state();
+    if (before == S::Fault) {
+        // Transition 15 (Fault -> Switch on disabled, "recovers from the fault"):
         // the reset clears the latched limit / StepNLoop errors as 200Dh does,
         // so a generic CiA 402 master (reset, shutdown, enable) gets the drive back.
-        if (rising_fault_reset) {
+        if (after == S::SwitchOnDisabled) {
             command("CLR");
-            co.state = CoState::SwitchOnDisabled;
             command("EO=0");
         }
         return;
     }
-    if (v & kFaultReset) return;
-    const bool shutdown = (v & 0x07) == 0x06;
-    const bool switch_on = (v & 0x0F) == 0x07;
-    const bool enable_op = (v & 0x0F) == 0x0F;
-    const bool disable_voltage = (v & 0x02) == 0;
-    const bool quick_stop = (v & 0x06) == 0x02;
+    if (v & kFaultReset) return;  // bit 7 outside FAULT: nothing (and no mode bits)
     auto enter_mode = [&] {
-        co.state = CoState::OperationEnabled;
         co.active_mode = co.mode;
         co.setpoints.reset();
         co.homing_started = co.homing_attained = co.homing_error = false;
@@ -637,63 +626,37 @@ void Sim::controlword(std::uint16_t v) {
         co.pv_pending = false;
         if (s.motor->moving()) command("STOP");
     };
-    switch (co.state) {
-        case CoState::SwitchOnDisabled:
-            if (shutdown) co.state = CoState::ReadyToSwitchOn;
-            return;
-        case CoState::ReadyToSwitchOn:
-            if (disable_voltage || quick_stop) {
-                co.state = CoState::SwitchOnDisabled;
-            } else if (switch_on || enable_op) {
-                command("EO=1");  // T1: motor enabled
-                co.state = CoState::SwitchedOn;
-                if (enable_op) enter_mode();
-            }
-            return;
-        case CoState::SwitchedOn:
-            if (disable_voltage || quick_stop) {
-                command("EO=0");  // T6
-                co.state = CoState::SwitchOnDisabled;
-            } else if (shutdown) {
-                command("EO=0");  // T2
-                co.state = CoState::ReadyToSwitchOn;
-            } else if (enable_op) {
-                enter_mode();  // T3
-            }
-            return;
-        case CoState::OperationEnabled:
-            if (quick_stop) {
-                // Immediate stop (ASCII ABORT), then Switch on disabled (B-A11).
-                command("ABORT");
-                command("EO=0");
-                co.setpoints.drop_buffered();
-                co.pv_pending = false;
-                co.state = CoState::SwitchOnDisabled;
-                return;
-            }
-            if (disable_voltage) {
-                command("EO=0");
-                co.setpoints.drop_buffered();
-                co.pv_pending = false;
-                co.state = CoState::SwitchOnDisabled;
-                return;
-            }
-            if (shutdown) {  // T5
-                exit_mode();
-                command("EO=0");
-                co.state = CoState::ReadyToSwitchOn;
-                return;
-            }
-            if (switch_on) {  // T4
-                exit_mode();
-                co.state = CoState::SwitchedOn;
-                return;
-            }
-            break;
-        case CoState::QuickStopActive:
-        case CoState::Fault:
-            return;
+    // What the firmware does on each transition.
+    if (before == S::ReadyToSwitchOn && (after == S::SwitchedOn || after == S::OperationEnabled)) {
+        command("EO=1");  // 3: motor enabled
+        if (after == S::OperationEnabled) enter_mode();  // 3 + 4
+        return;
     }
+    if (before == S::SwitchedOn) {
+        if (after == S::SwitchOnDisabled || after == S::ReadyToSwitchOn) command("EO=0");  // 10, 6
+        if (after == S::OperationEnabled) enter_mode();                                    // 4
+        return;
+    }
+    if (before == S::OperationEnabled && after != S::OperationEnabled) {
+        if (after == S::SwitchOnDisabled && (v & 0x06) == 0x02) {
+            // Quick stop: an immediate stop (ASCII ABORT), then Switch on disabled (11 + 12, B-A11).
+            command("ABORT");
+            command("EO=0");
+            co.setpoints.drop_buffered();
+            co.pv_pending = false;
+        } else if (after == S::SwitchOnDisabled) {  // 9: disable voltage
+            command("EO=0");
+            co.setpoints.drop_buffered();
+            co.pv_pending = false;
+        } else if (after == S::ReadyToSwitchOn) {  // 8: shutdown
+            exit_mode();
+            command("EO=0");
+        } else {  // 5: switch on (disable operation)
+            exit_mode();
+        }
+        return;
+    }
+    if (after != S::OperationEnabled) return;
 
     // Operation enabled: the mode's bits, through the handshake every CiA 402 drive shares.
     const bool idle = !s.motor->moving() && s.job == Job::None;
@@ -781,17 +744,20 @@ void Sim::canopen_service() {
     const Nanos now = clock_.now();
     if (co.clear_error && now >= co.clear_until) co.clear_error = 0;
     if (co.store && now >= co.store_until) co.store = 0;
-    const bool enabled = co.state == CoState::ReadyToSwitchOn || co.state == CoState::SwitchedOn ||
-                         co.state == CoState::OperationEnabled || co.state == CoState::QuickStopActive;
+    const Cia402State st = co.state();
+    const bool enabled = st == Cia402State::ReadyToSwitchOn || st == Cia402State::SwitchedOn ||
+                         st == Cia402State::OperationEnabled || st == Cia402State::QuickStopActive;
     if (enabled && errors_latched(s)) {
-        // A limit or StepNLoop error is a Fault until 200Dh clears it (B-A18, B-A22).
-        co.state = CoState::Fault;
+        // A limit or StepNLoop error is a Fault until 200Dh clears it (B-A18, B-A22):
+        // transitions 13 + 14, the motor already stopped by the firmware.
+        co.device->fault(0);
+        co.device->fault_reaction_done();
         co.setpoints.drop_buffered();
         co.pv_pending = false;
         if (co.homing_started && !co.homing_attained) co.homing_error = true;
         return;
     }
-    if (co.state != CoState::OperationEnabled) return;
+    if (st != Cia402State::OperationEnabled) return;
     const bool idle = !s.motor->moving() && s.job == Job::None;
     if (idle && co.mode != co.active_mode) {
         // A 6060h written while the motor ran takes over once it is idle (B-A10).

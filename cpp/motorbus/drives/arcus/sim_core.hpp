@@ -63,14 +63,23 @@ inline motion::MotorConfig motor_config(const SimOptions& o) {
     return c;
 }
 
-// The CiA 402 device states as manual 000 §8 names them (Fig. 8.3).
-enum class CoState { SwitchOnDisabled, ReadyToSwitchOn, SwitchedOn, OperationEnabled, QuickStopActive, Fault };
+// The power state machine (manual 000 §8, Fig. 8.3) is CiA 402's, as every CiA 402
+// device runs it (canopen::Cia402Device).  The DMX-CAN's reading: a quick stop is an
+// immediate stop straight to Switch on disabled (605Ah = 0, B-A11) and a fault has no
+// reaction to wait for.
+inline std::unique_ptr<canopen::Cia402Device> make_power_state_machine() {
+    auto d = std::make_unique<canopen::Cia402Device>();
+    d->set_quick_stop_option(0);
+    return d;
+}
 
 // The CANopen front end's own (volatile) objects; everything else it shows is
 // the shared firmware state.  Defaults the manual leaves open are the ASCII
 // power-on values of the same quantities (HSPD 1000, LSPD 100, ACC/DEC 300).
 struct CanopenState {
-    CoState state = CoState::SwitchOnDisabled;
+    // Held by pointer: the device has a mutex, and a power cycle assigns a new State.
+    std::unique_ptr<canopen::Cia402Device> device = make_power_state_machine();
+    canopen::Cia402State state() const { return device->state(); }
     std::uint16_t cw = 0;
     std::int8_t mode = 0;         // 6060h as last written
     std::int8_t active_mode = 0;  // the mode entered at T3 (6061h while Operation enabled)
