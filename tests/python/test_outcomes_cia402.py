@@ -13,6 +13,7 @@ import gc
 import os
 import threading
 import time
+import weakref
 
 import pytest
 
@@ -382,15 +383,20 @@ def test_no_simulator_outlives_its_bench(tmp_path):
     Bench(sim=True) cycles: +80 MB)."""
     from motorbus.drives import cia402
 
+    # The simulator is a C++ object (pybind11 instances are not tracked by the garbage
+    # collector, so gc.get_objects() would never list one): weak references say whether
+    # each one was freed.
+    refs: list = []
+
     def alive() -> int:
         gc.collect()
-        return sum(1 for o in gc.get_objects() if type(o) is cia402.Cia402Sim)   # type(): no attribute access
+        return sum(1 for r in refs if r() is not None)
 
     def rss_kb() -> int:
         with open("/proc/self/statm") as f:
             return int(f.read().split()[1]) * 4
 
-    before = alive()
+    before = 0
     bus = motorbus.open_bus("virtual:leak-check")
     try:
         for _ in range(10):                 # warm-up: allocator pools, caches
@@ -398,8 +404,11 @@ def test_no_simulator_outlives_its_bench(tmp_path):
         gc.collect()
         rss0 = rss_kb()
         for _ in range(100):
-            cia402.make_sim(5, bus=bus).close()
-        assert alive() == before
+            sim = cia402.make_sim(5, bus=bus)
+            refs.append(weakref.ref(sim))
+            sim.close()
+        del sim
+        assert len(refs) == 100 and alive() == before
         grown = rss_kb() - rss0
     finally:
         bus.close()
@@ -414,8 +423,11 @@ def test_no_simulator_outlives_its_bench(tmp_path):
     gc.collect()
     rss0 = rss_kb()
     for _ in range(100):
-        motorbus.Bench.load(p, sim=True).close()
-    assert alive() == before
+        bench = motorbus.Bench.load(p, sim=True)
+        refs.extend(weakref.ref(sim) for sim in bench.sims.values())
+        bench.close()
+    del bench
+    assert len(refs) == 200 and alive() == before
     grown = rss_kb() - rss0
     if "asan" not in os.environ.get("LD_PRELOAD", ""):
         assert grown < 4000, f"{grown} KB for 100 simulated benches"
