@@ -147,6 +147,7 @@ private:
     std::uint32_t od_read(std::uint16_t index, std::uint8_t sub, std::uint32_t& value, int& size);
     std::uint32_t od_write(std::uint16_t index, std::uint8_t sub, std::uint32_t value, int size);
     void controlword(std::uint16_t value);
+    void canopen_home();  // HM set-point: the CiA 402 method as the firmware's homing command
     void canopen_service();  // buffered set-points, PV restarts, error -> Fault
     void send_frames(const std::vector<can::Frame>& frames);
     // While set, the firmware runs a command at this (past) instant rather than

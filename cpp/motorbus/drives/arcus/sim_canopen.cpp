@@ -686,54 +686,59 @@ void Sim::controlword(std::uint16_t v) {
         case canopen::SetPointAction::StartHoming: break;
         default: return;  // Buffer (C-A09: played after this move), Refuse, None
     }
-    if (co.active_mode == 6) {
-        if (errors_latched(s) || !idle) return;
-        co.homing_started = true;
-        co.homing_attained = co.homing_error = false;
-        const int method = co.homing_method;
-        if (method == 35) {
-            // The current position becomes home (no motion).
-            command("PX=0");
-            command("EX=0");
-            co.homing_attained = true;
-            return;
-        }
-        load_profile(s, co.home_switch_speed, co.home_zero_speed, co.homing_acceleration, co.homing_acceleration);
-        // 607Ch in the drive's frame: 607Eh bit 7 reverses it like every
-        // position value (B-A15), its sign kept (issue 23 #3).
-        const double offset = ((s.cfg.cpol & 0x80) ? -1.0 : 1.0) * static_cast<double>(s.cfg.hofs);
-        const int dir = (method == 7 || method == 17 || method == 19 || method == 33) ? 1 : -1;
-        const std::int64_t lca = s.cfg.lca;
-        // Limit homing moves away from the limit by the offset's size (C-A11: 607Ch
-        // stands for LCA), at the zero-position speed; toward the limit is no option.
-        s.cfg.lca = std::llabs(s.cfg.hofs);
-        s.home_backoff_lspd = method == 17 || method == 18;
-        // 7/11: "change direction and move by the home offset"; 33/34: "continue
-        // moving by the home offset amount"; 19/20: from the home edge "move back
-        // by the Home Offset amount".  That end point is zero.
-        if (method == 7 || method == 11 || method == 19 || method == 20) s.home_final_target = -dir * offset;
-        if (method == 33 || method == 34) s.home_final_target = dir * offset;
-        // Manual 000's directions (C-A06): 17/33 positive, 18/34 negative.  19/20
-        // run H: zero at the home edge, ramp down to the zero-position speed and
-        // stop, then back to the offset from that edge.
-        const char* c = method == 7    ? "ZH+"
-                        : method == 11 ? "ZH-"
-                        : method == 17 ? "L+"
-                        : method == 18 ? "L-"
-                        : method == 19 ? "H+"
-                        : method == 20 ? "H-"
-                        : method == 33 ? "Z+"
-                                       : "Z-";
-        if (command(c) != "OK") co.homing_error = true;
-        s.cfg.lca = lca;
-        s.home_final_target.reset();
-        s.home_backoff_lspd = false;
-        if (!s.motor->moving() && s.job == Job::None && !co.homing_error) {
-            // Finished at once (a switch already active): decide now.
-            const bool ok = !s.homing || s.homing->result() == motion::HomingResult::Done;
-            co.homing_attained = ok;
-            co.homing_error = !ok;
-        }
+    if (co.active_mode == 6 && !errors_latched(s) && idle) canopen_home();
+}
+
+// Homing mode, new set-point (bit 4): the DMX-CAN runs each CiA 402 method with one of
+// its ASCII homing commands (manual 000 C-A06, C-A11), 607Ch as their end point.
+void Sim::canopen_home() {
+    State& s = *s_;
+    CanopenState& co = s.co;
+    co.homing_started = true;
+    co.homing_attained = co.homing_error = false;
+    const int method = co.homing_method;
+    if (method == 35) {
+        // The current position becomes home (no motion).
+        command("PX=0");
+        command("EX=0");
+        co.homing_attained = true;
+        return;
+    }
+    load_profile(s, co.home_switch_speed, co.home_zero_speed, co.homing_acceleration, co.homing_acceleration);
+    // 607Ch in the drive's frame: 607Eh bit 7 reverses it like every
+    // position value (B-A15), its sign kept (issue 23 #3).
+    const double offset = ((s.cfg.cpol & 0x80) ? -1.0 : 1.0) * static_cast<double>(s.cfg.hofs);
+    const int dir = (method == 7 || method == 17 || method == 19 || method == 33) ? 1 : -1;
+    const std::int64_t lca = s.cfg.lca;
+    // Limit homing moves away from the limit by the offset's size (C-A11: 607Ch
+    // stands for LCA), at the zero-position speed; toward the limit is no option.
+    s.cfg.lca = std::llabs(s.cfg.hofs);
+    s.home_backoff_lspd = method == 17 || method == 18;
+    // 7/11: "change direction and move by the home offset"; 33/34: "continue
+    // moving by the home offset amount"; 19/20: from the home edge "move back
+    // by the Home Offset amount".  That end point is zero.
+    if (method == 7 || method == 11 || method == 19 || method == 20) s.home_final_target = -dir * offset;
+    if (method == 33 || method == 34) s.home_final_target = dir * offset;
+    // Manual 000's directions (C-A06): 17/33 positive, 18/34 negative.  19/20
+    // run H: zero at the home edge, ramp down to the zero-position speed and
+    // stop, then back to the offset from that edge.
+    const char* c = method == 7    ? "ZH+"
+                    : method == 11 ? "ZH-"
+                    : method == 17 ? "L+"
+                    : method == 18 ? "L-"
+                    : method == 19 ? "H+"
+                    : method == 20 ? "H-"
+                    : method == 33 ? "Z+"
+                                   : "Z-";
+    if (command(c) != "OK") co.homing_error = true;
+    s.cfg.lca = lca;
+    s.home_final_target.reset();
+    s.home_backoff_lspd = false;
+    if (!s.motor->moving() && s.job == Job::None && !co.homing_error) {
+        // Finished at once (a switch already active): decide now.
+        const bool ok = !s.homing || s.homing->result() == motion::HomingResult::Done;
+        co.homing_attained = ok;
+        co.homing_error = !ok;
     }
 }
 
