@@ -203,6 +203,36 @@ TEST_F(AxisRig, Homing35TakesThePositionAsHomeAndUnsupportedMethodsAreRefused) {
     EXPECT_EQ(axis.position(), -10);
 }
 
+// Every method the axis accepts ends attained at 607Ch, started on the side of the home
+// switch (1000..1400) its search direction reaches it from: 7, 19, 20 search in +, from 0;
+// 11 in -, from 2000; 17/18 find the -/+ limit, 33/34 the next index, 35 takes the position.
+class AxisHomingMethods : public AxisRig, public ::testing::WithParamInterface<int> {};
+
+TEST_P(AxisHomingMethods, EndsAttainedAtTheHomeOffset) {
+    if (GetParam() == 11) {
+        motor.displace(2000);  // the shaft (the switches see it) ...
+        motor.set_pulse_position(2000);  // ... and the counter
+    }
+    // A search speed whose stopping distance (10 steps) fits in the 400-step switch: method
+    // 20 turns back on the switch's edge before it has passed the switch.
+    axis.update_settings([](Cia402AxisSettings& s) {
+        s.homing_speed_switch = 2000;
+        s.homing_speed_zero = 500;
+        s.homing_acceleration = 200000;
+        s.home_offset = 77;
+    });
+    ASSERT_EQ(axis.set_homing_method(static_cast<std::int8_t>(GetParam())), 0u);
+    enable(OpMode::Homing);
+    axis.write_controlword(kEnable | kNew);
+    ASSERT_TRUE(run_until([&] { return reached(); }, 120)) << "method " << GetParam();  // 17/18: 100000 steps away
+    const auto s = axis.statusword();
+    EXPECT_TRUE(s & sw::kSetPointAck) << "method " << GetParam() << " statusword " << std::hex << s;
+    EXPECT_FALSE(s & sw::kFollowingError) << "method " << GetParam();
+    EXPECT_EQ(axis.position(), 77) << "method " << GetParam();
+}
+
+INSTANTIATE_TEST_SUITE_P(Cia402, AxisHomingMethods, ::testing::Values(7, 11, 17, 18, 19, 20, 33, 34, 35));
+
 TEST_F(AxisRig, AJammedRotorFaultsWithAFollowingError) {
     axis.update_settings([](Cia402AxisSettings& s) { s.following_error_window = 200; });
     enable(OpMode::ProfilePosition);
