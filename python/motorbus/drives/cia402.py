@@ -41,8 +41,7 @@ from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, 
 __all__ = ["Cia402Drive", "Cia402Sim", "ERROR_CODES", "SYNC_START_RPDO", "make_sim", "OBJECTS",
            "error_text", "synchronised_start"]
 
-# Statusword bits the simulator drives itself (the state bits come from Cia402Device).
-_SW_REMOTE = 1 << 9
+# Statusword bits beyond the state that the adapter reads.
 _SW_TARGET_REACHED = 1 << 10
 _SW_INTERNAL_LIMIT = 1 << 11
 _SW_BIT12 = 1 << 12   # PV: speed zero; HM: homing attained (bit 12 of PP is the set-point ack)
