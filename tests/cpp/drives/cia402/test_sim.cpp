@@ -192,6 +192,27 @@ TEST_F(SimRig, RequestsAreServedOnTheBusThreadNotTheNodesWorker) {
     EXPECT_EQ(served_on.load(), delivered_on.load());
 }
 
+TEST(Cia402SimLifetime, ADictionaryThatOutlivesItsSimulatorNoLongerReachesIt) {
+    // Python may hold sim.od after the simulator is gone: the destructor takes its hooks
+    // off, so a read or write is the dictionary's own (under ASan, a hook left behind is
+    // a use after free).
+    SimClock clock{0};
+    std::shared_ptr<canopen::ObjectDictionary> od;
+    {
+        Sim sim(5, clock);
+        od = sim.od_ptr();
+        canopen::Bytes b;
+        ASSERT_EQ(od->at(0x6041, 0)->remote_read(b), 0u);
+        EXPECT_EQ(b.size(), 2u);
+    }
+    canopen::Bytes b;
+    EXPECT_EQ(od->at(0x6041, 0)->remote_read(b), 0u);
+    EXPECT_EQ(b, (canopen::Bytes{0, 0}));  // the stored default: no axis behind it any more
+    const std::uint8_t cw[] = {0x06, 0x00};
+    EXPECT_EQ(od->at(0x6040, 0)->remote_write(cw), 0u);
+    EXPECT_FALSE(od->at(0x6041, 0)->has_hooks());
+}
+
 TEST_F(SimRig, SimulatedDeviceContract) {
     EXPECT_TRUE(sim->attached());
     EXPECT_EQ(sim->describe(), "cia402 sim node 5");
