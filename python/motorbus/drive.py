@@ -32,6 +32,7 @@ import enum
 import inspect
 import logging
 import math
+import os
 import time
 from collections.abc import Iterator, MutableMapping
 from dataclasses import dataclass
@@ -350,6 +351,10 @@ class Drive(abc.ABC):
     #: How far from its target (native units) a move may come to rest and still count as
     #: arrived, when the kind does not read it from the drive (``_in_position_window``).
     in_position_window: float = 0.0
+    #: The file, in ``sim serve --store-dir``'s folder, that keeps a served drive's stored
+    #: parameters (``"mykind-{address}.flash"``: formatted with the canonical address and
+    #: handed to ``make_sim`` as ``store_path`` by ``store_options``); "" = the kind keeps none.
+    store_file: str = ""
 
     # ---- the plugin: hooks of the kind (classmethods) and of an open drive -------------
     @classmethod
@@ -358,6 +363,41 @@ class Drive(abc.ABC):
         """The kind's Drive on an open LineLink/port (``line``, serial kinds) or Bus/spec
         (``bus``, CAN kinds) at a canonical ``address`` (``open_drive`` checks both first)."""
         raise _core.InvalidArgument(f"drive kind {cls.kind!r} cannot be opened (its class has no open())")
+
+    @classmethod
+    def _open_on(cls, line: Any, bus: Any, native: Callable[[Any], Any], **drive_options: Any) -> "Drive":
+        """What every kind's ``open`` does around its own construction, so that it states only
+        that: takes the link of the kind's transport (``line=`` serial, ``bus=`` CAN; the
+        other is refused), opens a bus given as an ``open_bus`` spec (closed with the drive),
+        builds the vendor client on the link with ``native(link)`` and the Drive on it with
+        ``cls(client, **drive_options)``.  If either fails, the client and a bus opened here
+        are closed before the error goes on: a failed open leaves nothing open behind it.
+        (A serial client given a port path opens and owns its port itself.)"""
+        opened = None
+        if cls.transport == "serial":
+            if bus is not None or line is None:
+                raise _core.InvalidArgument(f"{cls.kind}: a serial drive takes line=, not bus=")
+            link = line
+        else:
+            if line is not None or bus is None:
+                raise _core.InvalidArgument(f"{cls.kind}: a CAN drive takes bus=, not line=")
+            if isinstance(bus, str):
+                from .bus import open_bus
+
+                bus = opened = open_bus(bus)
+            link = bus
+        client = None
+        try:
+            client = native(link)
+            return cls(client, close_native=None if opened is None else opened.close, **drive_options)
+        except BaseException:
+            try:
+                if client is not None:
+                    client.close()
+            finally:
+                if opened is not None:
+                    opened.close()
+            raise
 
     @classmethod
     def make_sim(cls, address: Any, clock: Any = None, **options: Any) -> Any:
@@ -377,8 +417,11 @@ class Drive(abc.ABC):
     @classmethod
     def store_options(cls, store_dir: str, address: str) -> dict:
         """The ``make_sim`` options that keep a served drive's stored parameters in
-        ``store_dir`` (``sim serve --store-dir``); none by default."""
-        return {}
+        ``store_dir`` (``sim serve --store-dir``): ``store_path`` = ``store_file`` there,
+        none when the kind has no ``store_file``."""
+        if not cls.store_file:
+            return {}
+        return {"store_path": os.path.join(store_dir, cls.store_file.format(address=address))}
 
     @classmethod
     def wire_line(cls, sims: list) -> None:

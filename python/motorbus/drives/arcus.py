@@ -274,6 +274,11 @@ def _address(address: Union[str, int]) -> int:
     return value
 
 
+def check_address(text: str) -> str:
+    """'1', '01', 'DMC01' -> '01'; InvalidArgument naming the problem."""
+    return f"{_address(text):02d}"
+
+
 def make_sim(address: Union[str, int] = "01", clock: Optional["_core.Clock"] = None,
              store_path: Optional[str] = None, **options: Any) -> ArcusSim:
     """A simulated DMX-CAN answering at ``address`` ("01".."99", "DMC05" accepted).
@@ -461,6 +466,7 @@ class ArcusDrive(_drive.Drive):
     default_baud = 9600
     sim_options = ("response_type", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
                    "start_position", "tick", "store_path")
+    store_file = "arcus-{address}.store"
     probe_addresses = tuple(f"{a:02d}" for a in range(1, 100))   # DN 01-99
     probe_bauds = (9600, 19200, 38400, 57600, 115200)              # the DB settings
 
@@ -670,35 +676,18 @@ class ArcusDrive(_drive.Drive):
 
     # ---- the plugin's hooks (motorbus.registry) ------------------------------------------
     @classmethod
-    def open(cls, *, line: Any, bus: Any = None, address: str = "01", units: Optional[_drive.Units] = None,
+    def open(cls, *, line: Any = None, bus: Any = None, address: str = "01", units: Optional[_drive.Units] = None,
              baud: int = 9600, timeout: Optional[float] = None, on_error: Optional[str] = "stop",
              on_exit: Optional[str] = "stop", query_retries: int = 1) -> "ArcusDrive":
-        """``line`` is a path (opened here, closed with the drive) or a shared LineLink."""
-        if bus is not None:
-            raise _core.InvalidArgument("arcus: a serial drive takes line=, not bus=")
-        if line is None:
-            raise _core.InvalidArgument("arcus: line= (a port path or a LineLink) is required")
+        """``line`` is a path (the client opens it, closed with the drive) or a shared LineLink."""
         # The Drive applies on_error/on_exit; the client itself stays quiet.
-        native = ArcusClient(line, address, baud=baud, timeout=timeout, on_error=None, on_exit=None,
-                             query_retries=query_retries)
-        try:
-            return cls(native, units=units, on_error=on_error, on_exit=on_exit)
-        except BaseException:
-            native.close()
-            raise
+        return cls._open_on(line, bus, lambda link: ArcusClient(link, address, baud=baud, timeout=timeout,
+                                                                on_error=None, on_exit=None,
+                                                                query_retries=query_retries),
+                            units=units, on_error=on_error, on_exit=on_exit)
 
-    @classmethod
-    def make_sim(cls, address: Union[str, int] = "01", clock: Optional["_core.Clock"] = None,
-                 **options: Any) -> Any:
-        return make_sim(address, clock, **options)
-
-    @classmethod
-    def check_address(cls, text: Any) -> str:
-        return check_address(text)
-
-    @classmethod
-    def store_options(cls, store_dir: str, address: str) -> dict:
-        return {"store_path": os.path.join(store_dir, f"arcus-{address}.store")}
+    make_sim = staticmethod(make_sim)
+    check_address = staticmethod(check_address)
 
     @classmethod
     def probe(cls, line: "_core.LineLink", address: str) -> Optional[dict]:
@@ -744,11 +733,6 @@ class ArcusDrive(_drive.Drive):
         if error:
             raise _core.InvalidArgument(f"arcus plan_move {start} -> {target}: the drive would answer {error}")
         return model.profile
-
-
-def check_address(text: str) -> str:
-    """'1', '01', 'DMC01' -> '01'; InvalidArgument naming the problem."""
-    return f"{_address(text):02d}"
 
 
 def _limit_fault(sim: ArcusSim, direction: Any = 1) -> None:

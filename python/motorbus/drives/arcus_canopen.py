@@ -349,6 +349,7 @@ class ArcusCanopenDrive(Cia402Drive):
     transport = "can"
     default_address = "1"
     sim_options = _SIM_OPTIONS
+    store_file = "arcus-canopen-{address}.store"
     # Not offered by this persona (Cia402Drive's would be inherited): the SYNC start
     # and the TPDO capture were never validated against the DMX-CAN's manual.
     synchronised_start = classmethod(Drive.synchronised_start.__func__)
@@ -358,39 +359,13 @@ class ArcusCanopenDrive(Cia402Drive):
     def open(cls, *, line: Any = None, bus: Any = None, address: str = "1", units: Optional[Units] = None,
              timeout: float = 1.0, on_error: Optional[str] = "quick_stop",
              on_exit: Optional[str] = "quick_stop") -> "ArcusCanopenDrive":
-        """``open_drive("arcus-canopen", bus=..., address=1)``."""
-        from ..bus import open_bus
+        """``open_drive("arcus-canopen", bus=..., address=1)`` (the ASCII persona is ``arcus``, on a line)."""
+        return cls._open_on(line, bus, lambda b: ArcusCanopen(b, int(_check_node(address)), timeout=timeout,
+                                                              on_error=None, on_exit=None),
+                            units=units, on_error=on_error, on_exit=on_exit)
 
-        if line is not None:
-            raise _core.InvalidArgument("arcus-canopen: a CAN drive takes bus=, not line= (the ASCII persona is "
-                                        "'arcus')")
-        if bus is None:
-            raise _core.InvalidArgument("arcus-canopen: bus= (a bus or a bus address) is required")
-        owns = isinstance(bus, str)
-        b = open_bus(bus) if owns else bus
-        try:
-            host = ArcusCanopen(b, int(_check_node(address)), timeout=timeout, on_error=None, on_exit=None)
-            drive = cls(host, units=units, on_error=on_error, on_exit=on_exit,
-                        close_native=b.close if owns else None)
-        except Exception:
-            if owns:
-                b.close()
-            raise
-        return drive
-
-    @classmethod
-    def make_sim(cls, address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, **options: Any) -> Any:
-        return make_sim(address, clock, **options)
-
-    @classmethod
-    def check_address(cls, text: Any) -> str:
-        return _check_node(text)
-
-    @classmethod
-    def store_options(cls, store_dir: str, address: str) -> dict:
-        import os
-
-        return {"store_path": os.path.join(store_dir, f"arcus-canopen-{address}.store")}
+    make_sim = staticmethod(make_sim)
+    check_address = staticmethod(_check_node)
 
     @classmethod
     def canopen_match(cls, node: Any) -> int:

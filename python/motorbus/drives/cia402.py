@@ -231,29 +231,19 @@ class Cia402Drive(Drive):
              watchdog: Optional[dict] = None) -> "Cia402Drive":
         """``open_drive("cia402", bus=..., address=5)``.  ``watchdog={"host_node": 127, "period": 0.1}``
         arms the drive's heartbeat consumer at once (see Cia402.start_watchdog)."""
-        from ..bus import open_bus
-
-        owns = isinstance(bus, str)
-        b = open_bus(bus) if owns else bus
-        try:
-            host = Cia402(b, int(address), timeout=timeout, on_error=None, on_exit=None)
-            drive = cls(host, units=units, on_error=on_error, on_exit=on_exit,
-                        close_native=b.close if owns else None)
-        except Exception:
-            if owns:
-                b.close()
-            raise
+        drive = cls._open_on(line, bus, lambda b: Cia402(b, int(address), timeout=timeout, on_error=None,
+                                                         on_exit=None),
+                             units=units, on_error=on_error, on_exit=on_exit)
         if watchdog:
-            drive.start_watchdog(**watchdog)
+            try:
+                drive.start_watchdog(**watchdog)
+            except BaseException:
+                drive.close()       # and the bus, if opened from a spec
+                raise
         return drive
 
-    @classmethod
-    def make_sim(cls, address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, **options: Any) -> Any:
-        return make_sim(address, clock, **options)
-
-    @classmethod
-    def check_address(cls, text: Any) -> str:
-        return _check_node(text)
+    make_sim = staticmethod(make_sim)
+    check_address = staticmethod(_check_node)
 
     @classmethod
     def canopen_match(cls, node: Any) -> int:

@@ -868,33 +868,24 @@ class DmacDrive(Drive):
             raise _core.InvalidArgument(f"dmac: position {x:g} increments is outside int32")
         return n
 
+    def _close(self) -> None:
+        self.native.close()     # and the port, if the client opened it from a path
+
     # ---- the plugin's hooks (motorbus.registry) ------------------------------------------
     @classmethod
-    def open(cls, *, line: Any, bus: Any = None, address: str = DEFAULT_ADDRESS, units: Any = None,
+    def open(cls, *, line: Any = None, bus: Any = None, address: str = DEFAULT_ADDRESS, units: Any = None,
              baud: int = DEFAULT_BAUD, timeout: Optional[float] = None, on_error: Optional[str] = "stop",
              on_exit: Optional[str] = "stop", sleep: Any = None) -> "DmacDrive":
-        if bus is not None:
-            raise _core.InvalidArgument("dmac: a serial drive takes line=, not bus=")
         # The adapter owns the safety words: the client does nothing at exit itself.
-        client = DmacClient(line, check_address(str(address)), baud=baud, timeout=timeout, sleep=sleep,
-                            on_error=None, on_exit=None)
-        return cls(client, units=units, on_error=on_error, on_exit=on_exit, close_native=client.close)
+        return cls._open_on(line, bus, lambda link: DmacClient(link, check_address(str(address)), baud=baud,
+                                                               timeout=timeout, sleep=sleep, on_error=None,
+                                                               on_exit=None),
+                            units=units, on_error=on_error, on_exit=on_exit)
 
-    @classmethod
-    def make_sim(cls, address: Any = "00", clock: Any = None, **options: Any) -> DmacSim:
-        return make_sim(address, clock, **options)
-
-    @classmethod
-    def check_address(cls, text: Any) -> str:
-        return check_address(text)
-
-    @classmethod
-    def wire_line(cls, sims: Sequence[DmacSim]) -> None:
-        wire_line(sims)
-
-    @classmethod
-    def synchronised_start(cls, link: Any, drives: Sequence[Any]) -> Any:
-        return synchronised_start(link, drives)
+    make_sim = staticmethod(make_sim)
+    check_address = staticmethod(check_address)
+    wire_line = staticmethod(wire_line)
+    synchronised_start = staticmethod(synchronised_start)
 
     @classmethod
     def probe(cls, line: "_core.LineLink", address: str) -> Optional[dict]:

@@ -573,6 +573,7 @@ class Pmc007Drive(Drive):
     default_address = "5"
     sim_options = ("steps_per_rev", "pull_out_speed", "ext1_switch", "store_path", "vendor_id", "product_code",
                    "revision", "serial")
+    store_file = "pmc007-{address}.flash"
 
     @classmethod
     def open(cls, *, line: Any = None, bus: Any = None, address: str, units: Optional[Units] = None,
@@ -580,31 +581,13 @@ class Pmc007Drive(Drive):
              home_speed: int = 2000, ext_limits: Optional[dict] = None) -> "Pmc007Drive":
         """``open_drive("pmc007", bus=..., address=5)``; ``ext_limits={"ext2": +1}``: external stop
         inputs wired as limit switches (their stop is then LimitReached, not MoveInterrupted)."""
-        from ..bus import open_bus
+        return cls._open_on(line, bus, lambda b: Pmc007(b, int(_check_node(address)), timeout=timeout,
+                                                        on_error=None, on_exit=None),
+                            units=units, on_error=on_error, on_exit=on_exit, home_speed=home_speed,
+                            ext_limits=ext_limits)
 
-        owns = isinstance(bus, str)
-        b = open_bus(bus) if owns else bus
-        try:
-            native = Pmc007(b, int(_check_node(address)), timeout=timeout, on_error=None, on_exit=None)
-            drive = cls(native, units=units, on_error=on_error, on_exit=on_exit,
-                        close_native=b.close if owns else None, home_speed=home_speed, ext_limits=ext_limits)
-        except Exception:
-            if owns:
-                b.close()
-            raise
-        return drive
-
-    @classmethod
-    def make_sim(cls, address: Union[str, int] = "5", clock: Any = None, **options: Any) -> Any:
-        return make_sim(address, clock, **options)
-
-    @classmethod
-    def check_address(cls, text: Any) -> str:
-        return _check_node(text)
-
-    @classmethod
-    def store_options(cls, store_dir: str, address: str) -> dict:
-        return {"store_path": os.path.join(store_dir, f"pmc007-{address}.flash")}
+    make_sim = staticmethod(make_sim)
+    check_address = staticmethod(_check_node)
 
     @classmethod
     def canopen_match(cls, node: Any) -> int:

@@ -634,6 +634,7 @@ class UnitekDrive(Drive):
     transport = "can"
     default_address = "0x201"
     sim_options = _SIM_OPTIONS
+    store_file = "unitek-{address}.eeprom.json"
     probe_addresses = tuple(f"0x{i:03X}" for i in range(0x201, 0x280))   # the receive-id range
     #: Seconds a move may show no motion before a still motor counts as at rest (a
     #: stop that came before the motor got going); a drive showing why it stopped, or
@@ -864,34 +865,13 @@ class UnitekDrive(Drive):
              n_max_rpm: float = 3000.0, device: str = "DS 205/405", tol_num: float = 64) -> "UnitekDrive":
         """``open_drive("unitek", bus=..., address="0x201")``; ``tol_num``: the drive's Tol window
         (num), the in-position window a move is judged by."""
-        from ..bus import open_bus
+        return cls._open_on(line, bus, lambda b: Unitek(b, int(check_address(address), 16), tx_id, timeout=timeout,
+                                                        registers=registers, n_max_rpm=n_max_rpm, device=device,
+                                                        on_error=None, on_exit=None),
+                            units=units, on_error=on_error, on_exit=on_exit, tol_num=tol_num)
 
-        if bus is None:
-            raise _core.InvalidArgument("unitek: a CAN drive needs bus=")
-        owns = isinstance(bus, str)
-        b = open_bus(bus) if owns else bus
-        try:
-            native = Unitek(b, int(check_address(address), 16), tx_id, timeout=timeout, registers=registers,
-                            n_max_rpm=n_max_rpm, device=device, on_error=None, on_exit=None)
-            drive = cls(native, units=units, on_error=on_error, on_exit=on_exit,
-                        close_native=b.close if owns else None, tol_num=tol_num)
-        except Exception:
-            if owns:
-                b.close()
-            raise
-        return drive
-
-    @classmethod
-    def make_sim(cls, address: Union[str, int] = "0x201", clock: Any = None, **options: Any) -> "UnitekSim":
-        return make_sim(address, clock, **options)
-
-    @classmethod
-    def check_address(cls, text: Any) -> str:
-        return check_address(text)
-
-    @classmethod
-    def store_options(cls, store_dir: str, address: str) -> dict:
-        return {"store_path": str(Path(store_dir) / f"unitek-{address}.eeprom.json")}
+    make_sim = staticmethod(make_sim)
+    check_address = staticmethod(check_address)
 
     @classmethod
     def probe(cls, bus: Any, address: str) -> Optional[dict]:
