@@ -60,7 +60,7 @@ def main():
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 2000
     print(f"Arcus round trip '@01PX\\r' -> '<n>\\0' on a pty, {n} iterations (Python)")
     for name, baud in (("unthrottled", 0), ("115200 baud", 115200)):
-        with core.PtyLineServer([make_sim("01")], baud, None) as server:
+        with core.serial.PtyLineServer([make_sim("01")], baud, None) as server:
             mb = bench_motorbus(server.slave_path, n)
             ref = bench_pyserial(server.slave_path, n)
         print(f"{name:12s} motorbus ArcusClient: mean {mb[0]:8.1f} us  p50 {mb[1]:8.1f}  p99 {mb[2]:8.1f} | "

@@ -36,7 +36,7 @@ def emit(**row: Any) -> None:
 
 def serial_sweep(reply_timeout: float) -> None:
     plugins = [p for p in registry.drive_plugins().values() if p.transport == "serial" and p.provides("probe")]
-    empty = _core.PtyLineServer([], 9600)
+    empty = _core.serial.PtyLineServer([], 9600)
     try:
         t = time.perf_counter()
         r = discover([empty.slave_path], [], reply_timeout=reply_timeout, timeout=3600)
@@ -49,7 +49,7 @@ def serial_sweep(reply_timeout: float) -> None:
          seconds=round(took, 2), bound_seconds=round(bound, 2), per_probe_ms=round(1000 * took / r.probes, 1),
          reply_timeout=reply_timeout)
     from motorbus.drives import arcus
-    line = _core.PtyLineServer([arcus.make_sim("07"), arcus.make_sim("42")], 9600)
+    line = _core.serial.PtyLineServer([arcus.make_sim("07"), arcus.make_sim("42")], 9600)
     try:
         t = time.perf_counter()
         r = discover([line.slave_path], [], reply_timeout=reply_timeout, timeout=3600)

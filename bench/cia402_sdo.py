@@ -161,7 +161,7 @@ def socketcand(a: argparse.Namespace, eds: str) -> None:
     index = a.object
     nets: list = []
 
-    def connect(server: "_core.SocketcandServer") -> "canopen.Network":
+    def connect(server: "_core.can.SocketcandServer") -> "canopen.Network":
         net = canopen.Network(can.Bus(interface="socketcand", host=server.host, port=server.port, channel="can0"))
         net.connect = lambda *args, **kw: None  # the bus is open already
         net.notifier = can.Notifier(net.bus, net.listeners, 0.1)
@@ -176,8 +176,8 @@ def socketcand(a: argparse.Namespace, eds: str) -> None:
         sim = cia402.make_sim(5, bus=node_side)
         with open(eds, "w") as f:
             f.write(sim.od.to_eds(False))
-        with _core.SocketcandServer(hub, host="127.0.0.1", port=0, channel="can0") as srv, \
-                _core.SocketcandServer(ref_hub, host="127.0.0.1", port=0, channel="can0") as ref_srv:
+        with _core.can.SocketcandServer(hub, host="127.0.0.1", port=0, channel="can0") as srv, \
+                _core.can.SocketcandServer(ref_hub, host="127.0.0.1", port=0, channel="can0") as ref_srv:
             try:
                 to_sim = connect(srv).add_node(5, eds)
                 connect(ref_srv).add_node(canopen.LocalNode(5, eds))

@@ -68,7 +68,7 @@ def main() -> None:
         print(f"  {name:7s} motorbus {m_ns:8.0f}   canopen {c_ns:8.0f}   ratio {c_ns / m_ns:5.1f}x")
 
     name = f"bench-pdo-{time.monotonic_ns()}"
-    bus, _sink = _core.open_virtual(name), _core.open_virtual(name)
+    bus, _sink = _core.can.open_virtual(name), _core.can.open_virtual(name)
     for rt in (False, True):
         s = SyncProducer(bus, a.period_us / 1e6)
         s.start(realtime=rt)

@@ -62,11 +62,11 @@ def main() -> None:
         with motorbus.open_bus(name + "-setup") as sb, motorbus.open_bus(name + "-setup") as sh:
             for n, sim in enumerate(sims, 1):
                 sim.attach(sb)
-                setup = _core.SdoClient(sh, n, timeout=2.0)
+                setup = _core.canopen.SdoClient(sh, n, timeout=2.0)
                 setup.download(0x2002, 0, bytes([n]))
                 setup.download(0x2003, 0, bytes([bauds[a.bitrate]]))
                 setup.download(0x2007, 0, bytes([2]))
-                sh.send(_core.Frame(0, bytes([0x81, n])))
+                sh.send(_core.can.Frame(0, bytes([0x81, n])))
                 deadline = time.monotonic() + 2
                 while sim.active_baud_index != bauds[a.bitrate]:
                     if time.monotonic() > deadline:
@@ -76,7 +76,7 @@ def main() -> None:
     for sim in sims:
         sim.attach(dev)
     for n in range(1, a.nodes + 1):
-        sdo = _core.SdoClient(host, n, timeout=2.0)
+        sdo = _core.canopen.SdoClient(host, n, timeout=2.0)
         sdo.download(0x1800, 1, (0x180 + n).to_bytes(4, "little"))
         sdo.download(0x1800, 2, bytes([1]))                       # every SYNC
         sdo.download(0x1A00, 0, bytes([1]))
@@ -84,9 +84,9 @@ def main() -> None:
     # Counted in C++ (bus counters), not by a Python callback: at 127 k frames/s the
     # GIL, not the simulators, would be measured.
     host.set_filters([{"can_id": 0x180, "can_mask": 0x780}])
-    host.send(_core.Frame(0, bytes([0x01, 0x00])))               # NMT start, all nodes
+    host.send(_core.can.Frame(0, bytes([0x01, 0x00])))               # NMT start, all nodes
     time.sleep(0.2)
-    sync = _core.SyncProducer(host, 1.0 / rate)
+    sync = _core.canopen.SyncProducer(host, 1.0 / rate)
     rx0, tx0 = host.counters.rx_frames, dev.counters.tx_frames
     r0, t0 = resource.getrusage(resource.RUSAGE_SELF), time.perf_counter()
     sync.start()

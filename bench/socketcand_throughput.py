@@ -17,7 +17,7 @@ import time
 import can
 
 from motorbus import Frame
-from motorbus._core import open_virtual
+from motorbus._core.can import open_virtual
 from motorbus.socketcand import SocketcandServer, open_socketcand
 
 logging.getLogger("can").setLevel(logging.ERROR)  # python-can warns on every partial read

@@ -81,11 +81,11 @@ def main() -> None:
             with tempfile.NamedTemporaryFile("w", suffix=".log", delete=False) as f:
                 for i in range(a.frames):
                     f.write(f"(0.000000) can0 181#30{i & 0xFF:02X}{(i >> 8) & 0x7F:02X}00\n")
-            entries, bad = _core.read_log(f.name)
+            entries, bad = _core.can.read_log(f.name)
             assert bad == 0 and len(entries) == a.frames
         t0 = time.perf_counter()
         if entries is not None:
-            _core.play(flood, entries, 0.0)
+            _core.can.play(flood, entries, 0.0)
         else:
             for i in range(a.frames):
                 flood.send(frames[i & 0xFF])

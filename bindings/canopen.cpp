@@ -203,7 +203,7 @@ TransferMode mode_of(bool block, bool segmented) {
 
 static void bind_errors_and_types(py::module_& m) {
     // ---- errors (the table of errors.hpp) ---------------------------------------
-    py_errors::add_error_classes(m, {
+    py_errors::add_error_classes({
         {"SdoAbortError", {"MotorbusError"},
          "An SDO transfer was aborted: .code (CiA 301 abort code), .text, .index, .subindex."},
         {"SdoTimeout", {"TimeoutError"},
@@ -212,16 +212,16 @@ static void bind_errors_and_types(py::module_& m) {
          "The server broke the SDO protocol; .data is its frame, .code the abort code we sent."},
     }, "motorbus.canopen");
     // Class-level defaults, so the attributes exist on instances made from Python too.
-    for (const char* n : {"SdoAbortError", "SdoProtocolError"}) m.attr(n).attr("code") = 0;
-    m.attr("SdoAbortError").attr("text") = "";
+    for (const char* n : {"SdoAbortError", "SdoProtocolError"}) py_errors::error_class(n).attr("code") = 0;
+    py_errors::error_class("SdoAbortError").attr("text") = "";
     for (const char* n : {"SdoAbortError", "SdoTimeout", "SdoProtocolError"}) {
-        m.attr(n).attr("index") = 0;
-        m.attr(n).attr("subindex") = 0;
+        py_errors::error_class(n).attr("index") = 0;
+        py_errors::error_class(n).attr("subindex") = 0;
     }
-    g_abort = m.attr("SdoAbortError");  // owned by the module for the interpreter's life
-    py_errors::translate<SdoAbortError, fill_abort>(m.attr("SdoAbortError"));
-    py_errors::translate<SdoTimeout, fill_timeout>(m.attr("SdoTimeout"));
-    py_errors::translate<SdoProtocolError, fill_protocol>(m.attr("SdoProtocolError"));
+    g_abort = py_errors::error_class("SdoAbortError");  // owned by the module for the interpreter's life
+    py_errors::translate<SdoAbortError, fill_abort>(py_errors::error_class("SdoAbortError"));
+    py_errors::translate<SdoTimeout, fill_timeout>(py_errors::error_class("SdoTimeout"));
+    py_errors::translate<SdoProtocolError, fill_protocol>(py_errors::error_class("SdoProtocolError"));
 
     m.def("abort_text", [](std::uint32_t c) -> py::object {
         const char* t = abort_text(c);

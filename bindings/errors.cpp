@@ -11,16 +11,27 @@ namespace py = pybind11;
 
 namespace motorbus::py_errors {
 
-void add_error_classes(py::module_& m, std::initializer_list<ErrorClass> table, const char* module_name) {
+namespace {
+// The top-level _core module: every error class lives there (set by bind_errors,
+// which runs first; the module lives as long as the interpreter).
+PyObject* g_root = nullptr;
+}  // namespace
+
+py::object error_class(const char* name) {
+    return py::reinterpret_borrow<py::module_>(g_root).attr(name);
+}
+
+void add_error_classes(std::initializer_list<ErrorClass> table, const char* module_name) {
+    py::module_ root = py::reinterpret_borrow<py::module_>(g_root);
     py::module_ builtins = py::module_::import("builtins");
     for (const ErrorClass& row : table) {
         py::list bases;
         for (const char* b : row.bases)
-            bases.append(py::hasattr(m, b) ? m.attr(b) : builtins.attr(b));
+            bases.append(py::hasattr(root, b) ? root.attr(b) : builtins.attr(b));
         const std::string qualified = std::string(module_name) + "." + row.name;
         PyObject* cls = PyErr_NewExceptionWithDoc(qualified.c_str(), row.doc, py::tuple(bases).ptr(), nullptr);
         if (cls == nullptr) throw py::error_already_set();
-        m.attr(row.name) = py::reinterpret_steal<py::object>(cls);
+        root.attr(row.name) = py::reinterpret_steal<py::object>(cls);
     }
 }
 
@@ -35,7 +46,8 @@ void fill_bytes(py::object& exc, const motorbus::ProtocolError& e) {
 void bind_errors(py::module_& m) {
     using namespace motorbus;
     using py_errors::translate;
-    py_errors::add_error_classes(m, {
+    py_errors::g_root = m.ptr();
+    py_errors::add_error_classes({
         {"MotorbusError", {"RuntimeError"}, "Base of every error motorbus raises on purpose."},
         {"InvalidArgument", {"MotorbusError", "ValueError"}, "A value that can never be valid; the message names the field."},
         {"TimeoutError", {"MotorbusError", "TimeoutError"}, "A blocking call did not complete within its timeout."},

@@ -17,14 +17,17 @@ namespace py = pybind11;
 
 struct ErrorClass {
     const char* name;                          // motorbus.<name>
-    std::initializer_list<const char*> bases;  // classes of this module first, then builtins
+    std::initializer_list<const char*> bases;  // classes of _core first, then builtins
     const char* doc;
 };
 
-// Creates each class of `table` in module `m` (its __module__ = `module_name`)
-// and returns nothing; look them up with m.attr(name).
-void add_error_classes(py::module_& m, std::initializer_list<ErrorClass> table,
-                       const char* module_name = "motorbus");
+// Creates each class of `table` at the top level of _core, whichever area or
+// vendor submodule declares it (its __module__ = `module_name`): the errors are one
+// table, caught everywhere; look them up with error_class(name).
+void add_error_classes(std::initializer_list<ErrorClass> table, const char* module_name = "motorbus");
+
+// The error class `name` of _core's top level (created by add_error_classes).
+py::object error_class(const char* name);
 
 template <class E, auto Fill = nullptr>
 struct Translator {

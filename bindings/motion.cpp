@@ -41,9 +41,9 @@ py::array_t<double> vec_to_array(const std::vector<double>& v) {
 
 static void bind_planners(py::module_& m) {
     // ---- errors ----------------------------------------------------------------
-    py_errors::add_error_classes(m, {{"LimitExceeded", {"InvalidArgument"},
+    py_errors::add_error_classes({{"LimitExceeded", {"InvalidArgument"},
         "A motion request beyond a limit: .limit names it, .requested/.allowed/.excess quantify it."}});
-    py_errors::translate<LimitExceeded, fill_limit>(m.attr("LimitExceeded"));
+    py_errors::translate<LimitExceeded, fill_limit>(py_errors::error_class("LimitExceeded"));
 
     // ---- profiles and planners -------------------------------------------------
     py::class_<State>(m, "MotionState")

@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 
 #include "common.hpp"
+#include "errors.hpp"
 #include "motorbus/runtime/clock.hpp"
 
 namespace py = pybind11;
@@ -10,7 +11,7 @@ using namespace motorbus;
 void bind_runtime(py::module_& m) {
     // Safety net for argument conversions no helper names (common.hpp arg_cast):
     // a pybind11 cast failure inside a call is a bad argument, not a RuntimeError.
-    static py::handle invalid_argument = py::object(m.attr("InvalidArgument")).release();
+    static py::handle invalid_argument = py::object(motorbus::py_errors::error_class("InvalidArgument")).release();
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);

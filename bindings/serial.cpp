@@ -147,9 +147,9 @@ void fill_reply_too_long(py::object& exc, const ReplyTooLong& e) {
 
 static void bind_serial_records(py::module_& m) {
     // ReplyTooLong(ProtocolError): a distinct class so callers can catch it alone.
-    py_errors::add_error_classes(m, {{"ReplyTooLong", {"ProtocolError"},
+    py_errors::add_error_classes({{"ReplyTooLong", {"ProtocolError"},
         "A reply exceeded max_line; it was discarded up to its terminator. .data holds its first bytes."}});
-    py_errors::translate<ReplyTooLong, fill_reply_too_long>(m.attr("ReplyTooLong"));
+    py_errors::translate<ReplyTooLong, fill_reply_too_long>(py_errors::error_class("ReplyTooLong"));
 
     Record<LineCounters>(m, "LineCounters", "LineLink counters, read-only.")
         .field("bytes_in", &LineCounters::bytes_in, "read from the port (echo and stale bytes included)")

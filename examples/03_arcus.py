@@ -9,7 +9,7 @@ from motorbus.drives.arcus import make_sim
 # The simulator answers on a pty exactly like the device (real time); the home
 # switch sits 400 steps away so H+ homing is quick.
 sim = make_sim("01", eo_boot=True, home=(400, 800))
-with core.PtyLineServer([sim], 0, None) as server:
+with core.serial.PtyLineServer([sim], 0, None) as server:
     units = motorbus.Units("mm", 0.01)  # 100 encoder counts per mm (StepNLoop on)
     with motorbus.open_drive("arcus", line=server.slave_path, address="01", units=units) as x:
         x.params["HSPD"] = 20000        # counts/s: the manual's own names

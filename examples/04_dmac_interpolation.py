@@ -5,7 +5,7 @@ are played in a moment and the end positions are exact.
 
     python examples/04_dmac_interpolation.py
 """
-from motorbus._core import SimClock
+from motorbus._core.runtime import SimClock
 from motorbus.drives.dmac import DmacClient, make_sim, open_line, stream_interpolation
 from motorbus.serial import PtyLineServer
 

@@ -7,7 +7,7 @@ import motorbus
 from motorbus import _core
 from motorbus.drives import pmc007
 
-clock = _core.SimClock(0)                       # the sim's time moves only when we say so
+clock = _core.runtime.SimClock(0)                       # the sim's time moves only when we say so
 with motorbus.open_bus("virtual:example-07") as sim_bus, motorbus.open_bus("virtual:example-07") as bus:
     sim = pmc007.make_sim(5, clock=clock, bus=sim_bus)
     drive = pmc007.Pmc007(bus, 5)

@@ -12,7 +12,7 @@ import motorbus
 from motorbus import _core
 from motorbus.drives.unitek import Reg, Status, Unitek, make_sim
 
-clock = _core.SimClock(0)
+clock = _core.runtime.SimClock(0)
 
 
 def run(ms, sim, stream=None):

@@ -1,7 +1,12 @@
-"""Keeps python/motorbus/_core.pyi in sync with the compiled extension.
+"""Keeps the _core stubs in sync with the compiled extension.
 
     python tools/gen_stubs.py write   # regenerate after changing bindings/
-    python tools/gen_stubs.py check   # fail (exit 1) if the committed stub is stale (`make test`)
+    python tools/gen_stubs.py check   # fail (exit 1) if the committed stubs are stale (`make test`)
+
+_core has one submodule per area and per vendor, so its stubs are a stub package,
+python/motorbus/_core/: __init__.pyi (the errors, the submodule imports) and one
+<submodule>.pyi each.  The directory holds no __init__.py: Python imports the
+extension module beside it, type checkers read the stubs.
 
 The stub describes motorbus's own module.  A build with MOTORBUS_EXTRA_VENDOR_DIRS (the
 tests build compiles tests/plugin_kind's `toy` kind in) also holds what those out-of-tree
@@ -20,7 +25,9 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-STUB = ROOT / "python" / "motorbus" / "_core.pyi"
+PACKAGE = ROOT / "python" / "motorbus"
+STUB_DIR = PACKAGE / "_core"            # the stub package of the extension's submodules
+FLAT_STUB = PACKAGE / "_core.pyi"       # the stub of a flat _core (no submodules)
 BUILD = pathlib.Path(os.environ.get("MOTORBUS_BUILD_DIR", ROOT / "build" / "dev"))
 
 # What a bindings file registers on the module it is given (conventionally `m`):
@@ -93,7 +100,8 @@ def drop_names(text: str, names: set[str]) -> str:
     return "".join(line for i, line in enumerate(lines) if i not in cut)
 
 
-def generate() -> str:
+def generate() -> dict[pathlib.Path, str]:
+    """{stub file: its text} for motorbus's own _core, without the out-of-tree vendors."""
     extra = extra_vendors()
     with tempfile.TemporaryDirectory() as out:
         subprocess.run(
@@ -101,31 +109,47 @@ def generate() -> str:
              "--numpy-array-remove-parameters", "--ignore-all-errors"],
             check=True, capture_output=True, text=True,
         )
-        files = list(pathlib.Path(out).rglob("_core.pyi")) + list(pathlib.Path(out).rglob("_core/__init__.pyi"))
-        if not files:
-            raise SystemExit("pybind11-stubgen produced no _core.pyi")
-        text = files[0].read_text()
-        package = files[0].name == "__init__.pyi"
-    # A vendor bound into its own submodule is that submodule (its `from . import <vendor>`);
-    # in a flat module, the names its bindings register.
-    names = set(extra)
-    if not package:
-        for bindings in extra.values():
-            names |= registered_names(bindings)
-    return drop_names(text, names)
+        flat = list(pathlib.Path(out).rglob("_core.pyi"))
+        init = list(pathlib.Path(out).rglob("_core/__init__.pyi"))
+        if not flat and not init:
+            raise SystemExit("pybind11-stubgen produced no _core stub")
+        if flat:
+            # A flat module: drop the names the extra vendors' bindings files register.
+            names: set[str] = set()
+            for bindings in extra.values():
+                names |= registered_names(bindings)
+            return {FLAT_STUB: drop_names(flat[0].read_text(), names)}
+        # A vendor bound into its own submodule is that submodule: its `from . import <vendor>`
+        # in __init__.pyi and its <vendor>.pyi go.
+        stubs = {STUB_DIR / "__init__.pyi": drop_names(init[0].read_text(), set(extra))}
+        for f in sorted(init[0].parent.glob("*.pyi")):
+            if f.name != "__init__.pyi" and f.stem not in extra:
+                stubs[STUB_DIR / f.name] = f.read_text()
+        return stubs
+
+
+def committed() -> set[pathlib.Path]:
+    """The stub files in the tree now."""
+    return set(STUB_DIR.glob("*.pyi")) | ({FLAT_STUB} if FLAT_STUB.exists() else set())
 
 
 def main() -> int:
     mode = sys.argv[1] if len(sys.argv) > 1 else "check"
-    text = generate()
+    stubs = generate()
     if mode == "write":
-        STUB.write_text(text)
-        print(f"wrote {STUB.relative_to(ROOT)}")
+        for stale in committed() - set(stubs):
+            stale.unlink()
+        for path, text in stubs.items():
+            path.parent.mkdir(exist_ok=True)
+            path.write_text(text)
+        print(f"wrote {len(stubs)} stub files: {', '.join(str(p.relative_to(ROOT)) for p in stubs)}")
         return 0
-    if not STUB.exists() or STUB.read_text() != text:
-        print("python/motorbus/_core.pyi is stale: run `make stubs` and commit it", file=sys.stderr)
+    stale = sorted(str(p.relative_to(ROOT)) for p in committed() ^ set(stubs)) + sorted(
+        str(p.relative_to(ROOT)) for p, text in stubs.items() if p.exists() and p.read_text() != text)
+    if stale:
+        print(f"stale _core stubs ({', '.join(stale)}): run `make stubs` and commit them", file=sys.stderr)
         return 1
-    print("stubs: _core.pyi is in sync with the extension")
+    print(f"stubs: {len(stubs)} _core stub files are in sync with the extension")
     return 0
 
 

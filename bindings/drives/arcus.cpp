@@ -53,8 +53,8 @@ constexpr ReplyClass kReplyClasses[] = {
 py::handle g_reply_class[std::size(kReplyClasses)];
 py::handle g_arcus_error;
 
-void register_errors(py::module_& m) {
-    py_errors::add_error_classes(m, {
+void register_errors() {
+    py_errors::add_error_classes({
         {"ArcusError", {"DriveFault"}, "An Arcus drive refused a command with a Table 11.1 reply. .code, .reply, .command."},
         {"ArcusUnknownCommand", {"ArcusError"}, "?<command>: the controller did not understand the command."},
         {"ArcusBadSspd", {"ArcusError"}, "?Bad SSPD Command"},
@@ -67,9 +67,9 @@ void register_errors(py::module_& m) {
         {"ArcusStateError", {"ArcusError"},
          "?State Error (a move while a limit or StepNLoop error is latched; CLR clears it)"},
     });
-    g_arcus_error = py::object(m.attr("ArcusError")).release();
+    g_arcus_error = py::object(py_errors::error_class("ArcusError")).release();
     for (std::size_t i = 0; i < std::size(kReplyClasses); ++i)
-        g_reply_class[i] = py::object(m.attr(kReplyClasses[i].name)).release();
+        g_reply_class[i] = py::object(py_errors::error_class(kReplyClasses[i].name)).release();
     // The class depends on the reply code, so this translator picks it itself.
     py::register_exception_translator([](std::exception_ptr p) {
         try {
@@ -123,7 +123,7 @@ namespace {
 void bind_arcus_motion(py::module_& m) {
     using namespace motorbus::motion;
     // ---- Arcus -----------------------------------------------------------------
-    py::class_<ArcusSpeedWindow>(m, "ArcusSpeedWindow")
+    py::class_<ArcusSpeedWindow>(m, "SpeedWindow")
         .def_readonly("number", &ArcusSpeedWindow::number)
         .def_readonly("sspdm_first", &ArcusSpeedWindow::sspdm_first)
         .def_readonly("sspdm_last", &ArcusSpeedWindow::sspdm_last)
@@ -132,14 +132,14 @@ void bind_arcus_motion(py::module_& m) {
         .def_readonly("min_lspd", &ArcusSpeedWindow::min_lspd)
         .def_readonly("min_acc_ms", &ArcusSpeedWindow::min_acc_ms)
         .def_readonly("delta", &ArcusSpeedWindow::delta);
-    m.def("arcus_speed_windows", [] {
+    m.def("speed_windows", [] {
         const auto& w = arcus_speed_windows();
         return std::vector<ArcusSpeedWindow>(w.begin(), w.end());
     });
-    m.def("arcus_window_for_hspd", &arcus_window_for_hspd, py::arg("hspd_pps"), py::return_value_policy::copy);
-    m.def("arcus_window_for_sspdm", &arcus_window_for_sspdm, py::arg("sspdm"), py::return_value_policy::copy);
-    m.def("arcus_max_acc_ms", &arcus_max_acc_ms, py::arg("hspd_pps"), py::arg("lspd_pps"));
-    py::class_<ProfileParams>(m, "ArcusProfileParams")
+    m.def("window_for_hspd", &arcus_window_for_hspd, py::arg("hspd_pps"), py::return_value_policy::copy);
+    m.def("window_for_sspdm", &arcus_window_for_sspdm, py::arg("sspdm"), py::return_value_policy::copy);
+    m.def("max_acc_ms", &arcus_max_acc_ms, py::arg("hspd_pps"), py::arg("lspd_pps"));
+    py::class_<ProfileParams>(m, "ProfileParams")
         .def(py::init([](double hspd, double lspd, double acc_ms, double dec_ms, bool edec, bool scv, double ratio) {
                  return ProfileParams{hspd, lspd, acc_ms, dec_ms, edec, scv, ratio};
              }),
@@ -152,18 +152,18 @@ void bind_arcus_motion(py::module_& m) {
         .def_readwrite("edec", &ProfileParams::edec)
         .def_readwrite("scv", &ProfileParams::scv)
         .def_readwrite("snl_ratio", &ProfileParams::snl_ratio);
-    m.def("arcus_effective", [](const ProfileParams& p) {
+    m.def("effective", [](const ProfileParams& p) {
         auto e = arcus_effective(p);
         return py::make_tuple(e.params, e.window ? e.window->number : 0, e.adjustments);
     }, py::arg("params"), "(effective params, window number, [adjustments]) after Appendix A.");
-    m.def("arcus_check_strict", &arcus_check_strict, py::arg("params"));
-    m.attr("ARCUS_MAX_MOVE_DISTANCE") = kArcusMaxMoveDistance;
-    py::enum_<Phase>(m, "ArcusPhase", "Where an ArcusMotion is in its move (MST bits 0..2).")
+    m.def("check_strict", &arcus_check_strict, py::arg("params"));
+    m.attr("MAX_MOVE_DISTANCE") = kArcusMaxMoveDistance;
+    py::enum_<Phase>(m, "Phase", "Where an Motion is in its move (MST bits 0..2).")
         .value("IDLE", Phase::Idle)
         .value("ACCEL", Phase::Accel)
         .value("CONST", Phase::Const, "at constant speed")
         .value("DECEL", Phase::Decel);
-    py::class_<Motion>(m, "ArcusMotion")
+    py::class_<Motion>(m, "Motion")
         .def(py::init<ProfileParams, int>(), py::arg("params") = ProfileParams{}, py::arg("sspdm") = 0)
         .def("set_params", [](Motion& a, const ProfileParams& p) { return a.set_params(p).params; })
         .def("set_sspdm", &Motion::set_sspdm)
@@ -181,16 +181,16 @@ void bind_arcus_motion(py::module_& m) {
         .def("abort", &Motion::abort, py::arg("t"))
         .def_property_readonly("profile", &Motion::profile, py::return_value_policy::copy)
         .def("moving", &Motion::moving, py::arg("t"))
-        .def("phase", &Motion::phase, py::arg("t"), "The ArcusPhase at time t (MST bits 0..2).");
+        .def("phase", &Motion::phase, py::arg("t"), "The Phase at time t (MST bits 0..2).");
 
-    py::class_<HomingOptions>(m, "ArcusHomingOptions")
+    py::class_<HomingOptions>(m, "HomingOptions")
         .def(py::init([](double hca, double lca, bool rz) { return HomingOptions{hca, lca, rz}; }),
              py::arg("hca") = 0.0, py::arg("lca") = 1000.0, py::arg("rz") = false);
-    named_enum<Homing::Method>(m, "ArcusHomingMethod", "The routines ArcusHoming runs on a MotorModel.",
+    named_enum<Homing::Method>(m, "HomingMethod", "The routines Homing runs on a MotorModel.",
                                "ArcusHoming.start method", {{"H", Homing::Method::H}, {"HL", Homing::Method::HL},
                                                             {"L", Homing::Method::L}, {"Z", Homing::Method::Z},
                                                             {"ZH", Homing::Method::ZH}});
-    py::class_<Homing>(m, "ArcusHoming")
+    py::class_<Homing>(m, "Homing")
         .def(py::init<MotorModel&, ProfileParams, HomingOptions>(), py::arg("motor"), py::arg("params"),
              py::arg("options") = HomingOptions{}, py::keep_alive<1, 2>())
         .def("start", [](Homing& h, const EnumOrName<Homing::Method>& method, int dir) {
@@ -205,14 +205,14 @@ void bind_arcus_motion(py::module_& m) {
 
 static void bind_arcus_codec(py::module_& m) {
     bind_arcus_motion(m);
-    register_errors(m);
+    register_errors();
 
-    m.attr("ARCUS_MAX_REPLY") = kMaxReply;
-    m.attr("ARCUS_MAX_REQUEST") = kMaxRequest;
-    m.def("arcus_build_request", [](int address, const std::string& cmd) { return to_py(build_request(address, cmd)); },
+    m.attr("MAX_REPLY") = kMaxReply;
+    m.attr("MAX_REQUEST") = kMaxRequest;
+    m.def("build_request", [](int address, const std::string& cmd) { return to_py(build_request(address, cmd)); },
           py::arg("address"), py::arg("command"), "b'@NN<command>\\r' (validated).");
     m.def(
-        "arcus_parse_reply",
+        "parse_reply",
         [](const py::object& raw) {
             auto r = parse_reply(bytes_or_str(raw, "reply"));
             return py::make_tuple(r.address ? py::cast(*r.address) : py::none(), r.body);
@@ -222,7 +222,7 @@ static void bind_arcus_codec(py::module_& m) {
         return [f](const CommandInfo& c) { return std::string(c.*f); };
     };
     auto form = [](unsigned bit) { return [bit](const CommandInfo& c) { return bool(c.forms & bit); }; };
-    Record<CommandInfo>(m, "ArcusCommandInfo", "One row of the Arcus command table (arcus_commands()), read-only.")
+    Record<CommandInfo>(m, "CommandInfo", "One row of the Arcus command table (commands()), read-only.")
         .prop("name", text(&CommandInfo::name))
         .prop("query", form(kQuery), "answers the bare name (\"HSPD\" -> value)")
         .prop("set", form(kSet), "takes NAME=value")
@@ -233,14 +233,14 @@ static void bind_arcus_codec(py::module_& m) {
         .field("stored", &CommandInfo::stored, "written to flash by STORE (Table 7.10)")
         .prop("description", text(&CommandInfo::description));
     m.def(
-        "arcus_commands",
+        "commands",
         [] {
             auto t = command_table();
             return std::vector<CommandInfo>(t.begin(), t.end());
         },
         "The command table (Table 11.0 plus the commands the sections describe).");
     m.def(
-        "arcus_acc_range", [](std::int64_t hspd, std::int64_t lspd) {
+        "acc_range", [](std::int64_t hspd, std::int64_t lspd) {
             return std::make_pair(min_acc_ms(hspd), max_acc_ms(hspd, lspd));
         },
         py::arg("hspd"), py::arg("lspd"),
@@ -252,7 +252,7 @@ static void bind_arcus_sim(py::module_& m) {
     // One drive, two faces: a LineDevice for its serial line, a SimulatedDevice (attach / close /
     // attached / describe / power_cycle, the base's binding) for its CAN port.
     py::class_<Sim, serial::LineDevice, can::SimulatedDevice, std::shared_ptr<Sim>>(
-        m, "ArcusSim",
+        m, "Sim",
         "A simulated Arcus DMX-CAN: answers ASCII lines (a LineDevice for PtyLineServer) and, attached to a "
         "CAN bus, CANopen (a SimulatedDevice).")
         .def(py::init([](std::shared_ptr<Clock> clock, int address, int response_type, const std::string& store_path,
@@ -305,10 +305,10 @@ static void bind_arcus_sim(py::module_& m) {
         .def_property_readonly("can_node_id", &Sim::can_node_id)
         .def_property_readonly("can_bit_rate", &Sim::can_bit_rate);
 
-    m.def("arcus_canopen_object_dictionary", &canopen_object_dictionary,
+    m.def("canopen_object_dictionary", &canopen_object_dictionary,
           "Table 10.1 as a typed canopen.ObjectDictionary (types, access, limits, defaults, codecs): what the "
           "arcus-canopen client reads and writes by, and the source of the shipped EDS.");
-    m.def("arcus_canopen_objects", [] {
+    m.def("canopen_objects", [] {
         py::list out;
         for (const auto& o : canopen_objects())
             out.append(py::make_tuple(o.index, o.sub, o.name, o.type, o.access, o.default_value, o.low, o.high,
@@ -320,10 +320,10 @@ static void bind_arcus_sim(py::module_& m) {
 
 static void bind_arcus_client(py::module_& m) {
     // The home command's method; ArcusClientBase.home takes it or its name ("HL").
-    named_enum<HomeMethod>(m, "ArcusHomeMethod", "The homing routines: H, HL, ZH, Z, L (Table 11.0; + or - is the direction).",
+    named_enum<HomeMethod>(m, "HomeMethod", "The homing routines: H, HL, ZH, Z, L (Table 11.0; + or - is the direction).",
                            "home method", {{"H", HomeMethod::H}, {"HL", HomeMethod::HL}, {"ZH", HomeMethod::ZH},
                                            {"Z", HomeMethod::Z}, {"L", HomeMethod::L}});
-    Record<ClientCounters>(m, "ArcusClientCounters", "ArcusClient counters (ArcusClient.counters), read-only.")
+    Record<ClientCounters>(m, "ClientCounters", "ArcusClient counters (ArcusClient.counters), read-only.")
         .field("requests", &ClientCounters::requests)
         .field("timeouts", &ClientCounters::timeouts)
         .field("retries", &ClientCounters::retries, "queries sent again after a timeout")
@@ -336,7 +336,7 @@ static void bind_arcus_client(py::module_& m) {
     // Property accessors release the GIL like the methods (each is a line transaction).
     auto get = [rel](auto f) { return py::cpp_function(f, rel); };
     auto put = [rel](auto f) { return py::cpp_function(f, py::is_setter(), rel); };
-    py::class_<C, std::shared_ptr<C>> c(m, "ArcusClientBase",
+    py::class_<C, std::shared_ptr<C>> c(m, "ClientBase",
                                         "Typed client for one DMX-CAN address on a LineLink (see ArcusClient).");
     c.def(py::init([](std::shared_ptr<serial::LineLink> link, int address, const py::object& timeout,
                       int query_retries) {
@@ -462,7 +462,7 @@ static void bind_arcus_client(py::module_& m) {
 static void bind_arcus_poll(py::module_& m) {
     // A PollSource querying `names` (e.g. ["EX", "PS", "MST"]) each sample, with a
     // client of its own on the drive's LineLink (motorbus.Poller).
-    m.def("arcus_poll_source",
+    m.def("poll_source",
           [](std::shared_ptr<serial::LineLink> link, int address, std::vector<std::string> names,
              const py::object& timeout, int query_retries) -> std::shared_ptr<poll::Source> {
               py_helpers::not_none(link, "link");

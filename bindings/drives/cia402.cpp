@@ -32,7 +32,7 @@ py::object opt(const std::optional<std::int64_t>& v) { return v ? py::object(py:
 }  // namespace
 
 void bind_cia402(py::module_& m) {
-    m.def("cia402_objects", [] {
+    m.def("objects", [] {
         py::list out;
         for (const auto& r : objects())
             out.append(py::make_tuple(r.index, r.sub, r.name, type_code(r.type), canopen::access_name(r.access),
@@ -40,13 +40,13 @@ void bind_cia402(py::module_& m) {
         return out;
     }, "The generic CiA 402 simulator's objects: (index, sub, name, type, access, default, low, high, unit, "
        "persists, description).");
-    m.def("cia402_object_dictionary", &object_dictionary, py::arg("node_id") = 1,
+    m.def("object_dictionary", &object_dictionary, py::arg("node_id") = 1,
           "The same objects as a typed canopen.ObjectDictionary (types, access, limits, defaults, codecs): what the "
           "generic Drive adapter reads and writes by.");
 
     auto rel = py::call_guard<py::gil_scoped_release>();
     // attach / close / attached / describe / power_cycle: the SimulatedDevice base's.
-    py::class_<Sim, can::SimulatedDevice, std::shared_ptr<Sim>>(m, "Cia402Sim",
+    py::class_<Sim, can::SimulatedDevice, std::shared_ptr<Sim>>(m, "Sim",
         "A simulated CiA 402 drive served by a LocalNode (see cpp/motorbus/drives/cia402/sim.hpp).")
         .def(py::init([](int node_id, std::shared_ptr<Clock> clock, double steps_per_rev,
                          std::pair<double, double> home, std::optional<double> minus_limit,

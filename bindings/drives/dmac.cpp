@@ -54,7 +54,7 @@ namespace {
 void bind_dmac_motion(py::module_& m) {
     using namespace motorbus::motion;
     // ---- DMAC ------------------------------------------------------------------
-    py::class_<ProfileParams>(m, "DmacProfileParams")
+    py::class_<ProfileParams>(m, "ProfileParams")
         .def(py::init([](std::int32_t hs, std::int32_t ls, std::int32_t ati, std::int32_t dti, bool sc) {
                  ProfileParams p{hs, ls, ati, dti, sc};
                  p.validate();
@@ -67,11 +67,11 @@ void bind_dmac_motion(py::module_& m) {
         .def_readwrite("accel_time_ms", &ProfileParams::accel_time_ms)
         .def_readwrite("decel_time_ms", &ProfileParams::decel_time_ms)
         .def_readwrite("s_curve", &ProfileParams::s_curve);
-    m.def("dmac_ramp_time", &ramp_time, py::arg("params"), py::arg("v_from"), py::arg("v_to"));
-    m.def("dmac_position_profile", &position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
-    m.def("dmac_speed_profile", &speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
+    m.def("ramp_time", &ramp_time, py::arg("params"), py::arg("v_from"), py::arg("v_to"));
+    m.def("position_profile", &position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
+    m.def("speed_profile", &speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
           py::arg("hold") = 0.0);
-    py::class_<Motion>(m, "DmacMotion")
+    py::class_<Motion>(m, "Motion")
         .def(py::init<ProfileParams, double>(), py::arg("params") = ProfileParams{}, py::arg("position") = 0.0)
         .def("set_params", &Motion::set_params)
         .def("move_to", &Motion::move_to, py::arg("t"), py::arg("target"))
@@ -94,45 +94,45 @@ static void bind_dmac_streaming(py::module_& m);
 static void bind_dmac_codec(py::module_& m) {
     bind_dmac_motion(m);
     // ---- errors ---------------------------------------------------------------
-    py_errors::add_error_classes(m, {
+    py_errors::add_error_classes({
         {"DmacUnknownCommand", {"DriveFault"},
          "The DMAC rejected a command as undefined (#ERROR bit 12), or a peer answered '?'."},
         {"DmacCommandRejected", {"DriveFault"},
          "The DMAC refused a parameter (#ERROR bit 7 limit, bit 8 computation); .error holds #ERROR."},
     });
-    py_errors::translate<UnknownCommand>(m.attr("DmacUnknownCommand"));
-    py_errors::translate<CommandRejected, fill_rejected>(m.attr("DmacCommandRejected"));
+    py_errors::translate<UnknownCommand>(py_errors::error_class("DmacUnknownCommand"));
+    py_errors::translate<CommandRejected, fill_rejected>(py_errors::error_class("DmacCommandRejected"));
 
     // ---- codec helpers ---------------------------------------------------------------
     // The enums the client and the simulator take; each also accepts its names
     // as strings, in any case (named_enum.hpp).
-    named_enum<Radix>(m, "DmacRadix", "How a DMAC value is written: +123, h0000007B or b00000000 ... 01111011.",
+    named_enum<Radix>(m, "Radix", "How a DMAC value is written: +123, h0000007B or b00000000 ... 01111011.",
                       "radix", {{"DEC", Radix::Dec}, {"HEX", Radix::Hex}, {"BIN", Radix::Bin}},
                       {{"d", Radix::Dec}, {"", Radix::Dec}, {"h", Radix::Hex}, {"b", Radix::Bin}});
-    named_enum<StopWhat>(m, "DmacStopWhat", "What STOP / HALT stop: everything, the movement (MOUV) or the sequence (SEQ).",
+    named_enum<StopWhat>(m, "StopWhat", "What STOP / HALT stop: everything, the movement (MOUV) or the sequence (SEQ).",
                          "what", {{"ALL", StopWhat::All}, {"MOVEMENT", StopWhat::Movement}, {"SEQUENCE", StopWhat::Sequence}},
                          {{"MOUV", StopWhat::Movement}, {"SEQ", StopWhat::Sequence}});
-    named_enum<PowerMode>(m, "DmacPowerMode", "POWER ON, OFF (freewheel) or SC (short-circuited coils).", "POWER",
+    named_enum<PowerMode>(m, "PowerMode", "POWER ON, OFF (freewheel) or SC (short-circuited coils).", "POWER",
                           {{"ON", PowerMode::On}, {"OFF", PowerMode::Off}, {"SC", PowerMode::ShortCircuit}});
-    named_enum<EndStops>(m, "DmacEndStops", "HARD_ENDS: which hard end-stop inputs stop the motor.", "HARD_ENDS",
+    named_enum<EndStops>(m, "EndStops", "HARD_ENDS: which hard end-stop inputs stop the motor.", "HARD_ENDS",
                          {{"OFF", EndStops::Off}, {"ALL", EndStops::All}, {"POS", EndStops::Positive},
                           {"NEG", EndStops::Negative}});
-    named_enum<Polarity>(m, "DmacPolarity", "INVERSE_POLARITY: which of the inputs and outputs are inverted.",
+    named_enum<Polarity>(m, "Polarity", "INVERSE_POLARITY: which of the inputs and outputs are inverted.",
                          "INVERSE_POLARITY", {{"OFF", Polarity::Off}, {"ALL", Polarity::All}, {"IN", Polarity::Inputs},
                                               {"OUT", Polarity::Outputs}});
     // SYNCHRO's words (dmac_synchro refuses the other keywords).
-    named_enum<Keyword>(m, "DmacKeyword", "The keywords of the DMAC command language.", "SYNCHRO",
+    named_enum<Keyword>(m, "Keyword", "The keywords of the DMAC command language.", "SYNCHRO",
                         {{"ON", Keyword::On}, {"OFF", Keyword::Off}, {"SC", Keyword::Sc}, {"ALL", Keyword::All},
                          {"POS", Keyword::Pos}, {"NEG", Keyword::Neg}, {"IN", Keyword::In}, {"OUT", Keyword::Out},
                          {"MOUV", Keyword::Mouv}, {"SEQ", Keyword::Seq}, {"TOP", Keyword::Top},
                          {"INTERPOL", Keyword::Interpol}});
-    Record<ReadReply>(m, "DmacReadReply", "One parsed 'aa#MNE[.bit]=value' reply (dmac_parse_read_reply), read-only.")
+    Record<ReadReply>(m, "ReadReply", "One parsed 'aa#MNE[.bit]=value' reply (parse_read_reply), read-only.")
         .field("address", &ReadReply::address)
         .field("mnemonic", &ReadReply::mnemonic, "'#ATI'")
         .field("bit", &ReadReply::bit, "0 for a whole-variable read")
         .field("value", &ReadReply::value)
         .field("radix", &ReadReply::radix);
-    Record<VarInfo>(m, "DmacVariableInfo", "One DMAC variable (dmac_variable()), read-only.")
+    Record<VarInfo>(m, "VariableInfo", "One DMAC variable (variable()), read-only.")
         .field("name", &VarInfo::name, "'#ACCEL_TIME'")
         .field("mnemonic", &VarInfo::mnemonic, "'#ATI'")
         .field("stored", &VarInfo::stored, "survives power cycle / MODULE_RESET")
@@ -141,7 +141,7 @@ static void bind_dmac_codec(py::module_& m) {
         .field("min", &VarInfo::min, "lowest value a write accepts")
         .field("max", &VarInfo::max, "highest value a write accepts")
         .field("dmac34_only", &VarInfo::dmac34_only, "exists on the DMAC34 only");
-    Record<VersionInfo>(m, "DmacVersionInfo", "A parsed REQUEST_VERSION banner (DmacClient.request_version()), read-only.")
+    Record<VersionInfo>(m, "VersionInfo", "A parsed REQUEST_VERSION banner (Client.request_version()), read-only.")
         .field("address", &VersionInfo::address)
         .field("version", &VersionInfo::version, "1 in v1.7")
         .field("release", &VersionInfo::release, "7 in v1.7")
@@ -155,24 +155,24 @@ static void bind_dmac_codec(py::module_& m) {
         .field("revision_date", &VersionInfo::revision_date)
         .field("phase", &VersionInfo::phase, "'6A'")
         .field("boot", &VersionInfo::boot, "'v1.1'");
-    m.def("dmac_format_value", [](std::int32_t v, const EnumOrName<Radix>& r) { return format_value(v, enum_arg<Radix>(r)); },
+    m.def("format_value", [](std::int32_t v, const EnumOrName<Radix>& r) { return format_value(v, enum_arg<Radix>(r)); },
           py::arg("value"), py::arg("radix") = Radix::Dec,
-          "'+123', 'h0000007B' or 'b00000000 ... 01111011'; radix is a DmacRadix or 'dec'/'hex'/'bin'.");
+          "'+123', 'h0000007B' or 'b00000000 ... 01111011'; radix is a Radix or 'dec'/'hex'/'bin'.");
     m.def(
-        "dmac_parse_read_reply", [](const py::bytes& b) { return parse_read_reply(std::string(b)); },
-        py::arg("reply"), "Parses 'aa#MNE[.bit]=value' strictly into a DmacReadReply; None when it breaks the grammar.");
-    m.def("dmac_status_names", [](std::uint32_t s) { return status_names(s); }, py::arg("status"));
-    m.def("dmac_error_names", [](std::uint32_t e) { return error_names(e); }, py::arg("error"));
-    m.def("dmac_variable", [](const std::string& name) { return var_info(var_arg(name)); }, py::arg("name"),
-          "The DmacVariableInfo of a variable, by full name or mnemonic ('#ACCEL_TIME', 'ATI').");
+        "parse_read_reply", [](const py::bytes& b) { return parse_read_reply(std::string(b)); },
+        py::arg("reply"), "Parses 'aa#MNE[.bit]=value' strictly into a ReadReply; None when it breaks the grammar.");
+    m.def("status_names", [](std::uint32_t s) { return status_names(s); }, py::arg("status"));
+    m.def("error_names", [](std::uint32_t e) { return error_names(e); }, py::arg("error"));
+    m.def("variable", [](const std::string& name) { return var_info(var_arg(name)); }, py::arg("name"),
+          "The VariableInfo of a variable, by full name or mnemonic ('#ACCEL_TIME', 'ATI').");
 }
 
 static void bind_dmac_sim(py::module_& m) {
     // ---- simulator -----------------------------------------------------------------
-    named_enum<Sim::Sensor>(m, "DmacSensor", "The temperature sensors of a module (DmacSim.set_temperature).",
+    named_enum<Sim::Sensor>(m, "Sensor", "The temperature sensors of a module (Sim.set_temperature).",
                             "sensor", {{"CPU", Sim::Sensor::Cpu}, {"DRIVER", Sim::Sensor::Driver},
                                        {"MOTOR", Sim::Sensor::Motor}});
-    Record<SimState>(m, "DmacSimState", "A snapshot of a DmacSim (DmacSim.state()), read-only.")
+    Record<SimState>(m, "SimState", "A snapshot of a Sim (Sim.state()), read-only.")
         .field("now_ms", &SimState::now_ms, "device time (ms)")
         .field("position", &SimState::position, "#POSITION (1/10000 rev)")
         .field("speed", &SimState::speed, "#SPEED (0.01 rpm, signed)")
@@ -184,7 +184,7 @@ static void bind_dmac_sim(py::module_& m) {
         .field("interpolating", &SimState::interpolating)
         .field("power", &SimState::power, "the motor is powered");
     py::class_<Sim, serial::LineDevice, std::shared_ptr<Sim>>(
-        m, "DmacSim",
+        m, "Sim",
         "A simulated DMAC module (a LineDevice: serve it with PtyLineServer). Device time runs on `clock` "
         "(a SimClock in tests); nothing runs in the background.")
         .def(py::init([](std::shared_ptr<Clock> clock, int address, const std::string& model,
@@ -217,7 +217,7 @@ static void bind_dmac_sim(py::module_& m) {
              py::arg("positive_end_switch") = py::none(), py::arg("negative_end_switch") = py::none(),
              py::arg("end_switch_active_low") = false, py::arg("reference_switch") = py::none())
         .def("poll", &Sim::poll, py::call_guard<py::gil_scoped_release>(), "Catch up with the clock.")
-        .def("state", &Sim::state, py::call_guard<py::gil_scoped_release>(), "A DmacSimState snapshot.")
+        .def("state", &Sim::state, py::call_guard<py::gil_scoped_release>(), "A SimState snapshot.")
         .def("read", [](Sim& s, const std::string& var) { return s.read(var_arg(var)); }, py::arg("variable"),
              py::call_guard<py::gil_scoped_release>())
         .def_property_readonly("address", &Sim::address)
@@ -251,7 +251,7 @@ static void bind_dmac_sim(py::module_& m) {
 
 static void bind_dmac_client(py::module_& m) {
     // ---- client --------------------------------------------------------------------
-    Record<ClientCounters>(m, "DmacClientCounters", "DmacClient counters (DmacClient.counters), read-only.")
+    Record<ClientCounters>(m, "ClientCounters", "Client counters (Client.counters), read-only.")
         .field("transactions", &ClientCounters::transactions)
         .field("stray_lines", &ClientCounters::stray_lines, "lines that were not the awaited reply (late, misrouted)")
         .field("xon_errors", &ClientCounters::xon_errors, "MOVE_INTERPOL refused: FIFO full")
@@ -266,7 +266,7 @@ static void bind_dmac_client(py::module_& m) {
         };
     };
     auto wo = [](auto f) { return dmac_setter(f); };
-    py::class_<C, std::shared_ptr<C>> cls(m, "DmacClient",
+    py::class_<C, std::shared_ptr<C>> cls(m, "Client",
                                           "Typed DMAC commands over a LineLink (one client per module address).");
     cls.def(py::init([](std::shared_ptr<serial::LineLink> link, int address, int baud, bool verify,
                          const py::object& timeout, const py::object& sleep) {
@@ -298,7 +298,7 @@ static void bind_dmac_client(py::module_& m) {
                  py::gil_scoped_release nogil;
                  return c.read(var, rx);
              }, py::arg("variable"), py::arg("radix") = Radix::Dec,
-             "READ a variable; radix is a DmacRadix or 'dec'/'hex'/'bin' (default DmacRadix.DEC).")
+             "READ a variable; radix is a Radix or 'dec'/'hex'/'bin' (default Radix.DEC).")
         .def("read_bit", [](C& c, const std::string& v, int bit) { return c.read_bit(var_arg(v), bit); },
              py::arg("variable"), py::arg("bit"), rel)
         .def("write", [](C& c, const std::string& v, std::int32_t x) { c.write(var_arg(v), x); }, py::arg("variable"),
@@ -408,7 +408,7 @@ static void bind_dmac_client_commands(py::class_<Client, std::shared_ptr<Client>
         .def("module_reset", &C::module_reset, py::arg("factory") = false, rel)
         .def("set_address", &C::set_address, py::arg("address"), rel)
         .def("set_baudrate", &C::set_baudrate, py::arg("baud"), rel)
-        .def("request_version", &C::request_version, rel, "REQUEST_VERSION, parsed into a DmacVersionInfo.")
+        .def("request_version", &C::request_version, rel, "REQUEST_VERSION, parsed into a VersionInfo.")
         .def("wait_idle", [](C& c, const py::object& timeout, const py::object& poll) {
             using namespace motorbus::py_helpers;
             auto t = duration_arg(timeout, "timeout", Forever::Allowed);
@@ -430,20 +430,20 @@ static void bind_dmac_client_commands(py::class_<Client, std::shared_ptr<Client>
 
 static void bind_dmac_streaming(py::module_& m) {
     using C = Client;
-    m.def("dmac_synchro", [](std::shared_ptr<serial::LineLink> link, const EnumOrName<Keyword>& what) {
+    m.def("synchro", [](std::shared_ptr<serial::LineLink> link, const EnumOrName<Keyword>& what) {
         Keyword k = enum_arg<Keyword>(what);
         py::gil_scoped_release nogil;
         synchro(*link, k);
     }, py::arg("link"), py::arg("what"), "Global SYNCHRO ON|OFF|TOP|INTERPOL (no reply).");
 
-    Record<StreamStats>(m, "DmacStreamStats", "What dmac_stream_interpolation did, read-only.")
+    Record<StreamStats>(m, "StreamStats", "What stream_interpolation did, read-only.")
         .field("segments", &StreamStats::segments, "segments queued per axis")
         .field("frames", &StreamStats::frames, "MOVE_INTERPOL frames sent (all axes, retries included)")
         .field("xon_errors", &StreamStats::xon_errors, "refusals on a full FIFO")
         .field("min_level_after_start", &StreamStats::min_level_after_start,
                "lowest FIFO level seen once moving (0 = underrun)")
         .field("underruns", &StreamStats::underruns, "times an axis reported an empty FIFO before the end");
-    m.def("dmac_stream_interpolation",
+    m.def("stream_interpolation",
           [](std::vector<std::shared_ptr<C>> axes, const std::vector<std::vector<long long>>& segments,
              int interpol_time_ms, int fifo_size, const py::object& sleep, const py::object& backoff) {
               std::vector<C*> raw;
@@ -466,7 +466,7 @@ static void bind_dmac_streaming(py::module_& m) {
 
     // A PollSource reading `names` (e.g. ["POSITION", "SPEED", "STATUS"]) each sample,
     // with a client of its own on the drive's LineLink (motorbus.Poller).
-    m.def("dmac_poll_source",
+    m.def("poll_source",
           [](std::shared_ptr<serial::LineLink> link, int address, std::vector<std::string> names, int baud,
              const py::object& timeout) -> std::shared_ptr<poll::Source> {
               motorbus::py_helpers::not_none(link, "link");

@@ -22,11 +22,11 @@ namespace {
 }  // namespace
 
 void bind_pmc007(py::module_& m) {
-    m.def("pmc007_gear_acceleration", &gear_acceleration, py::arg("gear"));
-    m.def("pmc007_microsteps", &microsteps, py::arg("setting"));
-    m.def("pmc007_convert_position", &convert_position, py::arg("position"), py::arg("from_setting"),
+    m.def("gear_acceleration", &gear_acceleration, py::arg("gear"));
+    m.def("microsteps", &microsteps, py::arg("setting"));
+    m.def("convert_position", &convert_position, py::arg("position"), py::arg("from_setting"),
           py::arg("to_setting"));
-    py::class_<ProfileParams>(m, "Pmc007ProfileParams")
+    py::class_<ProfileParams>(m, "ProfileParams")
         .def(py::init([](double speed, double start_speed, double stop_speed, int ag, int dg, int micro) {
                  ProfileParams p{speed, start_speed, stop_speed, ag, dg, micro};
                  p.validate();
@@ -40,22 +40,22 @@ void bind_pmc007(py::module_& m) {
         .def_readwrite("accel_gear", &ProfileParams::accel_gear)
         .def_readwrite("decel_gear", &ProfileParams::decel_gear)
         .def_readwrite("microstepping", &ProfileParams::microstepping);
-    m.def("pmc007_position_profile", &position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
-    m.def("pmc007_speed_profile", &speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
+    m.def("position_profile", &position_profile, py::arg("start"), py::arg("target"), py::arg("params"));
+    m.def("speed_profile", &speed_profile, py::arg("start"), py::arg("speed"), py::arg("params"),
           py::arg("hold") = 0.0);
 
     // ---- the object dictionary table ----
     // Handed up as the typed dictionary itself (canopen.ObjectDictionary: types, access,
     // limits, defaults and the C++ codecs of each entry): the host profile (Pmc007)
     // reads and writes by it; nothing about a type is said again in Python.
-    m.def("pmc007_object_dictionary", [](std::uint8_t node_id) { return build_pmc007_od(node_id); },
+    m.def("object_dictionary", [](std::uint8_t node_id) { return build_pmc007_od(node_id); },
           py::arg("node_id") = 5,
           "The PMC007 dictionary (every row of the table), defaults evaluated for `node_id`.");
-    py::enum_<Storage>(m, "Pmc007Storage", "How an object behaves over reset node / power-up (B-P37).")
+    py::enum_<Storage>(m, "Storage", "How an object behaves over reset node / power-up (B-P37).")
         .value("ROM", Storage::Rom, "saved to flash by 2007h = 2, reloaded at reset node")
         .value("RAM", Storage::Ram, "back to the default at reset node / power-up")
         .value("CONST", Storage::Const, "never changes");
-    m.def("pmc007_storage", [](std::uint16_t index, std::uint8_t sub) {
+    m.def("storage", [](std::uint16_t index, std::uint8_t sub) {
               const OdRow* r = od_row(index, sub);
               if (!r) {
                   char where[16];
@@ -64,17 +64,17 @@ void bind_pmc007(py::module_& m) {
               }
               return r->storage;
           }, py::arg("index"), py::arg("subindex") = 0, "The table's storage class of one object (B-P37).");
-    m.def("pmc007_eds", &eds, "The EDS text generated from the table (node-ID as $NODEID).");
+    m.def("eds", &eds, "The EDS text generated from the table (node-ID as $NODEID).");
 
     // ---- offline program codec ----
-    m.def("pmc007_assemble", [](const std::string& text) { return assemble(text); }, py::arg("text"),
+    m.def("assemble", [](const std::string& text) { return assemble(text); }, py::arg("text"),
           "Mnemonic text -> 32-bit words (the spec's reading of the encoding).");
-    m.def("pmc007_disassemble", [](const std::vector<std::uint32_t>& w) { return disassemble(w); }, py::arg("words"));
+    m.def("disassemble", [](const std::vector<std::uint32_t>& w) { return disassemble(w); }, py::arg("words"));
 
     // ---- the simulator ----
     auto rel = py::call_guard<py::gil_scoped_release>();
     // attach / close / attached / describe / power_cycle: the SimulatedDevice base's.
-    py::class_<Sim, can::SimulatedDevice, std::shared_ptr<Sim>>(m, "Pmc007Sim",
+    py::class_<Sim, can::SimulatedDevice, std::shared_ptr<Sim>>(m, "Sim",
                                                               "A simulated CQPUSI PMC007 CANopen node (see sim.hpp).")
         .def(py::init([](int node_id, std::shared_ptr<Clock> clock, double steps_per_rev, double pull_out_speed,
                          std::optional<std::pair<double, double>> ext1_switch, std::string store_path,

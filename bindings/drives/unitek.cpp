@@ -97,19 +97,19 @@ py::tuple stream_read(StreamView& v, std::int64_t max) {
 }  // namespace
 
 static void bind_unitek_errors_and_profile(py::module_& m) {
-    py_errors::add_error_classes(m, {
+    py_errors::add_error_classes({
         {"UnitekFrameError", {"ProtocolError"},
          "A UNITEK frame that breaks the protocol (wrong DLC...); .byte is the 0-based index of the byte at fault, .data the frame."},
         {"UnitekUnknownRegister", {"InvalidArgument", "KeyError"},
          "A REGID the register table does not know (extend it from the NDrive list); .regid."},
         {"UnitekCyclicLimit", {"InvalidArgument"}, "A 9th cyclic register: the drive transmits at most 8 (002 ex 9)."},
     });
-    py_errors::translate<UnknownRegister, fill_unknown>(m.attr("UnitekUnknownRegister"));
-    py_errors::translate<CyclicLimit>(m.attr("UnitekCyclicLimit"));
-    py_errors::translate<FrameError, fill_frame_error>(m.attr("UnitekFrameError"));
+    py_errors::translate<UnknownRegister, fill_unknown>(py_errors::error_class("UnitekUnknownRegister"));
+    py_errors::translate<CyclicLimit>(py_errors::error_class("UnitekCyclicLimit"));
+    py_errors::translate<FrameError, fill_frame_error>(py_errors::error_class("UnitekFrameError"));
 
     // ---- profile (existing) ----
-    py::class_<RampParams>(m, "UnitekRampParams")
+    py::class_<RampParams>(m, "RampParams")
         .def(py::init([](double nmax, double acc, double dec) {
                  RampParams p{nmax, acc, dec};
                  p.validate();
@@ -119,18 +119,18 @@ static void bind_unitek_errors_and_profile(py::module_& m) {
         .def_readwrite("n_max_rpm", &RampParams::n_max_rpm)
         .def_readwrite("acc_ramp_ms", &RampParams::acc_ramp_ms)
         .def_readwrite("dec_ramp_ms", &RampParams::dec_ramp_ms);
-    m.def("unitek_speed_profile", &speed_profile, py::arg("start"), py::arg("speed_num"), py::arg("params"),
+    m.def("speed_profile", &speed_profile, py::arg("start"), py::arg("speed_num"), py::arg("params"),
           py::arg("hold") = 0.0);
 }
 
 static void bind_unitek_registers(py::module_& m) {
     // ---- register table ----
-    py::enum_<Access>(m, "UnitekAccess")
+    py::enum_<Access>(m, "Access")
         .value("RW", Access::ReadWrite).value("RO", Access::ReadOnly).value("WO", Access::WriteOnly);
-    py::enum_<Quantity>(m, "UnitekQuantity")
+    py::enum_<Quantity>(m, "Quantity")
         .value("RAW", Quantity::Raw).value("SPEED", Quantity::Speed).value("POSITION", Quantity::Position)
         .value("CURRENT", Quantity::Current).value("TORQUE", Quantity::Torque).value("TIME", Quantity::Time);
-    py::class_<Register>(m, "UnitekRegister", "One row of the UNITEK register table.")
+    py::class_<Register>(m, "Register", "One row of the UNITEK register table.")
         .def(py::init([](std::int64_t regid, std::string name, int bits, bool is_signed, Access access,
                          Quantity quantity, std::string unit, double scale, std::optional<std::int64_t> lo,
                          std::optional<std::int64_t> hi, std::string description) {
@@ -177,7 +177,7 @@ static void bind_unitek_registers(py::module_& m) {
             return "<UnitekRegister 0x" + hex(std::vector<std::uint8_t>{r.regid}) + " " + r.name + " " +
                    std::to_string(r.bits) + "-bit>";
         });
-    py::class_<RegisterTable>(m, "UnitekRegisterTable", "The UNITEK REGIDs: the 12 documented ones, extendable.")
+    py::class_<RegisterTable>(m, "RegisterTable", "The UNITEK REGIDs: the 12 documented ones, extendable.")
         .def(py::init([](bool builtin) { return builtin ? RegisterTable::builtin() : RegisterTable{}; }),
              py::arg("builtin") = true)
         .def("add", &RegisterTable::add, py::arg("register"))
@@ -193,7 +193,7 @@ static void bind_unitek_registers(py::module_& m) {
         .def("__len__", &RegisterTable::size)
         .def("rows", &RegisterTable::rows);
 
-    py::class_<Scalings>(m, "UnitekScalings", "§6.1 scalings: N max, 65536 num/rev, device current.")
+    py::class_<Scalings>(m, "Scalings", "§6.1 scalings: N max, 65536 num/rev, device current.")
         .def(py::init([](double n, double c, double inum, double ia) {
                  Scalings s{n, c, inum, ia};
                  s.validate();
@@ -207,7 +207,7 @@ static void bind_unitek_registers(py::module_& m) {
         .def_readonly("i_max_a", &Scalings::i_max_a)
         .def("to_physical", &Scalings::to_physical, py::arg("register"), py::arg("num"))
         .def("to_num", &Scalings::to_num, py::arg("register"), py::arg("value"));
-    m.def("unitek_device_currents", [] {
+    m.def("device_currents", [] {
         py::list out;
         for (const auto& d : device_currents())
             out.append(py::dict(py::arg("device") = d.device, py::arg("i100_mv") = d.i100_mv,
@@ -216,45 +216,45 @@ static void bind_unitek_registers(py::module_& m) {
                                 py::arg("i_max_a") = d.i_max_a));
         return out;
     });
-    m.def("unitek_continuous_current_num", [](const std::string& device, double amps) {
+    m.def("continuous_current_num", [](const std::string& device, double amps) {
         return continuous_current_num(device_current(device), amps);
     }, py::arg("device"), py::arg("amps"));
-    m.def("unitek_effective_current_limit_num", [](const std::string& device, std::int64_t motor_limit_num) {
+    m.def("effective_current_limit_num", [](const std::string& device, std::int64_t motor_limit_num) {
         return effective_current_limit_num(device_current(device), motor_limit_num);
     }, py::arg("device"), py::arg("motor_limit_num"),
        "§6.1: the smaller of the motor's and the device's peak current (num)");
-    m.def("unitek_bit_timings", [] {
+    m.def("bit_timings", [] {
         py::list out;
         for (const auto& b : bit_timings())
             out.append(py::dict(py::arg("kbit_s") = b.kbit_s, py::arg("btr") = b.btr,
                                 py::arg("max_line_m") = b.max_line_m));
         return out;
     }, "§3.1: bit rate (kbit/s), BTR setting value, longest line (m)");
-    m.def("unitek_btr_for_bit_rate", [](double bit_s) { return bit_timing_for_bit_rate(bit_s).btr; },
+    m.def("btr_for_bit_rate", [](double bit_s) { return bit_timing_for_bit_rate(bit_s).btr; },
           py::arg("bit_rate"));
-    m.def("unitek_bit_rate_for_btr", [](std::int64_t btr) {
+    m.def("bit_rate_for_btr", [](std::int64_t btr) {
         if (btr < 0 || btr > 0xFFFF) throw InvalidArgument("unitek BTR: a 16-bit setting value");
         return bit_timing_for_btr(static_cast<std::uint16_t>(btr)).bit_rate();
     }, py::arg("btr"));
-    m.def("unitek_analog_command_num", &analog_command_num, py::arg("volts"),
+    m.def("analog_command_num", &analog_command_num, py::arg("volts"),
           "§6.1: the num of an analog command (10 V = 29490)");
-    m.def("unitek_sim_default_table", &sim_default_table);
+    m.def("sim_default_table", &sim_default_table);
 }
 
 static void bind_unitek_codec(py::module_& m) {
     // ---- codec ----
-    m.def("unitek_encode_write", [](std::int64_t regid, std::int64_t value, int bits) {
+    m.def("encode_write", [](std::int64_t regid, std::int64_t value, int bits) {
         return to_bytes(encode_write(regid_arg(regid), value, bits));
     }, py::arg("regid"), py::arg("value"), py::arg("bits") = 16);
-    m.def("unitek_encode_request", [](std::int64_t regid, std::int64_t interval) {
+    m.def("encode_request", [](std::int64_t regid, std::int64_t interval) {
         if (interval < 0 || interval > 255) throw InvalidArgument("interval: 0 (once), 1..254 ms, 255 (stop)");
         return to_bytes(encode_request(regid_arg(regid), static_cast<std::uint8_t>(interval)));
     }, py::arg("regid"), py::arg("interval"));
-    m.def("unitek_decode_to_drive", [](const py::object& data) {
+    m.def("decode_to_drive", [](const py::object& data) {
         const auto t = decode_to_drive(bytes_of(data, "data"));
         return py::make_tuple(t.regid, t.value, t.value_bits);
     }, py::arg("data"), "(regid, raw value, bits) as the drive evaluates the frame; UnitekFrameError for DLC < 3 or > 8");
-    m.def("unitek_decode_from_drive", [](const py::object& data) {
+    m.def("decode_from_drive", [](const py::object& data) {
         const auto f = decode_from_drive(bytes_of(data, "data"));
         return py::make_tuple(f.regid, f.value, f.value_bits);
     }, py::arg("data"), "(regid, raw value, bits) of a frame from the drive; UnitekFrameError unless DLC 4 or 6");
@@ -262,7 +262,7 @@ static void bind_unitek_codec(py::module_& m) {
 
 static void bind_unitek_client(py::module_& m) {
     // ---- client ----
-    py::class_<StreamView, std::shared_ptr<StreamView>>(m, "UnitekStream",
+    py::class_<StreamView, std::shared_ptr<StreamView>>(m, "Stream",
         "One cyclic register: a ring of (timestamp ns, value num) filled by the bus thread.")
         .def_property_readonly("regid", [](const StreamView& v) { return v.s->regid; })
         .def_property_readonly("interval_ms", [](const StreamView& v) { return v.s->interval_ms.load(); })
@@ -285,13 +285,13 @@ static void bind_unitek_client(py::module_& m) {
                                              v.s->ring.values(), self);
         });
 
-    py::class_<ClientCounters>(m, "UnitekClientCounters")
+    py::class_<ClientCounters>(m, "ClientCounters")
         .def_readonly("replies", &ClientCounters::replies)
         .def_readonly("rejected", &ClientCounters::rejected)
         .def_readonly("unsolicited", &ClientCounters::unsolicited)
         .def_readonly("callback_errors", &ClientCounters::callback_errors);
 
-    py::class_<ClientHolder>(m, "UnitekClient", "UNITEK register protocol client over a CAN bus (see client.hpp).")
+    py::class_<ClientHolder>(m, "Client", "UNITEK register protocol client over a CAN bus (see client.hpp).")
         .def(py::init([](std::shared_ptr<can::Bus> bus, std::uint32_t rx_id, std::uint32_t tx_id, const py::object& timeout,
                          std::optional<RegisterTable> table, std::shared_ptr<Clock> clock) {
                  if (!bus) throw InvalidArgument("bus: None (a motorbus Bus is required)");
@@ -386,7 +386,7 @@ static void bind_unitek_client(py::module_& m) {
 
 static void bind_unitek_sim(py::module_& m) {
     // ---- simulator ----
-    py::class_<SimCounters>(m, "UnitekSimCounters")
+    py::class_<SimCounters>(m, "SimCounters")
         .def_readonly("frames_in", &SimCounters::frames_in)
         .def_readonly("ignored", &SimCounters::ignored)
         .def_readonly("malformed", &SimCounters::malformed)
@@ -399,7 +399,7 @@ static void bind_unitek_sim(py::module_& m) {
 
     // attach / close / attached / describe / power_cycle: the SimulatedDevice base's.
     py::class_<Sim, can::SimulatedDevice, std::shared_ptr<Sim>>(
-        m, "UnitekSim", "A simulated UNITEK servo on the register protocol (see sim.hpp).")
+        m, "Sim", "A simulated UNITEK servo on the register protocol (see sim.hpp).")
         .def(py::init([](std::shared_ptr<Clock> clock, std::uint32_t rx_id, std::uint32_t tx_id, double n_max_rpm,
                          double acc_ramp_ms, double dec_ramp_ms, bool position_control, bool speed_control,
                          bool calibrated, std::int64_t tol_num, std::optional<double> minus_limit_num,
@@ -522,19 +522,19 @@ static void bind_unitek_poll(py::module_& m) {
         for (auto id : ids) r.push_back(regid_arg(id));
         return r;
     };
-    m.def("unitek_poll_source", [regids_arg](ClientHolder& h, const std::vector<std::int64_t>& regids) -> std::shared_ptr<poll::Source> {
+    m.def("poll_source", [regids_arg](ClientHolder& h, const std::vector<std::int64_t>& regids) -> std::shared_ptr<poll::Source> {
               auto r = regids_arg(regids);
               return std::make_shared<PollSource>(*h.client, std::move(r));
           }, py::arg("client"), py::arg("regids"), py::keep_alive<0, 1>(),
           "A PollSource reading each register (3D REGID 00) every sample.");
     py::class_<CaptureSource, poll::Source, std::shared_ptr<CaptureSource>>(
-        m, "UnitekCaptureSource",
+        m, "CaptureSource",
         "A PollSource taking the latest cyclic transmission of each register (columns: arrival ns, values).")
         .def_property_readonly("interval_ms", &CaptureSource::interval_ms)
         .def_property_readonly("max_age", [](const CaptureSource& s) { return s.max_age_ns() / 1e9; })
         .def("close", &CaptureSource::close, py::call_guard<py::gil_scoped_release>(),
              "Stops the cyclic transmissions this source started (idempotent).");
-    m.def("unitek_capture_source", [regids_arg](ClientHolder& h, const std::vector<std::int64_t>& regids,
+    m.def("capture_source", [regids_arg](ClientHolder& h, const std::vector<std::int64_t>& regids,
                                                 int interval_ms, const py::object& max_age) {
               auto r = regids_arg(regids);
               const Nanos age = max_age.is_none() ? 0 : duration_arg(max_age, "max_age").count();

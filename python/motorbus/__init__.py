@@ -2,19 +2,10 @@
 from __future__ import annotations
 
 from ._core import (  # noqa: F401
-    Bus,
-    ExternalBus,
-    VirtualBus,
-    ClosedError,
-    DriveFault,
-    Frame,
-    InvalidArgument,
-    LinkDown,
-    MotorbusError,
-    ProtocolError,
-    TimeoutError,
-    monotonic_ns,
+    ClosedError, DriveFault, InvalidArgument, LinkDown, MotorbusError, ProtocolError, TimeoutError,
 )
+from ._core.can import Bus, ExternalBus, VirtualBus, Frame  # noqa: F401
+from ._core.runtime import monotonic_ns  # noqa: F401
 
 from .bus import open_bus  # noqa: E402,F401
 from .log import LogEntry, Recorder, play, read_log  # noqa: E402,F401

@@ -680,7 +680,7 @@ class Bench:
             for a in axes:
                 devices.append(self._make_sim(a, clock))
                 self.sims[a.name] = devices[-1]
-            server = _core.PtyLineServer(devices=devices, baud=0)
+            server = _core.serial.PtyLineServer(devices=devices, baud=0)
             self._servers.append(server)
             self.served_lines[line_name] = server
             cfg["port"] = server.slave_path
@@ -778,7 +778,7 @@ class Bench:
             plugin = registry.drive_plugin(axes[0].kind)
             baud = cfg.get("baud", plugin.default_baud)
             try:
-                port = _core.open_port(cfg["port"], baud)
+                port = _core.serial.open_port(cfg["port"], baud)
             except _core.InvalidArgument as e:
                 raise self._fail(str(e), "line", name, "port") from None
             except (TypeError, ValueError, OverflowError) as e:
@@ -786,8 +786,8 @@ class Bench:
             except _core.MotorbusError as e:
                 raise _with_context(e, f"{self._where('line', name, 'port')}: line {name!r}") from e
             settings = dict(plugin.line_settings or {})
-            self.lines[name] = _core.LineLink(port, reply_timeout=cfg["timeout"], turnaround=cfg["turnaround"],
-                                              **settings)
+            self.lines[name] = _core.serial.LineLink(port, reply_timeout=cfg["timeout"], turnaround=cfg["turnaround"],
+                                                     **settings)
 
     def _open_axis(self, cfg: AxisConfig) -> Drive:
         plugin = registry.drive_plugin(cfg.kind)

@@ -168,11 +168,11 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
         for old in _candumps(candump, len(bench.buses)):
             os.remove(old)   # a log left by an earlier run must not be listed as this run's
         report = None
-        t_cmd = _core.monotonic_ns() / 1e9
+        t_cmd = _core.runtime.monotonic_ns() / 1e9
         with (Poller(pollable, fields=("position",), rate_hz=RATE_HZ, candump=candump) if pollable
               else contextlib.nullcontext()) as poller:
             time.sleep(0.05)
-            t_cmd = _core.monotonic_ns() / 1e9
+            t_cmd = _core.runtime.monotonic_ns() / 1e9
             if movers:
                 try:
                     report = bench.move_together(targets, wait=False)

@@ -44,7 +44,7 @@ def parse_spec(spec: str) -> tuple[str, dict[str, Any]]:
         raise _core.InvalidArgument(f"bus spec {spec!r}: {e}") from None
 
 
-def open_bus(spec: Any, **options: Any) -> _core.Bus:
+def open_bus(spec: Any, **options: Any) -> _core.can.Bus:
     """Open a bus from a spec string or wrap a python-can bus. See the module doc."""
     if not isinstance(spec, str):
         return _bridge(spec, **options)
@@ -58,20 +58,20 @@ def _parse_virtual(rest: str) -> dict[str, Any]:
 
 #: ``virtual:NAME``: every bus opened with one NAME in this process is one CAN bus.
 VIRTUAL = registry.BusScheme("virtual", "in-process hub: wire time at a bit rate, arbitration, fault injection",
-                             parse=_parse_virtual, open=_core.open_virtual, example="virtual:bench")
+                             parse=_parse_virtual, open=_core.can.open_virtual, example="virtual:bench")
 
 
 # ---------------------------------------------------------------------------
 # python-can -> motorbus
 
-def message_to_frame(msg: Any) -> _core.Frame:
+def message_to_frame(msg: Any) -> _core.can.Frame:
     """python-can Message -> Frame (validated)."""
     if msg.is_remote_frame:
-        return _core.Frame(msg.arbitration_id, b"", extended=msg.is_extended_id, rtr=True, dlc=msg.dlc)
-    return _core.Frame(msg.arbitration_id, bytes(msg.data), extended=msg.is_extended_id)
+        return _core.can.Frame(msg.arbitration_id, b"", extended=msg.is_extended_id, rtr=True, dlc=msg.dlc)
+    return _core.can.Frame(msg.arbitration_id, bytes(msg.data), extended=msg.is_extended_id)
 
 
-def frame_to_message(frame: _core.Frame, channel: Any = None) -> Any:
+def frame_to_message(frame: _core.can.Frame, channel: Any = None) -> Any:
     """Frame -> python-can Message (timestamp in epoch seconds, as python-can uses)."""
     import can
 
@@ -95,7 +95,7 @@ class _Bridge:
         self._pc = pcbus
         self._poll = poll
         self._stop = threading.Event()
-        self.bus = _core.ExternalBus(
+        self.bus = _core.can.ExternalBus(
             channel=f"python-can:{getattr(pcbus, 'channel_info', type(pcbus).__name__)}",
             send=self._send,
             close=self._close,
@@ -104,7 +104,7 @@ class _Bridge:
         self._thread = threading.Thread(target=self._reader, name="motorbus-python-can-bridge", daemon=True)
         self._thread.start()
 
-    def _send(self, frame: _core.Frame, timeout: float) -> None:
+    def _send(self, frame: _core.can.Frame, timeout: float) -> None:
         import can
 
         try:
@@ -126,7 +126,7 @@ class _Bridge:
             except _core.InvalidArgument:
                 self.bus.feed_parse_error()
                 continue
-            frame.timestamp_ns = _core.monotonic_ns()
+            frame.timestamp_ns = _core.runtime.monotonic_ns()
             self.bus.feed(frame)
 
     def _close(self) -> None:
@@ -135,7 +135,7 @@ class _Bridge:
             self._thread.join()
 
 
-def _bridge(pcbus: Any, poll: float = 0.01, receive_own: bool = False) -> _core.Bus:
+def _bridge(pcbus: Any, poll: float = 0.01, receive_own: bool = False) -> _core.can.Bus:
     import can
 
     if not isinstance(pcbus, can.BusABC):

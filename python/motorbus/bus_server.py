@@ -44,25 +44,25 @@ class BusServers:
         self.spec = spec
         self.channel = channel
         self._options = bus_options
-        self._shared: Optional[_core.Bus] = None if scheme == "virtual" else open_bus(spec, **bus_options)
-        self._buses: list[_core.Bus] = []
+        self._shared: Optional[_core.can.Bus] = None if scheme == "virtual" else open_bus(spec, **bus_options)
+        self._buses: list[_core.can.Bus] = []
         self.servers: list[Any] = []
         self._lines: list[str] = []
         try:
             for text in socketcand:
                 host, port = parse_host_port(text)
-                srv = _core.SocketcandServer(self.endpoint(), host=host, port=port, channel=channel)
+                srv = _core.can.SocketcandServer(self.endpoint(), host=host, port=port, channel=channel)
                 self.servers.append(srv)
                 self._lines.append(f"socketcand {srv.host}:{srv.port} {channel}")
             for _ in range(int(slcan_ptys)):
-                srv = _core.SlcanServer(self.endpoint())
+                srv = _core.can.SlcanServer(self.endpoint())
                 self.servers.append(srv)
                 self._lines.append(f"slcan {srv.pty_path}")
         except Exception:
             self.close()
             raise
 
-    def endpoint(self) -> _core.Bus:
+    def endpoint(self) -> _core.can.Bus:
         """A bus endpoint on the served bus (closed with the servers)."""
         if self._shared is not None:
             return self._shared

@@ -76,7 +76,7 @@ def _report(servers: Any) -> None:
 
 def cmd_bus_dump(args: argparse.Namespace) -> int:
     bus = open_bus(args.spec)
-    rec = _core.Recorder(bus, args.log) if args.log else None
+    rec = _core.can.Recorder(bus, args.log) if args.log else None
     n = 0
     try:
         while args.count == 0 or n < args.count:
@@ -95,9 +95,9 @@ def cmd_bus_dump(args: argparse.Namespace) -> int:
 
 
 def cmd_bus_play(args: argparse.Namespace) -> int:
-    entries, bad = _core.read_log(args.file)
+    entries, bad = _core.can.read_log(args.file)
     with open_bus(args.spec) as bus:
-        n = _core.play(bus, entries, args.speed)
+        n = _core.can.play(bus, entries, args.speed)
     _say(f"played {n} frames ({bad} unreadable lines skipped)")
     return 0
 

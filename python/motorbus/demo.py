@@ -86,16 +86,16 @@ def can_bench(quick: bool, workdir: str) -> None:
     # In-process: a recorder on a virtual bus with wire time, and the log read back.
     log = os.path.join(workdir, "demo.log")
     with open_bus("virtual:demo", bitrate=500_000) as tx, open_bus("virtual:demo", bitrate=500_000) as rx:
-        with _core.Recorder(rx, log) as rec:
+        with _core.can.Recorder(rx, log) as rec:
             t0 = time.monotonic()
             for i in range(100):
-                tx.send(_core.Frame(0x200 + (i % 8), bytes(8)))
+                tx.send(_core.can.Frame(0x200 + (i % 8), bytes(8)))
             for _ in range(100):
                 rx.recv(2.0)
             dt = time.monotonic() - t0
         print(f"  100 frames on a 500 kbit/s virtual bus took {dt * 1000:.1f} ms "
               f"(theory {100 * 135 / 500:.1f} ms); recorded {rec.count} frames to {log}")
-    entries, bad = _core.read_log(log)
+    entries, bad = _core.can.read_log(log)
     print(f"  read back {len(entries)} frames ({bad} bad lines): {entries[0]!r} ...")
 
 
@@ -113,7 +113,7 @@ def canopen_bench(quick: bool, workdir: str) -> None:
     od.add_variable(0x1F50, "Program", "DOMAIN", "rw", max_size=256 * 1024)
     with open_bus("virtual:co-demo") as node_side, open_bus("virtual:co-demo") as server_side:
         node = canopen.LocalNode(node_side, 5, od)
-        server = _core.SocketcandServer(server_side, host="127.0.0.1", port=0)
+        server = _core.can.SocketcandServer(server_side, host="127.0.0.1", port=0)
         try:
             with open_bus(f"socketcand:127.0.0.1:{server.port}/can0") as remote:
                 sdo = canopen.SdoClient(remote, 5, timeout=1.0)

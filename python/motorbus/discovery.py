@@ -141,9 +141,9 @@ def discover(lines: Sequence[str] = (), buses: Sequence[Any] = (), *, kinds: Opt
                     continue
                 bar.note(f"{port}: {plugin.kind} at {baud} baud, {len(plugin.probe_addresses)} addresses")
                 try:
-                    opened = _core.open_port(port, baud)
-                    link = _core.LineLink(opened, reply_timeout=reply_timeout + _wire_time(baud),
-                                          **(plugin.line_settings or {}))
+                    opened = _core.serial.open_port(port, baud)
+                    link = _core.serial.LineLink(opened, reply_timeout=reply_timeout + _wire_time(baud),
+                                                 **(plugin.line_settings or {}))
                 except _core.MotorbusError as e:
                     skipped.append(f"{port}: {e}")
                     break
@@ -167,7 +167,7 @@ def discover(lines: Sequence[str] = (), buses: Sequence[Any] = (), *, kinds: Opt
         label = spec if isinstance(spec, str) else getattr(bus, "channel", "bus")
         try:
             if canopen and time.monotonic() < deadline:
-                nodes = _core.scan_network(bus, sdo_timeout=sdo_timeout, listen=0.0)
+                nodes = _core.canopen.scan_network(bus, sdo_timeout=sdo_timeout, listen=0.0)
                 bar.step(f"{label}: CANopen scan, {len(nodes)} node(s)")
                 bar.note(f"{label}: CANopen scan found node(s) {[n.node for n in nodes]}")
                 for node in nodes:

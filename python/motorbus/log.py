@@ -7,6 +7,6 @@
 
 python-can's ``can.LogReader`` reads these files back frame for frame.
 """
-from ._core import LogEntry, Recorder, parse_candump_line, play, read_log
+from ._core.can import LogEntry, Recorder, parse_candump_line, play, read_log
 
 __all__ = ["LogEntry", "Recorder", "parse_candump_line", "play", "read_log"]

@@ -16,37 +16,13 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from ._core import (  # noqa: F401
-    Cia402Homing,
-    Cia402HomingParams,
-    Cia402ProfileParams,
-    Cia402ProfilePosition,
-    InvalidArgument,
-    LimitExceeded,
-    Limits,
-    MotionState,
-    MotorConfig,
-    MotorEvent,
-    MotorEventKind,
-    MotorModel,
-    Profile,
-    RampShape,
-    SnlActivity,
-    SnlConfig,
-    StepNLoop,
-    SwitchConfig,
-    cia402_position_profile,
-    cia402_quick_stop_profile,
-    cia402_velocity_profile,
-    jerk_limited_durations,
-    plan_jerk_limited,
-    plan_jerk_limited_velocity,
-    plan_straight_line,
-    plan_synchronized,
-    plan_synchronized_jerk_limited,
-    plan_trapezoid,
-    plan_velocity,
-    split_interpolation,
+from ._core import InvalidArgument, LimitExceeded  # noqa: F401
+from ._core.motion import (  # noqa: F401
+    Cia402Homing, Cia402HomingParams, Cia402ProfileParams, Cia402ProfilePosition, Limits, MotionState, MotorConfig,
+    MotorEvent, MotorEventKind, MotorModel, Profile, RampShape, SnlActivity, SnlConfig, StepNLoop, SwitchConfig,
+    cia402_position_profile, cia402_quick_stop_profile, cia402_velocity_profile, jerk_limited_durations,
+    plan_jerk_limited, plan_jerk_limited_velocity, plan_straight_line, plan_synchronized,
+    plan_synchronized_jerk_limited, plan_trapezoid, plan_velocity, split_interpolation,
     synchronized_jerk_limited_durations,
 )
 

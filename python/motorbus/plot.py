@@ -187,13 +187,13 @@ def _crc15(bits: Sequence[int]) -> int:
 def frame_bits(frame: Any, stuffing: str = "worst") -> int:
     """Bits a classic CAN frame takes on the wire, with the 3-bit intermission.
 
-    ``stuffing="worst"``: the worst case for its length (``_core.wire_bits_worst_case``,
+    ``stuffing="worst"``: the worst case for its length (``_core.can.wire_bits_worst_case``,
     what the virtual bus's timing uses): 47 + 8n bits + (34 + 8n - 1) // 4 stuff bits
     for a standard id, 67 + 8n + (54 + 8n - 1) // 4 extended.  ``"exact"``: the stuff
     bits this frame's own bit stream needs (its id, data and CRC-15); ``"none"``:
     no stuff bits."""
     if stuffing == "worst":
-        return int(_core.wire_bits_worst_case(frame))
+        return int(_core.can.wire_bits_worst_case(frame))
     if stuffing not in ("exact", "none"):
         raise _core.InvalidArgument(f"frame_bits stuffing: 'worst', 'exact' or 'none', not {stuffing!r}")
     data = b"" if frame.rtr else bytes(frame.data)
@@ -225,7 +225,7 @@ def frame_bits(frame: Any, stuffing: str = "worst") -> int:
 
 def _timed_frames(source: Any) -> list[tuple[float, Any]]:
     if isinstance(source, (str, os.PathLike)):
-        entries, _bad = _core.read_log(os.fspath(source))
+        entries, _bad = _core.can.read_log(os.fspath(source))
         return [(float(e.time), e.frame) for e in entries]
     out = []
     for item in source:

@@ -200,14 +200,14 @@ class Poller:
         if self._started:
             raise _core.InvalidArgument("Poller: already started (make a new Poller to poll again)")
         self._started = True
-        self._t0_ns = _core.monotonic_ns() + max(_START_DELAY_NS, self.period_ns)
+        self._t0_ns = _core.runtime.monotonic_ns() + max(_START_DELAY_NS, self.period_ns)
         can_groups = [g for g in self._groups if g.bus is not None]
         try:
             for g in self._groups:
                 if self._candump and g.bus is not None:
-                    g.recorder = _core.Recorder(g.bus, _numbered(self._candump, can_groups.index(g)))
-                g.core = _core.PollGroup(g.sources, self.period_ns / 1e9, capacity=self._capacity,
-                                         spin=self._spin_ns / 1e9, realtime=self._realtime, start_ns=self._t0_ns)
+                    g.recorder = _core.can.Recorder(g.bus, _numbered(self._candump, can_groups.index(g)))
+                g.core = _core.poll.PollGroup(g.sources, self.period_ns / 1e9, capacity=self._capacity,
+                                              spin=self._spin_ns / 1e9, realtime=self._realtime, start_ns=self._t0_ns)
                 g.core.start()
         except BaseException:
             self.stop()

@@ -176,6 +176,6 @@ class MotorbusCanBus(can.BusABC):
         raise NotImplementedError("motorbus: the bus state cannot be set through python-can")
 
     @property
-    def motorbus_bus(self) -> _core.Bus:
+    def motorbus_bus(self) -> _core.can.Bus:
         """The underlying motorbus bus (counters, subscribe, ...)."""
         return self._bus

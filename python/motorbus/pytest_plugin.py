@@ -200,7 +200,7 @@ def _canopen_strings(bus: Any, node: int) -> dict:
     from . import _core
 
     out = {}
-    sdo = _core.SdoClient(bus, node, timeout=0.3)
+    sdo = _core.canopen.SdoClient(bus, node, timeout=0.3)
     try:
         for index, key in _CANOPEN_STRINGS:
             try:

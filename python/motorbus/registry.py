@@ -35,7 +35,7 @@ BUS_GROUP = "motorbus.bus"
 class PollSpec:
     """What a drive's ``poll_fields(fields)`` gives :class:`motorbus.Poller`.
 
-    * ``source``: a ``_core.PollSource`` (built on the kind's native C++ client)
+    * ``source``: a ``_core.poll.PollSource`` (built on the kind's native C++ client)
       that reads the fields, in the order asked, on the poll thread;
     * ``scales``: per field, the factor from the source's reading to the Drive's
       native units (the Poller then applies ``drive.units`` to position and velocity);

@@ -26,18 +26,9 @@ The classes' own docstrings are written once, in the extension (bindings/serial.
 """
 from __future__ import annotations
 
-from ._core import (  # noqa: F401
-    EchoLineDevice,
-    LineDevice,
-    LineLink,
-    Port,
-    PtyLineServer,
-    PtyPair,
-    ReplyTooLong,
-    Rfc2217Port,
-    TcpPort,
-    TtyPort,
-    open_port,
+from ._core import ReplyTooLong  # noqa: F401
+from ._core.serial import (  # noqa: F401
+    EchoLineDevice, LineDevice, LineLink, Port, PtyLineServer, PtyPair, Rfc2217Port, TcpPort, TtyPort, open_port,
 )
 
 __all__ = [

@@ -95,7 +95,7 @@ def serve_line(spec: str, baud: int = 0, clock: Any = None, store_dir: Optional[
     drives = [make_sim(plugin.kind, a, clock=clock, store_dir=store_dir, **options) for a in addresses]
     # A kind may wire the modules of one line together (e.g. a synchronisation chain on their I/Os).
     plugin.wire_line(drives)
-    server = _core.PtyLineServer(devices=drives, baud=baud)
+    server = _core.serial.PtyLineServer(devices=drives, baud=baud)
     server.enforce_baud = strict_baud
     return ServedLine(label=spec, server=server, drives=drives)
 
@@ -313,7 +313,7 @@ class BenchTwin:
         for a in axes:
             devices.append(self._make_sim(a, store_dir, clock))
             self.sims[a.name] = devices[-1]
-        server = _core.PtyLineServer(devices=devices, baud=baud)
+        server = _core.serial.PtyLineServer(devices=devices, baud=baud)
         server.enforce_baud = strict_baud
         self.lines[name] = ServedLine(label=name, server=server, drives=devices)
         link = os.path.join(self.link_dir, name)

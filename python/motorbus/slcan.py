@@ -11,8 +11,10 @@ See docs/slcan.md.
 from __future__ import annotations
 
 from . import _core, registry
-from ._core import (SlcanBus, SlcanDecoder, SlcanDecoderCounters, SlcanEvent, SlcanEventKind, SlcanServer,
-                    SlcanServerStats, SlcanStats, open_slcan, slcan_encode)
+from ._core.can import (
+    SlcanBus, SlcanDecoder, SlcanDecoderCounters, SlcanEvent, SlcanEventKind, SlcanServer, SlcanServerStats,
+    SlcanStats, open_slcan, slcan_encode,
+)
 
 __all__ = ["SlcanBus", "SlcanDecoder", "SlcanDecoderCounters", "SlcanEvent", "SlcanEventKind", "SlcanServer",
            "SlcanServerStats", "SlcanStats", "open_slcan", "slcan_encode",

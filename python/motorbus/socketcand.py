@@ -22,13 +22,8 @@ SocketCAN::
 from __future__ import annotations
 
 from . import _core, registry
-from ._core import (  # noqa: F401
-    SocketCanBus,
-    SocketcandBus,
-    SocketcandServer,
-    open_socketcan,
-    open_socketcand,
-    socketcan_unavailable_reason,
+from ._core.can import (  # noqa: F401
+    SocketCanBus, SocketcandBus, SocketcandServer, open_socketcan, open_socketcand, socketcan_unavailable_reason,
 )
 
 __all__ = [

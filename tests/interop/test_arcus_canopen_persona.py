@@ -44,7 +44,7 @@ def bench(tmp_path):
     with BusServers("virtual:arcus-persona", socketcand=["127.0.0.1:0"]) as servers, \
             motorbus.open_bus("virtual:arcus-persona") as sim_bus:
         sim = arcus_canopen.make_sim(1, protocol="ascii", store_path=str(tmp_path / "flash"), bus=sim_bus)
-        pty = core.PtyLineServer([sim], 0, None)
+        pty = core.serial.PtyLineServer([sim], 0, None)
         port = serial.Serial(pty.slave_path, 9600, timeout=0.05)
         srv = servers.servers[0]
         pcan = can.Bus(interface="socketcand", host=srv.host, port=srv.port, channel="can0")

@@ -35,9 +35,9 @@ def read_reply(port: serial.Serial, timeout: float = 2.0) -> bytes:
 @pytest.fixture
 def line():
     """A DMX-CAN at 01 on a pty, driven by simulated time."""
-    clock = core.SimClock()
+    clock = core.runtime.SimClock()
     sim = make_sim("01", clock=clock)
-    server = core.PtyLineServer([sim], 0, None)
+    server = core.serial.PtyLineServer([sim], 0, None)
     port = serial.Serial(server.slave_path, 9600, timeout=0.05)
     yield sim, clock, port
     port.close()
@@ -75,10 +75,10 @@ def test_seed_example_rt0_byte_for_byte(line, exchange):
                          ids=lambda e: e["send"].strip())
 def test_seed_example_rt1_byte_for_byte(tmp_path, exchange):
     # RT=1 takes effect after STORE and a power cycle, as the manual says.
-    clock = core.SimClock()
+    clock = core.runtime.SimClock()
     store = tmp_path / "flash.txt"
     sim = make_sim("01", clock=clock, store_path=str(store))
-    with core.PtyLineServer([sim], 0, None) as server:
+    with core.serial.PtyLineServer([sim], 0, None) as server:
         with serial.Serial(server.slave_path, 9600, timeout=0.05) as port:
             for cmd, reply in ((b"@01RT=1\r", b"OK\0"), (b"@01STORE\r", b"OK\0")):
                 port.write(cmd)
@@ -96,9 +96,9 @@ def _prepare_rt1(port, exchange):
 
 
 def test_abort_stops_a_jog_and_broadcast_reaches_every_device():
-    clock = core.SimClock()
+    clock = core.runtime.SimClock()
     sims = [make_sim(a, clock=clock, eo_boot=True, snl=False) for a in ("01", "02", "03")]
-    with core.PtyLineServer(sims, 0, None) as server, serial.Serial(server.slave_path, 9600, timeout=0.05) as port:
+    with core.serial.PtyLineServer(sims, 0, None) as server, serial.Serial(server.slave_path, 9600, timeout=0.05) as port:
         for a in ("01", "02", "03"):
             port.write(f"@{a}J+\r".encode())
             assert read_reply(port) == b"OK\0"
@@ -173,7 +173,7 @@ def test_mst_examples_of_the_manual(line):
 
 @pytest.mark.parametrize("ex", ARCUS["accel_limits_examples"], ids=lambda e: f"HSPD{e['HSPD']}")
 def test_appendix_a_accel_examples(line, ex):
-    assert core.arcus_acc_range(ex["HSPD"], ex["LSPD"]) == (ex["min_acc_ms"], ex["max_acc_ms"])
+    assert core.arcus.acc_range(ex["HSPD"], ex["LSPD"]) == (ex["min_acc_ms"], ex["max_acc_ms"])
     # The simulator adjusts ACC into that range, as the manual says.
     _, _, port = line
     for cmd in (f"@01HSPD={ex['HSPD']}\r", f"@01LSPD={ex['LSPD']}\r", "@01ACC=999999\r"):
@@ -189,7 +189,7 @@ def test_appendix_a_windows(w):
     scale = {"K": 1_000, "M": 1_000_000}
     lo = float(lo_text[:-1]) * scale[lo_text[-1]] if lo_text[-1] in scale else float(lo_text)
     hspd = int(lo) + 1
-    lo_ms, hi_ms = core.arcus_acc_range(hspd, w["min_lspd"])
+    lo_ms, hi_ms = core.arcus.acc_range(hspd, w["min_lspd"])
     assert lo_ms == w["min_acc_ms"]
     # max ACC = ((HSPD - LSPD) / delta) x 1000 ms (truncated to 10 ms, as the manual's example).
     assert hi_ms == max(lo_ms, (hspd - w["min_lspd"]) * 100 // w["delta"] * 10)
@@ -226,9 +226,9 @@ def test_pol_bits_7_and_8_invert_in_position_and_alarm_outputs(line):
 
 def test_slr_reads_and_sets_the_stepnloop_ratio(tmp_path):
     """Table 7.10 lists SLR (stored); syntax as docs/drives/arcus.md: x.xxx pulses per count."""
-    clock = core.SimClock()
+    clock = core.runtime.SimClock()
     sim = make_sim("01", clock=clock, store_path=str(tmp_path / "flash.txt"))
-    with core.PtyLineServer([sim], 0, None) as server, serial.Serial(server.slave_path, 9600, timeout=0.05) as port:
+    with core.serial.PtyLineServer([sim], 0, None) as server, serial.Serial(server.slave_path, 9600, timeout=0.05) as port:
         assert _say(port, "SLR") == b"0.800"
         _ok(port, "SLR=1.25")
         assert _say(port, "SLR") == b"1.250"

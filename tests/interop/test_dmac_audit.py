@@ -11,7 +11,7 @@ import pytest
 
 serial = pytest.importorskip("serial")
 
-from motorbus._core import SimClock  # noqa: E402
+from motorbus._core.runtime import SimClock  # noqa: E402
 from motorbus.drives.dmac import chain_ultrasync, make_sim  # noqa: E402
 from motorbus.serial import PtyLineServer  # noqa: E402
 from motorbus.sim import SimBench  # noqa: E402

@@ -10,7 +10,7 @@ import pytest
 
 serial = pytest.importorskip("serial")
 
-from motorbus._core import SimClock  # noqa: E402
+from motorbus._core.runtime import SimClock  # noqa: E402
 from motorbus.drives.dmac import LINE_SETTINGS, XON_ERROR, make_sim  # noqa: E402
 from motorbus.serial import PtyLineServer  # noqa: E402
 

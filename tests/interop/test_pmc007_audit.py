@@ -423,13 +423,13 @@ ACTIONS = {(0x2002, 0), (0x2003, 0), (0x2007, 0), (0x6000, 0), (0x6001, 0), (0x6
            (0x6018, 2), (0x6019, 3), (0x6019, 5), (0x601C, 0), (0x6020, 0), (0x1003, 0)}
 
 
-_TYPE = {_core.DataType.UNSIGNED8: "U8", _core.DataType.UNSIGNED16: "U16", _core.DataType.UNSIGNED32: "U32",
-         _core.DataType.INTEGER32: "I32", _core.DataType.VISIBLE_STRING: "VISIBLE_STRING"}
+_TYPE = {_core.canopen.DataType.UNSIGNED8: "U8", _core.canopen.DataType.UNSIGNED16: "U16", _core.canopen.DataType.UNSIGNED32: "U32",
+         _core.canopen.DataType.INTEGER32: "I32", _core.canopen.DataType.VISIBLE_STRING: "VISIBLE_STRING"}
 
 
 def _rows():
     """Every entry of the table (the typed dictionary the library hands up), as this audit reads them."""
-    od = _core.pmc007_object_dictionary(NODE)
+    od = _core.pmc007.object_dictionary(NODE)
     out = []
     for index in od.indices():
         for sub in od.subindices(index):
@@ -444,7 +444,7 @@ def _rows():
             elif sub == 1 and (0x1400 <= index <= 0x1403 or 0x1800 <= index <= 0x1803):
                 default = (0x200 if index < 0x1800 else 0x180) + 0x100 * (index & 3) + NODE
             out.append(dict(index=index, sub=sub, name=var.name, type=_TYPE[var.data_type], access=var.access,
-                            storage=_core.pmc007_storage(index, sub).name.lower(), default=default))
+                            storage=_core.pmc007.storage(index, sub).name.lower(), default=default))
     return out
 
 
@@ -762,7 +762,7 @@ GEARS = {1: 77440, 2: 48410, 3: 27170, 4: 21510, 5: 14080, 6: 10460, 7: 6915, 8:
 @pytest.fixture
 def clocked():
     from motorbus import _core as core
-    clock = core.SimClock(1_000_000_000)
+    clock = core.runtime.SimClock(1_000_000_000)
     with SimBench([f"pmc007:{NODE}"], bus=f"virtual:pmc007-audit-clk-{time.monotonic_ns()}",
                   clock=clock) as bench:
         srv = bench.can.servers[0]

@@ -38,7 +38,7 @@ def bench():
 
 
 def test_the_dictionary_python_sees_is_the_typed_cpp_table():
-    od = _core.pmc007_object_dictionary(NODE)
+    od = _core.pmc007.object_dictionary(NODE)
     assert isinstance(od, ObjectDictionary)
     assert len(pmc007.OBJECTS) == 210
     assert all(isinstance(v, Variable) for v in pmc007.OBJECTS.values())
@@ -50,7 +50,7 @@ def test_the_dictionary_python_sees_is_the_typed_cpp_table():
     assert speed.value_range == (-32000, 32000)     # the table's limits (003 §4.5.4)
     assert pmc007.OBJECTS["controller_status"].value_range == (0, 255)   # no limits: the type's range
     # The entry's codec is the C++ one (the same bytes as canopen.encode_value, and the manual's).
-    assert speed.encode(-1200) == _core.encode_value(DataType.INTEGER32, -1200) == b"\x50\xfb\xff\xff"
+    assert speed.encode(-1200) == _core.canopen.encode_value(DataType.INTEGER32, -1200) == b"\x50\xfb\xff\xff"
     assert speed.decode(b"\x50\xfb\xff\xff") == -1200
     assert start.encode(600) == b"\x58\x02"
     with pytest.raises(motorbus.InvalidArgument, match="Start speed: 70000 does not fit UNSIGNED16"):
@@ -58,9 +58,9 @@ def test_the_dictionary_python_sees_is_the_typed_cpp_table():
     name = pmc007.OBJECTS["manufacturer_device_name"]
     assert name.data_type == DataType.VISIBLE_STRING and name.decode(b"PMC007") == "PMC007"
     # A client's dictionary is its node's: $NODEID defaults evaluated for that node.
-    assert _core.pmc007_object_dictionary(9)[0x1800, 1].default == 0x189
-    assert _core.pmc007_storage(0x6006) == _core.Pmc007Storage.ROM
-    assert _core.pmc007_storage(0x600C) == _core.Pmc007Storage.RAM
+    assert _core.pmc007.object_dictionary(9)[0x1800, 1].default == 0x189
+    assert _core.pmc007.storage(0x6006) == _core.pmc007.Storage.ROM
+    assert _core.pmc007.storage(0x600C) == _core.pmc007.Storage.RAM
 
 
 # One object of every data type the dictionary has, written by name at both ends of its

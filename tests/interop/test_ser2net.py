@@ -113,14 +113,14 @@ def gateway(served_pty, tmp_path):
     g.kill()
 
 
-def _replay(port: _core.Port, example: dict) -> bytes:
+def _replay(port: _core.serial.Port, example: dict) -> bytes:
     """One manual example, after the set-up it needs (EX reads back what EX= wrote)."""
     if example["send"] == "@01EX\r":
         assert _exchange(port, "@01EX=1000\r") == b"OK\0"
     return _exchange(port, example["send"])
 
 
-def _exchange(port: _core.Port, request: str, timeout: float = 2.0) -> bytes:
+def _exchange(port: _core.serial.Port, request: str, timeout: float = 2.0) -> bytes:
     """Sends one request and reads up to and including the NUL that ends a DMX-CAN reply."""
     port.write(request.encode())
     out = b""
@@ -133,14 +133,14 @@ def _exchange(port: _core.Port, request: str, timeout: float = 2.0) -> bytes:
 @pytest.mark.parametrize("example", EXAMPLES, ids=lambda e: e["send"].strip())
 def test_manual_examples_byte_for_byte_over_raw_tcp(gateway, example):
     with open_port(gateway.raw_url) as port:
-        assert isinstance(port, _core.TcpPort)
+        assert isinstance(port, _core.serial.TcpPort)
         assert _replay(port, example) == example["reply_rt0"].encode()
 
 
 @pytest.mark.parametrize("example", EXAMPLES, ids=lambda e: e["send"].strip())
 def test_manual_examples_byte_for_byte_over_rfc2217(gateway, example):
     with open_port(gateway.rfc2217_url, LINE_BAUD) as port:
-        assert isinstance(port, _core.Rfc2217Port) and port.baud == LINE_BAUD
+        assert isinstance(port, _core.serial.Rfc2217Port) and port.baud == LINE_BAUD
         assert _replay(port, example) == example["reply_rt0"].encode()
 
 

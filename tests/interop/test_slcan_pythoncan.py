@@ -87,8 +87,8 @@ def _exchange_every_frame(bus, peer):
 @pytest.fixture
 def hub():
     name = f"slcan-interop-{os.getpid()}-{id(object())}"
-    inner = _core.open_virtual(name)
-    peer = _core.open_virtual(name)
+    inner = _core.can.open_virtual(name)
+    peer = _core.can.open_virtual(name)
     yield inner, peer
     inner.close()
     peer.close()

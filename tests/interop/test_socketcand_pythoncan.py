@@ -15,7 +15,7 @@ import can
 import pytest
 
 from motorbus import Frame
-from motorbus._core import open_virtual
+from motorbus._core.can import open_virtual
 from motorbus.socketcand import SocketcandServer, open_socketcand
 from polling import wait_for
 

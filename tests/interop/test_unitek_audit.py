@@ -193,10 +193,10 @@ def test_device_rows_of_the_current_table(device, peak):
             assert read(peer, 0x20, signed=True) == -(peak - 1)
         finally:
             peer.shutdown()
-    assert _core.unitek_effective_current_limit_num(device, 999) == peak
-    assert _core.unitek_effective_current_limit_num(device, 12) == 12
+    assert _core.unitek.effective_current_limit_num(device, 999) == peak
+    assert _core.unitek.effective_current_limit_num(device, 12) == 12
     with pytest.raises(_core.InvalidArgument, match="DS 420"):
-        _core.unitek_effective_current_limit_num("DS 999", 1)
+        _core.unitek.effective_current_limit_num("DS 999", 1)
 
 
 def test_client_refuses_a_current_command_beyond_9_bit_before_sending():
@@ -233,22 +233,22 @@ def test_analog_command_10_volts_is_29490_num_and_90_percent_of_n_max():
                 sim.set_analog_input(1, 10.5)
         finally:
             peer.shutdown()
-    assert _core.unitek_analog_command_num(10.0) == 29490
+    assert _core.unitek.analog_command_num(10.0) == 29490
     # 29490 of 32767 is 90 % of N max: 2700 rpm on a 3000 rpm drive.
-    assert _core.UnitekScalings(n_max_rpm=3000).to_physical(_core.unitek_sim_default_table()[0xD5], 29490) \
+    assert _core.unitek.Scalings(n_max_rpm=3000).to_physical(_core.unitek.sim_default_table()[0xD5], 29490) \
         == pytest.approx(2700, abs=0.1)
 
 
 # ---- item 16: the bit-timing table --------------------------------------------------------
 
 def test_bit_timing_table():
-    rows = [(r["kbit_s"], r["btr"], r["max_line_m"]) for r in _core.unitek_bit_timings()]
+    rows = [(r["kbit_s"], r["btr"], r["max_line_m"]) for r in _core.unitek.bit_timings()]
     assert rows == [(1000, 0x4002, 20), (500, 0x4025, 70), (625, 0x4014, 70), (250, 0x405C, 100),
                     (100, 0x4425, 500)]
-    assert _core.unitek_btr_for_bit_rate(250000) == 0x405C
-    assert _core.unitek_bit_rate_for_btr(0x4014) == 625000       # C-U08: 625, not "615"
+    assert _core.unitek.btr_for_bit_rate(250000) == 0x405C
+    assert _core.unitek.bit_rate_for_btr(0x4014) == 625000       # C-U08: 625, not "615"
     with pytest.raises(_core.InvalidArgument, match="0x4026.*0x4025"):
-        _core.unitek_bit_rate_for_btr(0x4026)
+        _core.unitek.bit_rate_for_btr(0x4026)
     with pytest.raises(_core.InvalidArgument, match="btr|BTR"):
         make_sim("0x201", btr=0x1234)
     assert make_sim("0x201").bit_rate == 500000                  # the UNITEK standard (§4.1)

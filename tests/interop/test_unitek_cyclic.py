@@ -32,7 +32,7 @@ def wait(cond, what: str, timeout: float = 5.0) -> None:
 
 
 def test_eight_registers_every_ms_for_10_s_into_numpy():
-    clock = _core.SimClock(1_000_000_000)
+    clock = _core.runtime.SimClock(1_000_000_000)
     with SimBench(["unitek:0x201"], clock=clock) as bench:
         sim = bench.sims[("unitek", "0x201")]
         srv = bench.can.servers[0]

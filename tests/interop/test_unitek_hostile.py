@@ -77,7 +77,7 @@ def test_r1_wrong_dlc_from_the_drive_rejected_and_counted(bench):
         assert d.read(Reg.KERN_STATUS) == 0x0181         # and the next real reply still works
         d.close()
     with pytest.raises(unitek.FrameError) as e:
-        motorbus._core.unitek_decode_from_drive(bytes([0x40, 0x81, 0x01]))
+        motorbus._core.unitek.decode_from_drive(bytes([0x40, 0x81, 0x01]))
     assert e.value.byte == 3
 
 

@@ -19,7 +19,7 @@ class Rig:
     def __init__(self, *sims, clock):
         self.clock = clock
         self.sims = sims
-        self.server = core.PtyLineServer(list(sims), 0, None)
+        self.server = core.serial.PtyLineServer(list(sims), 0, None)
         self.link = open_line(self.server.slave_path, baud=0, timeout=0.2)
 
     def client(self, address=1, **kw):
@@ -35,7 +35,7 @@ class Rig:
 
 @pytest.fixture
 def rig():
-    clock = core.SimClock()
+    clock = core.runtime.SimClock()
     r = Rig(make_sim("01", clock=clock), clock=clock)
     yield r
     r.close()
@@ -186,7 +186,7 @@ def test_currents_after_curt(rig):
 
 
 def test_store_persists_and_power_cycle_applies(tmp_path):
-    clock = core.SimClock()
+    clock = core.runtime.SimClock()
     store = tmp_path / "dmx.flash"
     sim = make_sim("01", clock=clock, store_path=str(store))
     r = Rig(sim, clock=clock)
@@ -206,7 +206,7 @@ def test_store_persists_and_power_cycle_applies(tmp_path):
 
 
 def test_rs485_line_with_several_devices():
-    clock = core.SimClock()
+    clock = core.runtime.SimClock()
     sims = [make_sim(f"{a:02d}", clock=clock, snl=False, eo_boot=True) for a in (1, 2, 42, 99)]
     r = Rig(*sims, clock=clock)
     try:
@@ -282,7 +282,7 @@ def test_motor_stopped_at_process_exit(tmp_path):
         import motorbus._core as core
         from motorbus.drives.arcus import ArcusClient, make_sim
         sim = state["sim"] = make_sim("01", snl=False, eo_boot=True)
-        server = core.PtyLineServer([sim], 0, None)
+        server = core.serial.PtyLineServer([sim], 0, None)
         c = ArcusClient(server.slave_path, 1, baud=0)
         c.jog(1)
         assert c.moving
@@ -308,7 +308,7 @@ def test_make_sim_arguments():
 def test_real_time_sim_and_wait_idle():
     """The default (real-time) simulator, as `motorbus sim serve` runs it."""
     sim = make_sim("01", snl=False, eo_boot=True)
-    with core.PtyLineServer([sim], 0, None) as server:
+    with core.serial.PtyLineServer([sim], 0, None) as server:
         with ArcusClient(server.slave_path, 1, baud=0) as d:
             d.high_speed = 100000
             d.low_speed = 1000
@@ -327,7 +327,7 @@ def test_real_time_sim_and_wait_idle():
 def test_typed_records_and_phase_enum():
     from motorbus.drives.arcus import ArcusCommandInfo, ArcusMotion, ArcusPhase, ArcusProfileParams
 
-    rows = {c.name: c for c in core.arcus_commands()}
+    rows = {c.name: c for c in core.arcus.commands()}
     assert isinstance(rows["HSPD"], ArcusCommandInfo)
     assert rows["HSPD"].query and rows["HSPD"].set and not rows["HSPD"].action
     assert rows["DI"].indexed == 6

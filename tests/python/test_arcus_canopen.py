@@ -18,7 +18,7 @@ NODE = 1
 
 def sdo(sim, *payload: int, node: int = NODE) -> bytes:
     """One SDO request in, the reply payload out (b"" = silent)."""
-    replies = sim.on_can_frame(_core.Frame(0x600 + node, bytes(payload)))
+    replies = sim.on_can_frame(_core.can.Frame(0x600 + node, bytes(payload)))
     sdo_replies = [f for f in replies if f.id == 0x580 + node]
     return bytes(sdo_replies[0].data) if sdo_replies else b""
 
@@ -46,7 +46,7 @@ def ok(reply: bytes, index: int, sub: int = 0) -> None:
 
 @pytest.fixture
 def clock():
-    return _core.SimClock()
+    return _core.runtime.SimClock()
 
 
 # ---- the persona switch (B-A01, B-A04, B-A05) ------------------------------------------
@@ -63,7 +63,7 @@ def test_factory_fresh_unit_talks_rs232_then_can_after_store_and_power_cycle_and
     assert ascii(sim, "CM=2") == "OK" and ascii(sim, "CURR=1200") == "OK"
     assert sdo(sim, 0x40, 0x00, 0x10, 0, 0, 0, 0, 0) == b""        # still RS-232 until the power cycle
     assert ascii(sim, "STORE") == "OK"
-    boot = sim.on_can_frame(_core.Frame(0x000, bytes([0x81, NODE])))
+    boot = sim.on_can_frame(_core.can.Frame(0x000, bytes([0x81, NODE])))
     assert boot == []                                                 # NMT means nothing to a serial unit
     sim.power_cycle()
     assert sim.active_protocol == 2
@@ -76,7 +76,7 @@ def test_factory_fresh_unit_talks_rs232_then_can_after_store_and_power_cycle_and
     assert read(sim, 0x200A) == 0 and sim.active_protocol == 2
     ok(write(sim, 0x200E, 0, 1, 1), 0x200E)
     assert read(sim, 0x200E) == 0                                     # the store finished
-    replies = sim.on_can_frame(_core.Frame(0x000, bytes([0x81, NODE])))  # NMT reset node = power cycle
+    replies = sim.on_can_frame(_core.can.Frame(0x000, bytes([0x81, NODE])))  # NMT reset node = power cycle
     assert [(f.id, bytes(f.data)) for f in replies] == []             # it came up on RS-232: no boot-up
     assert sim.active_protocol == 0
     assert sdo(sim, 0x40, 0x00, 0x10, 0, 0, 0, 0, 0) == b""
@@ -92,7 +92,7 @@ def test_node_id_and_bit_rate_take_effect_only_after_store_and_power_cycle(tmp_p
     assert read(sim, 0x200C) == 1
     ok(write(sim, 0x200C, 0, 9, 1), 0x200C)
     ok(write(sim, 0x200E, 0, 1, 1), 0x200E)
-    replies = sim.on_can_frame(_core.Frame(0x000, bytes([0x81, 0])))  # reset all nodes
+    replies = sim.on_can_frame(_core.can.Frame(0x000, bytes([0x81, 0])))  # reset all nodes
     assert [(f.id, bytes(f.data)) for f in replies] == [(0x709, b"\x00")]
     assert sim.can_node_id == 9
     assert sdo(sim, 0x40, 0x00, 0x10, 0, 0, 0, 0, 0) == b""
@@ -498,7 +498,7 @@ def test_sim_serve_store_dir_gives_each_node_its_flash_file(tmp_path):
     with SimBench(["arcus-canopen:3"], bus="virtual:arcus-canopen-store", store_dir=str(tmp_path)) as bench:
         sim = bench.sims[("arcus-canopen", "3")]
         assert sim.store_path == str(tmp_path / "arcus-canopen-3.store")
-        sdo_reply = sim.on_can_frame(_core.Frame(0x603, bytes([0x2F, 0x0E, 0x20, 0, 1, 0, 0, 0])))
+        sdo_reply = sim.on_can_frame(_core.can.Frame(0x603, bytes([0x2F, 0x0E, 0x20, 0, 1, 0, 0, 0])))
         assert bytes(sdo_reply[0].data)[0] == 0x60
     assert (tmp_path / "arcus-canopen-3.store").read_text().count("CM=2") == 1
 
@@ -538,7 +538,7 @@ def test_the_same_drive_api_script_through_both_personas_of_one_drive(tmp_path):
 
     with motorbus.open_bus("virtual:arcus-both") as sim_bus:
         sim = ac.make_sim(NODE, protocol="ascii", store_path=str(tmp_path / "flash"), bus=sim_bus, eo_boot=True)
-        pty = _core.PtyLineServer([sim], 0, None)
+        pty = _core.serial.PtyLineServer([sim], 0, None)
         try:
             with motorbus.open_drive("arcus", line=pty.slave_path, address="01", units=units) as axis:
                 by_ascii = script(axis, "HL+", {"HSPD": 20000, "LSPD": 2000, "ACC": 20, "DEC": 20})

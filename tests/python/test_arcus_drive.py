@@ -22,7 +22,7 @@ class Served:
     def __init__(self, **options):
         options.setdefault("eo_boot", True)
         self.sim = make_sim("01", **options)
-        self.server = core.PtyLineServer([self.sim], 0, None)
+        self.server = core.serial.PtyLineServer([self.sim], 0, None)
         self.path = self.server.slave_path
 
     def open(self, **kw):

@@ -13,7 +13,7 @@ import motorbus._core as core
 from motorbus.drives.arcus import ArcusClient, make_sim, open_line
 
 
-class Tamper(core.LineDevice):
+class Tamper(core.serial.LineDevice):
     """Passes lines to the simulator; `mangle(reply) -> bytes` rewrites its answers."""
 
     def __init__(self, sim):
@@ -28,10 +28,10 @@ class Tamper(core.LineDevice):
 
 @pytest.fixture
 def rig():
-    clock = core.SimClock()
+    clock = core.runtime.SimClock()
     sim = make_sim("01", clock=clock)
     dev = Tamper(sim)
-    server = core.PtyLineServer([dev], 0, None)
+    server = core.serial.PtyLineServer([dev], 0, None)
     link = open_line(server.slave_path, baud=0, timeout=0.1)
     client = ArcusClient(link, 1, on_exit=None)
     yield dev, client, sim
@@ -174,7 +174,7 @@ def test_a14_motion_not_retried_query_retried(rig):
 
 def test_a15_simulator_survives_hostile_lines_on_the_pty():
     sim = make_sim("01")
-    with core.PtyLineServer([sim], 0, None) as server, serial.Serial(server.slave_path, 115200, timeout=0.2) as p:
+    with core.serial.PtyLineServer([sim], 0, None) as server, serial.Serial(server.slave_path, 115200, timeout=0.2) as p:
         p.write(bytes(range(256)) * 20 + b"\r")
         p.write(b"@01" + b"Z" * 300 + b"\r")
         p.write(b"@01\x00\x01\x02\r")

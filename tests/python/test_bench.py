@@ -417,7 +417,7 @@ def test_cia402_axes_start_together_on_one_sync(tmp_path):
             d.enable()
             d.params["0x6081"] = 20000
         sims = [bench.sims["a"], bench.sims["b"]]
-        clock = motorbus._core.RealClock()          # the simulators' time base
+        clock = motorbus._core.runtime.RealClock()          # the simulators' time base
         sync = registry.drive_plugin("cia402").synchronised_start
         with sync(bench.buses["can0"], [a, b]) as how:
             a.move_to(3000, wait=False)

@@ -58,7 +58,7 @@ class Cia402Node:
 @pytest.fixture()
 def bench():
     name = f"cia402-safety-{next(_hub)}"
-    dev_bus, host_bus = _core.open_virtual(name), _core.open_virtual(name)
+    dev_bus, host_bus = _core.can.open_virtual(name), _core.can.open_virtual(name)
     node = Cia402Node(dev_bus)
     yield node, host_bus
     node.close()
@@ -144,7 +144,7 @@ def test_drives_still_open_at_interpreter_exit_are_quick_stopped():
         from motorbus import _core
         from motorbus.canopen.cia402 import Cia402
         from test_canopen_cia402_safety import Cia402Node
-        dev, host = _core.open_virtual("exit"), _core.open_virtual("exit")
+        dev, host = _core.can.open_virtual("exit"), _core.can.open_virtual("exit")
         state["node"] = Cia402Node(dev)
         drive = Cia402(host, 5, timeout=1.0, poll=0.001)
         drive.enable()

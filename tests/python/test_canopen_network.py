@@ -84,7 +84,7 @@ class SimulatedDrive:
 @pytest.fixture()
 def net():
     name = f"net-{next(_hub)}"
-    dev_bus = _core.open_virtual(name)
+    dev_bus = _core.can.open_virtual(name)
     drive = SimulatedDrive(dev_bus)
     with Network(f"virtual:{name}", sdo_timeout=0.5) as network:
         yield network, drive
@@ -235,14 +235,14 @@ def test_cia402_enable_and_move_through_the_node(net):
 
 def test_network_opens_and_closes_its_own_bus_but_not_a_given_one():
     name = f"net-own-{next(_hub)}"
-    bus = _core.open_virtual(name)
+    bus = _core.can.open_virtual(name)
     with Network(bus) as network:
         assert network.bus is bus
-    bus.send(_core.Frame(0x123, b""))                   # still open: the network did not own it
+    bus.send(_core.can.Frame(0x123, b""))                   # still open: the network did not own it
     with Network(f"virtual:{name}") as network:
         own = network.bus
     with pytest.raises(motorbus.ClosedError):
-        own.send(_core.Frame(0x123, b""))
+        own.send(_core.can.Frame(0x123, b""))
     bus.close()
     with pytest.raises(motorbus.InvalidArgument, match="spec string"):
         Network(42)

@@ -24,7 +24,7 @@ _hub = iter(range(1_000_000))
 
 def pair():
     name = f"svc-py-{next(_hub)}"
-    return _core.open_virtual(name), _core.open_virtual(name)
+    return _core.can.open_virtual(name), _core.can.open_virtual(name)
 
 
 # ---- PDO codec ---------------------------------------------------------------
@@ -105,16 +105,16 @@ def test_nmt_master_commands_and_states():
     assert recv_id(dev, 0x000).data == b"\x81\x00"
     dev.send(hb_mod.heartbeat_encode(5, "PRE-OPERATIONAL"))
     assert m.wait_for_state(5, "PRE-OPERATIONAL", timeout=1.0)
-    dev.send(_core.Frame(0x705, b"\x42"))  # N7
+    dev.send(_core.can.Frame(0x705, b"\x42"))  # N7
     wait_for(lambda: m.raw_state(5) == 0x42, 1.0)
     assert m.state(5) == "UNKNOWN"
     assert changes[0] == (5, "UNKNOWN", "PRE-OPERATIONAL")
-    assert nmt_mod.nmt_decode(_core.Frame(0, b"\x01")) is None  # N1
+    assert nmt_mod.nmt_decode(_core.can.Frame(0, b"\x01")) is None  # N1
 
 
 def test_heartbeat_consumer_lost_on_sim_clock():
     host, dev = pair()
-    clock = _core.SimClock(0)
+    clock = _core.runtime.SimClock(0)
     hb = HeartbeatConsumer(host, clock)
     events = []
     got = threading.Event()
@@ -136,7 +136,7 @@ def test_heartbeat_consumer_lost_on_sim_clock():
 def test_emcy_consumer_and_producer_inhibit():
     host, dev = pair()
     c = EmcyConsumer(host, history=4)
-    clock = _core.SimClock(0)
+    clock = _core.runtime.SimClock(0)
     p = EmcyProducer(dev, 5, inhibit_100us=100, clock=clock)
     assert p.report(0x2310, 0x03, b"\x01\x02")
     e = c.wait(5, timeout=1.0)
@@ -148,11 +148,11 @@ def test_emcy_consumer_and_producer_inhibit():
     p.process()
     e2 = c.wait(5, timeout=1.0)
     assert e2.code == 0x3210
-    dev.send(_core.Frame(0x85, b"\x10\x42"))  # E1: short
+    dev.send(_core.can.Frame(0x85, b"\x10\x42"))  # E1: short
     e3 = c.wait(5, timeout=1.0)
     assert e3.short and e3.code == 0x4210 and e3.register == 0
     assert c.active(5) == [0x2310, 0x3210, 0x4210]
-    dev.send(_core.emcy_encode(5, 0, 0))
+    dev.send(_core.canopen.emcy_encode(5, 0, 0))
     assert c.wait(5, timeout=1.0).is_reset
     assert c.active(5) == []
 
@@ -177,8 +177,8 @@ def test_pdo_receiver_values_and_short_frames():
     rx = PdoReceiver(host, 0x185, [(0x6041, 0, 16), (0x6064, 0, 32)])
     seen = threading.Event()
     rx.set_callback(lambda values, ts: seen.set())
-    dev.send(_core.Frame(0x185, b"\x37\x06"))  # too short: counted
-    dev.send(_core.Frame(0x185, b"\x37\x06\x10\x27\x00\x00"))
+    dev.send(_core.can.Frame(0x185, b"\x37\x06"))  # too short: counted
+    dev.send(_core.can.Frame(0x185, b"\x37\x06\x10\x27\x00\x00"))
     assert seen.wait(1.0)
     assert rx.values == [0x0637, 10000]
     assert rx.value(0x6064) == 10000
@@ -271,7 +271,7 @@ def test_scan_network_finds_a_responder():
         if len(d) != 8 or d[0] != 0x40:
             return
         v = objs[(d[1] | d[2] << 8, d[3])]
-        dev.send(_core.Frame(0x585, bytes([0x43]) + d[1:4] + v.to_bytes(4, "little")))
+        dev.send(_core.can.Frame(0x585, bytes([0x43]) + d[1:4] + v.to_bytes(4, "little")))
 
     dev.subscribe(answer, id=0x605)
     found = scan_network(host, sdo_timeout=0.1)
@@ -289,7 +289,7 @@ def test_pmc007_end_to_end_on_local_node():
 
     seq = VECTORS["pmc007_canopen"]["pdo_config_sequence"]
     name = f"svc-py-{next(_hub)}"
-    dev, host, sniff = _core.open_virtual(name), _core.open_virtual(name), _core.open_virtual(name)
+    dev, host, sniff = _core.can.open_virtual(name), _core.can.open_virtual(name), _core.can.open_virtual(name)
     od = ObjectDictionary()
     od.add_variable(0x6012, "GPIO value", "U16", access="rw", pdo_mappable=True, default=3)
     node = LocalNode(dev, 5, od)
@@ -332,7 +332,7 @@ def test_tpdo_carries_what_the_read_hook_answers():
     for position in (-1234, 5678):
         live["position"] = position
         after = rx.received
-        host.send(_core.Frame(0x080, b""))                   # SYNC: transmission type 1 sends TPDO 1
+        host.send(_core.can.Frame(0x080, b""))                   # SYNC: transmission type 1 sends TPDO 1
         assert rx.wait_newer(after, timeout=2.0) is not None
         seen.append(rx.value(0x6064))
     assert [v - (1 << 32) if v >= 1 << 31 else v for v in seen] == [-1234, 5678]
@@ -345,7 +345,7 @@ def test_heartbeat_service_on_local_node_applies_loss_of_master():
     from motorbus.canopen import LocalNode, ObjectDictionary, SdoClient
 
     name = f"svc-py-{next(_hub)}"
-    dev, host = _core.open_virtual(name), _core.open_virtual(name)
+    dev, host = _core.can.open_virtual(name), _core.can.open_virtual(name)
     node = LocalNode(dev, 5, ObjectDictionary())
     hb = HeartbeatService(node, consumer_entries=2)
     drive = Cia402Device()
@@ -368,7 +368,7 @@ def test_heartbeat_service_on_local_node_applies_loss_of_master():
 
 def test_heartbeat_producer_with_python_state_function():
     host, dev = pair()
-    clock = _core.SimClock(0)
+    clock = _core.runtime.SimClock(0)
     states = iter(["PRE-OPERATIONAL", "OPERATIONAL"])
     p = hb_mod.HeartbeatProducer(dev, 9, 0.1, lambda: next(states), clock=clock)
     p.send_boot_up()

@@ -310,15 +310,15 @@ def test_trace_shows_frames_and_lines(served):
 def test_line_link_trace_reports_requests_replies_and_timeouts():
     from motorbus import _core
     seen = []
-    with _core.PtyLineServer([_core.EchoLineDevice("E:")]) as server:
-        link = _core.LineLink(_core.open_port(server.slave_path), reply_timeout=0.2)
+    with _core.serial.PtyLineServer([_core.serial.EchoLineDevice("E:")]) as server:
+        link = _core.serial.LineLink(_core.serial.open_port(server.slave_path), reply_timeout=0.2)
         link.set_trace(lambda direction, data: seen.append((direction, bytes(data))))
         assert link.transact("hello\x01") == b"E:hello\x01"
         link.set_trace(None)
         assert link.transact("quiet") == b"E:quiet"
     assert seen == [(">", b"hello\x01"), ("<", b"E:hello\x01")]
-    with _core.PtyPair() as pair:          # nobody answers on the other side
-        link = _core.LineLink(pair.open_slave(), reply_timeout=0.1)
+    with _core.serial.PtyPair() as pair:          # nobody answers on the other side
+        link = _core.serial.LineLink(pair.open_slave(), reply_timeout=0.1)
         link.set_trace(lambda direction, data: seen.append((direction, bytes(data))))
         with pytest.raises(motorbus.TimeoutError):
             link.transact("ping")

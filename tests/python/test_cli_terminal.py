@@ -68,7 +68,7 @@ def pane(tmp_path):
 
 
 def test_scan_status_move_and_ctrl_c_in_a_terminal(pane, tmp_path):
-    line = _core.PtyLineServer([arcus.make_sim("07")], 9600)
+    line = _core.serial.PtyLineServer([arcus.make_sim("07")], 9600)
     try:
         mb = f"{sys.executable} -m motorbus"
         # (the echo's quotes keep the typed command line from matching what we wait for)

@@ -20,10 +20,10 @@ def wired():
     CiA 402 nodes 9 and 77, a PMC007 on node 5, a DMX-CAN (CANopen persona) on node 3 and a
     UNITEK servo on receive id 0x210 on a bus served over socketcand."""
     arcus_sims = [arcus.make_sim("07"), arcus.make_sim("42")]
-    line1 = _core.PtyLineServer(arcus_sims, 9600)
+    line1 = _core.serial.PtyLineServer(arcus_sims, 9600)
     line1.enforce_baud = True
     dmac_sim = dmac.make_sim("13")
-    line2 = _core.PtyLineServer([dmac_sim], 19200)
+    line2 = _core.serial.PtyLineServer([dmac_sim], 19200)
     line2.enforce_baud = True
     servers = BusServers("virtual:discovery-test", socketcand=["127.0.0.1:0"], channel="can0")
     nodes = [cia402.make_sim(n) for n in (9, 77)] + [unitek.make_sim("0x210"), pmc007.make_sim(5),

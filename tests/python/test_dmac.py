@@ -12,7 +12,7 @@ import textwrap
 import pytest
 
 import motorbus
-from motorbus._core import SimClock
+from motorbus._core.runtime import SimClock
 from motorbus.drives import dmac
 from motorbus.drives.dmac import (CommandRejected, DmacClient, DmacStatus, UnknownCommand, make_sim, open_line,
                                   stream_interpolation, synchro)
@@ -314,6 +314,6 @@ def test_codec_records_and_radix_enum():
     assert dmac.format_value(500, r.radix) == dmac.format_value(500, "hex") == "h000001F4"
     v = dmac.variable_info("HSP")
     assert isinstance(v, dmac.DmacVariableInfo) and (v.name, v.mnemonic) == ("#HIGH_SPEED", "#HSP")
-    assert "DmacVariableInfo(name='#HIGH_SPEED'" in repr(v)
+    assert "VariableInfo(name='#HIGH_SPEED'" in repr(v)
     with pytest.raises(motorbus.InvalidArgument):
         dmac.format_value(1, "octal")

@@ -30,42 +30,42 @@ def ready():
 """
 
 BLOCKING = {
-    "bus_recv": "b = _core.open_virtual('sig'); ready(); b.recv(None)",
-    "bus_recv_many": "b = _core.open_virtual('sig'); ready(); b.recv_many(8, None)",
-    "port_read": "p = _core.PtyPair(); ready(); p.port.read(16, None)",
-    "line_transact": "p = _core.PtyPair(); l = _core.LineLink(p.port, reply_timeout=None); ready(); l.transact('x')",
-    "line_read_line": "p = _core.PtyPair(); l = _core.LineLink(p.port, reply_timeout=None); ready(); l.read_line(None)",
+    "bus_recv": "b = _core.can.open_virtual('sig'); ready(); b.recv(None)",
+    "bus_recv_many": "b = _core.can.open_virtual('sig'); ready(); b.recv_many(8, None)",
+    "port_read": "p = _core.serial.PtyPair(); ready(); p.port.read(16, None)",
+    "line_transact": "p = _core.serial.PtyPair(); l = _core.serial.LineLink(p.port, reply_timeout=None); ready(); l.transact('x')",
+    "line_read_line": "p = _core.serial.PtyPair(); l = _core.serial.LineLink(p.port, reply_timeout=None); ready(); l.read_line(None)",
     "pycan_recv": "import can; c = can.Bus(interface='motorbus', channel='virtual:sig'); ready(); c.recv(None)",
-    "sdo_upload": "b = _core.open_virtual('sig'); c = _core.SdoClient(b, 5, timeout=1e6); ready(); c.upload(0x1000)",
-    "sdo_download": ("b = _core.open_virtual('sig'); c = _core.SdoClient(b, 5, timeout=1e6); ready(); "
+    "sdo_upload": "b = _core.can.open_virtual('sig'); c = _core.canopen.SdoClient(b, 5, timeout=1e6); ready(); c.upload(0x1000)",
+    "sdo_download": ("b = _core.can.open_virtual('sig'); c = _core.canopen.SdoClient(b, 5, timeout=1e6); ready(); "
                      "c.download(0x2000, 0, b'\\x01\\x02')"),
-    "sdo_read_u32": "b = _core.open_virtual('sig'); c = _core.SdoClient(b, 5, timeout=1e6); ready(); c.read_u32(0x1000)",
-    "cia402_wait_statusword": ("b = _core.open_virtual('sig'); c = _core.SdoClient(b, 5, timeout=1e6); "
-                               "h = _core.Cia402Host(c, 5, timeout=1e6); ready(); h.wait_statusword(0xffff, 0x1234, None)"),
-    "nmt_wait_for_boot": "b = _core.open_virtual('sig'); m = _core.NmtMaster(b); ready(); m.wait_for_boot(5, None)",
-    "emcy_wait": "b = _core.open_virtual('sig'); e = _core.EmcyConsumer(b); ready(); e.wait(0, None)",
+    "sdo_read_u32": "b = _core.can.open_virtual('sig'); c = _core.canopen.SdoClient(b, 5, timeout=1e6); ready(); c.read_u32(0x1000)",
+    "cia402_wait_statusword": ("b = _core.can.open_virtual('sig'); c = _core.canopen.SdoClient(b, 5, timeout=1e6); "
+                               "h = _core.canopen.Cia402Host(c, 5, timeout=1e6); ready(); h.wait_statusword(0xffff, 0x1234, None)"),
+    "nmt_wait_for_boot": "b = _core.can.open_virtual('sig'); m = _core.canopen.NmtMaster(b); ready(); m.wait_for_boot(5, None)",
+    "emcy_wait": "b = _core.can.open_virtual('sig'); e = _core.canopen.EmcyConsumer(b); ready(); e.wait(0, None)",
     # Vendor clients poll the drive; every poll is an interruption point (timeout None = forever).
     "arcus_wait_idle": ("from motorbus.drives.arcus import make_sim, ArcusClient, open_line; "
-                        "s = _core.PtyLineServer([make_sim('01')], 0, None); "
+                        "s = _core.serial.PtyLineServer([make_sim('01')], 0, None); "
                         "c = ArcusClient(open_line(s.slave_path, baud=0, timeout=0.5), 1); "
                         "c.enable(); c.jog(1); ready(); c.wait_idle(None)"),
     "dmac_wait_idle": ("from motorbus.drives.dmac import make_sim, DmacClient, open_line; "
-                       "s = _core.PtyLineServer([make_sim('00')], 0, None); "
+                       "s = _core.serial.PtyLineServer([make_sim('00')], 0, None); "
                        "c = DmacClient(open_line(s.slave_path, baud=38400, timeout=0.5), address=0); "
                        "c.brake(False); c.move_speed(20000); ready(); c.wait_idle(None)"),
     # An SLCAN adapter that acknowledges the open sequence and then goes silent.
-    "slcan_query_status": ("import threading; p = _core.PtyPair(); "
+    "slcan_query_status": ("import threading; p = _core.serial.PtyPair(); "
                            "threading.Thread(target=lambda: [p.port.write(b'\\r') for _ in range(3) "
                            "if p.port.read(64, 5.0)], daemon=True).start(); "
                            "b = motorbus.slcan.open_slcan(p.slave_path, bitrate=0); ready(); b.query_status(None)"),
-    "clock_sleep_until": "c = _core.RealClock(); ready(); c.sleep_until(c.now() + 10**12)",
-    "sim_clock_sleep_until": "c = _core.SimClock(); ready(); c.sleep_until(10**9)",
-    "log_play": ("b = _core.open_virtual('sig'); "
+    "clock_sleep_until": "c = _core.runtime.RealClock(); ready(); c.sleep_until(c.now() + 10**12)",
+    "sim_clock_sleep_until": "c = _core.runtime.SimClock(); ready(); c.sleep_until(10**9)",
+    "log_play": ("b = _core.can.open_virtual('sig'); "
                  "import tempfile, os; f = tempfile.NamedTemporaryFile('w', suffix='.log', delete=False); "
                  "f.write('(0.000000) vcan0 123#01\\n(1000.000000) vcan0 123#02\\n'); f.close(); "
-                 "e, _ = _core.read_log(f.name); os.unlink(f.name); ready(); _core.play(b, e)"),
-    "socketcand_recv": ("b = _core.open_virtual('sig'); s = _core.SocketcandServer(b, channel='can0'); "
-                        "c = _core.open_socketcand('127.0.0.1', s.port, 'can0'); ready(); c.recv(None)"),
+                 "e, _ = _core.can.read_log(f.name); os.unlink(f.name); ready(); _core.can.play(b, e)"),
+    "socketcand_recv": ("b = _core.can.open_virtual('sig'); s = _core.can.SocketcandServer(b, channel='can0'); "
+                        "c = _core.can.open_socketcand('127.0.0.1', s.port, 'can0'); ready(); c.recv(None)"),
 }
 
 
@@ -115,8 +115,8 @@ def test_ctrl_c_interrupts_blocking_call(case):
 _EXIT_CHILD = """
 import atexit, threading, time
 from motorbus import _core
-bus = _core.open_virtual("exit")
-port = _core.PtyPair()
+bus = _core.can.open_virtual("exit")
+port = _core.serial.PtyPair()
 def recv():
     try:
         bus.recv(None)
@@ -151,7 +151,7 @@ INF, NAN = float("inf"), float("nan")
 
 @pytest.fixture
 def vbus():
-    b = _core.open_virtual("durations")
+    b = _core.can.open_virtual("durations")
     yield b
     b.close()
 
@@ -159,18 +159,18 @@ def vbus():
 def test_sdo_client_timeout_inf_waits_for_the_answer():
     # Before: timeout=inf overflowed to a negative deadline and gave up at once.
     elapsed, _, err = _interrupt_child(
-        "b = _core.open_virtual('sig'); c = _core.SdoClient(b, 5, timeout=float('inf')); ready(); c.upload(0x1000)")
+        "b = _core.can.open_virtual('sig'); c = _core.canopen.SdoClient(b, 5, timeout=float('inf')); ready(); c.upload(0x1000)")
     assert "KeyboardInterrupt" in err, err
     assert elapsed < 1.0
 
 
 def test_sdo_client_timeout_values(vbus):
-    assert _core.SdoClient(vbus, 5, timeout=INF).timeout == INF
-    c = _core.SdoClient(vbus, 6, timeout=0.25)
+    assert _core.canopen.SdoClient(vbus, 5, timeout=INF).timeout == INF
+    c = _core.canopen.SdoClient(vbus, 6, timeout=0.25)
     assert c.timeout == 0.25
     for bad in (NAN, -1.0):
         with pytest.raises(motorbus.InvalidArgument, match="timeout"):
-            _core.SdoClient(vbus, 7, timeout=bad)
+            _core.canopen.SdoClient(vbus, 7, timeout=bad)
         with pytest.raises(motorbus.InvalidArgument, match="timeout"):
             c.timeout = bad
 
@@ -178,7 +178,7 @@ def test_sdo_client_timeout_values(vbus):
 @pytest.mark.parametrize("bad", [-1.0, NAN, INF, 1e300, 0.0])
 def test_local_node_sdo_timeout_must_be_positive_and_finite(vbus, bad):
     with pytest.raises(motorbus.InvalidArgument, match="sdo_timeout"):
-        _core.LocalNode(vbus, 5, _core.ObjectDictionary(), sdo_timeout=bad)
+        _core.canopen.LocalNode(vbus, 5, _core.canopen.ObjectDictionary(), sdo_timeout=bad)
 
 
 @pytest.mark.parametrize("bad", [NAN, -1.0, INF])
@@ -189,7 +189,7 @@ def test_set_faults_delay_refused(vbus, bad):
 
 def test_open_virtual_rx_spin_inf_refused():
     with pytest.raises(motorbus.InvalidArgument, match="rx_spin"):
-        _core.open_virtual("durations-spin", rx_spin=INF)
+        _core.can.open_virtual("durations-spin", rx_spin=INF)
 
 
 @pytest.mark.parametrize("bad", [NAN, -1.0])
@@ -199,12 +199,12 @@ def test_blocking_timeouts_refuse_nan_and_negative(vbus, bad):
     with pytest.raises(motorbus.InvalidArgument, match="timeout"):
         vbus.recv_many(4, timeout=bad)
     with pytest.raises(motorbus.InvalidArgument, match="timeout"):
-        vbus.send(_core.Frame(1), timeout=bad)
-    with _core.PtyPair() as p:
+        vbus.send(_core.can.Frame(1), timeout=bad)
+    with _core.serial.PtyPair() as p:
         with pytest.raises(motorbus.InvalidArgument, match="timeout"):
             p.port.read(4, timeout=bad)
     with pytest.raises(motorbus.InvalidArgument, match="timeout"):
-        _core.NmtMaster(vbus).wait_for_boot(5, timeout=bad)
+        _core.canopen.NmtMaster(vbus).wait_for_boot(5, timeout=bad)
 
 
 def test_blocking_timeouts_zero_polls(vbus):
@@ -215,35 +215,35 @@ def test_blocking_timeouts_zero_polls(vbus):
 @pytest.mark.parametrize("kwargs, name", [
     ({"turnaround": INF}, "turnaround"), ({"turnaround": NAN}, "turnaround"), ({"reply_timeout": NAN}, "reply_timeout")])
 def test_line_link_durations(kwargs, name):
-    with _core.PtyPair() as p:
+    with _core.serial.PtyPair() as p:
         with pytest.raises(motorbus.InvalidArgument, match=name):
-            _core.LineLink(p.port, **kwargs)
+            _core.serial.LineLink(p.port, **kwargs)
 
 
 def test_canopen_service_durations(vbus):
-    c = _core.SdoClient(vbus, 5)
+    c = _core.canopen.SdoClient(vbus, 5)
     with pytest.raises(motorbus.InvalidArgument, match="timeout"):
-        _core.Cia402Host(c, 5, timeout=NAN)
+        _core.canopen.Cia402Host(c, 5, timeout=NAN)
     with pytest.raises(motorbus.InvalidArgument, match="poll"):
-        _core.Cia402Host(c, 5, poll=INF)
+        _core.canopen.Cia402Host(c, 5, poll=INF)
     with pytest.raises(motorbus.InvalidArgument, match="timeout"):
-        _core.HeartbeatConsumer(vbus).monitor(5, INF)
+        _core.canopen.HeartbeatConsumer(vbus).monitor(5, INF)
     for bad in (INF, NAN):
         with pytest.raises(motorbus.InvalidArgument, match="period"):
-            _core.HeartbeatProducer(vbus, 5, bad)
+            _core.canopen.HeartbeatProducer(vbus, 5, bad)
         with pytest.raises(motorbus.InvalidArgument, match="period"):
-            _core.SyncProducer(vbus, bad)
+            _core.canopen.SyncProducer(vbus, bad)
     with pytest.raises(motorbus.InvalidArgument, match="sdo_timeout"):
-        _core.scan_network(vbus, sdo_timeout=NAN)
+        _core.canopen.scan_network(vbus, sdo_timeout=NAN)
     with pytest.raises(motorbus.InvalidArgument, match="listen"):
-        _core.scan_network(vbus, listen=INF)
+        _core.canopen.scan_network(vbus, listen=INF)
 
 
 def test_server_durations(vbus):
     with pytest.raises(motorbus.InvalidArgument, match="bus_send_timeout"):
-        _core.SlcanServer(vbus, bus_send_timeout=INF)
+        _core.can.SlcanServer(vbus, bus_send_timeout=INF)
     with pytest.raises(motorbus.InvalidArgument, match="idle_timeout"):
-        _core.SocketcandServer(vbus, idle_timeout=NAN)
+        _core.can.SocketcandServer(vbus, idle_timeout=NAN)
 
 
 # ---------------------------------------------------------------------------
@@ -257,24 +257,24 @@ BAD_VALUES = ["x", None, -1, 2**70, float("nan"), b"", object()]
 
 
 @pytest.mark.parametrize("call, name", [
-    (lambda b: _core.Frame(1, dlc="x"), "dlc"),
-    (lambda b: _core.Frame(1, data=["a"]), "data"),
-    (lambda b: _core.Frame(1, data=5), "data"),
+    (lambda b: _core.can.Frame(1, dlc="x"), "dlc"),
+    (lambda b: _core.can.Frame(1, data=["a"]), "data"),
+    (lambda b: _core.can.Frame(1, data=5), "data"),
     (lambda b: b.set_filters([{"mask": 1}]), "can_id"),
     (lambda b: b.set_filters(["x"]), "filters"),
     (lambda b: b.set_filters(5), "filters"),
     (lambda b: b.recv(timeout="x"), "timeout"),
-    (lambda b: _core.LineLink(_core.PtyPair().port, reply_terminators=5), "reply_terminators"),
-    (lambda b: _core.ObjectDictionary().add_variable(0x2000, "v", 1.5), "data_type"),
-    (lambda b: _core.SdoClient(b, 5).download(0x2000, 0, 5), "data"),
-    (lambda b: _core.SlcanServer(b, port=5), "port"),
-    (lambda b: _core.slcan_encode(_core.Frame(1), timestamp_ms="x"), "timestamp_ms"),
-    (lambda b: _core.Recorder(b, "/dev/null", format=5), "format"),
-    (lambda b: _core.EmcyConsumer(None), "bus"),
-    (lambda b: _core.NmtMaster(None), "bus"),
-    (lambda b: _core.HeartbeatConsumer(None), "bus"),
-    (lambda b: _core.scan_network(None), "bus"),
-    (lambda b: _core.Recorder(None, "/dev/null"), "bus"),
+    (lambda b: _core.serial.LineLink(_core.serial.PtyPair().port, reply_terminators=5), "reply_terminators"),
+    (lambda b: _core.canopen.ObjectDictionary().add_variable(0x2000, "v", 1.5), "data_type"),
+    (lambda b: _core.canopen.SdoClient(b, 5).download(0x2000, 0, 5), "data"),
+    (lambda b: _core.can.SlcanServer(b, port=5), "port"),
+    (lambda b: _core.can.slcan_encode(_core.can.Frame(1), timestamp_ms="x"), "timestamp_ms"),
+    (lambda b: _core.can.Recorder(b, "/dev/null", format=5), "format"),
+    (lambda b: _core.canopen.EmcyConsumer(None), "bus"),
+    (lambda b: _core.canopen.NmtMaster(None), "bus"),
+    (lambda b: _core.canopen.HeartbeatConsumer(None), "bus"),
+    (lambda b: _core.canopen.scan_network(None), "bus"),
+    (lambda b: _core.can.Recorder(None, "/dev/null"), "bus"),
 ])
 def test_bad_argument_is_invalid_argument_naming_it(vbus, call, name):
     with pytest.raises(motorbus.InvalidArgument, match=name):
@@ -287,16 +287,19 @@ import motorbus
 from motorbus import _core
 BAD = [("x"), None, -1, 2**70, float("nan"), b"", object()]
 SKIP = {"play", "open_port", "TtyPort"}          # real devices / replays
-bus = _core.open_virtual("sweep")
-pty = _core.PtyPair()
-link = _core.LineLink(pty.port)
+# _core's top level (the errors) and its submodules (one per area and per vendor), one namespace.
+MODULES = [_core] + [m for m in vars(_core).values() if type(m) is type(_core)]
+NAMES = {k: v for m in MODULES for k, v in vars(m).items()}
+bus = _core.can.open_virtual("sweep")
+pty = _core.serial.PtyPair()
+link = _core.serial.LineLink(pty.port)
 FIX = {"bool": False, "str": "x", "bytes": b"", "object": b"", "float": 0.1, "int": 1,
-       "motorbus._core.Bus": bus, "motorbus._core.VirtualBus": bus, "motorbus._core.Port": pty.port,
-       "motorbus._core.Frame": _core.Frame(1), "motorbus._core.LineLink": link,
+       "motorbus._core.can.Bus": bus, "motorbus._core.can.VirtualBus": bus, "motorbus._core.serial.Port": pty.port,
+       "motorbus._core.can.Frame": _core.can.Frame(1), "motorbus._core.serial.LineLink": link,
        "collections.abc.Sequence[object]": [], "collections.abc.Sequence[str]": [],
-       "motorbus._core.Clock": None, "motorbus._core.Clock | None": None}
-INSTANCES = {"Bus": bus, "Port": pty.port, "LineLink": link, "SdoClient": _core.SdoClient(bus, 5, 0.01),
-             "ObjectDictionary": _core.ObjectDictionary()}
+       "motorbus._core.runtime.Clock": None, "motorbus._core.runtime.Clock | None": None}
+INSTANCES = {"Bus": bus, "Port": pty.port, "LineLink": link, "SdoClient": _core.canopen.SdoClient(bus, 5, 0.01),
+             "ObjectDictionary": _core.canopen.ObjectDictionary()}
 
 def sample(ann):
     ann = ann.strip()
@@ -327,7 +330,7 @@ def signatures(f):
             ann, eq, default = ann.partition("=")
             if eq:
                 if "timeout" in name or name.strip() in ("delay", "poll", "period", "listen"): default = "0.01"
-                try: value = eval(default.strip(), vars(_core))
+                try: value = eval(default.strip(), NAMES)
                 except Exception: break
             else:
                 try: value = sample(ann)
@@ -341,8 +344,8 @@ def targets():
         for mn in dir(type(inst)):
             if not mn.startswith("_") and mn != "close" and callable(getattr(inst, mn)):
                 yield cname + "." + mn, getattr(inst, mn), getattr(inst, mn)
-    for name, obj in sorted(vars(_core).items()):
-        if name.startswith("_") or name in SKIP: continue
+    for name, obj in ((k, v) for m in MODULES for k, v in sorted(vars(m).items(), key=lambda kv: kv[0])):
+        if name.startswith("_") or name in SKIP or type(obj) is type(_core): continue
         if isinstance(obj, type):
             if not issubclass(obj, BaseException): yield name, obj, obj.__init__
         elif callable(obj):

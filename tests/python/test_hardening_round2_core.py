@@ -63,7 +63,7 @@ def _in_thread(fn):
 @pytest.mark.parametrize("block", [False, True])
 def test_sdo_transfer_ends_with_linkdown_when_the_server_is_killed(timeout, block):
     served = motorbus.open_bus(f"virtual:{_hub('kill')}")
-    server = _core.SocketcandServer(served, host="127.0.0.1", port=0)
+    server = _core.can.SocketcandServer(served, host="127.0.0.1", port=0)
     client = open_socketcand("127.0.0.1", server.port, "can0", keepalive=None)
     try:
         sdo = SdoClient(client, 9, timeout=timeout)          # node 9 never answers
@@ -132,7 +132,7 @@ def test_two_clients_on_one_node_through_socketcand_each_get_their_own_answers()
     name = _hub("two")
     dev = motorbus.open_bus(f"virtual:{name}")
     served = motorbus.open_bus(f"virtual:{name}")
-    server = _core.SocketcandServer(served, host="127.0.0.1", port=0)
+    server = _core.can.SocketcandServer(served, host="127.0.0.1", port=0)
     od = ObjectDictionary()
     od.add_variable(0x6064, "Position actual value", "i32", "rw", default=123456)
     od.add_variable(0x606C, "Velocity actual value", "i32", "rw", default=-777)
@@ -218,7 +218,7 @@ def test_127_simulated_nodes_keep_bounded_receive_queues():
         frames = 6000
         before = _rss_mb()
         for i in range(frames):
-            tx.send(_core.Frame(0x123, i.to_bytes(4, "little")), timeout=10)
+            tx.send(_core.can.Frame(0x123, i.to_bytes(4, "little")), timeout=10)
         deadline = time.monotonic() + 60
         while any(b.counters.rx_frames < frames for b in buses) and time.monotonic() < deadline:
             time.sleep(0.05)
@@ -244,16 +244,16 @@ def test_127_simulated_nodes_keep_bounded_receive_queues():
 
 CTRL_C = {
     # A 1 bit/s wire (a frame lasts 47 s) with one transmit slot: the third send waits for room.
-    "send_full_queue": ("b = _core.open_virtual('sig', bitrate=1, tx_queue=1); "
-                        "r = _core.open_virtual('sig', bitrate=1, tx_queue=1); "
-                        "b.send(_core.Frame(1, b'')); b.send(_core.Frame(1, b'')); ready(); "
-                        "[b.send(_core.Frame(1, b''), timeout=30) for _ in range(10)]"),
+    "send_full_queue": ("b = _core.can.open_virtual('sig', bitrate=1, tx_queue=1); "
+                        "r = _core.can.open_virtual('sig', bitrate=1, tx_queue=1); "
+                        "b.send(_core.can.Frame(1, b'')); b.send(_core.can.Frame(1, b'')); ready(); "
+                        "[b.send(_core.can.Frame(1, b''), timeout=30) for _ in range(10)]"),
     # A server that accepts the connection (the kernel does) and never says < hi >.
     "socketcand_handshake": ("import socket; s = socket.socket(); s.bind(('127.0.0.1', 0)); s.listen(); "
-                             "ready(); _core.open_socketcand('127.0.0.1', s.getsockname()[1], 'can0', "
+                             "ready(); _core.can.open_socketcand('127.0.0.1', s.getsockname()[1], 'can0', "
                              "handshake_timeout=30)"),
     # An SLCAN adapter that never answers the open sequence.
-    "slcan_open": "p = _core.PtyPair(); ready(); _core.open_slcan(p.slave_path, open_timeout=30)",
+    "slcan_open": "p = _core.serial.PtyPair(); ready(); _core.can.open_slcan(p.slave_path, open_timeout=30)",
 }
 
 
@@ -297,6 +297,6 @@ def test_write_f32_refuses_values_outside_the_float_range():
 @pytest.mark.parametrize("kwargs", [dict(rtr=True, dlc=-1), dict(rtr=True, dlc=-100), dict(dlc=-1), dict(rtr=True, dlc=9)])
 def test_frame_refuses_a_negative_or_oversized_dlc(kwargs):
     with pytest.raises(motorbus.InvalidArgument, match="dlc"):
-        _core.Frame(0x123, b"", **kwargs)
-    assert _core.Frame(0x123, b"", rtr=True, dlc=0).dlc == 0
-    assert _core.Frame(0x123, b"", rtr=True).dlc == 0
+        _core.can.Frame(0x123, b"", **kwargs)
+    assert _core.can.Frame(0x123, b"", rtr=True, dlc=0).dlc == 0
+    assert _core.can.Frame(0x123, b"", rtr=True).dlc == 0

@@ -129,7 +129,7 @@ def test_pmc007_cia402_unitek_models():
 
 
 def test_motor_model_and_homing_on_sim_clock():
-    from motorbus._core import SimClock
+    from motorbus._core.runtime import SimClock
 
     clk = SimClock()
     cfg = motion.MotorConfig()

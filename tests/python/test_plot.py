@@ -39,7 +39,7 @@ def test_bus_load_of_known_frames_matches_the_hand_count(tmp_path):
 def test_exact_stuffing_of_an_all_zero_frame():
     # id 0, no data: SOF..CRC are 34 dominant bits (the CRC of zeros is 0): a stuff bit
     # after the 5th, 10th, ... 30th = 6, so 34 + 6 + 13 = 53 (worst case says 55).
-    f = _core.Frame(0, b"")
+    f = _core.can.Frame(0, b"")
     assert plot.frame_bits(f, "exact") == 53
     assert plot.frame_bits(f, "worst") == 55
     assert plot.frame_bits(f, "none") == 47
@@ -47,8 +47,8 @@ def test_exact_stuffing_of_an_all_zero_frame():
     rng = np.random.default_rng(1)
     for _ in range(200):
         ext = bool(rng.integers(2))
-        fr = _core.Frame(int(rng.integers(1 << (29 if ext else 11))), rng.integers(0, 256, rng.integers(9)).astype(np.uint8).tobytes(),
-                         extended=ext)
+        fr = _core.can.Frame(int(rng.integers(1 << (29 if ext else 11))), rng.integers(0, 256, rng.integers(9)).astype(np.uint8).tobytes(),
+                             extended=ext)
         assert plot.frame_bits(fr, "none") <= plot.frame_bits(fr, "exact") <= plot.frame_bits(fr, "worst")
     with pytest.raises(motorbus.InvalidArgument, match="stuffing"):
         plot.frame_bits(f, "some")

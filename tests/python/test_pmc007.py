@@ -21,7 +21,7 @@ _names = itertools.count()
 @pytest.fixture
 def rig():
     name = f"virtual:pmc007-py-{next(_names)}"
-    clock = _core.SimClock(1_000_000_000)
+    clock = _core.runtime.SimClock(1_000_000_000)
     with motorbus.open_bus(name) as sim_bus, motorbus.open_bus(name) as host_bus:
         sim = pmc007.make_sim(5, clock=clock, bus=sim_bus)
         client = Pmc007(host_bus, 5)

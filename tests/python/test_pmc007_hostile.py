@@ -22,9 +22,9 @@ class Raw:
 
     def send(self, cob: int, data: bytes, rtr: bool = False, dlc=None) -> None:
         if rtr:
-            self.bus.send(_core.Frame(cob, b"", rtr=True, dlc=dlc if dlc is not None else 0))
+            self.bus.send(_core.can.Frame(cob, b"", rtr=True, dlc=dlc if dlc is not None else 0))
         else:
-            self.bus.send(_core.Frame(cob, bytes(data)))
+            self.bus.send(_core.can.Frame(cob, bytes(data)))
 
     def reply(self, cob: int = 0x585, timeout: float = 0.3):
         deadline = time.monotonic() + timeout
@@ -46,7 +46,7 @@ class Raw:
 @pytest.fixture
 def raw():
     name = f"virtual:pmc007-hostile-{next(_names)}"
-    clock = _core.SimClock(1_000_000_000)
+    clock = _core.runtime.SimClock(1_000_000_000)
     with motorbus.open_bus(name) as sim_bus, motorbus.open_bus(name) as host_bus:
         sim = pmc007.make_sim(5, clock=clock, bus=sim_bus)
         r = Raw(host_bus)

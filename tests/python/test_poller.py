@@ -129,7 +129,7 @@ def test_a_lost_link_ends_its_group_with_the_error_and_the_other_goes_on(lose):
         with Poller(bench.axes, rate_hz=200) as poller:
             time.sleep(0.1)
             gone, other = ("x+y", "z") if lose == "line" else ("z", "x+y")
-            kind = motorbus._core.PtyLineServer if lose == "line" else motorbus.bus_server.BusServers
+            kind = motorbus._core.serial.PtyLineServer if lose == "line" else motorbus.bus_server.BusServers
             for srv in [s for s in bench._servers if isinstance(s, kind)]:
                 srv.close()
             deadline = time.monotonic() + 5
@@ -156,7 +156,7 @@ def test_lost_serial_link_is_linkdown():
     try:
         with Poller({"x": bench["x"]}, rate_hz=200) as poller:
             time.sleep(0.05)
-            for srv in [s for s in bench._servers if isinstance(s, motorbus._core.PtyLineServer)]:
+            for srv in [s for s in bench._servers if isinstance(s, motorbus._core.serial.PtyLineServer)]:
                 srv.close()
             deadline = time.monotonic() + 5
             while poller.running and time.monotonic() < deadline:
@@ -331,7 +331,7 @@ def test_a_push_that_stops_is_counted_stale_and_its_age_shows():
             time.sleep(0.15)
             before = poller.stats["u"]["stale"]
             # The C++ client's own unsubscribe, behind the Python stream bookkeeping: the drive stops pushing.
-            motorbus._core.UnitekClient.unsubscribe(u.native, int(motorbus.drives.unitek.Reg.POS_IST))
+            motorbus._core.unitek.Client.unsubscribe(u.native, int(motorbus.drives.unitek.Reg.POS_IST))
             time.sleep(0.2)
         stats = poller.stats["u"]
         frame = poller.frame()
@@ -360,7 +360,7 @@ def test_capture_sends_nothing_per_sample_and_stops_the_pushes_at_stop(tmp_path)
         samples = poller.stats["z+u"]["samples"]
         time.sleep(0.1)
         # After stop the drives no longer push: a new listener hears nothing of them.
-        rx = motorbus._core.PdoReceiver(z.native.bus, 0x185, [(0x6064, 0, 32)])
+        rx = motorbus._core.canopen.PdoReceiver(z.native.bus, 0x185, [(0x6064, 0, 32)])
         time.sleep(0.1)
         assert rx.received == 0, "the TPDO still flows after the Poller stopped"
         assert not u.native.cyclic

@@ -1,4 +1,4 @@
-"""can::SimulatedDevice from Python: every CAN simulator is a ``_core.SimulatedDevice`` with
+"""can::SimulatedDevice from Python: every CAN simulator is a ``_core.can.SimulatedDevice`` with
 one ``attach(bus)`` / ``close()`` / ``attached`` / ``describe()``, and keeps the bus it was
 given alive (the holder structs that used to do it in the bindings are gone)."""
 import gc
@@ -21,26 +21,26 @@ def _wait(pred, timeout=2.0):
 
 
 def _pmc007():
-    return _core.Pmc007Sim(node_id=5), _core.Frame(0x605, bytes([0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])), 0x585
+    return _core.pmc007.Sim(node_id=5), _core.can.Frame(0x605, bytes([0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])), 0x585
 
 
 def _unitek():
-    return _core.UnitekSim(_core.RealClock()), _core.Frame(0x201, bytes([0x3D, 0x40, 0x00])), 0x181
+    return _core.unitek.Sim(_core.runtime.RealClock()), _core.can.Frame(0x201, bytes([0x3D, 0x40, 0x00])), 0x181
 
 
 def _arcus():
-    sim = _core.ArcusSim(None, node_id=3, comm_type=2)  # a unit stored as CAN
-    return sim, _core.Frame(0x603, bytes([0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])), 0x583
+    sim = _core.arcus.Sim(None, node_id=3, comm_type=2)  # a unit stored as CAN
+    return sim, _core.can.Frame(0x603, bytes([0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])), 0x583
 
 
 def _cia402():
-    return _core.Cia402Sim(7), _core.Frame(0x607, bytes([0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])), 0x587
+    return _core.cia402.Sim(7), _core.can.Frame(0x607, bytes([0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0])), 0x587
 
 
 @pytest.mark.parametrize("make", [_pmc007, _unitek, _arcus, _cia402], ids=["pmc007", "unitek", "arcus", "cia402"])
 def test_every_can_sim_is_one_simulated_device(make):
     sim, request, reply_id = make()
-    assert isinstance(sim, _core.SimulatedDevice)
+    assert isinstance(sim, _core.can.SimulatedDevice)
     kind = type(sim).__name__
     hub = f"simdev-py-{kind}-{next(_hubs)}"
     host = motorbus.open_bus("virtual:" + hub)

@@ -17,12 +17,12 @@ def _hub(tag: str) -> str:
 
 
 def test_encode_every_kind():
-    assert slcan_encode(_core.Frame(0x123, b"\xde\xad")) == b"t1232DEAD\r"
-    assert slcan_encode(_core.Frame(0x1FFFFFFF, b"", extended=True)) == b"T1FFFFFFF0\r"
-    assert slcan_encode(_core.Frame(0x7FF, rtr=True, dlc=8)) == b"r7FF8\r"
-    assert slcan_encode(_core.Frame(1, b"\x01"), timestamp_ms=0xEA5F) == b"t001101EA5F\r"
+    assert slcan_encode(_core.can.Frame(0x123, b"\xde\xad")) == b"t1232DEAD\r"
+    assert slcan_encode(_core.can.Frame(0x1FFFFFFF, b"", extended=True)) == b"T1FFFFFFF0\r"
+    assert slcan_encode(_core.can.Frame(0x7FF, rtr=True, dlc=8)) == b"r7FF8\r"
+    assert slcan_encode(_core.can.Frame(1, b"\x01"), timestamp_ms=0xEA5F) == b"t001101EA5F\r"
     with pytest.raises(motorbus.InvalidArgument):
-        slcan_encode(_core.Frame(1), timestamp_ms=60000)
+        slcan_encode(_core.can.Frame(1), timestamp_ms=60000)
 
 
 def test_decoder_hostile_rows_and_recovery():
@@ -42,8 +42,8 @@ def test_decoder_hostile_rows_and_recovery():
 
 @pytest.mark.threaded
 def test_server_with_pyserial_peer_answers_and_forwards():
-    inner = _core.open_virtual(_hub("a"))
-    peer = _core.open_virtual(_hub("a"))
+    inner = _core.can.open_virtual(_hub("a"))
+    peer = _core.can.open_virtual(_hub("a"))
     with SlcanServer(inner) as server, serial.Serial(server.pty_path, timeout=2) as tty:
         tty.write(b"V\rS6\rO\r")
         assert tty.read_until(b"\r") == b"V1013\r"
@@ -61,8 +61,8 @@ def test_server_with_pyserial_peer_answers_and_forwards():
 
 @pytest.mark.threaded
 def test_open_slcan_through_server_both_directions():
-    inner = _core.open_virtual(_hub("b"))
-    peer = _core.open_virtual(_hub("b"))
+    inner = _core.can.open_virtual(_hub("b"))
+    peer = _core.can.open_virtual(_hub("b"))
     with SlcanServer(inner) as server:
         with open_slcan(server.pty_path, 500000) as bus:
             assert isinstance(bus, motorbus.Bus) and bus.link_up
@@ -82,7 +82,7 @@ def test_open_slcan_through_server_both_directions():
 
 @pytest.mark.threaded
 def test_open_bus_spec_reaches_open_slcan():
-    inner = _core.open_virtual(_hub("c"))
+    inner = _core.can.open_virtual(_hub("c"))
     with SlcanServer(inner) as server:
         with motorbus.open_bus(f"slcan:{server.pty_path}@250000") as bus:
             assert bus.channel.startswith("slcan:")
@@ -91,7 +91,7 @@ def test_open_bus_spec_reaches_open_slcan():
 def test_open_slcan_errors_are_typed():
     with pytest.raises(motorbus.InvalidArgument):
         open_slcan("/nonexistent/tty", 500000)
-    inner = _core.open_virtual(_hub("d"))
+    inner = _core.can.open_virtual(_hub("d"))
     with SlcanServer(inner) as server:
         with pytest.raises(motorbus.InvalidArgument):
             open_slcan(server.pty_path, 83333)
@@ -105,7 +105,7 @@ def test_server_on_an_existing_serial_port():
     import tty as ttymod
     master, slave = os.openpty()
     ttymod.setraw(slave)
-    inner = _core.open_virtual(_hub("e"))
+    inner = _core.can.open_virtual(_hub("e"))
     try:
         with SlcanServer(inner, port=os.ttyname(slave), baud=0) as server:
             assert server.pty_path is None

@@ -9,7 +9,7 @@ import pytest
 
 import motorbus
 from motorbus import Frame
-from motorbus._core import open_virtual
+from motorbus._core.can import open_virtual
 from motorbus.socketcand import (
     SocketcandServer,
     open_socketcan,

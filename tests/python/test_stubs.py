@@ -57,7 +57,11 @@ def test_drop_names_removes_classes_overloads_and_all_entries():
 
 
 def test_the_committed_stub_names_nothing_the_toy_registers():
-    text = (ROOT / "python" / "motorbus" / "_core.pyi").read_text()
+    stubs = ROOT / "python" / "motorbus" / "_core"      # one stub per submodule of _core
+    assert (stubs / "__init__.pyi").exists() and (stubs / "can.pyi").exists()
+    assert not (stubs / "toy.pyi").exists()             # the toy kind's submodule is not motorbus's
+    text = (stubs / "__init__.pyi").read_text()
     leaked = (gen_stubs.registered_names(TOY_BINDINGS) | {"toy"}) & _top_level_names(text)
     assert not leaked
-    assert "Toy" not in text
+    for f in stubs.glob("*.pyi"):
+        assert "Toy" not in f.read_text() and "motorbus._core.toy" not in f.read_text(), f.name

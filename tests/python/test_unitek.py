@@ -21,7 +21,7 @@ _names = itertools.count()
 @pytest.fixture()
 def rig():
     name = f"virtual:unitek-py-{next(_names)}"
-    clock = _core.SimClock(1_000_000_000)
+    clock = _core.runtime.SimClock(1_000_000_000)
     with motorbus.open_bus(name) as sim_bus, motorbus.open_bus(name) as host_bus:
         sim = unitek.make_sim("0x201", clock, bus=sim_bus, acc_ramp_ms=10)
         drive = Unitek(host_bus, 0x201, clock=clock, timeout=0.5)
@@ -43,7 +43,7 @@ def test_builtin_table_is_the_manual(tmp_path):
     assert sorted(r.regid for r in t.rows()) == [0x30, 0x31, 0x35, 0x40, 0x51, 0x52, 0x68, 0x6E, 0x84, 0x90, 0xA8]
     pos = t["POS_DEST"]
     assert (pos.bits, pos.signed, pos.min, pos.max, pos.unit) == (32, True, -2147483647, 2147483647, "rev")
-    assert t[0x31].quantity == _core.UnitekQuantity.SPEED
+    assert t[0x31].quantity == _core.unitek.Quantity.SPEED
     assert not t["KERN_STATUS"].writable and not t["MODE"].readable
     with pytest.raises(unitek.UnknownRegister) as e:
         t[0x99]
@@ -69,21 +69,21 @@ def test_toml_register_list_extends_the_table(tmp_path):
 
 
 def test_scalings_from_section_6():
-    s = _core.UnitekScalings(n_max_rpm=2000)
+    s = _core.unitek.Scalings(n_max_rpm=2000)
     t = unitek.builtin_registers()
     assert s.to_num(t["SPEED_CMD"], 1500) == 24575
     assert s.to_num(t["POS_DEST"], 200) == 13_107_200
-    assert _core.unitek_continuous_current_num("DS 205/405", 2) == 44
-    assert [d["device"] for d in _core.unitek_device_currents()] == ["DS 205/405", "DS 412", "DS 420"]
+    assert _core.unitek.continuous_current_num("DS 205/405", 2) == 44
+    assert [d["device"] for d in _core.unitek.device_currents()] == ["DS 205/405", "DS 412", "DS 420"]
 
 
 def test_codec_functions():
-    assert _core.unitek_encode_write(0x6E, 3_000_000, 32) == bytes.fromhex("6EC0C62D00")
-    assert _core.unitek_encode_request(0x30, 100) == bytes.fromhex("3D3064")
-    assert _core.unitek_decode_from_drive(bytes.fromhex("4081315A")) == (0x40, 0x3181, 16)
-    assert _core.unitek_decode_to_drive(bytes.fromhex("31CD0C99")) == (0x31, 0x0CCD, 16)
+    assert _core.unitek.encode_write(0x6E, 3_000_000, 32) == bytes.fromhex("6EC0C62D00")
+    assert _core.unitek.encode_request(0x30, 100) == bytes.fromhex("3D3064")
+    assert _core.unitek.decode_from_drive(bytes.fromhex("4081315A")) == (0x40, 0x3181, 16)
+    assert _core.unitek.decode_to_drive(bytes.fromhex("31CD0C99")) == (0x31, 0x0CCD, 16)
     with pytest.raises(unitek.FrameError) as e:
-        _core.unitek_decode_from_drive(b"\x40\x81\x01\x00\x00")
+        _core.unitek.decode_from_drive(b"\x40\x81\x01\x00\x00")
     assert e.value.byte == 5 and e.value.data == b"\x40\x81\x01\x00\x00"
     assert isinstance(e.value, motorbus.ProtocolError)
 
@@ -190,7 +190,7 @@ def test_a_client_still_open_at_exit_is_stopped_with_on_exit(rig):
     from motorbus import _stop_at_exit
     drive, sim, clock, bus = rig
     d = Unitek(bus, 0x201, clock=clock, on_exit="disable")
-    assert isinstance(d, _core.UnitekClient)
+    assert isinstance(d, _core.unitek.Client)
     assert d in _stop_at_exit._live
     d.speed_rpm = 100
     settle(sim, bus)
@@ -274,11 +274,11 @@ def test_bad_arguments_are_typed(rig):
     with pytest.raises(motorbus.InvalidArgument, match="0x201..0x27F"):
         drive.set_receive_id(0x300)
     with pytest.raises(motorbus.InvalidArgument, match="bus"):
-        _core.UnitekClient(None)
+        _core.unitek.Client(None)
     with pytest.raises(motorbus.InvalidArgument, match="clock"):
-        _core.UnitekSim(None)
+        _core.unitek.Sim(None)
     with pytest.raises(motorbus.InvalidArgument, match="rx_id"):
-        _core.UnitekSim(clock, rx_id=0x100)
+        _core.unitek.Sim(clock, rx_id=0x100)
     with pytest.raises(motorbus.InvalidArgument, match="N max"):
         unitek.make_sim("0x201", n_max_rpm=0)
     with pytest.raises(motorbus.InvalidArgument, match="device"):
@@ -286,4 +286,4 @@ def test_bad_arguments_are_typed(rig):
     with pytest.raises(motorbus.InvalidArgument, match="on_error"):
         Unitek(bus, 0x201, on_error="explode")
     with pytest.raises(motorbus.InvalidArgument, match="bits 16 or 32"):
-        _core.unitek_encode_write(0x31, 1, 24)
+        _core.unitek.encode_write(0x31, 1, 24)

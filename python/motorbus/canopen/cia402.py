@@ -25,8 +25,9 @@ __all__ = ["ABORT_CONNECTION_ACTIONS", "Cia402", "Cia402Device", "OpMode", "STAT
 STATES = ("NOT READY TO SWITCH ON", "SWITCH ON DISABLED", "READY TO SWITCH ON", "SWITCHED ON",
           "OPERATION ENABLED", "QUICK STOP ACTIVE", "FAULT REACTION ACTIVE", "FAULT", "UNKNOWN")
 
-decode_statusword = _core.cia402_decode_statusword
-next_step = _core.cia402_next_step
+from .._core.canopen import (  # noqa: E402,F401
+    cia402_decode_statusword as decode_statusword, cia402_next_step as next_step,
+)
 
 
 class OpMode(enum.IntEnum):
@@ -57,7 +58,7 @@ class Controlword(enum.IntEnum):
 ABORT_CONNECTION_ACTIONS = {"fault": 1, "disable_voltage": 2, "quick_stop": 3}
 
 
-class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
+class Cia402(_stop_at_exit.StopsMotor, _core.canopen.Cia402Host):
     """Host-side CiA 402 state machine of one drive.
 
     ``Cia402(bus_or_sdo, node, timeout=2.0, poll=0.005, on_error="quick_stop",
@@ -80,14 +81,14 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
 
     def __init__(self, sdo, node: int, timeout: float = 2.0, poll: float = 0.005, *,
                  on_error: Optional[str] = "quick_stop", on_exit: Optional[str] = "quick_stop",
-                 bus: Optional[_core.Bus] = None) -> None:
+                 bus: Optional[_core.can.Bus] = None) -> None:
         check_stop_way(on_error, "Cia402 on_error", _HALTS)
         check_stop_way(on_exit, "Cia402 on_exit", _HALTS)
-        if isinstance(sdo, _core.Bus):
+        if isinstance(sdo, _core.can.Bus):
             # One SDO client for the state machine and the watchdog set-up: two
             # clients on one COB-ID would take each other's responses.
             self._bus = sdo
-            sdo = _core.SdoClient(sdo, node, timeout=timeout)
+            sdo = _core.canopen.SdoClient(sdo, node, timeout=timeout)
         else:
             self._bus = bus
         super().__init__(sdo, node, timeout, poll)
@@ -95,7 +96,7 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
         self._node = node
         self._on_error = on_error
         self._on_exit = on_exit
-        self._heartbeat: Optional[_core.HeartbeatProducer] = None
+        self._heartbeat: Optional[_core.canopen.HeartbeatProducer] = None
         self._watchdog_sub: Optional[int] = None
         self._closed = False
         _stop_at_exit.track(self)
@@ -112,7 +113,7 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
         return self._node
 
     @property
-    def bus(self) -> Optional[_core.Bus]:
+    def bus(self) -> Optional[_core.can.Bus]:
         """The bus this drive object was opened on (None when given only an SDO client)."""
         return self._bus
 
@@ -153,7 +154,7 @@ class Cia402(_stop_at_exit.StopsMotor, _core.Cia402Host):
             raise _core.InvalidArgument("start_watchdog: pass bus= (this drive was opened on an SDO client)")
         self.stop_watchdog()
         # Produce first, then arm the consumer: the drive must never watch a silent producer.
-        hb = _core.HeartbeatProducer(bus, int(host_node), period)
+        hb = _core.canopen.HeartbeatProducer(bus, int(host_node), period)
         hb.start()
         self._heartbeat = hb
         try:
@@ -219,4 +220,4 @@ _HALTS = ("quick_stop", "disable", None)
 
 
 #: The device-side state machine for simulators (C++ Cia402Device).
-Cia402Device = _core.Cia402Device
+Cia402Device = _core.canopen.Cia402Device

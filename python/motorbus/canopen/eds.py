@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 from typing import Optional
 
-from .._core import ObjectDictionary
+from .._core.canopen import ObjectDictionary
 
 __all__ = ["load_eds", "save_eds", "to_eds"]
 

@@ -15,16 +15,12 @@ from .. import _core
 __all__ = ["EmcyError", "EmcyConsumer", "EmcyProducer", "emcy_encode", "emcy_decode", "emcy_code_text"]
 
 #: One received message: node, code, register, data, short, timestamp_ns, text, is_reset.
-EmcyError = _core.EmcyError
-EmcyProducer = _core.EmcyProducer
-emcy_encode = _core.emcy_encode
-emcy_decode = _core.emcy_decode
-emcy_code_text = _core.emcy_code_text
+from .._core.canopen import EmcyError, EmcyProducer, emcy_encode, emcy_decode, emcy_code_text  # noqa: E402,F401
 
 
 class EmcyConsumer:
-    def __init__(self, bus: _core.Bus, history: int = 32) -> None:
-        self._c = _core.EmcyConsumer(bus, history)
+    def __init__(self, bus: _core.can.Bus, history: int = 32) -> None:
+        self._c = _core.canopen.EmcyConsumer(bus, history)
         self._cb = None
 
     def history(self, node: int) -> List[EmcyError]:
@@ -61,7 +57,7 @@ class NodeEmcy:
     """``node.emcy``: the network's EMCY consumer, for one node (names as in the
     `canopen` package: ``active``, ``log``, ``wait``, ``add_callback``, ``reset``)."""
 
-    def __init__(self, consumer: "_core.EmcyConsumer", node_id: int) -> None:
+    def __init__(self, consumer: "_core.canopen.EmcyConsumer", node_id: int) -> None:
         self._c = consumer
         self.node_id = node_id
         self._callbacks: list = []

@@ -19,21 +19,18 @@ from .. import _core
 __all__ = ["HeartbeatConsumer", "HeartbeatProducer", "HeartbeatService", "NodeHealth",
            "heartbeat_encode", "heartbeat_decode"]
 
-heartbeat_encode = _core.heartbeat_encode
-heartbeat_decode = _core.heartbeat_decode
-NodeHealth = _core.NodeHealth
-HeartbeatProducer = _core.HeartbeatProducer
+from .._core.canopen import heartbeat_encode, heartbeat_decode, NodeHealth, HeartbeatProducer  # noqa: E402,F401
 #: HeartbeatService(local_node, consumer_entries=4, producer_ms=0): 0x1017/0x1016 of a served
 #: node; set_lost_callback(cb) for the loss-of-master reaction.
-HeartbeatService = _core.HeartbeatService
+from .._core.canopen import HeartbeatService  # noqa: E402,F401
 
 
 class HeartbeatConsumer:
     """Per-node heartbeat timeouts; events: started, lost, back, reset,
     state-changed, unknown-state."""
 
-    def __init__(self, bus: _core.Bus, clock: Optional[_core.Clock] = None) -> None:
-        self._c = _core.HeartbeatConsumer(bus, clock)
+    def __init__(self, bus: _core.can.Bus, clock: Optional[_core.runtime.Clock] = None) -> None:
+        self._c = _core.canopen.HeartbeatConsumer(bus, clock)
         self._cb = None
 
     def monitor(self, node: int, timeout: float) -> None:
@@ -72,7 +69,7 @@ class HeartbeatConsumer:
 class NodeHeartbeat:
     """``node.heartbeat``: the network's heartbeat consumer, for one node."""
 
-    def __init__(self, consumer: "_core.HeartbeatConsumer", node_id: int) -> None:
+    def __init__(self, consumer: "_core.canopen.HeartbeatConsumer", node_id: int) -> None:
         self._c = consumer
         self.node_id = node_id
         self._callbacks: list = []

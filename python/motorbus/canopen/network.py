@@ -35,11 +35,11 @@ class Network:
     """``Network(bus, sdo_timeout=1.0, emcy_history=32)``: ``bus`` is a motorbus Bus
     or an ``open_bus`` spec string (the network then owns the bus and closes it)."""
 
-    def __init__(self, bus: Union[str, _core.Bus], *, sdo_timeout: float = 1.0, emcy_history: int = 32) -> None:
+    def __init__(self, bus: Union[str, _core.can.Bus], *, sdo_timeout: float = 1.0, emcy_history: int = 32) -> None:
         if isinstance(bus, str):
             self.bus = open_bus(bus)
             self._owns_bus = True
-        elif isinstance(bus, _core.Bus):
+        elif isinstance(bus, _core.can.Bus):
             self.bus = bus
             self._owns_bus = False
         else:
@@ -50,10 +50,10 @@ class Network:
         # Made at once, so boot-ups, heartbeats and EMCYs sent before a node is
         # added (or waited for) are already seen.
         self.nmt = NmtMaster(self.bus)
-        self._heartbeat = _core.HeartbeatConsumer(self.bus, None)
+        self._heartbeat = _core.canopen.HeartbeatConsumer(self.bus, None)
         self._heartbeat.set_callback(self._on_heartbeat)
         self._heartbeat.start()
-        self._emcy = _core.EmcyConsumer(self.bus, emcy_history)
+        self._emcy = _core.canopen.EmcyConsumer(self.bus, emcy_history)
         self._emcy.set_callback(self._on_emcy)
         self._closed = False
 

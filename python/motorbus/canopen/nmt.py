@@ -21,16 +21,14 @@ __all__ = ["NmtCommand", "NmtMaster", "NMT_STATES", "nmt_encode", "nmt_decode"]
 
 NMT_STATES = ("INITIALISING", "STOPPED", "OPERATIONAL", "PRE-OPERATIONAL", "UNKNOWN")
 
-nmt_encode = _core.nmt_encode
-nmt_decode = _core.nmt_decode
-NmtCommand = _core.NmtCommand
+from .._core.canopen import nmt_encode, nmt_decode, NmtCommand  # noqa: E402,F401
 
 
 class NmtMaster:
     """Commands nodes (node 0 = all) and tracks their states from heartbeats."""
 
-    def __init__(self, bus: _core.Bus, own_node_id: Optional[int] = None) -> None:
-        self._m = _core.NmtMaster(bus, own_node_id)
+    def __init__(self, bus: _core.can.Bus, own_node_id: Optional[int] = None) -> None:
+        self._m = _core.canopen.NmtMaster(bus, own_node_id)
         self._cb: Optional[Callable[[int, str, str], None]] = None
 
     def send(self, command: "NmtCommand | int", node: int = 0) -> None:

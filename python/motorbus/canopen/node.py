@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Optional, Union
 
 from .. import _core
-from .._core import LocalNode, LocalNodeCounters, SdoClient, SdoServerCounters  # noqa: F401
+from .._core.canopen import LocalNode, LocalNodeCounters, SdoClient, SdoServerCounters  # noqa: F401
 from .cia402 import Cia402
 from .emcy import NodeEmcy
 from .heartbeat import NodeHeartbeat
@@ -58,9 +58,9 @@ class RemoteNode:
     has SDO, NMT and PDOs; EMCY and heartbeat consumers come with a Network.
     """
 
-    def __init__(self, network: "Union[Network, _core.Bus]", node_id: int, od: Optional[ObjectDictionary],
+    def __init__(self, network: "Union[Network, _core.can.Bus]", node_id: int, od: Optional[ObjectDictionary],
                  sdo_timeout: float) -> None:
-        if isinstance(network, _core.Bus):
+        if isinstance(network, _core.can.Bus):
             self.network, self.bus = None, network
         else:
             self.network, self.bus = network, network.bus

@@ -1,7 +1,8 @@
 """Object dictionary: variables addressed by (index, subindex) or by name."""
 from __future__ import annotations
 
-from .._core import DataType, MotorbusError, ObjectDictionary, Variable, decode_value, encode_value  # noqa: F401
+from .._core import MotorbusError  # noqa: F401
+from .._core.canopen import DataType, ObjectDictionary, Variable, decode_value, encode_value  # noqa: F401
 
 __all__ = ["ObjectDictionary", "Variable", "DataType", "NotFound", "decode_value", "encode_value"]
 

@@ -24,13 +24,10 @@ __all__ = ["PdoMap", "pack", "unpack", "configure_pdo", "read_pdo_config", "PdoC
 
 Entry = Union[Tuple[int, int, int], Tuple[int, int, int, bool]]
 
-PdoReceiver = _core.PdoReceiver
+from .._core.canopen import PdoReceiver  # noqa: E402,F401
 #: PdoService(local_node, strict=True): the PDO engine of a served LocalNode.
 #: strict=False accepts parameter changes while a PDO is valid (as some devices do).
-PdoService = _core.PdoService
-PdoSender = _core.PdoSender
-PdoConfig = _core.PdoConfig
-PdoCounters = _core.PdoCounters
+from .._core.canopen import PdoService, PdoSender, PdoConfig, PdoCounters  # noqa: E402,F401
 
 
 class PdoMap:
@@ -38,7 +35,7 @@ class PdoMap:
 
     def __init__(self, entries: Iterable[Entry]) -> None:
         self.entries = [tuple(e) for e in entries]
-        self._layout = _core.PdoLayout(self.entries)
+        self._layout = _core.canopen.PdoLayout(self.entries)
 
     def __repr__(self) -> str:
         return f"PdoMap({self.entries!r})"
@@ -87,22 +84,22 @@ def configure_pdo(sdo, node: int, *, tpdo: Optional[int] = None, rpdo: Optional[
                   transmission_type: Optional[int] = None, inhibit_100us: Optional[int] = None,
                   event_timer_ms: Optional[int] = None, sync_start: Optional[int] = None,
                   mapping: Optional[Iterable[Entry]] = None,
-                  procedure: "str | _core.PdoProcedure" = "cia301") -> None:
+                  procedure: "str | _core.canopen.PdoProcedure" = "cia301") -> None:
     """Write a PDO's parameters and mapping. procedure='cia301' (PdoProcedure.CIA301) disables the PDO,
     clears the mapping, writes the entries and re-enables it; 'direct' writes in
     the order some devices' manuals document, without those steps."""
     if (tpdo is None) == (rpdo is None):
         raise _core.InvalidArgument("configure_pdo: give exactly one of tpdo= or rpdo=")
-    _core.pdo_write_config(sdo, node, tpdo is not None, tpdo if tpdo is not None else rpdo,
-                           cob_id, enabled, transmission_type, inhibit_100us, event_timer_ms,
-                           sync_start, None if mapping is None else [tuple(e) for e in mapping],
-                           procedure)
+    _core.canopen.pdo_write_config(sdo, node, tpdo is not None, tpdo if tpdo is not None else rpdo,
+                                   cob_id, enabled, transmission_type, inhibit_100us, event_timer_ms,
+                                   sync_start, None if mapping is None else [tuple(e) for e in mapping],
+                                   procedure)
 
 
 def read_pdo_config(sdo, node: int, *, tpdo: Optional[int] = None, rpdo: Optional[int] = None) -> PdoConfig:
     if (tpdo is None) == (rpdo is None):
         raise _core.InvalidArgument("read_pdo_config: give exactly one of tpdo= or rpdo=")
-    return _core.pdo_read_config(sdo, node, tpdo is not None, tpdo if tpdo is not None else rpdo)
+    return _core.canopen.pdo_read_config(sdo, node, tpdo is not None, tpdo if tpdo is not None else rpdo)
 
 
 # Signed CiA 301 types (INTEGER8..64, INTEGER24..56): their PDO fields are sign-extended.
@@ -124,8 +121,8 @@ class PdoChannel:
         self.config: Optional[PdoConfig] = None
         #: Receive time (s, the bus clock) of the latest TPDO, set before its callbacks run.
         self.timestamp: Optional[float] = None
-        self._rx: Optional[_core.PdoReceiver] = None
-        self._tx: Optional[_core.PdoSender] = None
+        self._rx: Optional[_core.canopen.PdoReceiver] = None
+        self._tx: Optional[_core.canopen.PdoSender] = None
         self._callbacks: List[Callable[[Dict[Tuple[int, int], int]], None]] = []
         self._lock = threading.Lock()
 
@@ -169,13 +166,13 @@ class PdoChannel:
             raise _core.InvalidArgument(f"{self!r}: nothing is mapped (configure(mapping=...) first)")
         return out
 
-    def _receiver(self) -> _core.PdoReceiver:
+    def _receiver(self) -> _core.canopen.PdoReceiver:
         if not self.tpdo:
             raise _core.InvalidArgument(f"{self!r}: an RPDO is sent by the host, not received (use transmit)")
         with self._lock:
             if self._rx is None:
                 entries = self._entries()
-                rx = _core.PdoReceiver(self._node.bus, self.cob_id, entries)
+                rx = _core.canopen.PdoReceiver(self._node.bus, self.cob_id, entries)
                 self._keys = [(e[0], e[1]) for e in entries]
                 # The receiver keeps raw field bits; signed objects are sign-extended here.
                 self._signs = [(1 << (e[2] - 1)) if e[3] else 0 for e in entries]
@@ -223,7 +220,7 @@ class PdoChannel:
             raise _core.InvalidArgument(f"{self!r}: a TPDO is sent by the device (use add_callback)")
         with self._lock:
             if self._tx is None:
-                self._tx = _core.PdoSender(self._node.bus, self.cob_id, self._entries())
+                self._tx = _core.canopen.PdoSender(self._node.bus, self.cob_id, self._entries())
             tx = self._tx
         tx.send([int(v) for v in values], timeout)
 

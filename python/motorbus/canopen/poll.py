@@ -38,7 +38,7 @@ def sdo_poll_spec(kind: str, sdo: Any, bus: Any, fields: Sequence[str],
         if f not in objects:
             raise _core.InvalidArgument(f"{kind} poll field {f!r}: this kind gives {', '.join(objects)}")
         rows.append(objects[f])
-    source = _core.sdo_poll_source(sdo, [(i, s, t) for (i, s, t, _) in rows])
+    source = _core.canopen.sdo_poll_source(sdo, [(i, s, t) for (i, s, t, _) in rows])
     return PollSpec(source=source, scales=tuple(float(r[3]) for r in rows),
                     transport=bus if bus is not None else sdo, bus=bus)
 
@@ -81,16 +81,16 @@ def tpdo_capture_spec(kind: str, sdo: Any, bus: Any, node: int, fields: Sequence
     tpdos = []
     for number, mapping in zip(numbers, pdos):
         cob = 0x180 + 0x100 * (number - 1) + node   # the predefined connection set's COB-ID
-        _core.pdo_write_config(sdo, node, True, number, cob_id=cob, transmission_type=254, inhibit_100us=0,
-                               event_timer_ms=timer_ms, mapping=mapping, procedure=procedure)
+        _core.canopen.pdo_write_config(sdo, node, True, number, cob_id=cob, transmission_type=254, inhibit_100us=0,
+                                       event_timer_ms=timer_ms, mapping=mapping, procedure=procedure)
         tpdos.append((cob, mapping))
-    source = _core.PdoCaptureSource(bus, node, tpdos, columns, max_age=(3 * timer_ms + 2) / 1000)
-    bus.send(_core.nmt_encode(_core.NmtCommand.START, node))   # PDOs flow only in OPERATIONAL
+    source = _core.canopen.PdoCaptureSource(bus, node, tpdos, columns, max_age=(3 * timer_ms + 2) / 1000)
+    bus.send(_core.canopen.nmt_encode(_core.canopen.NmtCommand.START, node))   # PDOs flow only in OPERATIONAL
 
     def close() -> None:
         source.close()
         for number, (cob, _) in zip(numbers, tpdos):
-            _core.pdo_write_config(sdo, node, True, number, cob_id=cob, enabled=False, procedure="direct")
+            _core.canopen.pdo_write_config(sdo, node, True, number, cob_id=cob, enabled=False, procedure="direct")
 
 
     return PollSpec(source=source, scales=tuple(r[4] for r in rows), transport=bus, bus=bus,

@@ -12,11 +12,11 @@ from .. import _core
 
 __all__ = ["NodeInfo", "scan_network"]
 
-NodeInfo = _core.NodeInfo
+from .._core.canopen import NodeInfo  # noqa: E402,F401
 
 
-def scan_network(bus: _core.Bus, first: int = 1, last: int = 127, sdo_timeout: float = 0.2,
+def scan_network(bus: _core.can.Bus, first: int = 1, last: int = 127, sdo_timeout: float = 0.2,
                  listen: float = 0.0, probe_sdo: bool = True, identity: bool = True) -> List[NodeInfo]:
     """Nodes that answered an SDO probe of 0x1000 or were heard; sorted by node id.
     Takes about (1 + 4 if identity) x sdo_timeout, plus `listen`."""
-    return _core.scan_network(bus, first, last, sdo_timeout, listen, probe_sdo, identity)
+    return _core.canopen.scan_network(bus, first, last, sdo_timeout, listen, probe_sdo, identity)

@@ -11,15 +11,8 @@ from __future__ import annotations
 from typing import Iterator, Optional, Union
 
 from .. import _core
-from .._core import (  # noqa: F401
-    ABORT_CODES,
-    SdoAbortError,
-    SdoClient,
-    SdoClientCounters,
-    SdoProtocolError,
-    SdoTimeout,
-    abort_text,
-)
+from .._core import SdoAbortError, SdoProtocolError, SdoTimeout  # noqa: F401
+from .._core.canopen import ABORT_CODES, SdoClient, SdoClientCounters, abort_text  # noqa: F401
 from .od import NotFound, ObjectDictionary, Variable
 
 __all__ = ["SdoClient", "SdoClientCounters", "SdoAbortError", "SdoTimeout", "SdoProtocolError", "abort_text",

@@ -7,10 +7,7 @@
 """
 from __future__ import annotations
 
-from .. import _core
 
 __all__ = ["SyncProducer", "JitterStats", "sync_encode"]
 
-SyncProducer = _core.SyncProducer
-JitterStats = _core.JitterStats
-sync_encode = _core.sync_encode
+from .._core.canopen import SyncProducer, JitterStats, sync_encode  # noqa: E402,F401

@@ -6,9 +6,7 @@
 """
 from __future__ import annotations
 
-from .. import _core
 
 __all__ = ["time_encode", "time_decode"]
 
-time_encode = _core.time_encode
-time_decode = _core.time_decode
+from .._core.canopen import time_encode, time_decode  # noqa: E402,F401

@@ -19,12 +19,19 @@ from typing import Any, Optional, Union
 
 from .. import _core, _stop_at_exit
 from ..stopping import STOP_WAYS, check_stop_way  # noqa: F401  (STOP_WAYS re-exported: motorbus's, said once)
-from .._core import ArcusClientBase, ArcusClientCounters, ArcusCommandInfo, ArcusPhase, ArcusSim  # noqa: F401  (re-exported)
+from .._core.arcus import (  # noqa: F401  (re-exported)
+    ClientBase as ArcusClientBase, ClientCounters as ArcusClientCounters, CommandInfo as ArcusCommandInfo,
+    Phase as ArcusPhase, Sim as ArcusSim,
+)
 # The DMX-CAN's profile model (manual 000, Appendix A) and homing engine, with the motion
 # library's generic pieces in motorbus.motion: re-exported here, the vendor's own module.
-from .._core import (ARCUS_MAX_MOVE_DISTANCE, ArcusHoming, ArcusHomingOptions, ArcusMotion,  # noqa: F401
-                     ArcusProfileParams, ArcusSpeedWindow, arcus_check_strict, arcus_effective, arcus_max_acc_ms,
-                     arcus_speed_windows, arcus_window_for_hspd, arcus_window_for_sspdm)
+from .._core.arcus import (  # noqa: F401
+    MAX_MOVE_DISTANCE as ARCUS_MAX_MOVE_DISTANCE, Homing as ArcusHoming, HomingOptions as ArcusHomingOptions,
+    Motion as ArcusMotion, ProfileParams as ArcusProfileParams, SpeedWindow as ArcusSpeedWindow,
+    check_strict as arcus_check_strict, effective as arcus_effective, max_acc_ms as arcus_max_acc_ms,
+    speed_windows as arcus_speed_windows, window_for_hspd as arcus_window_for_hspd,
+    window_for_sspdm as arcus_window_for_sspdm,
+)
 
 __all__ = [
     "ARCUS_MAX_MOVE_DISTANCE", "ArcusHoming", "ArcusHomingOptions", "ArcusMotion", "ArcusProfileParams",
@@ -65,11 +72,10 @@ REPLY_TERMINATOR = b"\0"
 LINE_SETTINGS = {
     "request_terminator": REQUEST_TERMINATOR,
     "reply_terminators": [REPLY_TERMINATOR],
-    "max_line": _core.ARCUS_MAX_REPLY,
+    "max_line": _core.arcus.MAX_REPLY,
 }
 
-build_request = _core.arcus_build_request
-parse_reply = _core.arcus_parse_reply
+from .._core.arcus import build_request, parse_reply  # noqa: E402,F401
 
 
 class MotorStatus(enum.IntFlag):
@@ -142,8 +148,8 @@ class SyncCondition(enum.IntEnum):
     GREATER = 3
 
 
-def open_line(port: Union[str, "os.PathLike[str]", "_core.Port"], *, baud: int = 9600, timeout: float = 0.2,
-              turnaround: float = 0.0) -> "_core.LineLink":
+def open_line(port: Union[str, "os.PathLike[str]", "_core.serial.Port"], *, baud: int = 9600, timeout: float = 0.2,
+              turnaround: float = 0.0) -> "_core.serial.LineLink":
     """A LineLink framed for DMX-CAN (CR after requests, NUL after replies).
 
     ``port``: a device path (opened at ``baud``) or an open ``motorbus.serial.Port``.
@@ -151,11 +157,11 @@ def open_line(port: Union[str, "os.PathLike[str]", "_core.Port"], *, baud: int =
     before each request (slow RS-485 transceivers).  Share the link between
     several ArcusClient objects to talk to up to 99 devices on one RS-485 line."""
     if isinstance(port, (str, os.PathLike)):
-        port = _core.open_port(os.fspath(port), baud)
-    elif not isinstance(port, _core.Port):
+        port = _core.serial.open_port(os.fspath(port), baud)
+    elif not isinstance(port, _core.serial.Port):
         raise _core.InvalidArgument(f"arcus open_line: a path or a motorbus Port, not {type(port).__name__}")
-    return _core.LineLink(port, request_terminator=REQUEST_TERMINATOR, reply_terminators=[REPLY_TERMINATOR],
-                          max_line=_core.ARCUS_MAX_REPLY, reply_timeout=timeout, turnaround=turnaround)
+    return _core.serial.LineLink(port, request_terminator=REQUEST_TERMINATOR, reply_terminators=[REPLY_TERMINATOR],
+                                 max_line=_core.arcus.MAX_REPLY, reply_timeout=timeout, turnaround=turnaround)
 
 
 class ArcusClient(_stop_at_exit.StopsMotor, ArcusClientBase):
@@ -187,9 +193,9 @@ class ArcusClient(_stop_at_exit.StopsMotor, ArcusClientBase):
         check_stop_way(on_exit, "on_exit")
         number = _address(address)
         self._owned_port = None
-        if isinstance(line, _core.LineLink):
+        if isinstance(line, _core.serial.LineLink):
             link = line
-        elif isinstance(line, _core.Port):
+        elif isinstance(line, _core.serial.Port):
             link = open_line(line, timeout=0.2 if timeout is None else timeout)
         else:
             link = open_line(line, baud=baud, timeout=0.2 if timeout is None else timeout)
@@ -279,7 +285,7 @@ def check_address(text: str) -> str:
     return f"{_address(text):02d}"
 
 
-def make_sim(address: Union[str, int] = "01", clock: Optional["_core.Clock"] = None,
+def make_sim(address: Union[str, int] = "01", clock: Optional["_core.runtime.Clock"] = None,
              store_path: Optional[str] = None, **options: Any) -> ArcusSim:
     """A simulated DMX-CAN answering at ``address`` ("01".."99", "DMC05" accepted).
 
@@ -531,11 +537,11 @@ class ArcusDrive(_drive.Drive):
             # "?X..." also answers a move longer than the drive's largest (Table 11.0):
             # say which, in the Drive's words (read only on this path: a move stays one request).
             here = self._position()
-            if abs(goal - here) > _core.ARCUS_MAX_MOVE_DISTANCE:
+            if abs(goal - here) > _core.arcus.MAX_MOVE_DISTANCE:
                 raise _core.InvalidArgument(
                     f"arcus {self.native.address:02d}: a move from {here:g} to {goal} is "
                     f"{abs(goal - here):g} {'counts' if self._snl else 'pulses'}; the DMX-CAN moves at most "
-                    f"{_core.ARCUS_MAX_MOVE_DISTANCE} in one X (Table 11.0): split it") from None
+                    f"{_core.arcus.MAX_MOVE_DISTANCE} in one X (Table 11.0): split it") from None
             raise
 
     def _move_by(self, distance: float, velocity: Optional[float]) -> None:
@@ -690,7 +696,7 @@ class ArcusDrive(_drive.Drive):
     check_address = staticmethod(check_address)
 
     @classmethod
-    def probe(cls, line: "_core.LineLink", address: str) -> Optional[dict]:
+    def probe(cls, line: "_core.serial.LineLink", address: str) -> Optional[dict]:
         """Discovery: the product id and firmware of the drive at `address`, or None.
         Reads only (ID, VER): never moves the motor nor writes a parameter."""
         client = ArcusClient(line, address, on_error=None, on_exit=None, query_retries=0)
@@ -716,7 +722,7 @@ class ArcusDrive(_drive.Drive):
                 raise _core.InvalidArgument(f"arcus poll field {f!r}: this kind gives {', '.join(queries)}")
             names.append(queries[f])
         link = self.native.link
-        source = _core.arcus_poll_source(link, self.native.address, names)
+        source = _core.arcus.poll_source(link, self.native.address, names)
         return PollSpec(source=source, scales=(1.0,) * len(names), transport=link)
 
     def plan_move(self, start: float, target: float) -> Any:

@@ -7,7 +7,7 @@
         axis.home(19)                       # manual 000's method 19: home input, positive
         axis.params["Run current"] = 1200   # 2004h:02, by name or "0x2004:02"
 
-It is the same drive as the ASCII kind ``arcus``: one simulator (``_core.ArcusSim``)
+It is the same drive as the ASCII kind ``arcus``: one simulator (``_core.arcus.Sim``)
 with two front ends.  Which one answers is the communication type stored in
 200Ah (ASCII ``CM``) at the last power-up: a factory-fresh unit talks RS-232;
 ``make_sim(1, protocol="canopen")`` gives a unit set up for CAN.
@@ -27,7 +27,7 @@ import time
 from typing import Any, Optional, Union
 
 from .. import _core
-from .._core import ArcusMotion, ArcusProfileParams  # the DMX-CAN's profile model
+from .._core.arcus import Motion as ArcusMotion, ProfileParams as ArcusProfileParams  # the DMX-CAN's profile model
 from ..canopen.cia402 import Cia402, Controlword, OpMode
 from ..canopen.node import check_node_id
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveStalled, ParamInfo, Params,
@@ -40,7 +40,7 @@ __all__ = ["ArcusCanopen", "ArcusCanopenDrive", "ArcusCanopenSim", "ArcusHomingM
 
 # (index, sub, name, type, access, default, low, high, unit, persists): the OD the
 # simulator serves (Table 10.1), from the C++ table.
-OBJECTS = [tuple(row) for row in _core.arcus_canopen_objects()]
+OBJECTS = [tuple(row) for row in _core.arcus.canopen_objects()]
 _BY_KEY = {(r[0], r[1]): r for r in OBJECTS}
 
 _SW_INTERNAL_LIMIT = 1 << 11
@@ -88,7 +88,7 @@ def _check_node(address: Union[str, int]) -> str:
     return str(check_node_id(address, "arcus-canopen"))
 
 
-def _entry(index: int, sub: int) -> "_core.Variable":
+def _entry(index: int, sub: int) -> "_core.canopen.Variable":
     """The typed dictionary entry of one object of Table 10.1 (its C++ codec encodes and decodes)."""
     od = _dictionary()
     if (index, sub) not in od:
@@ -96,7 +96,7 @@ def _entry(index: int, sub: int) -> "_core.Variable":
     return od[index, sub]
 
 
-def _encode(var: "_core.Variable", value: int) -> bytes:
+def _encode(var: "_core.canopen.Variable", value: int) -> bytes:
     """The manual's range checked before anything is sent (the drive's answer to a value
     outside it is a bare abort), then the entry's codec."""
     where = f"arcus-canopen {var.name} (0x{var.index:04X}:{var.subindex:02X})"
@@ -212,11 +212,11 @@ class ArcusCanopen(Cia402):
         self.home(None if method is None else int(method), timeout)
 
 
-#: One simulated DMX-CAN: ``_core.ArcusSim`` itself, the whole drive in one object.  It is a
+#: One simulated DMX-CAN: ``_core.arcus.Sim`` itself, the whole drive in one object.  It is a
 #: ``SimulatedDevice`` (``attach(bus)`` serves its CAN front end, boot-up 0x700+n sent when CAN is in
 #: effect, and keeps the bus; ``close()``) and a ``LineDevice`` (``on_line``, for the pty server):
 #: it answers SDO while its stored communication type is CAN, ASCII lines while it is RS-232/485.
-ArcusCanopenSim = _core.ArcusSim
+ArcusCanopenSim = _core.arcus.Sim
 
 
 _SIM_OPTIONS = ("protocol", "store_path", "eo_boot", "snl", "home", "minus_limit", "plus_limit", "z_position",
@@ -230,8 +230,8 @@ SERVED_STORE_TIME = 0.1
 SERVED_CLEAR_TIME = 0.02
 
 
-def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, *,
-             bus: Optional[_core.Bus] = None, protocol: str = "canopen", ascii_address: int = 1,
+def make_sim(address: Union[str, int] = "1", clock: Optional[_core.runtime.Clock] = None, *,
+             bus: Optional[_core.can.Bus] = None, protocol: str = "canopen", ascii_address: int = 1,
              **options: Any) -> ArcusCanopenSim:
     """A simulated DMX-CAN at node-ID ``address``.  ``protocol="canopen"``: a unit set
     up for CAN (200Ah = 2, the CANopen tables' defaults); ``"ascii"``: factory-fresh
@@ -241,7 +241,7 @@ def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None
     rate the node answers only when its code in effect gives that rate.
     ``store_time``/``clear_time`` (s): how long 200Eh/200Dh read 1 (default
     SERVED_STORE_TIME/SERVED_CLEAR_TIME on the real clock, 0 on a given clock).
-    Other options: those of ``_core.ArcusSim`` (home, limits, snl, eo_boot, tick...)."""
+    Other options: those of ``_core.arcus.Sim`` (home, limits, snl, eo_boot, tick...)."""
     unknown = set(options) - set(_SIM_OPTIONS)
     if unknown:
         raise _core.InvalidArgument(f"arcus-canopen sim options: unknown {sorted(unknown)}; known {sorted(_SIM_OPTIONS)}")
@@ -251,8 +251,8 @@ def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None
     if clock is None:
         options.setdefault("store_time", SERVED_STORE_TIME)
         options.setdefault("clear_time", SERVED_CLEAR_TIME)
-    core = _core.ArcusSim(clock, address=int(ascii_address), node_id=node,
-                          comm_type=2 if protocol == "canopen" else 0, **options)
+    core = _core.arcus.Sim(clock, address=int(ascii_address), node_id=node,
+                           comm_type=2 if protocol == "canopen" else 0, **options)
     if bus is not None:
         core.attach(bus)
     return core
@@ -302,7 +302,7 @@ class ArcusCanopenParams(Params):
         var = _entry(index, sub)            # type, range, default: the typed entry's
         writable = var.access in ("rw", "wo")
         low, high = var.value_range if writable else (None, None)
-        return ParamInfo(name=name, type="str" if var.data_type == _core.DataType.VISIBLE_STRING else "int",
+        return ParamInfo(name=name, type="str" if var.data_type == _core.canopen.DataType.VISIBLE_STRING else "int",
                          minimum=low, maximum=high, unit=unit, default=var.default, persists=bool(persists),
                          writable=writable,
                          description=f"{n} (write-only: the drive cannot read it back)" if access == "wo" else n)
@@ -432,10 +432,10 @@ class ArcusCanopenDrive(Cia402Drive):
                 raise _core.DriveFault("arcus-canopen: move refused while the motor moves (the drive takes "
                                        "a single set-point once the move is done; stop() first)") from None
             distance = abs(target if relative else target - self._position())
-            if distance > _core.ARCUS_MAX_MOVE_DISTANCE:
+            if distance > _core.arcus.MAX_MOVE_DISTANCE:
                 raise _core.InvalidArgument(
                     f"{self.name}: move of {distance:g} refused by the drive: at most "
-                    f"{_core.ARCUS_MAX_MOVE_DISTANCE} per move (the firmware's limit; split it)") from None
+                    f"{_core.arcus.MAX_MOVE_DISTANCE} per move (the firmware's limit; split it)") from None
             raise
 
     def _jog(self, velocity: float) -> None:
@@ -453,7 +453,7 @@ class ArcusCanopenDrive(Cia402Drive):
         self.native.set_velocity(int(round(velocity)))
 
     @staticmethod
-    def object_dictionary() -> "_core.ObjectDictionary":
+    def object_dictionary() -> "_core.canopen.ObjectDictionary":
         """Table 10.1, typed: the CiA 402 adapter's reads and writes use its entries."""
         return _dictionary()
 
@@ -491,7 +491,7 @@ class ArcusCanopenDrive(Cia402Drive):
         bits (statusword 11, 60FDh).  The DMX-CAN has no 603Fh: a fault has no code beyond
         the StepNLoop status.  Out of FAULT: as any CiA 402 drive (quick stop, halt...)."""
         sw = int(status.raw)
-        state = _core.cia402_decode_statusword(sw)
+        state = _core.canopen.cia402_decode_statusword(sw)
         if state not in ("FAULT", "FAULT REACTION ACTIVE"):
             return super()._stop_reason(status)
         sls = int(self._read(0x2003))
@@ -538,18 +538,18 @@ SIM_FAULTS = {
 }
 
 
-def object_dictionary() -> "_core.ObjectDictionary":
+def object_dictionary() -> "_core.canopen.ObjectDictionary":
     """Table 10.1 as a typed motorbus ObjectDictionary (types, access, defaults, ranges and the
     C++ codec of each entry), built in C++ from the table the simulator serves
     (``cpp/motorbus/drives/arcus/canopen_od.cpp``); the EDS (:func:`eds_text`) is generated
     from it.  A fresh dictionary per call (tools may change its values)."""
-    return _core.arcus_canopen_object_dictionary()
+    return _core.arcus.canopen_object_dictionary()
 
 
-_OD: Optional["_core.ObjectDictionary"] = None
+_OD: Optional["_core.canopen.ObjectDictionary"] = None
 
 
-def _dictionary() -> "_core.ObjectDictionary":
+def _dictionary() -> "_core.canopen.ObjectDictionary":
     """object_dictionary(), made once: the client's and the adapter's codecs (read only)."""
     global _OD
     if _OD is None:

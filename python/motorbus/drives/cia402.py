@@ -56,19 +56,19 @@ _CW_HALT = 1 << 8
 # (index, sub, name, type, access, default, low, high, unit, persists, description): the objects
 # the simulator serves and the adapter's params describe -- one table, in C++
 # (cpp/motorbus/drives/cia402/sim.cpp ``objects()``); typed, it is object_dictionary().
-OBJECTS = [tuple(row) for row in _core.cia402_objects()]
+OBJECTS = [tuple(row) for row in _core.cia402.objects()]
 _SAVE = 0x65766173  # CiA 301 1010h signature "save" (ASCII, little-endian)
-_OD: Optional["_core.ObjectDictionary"] = None
+_OD: Optional["_core.canopen.ObjectDictionary"] = None
 
 
-def object_dictionary() -> "_core.ObjectDictionary":
+def object_dictionary() -> "_core.canopen.ObjectDictionary":
     """The objects the generic simulator serves, as the typed dictionary built in C++ from
-    its table (``_core.cia402_object_dictionary``: the rows plus 1010h:01): the adapter
+    its table (``_core.cia402.object_dictionary``: the rows plus 1010h:01): the adapter
     reads and writes each object with its entry's codec (``Variable.encode/decode``);
     nothing is packed in Python.  Made once, read only."""
     global _OD
     if _OD is None:
-        _OD = _core.cia402_object_dictionary()
+        _OD = _core.cia402.object_dictionary()
     return _OD
 
 
@@ -79,12 +79,12 @@ def _check_node(address: Union[str, int]) -> str:
 
 # The simulator is C++ (cpp/motorbus/drives/cia402/sim.hpp): a LocalNode with a
 # HeartbeatService, a PdoService and a canopen::Cia402Axis on a motor model.
-Cia402Sim = _core.Cia402Sim
+Cia402Sim = _core.cia402.Sim
 _SIM_OPTIONS = ("steps_per_rev", "home", "minus_limit", "plus_limit", "heartbeat_ms", "start_position")
 
 
-def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None, *,
-             bus: Optional[_core.Bus] = None, **options: Any) -> Any:
+def make_sim(address: Union[str, int] = "1", clock: Optional[_core.runtime.Clock] = None, *,
+             bus: Optional[_core.can.Bus] = None, **options: Any) -> Any:
     """A simulated CiA 402 drive at node ``address`` (the C++ ``Cia402Sim``); attached to
     ``bus`` when given.  Options: ``steps_per_rev`` (motor model, default 3200), ``home=(lo, hi)``
     (home switch window in increments, default (1000, 1400)), ``minus_limit`` / ``plus_limit``
@@ -96,7 +96,7 @@ def make_sim(address: Union[str, int] = "1", clock: Optional[_core.Clock] = None
         raise _core.InvalidArgument(f"cia402 sim options: unknown {sorted(unknown)}; known {sorted(_SIM_OPTIONS)}")
     # A value of the wrong type is pybind's TypeError, as for every simulator's constructor:
     # a bench file's loader then names the option (Bench._make_sim).
-    sim = _core.Cia402Sim(int(_check_node(address)), clock, **options)
+    sim = _core.cia402.Sim(int(_check_node(address)), clock, **options)
     if bus is not None:
         sim.attach(bus)
     return sim
@@ -185,12 +185,12 @@ class Cia402Params(Params):
             if name == f"0x{i:04X}" + (f":{s:02X}" if s else ""):
                 var = object_dictionary()[i, s]     # type and range: the typed entry's
                 low, high = var.value_range or (None, None)
-                return ParamInfo(name=name, type="str" if var.data_type == _core.DataType.VISIBLE_STRING else "int",
+                return ParamInfo(name=name, type="str" if var.data_type == _core.canopen.DataType.VISIBLE_STRING else "int",
                                  minimum=low, maximum=high, unit=unit, default=default, persists=persists,
                                  writable=access != "ro", description=f"{n}: {desc[0]}" if desc else n)
         return None
 
-    def _where(self, info: ParamInfo) -> "_core.Variable":
+    def _where(self, info: ParamInfo) -> "_core.canopen.Variable":
         idx, _, sub = info.name.partition(":")
         return object_dictionary()[int(idx, 16), int(sub, 16) if sub else 0]
 
@@ -251,7 +251,7 @@ class Cia402Drive(Drive):
         return 1 if node.profile == 402 else 0
 
     @classmethod
-    def synchronised_start(cls, bus: _core.Bus, drives: Sequence["Cia402Drive"]) -> Any:
+    def synchronised_start(cls, bus: _core.can.Bus, drives: Sequence["Cia402Drive"]) -> Any:
         return synchronised_start(bus, drives)
 
     @classmethod
@@ -293,7 +293,7 @@ class Cia402Drive(Drive):
         self._mode: Optional[int] = None
         # A synchronised start in progress: the bus its SYNC comes on, and the controlword
         # (without the set-point bit) of the move held in the RPDO until then.
-        self._sync_bus: Optional[_core.Bus] = None
+        self._sync_bus: Optional[_core.can.Bus] = None
         self._held_cw: Optional[int] = None
         self._sync_rpdo: Optional[tuple] = None   # (COB-ID, PdoMap) of the synchronised-start RPDO
         self._homed = False                      # the last homing attained (sticky until the next)
@@ -376,7 +376,7 @@ class Cia402Drive(Drive):
             raise
 
     # ---- SYNC-triggered start (see synchronised_start) ----
-    def _arm_sync_start(self, bus: _core.Bus) -> None:
+    def _arm_sync_start(self, bus: _core.can.Bus) -> None:
         """Maps RPDO SYNC_START_RPDO (once): synchronous (type 1), target position then
         controlword — in that order, because the drive applies the entries in mapping order
         and the set-point edge must find the new target already written.  Starts the node
@@ -390,7 +390,7 @@ class Cia402Drive(Drive):
                 entries.append((index, 0, 8 * var.size, var.value_range[0] < 0))
             configure_pdo(self._sdo, node, rpdo=SYNC_START_RPDO, transmission_type=1, mapping=entries)
             self._sync_rpdo = (read_pdo_config(self._sdo, node, rpdo=SYNC_START_RPDO).cob_id, PdoMap(entries))
-        bus.send(_core.nmt_encode(_core.NmtCommand.START, node))   # PDOs flow only in OPERATIONAL
+        bus.send(_core.canopen.nmt_encode(_core.canopen.NmtCommand.START, node))   # PDOs flow only in OPERATIONAL
         self._sync_bus = bus
 
     def _hold_set_point(self, target: int, relative: bool) -> None:
@@ -398,7 +398,7 @@ class Cia402Drive(Drive):
         # As in an SDO move: the previous acknowledge must have dropped for the edge to count.
         self.native.wait_statusword(_SW_BIT12, 0)
         cob, layout = self._sync_rpdo
-        self._sync_bus.send(_core.Frame(cob, layout.pack([target, base | _CW_NEW_SETPOINT])))
+        self._sync_bus.send(_core.can.Frame(cob, layout.pack([target, base | _CW_NEW_SETPOINT])))
         self._held_cw = base
 
     def _release_sync_start(self, started: bool) -> None:
@@ -411,7 +411,7 @@ class Cia402Drive(Drive):
             return
         if not started:
             cob, layout = self._sync_rpdo
-            bus.send(_core.Frame(cob, layout.pack([int(self._read(0x607A)), base])))
+            bus.send(_core.can.Frame(cob, layout.pack([int(self._read(0x607A)), base])))
             return
         try:
             self.native.wait_statusword(_SW_BIT12, _SW_BIT12)
@@ -448,7 +448,7 @@ class Cia402Drive(Drive):
         self._operation_enabled()
         self._use_mode(OpMode.HOMING)
         if method is not None:
-            if not isinstance(method, int) or not _core.Cia402Homing.supported(method):
+            if not isinstance(method, int) or not _core.motion.Cia402Homing.supported(method):
                 raise _core.InvalidArgument(f"cia402 home: method 7, 11, 17-20 or 33-35, not {method!r}")
             self._download(0x6098, int(method))
         self._start_homing()
@@ -470,7 +470,7 @@ class Cia402Drive(Drive):
         interrupted homing (reached without attained, or the drive left Operation Enabled)
         so that the outcome is judged (a halt or quick stop: MoveInterrupted)."""
         sw = self._statusword()
-        state = _core.cia402_decode_statusword(sw)
+        state = _core.canopen.cia402_decode_statusword(sw)
         if state in ("FAULT", "FAULT REACTION ACTIVE") or sw & _SW_BIT13:
             if sw & _SW_BIT13 and state == "OPERATION ENABLED":
                 self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
@@ -512,7 +512,7 @@ class Cia402Drive(Drive):
         error (bit 13), a standstill at an internal limit (bit 11); or out of Operation
         Enabled (fault, quick stop done, disabled) -- with the velocity 0."""
         sw = self._statusword()
-        state = _core.cia402_decode_statusword(sw)
+        state = _core.canopen.cia402_decode_statusword(sw)
         if state == "FAULT REACTION ACTIVE":
             return False
         if state == "OPERATION ENABLED":
@@ -566,7 +566,7 @@ class Cia402Drive(Drive):
         drive out of Operation Enabled, or a halt (6040h bit 8) that this program did not
         send."""
         sw = int(status.raw)
-        state = _core.cia402_decode_statusword(sw)
+        state = _core.canopen.cia402_decode_statusword(sw)
         ours = self._move is not None and self._move.stopped_by is not None
         if state in ("FAULT", "FAULT REACTION ACTIVE"):
             code = int(self._read(0x603F))
@@ -625,7 +625,7 @@ class Cia402Drive(Drive):
 
     def _status(self) -> DriveStatus:
         sw = self._statusword()
-        state = _core.cia402_decode_statusword(sw)
+        state = _core.canopen.cia402_decode_statusword(sw)
         inputs = self._digital_inputs()
         velocity = self._velocity()
         mode = self._mode
@@ -669,7 +669,7 @@ SYNC_START_RPDO = 4
 
 
 @contextlib.contextmanager
-def synchronised_start(bus: _core.Bus, drives: Sequence[Cia402Drive]) -> Iterator[str]:
+def synchronised_start(bus: _core.can.Bus, drives: Sequence[Cia402Drive]) -> Iterator[str]:
     """Moves commanded inside the block start together on one CANopen SYNC.
 
     Each drive gets its set-point (target position and the controlword with the
@@ -686,7 +686,7 @@ def synchronised_start(bus: _core.Bus, drives: Sequence[Cia402Drive]) -> Iterato
         for d in drives:
             d._release_sync_start(started=False)
         raise
-    bus.send(_core.Frame(0x080, b""))       # SYNC (COB-ID 0x080): every held RPDO applies now
+    bus.send(_core.can.Frame(0x080, b""))       # SYNC (COB-ID 0x080): every held RPDO applies now
     for d in drives:
         d._release_sync_start(started=True)
 

@@ -2,7 +2,7 @@
 
 Example — a simulated module on a pty, driven through the typed client::
 
-    from motorbus._core import SimClock
+    from motorbus._core.runtime import SimClock
     from motorbus.serial import PtyLineServer
     from motorbus.drives.dmac import DmacClient, DmacStatus, make_sim
 
@@ -30,26 +30,23 @@ from .. import _core, _stop_at_exit
 from ..stopping import check_stop_way
 # The DMAC's profile model (#ACCEL_TIME/#DECEL_TIME, the closed-loop approach at #LOW_SPEED):
 # the vendor's own module re-exports it (motorbus.motion keeps the generic planners).
-from .._core import (DmacMotion, DmacProfileParams, dmac_position_profile, dmac_ramp_time,  # noqa: F401
-                     dmac_speed_profile)
+from .._core.dmac import (  # noqa: F401
+    Motion as DmacMotion, ProfileParams as DmacProfileParams, position_profile as dmac_position_profile,
+    ramp_time as dmac_ramp_time, speed_profile as dmac_speed_profile,
+)
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFailed, MoveFaulted, MoveInterrupted,
                      MoveTimedOut, ParamInfo, Params, StopReason)
 
-DmacSim = _core.DmacSim
-DmacSimState = _core.DmacSimState
-DmacRadix = _core.DmacRadix
-DmacReadReply = _core.DmacReadReply
-DmacVariableInfo = _core.DmacVariableInfo
-DmacVersionInfo = _core.DmacVersionInfo
-DmacClientCounters = _core.DmacClientCounters
-DmacStreamStats = _core.DmacStreamStats
+from .._core.dmac import (  # noqa: E402,F401
+    Sim as DmacSim, SimState as DmacSimState, Radix as DmacRadix, ReadReply as DmacReadReply,
+    VariableInfo as DmacVariableInfo, VersionInfo as DmacVersionInfo, ClientCounters as DmacClientCounters,
+    StreamStats as DmacStreamStats,
+)
 UnknownCommand = _core.DmacUnknownCommand
 CommandRejected = _core.DmacCommandRejected
-format_value = _core.dmac_format_value
-parse_read_reply = _core.dmac_parse_read_reply
-status_names = _core.dmac_status_names
-error_names = _core.dmac_error_names
-variable_info = _core.dmac_variable
+from .._core.dmac import (  # noqa: E402,F401
+    format_value, parse_read_reply, status_names, error_names, variable as variable_info,
+)
 
 #: Line settings of a DMAC bus (what ``motorbus sim serve --drive dmac:NN`` uses).
 LINE_SETTINGS = {"request_terminator": b"\r", "reply_terminators": [b"\r\n"], "max_line": 256}
@@ -238,7 +235,7 @@ def open_line(port: Any, *, baud: int = DEFAULT_BAUD, timeout: float = 0.5, turn
                     max_line=LINE_SETTINGS["max_line"], reply_timeout=timeout, turnaround=turnaround)
 
 
-class DmacClient(_stop_at_exit.StopsMotor, _core.DmacClient):
+class DmacClient(_stop_at_exit.StopsMotor, _core.dmac.Client):
     """Typed DMAC commands for the module at ``address`` on a line.
 
     ``DmacClient(line, address=0, *, baud=38400, timeout=None, verify=True,
@@ -269,9 +266,9 @@ class DmacClient(_stop_at_exit.StopsMotor, _core.DmacClient):
             from ..serial import open_port
             self._port = open_port(line, baud)
             line = open_line(self._port, baud=baud, timeout=0.5 if timeout is None else timeout)
-        elif isinstance(line, _core.Port):
+        elif isinstance(line, _core.serial.Port):
             line = open_line(line, baud=baud, timeout=0.5 if timeout is None else timeout)
-        elif not isinstance(line, _core.LineLink):
+        elif not isinstance(line, _core.serial.LineLink):
             raise _core.InvalidArgument(f"DmacClient line: a path, a Port or a LineLink, not {type(line).__name__}")
         super().__init__(line, address=_parse_address(address), baud=baud, verify=verify, timeout=timeout,
                          sleep=sleep)
@@ -364,7 +361,7 @@ _REAL_CLOCK: Any = None
 def _real_clock() -> Any:
     global _REAL_CLOCK
     if _REAL_CLOCK is None:
-        _REAL_CLOCK = _core.RealClock()
+        _REAL_CLOCK = _core.runtime.RealClock()
     return _REAL_CLOCK
 
 
@@ -386,7 +383,7 @@ def wire_line(sims: Sequence[DmacSim]) -> None:
 
 def synchro(link: Any, what: str) -> None:
     """Global ``SYNCHRO ON|OFF|TOP|INTERPOL`` (no module answers it)."""
-    _core.dmac_synchro(link, what)
+    _core.dmac.synchro(link, what)
 
 
 @contextlib.contextmanager
@@ -408,7 +405,7 @@ def synchronised_start(link: Any, drives: Sequence[Any]) -> Iterator[str]:
 
 def stream_interpolation(axes: Sequence[DmacClient], segments: Iterable[Sequence[int]],
                          interpol_time_ms: int = 100, fifo_size: int = 64, sleep: Any = None,
-                         backoff: Optional[float] = None) -> "_core.DmacStreamStats":
+                         backoff: Optional[float] = None) -> "_core.dmac.StreamStats":
     """Stream ``segments[k][axis]`` (MOVE_INTERPOL offsets) to every axis.
 
     Pre-fills each FIFO, starts all axes with the global SYNCHRO INTERPOL, then
@@ -416,9 +413,9 @@ def stream_interpolation(axes: Sequence[DmacClient], segments: Iterable[Sequence
     ``DmacStreamStats`` (``.segments``, ``.xon_errors``, ``.underruns``,
     ``.min_level_after_start``...).
     """
-    return _core.dmac_stream_interpolation(list(axes), [list(map(int, s)) for s in segments],
+    return _core.dmac.stream_interpolation(list(axes), [list(map(int, s)) for s in segments],
                                            interpol_time_ms, fifo_size, sleep, backoff)
-def dmac_interpolation(start: Sequence[float], target: Sequence[float], limits: Sequence["_core.Limits"],
+def dmac_interpolation(start: Sequence[float], target: Sequence[float], limits: Sequence["_core.motion.Limits"],
                        period_ms: int = 100, straight_line: bool = True) -> Any:
     """Plan a synchronised multi-axis move and split it into MOVE_INTERPOL offsets.
 
@@ -432,7 +429,7 @@ def dmac_interpolation(start: Sequence[float], target: Sequence[float], limits: 
     from .. import motion
 
     # The module's own range for #INTERPOL_TIME (the splitter takes any period from 1 ms).
-    rng = _core.dmac_variable("#INTERPOL_TIME")
+    rng = _core.dmac.variable("#INTERPOL_TIME")
     if not rng.min <= period_ms <= rng.max:
         bound = rng.min if period_ms < rng.min else rng.max
         e = _core.LimitExceeded(f"#INTERPOL_TIME: requested {period_ms} is outside {rng.min}..{rng.max} (ms per segment)")
@@ -888,7 +885,7 @@ class DmacDrive(Drive):
     synchronised_start = staticmethod(synchronised_start)
 
     @classmethod
-    def probe(cls, line: "_core.LineLink", address: str) -> Optional[dict]:
+    def probe(cls, line: "_core.serial.LineLink", address: str) -> Optional[dict]:
         """Discovery: REQUEST_VERSION of the module at `address`, or None.  Reads only."""
         client = DmacClient(line, address=int(address), verify=False, on_error=None, on_exit=None)
         try:
@@ -916,7 +913,7 @@ class DmacDrive(Drive):
             if f not in reads:
                 raise _core.InvalidArgument(f"dmac poll field {f!r}: this kind gives {', '.join(reads)}")
         n = self.native
-        source = _core.dmac_poll_source(n.link, n.address, [reads[f][0] for f in fields], baud=n.baud,
+        source = _core.dmac.poll_source(n.link, n.address, [reads[f][0] for f in fields], baud=n.baud,
                                         timeout=n.timeout)
         return PollSpec(source=source, scales=tuple(reads[f][1] for f in fields), transport=n.link)
 

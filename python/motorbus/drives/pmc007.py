@@ -12,10 +12,10 @@
 The native client :class:`Pmc007` is a profile of the CANopen node facade, as
 canopen's ``BaseNode402`` is a ``RemoteNode``: a :class:`motorbus.canopen.RemoteNode`
 whose object dictionary is the C++ one of the device (``cpp/motorbus/drives/pmc007/od_table.cpp``,
-handed up typed by ``_core.pmc007_object_dictionary``; the EDS shipped next to this module
+handed up typed by ``_core.pmc007.object_dictionary``; the EDS shipped next to this module
 is generated from the same table).  An object by name is an entry of that dictionary
 read and written through the node's SDO client with the entry's C++ codec; PDOs are
-the node's ``tpdo``/``rpdo`` channels (the C++ PDO engine packs and unpacks them).  The simulator (:class:`~motorbus._core.Pmc007Sim`, ``make_sim``)
+the node's ``tpdo``/``rpdo`` channels (the C++ PDO engine packs and unpacks them).  The simulator (:class:`~motorbus._core.pmc007.Sim`, ``make_sim``)
 is C++: a LocalNode with that dictionary, heartbeat, PDOs, EMCY, motion on the
 motor model.
 
@@ -42,8 +42,11 @@ from ..canopen.pdo import PdoChannel
 from ..canopen.sdo import SdoVariable
 # The PMC007's profile model (start/stop speeds, gear table, microstepping): the vendor's own module
 # re-exports it (motorbus.motion keeps the generic planners).
-from .._core import (Pmc007ProfileParams, pmc007_convert_position, pmc007_gear_acceleration,  # noqa: F401
-                     pmc007_microsteps, pmc007_position_profile, pmc007_speed_profile)
+from .._core.pmc007 import (  # noqa: F401
+    ProfileParams as Pmc007ProfileParams, convert_position as pmc007_convert_position,
+    gear_acceleration as pmc007_gear_acceleration, microsteps as pmc007_microsteps,
+    position_profile as pmc007_position_profile, speed_profile as pmc007_speed_profile,
+)
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, MoveStalled,
                      ParamInfo, Params, StopReason, Units)
 
@@ -58,7 +61,7 @@ EDS_PATH = os.path.join(os.path.dirname(__file__), "pmc007.eds")
 #: 2003h baud index -> kbit/s (003 §4.3.2).
 BAUD_RATES = {0: 20, 1: 25, 2: 50, 3: 100, 4: 125, 5: 250, 6: 500, 7: 800, 8: 1000}
 #: 6008h/6009h gear -> pps² (003 §4.5.12; 0 = no ramp).
-GEAR_ACCELERATION = {g: _core.pmc007_gear_acceleration(g) for g in range(1, 9)}
+GEAR_ACCELERATION = {g: _core.pmc007.gear_acceleration(g) for g in range(1, 9)}
 #: 003 §4.5.19: the manual's stall-detection reference rows (6017h values).
 STALL_EXAMPLES = {
     "28mm 5.7mH 900mA 24V 8 microsteps": 0x64E6,
@@ -99,7 +102,7 @@ def _snake(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_")
 
 
-def _build_objects(od: "_core.ObjectDictionary") -> dict:
+def _build_objects(od: "_core.canopen.ObjectDictionary") -> dict:
     """Python name -> the dictionary's typed entry (``motorbus.canopen.Variable``); names
     are snake_case of the manual's object names ("start_speed"), "<record>.<member>" for
     sub-indexed ones ("external_emergency_stop.enable")."""
@@ -117,18 +120,18 @@ def _build_objects(od: "_core.ObjectDictionary") -> dict:
 
 #: Every object of the dictionary by its Python name (see _build_objects): the typed
 #: entries of the C++ table (data type, access, limits, default, encode/decode).
-OBJECTS = _build_objects(_core.pmc007_object_dictionary())
+OBJECTS = _build_objects(_core.pmc007.object_dictionary())
 _BY_INDEX = {(v.index, v.subindex): k for k, v in OBJECTS.items()}
 
 
 def assemble(text: str) -> list[int]:
     """Offline-program text ("ROT 0,3200" per line) -> 6019h:02 words.  The word encoding
     is not in the manual: opcode << 24 | option << 20 | data (the spec's reading)."""
-    return list(_core.pmc007_assemble(text))
+    return list(_core.pmc007.assemble(text))
 
 
 def disassemble(words: Iterable[int]) -> str:
-    return _core.pmc007_disassemble([int(w) for w in words])
+    return _core.pmc007.disassemble([int(w) for w in words])
 
 
 def _check_node(address: Union[str, int]) -> str:
@@ -144,7 +147,7 @@ def _object_property(name: str, doc: str) -> property:
 class Pmc007(_stop_at_exit.StopsMotor, RemoteNode):
     """The native client: a PMC007 profile of a CANopen node (``motorbus.canopen.RemoteNode``).
 
-    ``Pmc007(bus, node=5)`` (a ``_core.Bus`` or ``motorbus.open_bus`` text).  Objects by
+    ``Pmc007(bus, node=5)`` (a ``_core.can.Bus`` or ``motorbus.open_bus`` text).  Objects by
     name: ``drive["start_speed"]``, ``drive.read("0x6006")``, ``drive.write("6006h", 600)``;
     properties for the common ones.  Underneath is the node: ``object_dictionary`` (the
     device's C++ table, typed), ``sdo`` (its SDO client), ``tpdo``/``rpdo``, ``nmt``.
@@ -161,7 +164,7 @@ class Pmc007(_stop_at_exit.StopsMotor, RemoteNode):
         if self._owns:
             from ..bus import open_bus
             bus = open_bus(bus)
-        super().__init__(bus, node_id, _core.pmc007_object_dictionary(node_id), timeout)
+        super().__init__(bus, node_id, _core.pmc007.object_dictionary(node_id), timeout)
         self.node = node_id
         self.on_error, self.on_exit = on_error, on_exit
         self._vars: dict = {}       # Python name -> the node's SdoVariable (made on first use)
@@ -483,9 +486,9 @@ class TpdoStream:
 
 # ---- simulator -------------------------------------------------------------------------
 
-def make_sim(address: Union[str, int] = "5", clock: Optional[_core.Clock] = None, *,
-             bus: Optional[_core.Bus] = None, **options: Any) -> Any:
-    """A simulated PMC007 at node ``address`` (``_core.Pmc007Sim``); attached to ``bus`` when given.
+def make_sim(address: Union[str, int] = "5", clock: Optional[_core.runtime.Clock] = None, *,
+             bus: Optional[_core.can.Bus] = None, **options: Any) -> Any:
+    """A simulated PMC007 at node ``address`` (``_core.pmc007.Sim``); attached to ``bus`` when given.
     Options: ``steps_per_rev`` (200), ``pull_out_speed`` (0 = never stalls by speed),
     ``ext1_switch=(lo, hi)``: a switch wired to EXT1, low while the position is inside
     (default (-1e9, -1000): a home switch on the negative side, for homing into EXT1),
@@ -498,7 +501,7 @@ def make_sim(address: Union[str, int] = "5", clock: Optional[_core.Clock] = None
     unknown = set(options) - known
     if unknown:
         raise _core.InvalidArgument(f"pmc007 sim options: unknown {sorted(unknown)}; known {sorted(known)}")
-    sim = _core.Pmc007Sim(int(_check_node(address)), clock, **options)
+    sim = _core.pmc007.Sim(int(_check_node(address)), clock, **options)
     if bus is not None:
         sim.attach(bus)
     return sim
@@ -525,9 +528,9 @@ class Pmc007Params(Params):
             return None
         var = self._drive.native.variable(name).od     # the node's own entry (defaults for its node-ID)
         low, high = var.value_range or (None, None)
-        return ParamInfo(name=name, type="str" if var.data_type == _core.DataType.VISIBLE_STRING else "int",
+        return ParamInfo(name=name, type="str" if var.data_type == _core.canopen.DataType.VISIBLE_STRING else "int",
                          minimum=low, maximum=high, default=var.default,
-                         persists=_core.pmc007_storage(var.index, var.subindex) == _core.Pmc007Storage.ROM,
+                         persists=_core.pmc007.storage(var.index, var.subindex) == _core.pmc007.Storage.ROM,
                          writable=var.access in ("rw", "wo"),
                          description=f"{var.index:04X}h:{var.subindex:02X} {var.name}")
 

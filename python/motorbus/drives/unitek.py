@@ -54,7 +54,7 @@ from typing import Any, Callable, Optional, Sequence, Union
 from .. import _core, _stop_at_exit
 from ..stopping import check_stop_way
 # The drive's speed ramps (ACC 0x35 / DEC 0xED): the vendor's own module re-exports the model.
-from .._core import UnitekRampParams, unitek_speed_profile  # noqa: F401
+from .._core.unitek import RampParams as UnitekRampParams, speed_profile as unitek_speed_profile  # noqa: F401
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, ParamInfo, Params,
                      StopReason, Units)
 from ..registry import PollSpec
@@ -64,7 +64,7 @@ __all__ = ["FrameError", "UnknownRegister", "CyclicLimit", "Reg", "Status", "Mod
            "btr_for_bit_rate", "bit_rate_for_btr", "current_limit_num", "CURRENT_COMMAND_MAX", "UnitekRampParams",
            "unitek_speed_profile"]
 
-#: Typed errors (also motorbus._core.Unitek*).
+#: Typed errors (also motorbus._core.Unitek*: the errors are at _core top level).
 FrameError = _core.UnitekFrameError          # a frame breaking the protocol; .byte, .data
 UnknownRegister = _core.UnitekUnknownRegister  # REGID not in the table; .regid
 CyclicLimit = _core.UnitekCyclicLimit        # a 9th cyclic register
@@ -77,25 +77,25 @@ _NDRIVE_TOML = Path(__file__).with_name("unitek_ndrive.toml")
 
 #: §3.1: (bit rate in kbit/s, NDrive's BTR setting value, longest line in m).  The bit rate is
 #: set in NDrive's CAN-Setup, not over CAN: open the bus at the drive's rate.
-BIT_TIMINGS = tuple((r["kbit_s"], r["btr"], r["max_line_m"]) for r in _core.unitek_bit_timings())
+BIT_TIMINGS = tuple((r["kbit_s"], r["btr"], r["max_line_m"]) for r in _core.unitek.bit_timings())
 #: §6.1: the current command range, "+/- 9 bit".
 CURRENT_COMMAND_MAX = 511
 
 
 def btr_for_bit_rate(bit_rate: float) -> int:
     """The BTR setting of a bit rate (bit/s); InvalidArgument naming the table's five."""
-    return _core.unitek_btr_for_bit_rate(bit_rate)
+    return _core.unitek.btr_for_bit_rate(bit_rate)
 
 
 def bit_rate_for_btr(btr: int) -> float:
     """The bit rate (bit/s) of a BTR setting value; InvalidArgument naming the table's five."""
-    return _core.unitek_bit_rate_for_btr(btr)
+    return _core.unitek.bit_rate_for_btr(btr)
 
 
 def current_limit_num(device: str, motor_limit_num: int) -> int:
     """§6.1 "the smaller value is effective": the peak current (num) a ``device`` ("DS 205/405",
     "DS 412", "DS 420") delivers with a motor limit of ``motor_limit_num``."""
-    return _core.unitek_effective_current_limit_num(device, motor_limit_num)
+    return _core.unitek.effective_current_limit_num(device, motor_limit_num)
 
 
 class Reg(enum.IntEnum):
@@ -175,16 +175,16 @@ class ModeBit(enum.IntFlag):
     EVENTS = 1 << 4
 
 
-_QUANTITIES = {"raw": _core.UnitekQuantity.RAW, "speed": _core.UnitekQuantity.SPEED,
-               "position": _core.UnitekQuantity.POSITION, "current": _core.UnitekQuantity.CURRENT,
-               "torque": _core.UnitekQuantity.TORQUE, "time": _core.UnitekQuantity.TIME}
-_ACCESS = {"rw": _core.UnitekAccess.RW, "ro": _core.UnitekAccess.RO, "wo": _core.UnitekAccess.WO}
+_QUANTITIES = {"raw": _core.unitek.Quantity.RAW, "speed": _core.unitek.Quantity.SPEED,
+               "position": _core.unitek.Quantity.POSITION, "current": _core.unitek.Quantity.CURRENT,
+               "torque": _core.unitek.Quantity.TORQUE, "time": _core.unitek.Quantity.TIME}
+_ACCESS = {"rw": _core.unitek.Access.RW, "ro": _core.unitek.Access.RO, "wo": _core.unitek.Access.WO}
 _ROW_KEYS = {"regid", "name", "bits", "signed", "access", "quantity", "unit", "scale", "min", "max", "description"}
 
 
 def builtin_registers() -> Any:
     """The documented REGIDs as a register table (a copy you may extend)."""
-    return _core.UnitekRegisterTable()
+    return _core.unitek.RegisterTable()
 
 
 def _rows_from_toml(data: dict, where: str) -> list:
@@ -214,7 +214,7 @@ def _rows_from_toml(data: dict, where: str) -> list:
         if access not in _ACCESS:
             raise _core.InvalidArgument(f"{label} ({name}): access {access!r} not one of {sorted(_ACCESS)}")
         try:
-            out.append(_core.UnitekRegister(
+            out.append(_core.unitek.Register(
                 regid, name, bits=int(row.get("bits", 16)), signed=bool(row.get("signed", False)),
                 access=_ACCESS[access], quantity=_QUANTITIES[quantity], unit=str(row.get("unit", "")),
                 scale=float(row.get("scale", 1.0)), min=row.get("min"), max=row.get("max"),
@@ -314,7 +314,7 @@ class Stream:
 
 # ---- the native client ------------------------------------------------------------------
 
-class Unitek(_stop_at_exit.StopsMotor, _core.UnitekClient):
+class Unitek(_stop_at_exit.StopsMotor, _core.unitek.Client):
     """The register protocol of one drive (see the module doc): the C++
     ``unitek::Client`` with registers by name or :class:`Reg`, values in physical
     units, :class:`Status`/:class:`ModeBit` types and numpy streams.
@@ -329,11 +329,11 @@ class Unitek(_stop_at_exit.StopsMotor, _core.UnitekClient):
                  clock: Any = None, on_error: Optional[str] = "stop", on_exit: Optional[str] = "stop") -> None:
         check_stop_way(on_error, "on_error")
         check_stop_way(on_exit, "on_exit")
-        currents = {d["device"]: d for d in _core.unitek_device_currents()}
+        currents = {d["device"]: d for d in _core.unitek.device_currents()}
         if device not in currents:
             raise _core.InvalidArgument(f"unitek device: one of {sorted(currents)}, not {device!r}")
         d = currents[device]
-        self.scalings = _core.UnitekScalings(n_max_rpm=n_max_rpm, i_max_num=d["i_max_num"], i_max_a=d["i_max_a"])
+        self.scalings = _core.unitek.Scalings(n_max_rpm=n_max_rpm, i_max_num=d["i_max_num"], i_max_a=d["i_max_a"])
         if registers is None:
             table = ndrive_registers()
         elif isinstance(registers, (str, Path)):
@@ -402,12 +402,12 @@ class Unitek(_stop_at_exit.StopsMotor, _core.UnitekClient):
 
     @property
     def last_event_status(self) -> Optional[Status]:
-        st = _core.UnitekClient.last_event_status.fget(self)
+        st = _core.unitek.Client.last_event_status.fget(self)
         return None if st is None else Status(st)
 
     @property
     def mode(self) -> ModeBit:
-        return ModeBit(_core.UnitekClient.mode.fget(self))
+        return ModeBit(_core.unitek.Client.mode.fget(self))
 
     def set_receive_id(self, rx_id: int) -> None:
         """0x68: the drive listens on ``rx_id`` at once (persistent after store_eeprom)."""
@@ -487,12 +487,12 @@ class UnitekSim:
 
     def __init__(self, rx_id: int = 0x201, clock: Any = None, *, registers: Any = None, t_out_ms: float = 0,
                  store_path: Optional[str] = None, **options: Any) -> None:
-        self.clock = clock if clock is not None else _core.RealClock()
-        table = _core.unitek_sim_default_table()
+        self.clock = clock if clock is not None else _core.runtime.RealClock()
+        table = _core.unitek.sim_default_table()
         if registers is not None:
             table = load_registers(registers, table)
         options.setdefault("tx_id", _tx_for(rx_id))
-        self._core = _core.UnitekSim(self.clock, rx_id=rx_id, table=table, **options)
+        self._core = _core.unitek.Sim(self.clock, rx_id=rx_id, table=table, **options)
         self.rx = rx_id
         self._t_out = float(t_out_ms)
         if self._t_out < 0:
@@ -890,7 +890,7 @@ class UnitekDrive(Drive):
     def poll_fields(self, fields: Sequence[str]) -> PollSpec:
         """motorbus.Poller, asking: POS_IST/SPEED_IST/KERN_STATUS read (3D REGID 00) each sample."""
         regids, scales = _poll_rows(self, fields)
-        source = _core.unitek_poll_source(self.native, regids)
+        source = _core.unitek.poll_source(self.native, regids)
         return PollSpec(source=source, scales=scales, transport=self.native.bus, bus=self.native.bus)
 
     def capture_fields(self, fields: Sequence[str], period: float) -> PollSpec:
@@ -901,7 +901,7 @@ class UnitekDrive(Drive):
         transmit cyclically per drive (CyclicLimit beyond)."""
         regids, scales = _poll_rows(self, fields)
         interval_ms = min(254, max(1, int(round(period * 1000))))
-        source = _core.unitek_capture_source(self.native, regids, interval_ms)
+        source = _core.unitek.capture_source(self.native, regids, interval_ms)
         return PollSpec(source=source, scales=scales, transport=self.native.bus, bus=self.native.bus,
                         stamped=True, close=source.close)
 

@@ -12,21 +12,21 @@ using namespace motorbus;
 
 void bind_toy(py::module_& m) {
     auto rel = py::call_guard<py::gil_scoped_release>();
-    py::enum_<toy::LastStop>(m, "ToyLastStop", "How the toy drive's last motion ended (STATUS? second word).")
+    py::enum_<toy::LastStop>(m, "LastStop", "How the toy drive's last motion ended (STATUS? second word).")
         .value("NONE", toy::LastStop::None)
         .value("TARGET", toy::LastStop::Target)
         .value("STOP", toy::LastStop::Stop)
         .value("ABORT", toy::LastStop::Abort)
         .value("DISABLE", toy::LastStop::Disable)
         .value("FAULT", toy::LastStop::Fault);
-    py::class_<toy::Status>(m, "ToyStatus", "STATUS? parsed, read-only.")
+    py::class_<toy::Status>(m, "Status", "STATUS? parsed, read-only.")
         .def_readonly("enabled", &toy::Status::enabled)
         .def_readonly("moving", &toy::Status::moving)
         .def_readonly("fault", &toy::Status::fault)
         .def_readonly("homed", &toy::Status::homed)
         .def_readonly("last_stop", &toy::Status::last_stop);
     py::class_<toy::Sim, serial::LineDevice, std::shared_ptr<toy::Sim>>(
-        m, "ToySim", "A simulated toy stepper (a LineDevice: serve it with PtyLineServer); motion on a MotorModel.")
+        m, "Sim", "A simulated toy stepper (a LineDevice: serve it with PtyLineServer); motion on a MotorModel.")
         .def(py::init([](std::shared_ptr<Clock> clock, int address, double speed, double accel,
                          double start_position) {
                  toy::SimOptions o;
@@ -43,7 +43,7 @@ void bind_toy(py::module_& m) {
         .def_property_readonly("moving", &toy::Sim::moving)
         .def("set_fault_input", &toy::Sim::set_fault_input, py::arg("active"),
              py::call_guard<py::gil_scoped_release>(), "The drive's fault input (an overtemperature, say).");
-    py::class_<toy::Client, std::shared_ptr<toy::Client>>(m, "ToyClient",
+    py::class_<toy::Client, std::shared_ptr<toy::Client>>(m, "Client",
                                                           "The toy protocol on a LineLink, one address.")
         .def(py::init<std::shared_ptr<serial::LineLink>, int>(), py::arg("link"), py::arg("address"))
         .def_property_readonly("address", &toy::Client::address)

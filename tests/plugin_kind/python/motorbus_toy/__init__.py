@@ -87,12 +87,12 @@ class ToyDrive(Drive):
             raise _core.InvalidArgument("toy: a serial drive takes line=, not bus=")
         port = None
         if isinstance(line, (str, os.PathLike)):
-            port = _core.open_port(os.fspath(line), cls.default_baud)
-            line = _core.LineLink(port, reply_timeout=timeout, **LINE_SETTINGS)
-        elif not isinstance(line, _core.LineLink):
+            port = _core.serial.open_port(os.fspath(line), cls.default_baud)
+            line = _core.serial.LineLink(port, reply_timeout=timeout, **LINE_SETTINGS)
+        elif not isinstance(line, _core.serial.LineLink):
             raise _core.InvalidArgument(f"toy: line= a port path or a LineLink, not {type(line).__name__}")
         try:
-            return cls(_core.ToyClient(line, int(cls.check_address(address))), units=units, on_error=on_error,
+            return cls(_core.toy.Client(line, int(cls.check_address(address))), units=units, on_error=on_error,
                        on_exit=on_exit, close_native=None if port is None else port.close)
         except BaseException:
             if port is not None:
@@ -104,7 +104,7 @@ class ToyDrive(Drive):
         unknown = set(options) - set(cls.sim_options)
         if unknown:
             raise _core.InvalidArgument(f"toy sim options: unknown {sorted(unknown)}; known {list(cls.sim_options)}")
-        return _core.ToySim(clock, int(cls.check_address(address)), **options)
+        return _core.toy.Sim(clock, int(cls.check_address(address)), **options)
 
     @classmethod
     def check_address(cls, text: Any) -> str:
@@ -117,7 +117,7 @@ class ToyDrive(Drive):
     @classmethod
     def probe(cls, link: Any, address: str) -> Optional[dict]:
         """Discovery: STATUS? and ADDR? of the drive at ``address`` (reads only)."""
-        client = _core.ToyClient(link, int(address))
+        client = _core.toy.Client(link, int(address))
         client.status()
         return {"model": "toy stepper", "address": str(int(client.get("ADDR")))}
 
