@@ -58,20 +58,19 @@ std::shared_ptr<py::function> hold(py::function f) {
     });
 }
 
-// The client with what it needs kept alive (the bus).
-struct ClientHolder {
-    std::shared_ptr<can::Bus> bus;
-    std::shared_ptr<Clock> clock;
-    std::unique_ptr<Client> client;
-    ~ClientHolder() {
+// Destroyed without the GIL: the client's receive callbacks take the GIL to run a
+// Python on_status hook, so deleting it while holding the GIL could deadlock.
+struct ReleaseGilDeleteClient {
+    void operator()(Client* c) const {
         if (Py_IsInitialized() && PyGILState_Check()) {
             py::gil_scoped_release nogil;
-            client.reset();
+            delete c;
         } else {
-            client.reset();
+            delete c;
         }
     }
 };
+using ClientPtr = std::unique_ptr<Client, ReleaseGilDeleteClient>;
 
 // A Python view on a Stream: its ring as numpy, and a read cursor.
 struct StreamView {
@@ -291,7 +290,9 @@ static void bind_unitek_client(py::module_& m) {
         .def_readonly("unsolicited", &ClientCounters::unsolicited)
         .def_readonly("callback_errors", &ClientCounters::callback_errors);
 
-    py::class_<ClientHolder>(m, "Client", "UNITEK register protocol client over a CAN bus (see client.hpp).")
+    // The bus and the clock are kept alive by the Python objects (keep_alive), as for every
+    // class here that holds a C++ reference.
+    py::class_<Client, ClientPtr>(m, "Client", "UNITEK register protocol client over a CAN bus (see client.hpp).")
         .def(py::init([](std::shared_ptr<can::Bus> bus, std::uint32_t rx_id, std::uint32_t tx_id, const py::object& timeout,
                          std::optional<RegisterTable> table, std::shared_ptr<Clock> clock) {
                  if (!bus) throw InvalidArgument("bus: None (a motorbus Bus is required)");
@@ -300,30 +301,27 @@ static void bind_unitek_client(py::module_& m) {
                  o.tx_id = tx_id;
                  o.timeout = duration_arg(timeout, "timeout");
                  o.clock = clock.get();
-                 auto h = std::make_unique<ClientHolder>();
-                 h->bus = bus;
-                 h->clock = clock;
                  py::gil_scoped_release nogil;
-                 h->client = std::make_unique<Client>(*bus, table ? *table : RegisterTable::builtin(), o);
-                 return h;
+                 return ClientPtr(new Client(*bus, table ? *table : RegisterTable::builtin(), o));
              }),
              py::arg("bus"), py::arg("rx_id") = kDefaultRxId, py::arg("tx_id") = kDefaultTxId,
-             py::arg("timeout") = 0.2, py::arg("table") = py::none(), py::arg("clock") = py::none())
-        .def_property_readonly("table", [](const ClientHolder& h) { return h.client->table(); })
-        .def("add_register", [](ClientHolder& h, Register r) { h.client->add_register(std::move(r)); }, py::arg("register"))
-        .def("write", [](ClientHolder& h, std::int64_t regid, std::int64_t value) {
-            blocking_call([&] { h.client->write(regid_arg(regid), value); });
+             py::arg("timeout") = 0.2, py::arg("table") = py::none(), py::arg("clock") = py::none(),
+             py::keep_alive<1, 2>(), py::keep_alive<1, 7>())
+        .def_property_readonly("table", [](const Client& c) { return c.table(); })
+        .def("add_register", [](Client& c, Register r) { c.add_register(std::move(r)); }, py::arg("register"))
+        .def("write", [](Client& c, std::int64_t regid, std::int64_t value) {
+            blocking_call([&] { c.write(regid_arg(regid), value); });
         }, py::arg("regid"), py::arg("value"))
-        .def("write_raw", [](ClientHolder& h, std::int64_t regid, std::int64_t value, int bits) {
-            blocking_call([&] { h.client->write_raw(regid_arg(regid), value, bits); });
+        .def("write_raw", [](Client& c, std::int64_t regid, std::int64_t value, int bits) {
+            blocking_call([&] { c.write_raw(regid_arg(regid), value, bits); });
         }, py::arg("regid"), py::arg("value"), py::arg("bits") = 16)
-        .def("read", [](ClientHolder& h, std::int64_t regid, const py::object& timeout) {
+        .def("read", [](Client& c, std::int64_t regid, const py::object& timeout) {
             std::optional<std::chrono::nanoseconds> t;
             if (!timeout.is_none()) t = duration_arg(timeout, "timeout");
             const auto r = regid_arg(regid);
-            return blocking_call([&] { return h.client->read(r, t); });
+            return blocking_call([&] { return c.read(r, t); });
         }, py::arg("regid"), py::arg("timeout") = py::none())
-        .def("subscribe", [](ClientHolder& h, std::int64_t regid, int interval_ms, std::size_t capacity,
+        .def("subscribe", [](Client& c, std::int64_t regid, int interval_ms, std::size_t capacity,
                              const py::object& callback) {
             SampleCallback cb;
             if (!callback.is_none()) {
@@ -340,28 +338,28 @@ static void bind_unitek_client(py::module_& m) {
                 };
             }
             const auto r = regid_arg(regid);
-            auto s = blocking_call([&] { return h.client->subscribe(r, interval_ms, capacity, std::move(cb)); });
+            auto s = blocking_call([&] { return c.subscribe(r, interval_ms, capacity, std::move(cb)); });
             auto v = std::make_shared<StreamView>();
             v->s = s;
             return v;
         }, py::arg("regid"), py::arg("interval_ms"), py::arg("capacity") = 65536, py::arg("callback") = py::none())
-        .def("unsubscribe", [](ClientHolder& h, std::int64_t regid) {
-            blocking_call([&] { h.client->unsubscribe(regid_arg(regid)); });
+        .def("unsubscribe", [](Client& c, std::int64_t regid) {
+            blocking_call([&] { c.unsubscribe(regid_arg(regid)); });
         }, py::arg("regid"))
-        .def_property_readonly("cyclic", [](const ClientHolder& h) {
+        .def_property_readonly("cyclic", [](const Client& c) {
             std::vector<std::pair<int, int>> out;
-            for (auto& s : h.client->streams()) out.emplace_back(s->regid, s->interval_ms.load());
+            for (auto& s : c.streams()) out.emplace_back(s->regid, s->interval_ms.load());
             return out;
         })
-        .def("enable", [](ClientHolder& h) { blocking_call([&] { h.client->enable(); }); })
-        .def("disable", [](ClientHolder& h) { blocking_call([&] { h.client->disable(); }); })
-        .def("set_events", [](ClientHolder& h, bool on, std::optional<std::uint16_t> mask) {
-            blocking_call([&] { h.client->set_events(on, mask); });
+        .def("enable", [](Client& c) { blocking_call([&] { c.enable(); }); })
+        .def("disable", [](Client& c) { blocking_call([&] { c.disable(); }); })
+        .def("set_events", [](Client& c, bool on, std::optional<std::uint16_t> mask) {
+            blocking_call([&] { c.set_events(on, mask); });
         }, py::arg("on"), py::arg("mask") = py::none())
-        .def("on_status", [](ClientHolder& h, const py::object& callback) {
-            if (callback.is_none()) return h.client->on_status(nullptr);
+        .def("on_status", [](Client& c, const py::object& callback) {
+            if (callback.is_none()) return c.on_status(nullptr);
             auto f = hold(callback.cast<py::function>());
-            h.client->on_status([f](std::uint32_t st, Nanos t) {
+            c.on_status([f](std::uint32_t st, Nanos t) {
                 if (py_helpers::interpreter_finalizing()) return;
                 py::gil_scoped_acquire gil;
                 try {
@@ -371,17 +369,17 @@ static void bind_unitek_client(py::module_& m) {
                 }
             });
         }, py::arg("callback"))
-        .def_property_readonly("last_event_status", [](const ClientHolder& h) { return h.client->last_event_status(); })
-        .def_property_readonly("events", [](const ClientHolder& h) { return h.client->events(); })
-        .def_property_readonly("mode", [](const ClientHolder& h) { return h.client->mode(); })
-        .def("set_receive_id", [](ClientHolder& h, std::uint32_t id) { blocking_call([&] { h.client->set_receive_id(id); }); },
+        .def_property_readonly("last_event_status", [](const Client& c) { return c.last_event_status(); })
+        .def_property_readonly("events", [](const Client& c) { return c.events(); })
+        .def_property_readonly("mode", [](const Client& c) { return c.mode(); })
+        .def("set_receive_id", [](Client& c, std::uint32_t id) { blocking_call([&] { c.set_receive_id(id); }); },
              py::arg("rx_id"))
-        .def("store_eeprom", [](ClientHolder& h, int level) { blocking_call([&] { h.client->store_eeprom(level); }); },
+        .def("store_eeprom", [](Client& c, int level) { blocking_call([&] { c.store_eeprom(level); }); },
              py::arg("level") = 0)
-        .def_property_readonly("rx_id", [](const ClientHolder& h) { return h.client->rx_id(); })
-        .def_property_readonly("tx_id", [](const ClientHolder& h) { return h.client->tx_id(); })
-        .def_property_readonly("counters", [](const ClientHolder& h) { return h.client->counters(); })
-        .def("close", [](ClientHolder& h) { blocking_call([&] { h.client->close(); }); });
+        .def_property_readonly("rx_id", [](const Client& c) { return c.rx_id(); })
+        .def_property_readonly("tx_id", [](const Client& c) { return c.tx_id(); })
+        .def_property_readonly("counters", [](const Client& c) { return c.counters(); })
+        .def("close", [](Client& c) { blocking_call([&] { c.close(); }); });
 }
 
 static void bind_unitek_sim(py::module_& m) {
@@ -522,9 +520,9 @@ static void bind_unitek_poll(py::module_& m) {
         for (auto id : ids) r.push_back(regid_arg(id));
         return r;
     };
-    m.def("poll_source", [regids_arg](ClientHolder& h, const std::vector<std::int64_t>& regids) -> std::shared_ptr<poll::Source> {
+    m.def("poll_source", [regids_arg](Client& c, const std::vector<std::int64_t>& regids) -> std::shared_ptr<poll::Source> {
               auto r = regids_arg(regids);
-              return std::make_shared<PollSource>(*h.client, std::move(r));
+              return std::make_shared<PollSource>(c, std::move(r));
           }, py::arg("client"), py::arg("regids"), py::keep_alive<0, 1>(),
           "A PollSource reading each register (3D REGID 00) every sample.");
     py::class_<CaptureSource, poll::Source, std::shared_ptr<CaptureSource>>(
@@ -534,13 +532,13 @@ static void bind_unitek_poll(py::module_& m) {
         .def_property_readonly("max_age", [](const CaptureSource& s) { return s.max_age_ns() / 1e9; })
         .def("close", &CaptureSource::close, py::call_guard<py::gil_scoped_release>(),
              "Stops the cyclic transmissions this source started (idempotent).");
-    m.def("capture_source", [regids_arg](ClientHolder& h, const std::vector<std::int64_t>& regids,
+    m.def("capture_source", [regids_arg](Client& c, const std::vector<std::int64_t>& regids,
                                                 int interval_ms, const py::object& max_age) {
               auto r = regids_arg(regids);
               const Nanos age = max_age.is_none() ? 0 : duration_arg(max_age, "max_age").count();
-              auto* bus = h.bus.get();
+              auto* bus = &c.bus();
               py::gil_scoped_release nogil;
-              return std::make_shared<CaptureSource>(*h.client, *bus, std::move(r), interval_ms, age);
+              return std::make_shared<CaptureSource>(c, *bus, std::move(r), interval_ms, age);
           }, py::arg("client"), py::arg("regids"), py::arg("interval_ms"), py::arg("max_age") = py::none(),
           py::keep_alive<0, 1>(),
           "Subscribes each register every interval_ms (unless it already transmits) and captures it; "

@@ -79,6 +79,7 @@ struct ClientCounters {
 class Client {
 public:
     Client(can::Bus& bus, RegisterTable table = RegisterTable::builtin(), ClientOptions options = {});
+    can::Bus& bus() const { return bus_; }  // what capture sources subscribe on
     ~Client();
     Client(const Client&) = delete;
     Client& operator=(const Client&) = delete;
