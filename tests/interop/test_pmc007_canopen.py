@@ -1,5 +1,6 @@
 """canopen (PyPI) as an independent master of the simulated PMC007, with the EDS motorbus
-ships (python/motorbus/drives/pmc007.eds, generated from the simulator's own table).
+ships (cpp/motorbus/drives/pmc007/pmc007.eds, installed beside _core: pmc007.EDS_PATH; generated from the
+simulator's own table).
 
 The simulator is served by socketcand from a SimBench in this process; canopen talks to it
 through python-can's socketcand interface (no motorbus code on the client side)."""

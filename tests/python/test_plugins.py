@@ -10,25 +10,116 @@ import motorbus
 from motorbus import registry
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-SHARED = ["CMakeLists.txt", "bindings/module.cpp", "python/motorbus/cli.py", "python/motorbus/sim.py",
-          "python/motorbus/bus.py", "python/motorbus/__init__.py", "python/motorbus/drive.py",
-          "python/motorbus/registry.py", "python/motorbus/bus_server.py", "python/motorbus/poller.py",
-          "python/motorbus/pytest_plugin.py", "python/motorbus/cli_monitor.py",
-          "python/motorbus/canopen/poll.py", "bindings/poll.cpp"] + \
-    [str(p.relative_to(ROOT)) for p in sorted((ROOT / "cpp/motorbus/poll").iterdir())]
+
+
+# ---- vendor names stay in vendor folders (deny by default): the rule is the next test's docstring ----
+SCOPE = ["python", "cpp", "bindings", "CMakeLists.txt", "Makefile"]
+STANDARD = {"cia402"}
+ALIASES = {"arcus": ["dmx-can", "dmxcan"], "dmac": ["midi ing"], "pmc007": ["cqpusi"],
+           "unitek": ["bamocar", "bamobil", "ndrive"]}
+DEMO_DATA = {
+    "python/motorbus/demo_bench.toml": "the shipped demo bench: one axis of every in-tree kind, by kind name",
+}
+EXCEPTIONS = {
+    "python/motorbus/_core/__init__.pyi": "generated stub of _core's top level: the one error table (the vendors' "
+                                          "error classes among them) and a `from . import <vendor>` per vendor",
+}
 
 
 def vendors() -> list[str]:
     return sorted(p.name for p in (ROOT / "cpp/motorbus/drives").iterdir() if p.is_dir())
 
 
-def test_no_shared_file_names_a_vendor():
-    names = vendors() + [k for k in registry._load(registry.DRIVE_GROUP) if k != "cia402"]
-    assert {"arcus", "dmac"} <= set(names)
-    pattern = re.compile("|".join(sorted(set(names))), re.IGNORECASE)
-    for f in SHARED:
-        hits = [line for line in (ROOT / f).read_text().splitlines() if pattern.search(line)]
-        assert hits == [], f"{f} names a vendor: {hits}"
+def vendor_names() -> dict[str, list[str]]:
+    """Every vendor with the names that name it (lower case)."""
+    from importlib import metadata
+
+    kinds = {ep.name.split("-")[0] for ep in metadata.entry_points(group=registry.DRIVE_GROUP)}
+    return {v: [v] + ALIASES.get(v, []) for v in sorted((set(vendors()) | kinds) - STANDARD)}
+
+
+def vendor_of(path: str) -> str | None:
+    """The vendor whose folder holds `path` (None: a shared file)."""
+    m = re.match(r"cpp/motorbus/drives/([^/]+)/|bindings/drives/([^/]+)\.cpp$|"
+                 r"python/motorbus/drives/([a-z0-9]+)(?:_[a-z0-9_]+)?(?:\.py$|/)|"
+                 r"python/motorbus/_core/([a-z0-9]+)\.pyi$", path)  # the generated stub of _core.<vendor>
+    v = next((g for g in m.groups() if g), None) if m else None
+    if m and m.group(4) and not (ROOT / "cpp/motorbus/drives" / v).is_dir():
+        return None                     # the stub of an area's submodule (_core.can), not a vendor's
+    return None if v in STANDARD else v
+
+
+def tracked_product_files() -> list[str]:
+    out = subprocess.run(["git", "ls-files", "-z", "--", *SCOPE], cwd=ROOT, capture_output=True, check=True)
+    return [f for f in out.stdout.decode().split("\0") if f and (ROOT / f).is_file()]  # not a deletion under way
+
+
+def names_in(text: str, names: dict[str, list[str]]) -> list[str]:
+    pattern = re.compile("|".join(re.escape(n) for ns in names.values() for n in ns), re.IGNORECASE)
+    return [f"{i}: {line.strip()[:120]}" for i, line in enumerate(text.splitlines(), 1) if pattern.search(line)]
+
+
+def test_no_file_outside_a_vendor_folder_names_a_vendor():
+    """Vendor names stay in vendor folders, denied by default.
+
+    The rule, checked on every file git tracks in the product code — python/, cpp/, bindings/ and the
+    top-level CMakeLists.txt and Makefile: a file's path and text may name a vendor only when the file
+    is one of that vendor's own:
+
+      cpp/motorbus/drives/<v>/**         its C++ (codec, client, simulator, profile, data files)
+      bindings/drives/<v>.cpp            its bindings
+      python/motorbus/drives/<v>.py,     its Python module, or package folder, and its personas'
+      python/motorbus/drives/<v>/**,     (arcus_canopen.py is the arcus vendor's CANopen persona)
+      python/motorbus/drives/<v>_*.py
+      python/motorbus/_core/<v>.pyi      the generated stub of its _core submodule
+
+    Everything else is denied, but for two named lists above: DEMO_DATA (data that must name kinds to show
+    them) and EXCEPTIONS (each with its reason).  pyproject.toml names every in-tree kind in its entry
+    points, as an out-of-tree package names its own: it is outside the scanned scope by design.
+    Out of scope too, on purpose: docs/, tests/, examples/, notebooks/, bench/, fuzz/ and README.md.  They
+    are where a reader looks a vendor up (docs/drives/<v>.md, numbered examples per drive, a test file
+    per vendor, the README's table of drives) and nothing in the product imports them, so a vendor
+    named there couples no shared code to it.
+
+    A vendor is a folder of cpp/motorbus/drives/ or a kind declared as a motorbus.drive entry point
+    (up to its first "-": "arcus-canopen" is arcus), except STANDARD kinds, named after a profile that
+    the shared CANopen layer implements by right; ALIASES adds the makers' and products' names the
+    manuals use.  A name matches anywhere in a line, in any case ("ArcusMotion", "bind_arcus", "DMX-CAN").
+    """
+    names = vendor_names()
+    assert {"arcus", "dmac", "pmc007", "unitek"} <= set(names)
+    files = tracked_product_files()
+    assert "python/motorbus/motion.py" in files and "CMakeLists.txt" in files  # the scope is not empty
+    for listed in {**DEMO_DATA, **EXCEPTIONS}:          # a stale entry is a bug of the list
+        assert listed in files, f"{listed} is listed but not tracked"
+    offenders = {}
+    for f in files:
+        if vendor_of(f) is not None or f in DEMO_DATA or f in EXCEPTIONS:
+            continue
+        hits = names_in(f, names) + names_in((ROOT / f).read_text(errors="replace"), names)
+        if hits:
+            offenders[f] = hits
+    assert not offenders, "shared files that name a vendor (move the code to the vendor's folder, or say " \
+        "the point without the name):\n" + "\n".join(f"{f}:\n    " + "\n    ".join(h) for f, h in offenders.items())
+
+
+def test_the_vendor_check_denies_what_it_should():
+    """The rule on made-up paths and lines: a check that passes everything would pass the tree too."""
+    names = vendor_names()
+    assert vendor_of("cpp/motorbus/drives/arcus/sim.cpp") == "arcus"
+    assert vendor_of("python/motorbus/drives/arcus_canopen.py") == "arcus"
+    assert vendor_of("python/motorbus/drives/pmc007/pmc007.eds") == "pmc007"
+    assert vendor_of("cpp/motorbus/drives/unitek/ndrive.toml") == "unitek"
+    assert vendor_of("python/motorbus/_core/dmac.pyi") == "dmac"
+    assert vendor_of("bindings/drives/unitek.cpp") == "unitek"
+    for shared in ("python/motorbus/drives/cia402.py", "cpp/motorbus/drives/cia402/sim.cpp", "python/motorbus/_core/can.pyi",
+                   "python/motorbus/motion.py", "cpp/motorbus/canopen/od.hpp", "bindings/module.cpp",
+                   "python/motorbus/drives/__init__.py"):
+        assert vendor_of(shared) is None, shared
+    for line in ("from ._core import ArcusMotion", "void bind_dmac(py::module_& m);", "a DMX-CAN default",
+                 "CQPUSI manual", "BAMOCAR", "kind = \"pmc007\"", "unitek_ndrive.toml"):
+        assert names_in(line, names), line
+    assert names_in("CiA 402 profile position, a CANopen node, an arc of a circle", names) == []
 
 
 def test_every_vendor_folder_has_its_test_executable_and_bindings():

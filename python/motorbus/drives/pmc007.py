@@ -29,13 +29,13 @@ next call after a link loss raises (SdoTimeout).  ``has_watchdog`` is False.
 from __future__ import annotations
 
 import enum
-import os
 import re
 import threading
 import time
 from typing import Any, Callable, Iterable, Optional, Union
 
 from .. import _core, _stop_at_exit
+from . import data_file
 from ..stopping import check_stop_way
 from ..canopen.node import RemoteNode, check_node_id
 from ..canopen.pdo import PdoChannel
@@ -55,8 +55,9 @@ __all__ = ["ControllerStatus", "ErrorStatus", "Pmc007", "Pmc007Drive", "make_sim
            "ABORT_DEVICE_STATE", "Pmc007ProfileParams", "pmc007_convert_position",
            "pmc007_gear_acceleration", "pmc007_microsteps", "pmc007_position_profile", "pmc007_speed_profile"]
 
-#: The EDS shipped with the package (generated from the table the simulator uses).
-EDS_PATH = os.path.join(os.path.dirname(__file__), "pmc007.eds")
+#: The EDS shipped with the package (generated from the table the simulator uses; its home is
+#: cpp/motorbus/drives/pmc007/pmc007.eds, installed beside _core: see motorbus.drives.data_file).
+EDS_PATH = str(data_file("pmc007", "pmc007.eds"))
 
 #: 2003h baud index -> kbit/s (003 §4.3.2).
 BAUD_RATES = {0: 20, 1: 25, 2: 50, 3: 100, 4: 125, 5: 250, 6: 500, 7: 800, 8: 1000}

@@ -52,6 +52,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
 
 from .. import _core, _stop_at_exit
+from . import data_file
 from ..stopping import check_stop_way
 # The drive's speed ramps (ACC 0x35 / DEC 0xED): the vendor's own module re-exports the model.
 from .._core.unitek import RampParams as UnitekRampParams, speed_profile as unitek_speed_profile  # noqa: F401
@@ -73,7 +74,6 @@ COUNTS_PER_REV = 65536
 FULL_SCALE = 32767
 #: User units of revolutions for open_drive(..., units=REVOLUTIONS).
 REVOLUTIONS = Units("rev", 1.0 / COUNTS_PER_REV)
-_NDRIVE_TOML = Path(__file__).with_name("unitek_ndrive.toml")
 
 #: §3.1: (bit rate in kbit/s, NDrive's BTR setting value, longest line in m).  The bit rate is
 #: set in NDrive's CAN-Setup, not over CAN: open the bus at the drive's rate.
@@ -114,7 +114,7 @@ class Reg(enum.IntEnum):
     EEPROM_WRITE = 0x84
     TORQUE_CMD = 0x90
     REG_A8 = 0xA8
-    ERR_WARN = 0x8F     # NDrive list, not in 002 (unitek_ndrive.toml)
+    ERR_WARN = 0x8F     # NDrive list, not in 002 (ndrive.toml)
     I_ACT = 0x20        # NDrive list: actual current (num)
     I_MAX = 0x24        # NDrive list: the motor's peak current limit (num)
     I_CMD = 0x26        # NDrive list: current command, +/- 9 bit (§6.1)
@@ -246,7 +246,8 @@ def load_registers(path: Union[str, Path], table: Any = None) -> Any:
 
 def ndrive_registers() -> Any:
     """The built-in table plus the NDrive rows motorbus ships (POS_IST)."""
-    return load_registers(_NDRIVE_TOML)
+    # cpp/motorbus/drives/unitek/ndrive.toml, installed beside _core (motorbus.drives.data_file)
+    return load_registers(data_file("unitek", "ndrive.toml"))
 
 
 def _regid(reg: Union[int, str, Reg], table: Any) -> int:

@@ -37,7 +37,7 @@ inline constexpr std::uint8_t kRegTorqueCmd = 0x90;    // TORQUE-CMD
 inline constexpr std::uint8_t kRegA8 = 0xA8;           // unnamed, §5.2's request example
 // Not in 002: the actual position, which any position adapter needs.  NDrive's
 // register list (outside this manual) has it; the sim serves it and the Python
-// adapter adds it from its TOML file (python/motorbus/drives/unitek_ndrive.toml).
+// adapter adds it from its TOML file (cpp/motorbus/drives/unitek/ndrive.toml).
 inline constexpr std::uint8_t kRegPosActual = 0x6D;
 // Not in 002 either: NDrive's error/warning register (32 bit, read-only): bits 0-15
 // the errors (each switches the power stage off), bits 16-31 the warnings.  The sim

@@ -85,7 +85,7 @@ TEST(Pmc007Table, CountsOfTheSpec) {
 
 // The shipped EDS is the generated one.  MOTORBUS_WRITE_EDS=1 regenerates it.
 TEST(Pmc007Table, ShippedEdsIsGenerated) {
-    const std::string path = std::string(MOTORBUS_TEST_DATA) + "/../python/motorbus/drives/pmc007.eds";
+    const std::string path = std::string(MOTORBUS_TEST_DATA) + "/../cpp/motorbus/drives/pmc007/pmc007.eds";
     const std::string text = eds();
     if (const char* w = std::getenv("MOTORBUS_WRITE_EDS"); w && std::string(w) == "1") {
         std::ofstream(path, std::ios::binary) << text;
