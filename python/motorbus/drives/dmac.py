@@ -207,17 +207,18 @@ __all__ = [
     "make_sim",
     "open_line",
     "parse_read_reply",
+    "status_names",
+    "stream_interpolation",
     "dmac_interpolation",
     "DmacMotion",
     "DmacProfileParams",
     "dmac_position_profile",
     "dmac_ramp_time",
     "dmac_speed_profile",
-    "status_names",
-    "stream_interpolation",
     "synchro",
     "variable_info",
 ]
+
 
 def open_line(port: Any, *, baud: int = DEFAULT_BAUD, timeout: float = 0.5, turnaround: float = 0.0) -> Any:
     """A ``LineLink`` framed for the DMAC (CR / CR LF) on a path or an open ``Port``.
@@ -415,6 +416,8 @@ def stream_interpolation(axes: Sequence[DmacClient], segments: Iterable[Sequence
     """
     return _core.dmac.stream_interpolation(list(axes), [list(map(int, s)) for s in segments],
                                            interpol_time_ms, fifo_size, sleep, backoff)
+
+
 def dmac_interpolation(start: Sequence[float], target: Sequence[float], limits: Sequence["_core.motion.Limits"],
                        period_ms: int = 100, straight_line: bool = True) -> Any:
     """Plan a synchronised multi-axis move and split it into MOVE_INTERPOL offsets.
@@ -438,8 +441,6 @@ def dmac_interpolation(start: Sequence[float], target: Sequence[float], limits: 
     planner = motion.plan_straight_line if straight_line else motion.plan_synchronized
     axes = planner(list(map(float, start)), list(map(float, target)), list(limits))
     return np.asarray(motion.split_interpolation(axes, int(period_ms)), dtype=np.int64).reshape(-1, len(start))
-
-
 
 
 SIM_OPTIONS = ("model", "supply_voltage", "baudrate", "request_terminator", "reply_terminator",
