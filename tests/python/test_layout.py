@@ -1,4 +1,4 @@
-"""Code layout rules checked on the tree itself (docs/architecture.md, "Code layout")."""
+"""Code layout rules checked on the tree itself (docs/architecture.md, "Rules that keep it livable": no function over 150 lines)."""
 from __future__ import annotations
 
 import importlib.util
