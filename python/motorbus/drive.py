@@ -943,6 +943,8 @@ class Drive(abc.ABC):
         return f"<{type(self).__name__} {self.kind} {state}, units={self._units.name}>"
 
 
+registry.set_drive_base(Drive)
+
 #: The plugin hooks a kind may override (``Drive.provides``).
 HOOKS = ("open", "make_sim", "check_address", "store_options", "wire_line", "probe", "canopen_match", "synchronised_start",
          "sim_faults", "poll_fields", "capture_fields", "plan_move")

@@ -114,12 +114,23 @@ def register(group: str, name: str, obj: Any) -> None:
         _cache[group][name] = obj
 
 
+# The registry sits below the Drive class (drive.py imports it to open a kind), so it does
+# not import drive.py back: the Drive class names itself here when it is defined.
+_drive_base: Optional[type] = None
+
+
+def set_drive_base(cls: type) -> None:
+    """Called once by motorbus.drive: the class every registered drive kind must subclass."""
+    global _drive_base
+    _drive_base = cls
+
+
 def drive_plugin(kind: str) -> "type[Drive]":
     """The :class:`motorbus.Drive` subclass registered as ``kind`` (its entry point loaded)."""
-    from .drive import Drive
-
     cls = _resolve(DRIVE_GROUP, kind, "drive kind")
-    if not (isinstance(cls, type) and issubclass(cls, Drive)):
+    if _drive_base is None:  # only if motorbus.registry were imported without the package
+        raise _core.InvalidArgument("drive kinds: import motorbus first (motorbus.drive defines their base class)")
+    if not (isinstance(cls, type) and issubclass(cls, _drive_base)):
         raise _core.InvalidArgument(f"drive kind {kind!r}: its entry point is not a motorbus.Drive subclass "
                                     f"(it is {cls!r})")
     if cls.transport not in ("serial", "can"):

@@ -106,7 +106,7 @@ OUT_OF_TREE = {"toy": pathlib.Path(__file__).resolve().parents[1] / "plugin_kind
 @pytest.fixture(params=sorted(KINDS))
 def kind(request) -> Kind:
     if request.param in OUT_OF_TREE:
-        if not hasattr(motorbus._core, "ToySim"):
+        if not hasattr(motorbus._core, "toy"):
             pytest.skip("built without MOTORBUS_TESTS (the out-of-tree test kind's C++ is not in _core)")
         monkeypatch = request.getfixturevalue("monkeypatch")
         monkeypatch.syspath_prepend(str(OUT_OF_TREE[request.param]))

@@ -28,7 +28,7 @@ from motorbus import MoveFaulted, MoveInterrupted, registry
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 PLUGIN_PATH = ROOT / "tests" / "plugin_kind" / "python"
 
-pytestmark = pytest.mark.skipif(not hasattr(motorbus._core, "ToySim"),
+pytestmark = pytest.mark.skipif(not hasattr(motorbus._core, "toy"),
                                 reason="built without MOTORBUS_TESTS (the toy kind's C++ is not in _core)")
 
 
