@@ -58,7 +58,7 @@ fuzz: deps
 	bash tools/fuzz.sh runs 10000000
 
 fuzz-smoke: deps
-	bash tools/fuzz.sh run 5
+	bash tools/fuzz.sh run 3
 
 # tests/reliability scaled up (long; the default pytest run holds their bounded form).
 soak: build

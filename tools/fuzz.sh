@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every libFuzzer target in fuzz/ (built by tools/sanitize.sh into build/asan,
 # or built here), each on its own corpus fuzz/corpus-<target> plus fuzz/seeds/<target>.
-#   tools/fuzz.sh run SECONDS   each target for SECONDS        (make fuzz-smoke: 5)
+#   tools/fuzz.sh run SECONDS   each target for SECONDS        (make fuzz-smoke: 3)
 #   tools/fuzz.sh runs N        each target for N executions   (make fuzz: 10 000 000)
 # FUZZ_TARGETS="sdo_server slcan_decoder" runs only those targets, in that order (names without fuzz_);
 # JOBS targets run at once (default: the number of cores).  FUZZ_BIN=DIR runs the

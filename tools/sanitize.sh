@@ -26,7 +26,9 @@ stage=build/asan/pystage
 rm -rf "$stage" && mkdir -p "$stage"
 cp -r python/motorbus "$stage/"
 rm -f "$stage"/motorbus/_core*.so
-cp build/asan/_core*.so "$stage/motorbus/"
+# The sanitized _core and the vendors' data files (motorbus/drives/<vendor>/*.eds...),
+# placed by CMake's own install rules exactly where a wheel has them.
+cmake --install build/asan --prefix "$stage" >/dev/null
 SITE=$("$PY" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 ASAN_RT=$(clang -print-file-name=libclang_rt.asan-x86_64.so)
 [ -f "$ASAN_RT" ] || ASAN_RT=$(find /usr/lib/llvm-*/lib/clang -name 'libclang_rt.asan-x86_64.so' | head -1)
