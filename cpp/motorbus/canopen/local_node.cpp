@@ -49,7 +49,7 @@ std::set<std::pair<const void*, std::uint8_t>> g_claims;
 void LocalNode::claim_node_id(can::Bus& bus, std::uint8_t node_id) {
     std::lock_guard lock(g_claims_mutex);
     if (!g_claims.emplace(bus.medium(), node_id).second)
-        throw InvalidArgument("LocalNode node_id: " + std::to_string(node_id) + " is already served on " +
+        throw NodeIdTaken("LocalNode node_id: " + std::to_string(node_id) + " is already served on " +
                               bus.channel() + " (one LocalNode per node-ID per bus; close the other first)");
 }
 

@@ -56,6 +56,14 @@ enum class NmtCommand : std::uint8_t {
     ResetCommunication = 0x82,
 };
 
+// The node-ID is already served by another LocalNode on the same medium (one ID per
+// bus, as on a wire): a distinct type, so a device that restarts under a new ID can
+// tell "taken" from any other failure without reading the message.  Python sees an
+// InvalidArgument.
+struct NodeIdTaken : InvalidArgument {
+    using InvalidArgument::InvalidArgument;
+};
+
 class LocalNode;
 
 // A service living on a LocalNode.  All callbacks run with no node lock held.

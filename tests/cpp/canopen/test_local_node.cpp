@@ -340,6 +340,25 @@ TEST(LocalNodeArgs, N14_InvalidNodeIdRefused) {
     EXPECT_THROW(LocalNode(*bus, 128, od), InvalidArgument);
 }
 
+// A second node on a node-ID already served on the medium is refused with its own
+// type (a restarting device tells "taken" from other failures by it, not by text);
+// a range error is not that type; once the first closes, the ID is free again.
+TEST(LocalNodeArgs, ASecondNodeOnAServedIdIsNodeIdTaken) {
+    auto hub = std::make_shared<LoopHub>();
+    auto bus = hub->open();
+    auto first = std::make_unique<LocalNode>(*bus, 9, make_od());
+    EXPECT_THROW(LocalNode(*bus, 9, make_od()), NodeIdTaken);
+    try {
+        LocalNode(*bus, 0, make_od());
+        ADD_FAILURE() << "node-ID 0 accepted";
+    } catch (const NodeIdTaken&) {
+        ADD_FAILURE() << "a range error reported as a taken ID";
+    } catch (const InvalidArgument&) {
+    }
+    first->close();
+    EXPECT_NO_THROW(LocalNode(*bus, 9, make_od()));
+}
+
 // LocalNodeOptions::on_reset is told which reset it was, after the defaults
 // were restored and before the boot-up; sdo_require_dlc8 drops short requests.
 TEST_F(NodeFixture, OnResetHookAndStrictDlc) {

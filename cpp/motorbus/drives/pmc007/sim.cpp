@@ -50,12 +50,8 @@ constexpr std::pair<std::uint16_t, std::uint8_t> kLive[] = {
 }  // namespace
 
 namespace {
-// LocalNode refuses a node-ID already served on the medium with this InvalidArgument
-// (LocalNode::claim_node_id): the one failure of a (re)start that is device behaviour.
-bool id_taken(const std::exception& e) {
-    return dynamic_cast<const InvalidArgument*>(&e) != nullptr &&
-           std::string_view(e.what()).find("is already served") != std::string_view::npos;
-}
+// The one failure of a (re)start that is device behaviour: another node serves the ID.
+bool id_taken(const std::exception& e) { return dynamic_cast<const canopen::NodeIdTaken*>(&e) != nullptr; }
 }  // namespace
 
 Sim::Sim(std::uint8_t node_id, Clock& clock, SimOptions options)
