@@ -42,7 +42,7 @@ import tomllib
 from dataclasses import dataclass, field
 from typing import Any, Iterator, Mapping, Optional, Sequence
 
-from . import _core, registry
+from . import _core, faces, registry
 from .bus import open_bus, parse_spec
 from .drive import Drive, DriveStatus, MoveFailed, Units
 from .stopping import STOP_WAYS, check_stop_way
@@ -843,6 +843,13 @@ class Bench:
         axis starting when its own command arrives; their offsets are measured
         (seconds from the first command accepted to this axis's).  A group started
         by its drives counts as one command in that sequence."""
+        return faces.run(self._co_move_together(targets, relative=relative, velocity=velocity, wait=wait,
+                                                timeout=timeout))
+
+    async def _co_move_together(self, targets: Mapping[str, float], *, relative: bool = False,
+                                velocity: Optional[float] = None, wait: bool = True,
+                                timeout: Optional[float] = None) -> StartReport:
+        """The logic of ``move_together``, run blocking there and awaited by motorbus.aio."""
         drives = {name: self[name] for name in targets}
         if not drives:
             raise _core.InvalidArgument("move_together: no axis given")
@@ -854,42 +861,43 @@ class Bench:
         methods: list[str] = []
         t0: Optional[float] = None
 
-        def command(name: str) -> None:
+        async def command(name: str) -> None:
             d = drives[name]
-            (d.move_by if relative else d.move_to)(targets[name], velocity=velocity, wait=False)
+            await (d._co_move_by if relative else d._co_move_to)(targets[name], velocity=velocity, wait=False)
 
         for (kind, line, bus), names in groups.items():
             cls = registry.drive_plugin(kind)
             if cls.provides("synchronised_start") and len(names) > 1:
                 link = self.lines[line] if line else self.buses[bus]
+                # The kind's trigger is a short blocking exchange (a broadcast) on entry and exit.
                 with cls.synchronised_start(link, [drives[n] for n in names]) as how:
                     for n in names:
-                        command(n)
+                        await command(n)
                 now = time.perf_counter()
                 t0 = now if t0 is None else t0
                 offsets.update({n: now - t0 for n in names})
                 methods.append(how)
                 continue
             for n in names:
-                command(n)
+                await command(n)
                 now = time.perf_counter()
                 t0 = now if t0 is None else t0
                 offsets[n] = now - t0
             methods.append("software")
         if wait:
-            self._wait_all(drives, timeout)
+            await self._co_wait_all(drives, timeout)
         method = methods[0] if len(set(methods)) == 1 else " + ".join(dict.fromkeys(methods))
         return StartReport(method, offsets, max(offsets.values()))
 
     @staticmethod
-    def _wait_all(drives: Mapping[str, Drive], timeout: Optional[float]) -> None:
+    async def _co_wait_all(drives: Mapping[str, Drive], timeout: Optional[float]) -> None:
         """Waits for every axis, even after one failed (each outcome is judged and kept in
         its ``status.last_move``); then raises the first axis's :class:`MoveFailed`, with
         ``failures`` = every failed axis's error by name."""
         failures: dict[str, MoveFailed] = {}
         for name, d in drives.items():
             try:
-                d.wait_idle(timeout)
+                await d._co_wait_idle(timeout)
             except MoveFailed as e:
                 failures[name] = e
         if failures:
@@ -907,12 +915,15 @@ class Bench:
         fails does not keep the others from stopping.  Returns the failures."""
         # Checked before the getattr: any other word would call whatever method it names.
         check_stop_way(how, "Bench.stop_all how", tuple(w for w in STOP_WAYS if w is not None))
+        return faces.run(self._co_stop_all(how))
+
+    async def _co_stop_all(self, how: str) -> list[tuple[str, BaseException]]:
         failures = []
         for name, d in self._axes.items():
             if d.closed:
                 continue
             try:
-                getattr(d, how)()
+                await getattr(d, f"_co_{how}")()
             except Exception as e:  # noqa: BLE001 - the others must still stop
                 failures.append((name, e))
         return failures

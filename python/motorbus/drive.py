@@ -38,7 +38,7 @@ from collections.abc import Iterator, MutableMapping
 from dataclasses import dataclass
 from typing import Any, Callable, Optional, Union
 
-from . import _core, _stop_at_exit, registry
+from . import _core, _stop_at_exit, faces, registry
 
 #: A DEBUG line per command (``motorbus -vv``); the protocol itself: ``motorbus.trace``.
 log = logging.getLogger(__name__)
@@ -50,6 +50,24 @@ __all__ = ["open_drive", "Capability", "Drive", "DriveStatus", "ParamInfo", "Par
 # The one safety vocabulary (on_error, on_exit) lives in stopping.py, said once for
 # the Drive, the native clients, bench files and the CLI; re-exported here.
 from .stopping import STOP_WAYS, StopHow, check_stop_way  # noqa: E402
+
+
+async def _value(result: Any) -> Any:
+    """A kind's hook's result: awaited when the hook is a coroutine function."""
+    if inspect.isawaitable(result):
+        return await result
+    return result
+
+
+class _Done:
+    """An awaitable that is already done (``_for_this_move`` in the blocking face)."""
+
+    def __await__(self) -> Any:
+        return None
+        yield  # noqa: unreachable - makes this a generator
+
+
+_DONE = _Done()
 
 
 class Capability(enum.Enum):
@@ -220,7 +238,8 @@ class ParamInfo:
 class Params(MutableMapping):
     """``drive.params``: the vendor's parameters by their own names, read and
     written through the native protocol on every access (no cache: the drive is
-    the truth).  A vendor implements ``_names``, ``_info``, ``_read``, ``_write``."""
+    the truth).  A vendor implements ``_names``, ``_info`` (plain functions: the
+    kind's tables) and ``_read``, ``_write`` (coroutines over ``drive.io``)."""
 
     def __init__(self, drive: "Drive") -> None:
         self._drive = drive
@@ -247,10 +266,16 @@ class Params(MutableMapping):
         return info
 
     def __getitem__(self, name: str) -> Any:
+        return faces.run(self._co_get(name))
+
+    async def _co_get(self, name: str) -> Any:
         self._drive._check_open()
-        return self._read(self.describe(name))
+        return await _value(self._read(self.describe(name)))
 
     def __setitem__(self, name: str, value: Any) -> None:
+        faces.run(self._co_set(name, value))
+
+    async def _co_set(self, name: str, value: Any) -> None:
         self._drive._check_open()
         info = self.describe(name)
         if not info.writable:
@@ -261,7 +286,7 @@ class Params(MutableMapping):
             if info.minimum is not None and value < info.minimum or info.maximum is not None and value > info.maximum:
                 raise _core.InvalidArgument(
                     f"{self._drive.kind}: {info.name}={value!r} is outside [{info.minimum}, {info.maximum}]")
-        self._write(info, value)
+        await _value(self._write(info, value))
 
     def __delitem__(self, name: str) -> None:
         raise _core.InvalidArgument(f"{self._drive.kind}: parameters cannot be deleted")
@@ -506,56 +531,67 @@ class Drive(abc.ABC):
         self._last_move: Optional[MoveOutcome] = None
         #: The name errors give this axis (a bench sets its axis name).
         self.name = self.kind
+        #: The native client's calls as awaitables, for the kind's hooks (motorbus.faces):
+        #: done at once in the blocking face, on the link's worker in the awaitable one.
+        self.io = faces.NativeIo(native, self._io_link())
         _stop_at_exit.track(self)
 
+    def _io_link(self) -> Any:
+        """What this drive's native calls share a worker with in the awaitable face: the
+        line or bus they go over (``native.link`` where the client has one), so that
+        the drives of one RS-485 line queue on one worker as they queue on the wire."""
+        return getattr(self.native, "link", None)
+
     # ---- vendor side (native units) -------------------------------------------------
+    # The hooks are ``async def`` coroutines that talk to the drive through ``self.io``
+    # (motorbus.faces): written once, they serve the blocking verbs and motorbus.aio alike.
     @abc.abstractmethod
-    def _enable(self) -> None: ...
-
-    @abc.abstractmethod
-    def _disable(self) -> None: ...
-
-    @abc.abstractmethod
-    def _move_to(self, target: float, velocity: Optional[float]) -> None: ...
-
-    def _move_by(self, distance: float, velocity: Optional[float]) -> None:
-        self._move_to(self._position() + distance, velocity)
+    async def _enable(self) -> None: ...
 
     @abc.abstractmethod
-    def _jog(self, velocity: float) -> None: ...
+    async def _disable(self) -> None: ...
 
     @abc.abstractmethod
-    def _stop(self) -> None: ...
+    async def _move_to(self, target: float, velocity: Optional[float]) -> None: ...
+
+    async def _move_by(self, distance: float, velocity: Optional[float]) -> None:
+        await _value(self._move_to(await _value(self._position()) + distance, velocity))
 
     @abc.abstractmethod
-    def _quick_stop(self) -> None: ...
+    async def _jog(self, velocity: float) -> None: ...
 
-    def _home(self, method: Any) -> None:
+    @abc.abstractmethod
+    async def _stop(self) -> None: ...
+
+    @abc.abstractmethod
+    async def _quick_stop(self) -> None: ...
+
+    async def _home(self, method: Any) -> None:
         raise _core.InvalidArgument(f"{self.kind}: this drive has no homing")
 
-    def _homing_done(self) -> bool:
+    async def _homing_done(self) -> bool:
         """True when a homing started by _home has finished (raise on a homing error)."""
-        return not self._status().moving
+        return not (await _value(self._status())).moving
 
     @abc.abstractmethod
-    def _clear_faults(self) -> None: ...
+    async def _clear_faults(self) -> None: ...
 
-    def _store(self) -> None:
+    async def _store(self) -> None:
         raise _core.InvalidArgument(f"{self.kind}: this drive cannot store its parameters")
 
     @abc.abstractmethod
-    def _position(self) -> float: ...
+    async def _position(self) -> float: ...
 
     @abc.abstractmethod
-    def _velocity(self) -> float: ...
+    async def _velocity(self) -> float: ...
 
     @abc.abstractmethod
-    def _status(self) -> DriveStatus: ...
+    async def _status(self) -> DriveStatus: ...
 
-    def _is_idle(self) -> bool:
+    async def _is_idle(self) -> bool:
         """True once the motor is at rest, whatever the reason (target, limit, fault,
         stop): the outcome is judged afterwards from ``_stop_reason`` and the position."""
-        return not self._status().moving
+        return not (await _value(self._status())).moving
 
     def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
         """Why the drive stopped, as far as it says (a fault, a limit, a stall, a stop
@@ -575,13 +611,19 @@ class Drive(abc.ABC):
         """How far from its target (native units) a move may end and count as arrived."""
         return self.in_position_window
 
-    def _for_this_move(self, read: Callable[[], Any], write: Callable[[Any], None], value: Any) -> None:
-        """For a vendor's ``_move_to``: sets a drive setting (a speed) for the move being
-        started and puts the old value back once it has ended, however it ended."""
-        old = read()
-        write(value)
-        if self._move is not None:
-            self._move.restore.append(lambda: write(old))
+    def _for_this_move(self, read: Callable[[], Any], write: Callable[[Any], Any], value: Any) -> Any:
+        """For a vendor's ``_move_to`` (``await self._for_this_move(...)``): sets a drive
+        setting (a speed) for the move being started and puts the old value back once it
+        has ended, however it ended.  ``read``/``write`` may be coroutine functions."""
+        async def set_for_move() -> None:
+            old = await _value(read())
+            await _value(write(value))
+            if self._move is not None:
+                self._move.restore.append(lambda: write(old))
+        if faces.blocking():        # done at once: also for a hook that does not await it
+            faces.run(set_for_move())
+            return _DONE
+        return set_for_move()
 
     def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         """The soft travel limits the drive itself enforces now, native units (None: no limit that side)."""
@@ -593,82 +635,111 @@ class Drive(abc.ABC):
     def _close(self) -> None:
         """Release what the vendor opened (the native client); the link is closed by Drive."""
 
-    def _console(self, line: str) -> str:
+    async def _console(self, line: str) -> str:
         """One request in the drive's own protocol -> its answer as text (`console`)."""
         raise _core.InvalidArgument(f"{self.kind}: this drive has no protocol console")
 
     # ---- commands ------------------------------------------------------------------
+    # Each verb is one coroutine, ``_co_<verb>``: the logic, written once.  The blocking
+    # verb below runs it to its end on the calling thread (``faces.run``); motorbus.aio
+    # awaits the same coroutine.  A kind's hooks are coroutines too (``self.io``).
     def enable(self) -> None:
         """Power the motor (the drive holds position)."""
+        faces.run(self._co_enable())
+
+    async def _co_enable(self) -> None:
         self._check_open()
         log.debug("%s: enable", self.name)
-        self._enable()
+        await _value(self._enable())
 
     def disable(self) -> None:
         """Power stage off: the motor no longer holds position."""
+        faces.run(self._co_disable())
+
+    async def _co_disable(self) -> None:
         self._check_open()
         log.debug("%s: disable", self.name)
-        self._disable()
+        await _value(self._disable())
 
     def move_to(self, position: float, *, velocity: Optional[float] = None, wait: bool = True,
                 timeout: Optional[float] = None) -> None:
         """Absolute move in user units; ``velocity`` (user units/s) for this move, else the drive's own."""
+        faces.run(self._co_move_to(position, velocity=velocity, wait=wait, timeout=timeout))
+
+    async def _co_move_to(self, position: float, *, velocity: Optional[float] = None, wait: bool = True,
+                          timeout: Optional[float] = None) -> None:
         self._check_open()
         log.debug("%s: move_to %r %s (velocity %r, wait %s)", self.name, position, self._units.name, velocity, wait)
         target = self._units.to_native(self._number("position", position))
         speed = self._speed_arg(velocity)
-        self._start("move", target, lambda: self._move_to(target, speed))
+        await self._start("move", target, lambda: self._move_to(target, speed))
         if wait:
-            self.wait_idle(timeout)
+            await self._co_wait_idle(timeout)
 
     def move_by(self, distance: float, *, velocity: Optional[float] = None, wait: bool = True,
                 timeout: Optional[float] = None) -> None:
         """Relative move in user units."""
+        faces.run(self._co_move_by(distance, velocity=velocity, wait=wait, timeout=timeout))
+
+    async def _co_move_by(self, distance: float, *, velocity: Optional[float] = None, wait: bool = True,
+                          timeout: Optional[float] = None) -> None:
         self._check_open()
         log.debug("%s: move_by %r %s (velocity %r, wait %s)", self.name, distance, self._units.name, velocity, wait)
         distance = self._units.to_native(self._number("distance", distance))
         speed = self._speed_arg(velocity)
-        self._settle()
-        target = self._position() + distance
-        self._start("move", target, lambda: self._move_by(distance, speed))
+        await self._settle()
+        target = await _value(self._position()) + distance
+        await self._start("move", target, lambda: self._move_by(distance, speed))
         if wait:
-            self.wait_idle(timeout)
+            await self._co_wait_idle(timeout)
 
     def jog(self, velocity: float) -> None:
         """Run at ``velocity`` (user units/s, the sign is the direction) until stop()."""
+        faces.run(self._co_jog(velocity))
+
+    async def _co_jog(self, velocity: float) -> None:
         self._check_open()
         log.debug("%s: jog %r %s/s", self.name, velocity, self._units.name)
         v = self._units.to_native(self._number("velocity", velocity))
         if v == 0:
-            self.stop()
+            await self._co_stop()
             return
-        self._start("jog", None, lambda: self._jog(v))
+        await self._start("jog", None, lambda: self._jog(v))
 
     def stop(self) -> None:
         """Decelerate to a stop with the drive's deceleration.  A move this stops ends in
         ``MoveInterrupted`` (from its ``wait_idle``); a jog ends normally."""
+        faces.run(self._co_stop())
+
+    async def _co_stop(self, by: str = "stop()") -> None:
         self._check_open()
         log.debug("%s: stop", self.name)
         if self._move is not None and self._move.stopped_by is None:
-            self._move.stopped_by = "stop()"
-        self._stop()
+            self._move.stopped_by = by
+        await _value(self._stop())
 
     def quick_stop(self) -> None:
         """The fastest stop the drive has (an abort or the quick-stop ramp)."""
+        faces.run(self._co_quick_stop())
+
+    async def _co_quick_stop(self, by: str = "quick_stop()") -> None:
         self._check_open()
         log.debug("%s: quick_stop", self.name)
         if self._move is not None and self._move.stopped_by is None:
-            self._move.stopped_by = "quick_stop()"
-        self._quick_stop()
+            self._move.stopped_by = by
+        await _value(self._quick_stop())
 
     def home(self, method: Any = None, *, wait: bool = True, timeout: Optional[float] = None) -> None:
         """Run the drive's homing (``method``: the vendor's own, None = its default);
         returns once it has finished, else raises a :class:`MoveFailed`."""
+        faces.run(self._co_home(method, wait=wait, timeout=timeout))
+
+    async def _co_home(self, method: Any = None, *, wait: bool = True, timeout: Optional[float] = None) -> None:
         self._check_open()
         log.debug("%s: home (method %r, wait %s)", self.name, method, wait)
-        self._start("home", None, lambda: self._home(method))
+        await self._start("home", None, lambda: self._home(method))
         if wait:
-            self.wait_idle(timeout)
+            await self._co_wait_idle(timeout)
 
     def wait_idle(self, timeout: Optional[float] = None) -> None:
         """Return when the motor is at rest.  After a move, jog or homing of this Drive,
@@ -676,59 +747,62 @@ class Drive(abc.ABC):
         otherwise raise the :class:`MoveFailed` subclass that says why, once
         (``status.last_move`` keeps it).  ``MoveTimedOut`` (a ``TimeoutError``) after
         ``timeout`` s (None = ``default_timeout``)."""
+        faces.run(self._co_wait_idle(timeout))
+
+    async def _co_wait_idle(self, timeout: Optional[float] = None) -> None:
         self._check_open()
         move = self._move
         if move is None or move.judged:
-            self._wait(self._is_idle, timeout, "motion")
+            await self._wait(self._is_idle, timeout, "motion")
             return
         done = self._homing_done if move.what == "home" else self._is_idle
         limit = self.default_timeout if timeout is None else self._number("timeout", timeout)
         try:
-            self._wait(done, limit, "homing" if move.what == "home" else move.what)
+            await self._wait(done, limit, "homing" if move.what == "home" else move.what)
         except MoveFailed as e:
             self._finish(move, e)
             raise
         except _core.TimeoutError:
-            raise self._failure(move, StopReason(MoveTimedOut, f"the timeout ({limit:g} s)"),
-                                at_rest=False) from None
+            raise await self._failure(move, StopReason(MoveTimedOut, f"the timeout ({limit:g} s)"),
+                                      at_rest=False) from None
         except _core.DriveFault as e:       # a kind's own error while waiting: a fault
-            raise self._failure(move, StopReason(MoveFaulted, str(e))) from e
-        self._judge(move, raise_error=True)
+            raise await self._failure(move, StopReason(MoveFaulted, str(e))) from e
+        await self._judge(move, raise_error=True)
 
     # ---- the outcome of a move ----------------------------------------------------
-    def _start(self, what: str, target: Optional[float], command: Callable[[], None]) -> None:
+    async def _start(self, what: str, target: Optional[float], command: Callable[[], Any]) -> None:
         """Begins a move, jog or homing: the previous one's settings are put back first."""
-        self._settle()
+        await self._settle()
         move = _Move(what, target)
         self._move = move
         self._last_move = MoveOutcome(what, None if target is None else self._units.to_user(target), None, "running")
         try:
-            command()
+            await _value(command())
         except BaseException:
-            self._restore(move)
+            await self._restore(move)
             self._move, self._last_move = None, None
             raise
 
-    def _settle(self) -> None:
+    async def _settle(self) -> None:
         """Judges an earlier move nobody waited for, if it has ended (its outcome goes to
         ``status.last_move``, not raised), and puts its settings back."""
         move = self._move
         if move is not None and not move.judged:
             try:
-                if move.what == "home" or not self._is_idle():
-                    self._restore(move)     # superseded; a homing is not judged by rest alone
+                if move.what == "home" or not await _value(self._is_idle()):
+                    await self._restore(move)     # superseded; a homing is not judged by rest alone
                     move.judged = True
                     return
-                self._judge(move, raise_error=False)
+                await self._judge(move, raise_error=False)
             except MoveFailed:
                 pass
 
-    def _judge(self, move: _Move, *, raise_error: bool) -> None:
+    async def _judge(self, move: _Move, *, raise_error: bool) -> None:
         """The motor is at rest after ``move``: done, or the MoveFailed that says why."""
-        status = self._status()
-        reason = self._stop_reason(status)
-        position = self._position()
-        arrived = move.target is None or abs(position - move.target) <= self._in_position_window()
+        status = await _value(self._status())
+        reason = await _value(self._stop_reason(status))
+        position = await _value(self._position())
+        arrived = move.target is None or abs(position - move.target) <= await _value(self._in_position_window())
         if move.what == "home":
             failed = (reason is not None and reason.error is not LimitReached) or move.stopped_by is not None \
                 or not status.homed
@@ -737,7 +811,7 @@ class Drive(abc.ABC):
         else:
             failed = not arrived or (reason is not None and reason.error in (MoveFaulted, MoveStalled))
         if not failed:
-            self._finish(move, None, position)
+            await self._finish_restored(move, None, position)
             return
         if reason is None:
             if move.stopped_by is not None:
@@ -748,21 +822,21 @@ class Drive(abc.ABC):
             else:
                 reason = StopReason(MoveInterrupted, "a stop from another program or a stop input (the drive "
                                                      "shows no fault or limit)")
-        error = self._failure(move, reason, status=status, position=position)
+        error = await self._failure(move, reason, status=status, position=position)
         if raise_error:
             raise error
 
-    def _failure(self, move: _Move, reason: StopReason, *, status: Optional[DriveStatus] = None,
-                 position: Optional[float] = None, at_rest: bool = True) -> MoveFailed:
+    async def _failure(self, move: _Move, reason: StopReason, *, status: Optional[DriveStatus] = None,
+                       position: Optional[float] = None, at_rest: bool = True) -> MoveFailed:
         """Builds the error for ``move`` (and records it as the last outcome)."""
         if position is None:
             try:
-                position = self._position()
+                position = await _value(self._position())
             except Exception:  # noqa: BLE001 - the error must still be raised
                 position = math.nan
         if status is None:
             try:
-                status = self._status()
+                status = await _value(self._status())
             except Exception:  # noqa: BLE001
                 status = None
         u = self._units
@@ -775,13 +849,17 @@ class Drive(abc.ABC):
         message = f"{self.name}: {place} {where:g} {u.name} by {reason.text}, {what}"
         error = (reason.error(message, side=reason.side, **kw) if issubclass(reason.error, LimitReached)
                  else reason.error(message, **kw))
-        self._finish(move, error, position)
+        await self._finish_restored(move, error, position)
         return error
 
+    async def _finish_restored(self, move: _Move, error: Optional[MoveFailed], position: Optional[float] = None) -> None:
+        await self._restore(move)
+        self._finish(move, error, position)
+
     def _finish(self, move: _Move, error: Optional[MoveFailed], position: Optional[float] = None) -> None:
+        """Records how ``move`` ended (its settings are put back by the caller)."""
         log.debug("%s: %s ended: %s", self.name, move.what, "done" if error is None else error)
         move.judged = True
-        self._restore(move)
         u = self._units
         if position is None and error is not None:
             where = error.position
@@ -791,35 +869,44 @@ class Drive(abc.ABC):
                                       "done" if error is None else error.outcome,
                                       "" if error is None else error.reason, error)
 
-    def _restore(self, move: _Move) -> None:
+    async def _restore(self, move: _Move) -> None:
         steps, move.restore = move.restore, []
         for put_back in steps:
             try:
-                put_back()
+                await _value(put_back())
             except Exception:  # noqa: BLE001 - a lost link must not hide the move's outcome
                 pass
 
     def clear_faults(self) -> None:
         """Clear latched faults (limit errors, drive faults) so it accepts motion again."""
+        faces.run(self._co_clear_faults())
+
+    async def _co_clear_faults(self) -> None:
         self._check_open()
         log.debug("%s: clear_faults", self.name)
-        self._clear_faults()
+        await _value(self._clear_faults())
 
     def console(self, line: str) -> str:
         """Sends one request in the drive's own protocol and returns the answer as text:
         what ``motorbus terminal`` types (ASCII commands for serial drives, SDO reads and
         writes for CANopen drives...; the vendor's docs give the syntax).  Bypasses the
         Drive's bookkeeping: a move started here is not known to ``wait_idle``."""
+        return faces.run(self._co_console(line))
+
+    async def _co_console(self, line: str) -> str:
         self._check_open()
         if not isinstance(line, str):
             raise _core.InvalidArgument(f"{self.kind} console: a line of text, not {type(line).__name__}")
-        return self._console(line.strip())
+        return await _value(self._console(line.strip()))
 
     def store(self) -> None:
         """Persist the parameters in the drive's non-volatile memory."""
+        faces.run(self._co_store())
+
+    async def _co_store(self) -> None:
         self._check_open()
         log.debug("%s: store", self.name)
-        self._store()
+        await _value(self._store())
 
     def close(self) -> None:
         """Forget the drive (no stop); closes the line or bus if open_drive opened it."""
@@ -837,33 +924,42 @@ class Drive(abc.ABC):
     @property
     def position(self) -> float:
         """Position in user units (the encoder where the drive reads one)."""
+        return faces.run(self._co_position())
+
+    async def _co_position(self) -> float:
         self._check_open()
-        return self._units.to_user(self._position())
+        return self._units.to_user(await _value(self._position()))
 
     @property
     def velocity(self) -> float:
         """Velocity in user units per second."""
+        return faces.run(self._co_velocity())
+
+    async def _co_velocity(self) -> float:
         self._check_open()
-        return self._units.to_user(self._velocity())
+        return self._units.to_user(await _value(self._velocity()))
 
     @property
     def status(self) -> DriveStatus:
         """The drive's status now, with ``last_move``: how the last move, jog or homing
         ended (judged here if it ended while nobody waited)."""
+        return faces.run(self._co_status())
+
+    async def _co_status(self) -> DriveStatus:
         self._check_open()
-        self._settle_if_at_rest()
-        st = self._status()
+        await self._settle_if_at_rest()
+        st = await _value(self._status())
         last = self._last_move
         if last is not None and last.what == "move" and last.state != "done" and st.at_target:
             st = dataclasses.replace(st, at_target=False)     # halted short: not "at target"
         return dataclasses.replace(st, last_move=last)
 
-    def _settle_if_at_rest(self) -> None:
+    async def _settle_if_at_rest(self) -> None:
         move = self._move
         if move is not None and not move.judged and move.what != "home":
             try:
-                if self._is_idle():
-                    self._judge(move, raise_error=False)
+                if await _value(self._is_idle()):
+                    await self._judge(move, raise_error=False)
             except _core.DriveFault:    # judged and recorded in last_move
                 pass
 
@@ -875,8 +971,11 @@ class Drive(abc.ABC):
     def travel_limits(self) -> tuple[float, float]:
         """``(low, high)`` in user units: the soft limits the drive enforces now, read from it;
         ``-inf`` / ``inf`` on a side where it has none (most kinds have none at all)."""
+        return faces.run(self._co_travel_limits())
+
+    async def _co_travel_limits(self) -> tuple[float, float]:
         self._check_open()
-        lo, hi = self._travel_limits()
+        lo, hi = await _value(self._travel_limits())
         sign = 1.0 if self._units.scale > 0 else -1.0   # a negative scale swaps the ends
         a = -math.inf * sign if lo is None else self._units.to_user(lo)
         b = math.inf * sign if hi is None else self._units.to_user(hi)
@@ -908,7 +1007,9 @@ class Drive(abc.ABC):
 
     def _halt(self, how: StopHow) -> None:
         if not self._closed:
-            _stop_at_exit.halt(how, self._stop, self._quick_stop, self._disable)
+            _stop_at_exit.halt(how, lambda: faces.run(_value(self._stop())),
+                               lambda: faces.run(_value(self._quick_stop())),
+                               lambda: faces.run(_value(self._disable())))
 
     # ---- helpers -------------------------------------------------------------------------
     def _check_open(self) -> None:
@@ -928,15 +1029,17 @@ class Drive(abc.ABC):
             raise _core.InvalidArgument(f"{self.kind}: velocity must be non-zero")
         return v
 
-    def _wait(self, done: Callable[[], bool], timeout: Optional[float], what: str) -> None:
+    async def _wait(self, done: Callable[[], Any], timeout: Optional[float], what: str) -> None:
+        """Polls ``done`` every ``poll_interval`` until true: the thread sleeps between polls
+        in the blocking face, the task in the awaitable one."""
         limit = self.default_timeout if timeout is None else self._number("timeout", timeout)
         if limit < 0:
             raise _core.InvalidArgument(f"{self.name}: timeout must be >= 0, not {limit!r}")
         deadline = time.monotonic() + limit
-        while not done():
+        while not await _value(done()):
             if time.monotonic() >= deadline:
                 raise _core.TimeoutError(f"{self.name}: {what} not finished after {limit:g} s")
-            time.sleep(self.poll_interval)
+            await faces.sleep(self.poll_interval)
 
     def __repr__(self) -> str:
         state = "closed" if self._closed else "open"

@@ -17,7 +17,7 @@ import enum
 import os
 from typing import Any, Optional, Union
 
-from .. import _core, _stop_at_exit
+from .. import _core, _stop_at_exit, faces
 from ..stopping import STOP_WAYS, check_stop_way  # noqa: F401  (STOP_WAYS re-exported: motorbus's, said once)
 from .._core.arcus import (  # noqa: F401  (re-exported)
     ClientBase as ArcusClientBase, ClientCounters as ArcusClientCounters, CommandInfo as ArcusCommandInfo,
@@ -589,8 +589,8 @@ class ArcusDrive(_drive.Drive):
             error = ArcusHomingLimit if reason.error is _drive.LimitReached else ArcusHomingStalled
             move = self._move
             if move is not None:
-                raise self._failure(move, _drive.StopReason(error, f"{reason.text}: homing failed", reason.code,
-                                                            reason.side), status=status)
+                raise faces.run(self._failure(move, _drive.StopReason(error, f"{reason.text}: homing failed", reason.code,
+                                                            reason.side), status=status))
             raise error(f"arcus {self.native.address:02d}: homing failed: {reason.text}")
         # Nothing the drive shows tells a homing that found its switch from one a STOP
         # of another client on the line ended (docs/drives/arcus.md): it counts as homed.

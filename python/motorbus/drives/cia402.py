@@ -31,7 +31,7 @@ import contextlib
 import time
 from typing import Any, Iterator, Optional, Sequence, Union
 
-from .. import _core
+from .. import _core, faces
 from ..canopen.node import check_node_id
 from ..canopen.pdo import PdoMap, configure_pdo, read_pdo_config
 from ..canopen.cia402 import Cia402, Cia402Device, Controlword, OpMode
@@ -483,7 +483,7 @@ class Cia402Drive(Drive):
             elif not state.startswith("FAULT"):
                 reason = StopReason(reason.error, f"a homing error (statusword bit 13) at {reason.text}",
                                     reason.code, reason.side)
-            raise self._failure(self._move, reason, status=status)
+            raise faces.run(self._failure(self._move, reason, status=status))
         if state != "OPERATION ENABLED":
             return True             # quick stopped or disabled: judged (MoveInterrupted)
         reached = bool(sw & _SW_TARGET_REACHED)

@@ -26,7 +26,7 @@ import math
 import contextlib
 from typing import Any, Iterable, Iterator, Optional, Sequence
 
-from .. import _core, _stop_at_exit
+from .. import _core, _stop_at_exit, faces
 from ..stopping import check_stop_way
 # The DMAC's profile model (#ACCEL_TIME/#DECEL_TIME, the closed-loop approach at #LOW_SPEED):
 # the vendor's own module re-exports it (motorbus.motion keeps the generic planners).
@@ -723,7 +723,7 @@ class DmacDrive(Drive):
         error = {LimitReached: HomingLimitReached, MoveFaulted: HomingFaulted}.get(reason.error, HomingInterrupted)
         text = f"{reason.text}, while waiting for {waiting_for}"
         if move is not None:
-            raise self._failure(move, StopReason(error, text, reason.code, reason.side), status=status)
+            raise faces.run(self._failure(move, StopReason(error, text, reason.code, reason.side), status=status))
         raise error(f"dmac {self.native.address:02d}: homing failed: {text}")
 
     def _homing_done(self) -> bool:
@@ -757,11 +757,11 @@ class DmacDrive(Drive):
         self._homed = abs(self.native.position) <= self.in_position_window
         return True
 
-    def wait_idle(self, timeout: Optional[float] = None) -> None:
+    async def _co_wait_idle(self, timeout: Optional[float] = None) -> None:
         move = self._move
         phase = self._homing
         try:
-            super().wait_idle(timeout)
+            await super()._co_wait_idle(timeout)
         except MoveTimedOut as e:
             phase = self._homing or phase
             if move is None or move.what != "home" or phase is None:
@@ -778,8 +778,8 @@ class DmacDrive(Drive):
                       "search": "the IN5 reference edge (REFERENCE ON, clockwise at #LOW_SPEED); "
                                 "is a reference switch wired on IN5? the search was stopped",
                       "return": "the return to 0 after the IN5 edge"}[phase]
-            raise self._failure(move, StopReason(HomingTimedOut, f"{e.reason} waiting for {waited}"),
-                                status=None, position=None, at_rest=False) from None
+            raise await self._failure(move, StopReason(HomingTimedOut, f"{e.reason} waiting for {waited}"),
+                                      status=None, position=None, at_rest=False) from None
 
     def _clear_faults(self) -> None:
         self.native.clear_error()

@@ -45,13 +45,13 @@ class ToyParams(Params):
     def _info(self, name: str) -> Optional[ParamInfo]:
         return _SETTINGS.get(name.upper())
 
-    def _read(self, info: ParamInfo) -> Any:
-        return int(self._drive.native.get(info.name))
+    async def _read(self, info: ParamInfo) -> Any:
+        return int(await self._drive.io.get(info.name))
 
-    def _write(self, info: ParamInfo, value: Any) -> None:
+    async def _write(self, info: ParamInfo, value: Any) -> None:
         if value != int(value):
             raise _core.InvalidArgument(f"toy: {info.name} takes an integer, not {value!r}")
-        self._drive.native.set(info.name, int(value))
+        await self._drive.io.set(info.name, int(value))
 
 
 class ToyDrive(Drive):
@@ -131,51 +131,56 @@ class ToyDrive(Drive):
         }
 
     # ---- the Drive's hooks, native units (steps) -----------------------------------------------
-    def _enable(self) -> None:
-        self.native.enable()
+    # Coroutines over self.io (motorbus.faces): the same code serves drive.move_to(...) and
+    # `await aio_drive.move_to(...)`.
+    def _io_link(self) -> Any:
+        return self.native.link
 
-    def _disable(self) -> None:
-        self.native.disable()
+    async def _enable(self) -> None:
+        await self.io.enable()
 
-    def _move_to(self, target: float, velocity: Optional[float]) -> None:
+    async def _disable(self) -> None:
+        await self.io.disable()
+
+    async def _move_to(self, target: float, velocity: Optional[float]) -> None:
         if velocity is not None:
-            self._for_this_move(lambda: self.native.get("SPEED"), lambda v: self.native.set("SPEED", v),
-                                max(1, min(100000, round(velocity))))
-        self.native.move_to(round(target))
+            await self._for_this_move(lambda: self.io.get("SPEED"), lambda v: self.io.set("SPEED", v),
+                                      max(1, min(100000, round(velocity))))
+        await self.io.move_to(round(target))
 
-    def _jog(self, velocity: float) -> None:
-        self.native.jog(velocity)
+    async def _jog(self, velocity: float) -> None:
+        await self.io.jog(velocity)
 
-    def _stop(self) -> None:
-        self.native.stop()
+    async def _stop(self) -> None:
+        await self.io.urgent.stop()
 
-    def _quick_stop(self) -> None:
-        self.native.abort()
+    async def _quick_stop(self) -> None:
+        await self.io.urgent.abort()
 
-    def _home(self, method: Any) -> None:
+    async def _home(self, method: Any) -> None:
         if method not in (None, "here"):
             raise _core.InvalidArgument(f"toy: home method 'here' (the only one), not {method!r}")
-        self.native.home()
+        await self.io.home()
 
-    def _clear_faults(self) -> None:
-        self.native.clear()
+    async def _clear_faults(self) -> None:
+        await self.io.clear()
 
-    def _position(self) -> float:
-        return float(self.native.position())
+    async def _position(self) -> float:
+        return float(await self.io.position())
 
-    def _velocity(self) -> float:
-        return self.native.velocity()
+    async def _velocity(self) -> float:
+        return await self.io.velocity()
 
-    def _status(self) -> DriveStatus:
-        st = self.native.status()
+    async def _status(self) -> DriveStatus:
+        st = await self.io.status()
         state = "fault" if st.fault else "moving" if st.moving else "enabled" if st.enabled else "disabled"
         return DriveStatus(enabled=st.enabled, moving=st.moving, homed=st.homed, fault=st.fault,
                            at_target=not st.moving and st.last_stop.name in ("TARGET", "NONE") and not st.fault,
                            limit_positive=False, limit_negative=False, raw=st,
                            text=f"toy {self.native.address}: {state}, last motion ended by {st.last_stop.name}")
 
-    def _is_idle(self) -> bool:
-        return not self.native.status().moving
+    async def _is_idle(self) -> bool:
+        return not (await self.io.status()).moving
 
     def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
         last = status.raw.last_stop.name
@@ -186,11 +191,11 @@ class ToyDrive(Drive):
             return StopReason(MoveInterrupted, _STOPS[last])
         return None     # this program's stop(): Drive says so
 
-    def _in_position_window(self) -> float:
-        return max(0.5, float(self.native.get("WINDOW")))
+    async def _in_position_window(self) -> float:
+        return max(0.5, float(await self.io.get("WINDOW")))
 
     def _make_params(self) -> Params:
         return ToyParams(self)
 
-    def _console(self, line: str) -> str:
-        return self.native.command(line)
+    async def _console(self, line: str) -> str:
+        return await self.io.command(line)
