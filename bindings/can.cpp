@@ -5,6 +5,8 @@
 
 #include "can_filters.hpp"
 #include "common.hpp"
+#include "completions.hpp"
+#include "motorbus/can/async_receiver.hpp"
 #include "motorbus/can/bus.hpp"
 #include "motorbus/can/external_bus.hpp"
 #include "motorbus/can/log.hpp"
@@ -133,6 +135,20 @@ static void bind_buses(py::module_& m) {
              py::arg("max") = 1024, py::arg("timeout") = py::none(),
              "Up to max frames, oldest first: waits like recv() for the first, then takes what is "
              "already queued. An empty list after timeout.")
+        .def("_recv_or_wait",
+             [](Bus& b, std::size_t max, std::shared_ptr<Completions> done, std::uint64_t token) {
+                 not_none(done, "completions");
+                 return b.recv_or_wait(max, std::move(done), token);
+             },
+             py::arg("max"), py::arg("completions"), py::arg("token"),
+             "recv() for an event loop (Bus.arecv): up to max queued frames, or [] and a waiter completed "
+             "with a list of Frames (or recv()'s error) under token.")
+        .def("_cancel_wait",
+             [](Bus& b, const std::shared_ptr<Completions>& done, std::uint64_t token) {
+                 return b.cancel_wait(done.get(), token);
+             },
+             py::arg("completions"), py::arg("token"),
+             "Withdraws a _recv_or_wait waiter: False when it already completed.")
         .def("set_filters",
              [](Bus& b, const py::object& filters) {
                  b.set_filters(motorbus::py_helpers::filters_from_py(filters));
@@ -226,6 +242,38 @@ static void bind_buses(py::module_& m) {
         .def("feed_parse_error", &ExternalBus::feed_parse_error);
 }
 
+static void bind_async_receiver(py::module_& m) {
+    // A completion's batch of frames (Bus._recv_or_wait, AsyncReceiver) becomes a list of Frames.
+    motorbus::py_completions::convertible<std::vector<Frame>>();
+    Record<AsyncReceiverCounters>(m, "AsyncReceiverCounters", "A frame stream's counters, read-only.")
+        .field("received", &AsyncReceiverCounters::received, "frames that passed the filters")
+        .field("overflows", &AsyncReceiverCounters::overflows, "of those, dropped (the newest) with the queue full")
+        .field("wakeups", &AsyncReceiverCounters::wakeups, "completions pushed: one per burst the loop waited for");
+    py::class_<AsyncReceiver, std::shared_ptr<AsyncReceiver>>(
+        m, "AsyncReceiver",
+        "A bus's frames for an event loop (Bus.frames): its own subscription, filters and bounded queue.")
+        .def(py::init([](std::shared_ptr<Bus> bus, const py::object& filters, std::size_t queue) {
+                 not_none(bus, "bus");
+                 return std::make_shared<AsyncReceiver>(std::move(bus),
+                                                        motorbus::py_helpers::filters_from_py(filters), queue);
+             }),
+             py::arg("bus"), py::arg("filters") = py::none(), py::arg("queue") = 1024)
+        .def("take_or_arm",
+             [](AsyncReceiver& r, std::size_t max, std::shared_ptr<Completions> done, std::uint64_t token) {
+                 not_none(done, "completions");
+                 return r.take_or_arm(max, std::move(done), token);
+             },
+             py::arg("max"), py::arg("completions"), py::arg("token"),
+             "Up to max queued frames, or [] and armed: the next frames complete token as a list of Frames.")
+        .def("take", &AsyncReceiver::take, py::arg("max") = 1024)
+        .def("disarm", &AsyncReceiver::disarm)
+        .def("close", &AsyncReceiver::close, py::call_guard<py::gil_scoped_release>())
+        .def_property_readonly("ended", &AsyncReceiver::ended)
+        .def_property_readonly("queued", &AsyncReceiver::queued)
+        .def_property_readonly("capacity", &AsyncReceiver::capacity)
+        .def_property_readonly("counters", &AsyncReceiver::counters);
+}
+
 static void bind_logs(py::module_& m) {
     // ---- logs -------------------------------------------------------------
     py::class_<LogEntry>(m, "LogEntry", "One logged frame: time (s), channel, direction.")
@@ -275,5 +323,6 @@ static void bind_logs(py::module_& m) {
 void bind_can(py::module_& m) {
     bind_frames(m);
     bind_buses(m);
+    bind_async_receiver(m);
     bind_logs(m);
 }

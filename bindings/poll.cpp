@@ -70,6 +70,15 @@ void bind_poll(py::module_& m) {
         .def_property_readonly("capacity", [](poll::PollGroup& g) { return g.ring().capacity(); })
         .def_property_readonly("running", &poll::PollGroup::running)
         .def_property_readonly("stats", &poll::PollGroup::stats)
+        .def("notify_when",
+             [](poll::PollGroup& g, std::size_t rows, std::shared_ptr<Completions> done, std::uint64_t token) {
+                 motorbus::py_helpers::not_none(done, "completions");
+                 return g.notify_when(rows, std::move(done), token);
+             },
+             py::arg("rows"), py::arg("completions"), py::arg("token"),
+             "For an event loop: False, and token completes (with the unread row count) once the ring holds "
+             "rows unread rows or the thread ended; True when that is already so.")
+        .def("cancel_notify", &poll::PollGroup::cancel_notify)
         .def("take", [](poll::PollGroup& g) {
             auto& ring = g.ring();
             const std::size_t n = ring.available();  // more may arrive: take at most n

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "motorbus/errors.hpp"
+#include "motorbus/runtime/completions.hpp"
 
 namespace motorbus::can {
 
@@ -59,6 +60,7 @@ void Bus::link_lost(const std::string& reason) {
     }
     if (!closed_.load()) set_state(BusState::BusOff);
     rx_cv_.notify_all();
+    fail_waiters(std::make_exception_ptr(LinkDown("bus " + channel_ + ": link down: " + reason)));
     link_interrupted(reason);
 }
 
@@ -141,6 +143,41 @@ std::vector<Frame> Bus::recv_many(std::size_t max, Duration timeout) {
     return out;
 }
 
+std::vector<Frame> Bus::recv_or_wait(std::size_t max, std::shared_ptr<Completions> done, std::uint64_t token) {
+    if (max == 0) throw InvalidArgument("bus " + channel_ + " recv: max 0, must be >= 1 frame");
+    if (!done) throw InvalidArgument("bus " + channel_ + " recv: no completion queue");
+    std::vector<Frame> out;
+    std::unique_lock lock(rx_mutex_);
+    recv_used_ = true;
+    if (wait_for_rx(lock, Duration::zero())) {  // throws once closed / link-down and drained
+        const auto n = static_cast<std::ptrdiff_t>(std::min(max, rx_queue_.size()));
+        out.assign(rx_queue_.begin(), rx_queue_.begin() + n);
+        rx_queue_.erase(rx_queue_.begin(), rx_queue_.begin() + n);
+        return out;
+    }
+    rx_waiters_.push_back(RxWaiter{std::move(done), token, max});
+    return out;
+}
+
+bool Bus::cancel_wait(const Completions* done, std::uint64_t token) {
+    std::lock_guard lock(rx_mutex_);
+    auto it = std::find_if(rx_waiters_.begin(), rx_waiters_.end(),
+                           [&](const RxWaiter& w) { return w.done.get() == done && w.token == token; });
+    if (it == rx_waiters_.end()) return false;
+    rx_waiters_.erase(it);
+    return true;
+}
+
+void Bus::fail_waiters(std::exception_ptr error) {
+    std::deque<RxWaiter> waiters;
+    {
+        std::lock_guard lock(rx_mutex_);
+        waiters.swap(rx_waiters_);
+    }
+    // Outside the lock: a loop without add_reader is woken by a call that takes the GIL.
+    for (auto& w : waiters) w.done->fail(w.token, error);
+}
+
 void Bus::set_filters(std::vector<Filter> filters) {
     std::lock_guard lock(rx_mutex_);
     recv_used_ = true;  // filters are for recv(): someone means to read
@@ -216,6 +253,7 @@ void Bus::dispatch_batch(std::span<const Frame> frames) {
         }
         dispatch_thread_.store(std::thread::id{});
     }
+    std::vector<std::pair<RxWaiter, std::vector<Frame>>> served;
     {
         std::lock_guard lock(rx_mutex_);
         // Read only through callbacks so far: keep a few frames, not rx_queue_size.
@@ -232,7 +270,17 @@ void Bus::dispatch_batch(std::span<const Frame> frames) {
             }
             rx_queue_.push_back(frame);
         }
+        // Event-loop waiters take what arrived, each in one batch: the loop wakes once per burst.
+        while (!rx_waiters_.empty() && !rx_queue_.empty()) {
+            RxWaiter w = std::move(rx_waiters_.front());
+            rx_waiters_.pop_front();
+            const auto n = static_cast<std::ptrdiff_t>(std::min(w.max, rx_queue_.size()));
+            served.emplace_back(std::move(w), std::vector<Frame>(rx_queue_.begin(), rx_queue_.begin() + n));
+            rx_queue_.erase(rx_queue_.begin(), rx_queue_.begin() + n);
+        }
     }
+    // Outside rx_mutex_: a loop without add_reader is woken by a call that takes the GIL.
+    for (auto& [w, batch] : served) w.done->push(w.token, std::move(batch));
     if (frames.size() == 1)
         rx_cv_.notify_one();
     else
@@ -261,6 +309,7 @@ void Bus::close() {
         do_close();
         state_.store(BusState::Closed);
         rx_cv_.notify_all();
+        fail_waiters(std::make_exception_ptr(ClosedError("bus " + channel_ + " is closed")));
     });
 }
 

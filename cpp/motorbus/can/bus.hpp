@@ -24,6 +24,10 @@
 
 #include "motorbus/can/frame.hpp"
 
+namespace motorbus {
+class Completions;  // motorbus/runtime/completions.hpp
+}
+
 namespace motorbus::can {
 
 using Duration = std::chrono::nanoseconds;
@@ -92,6 +96,18 @@ public:
     // Empty after `timeout`.  One lock (and, from Python, one GIL release) per
     // batch instead of per frame, for consumers that drain a busy bus.
     std::vector<Frame> recv_many(std::size_t max, Duration timeout);
+
+    // recv() for an event loop (completion-based: no thread waits).  Returns up
+    // to `max` queued frames at once when there are any.  Otherwise returns an
+    // empty vector and leaves a waiter: the next frames that pass the filters
+    // are pushed to `done` under `token` as one std::vector<Frame> (a burst is
+    // one completion), or the ClosedError / LinkDown that recv() would throw
+    // is failed into it.  Throws like recv() when closed or link-down and
+    // drained; InvalidArgument for max 0.
+    std::vector<Frame> recv_or_wait(std::size_t max, std::shared_ptr<Completions> done, std::uint64_t token);
+    // Withdraws a waiter of recv_or_wait (a cancelled await): false when it was
+    // already completed (its frames are then on their way to `done`).
+    bool cancel_wait(const Completions* done, std::uint64_t token);
 
     // Acceptance filters for recv() (subscribers have their own).  Empty = all.
     void set_filters(std::vector<Filter> filters);
@@ -185,6 +201,13 @@ private:
     }
     SubscriptionId add_subscriber(std::shared_ptr<Subscriber> s, bool exact);
     bool wait_for_rx(std::unique_lock<std::mutex>& lock, Duration timeout);
+    // Completion-based waiters (recv_or_wait), oldest first, each served once.
+    struct RxWaiter {
+        std::shared_ptr<Completions> done;
+        std::uint64_t token;
+        std::size_t max;
+    };
+    void fail_waiters(std::exception_ptr error);
 
     std::string channel_;
     std::atomic<BusState> state_{BusState::Active};
@@ -199,6 +222,7 @@ private:
     std::atomic<bool> link_lost_{false};
     std::string link_lost_reason_;  // rx_mutex_
     bool recv_used_ = false;        // rx_mutex_: recv()/recv_many()/set_filters() was called
+    std::deque<RxWaiter> rx_waiters_;  // rx_mutex_
 
     // subscribers: copy-on-write table, read under table_mutex_ by dispatch()
     std::mutex table_mutex_;

@@ -43,6 +43,51 @@ void PollGroup::stop() {
     stop_ = true;
     if (thread_.joinable()) thread_.join();
     running_ = false;
+    check_notify();  // a group stopped before its thread started: a waiter still learns it
+}
+
+bool PollGroup::notify_when(std::size_t rows, std::shared_ptr<Completions> done, std::uint64_t token) {
+    if (!done) throw InvalidArgument("PollGroup notify_when: no completion queue");
+    if (rows == 0 || rows > ring_.capacity())
+        throw InvalidArgument("PollGroup notify_when: rows " + std::to_string(rows) + ", must be 1.." +
+                              std::to_string(ring_.capacity()) + " (the ring's capacity)");
+    std::lock_guard lock(notify_mutex_);
+    // running_ is cleared before the thread's last check_notify(), which takes this lock:
+    // a request made after it sees running_ false here, one made before is fired by it.
+    if (!running_.load() || ring_.available() >= rows) {
+        notify_done_.reset();
+        notify_armed_ = false;
+        return true;
+    }
+    notify_done_ = std::move(done);
+    notify_token_ = token;
+    notify_rows_ = rows;
+    notify_armed_ = true;
+    return false;
+}
+
+bool PollGroup::cancel_notify() {
+    std::lock_guard lock(notify_mutex_);
+    const bool armed = static_cast<bool>(notify_done_);
+    notify_done_.reset();
+    notify_armed_ = false;
+    return armed;
+}
+
+void PollGroup::check_notify() {
+    std::shared_ptr<Completions> done;
+    std::uint64_t token = 0;
+    std::size_t available = 0;
+    {
+        std::lock_guard lock(notify_mutex_);
+        if (!notify_done_) return;
+        available = ring_.available();
+        if (running_.load() && available < notify_rows_) return;
+        done.swap(notify_done_);
+        token = notify_token_;
+        notify_armed_ = false;
+    }
+    done->push(token, static_cast<std::int64_t>(available));
 }
 
 void PollGroup::fail(const char* type, const std::string& what) {
@@ -104,6 +149,7 @@ void PollGroup::run() {
             previous_start = start;
             previous_index = k;
             k = next.index;
+            if (notify_armed_.load(std::memory_order_relaxed)) check_notify();
         }
     } catch (const LinkDown& e) {
         fail("LinkDown", e.what());
@@ -119,6 +165,7 @@ void PollGroup::run() {
         fail("Error", e.what());
     }
     running_ = false;
+    check_notify();  // the loop waiting for rows learns the group ended
 }
 
 PollStats PollGroup::stats() const {

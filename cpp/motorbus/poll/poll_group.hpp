@@ -23,6 +23,7 @@
 #include "motorbus/poll/schedule.hpp"
 #include "motorbus/poll/source.hpp"
 #include "motorbus/poll/stats.hpp"
+#include "motorbus/runtime/completions.hpp"
 
 namespace motorbus::poll {
 
@@ -51,6 +52,15 @@ public:
     PollStats stats() const;
     bool running() const { return running_.load(); }
 
+    // For an event loop (Poller.chunks): returns false and, once the ring holds
+    // at least `rows` unread rows or the thread has ended, pushes `token` to
+    // `done` with the unread row count (an int64) -- from the poll thread,
+    // without the GIL, once per request; returns true (nothing armed) when that
+    // is already so.  A new request replaces the previous one.
+    bool notify_when(std::size_t rows, std::shared_ptr<Completions> done, std::uint64_t token);
+    // Withdraws the request: false when there was none (it already fired).
+    bool cancel_notify();
+
 private:
     void run();
     void fail(const char* type, const std::string& what);
@@ -67,6 +77,13 @@ private:
     std::uint64_t samples_ = 0, missed_ = 0, late_ = 0;
     bool realtime_ = false;
     std::string error_, error_type_;
+
+    void check_notify();
+    std::mutex notify_mutex_;
+    std::atomic<bool> notify_armed_{false};  // read per sample without the lock
+    std::shared_ptr<Completions> notify_done_;
+    std::uint64_t notify_token_ = 0;
+    std::size_t notify_rows_ = 0;
 };
 
 }  // namespace motorbus::poll
