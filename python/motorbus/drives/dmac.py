@@ -24,7 +24,7 @@ from __future__ import annotations
 import enum
 import math
 import contextlib
-from typing import Any, Iterable, Iterator, Optional, Sequence
+from typing import Any, AsyncIterator, Iterable, Iterator, Optional, Sequence
 
 from .. import _core, _stop_at_exit, faces
 from ..stopping import check_stop_way
@@ -506,13 +506,13 @@ class DmacParams(Params):
                          unit=_UNITS.get(canonical, ""), default=v.factory, persists=v.stored,
                          writable=writable, description=_DESCRIPTIONS.get(canonical, ""))
 
-    def _read(self, info: ParamInfo) -> Any:
-        return self._drive.native.read(info.name)
+    async def _read(self, info: ParamInfo) -> Any:
+        return await self._drive.io.read(info.name)
 
-    def _write(self, info: ParamInfo, value: Any) -> None:
+    async def _write(self, info: ParamInfo, value: Any) -> None:
         if isinstance(value, bool) or int(value) != value:
             raise _core.InvalidArgument(f"dmac: {info.name} takes an integer, not {value!r}")
-        self._drive.native.write(info.name, int(value))
+        await self._drive.io.write(info.name, int(value))
 
 
 class DmacDrive(Drive):
@@ -561,44 +561,61 @@ class DmacDrive(Drive):
         super().__init__(native, **kwargs)
         self._homed = False
         self._homing: Optional[str] = None      # "backoff", "search", "return" or None
+        self._model_is_dmac34: Optional[bool] = None
+
+    def _io_link(self) -> Any:
+        # The LineLink of the RS-485 line: the modules of one line take turns on its wire,
+        # so their exchanges queue on one worker in the awaitable face.
+        return self.native.link
 
     def _make_params(self) -> Params:
         return DmacParams(self)
 
-    def _console(self, line: str) -> str:
+    async def _console(self, line: str) -> str:
         # READ/REQUEST_* answer; every other DMAC command is silent, so it is sent
         # with the client's #ERROR check and "OK" stands for "accepted".
         if line.upper().startswith(("READ", "REQUEST")):
-            reply = self.native.raw(f"{self.native.address:02d}{line}", True)
+            reply = await self.io.raw(f"{self.native.address:02d}{line}", True)
             return reply.decode("ascii", "replace").strip()
-        self.native.command(line)
+        await self.io.command(line)
         return "OK"
 
+    # ---- faces of the module ----
+    async def _is_dmac34(self) -> bool:
+        # REQUEST_VERSION once (the client caches it too): kept here so that later
+        # questions cost no trip to the link's worker.
+        if self._model_is_dmac34 is None:
+            self._model_is_dmac34 = bool(await self.io.attr("is_dmac34"))
+        return self._model_is_dmac34
+
     # ---- faults in the Drive's words ----
-    def _fault_cause(self, err: DmacErrorWord) -> str:
+    async def _fault_cause(self, err: DmacErrorWord) -> str:
         """Whether the cause of the latched faults in ``err`` is still there, read from the module."""
-        n = self.native
-        under, over = (20, 170) if n.is_dmac34 else (12, 49)
+        dmac34 = await self._is_dmac34()
+        under, over = (20, 170) if dmac34 else (12, 49)
         present = []
         if err & (DmacErrorWord.UNDERVOLTAGE | DmacErrorWord.OVERVOLTAGE):
-            mv = n.supply_voltage
+            mv = await self.io.attr("supply_voltage")
             if mv < under * 1000 or mv > over * 1000:
                 present.append(f"#SUPPLY_VOLTAGE {mv / 1000:g} V, outside {under}..{over} V")
         if err & DmacErrorWord.THERMAL:
-            temps = [("#CPU_TEMPERATURE", n.cpu_temperature, 1200)]
-            if n.is_dmac34:
-                temps += [("#DRIVER_TEMPERATURE", n.driver_temperature, 850),
-                          ("#MOTOR_TEMPERATURE", n.motor_temperature, 850)]
-            present += [f"{name} {t / 10:g} degC, above {limit / 10:g}" for name, t, limit in temps if t > limit]
+            sensors = [("#CPU_TEMPERATURE", "cpu_temperature", 1200)]
+            if dmac34:
+                sensors += [("#DRIVER_TEMPERATURE", "driver_temperature", 850),
+                            ("#MOTOR_TEMPERATURE", "motor_temperature", 850)]
+            for name, attr, limit in sensors:
+                t = await self.io.attr(attr)
+                if t > limit:
+                    present.append(f"{name} {t / 10:g} degC, above {limit / 10:g}")
         return "; ".join(present)
 
-    def _fault_text(self, err: DmacErrorWord) -> str:
-        under, over = (20, 170) if self.native.is_dmac34 else (12, 49)
+    async def _fault_text(self, err: DmacErrorWord) -> str:
+        under, over = (20, 170) if await self._is_dmac34() else (12, 49)
         words = [_FAULT_TEXT[b].format(under=under, over=over) for b in (2, 3, 4, 5) if err.bit(b)]
         return "; ".join(words) or f"#ERROR {', '.join(err.names)}"
 
-    @contextlib.contextmanager
-    def _refused_in_drive_words(self, what: str) -> Iterator[None]:
+    @contextlib.asynccontextmanager
+    async def _refused_in_drive_words(self, what: str) -> AsyncIterator[None]:
         """A command the client refuses because a fault is latched: say so in the Drive's
         words (clear_faults(), and whether the cause is still there)."""
         try:
@@ -607,114 +624,111 @@ class DmacDrive(Drive):
             err = DmacErrorWord(int(getattr(e, "error", 0) or 0)) & FAULTS
             if not err:
                 raise
-            cause = self._fault_cause(err)
+            cause = await self._fault_cause(err)
             then = (f"its cause is still present ({cause}): remove it, then call clear_faults()" if cause else
                     "clear_faults() acknowledges it")
             error = CommandRejected(f"dmac {self.native.address:02d}: {what} refused: a fault is latched "
-                                    f"({self._fault_text(err)}); {then}")
+                                    f"({await self._fault_text(err)}); {then}")
             error.error = int(err)
             raise error from None
 
     # ---- motion ----
-    def _enable(self) -> None:
-        if self.native.is_dmac34:
-            self.native.brake(False)
-        with self._refused_in_drive_words("enable()"):
-            self.native.power("ON")
+    async def _enable(self) -> None:
+        if await self._is_dmac34():
+            await self.io.brake(False)
+        async with self._refused_in_drive_words("enable()"):
+            await self.io.power("ON")
 
-    def _disable(self) -> None:
-        self.native.power("OFF")
+    async def _disable(self) -> None:
+        await self.io.power("OFF")
 
-    def _speed_for_this_move(self, velocity: Optional[float]) -> None:
+    async def _speed_for_this_move(self, velocity: Optional[float]) -> None:
         if velocity is None:
             return
         speed = int(round(velocity * _SPEED_PER_INC_S))
         if not 1 <= speed <= 400000:
             raise _core.InvalidArgument(f"dmac: velocity {velocity:g} increments/s is outside "
                                         f"1..400000 (0.01 rpm, #HIGH_SPEED)")
-        old = self.native.high_speed
+        old = await self.io.attr("high_speed")
         if old != speed:       # a stored variable: no flash write when it would not change
-            self._for_this_move(lambda: old, self._set_high_speed, speed)
+            await self._for_this_move(lambda: old, lambda v: self.io.set_attr("high_speed", v), speed)
 
-    def _set_high_speed(self, value: int) -> None:
-        self.native.high_speed = value
-
-    def _abandon_homing(self) -> None:
+    async def _abandon_homing(self) -> None:
         # A reference run nobody waited to the end of: REFERENCE ON would otherwise stay
         # armed and silently re-home the axis at the next IN5 edge turning clockwise.
         if self._homing is not None:
             self._homing = None
-            self.native.reference(False)
+            await self.io.reference(False)
 
-    def _move_to(self, target: float, velocity: Optional[float]) -> None:
+    async def _move_to(self, target: float, velocity: Optional[float]) -> None:
         goal = self._increments(target)
-        self._abandon_homing()
-        self._speed_for_this_move(velocity)
-        with self._refused_in_drive_words(f"move_to (MOVE_TO {goal})"):
-            self.native.move_to(goal)
+        await self._abandon_homing()
+        await self._speed_for_this_move(velocity)
+        async with self._refused_in_drive_words(f"move_to (MOVE_TO {goal})"):
+            await self.io.move_to(goal)
 
-    def _move_by(self, distance: float, velocity: Optional[float]) -> None:
+    async def _move_by(self, distance: float, velocity: Optional[float]) -> None:
         # MOVE_ON counts from where the axis is at rest (the sim and the manual: from the
         # target of a move in progress), which is where Drive read the start it judges by.
         step = self._increments(distance)
-        self._abandon_homing()
-        self._speed_for_this_move(velocity)
-        with self._refused_in_drive_words(f"move_by (MOVE_ON {step})"):
-            self.native.move_on(step)
+        await self._abandon_homing()
+        await self._speed_for_this_move(velocity)
+        async with self._refused_in_drive_words(f"move_by (MOVE_ON {step})"):
+            await self.io.move_on(step)
 
-    def _jog(self, velocity: float) -> None:
+    async def _jog(self, velocity: float) -> None:
         speed = int(round(velocity * _SPEED_PER_INC_S))
         if abs(speed) > 400000:
             raise _core.InvalidArgument(f"dmac: jog velocity {velocity:g} increments/s exceeds 400000 (0.01 rpm)")
         if speed == 0:
-            self.native.stop()
+            await self.io.urgent.stop()
             return
-        self._abandon_homing()
-        with self._refused_in_drive_words(f"jog (MOVE_SPEED {speed})"):
-            self.native.move_speed(speed)  # the module limits |speed| to #HIGH_SPEED
+        await self._abandon_homing()
+        async with self._refused_in_drive_words(f"jog (MOVE_SPEED {speed})"):
+            await self.io.move_speed(speed)  # the module limits |speed| to #HIGH_SPEED
 
-    def _stop(self) -> None:
-        self.native.stop()
+    async def _stop(self) -> None:
+        await self.io.urgent.stop()
 
-    def _quick_stop(self) -> None:
-        self.native.halt()
+    async def _quick_stop(self) -> None:
+        await self.io.urgent.halt()
 
     # ---- homing ----
-    def _in5(self) -> bool:
-        return bool(self.native.inputs & (1 << 4))
+    async def _in5(self) -> bool:
+        return bool(await self.io.attr("inputs") & (1 << 4))
 
-    def _home(self, method: Any) -> None:
+    async def _home(self, method: Any) -> None:
         method = "reference" if method is None else method
         if method not in self.HOME_METHODS:
             raise _core.InvalidArgument(f"dmac: home method {method!r} is not one of {self.HOME_METHODS}")
         self._homed = False
-        self._abandon_homing()
+        await self._abandon_homing()
         if method == "here":
-            self.native.position = 0
+            await self.io.set_attr("position", 0)
             self._homed = True
             return
-        with self._refused_in_drive_words("home()"):
-            if self._in5():
+        async with self._refused_in_drive_words("home()"):
+            if await self._in5():
                 # REFERENCE needs a rising edge: leave the switch (counter-clockwise) first.
-                self.native.move_speed(-max(1, self.native.high_speed))
+                await self.io.move_speed(-max(1, await self.io.attr("high_speed")))
                 self._homing = "backoff"
             else:
-                self._start_search()
+                await self._start_search()
 
-    def _start_search(self) -> None:
-        self.native.reference(True)
-        self.native.move_speed(max(1, self.native.low_speed))
+    async def _start_search(self) -> None:
+        await self.io.reference(True)
+        await self.io.move_speed(max(1, await self.io.attr("low_speed")))
         self._homing = "search"
 
-    def _homing_failed(self, st: DmacStatus, waiting_for: str) -> None:
+    async def _homing_failed(self, st: DmacStatus, waiting_for: str) -> None:
         """The run stopped early: raise the HomingFailed subclass of the reason the module shows."""
         self._homing = None
         try:
-            self.native.reference(False)
+            await self.io.reference(False)
         except _core.MotorbusError:
             pass
-        status = self._status()
-        reason = self._stop_reason(status)
+        status = await self._status()
+        reason = await self._stop_reason(status)
         move = self._move
         if reason is None:
             by = move.stopped_by if move is not None else None
@@ -723,38 +737,38 @@ class DmacDrive(Drive):
         error = {LimitReached: HomingLimitReached, MoveFaulted: HomingFaulted}.get(reason.error, HomingInterrupted)
         text = f"{reason.text}, while waiting for {waiting_for}"
         if move is not None:
-            raise faces.run(self._failure(move, StopReason(error, text, reason.code, reason.side), status=status))
+            raise await self._failure(move, StopReason(error, text, reason.code, reason.side), status=status)
         raise error(f"dmac {self.native.address:02d}: homing failed: {text}")
 
-    def _homing_done(self) -> bool:
+    async def _homing_done(self) -> bool:
         phase = self._homing
         if phase is None:          # "here": done when it was asked
             return True
-        st = self.native.status
+        st = await self.io.attr("status")
         moving = DmacStatus.MOVEMENT in st
         if phase == "backoff":
-            if not self._in5():
-                self.native.stop()
+            if not await self._in5():
+                await self.io.stop()
                 self._homing = "backoff_stop"
             elif not moving or DmacStatus.ABNORMAL_STOP in st:
-                self._homing_failed(st, "IN5 to turn off (backing off the reference switch, counter-clockwise)")
+                await self._homing_failed(st, "IN5 to turn off (backing off the reference switch, counter-clockwise)")
             return False
         if phase == "backoff_stop":
             if not moving:
-                self._start_search()
+                await self._start_search()
             return False
         if phase == "search":
             if DmacStatus.REFERENCE not in st:         # IN5 rose: the module re-homed
-                self.native.move_to(0)                # back onto the reference point
+                await self.io.move_to(0)              # back onto the reference point
                 self._homing = "return"
                 return False
             if not moving or DmacStatus.ABNORMAL_STOP in st:
-                self._homing_failed(st, "the IN5 reference edge (REFERENCE ON, clockwise at #LOW_SPEED)")
+                await self._homing_failed(st, "the IN5 reference edge (REFERENCE ON, clockwise at #LOW_SPEED)")
             return False
         if moving:
             return False
         self._homing = None
-        self._homed = abs(self.native.position) <= self.in_position_window
+        self._homed = abs(await self.io.attr("position")) <= self.in_position_window
         return True
 
     async def _co_wait_idle(self, timeout: Optional[float] = None) -> None:
@@ -769,8 +783,8 @@ class DmacDrive(Drive):
             # A reference search turns until IN5 rises: stop it, and say what it waited for.
             self._homing = None
             try:
-                self.native.stop()
-                self.native.reference(False)
+                await self.io.urgent.stop()
+                await self.io.reference(False)
             except _core.MotorbusError:
                 pass
             waited = {"backoff": "IN5 to turn off (backing off the reference switch, counter-clockwise)",
@@ -781,37 +795,37 @@ class DmacDrive(Drive):
             raise await self._failure(move, StopReason(HomingTimedOut, f"{e.reason} waiting for {waited}"),
                                       status=None, position=None, at_rest=False) from None
 
-    def _clear_faults(self) -> None:
-        self.native.clear_error()
-        err = DmacErrorWord(int(self.native.error)) & FAULTS
+    async def _clear_faults(self) -> None:
+        await self.io.clear_error()
+        err = DmacErrorWord(int(await self.io.attr("error"))) & FAULTS
         if err:
-            cause = self._fault_cause(err)
+            cause = await self._fault_cause(err)
             raise _core.DriveFault(
                 f"dmac {self.native.address:02d}: clear_faults(): the fault latched again at once "
-                f"({self._fault_text(err)}): its cause is still present" + (f" ({cause})" if cause else ""))
+                f"({await self._fault_text(err)}): its cause is still present" + (f" ({cause})" if cause else ""))
 
-    def _store(self) -> None:
+    async def _store(self) -> None:
         # Stored variables go to non-volatile memory when written (manual 5.x,
         # "This parameter is stored in non-volatile memory"); HARD_ENDS and
         # OPTIMIZED_CURRENT at shut-down.  There is no save command to send.
         pass
 
     # ---- readings ----
-    def _position(self) -> float:
-        return float(self.native.position)
+    async def _position(self) -> float:
+        return float(await self.io.attr("position"))
 
-    def _velocity(self) -> float:
-        return self.native.speed / _SPEED_PER_INC_S
+    async def _velocity(self) -> float:
+        return await self.io.attr("speed") / _SPEED_PER_INC_S
 
-    def _is_idle(self) -> bool:
+    async def _is_idle(self) -> bool:
         # At rest, not merely at the target speed (BUSY ends there in velocity mode).
-        return DmacStatus.MOVEMENT not in self.native.status
+        return DmacStatus.MOVEMENT not in await self.io.attr("status")
 
-    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+    async def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
         st, err = status.raw
         faults = err & FAULTS
         if faults:
-            return StopReason(MoveFaulted, self._fault_text(faults), code=int(faults))
+            return StopReason(MoveFaulted, await self._fault_text(faults), code=int(faults))
         # An end-stop stops the motion with "movement stopped abnormally" (#STATUS bit 32);
         # the end-stop bits alone only say the axis sits on one (a move away may follow).
         if DmacStatus.ABNORMAL_STOP in st:
@@ -837,15 +851,15 @@ class DmacDrive(Drive):
                                                "target: the DMAC keeps no trace of it at rest)")
         return None
 
-    def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
+    async def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         # The soft end-stops bind only while SOFT_ENDS ON is in force (#STATUS bit 7).
-        if DmacStatus.SOFT_ENDS_ENABLED not in self.native.status:
+        if DmacStatus.SOFT_ENDS_ENABLED not in await self.io.attr("status"):
             return (None, None)
-        return (float(self.native.read("#NEGATIVE_END")), float(self.native.read("#POSITIVE_END")))
+        return (float(await self.io.read("#NEGATIVE_END")), float(await self.io.read("#POSITIVE_END")))
 
-    def _status(self) -> DriveStatus:
-        st = self.native.status
-        err = DmacErrorWord(int(self.native.error)) if DmacStatus.ERROR in st else DmacErrorWord(0)
+    async def _status(self) -> DriveStatus:
+        st = await self.io.attr("status")
+        err = DmacErrorWord(int(await self.io.attr("error"))) if DmacStatus.ERROR in st else DmacErrorWord(0)
         fault = bool(err & FAULTS)
         moving = DmacStatus.MOVEMENT in st
         words = [n for n in ("power on" if DmacStatus.POWER_ON in st else "power off",
