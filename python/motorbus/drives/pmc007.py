@@ -34,7 +34,7 @@ import threading
 import time
 from typing import Any, Callable, Iterable, Optional, Union
 
-from .. import _core, _stop_at_exit
+from .. import _core, _stop_at_exit, faces
 from . import data_file
 from ..stopping import check_stop_way
 from ..canopen.node import RemoteNode, check_node_id
@@ -535,11 +535,11 @@ class Pmc007Params(Params):
                          writable=var.access in ("rw", "wo"),
                          description=f"{var.index:04X}h:{var.subindex:02X} {var.name}")
 
-    def _read(self, info: ParamInfo) -> Any:
-        return self._drive.native.read(info.name)
+    async def _read(self, info: ParamInfo) -> Any:
+        return await self._drive.io.read(info.name)
 
-    def _write(self, info: ParamInfo, value: Any) -> None:
-        self._drive.native.write(info.name, int(value))
+    async def _write(self, info: ParamInfo, value: Any) -> None:
+        await self._drive.io.write(info.name, int(value))
 
 
 #: External stop inputs: 6001h latch bit -> (name, 600Fh enable bit).
@@ -551,6 +551,12 @@ def _flags(value: Any) -> str:
     """A status byte for a person: ``0x09 (EXT1|BUSY)``, ``0x00 (none)``."""
     names = "|".join(f.name for f in type(value) if f in value) or "none"
     return f"0x{int(value):02X} ({names})"
+
+
+def _read_state(native: Pmc007) -> tuple:
+    """(6000h error bits, 6001h controller bits, enabled): the three uploads a status takes,
+    run together (one job on the drive's worker in the awaitable face, not three)."""
+    return native.error_status, native.controller_status, native.enabled
 
 
 class Pmc007Drive(Drive):
@@ -652,112 +658,128 @@ class Pmc007Drive(Drive):
         self._sdo_misses = 0
         self._ext_limits = _check_ext_limits(ext_limits)
 
-    def _refusing(self, what: str, fn: Callable[[], None]) -> None:
+    # ---- Drive hooks, native units (steps) -------------------------------------------------
+    # Coroutines over self.io (motorbus.faces): the same code serves drive.move_to(...) and
+    # `await aio.Drive(drive).move_to(...)`.  Each exchange is one SDO transfer of the native
+    # client (Pmc007, blocking); the awaitable face runs them on the bus's worker.
+    def _io_link(self) -> Any:
+        # The drive's SDO transfers share a worker with every drive on the same CAN bus (one
+        # conversation at a time on the wire, one thread for a bench of axes); a node built
+        # without a bus object falls back to a worker of its own.
+        return getattr(self.native, "bus", None)
+
+    async def _refusing(self, what: str, call: Any) -> None:
+        """Awaits ``call`` (an exchange of self.io); the device-state abort 08000022 (a
+        command the drive refuses in its present state) becomes a DriveFault saying why."""
         try:
-            fn()
+            await call
         except _core.SdoAbortError as e:
-            if e.code == ABORT_DEVICE_STATE:
-                raise _core.DriveFault(f"pmc007: {what} refused (08000022): {self._fault_text()}") from None
-            raise
+            if e.code != ABORT_DEVICE_STATE:
+                raise
+            text = await self._fault_text()
+            raise _core.DriveFault(f"pmc007: {what} refused (08000022): {text}") from None
 
-    def _fault_text(self) -> str:
-        n = self.native
-        return f"6000h {_flags(n.error_status)}, 6001h {_flags(n.controller_status)}, enabled={n.enabled}"
+    async def _state(self) -> tuple:
+        """(6000h, 6001h, enabled) read as one snapshot (three SDO uploads in a row on the worker)."""
+        return await self.io.do(_read_state, self.native)
 
-    def _leave_speed_mode(self) -> None:
+    async def _fault_text(self) -> str:
+        err, st, enabled = await self._state()
+        return f"6000h {_flags(err)}, 6001h {_flags(st)}, enabled={enabled}"
+
+    async def _leave_speed_mode(self, urgent: bool = False) -> None:
         if self._speed_mode:
-            self.native.set_mode(False)
+            # speed -> position mode decelerates with the 6009h gear: a stop when urgent
+            await (self.io.urgent if urgent else self.io).set_mode(False)
             self._speed_mode = False
 
-    def _speed_for_this_move(self, velocity: Optional[float], sign: int = 1) -> Optional[int]:
+    async def _speed_for_this_move(self, velocity: Optional[float], sign: int = 1) -> Optional[int]:
         """6003h for this move only (Drive puts the old value back when it ends)."""
         if velocity is None:
             return None
         pps = abs(int(round(velocity)))
         if not 1 <= pps <= 32000:
             raise _core.InvalidArgument(f"pmc007: velocity {velocity:g} pps is outside 1..32000 (6003h)")
-        n = self.native
-        self._for_this_move(lambda: n.speed, lambda v: setattr(n, "speed", v), pps if sign >= 0 else -pps)
+        await self._for_this_move(lambda: self.io.attr("speed"), lambda v: self.io.set_attr("speed", v),
+                                  pps if sign >= 0 else -pps)
         return pps
 
-    # ---- Drive ----
-    def _enable(self) -> None:
-        self.native.enable(True)
+    async def _enable(self) -> None:
+        await self.io.enable(True)
 
-    def _disable(self) -> None:
-        self.native.release()
+    async def _disable(self) -> None:
+        await self.io.release()
 
-    def _wait_stopped(self) -> None:
+    async def _wait_stopped(self) -> None:
         # A step command while busy is ignored (B-P07): the previous move must be over.
         for _ in range(2000):
-            if not self.native.busy:
+            if not await self.io.attr("busy"):
                 return
-            threading.Event().wait(0.005)
+            await faces.sleep(0.005)
 
-    def _move_to(self, target: float, velocity: Optional[float]) -> None:
-        self._leave_speed_mode()
-        self._wait_stopped()
-        self._speed_for_this_move(velocity)
-        self._refusing("move", lambda: self.native.move_absolute(int(round(target))))
+    async def _move_to(self, target: float, velocity: Optional[float]) -> None:
+        await self._leave_speed_mode()
+        await self._wait_stopped()
+        await self._speed_for_this_move(velocity)
+        await self._refusing("move", self.io.move_absolute(int(round(target))))
 
-    def _move_by(self, distance: float, velocity: Optional[float]) -> None:
-        self._leave_speed_mode()
-        self._wait_stopped()
+    async def _move_by(self, distance: float, velocity: Optional[float]) -> None:
+        await self._leave_speed_mode()
+        await self._wait_stopped()
         steps = int(round(distance))
-        self._speed_for_this_move(velocity, 1 if steps >= 0 else -1)
-        self._refusing("move", lambda: self.native.step(steps))
+        await self._speed_for_this_move(velocity, 1 if steps >= 0 else -1)
+        await self._refusing("move", self.io.step(steps))
 
-    def _jog(self, velocity: float) -> None:
+    async def _jog(self, velocity: float) -> None:
         pps = int(round(velocity))
         self._speed_mode = True
-        self._refusing("jog", lambda: self.native.run(pps))
+        await self._refusing("jog", self.io.run(pps))
 
-    def _stop(self) -> None:
+    async def _stop(self) -> None:
         if self._speed_mode:
-            self._leave_speed_mode()  # speed -> position mode decelerates with the 6009h gear
+            await self._leave_speed_mode(urgent=True)  # speed -> position mode decelerates with the 6009h gear
         else:
-            self.native.stop()
+            await self.io.urgent.stop()
 
-    def _quick_stop(self) -> None:
-        self.native.stop()
-        self._leave_speed_mode()
+    async def _quick_stop(self) -> None:
+        await self.io.urgent.stop()
+        await self._leave_speed_mode(urgent=True)
 
-    def _home(self, method: Any) -> None:
+    async def _home(self, method: Any) -> None:
         inputs = {None: ControllerStatus.EXT1, "ext1": ControllerStatus.EXT1, "ext2": ControllerStatus.EXT2,
                   "ext3": ControllerStatus.EXT3}
         if method not in inputs:
             raise _core.InvalidArgument(f"pmc007 home: 'ext1', 'ext2', 'ext3' or None, not {method!r}")
         bit = inputs[method]
         enable_bit = _EXT_INPUTS[bit][1]
-        n = self.native
-        n.stop()
-        n.clear_status(int(bit))
-        n.write("external_emergency_stop.enable", int(n.read("external_emergency_stop.enable")) | enable_bit)
-        n.write("external_emergency_stop.trigger_mode",
-                int(n.read("external_emergency_stop.trigger_mode")) & ~enable_bit)  # falling edge
-        old_speed = n.speed
+        io = self.io
+        await io.stop()
+        await io.clear_status(int(bit))
+        await io.write("external_emergency_stop.enable",
+                       int(await io.read("external_emergency_stop.enable")) | enable_bit)
+        await io.write("external_emergency_stop.trigger_mode",
+                       int(await io.read("external_emergency_stop.trigger_mode")) & ~enable_bit)  # falling edge
+        old_speed = await io.attr("speed")
         if self._move is not None:
             # The homing runs in speed mode at -home_speed: 6003h is put back once it has
             # ended, but never while speed mode still runs (the write would set its speed).
-            self._move.restore.append(lambda: None if self._speed_mode else setattr(n, "speed", old_speed))
+            self._move.restore.append(lambda: None if self._speed_mode else io.set_attr("speed", old_speed))
         self._homing = bit
         self._homed = False
         self._speed_mode = True
-        self._refusing("home", lambda: n.run(-abs(self._home_speed)))
+        await self._refusing("home", io.run(-abs(self._home_speed)))
 
-    def _homing_done(self) -> bool:
-        n = self.native
-        err = n.error_status
-        st = n.controller_status
+    async def _homing_done(self) -> bool:
+        err, st, enabled = await self._state()
         if self._homing is None:
             return not st & ControllerStatus.BUSY
         failure = None
-        if err or st & ControllerStatus.STALL or not n.enabled:
-            failure = self._stop_reason_of(err, st, n.enabled)
+        if err or st & ControllerStatus.STALL or not enabled:
+            failure = self._stop_reason_of(err, st, enabled)
         elif st & self._homing and not st & ControllerStatus.BUSY:
-            n.clear_status(int(self._homing))
-            self._leave_speed_mode()
-            n.position = 0
+            await self.io.clear_status(int(self._homing))
+            await self._leave_speed_mode()
+            await self.io.set_attr("position", 0)
             self._homing = None
             self._homed = True
             return True
@@ -771,21 +793,21 @@ class Pmc007Drive(Drive):
         if failure is None:
             return False
         self._homing = None
-        self._leave_speed_mode()
-        where = self._position()
+        await self._leave_speed_mode()
+        where = await self._position()
         kw = {"side": failure.side} if issubclass(failure.error, LimitReached) else {}
         raise failure.error(f"{self.name}: homing stopped at {self._units.to_user(where):g} {self._units.name} "
                             f"by {failure.text}", axis=self.name, position=self._units.to_user(where),
                             reason=failure.text, code=failure.code, status=(int(err), int(st)),
                             units=self._units.name, **kw)
 
-    def _is_idle(self) -> bool:
+    async def _is_idle(self) -> bool:
         # Another program's SDO requests to this node (a second client on the same COB-IDs)
         # can take our reply (SdoProtocolError: it names another object) or take the node's
         # single request slot so ours is dropped (SdoTimeout): neither is an answer, so
         # the poll asks again; a second timeout in a row is a link that is gone.
         try:
-            busy = self.native.busy
+            busy = await self.io.attr("busy")
         except _core.SdoProtocolError:
             return False
         except _core.SdoTimeout:
@@ -819,35 +841,31 @@ class Pmc007Drive(Drive):
             return StopReason(MoveInterrupted, "the release of the motor (600Eh = 0)")
         return None
 
-    def _clear_faults(self) -> None:
-        self.native.clear_errors()
-        self.native.clear_status()
+    async def _clear_faults(self) -> None:
+        await self.io.clear_errors()
+        await self.io.clear_status()
 
-    def _store(self) -> None:
-        self.native.save()
+    async def _store(self) -> None:
+        await self.io.save()
 
-    def _position(self) -> float:
-        return float(self.native.position)
+    async def _position(self) -> float:
+        return float(await self.io.attr("position"))
 
     #: Seconds between the two position samples a velocity reading takes.
     velocity_window: float = 0.01
 
-    def _velocity(self) -> float:
+    async def _velocity(self) -> float:
         # The PMC007 has no actual-speed object: the speed is measured from the position
         # counter (600Ch) over velocity_window seconds while the motor is busy, else 0.
-        n = self.native
-        if not n.busy:
+        if not await self.io.attr("busy"):
             return 0.0
-        t0, p0 = time.monotonic(), n.position
-        time.sleep(self.velocity_window)
-        t1, p1 = time.monotonic(), n.position
+        t0, p0 = time.monotonic(), await self.io.attr("position")
+        await faces.sleep(self.velocity_window)
+        t1, p1 = time.monotonic(), await self.io.attr("position")
         return (p1 - p0) / (t1 - t0) if t1 > t0 else 0.0
 
-    def _status(self) -> DriveStatus:
-        n = self.native
-        err = n.error_status
-        st = n.controller_status
-        enabled = n.enabled
+    async def _status(self) -> DriveStatus:
+        err, st, enabled = await self._state()
         fault = bool(err) or bool(st & ControllerStatus.STALL)
         busy = bool(st & ControllerStatus.BUSY)
         lim = {side: any(st & bit for bit, (name, _) in _EXT_INPUTS.items() if self._ext_limits.get(name.lower()) == side)
@@ -856,10 +874,10 @@ class Pmc007Drive(Drive):
         return DriveStatus(enabled=enabled, moving=busy, homed=self._homed, fault=fault, at_target=not busy,
                            limit_positive=lim[1], limit_negative=lim[-1], raw=(int(err), int(st)), text=text)
 
-    def _console(self, line: str) -> str:
+    async def _console(self, line: str) -> str:
         # SDO reads and writes by index (motorbus.canopen.console has the syntax).
         from ..canopen.console import sdo_console
-        return sdo_console(self.native.sdo, line)
+        return await self.io.do(sdo_console, self.native.sdo, line)
 
     def _make_params(self) -> Params:
         return Pmc007Params(self)
