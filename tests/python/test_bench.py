@@ -16,7 +16,7 @@ import pytest
 import motorbus
 from motorbus import Bench, BenchFileError, registry
 
-from test_drive_api import KINDS  # per-kind address, parameters, homing method, sim options
+from drive_kinds import KINDS  # per-kind address, parameters, homing method, sim options
 from test_hardening_bindings import sigint_default
 
 

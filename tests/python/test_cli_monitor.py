@@ -17,7 +17,7 @@ from motorbus import Units
 from motorbus.sim import SimBench
 
 from test_cli_terminal import Pane, pytestmark  # noqa: F401 - the tmux skip applies here too
-from test_drive_api import KINDS
+from drive_kinds import KINDS
 
 SCALE = 0.0025   # mm per step
 

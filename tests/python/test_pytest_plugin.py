@@ -22,7 +22,7 @@ from motorbus import registry
 from motorbus.sim import SimBench
 
 from test_bench import _every_kind_file, _setup_params
-from test_drive_api import KINDS
+from drive_kinds import KINDS
 from test_hardening_bindings import sigint_default
 
 pytest_plugins = ["pytester"]
@@ -296,14 +296,8 @@ def test_sim_faults_skips_on_real_hardware(pytester, tmp_path):
 
 
 # ---- every axis stopped after a failure, an error, a timeout, Ctrl-C: seen from outside -------
-_SIM_POSITION = {   # where each simulator's shaft is (the test reads the simulators, not the drives)
-    "arcus": lambda sim: sim.pulse_position,
-    "arcus-canopen": lambda sim: sim.pulse_position,
-    "dmac": lambda sim: sim.state().position,
-    "cia402": lambda sim: sim.position,
-    "pmc007": lambda sim: sim.position,
-    "unitek": lambda sim: sim.position_num,
-}
+# Where each simulator's shaft is: drive_kinds' Kind.shaft (the test reads the simulators, not the drives).
+_SIM_POSITION = {k: v.shaft for k, v in KINDS.items()}
 
 
 class ServedBench:
