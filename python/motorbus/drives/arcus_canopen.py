@@ -28,7 +28,7 @@ from typing import Any, Optional, Union
 
 from .. import _core
 from .._core.arcus import Motion as ArcusMotion, ProfileParams as ArcusProfileParams  # the DMX-CAN's profile model
-from ..canopen.cia402 import Cia402, Controlword, OpMode
+from ..canopen.cia402 import Cia402, OpMode
 from ..canopen.node import check_node_id
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveStalled, ParamInfo, Params,
                      StopReason, Units)
@@ -307,17 +307,17 @@ class ArcusCanopenParams(Params):
                          writable=writable,
                          description=f"{n} (write-only: the drive cannot read it back)" if access == "wo" else n)
 
-    def _read(self, info: ParamInfo) -> Any:
+    async def _read(self, info: ParamInfo) -> Any:
         r = self._row(info.name)
         if r[4] == "wo":
             raise _core.InvalidArgument(
                 f"{self._drive.name}: parameter {info.name} ({r[2]}) is write-only: the DMX-CAN aborts a read of it "
                 f"(06010001); the mode in effect is 0x6061")
-        return self._drive.native.read(r[0], r[1])
+        return await self._drive.io.read(r[0], r[1])
 
-    def _write(self, info: ParamInfo, value: Any) -> None:
+    async def _write(self, info: ParamInfo, value: Any) -> None:
         r = self._row(info.name)
-        self._drive.native.write(r[0], r[1], int(value))
+        await self._drive.io.write(r[0], r[1], int(value))
 
 
 class ArcusCanopenDrive(Cia402Drive):
@@ -396,61 +396,54 @@ class ArcusCanopenDrive(Cia402Drive):
             raise _core.InvalidArgument(f"arcus-canopen plan_move {start} -> {target}: the model refuses: {error}")
         return model.profile
 
-    def _refused(self, what: str) -> None:
-        state = self.native.state
-        if state != "OPERATION ENABLED":
-            raise _core.DriveFault(f"arcus-canopen: {what} refused in state {state} (enable() first"
-                                   f"{', clear_faults()' if state == 'FAULT' else ''})")
-
-    def _snl_text(self) -> str:
+    async def _snl_text(self) -> str:
         try:
-            return SnlStatus(self._read(0x2003)).name
+            return SnlStatus(await self._read(0x2003)).name
         except ValueError:
             return "?"
 
-    def _home(self, method: Any) -> None:
-        self._operation_enabled()
-        self._use_mode(OpMode.HOMING)
+    async def _home(self, method: Any) -> None:
+        await self._operation_enabled()
+        await self._use_mode(OpMode.HOMING)
         if method is not None:
             if isinstance(method, bool) or not isinstance(method, int) or int(method) not in set(ArcusHomingMethod):
                 raise _core.InvalidArgument(f"arcus-canopen home: method 7, 11, 17-20 or 33-35, not {method!r}")
-            self.native.write(0x6098, 0, int(method))
-        self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
-        self.native.write_controlword(int(Controlword.ENABLE_OPERATION) | (1 << 4))
+            await self.io.write(0x6098, 0, int(method))
+        await self._new_set_point_edge()
 
-    def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
+    async def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
         # A single set-point (controlword bit 5 = 0), as the ASCII persona's X: manual 000
         # makes bit 5 = 1 a buffered "set of set-points" (native.move_to(..., immediate=True)).
         try:
-            self._use_mode(OpMode.PROFILE_POSITION)
-            self._speed_for_this_move(velocity)
-            self.native.move_to(int(round(target)), relative=relative, immediate=False)
+            await self._use_mode(OpMode.PROFILE_POSITION)
+            await self._speed_for_this_move(velocity)
+            await self.io.move_to(int(round(target)), relative, False)      # (target, relative, immediate)
         except _core.TimeoutError:
             # Not acknowledged: say why (checked only on failure: it costs SDO reads).
-            self._refused("move")
-            if self._velocity() != 0:
+            await self._refused("move")
+            if await self._velocity() != 0:
                 raise _core.DriveFault("arcus-canopen: move refused while the motor moves (the drive takes "
                                        "a single set-point once the move is done; stop() first)") from None
-            distance = abs(target if relative else target - self._position())
+            distance = abs(target if relative else target - await self._position())
             if distance > _core.arcus.MAX_MOVE_DISTANCE:
                 raise _core.InvalidArgument(
                     f"{self.name}: move of {distance:g} refused by the drive: at most "
                     f"{_core.arcus.MAX_MOVE_DISTANCE} per move (the firmware's limit; split it)") from None
             raise
 
-    def _jog(self, velocity: float) -> None:
+    async def _jog(self, velocity: float) -> None:
         # Refused before anything is sent when the drive cannot run; a jog that the
         # drive takes and then ends in a limit error is a fault seen in status.
-        self._refused("jog")
+        await self._refused("jog")
         try:
-            self._use_mode(OpMode.PROFILE_VELOCITY)
+            await self._use_mode(OpMode.PROFILE_VELOCITY)
         except _core.TimeoutError:
             # 6061h follows a new mode only once the motor is idle (B-A10).
-            if self._velocity() != 0:
+            if await self._velocity() != 0:
                 raise _core.DriveFault("arcus-canopen: jog refused while the motor moves a set-point "
                                        "(stop() first)") from None
             raise
-        self.native.set_velocity(int(round(velocity)))
+        await self.io.set_velocity(int(round(velocity)))
 
     @staticmethod
     def object_dictionary() -> "_core.canopen.ObjectDictionary":
@@ -460,19 +453,19 @@ class ArcusCanopenDrive(Cia402Drive):
     # _is_idle and _homing_done: the CiA 402 ones (at rest for any reason; a homing error
     # or a fault raises what _stop_reason below finds).
 
-    def _in_position_window(self) -> float:
+    async def _in_position_window(self) -> float:
         """StepNLoop on (2001h:01): its tolerance 2001h:03 (SLT, encoder counts: the drive
         corrects a larger error at the end of a move); off: 0 (an open-loop pulse counter
         ends exactly on its target).  Read at each judged move (two SDO reads): the manual
         has no 6067h."""
-        if not self._read(0x2001, 1):
+        if not await self._read(0x2001, 1):
             return 0.0
-        return float(self._read(0x2001, 3))
+        return float(await self._read(0x2001, 3))
 
-    def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
+    async def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         return (None, None)          # Table 10.1 has no 607Dh: no software limits
 
-    def _limit_side(self, status: DriveStatus) -> tuple[int, str]:
+    async def _limit_side(self, status: DriveStatus) -> tuple[int, str]:
         # 60FDh shows a switch still pressed; else the direction the move was going
         # (the ASCII persona's MST bits 6/7 say which, CANopen has no object for them).
         if status.limit_positive:
@@ -481,11 +474,11 @@ class ArcusCanopenDrive(Cia402Drive):
             return -1, "the -limit switch (60FDh bit 0)"
         move = self._move
         if move is not None and move.target is not None:
-            side = 1 if move.target > self._position() else -1
+            side = 1 if move.target > await self._position() else -1
             return side, f"the {'+' if side > 0 else '-'}limit (the switch no longer reads active; side from the move)"
         return 0, "a limit (the drive does not say which)"
 
-    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+    async def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
         """A latched error is the FAULT state (B-A18, B-A22); which one, from StepNLoop
         status 2003h (10 stall, 8 correction range, 9 attempts, 11 limit) and the limit
         bits (statusword 11, 60FDh).  The DMX-CAN has no 603Fh: a fault has no code beyond
@@ -493,31 +486,30 @@ class ArcusCanopenDrive(Cia402Drive):
         sw = int(status.raw)
         state = _core.canopen.cia402_decode_statusword(sw)
         if state not in ("FAULT", "FAULT REACTION ACTIVE"):
-            return super()._stop_reason(status)
-        sls = int(self._read(0x2003))
+            return await super()._stop_reason(status)
+        sls = int(await self._read(0x2003))
         if sls in (SnlStatus.STALL_ERROR, SnlStatus.CORRECTION_RANGE_ERROR, SnlStatus.CORRECTION_ATTEMPT_ERROR):
             words = {10: "stall", 8: "correction range", 9: "max attempts"}[sls]
             return StopReason(MoveStalled, f"StepNLoop error: {words} (2003h = {sls})", code=sls)
         if sls == SnlStatus.LIMIT_ERROR or sw & _SW_INTERNAL_LIMIT or status.limit_positive or status.limit_negative:
-            side, text = self._limit_side(status)
+            side, text = await self._limit_side(status)
             return StopReason(LimitReached, f"{text}: a limit error (statusword bit 11"
                                             f"{', StepNLoop status 11' if sls == SnlStatus.LIMIT_ERROR else ''})",
                               code=sls if sls == SnlStatus.LIMIT_ERROR else None, side=side)
         return StopReason(MoveFaulted, f"a fault (statusword 0x{sw:04X}, StepNLoop status {sls}; the DMX-CAN "
                                        "has no error code object)", code=sls)
 
-    def _clear_faults(self) -> None:
-        self.native.clear_errors()
+    async def _clear_faults(self) -> None:
+        # The 200Dh handshake (write 1, poll until 0) is the client's, one job on the
+        # node's worker: its polling sleeps that thread, never the event loop.
+        await self.io.clear_errors()
 
-    def _store(self) -> None:
-        self.native.store()
+    async def _store(self) -> None:
+        await self.io.store()         # the 200Eh handshake, as clear_errors
 
-    def _digital_inputs(self) -> int:
-        return int(self._read(0x60FD))
-
-    def _status_text(self, state: str, mode: Optional[int], sw: int, fault: bool) -> str:
+    async def _status_text(self, state: str, mode: Optional[int], sw: int, fault: bool) -> str:
         return (f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}, "
-                f"StepNLoop {self._snl_text()}")
+                f"StepNLoop {await self._snl_text()}")
 
     def _make_params(self) -> Params:
         return ArcusCanopenParams(self)

@@ -194,13 +194,13 @@ class Cia402Params(Params):
         idx, _, sub = info.name.partition(":")
         return object_dictionary()[int(idx, 16), int(sub, 16) if sub else 0]
 
-    def _read(self, info: ParamInfo) -> Any:
+    async def _read(self, info: ParamInfo) -> Any:
         var = self._where(info)
-        return var.decode(self._drive._sdo.upload(var.index, var.subindex))
+        return var.decode(await self._drive._sdo_upload(var.index, var.subindex))
 
-    def _write(self, info: ParamInfo, value: Any) -> None:
+    async def _write(self, info: ParamInfo, value: Any) -> None:
         var = self._where(info)
-        self._drive._sdo.download(var.index, var.subindex, var.encode(int(value)))
+        await self._drive._sdo_download(var.index, var.subindex, var.encode(int(value)))
         if var.index == 0x6067:
             self._drive._window = None      # the cached position window is read again
 
@@ -303,22 +303,39 @@ class Cia402Drive(Drive):
         self._homing_ran = False
 
     # ---- helpers ----
+    # Every exchange with the drive is an await on self.io (motorbus.faces): the same
+    # coroutines serve the blocking verbs and motorbus.aio.  In the awaitable face they run
+    # on the worker of this node's SDO client (_io_link), so nodes on one bus talk at once.
     #: The typed dictionary the adapter reads and writes by (a vendor kind gives its own).
     object_dictionary = staticmethod(object_dictionary)
 
-    def _read(self, index: int, sub: int = 0) -> Any:
+    def _io_link(self) -> Any:
+        """One worker per node: its SDO client (the same object for the drive's life).  The
+        node's transfers are one conversation anyway (one SDO channel); other nodes on the
+        bus have their own workers and their transfers overlap on the wire."""
+        return self.native.sdo
+
+    def _sdo_upload(self, index: int, sub: int) -> Any:
+        """One SDO upload, awaitable (the one place an SDO read is sent)."""
+        return self.io.do(self._sdo.upload, index, sub)
+
+    def _sdo_download(self, index: int, sub: int, data: bytes) -> Any:
+        """One SDO download, awaitable (the one place an SDO write is sent)."""
+        return self.io.do(self._sdo.download, index, sub, data)
+
+    async def _read(self, index: int, sub: int = 0) -> Any:
         """One object, decoded by its dictionary entry (C++ codec), through the read that
         survives a second SDO client (_upload)."""
-        return self.object_dictionary()[index, sub].decode(self._upload(index, sub))
+        return self.object_dictionary()[index, sub].decode(await self._upload(index, sub))
 
-    def _download(self, index: int, value: Any, sub: int = 0) -> None:
+    async def _download(self, index: int, value: Any, sub: int = 0) -> None:
         """One object, encoded by its dictionary entry (C++ codec)."""
-        self._sdo.download(index, sub, self.object_dictionary()[index, sub].encode(value))
+        await self._sdo_download(index, sub, self.object_dictionary()[index, sub].encode(value))
 
     #: Attempts of one read when another SDO client on the node takes the reply.
     sdo_read_attempts = 5
 
-    def _upload(self, index: int, sub: int = 0) -> bytes:
+    async def _upload(self, index: int, sub: int = 0) -> bytes:
         """One SDO read that survives another program's SDO client on this node (its
         requests and ours share the COB-IDs): a reply naming another object is not our
         answer (ask again), and one dropped request is a collision (ask once more); a
@@ -326,7 +343,7 @@ class Cia402Drive(Drive):
         timeouts = 0
         for attempt in range(self.sdo_read_attempts):
             try:
-                return bytes(self._sdo.upload(index, sub))
+                return bytes(await self._sdo_upload(index, sub))
             except _core.SdoProtocolError:
                 if attempt + 1 == self.sdo_read_attempts:
                     raise
@@ -336,47 +353,55 @@ class Cia402Drive(Drive):
                     raise
         raise AssertionError("unreachable")
 
-    def _statusword(self) -> int:
-        return int(self._read(0x6041))
+    async def _statusword(self) -> int:
+        return int(await self._read(0x6041))
 
-    def _use_mode(self, mode: OpMode) -> None:
+    async def _use_mode(self, mode: OpMode) -> None:
         if self._mode != mode:
-            self.native.set_mode(mode)
+            await self.io.set_mode(mode)
             self._mode = mode
 
-    def _operation_enabled(self) -> None:
-        if self.native.state != "OPERATION ENABLED":
-            self.native.go_to("OPERATION ENABLED")
+    async def _operation_enabled(self) -> None:
+        if await self.io.attr("state") != "OPERATION ENABLED":
+            await self.io.go_to("OPERATION ENABLED")
+
+    async def _new_set_point_edge(self) -> None:
+        """Controlword bit 4 low then high in Operation Enabled (a homing start): one job on
+        the link, so that a stop sent meanwhile lands after both writes instead of between
+        them, where the second (halt bit clear) would undo it."""
+        await self.io.do(_set_point_edge, self.native)
 
     # ---- Drive ----
-    def _enable(self) -> None:
-        self.native.enable()
+    async def _enable(self) -> None:
+        await self.io.enable()
 
-    def _disable(self) -> None:
-        self.native.disable()
+    async def _disable(self) -> None:
+        await self.io.disable()
 
-    def _speed_for_this_move(self, velocity: Optional[float]) -> None:
+    async def _speed_for_this_move(self, velocity: Optional[float]) -> None:
         """velocity= is for this move only: 6081h is put back when the move ends."""
         if velocity is not None:
-            self._for_this_move(lambda: self._read(0x6081), lambda v: self._download(0x6081, int(round(v))),
-                                int(round(velocity)))
+            await self._for_this_move(lambda: self._read(0x6081), lambda v: self._download(0x6081, int(round(v))),
+                                      int(round(velocity)))
 
-    def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
-        self._use_mode(OpMode.PROFILE_POSITION)
-        self._speed_for_this_move(velocity)
+    async def _set_point(self, target: float, relative: bool, velocity: Optional[float]) -> None:
+        await self._use_mode(OpMode.PROFILE_POSITION)
+        await self._speed_for_this_move(velocity)
         if self._sync_bus is not None:
-            self._hold_set_point(int(round(target)), relative)
+            await self._hold_set_point(int(round(target)), relative)
             return
         try:
-            self.native.move_to(int(round(target)), relative=relative)
+            # The set-point handshake (new set-point, acknowledge, release) is one native
+            # call: one job on the link's worker.
+            await self.io.move_to(int(round(target)), relative)
         except _core.TimeoutError:
             # A drive that is not in Operation Enabled never acknowledges a set-point:
             # say that rather than "timeout" (checked only on failure: it costs an SDO read).
-            self._refused("move")
+            await self._refused("move")
             raise
 
     # ---- SYNC-triggered start (see synchronised_start) ----
-    def _arm_sync_start(self, bus: _core.can.Bus) -> None:
+    async def _arm_sync_start(self, bus: _core.can.Bus) -> None:
         """Maps RPDO SYNC_START_RPDO (once): synchronous (type 1), target position then
         controlword — in that order, because the drive applies the entries in mapping order
         and the set-point edge must find the new target already written.  Starts the node
@@ -388,20 +413,24 @@ class Cia402Drive(Drive):
             for index in (0x607A, 0x6040):
                 var = self.object_dictionary()[index, 0]
                 entries.append((index, 0, 8 * var.size, var.value_range[0] < 0))
-            configure_pdo(self._sdo, node, rpdo=SYNC_START_RPDO, transmission_type=1, mapping=entries)
-            self._sync_rpdo = (read_pdo_config(self._sdo, node, rpdo=SYNC_START_RPDO).cob_id, PdoMap(entries))
-        bus.send(_core.canopen.nmt_encode(_core.canopen.NmtCommand.START, node))   # PDOs flow only in OPERATIONAL
+
+            def configure() -> Any:
+                configure_pdo(self._sdo, node, rpdo=SYNC_START_RPDO, transmission_type=1, mapping=entries)
+                return read_pdo_config(self._sdo, node, rpdo=SYNC_START_RPDO).cob_id
+            self._sync_rpdo = (await self.io.do(configure), PdoMap(entries))
+        # PDOs flow only in OPERATIONAL
+        await self.io.do(bus.send, _core.canopen.nmt_encode(_core.canopen.NmtCommand.START, node))
         self._sync_bus = bus
 
-    def _hold_set_point(self, target: int, relative: bool) -> None:
+    async def _hold_set_point(self, target: int, relative: bool) -> None:
         base = int(Controlword.ENABLE_OPERATION) | _CW_IMMEDIATE | (_CW_RELATIVE if relative else 0)
         # As in an SDO move: the previous acknowledge must have dropped for the edge to count.
-        self.native.wait_statusword(_SW_BIT12, 0)
+        await self.io.wait_statusword(_SW_BIT12, 0)
         cob, layout = self._sync_rpdo
-        self._sync_bus.send(_core.can.Frame(cob, layout.pack([target, base | _CW_NEW_SETPOINT])))
+        await self.io.do(self._sync_bus.send, _core.can.Frame(cob, layout.pack([target, base | _CW_NEW_SETPOINT])))
         self._held_cw = base
 
-    def _release_sync_start(self, started: bool) -> None:
+    async def _release_sync_start(self, started: bool) -> None:
         """After the SYNC (``started``): completes the set-point handshake.  Without it (the
         block failed): overwrites the held RPDO with one that carries no set-point edge, so a
         later SYNC from anyone starts nothing."""
@@ -411,107 +440,106 @@ class Cia402Drive(Drive):
             return
         if not started:
             cob, layout = self._sync_rpdo
-            bus.send(_core.can.Frame(cob, layout.pack([int(self._read(0x607A)), base])))
+            await self.io.do(bus.send, _core.can.Frame(cob, layout.pack([int(await self._read(0x607A)), base])))
             return
         try:
-            self.native.wait_statusword(_SW_BIT12, _SW_BIT12)
+            await self.io.wait_statusword(_SW_BIT12, _SW_BIT12)
         except _core.TimeoutError:
-            self._refused("move")
+            await self._refused("move")
             raise
-        self.native.write_controlword(base)
+        await self.io.write_controlword(base)
 
-    def _refused(self, what: str) -> None:
-        state = self.native.state
+    async def _refused(self, what: str) -> None:
+        state = await self.io.attr("state")
         if state != "OPERATION ENABLED":
-            raise _core.DriveFault(f"cia402: {what} refused in state {state} (enable() first"
+            raise _core.DriveFault(f"{self.kind}: {what} refused in state {state} (enable() first"
                                    f"{', clear_faults()' if state == 'FAULT' else ''})")
 
-    def _move_to(self, target: float, velocity: Optional[float]) -> None:
-        self._set_point(target, False, velocity)
+    async def _move_to(self, target: float, velocity: Optional[float]) -> None:
+        await self._set_point(target, False, velocity)
 
-    def _move_by(self, distance: float, velocity: Optional[float]) -> None:
-        self._set_point(distance, True, velocity)
+    async def _move_by(self, distance: float, velocity: Optional[float]) -> None:
+        await self._set_point(distance, True, velocity)
 
-    def _jog(self, velocity: float) -> None:
-        self._use_mode(OpMode.PROFILE_VELOCITY)
-        self.native.set_velocity(int(round(velocity)))
-        self._refused("jog")  # PV has no handshake: look whether the drive can run
+    async def _jog(self, velocity: float) -> None:
+        await self._use_mode(OpMode.PROFILE_VELOCITY)
+        await self.io.set_velocity(int(round(velocity)))
+        await self._refused("jog")  # PV has no handshake: look whether the drive can run
 
-    def _stop(self) -> None:
+    async def _stop(self) -> None:
         # Halt (controlword bit 8): decelerate with 6084h and stay in Operation Enabled.
-        self.native.write_controlword(int(Controlword.ENABLE_OPERATION) | _CW_HALT)
+        await self.io.urgent.write_controlword(int(Controlword.ENABLE_OPERATION) | _CW_HALT)
 
-    def _quick_stop(self) -> None:
-        self.native.write_controlword(int(Controlword.QUICK_STOP))
+    async def _quick_stop(self) -> None:
+        await self.io.urgent.write_controlword(int(Controlword.QUICK_STOP))
 
-    def _home(self, method: Any) -> None:
-        self._operation_enabled()
-        self._use_mode(OpMode.HOMING)
+    async def _home(self, method: Any) -> None:
+        await self._operation_enabled()
+        await self._use_mode(OpMode.HOMING)
         if method is not None:
             if not isinstance(method, int) or not _core.motion.Cia402Homing.supported(method):
                 raise _core.InvalidArgument(f"cia402 home: method 7, 11, 17-20 or 33-35, not {method!r}")
-            self._download(0x6098, int(method))
-        self._start_homing()
+            await self._download(0x6098, int(method))
+        await self._start_homing()
 
-    def _start_homing(self) -> None:
+    async def _start_homing(self) -> None:
         self._homed = False          # this homing decides; an earlier one no longer counts
         self._homing_since = time.monotonic()
         self._homing_ran = False
-        self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
-        self.native.write_controlword(int(Controlword.ENABLE_OPERATION) | _CW_NEW_SETPOINT)
+        await self._new_set_point_edge()
 
     #: Seconds after the homing start in which "target reached without homing attained"
     #: still means "not started yet" rather than "interrupted" (CiA 402 shows both alike).
     homing_start_grace = 0.2
 
-    def _homing_done(self) -> bool:
+    async def _homing_done(self) -> bool:
         """CiA 402 homing bits 13/12/10: error / attained / reached.  Ends on attained,
         raises the MoveFailed that says why on an error or a fault, and returns True on an
         interrupted homing (reached without attained, or the drive left Operation Enabled)
         so that the outcome is judged (a halt or quick stop: MoveInterrupted)."""
-        sw = self._statusword()
+        sw = await self._statusword()
         state = _core.canopen.cia402_decode_statusword(sw)
         if state in ("FAULT", "FAULT REACTION ACTIVE") or sw & _SW_BIT13:
             if sw & _SW_BIT13 and state == "OPERATION ENABLED":
-                self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
+                await self.io.write_controlword(int(Controlword.ENABLE_OPERATION))
             if state == "FAULT REACTION ACTIVE":
                 return False
-            status = self._status()
-            reason = self._stop_reason(status)
+            status = await self._status()
+            reason = await self._stop_reason(status)
             if reason is None or reason.error is MoveInterrupted:
                 reason = StopReason(MoveFaulted, "a homing error (statusword bit 13)")
             elif not state.startswith("FAULT"):
                 reason = StopReason(reason.error, f"a homing error (statusword bit 13) at {reason.text}",
                                     reason.code, reason.side)
-            raise faces.run(self._failure(self._move, reason, status=status))
+            raise await self._failure(self._move, reason, status=status)
         if state != "OPERATION ENABLED":
             return True             # quick stopped or disabled: judged (MoveInterrupted)
         reached = bool(sw & _SW_TARGET_REACHED)
         if (sw & (_SW_BIT12 | _SW_TARGET_REACHED)) == (_SW_BIT12 | _SW_TARGET_REACHED):
-            self.native.write_controlword(int(Controlword.ENABLE_OPERATION))
+            await self.io.write_controlword(int(Controlword.ENABLE_OPERATION))
             return True
         if not reached:
             self._homing_ran = True
             return False
         # Reached, not attained, no error: interrupted (a halt) -- or not started yet.
         if self._homing_ran or time.monotonic() - self._homing_since > self.homing_start_grace:
-            return self._velocity() == 0
+            return await self._velocity() == 0
         return False
 
-    def _controlword_now(self) -> int:
+    async def _controlword_now(self) -> int:
         """6040h as the drive holds it (another program may have written it)."""
-        return int(self._read(0x6040))
+        return int(await self._read(0x6040))
 
     #: Seconds a drive must stand still at an internal limit (bit 11) without showing
     #: target reached before it counts as at rest (a move leaving a limit starts at v = 0).
     limit_rest_time = 0.1
 
-    def _is_idle(self) -> bool:
+    async def _is_idle(self) -> bool:
         """At rest, whatever the reason: Operation Enabled with target reached (PP: the
         target, or a halt: CiA 402 sets bit 10 once a halted axis stands), a following
         error (bit 13), a standstill at an internal limit (bit 11); or out of Operation
         Enabled (fault, quick stop done, disabled) -- with the velocity 0."""
-        sw = self._statusword()
+        sw = await self._statusword()
         state = _core.canopen.cia402_decode_statusword(sw)
         if state == "FAULT REACTION ACTIVE":
             return False
@@ -531,35 +559,35 @@ class Cia402Drive(Drive):
             if not settled:
                 return False
         self._at_limit_since = None
-        return self._velocity() == 0
+        return await self._velocity() == 0
 
-    def _in_position_window(self) -> float:
+    async def _in_position_window(self) -> float:
         """6067h (position window), read once and kept: it is a setting, not a reading.
         FFFFFFFFh switches the drive's window off (CiA 402): then, as without 6067h, exactly."""
         if self._window is None:
             try:
-                window = int(self._read(0x6067))
+                window = int(await self._read(0x6067))
             except _core.SdoAbortError:
                 window = 0xFFFFFFFF
             self._window = self.in_position_window if window == 0xFFFFFFFF else float(window)
         return self._window
 
-    def _limit_side(self, status: DriveStatus) -> tuple[int, str]:
+    async def _limit_side(self, status: DriveStatus) -> tuple[int, str]:
         """Which limit the drive stands at, in its own terms (60FDh, then 607Dh)."""
         bit11 = "; statusword bit 11 internal limit active" if int(status.raw) & _SW_INTERNAL_LIMIT else ""
         if status.limit_positive:
             return 1, f"the +limit switch (60FDh bit 1{bit11})"
         if status.limit_negative:
             return -1, f"the -limit switch (60FDh bit 0{bit11})"
-        lo, hi = self._travel_limits()
-        position = self._position()
+        lo, hi = await self._travel_limits()
+        position = await self._position()
         if hi is not None and position >= hi:
             return 1, f"the software position limit 607Dh:02 = {hi:g}{bit11.replace(';', ' (') + ')' if bit11 else ''}"
         if lo is not None and position <= lo:
             return -1, f"the software position limit 607Dh:01 = {lo:g}{bit11.replace(';', ' (') + ')' if bit11 else ''}"
         return 0, "an internal limit (statusword bit 11; the drive does not say which)"
 
-    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+    async def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
         """The statusword and what it points to: a fault (603Fh code and CiA 402 text; a
         following error 0x8611 or motor blocked 0x7121 is a stall), a following error (PP
         bit 13), a limit (60FDh switches, 607Dh soft limits, bit 11), a quick stop, the
@@ -569,13 +597,13 @@ class Cia402Drive(Drive):
         state = _core.canopen.cia402_decode_statusword(sw)
         ours = self._move is not None and self._move.stopped_by is not None
         if state in ("FAULT", "FAULT REACTION ACTIVE"):
-            code = int(self._read(0x603F))
+            code = int(await self._read(0x603F))
             error = MoveStalled if code in STALL_CODES else MoveFaulted
             return StopReason(error, error_text(code), code=code)
         if self._mode == OpMode.PROFILE_POSITION and sw & _SW_BIT13:
             return StopReason(MoveStalled, "a following error (statusword bit 13)")
         if sw & _SW_INTERNAL_LIMIT or status.limit_positive or status.limit_negative:
-            side, text = self._limit_side(status)
+            side, text = await self._limit_side(status)
             return StopReason(LimitReached, text, side=side)
         if ours:
             return None             # this program's stop()/quick_stop(): Drive says so
@@ -586,72 +614,72 @@ class Cia402Drive(Drive):
             return StopReason(MoveInterrupted, f"the drive leaving OPERATION ENABLED (now {state}): a quick stop, "
                                                "disable or shutdown from another program, a stop input or a lost "
                                                "heartbeat")
-        if self._controlword_now() & _CW_HALT:
+        if await self._controlword_now() & _CW_HALT:
             return StopReason(MoveInterrupted, "a halt (controlword bit 8) from another program")
         return None
 
-    def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
+    async def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         """607Dh:01/02 (software position limits); the I32 extremes mean none."""
         try:
-            lo, hi = int(self._read(0x607D, 1)), int(self._read(0x607D, 2))
+            lo, hi = int(await self._read(0x607D, 1)), int(await self._read(0x607D, 2))
         except _core.SdoAbortError:
             return (None, None)      # the drive has no 607Dh
         if lo >= hi:
             return (None, None)      # CiA 402: min >= max switches the limits off on many drives
         return (None if lo <= _I32_MIN else float(lo), None if hi >= _I32_MAX else float(hi))
 
-    def _clear_faults(self) -> None:
-        self.native.fault_reset()
+    async def _clear_faults(self) -> None:
+        await self.io.fault_reset()
 
-    def _store(self) -> None:
-        self._download(0x1010, _SAVE, sub=1)
+    async def _store(self) -> None:
+        await self._download(0x1010, _SAVE, sub=1)
 
-    def _position(self) -> float:
-        return float(self._read(0x6064))
+    async def _position(self) -> float:
+        return float(await self._read(0x6064))
 
-    def _velocity(self) -> float:
-        return float(self._read(0x606C))
+    async def _velocity(self) -> float:
+        return float(await self._read(0x606C))
 
-    def _digital_inputs(self) -> int:
+    async def _digital_inputs(self) -> int:
         """60FDh (bit 0 negative limit, bit 1 positive limit)."""
-        return int(self._read(0x60FD))
+        return int(await self._read(0x60FD))
 
-    def _status_text(self, state: str, mode: Optional[int], sw: int, fault: bool) -> str:
+    async def _status_text(self, state: str, mode: Optional[int], sw: int, fault: bool) -> str:
         """The status line; a vendor kind adds what its drive says beyond CiA 402."""
         text = f"{state}, mode {OpMode(mode).name if mode is not None else '?'}, statusword 0x{sw:04X}"
         if fault:
-            text += f", {error_text(int(self._read(0x603F)))}"
+            text += f", {error_text(int(await self._read(0x603F)))}"
         return text
 
-    def _status(self) -> DriveStatus:
-        sw = self._statusword()
+    async def _status(self) -> DriveStatus:
+        sw = await self._statusword()
         state = _core.canopen.cia402_decode_statusword(sw)
-        inputs = self._digital_inputs()
-        velocity = self._velocity()
+        inputs = await self._digital_inputs()
+        velocity = await self._velocity()
         mode = self._mode
         fault = state in ("FAULT", "FAULT REACTION ACTIVE")
         if mode is None:        # not set by this Drive yet: the mode in effect (6061h), for the text
             try:
-                mode = int(self._read(0x6061))
+                mode = int(await self._read(0x6061))
                 OpMode(mode)
             except (_core.SdoAbortError, ValueError):
                 mode = None
         # With halt (6040h bit 8) set, bit 10 means "stands still", not "at target" (CiA 402),
         # whoever set it.
         at_target = bool(sw & _SW_TARGET_REACHED) and state == "OPERATION ENABLED" and not (
-            self._controlword_now() & _CW_HALT)
+            await self._controlword_now() & _CW_HALT)
         homed = self._mode == OpMode.HOMING and bool(sw & _SW_BIT12)
         self._homed = self._homed or homed
-        text = self._status_text(state, mode, sw, fault)
+        text = await self._status_text(state, mode, sw, fault)
         return DriveStatus(enabled=state == "OPERATION ENABLED",
                            moving=velocity != 0 or not (sw & _SW_TARGET_REACHED or state != "OPERATION ENABLED"),
                            homed=self._homed, fault=fault, at_target=at_target,
                            limit_positive=bool(inputs & 2), limit_negative=bool(inputs & 1), raw=sw, text=text)
 
-    def _console(self, line: str) -> str:
+    async def _console(self, line: str) -> str:
         # SDO reads and writes by index (motorbus.canopen.console has the syntax).
         from ..canopen.console import sdo_console
-        return sdo_console(self.native.sdo, line)
+        return await self.io.do(sdo_console, self._sdo, line)
 
     def _make_params(self) -> Params:
         return Cia402Params(self)
@@ -662,6 +690,12 @@ class Cia402Drive(Drive):
     def start_watchdog(self, host_node: int, period: float = 0.1, **kwargs: Any) -> None:
         """Arm the drive's own heartbeat consumer on a heartbeat this host produces."""
         self.native.start_watchdog(host_node, period, **kwargs)
+
+
+def _set_point_edge(host: Cia402) -> None:
+    """Controlword 0x0F then 0x1F: the new-set-point edge that starts a homing."""
+    host.write_controlword(int(Controlword.ENABLE_OPERATION))
+    host.write_controlword(int(Controlword.ENABLE_OPERATION) | _CW_NEW_SETPOINT)
 
 
 #: The RPDO a synchronised start maps on each drive (its previous mapping is replaced).
@@ -677,18 +711,22 @@ def synchronised_start(bus: _core.can.Bus, drives: Sequence[Cia402Drive]) -> Ite
     CiA 301 device holds until the next SYNC; when the block exits one SYNC frame on
     ``bus`` makes every drive apply it, so all start on the same frame.  The handshake is
     then completed over SDO as for any move.  If the block fails, the held RPDOs are
-    overwritten with ones that start nothing.  Yields the method's name."""
+    overwritten with ones that start nothing.  Yields the method's name.
+
+    A plain (blocking) context manager, as every kind's: under motorbus.aio its entry
+    and exit (the RPDO mapping once, the NMT start, then the handshakes' ends) run on
+    the loop's thread, a few SDO transfers per drive (``faces.run``)."""
     for d in drives:
-        d._arm_sync_start(bus)
+        faces.run(d._arm_sync_start(bus))
     try:
         yield "CANopen SYNC"
     except BaseException:
         for d in drives:
-            d._release_sync_start(started=False)
+            faces.run(d._release_sync_start(started=False))
         raise
     bus.send(_core.can.Frame(0x080, b""))       # SYNC (COB-ID 0x080): every held RPDO applies now
     for d in drives:
-        d._release_sync_start(started=True)
+        faces.run(d._release_sync_start(started=True))
 
 
 # Faults the simulator can be given (the pytest plugin's sim_faults fixture).
