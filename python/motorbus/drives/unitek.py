@@ -51,7 +51,7 @@ import time
 from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
 
-from .. import _core, _stop_at_exit
+from .. import _core, _stop_at_exit, faces
 from . import data_file
 from ..stopping import check_stop_way
 # The drive's speed ramps (ACC 0x35 / DEC 0xED): the vendor's own module re-exports the model.
@@ -591,11 +591,11 @@ class UnitekParams(Params):
         return ParamInfo(name=r.name, type="int", minimum=r.min, maximum=r.max, unit="num", persists=False,
                          writable=r.writable, description=f"0x{r.regid:02X} {r.description}")
 
-    def _read(self, info: ParamInfo) -> Any:
-        return self._drive.native.read(info.name)
+    async def _read(self, info: ParamInfo) -> Any:
+        return await self._drive.io.read(info.name)
 
-    def _write(self, info: ParamInfo, value: Any) -> None:
-        self._drive.native.write(info.name, int(value))
+    async def _write(self, info: ParamInfo, value: Any) -> None:
+        await self._drive.io.write(info.name, int(value))
 
 
 class UnitekDrive(Drive):
@@ -659,25 +659,34 @@ class UnitekDrive(Drive):
         self._counts_per_s_per_num = n_max / 60.0 * COUNTS_PER_REV / FULL_SCALE
 
     # ---- helpers ----
-    def _st(self) -> Status:
-        return self.native.status
+    # The hooks below are coroutines over self.io (motorbus.faces): written once, they
+    # serve the blocking verbs (drive.move_to) and motorbus.aio (await axis.move_to) alike.
+    def _io_link(self) -> Any:
+        # One worker per node: the client itself.  Its reads are matched to their replies
+        # by REGID on the node's own transmit id (the C++ client waits under its own lock),
+        # so the nodes of one bus need not queue behind each other as one serial line's
+        # drives must; a node's exchanges stay in order on its worker.
+        return self.native
 
-    def _require_enabled(self, what: str) -> None:
-        st = self._st()
+    async def _st(self) -> Status:
+        return await self.io.attr("status")      # KERN_STATUS as a Status
+
+    async def _require_enabled(self, what: str) -> None:
+        st = await self._st()
         if not st & Status.ENA:
             why = "fault: Ena is 0 although enabled" if self._want_enabled else "disabled"
-            errors = error_text(self._errors() or 0)
+            errors = error_text(await self._errors() or 0)
             raise _core.DriveFault(f"unitek: {what} refused, drive {why} (KERN_STATUS 0x{int(st):04X}"
                                    f"{'; ' + errors if errors else ''}; "
                                    f"{'clear_faults()/hardware enable' if self._want_enabled else 'enable() first'})")
 
-    def _errors(self) -> Optional[int]:
+    async def _errors(self) -> Optional[int]:
         """ERR_WARN (0x8F), None when the drive does not answer it (a firmware without it:
         asked once, then no more, so a move's judgement does not wait a timeout each time)."""
         if self._no_err_warn:
             return None
         try:
-            return int(self.native.read(Reg.ERR_WARN))
+            return int(await self.io.read(Reg.ERR_WARN))
         except (_core.TimeoutError, UnknownRegister):   # no reply, or a table without 0x8F
             self._no_err_warn = True
             return None
@@ -688,86 +697,92 @@ class UnitekDrive(Drive):
         self._started = time.monotonic()
 
     # ---- Drive ----
-    def _enable(self) -> None:
-        self.native.enable()
+    async def _enable(self) -> None:
+        await self.io.enable()
         self._want_enabled = True
 
-    def _disable(self) -> None:
-        self.native.disable()
+    async def _disable(self) -> None:
+        await self.io.disable()
         self._want_enabled = False
         self._activity = None
 
-    def _move_to(self, target: float, velocity: Optional[float]) -> None:
+    async def _move_to(self, target: float, velocity: Optional[float]) -> None:
         if velocity is not None:
             raise _core.InvalidArgument("unitek: velocity= is not supported: the positioning speed is an NDrive "
                                         "parameter (002 has no REGID for it)")
-        self._require_enabled("move")
+        await self._require_enabled("move")
         num = int(round(target))
         if not -2147483647 <= num <= 2147483647:
             raise _core.InvalidArgument(f"unitek: position {num} is outside ±2147483647 num (POS_DEST)")
-        start = self._position()
-        self._put_pos_dest(num)
+        start = await self._position()
+        await self._put_pos_dest(num)
         self._begin("position", num, (num > start) - (num < start))
 
-    def _put_pos_dest(self, num: int) -> None:
+    async def _put_pos_dest(self, num: int) -> None:
         # Writes are never acknowledged, and a reply can be a cyclic frame the drive
         # sent before it took the write: POS_DEST is read back until it shows the new
         # target, so nothing read afterwards judges the move by the drive's state
         # before it (issue 28: 5 of 2 860 moves returned at the previous target).
         for _ in range(2):
-            self.native.write(Reg.POS_DEST, num)
+            await self.io.write(Reg.POS_DEST, num)
             for _ in range(4):
-                if self.native.read(Reg.POS_DEST) == num:
+                if await self.io.read(Reg.POS_DEST) == num:
                     return
         raise _core.DriveFault(f"unitek move: POS_DEST does not read back {num} after two writes")
 
-    def _jog(self, velocity: float) -> None:
-        self._require_enabled("jog")
+    async def _jog(self, velocity: float) -> None:
+        await self._require_enabled("jog")
         num = int(round(velocity / self._counts_per_s_per_num))
         if abs(num) > FULL_SCALE:
             raise _core.InvalidArgument(f"unitek: jog velocity {velocity:g} num/s is above N max "
                                         f"({FULL_SCALE * self._counts_per_s_per_num:g} num/s)")
-        self.native.write(Reg.SPEED_CMD, num)
+        await self.io.write(Reg.SPEED_CMD, num)
         self._begin("speed", None, (num > 0) - (num < 0))
 
     def torque(self, percent: float) -> None:
         """Torque command in % of the drive's maximum (TORQUE_CMD, ±32767 = ±100 %)."""
+        faces.run(self._co_torque(percent))
+
+    async def _co_torque(self, percent: float) -> None:
+        """``torque`` as a coroutine (``await axis.sync._co_torque(p)`` from asyncio)."""
         self._check_open()
-        self._require_enabled("torque")
-        self.native.torque_percent(self._number("torque", percent))
+        await self._require_enabled("torque")
+        await self.io.torque_percent(self._number("torque", percent))
         self._begin("torque", None, (percent > 0) - (percent < 0))
 
-    def _stop(self) -> None:
+    async def _stop(self) -> None:
         # Writes are never acknowledged: a stop is read back, so it has reached the drive
         # before the call returns (a stop sent just before the link closes could
-        # otherwise be lost with it — seen when a bench closed under ASan).
+        # otherwise be lost with it — seen when a bench closed under ASan).  Urgent: in
+        # the awaitable face it overtakes the node's queued exchanges (a task's polls).
+        io = self.io.urgent
         for _ in range(2):
-            self.native.write(Reg.SPEED_CMD, 0)
-            if self.native.read(Reg.SPEED_CMD) == 0:
+            await io.write(Reg.SPEED_CMD, 0)
+            if await io.read(Reg.SPEED_CMD) == 0:
                 break
         else:
             raise _core.DriveFault("unitek stop: SPEED_CMD does not read back 0 after two writes")
         self._activity = "speed"
 
-    def _quick_stop(self) -> None:
-        self._stop()
+    async def _quick_stop(self) -> None:
+        await self._stop()      # the protocol has no faster stop than speed command 0 (but disable)
 
-    def _home(self, method: Any) -> None:
+    async def _home(self, method: Any) -> None:
         if method not in (None, "calibrated"):
             raise _core.InvalidArgument(f"unitek home: method None or 'calibrated', not {method!r}")
-        st = self._st()
+        st = await self._st()
         if not st & Status.CAL:
             raise _core.DriveFault("unitek home: the drive is not calibrated (KERN_STATUS bit 12 Cal = 0); "
                                    "calibrate it with NDrive")
-        self._move_to(0, None)
+        await self._move_to(0, None)
 
-    def _homing_done(self) -> bool:
-        if not self._is_idle():
+    async def _homing_done(self) -> bool:
+        if not await self._is_idle():
             return False
         # Homing is a move to 0: short of it, it failed the way a move does.
-        position = self._position()
+        position = await self._position()
         if self._target is not None and abs(position - self._target) > self._in_position_window():
-            reason = self._stop_reason(self._status())
+            reason = await self._stop_reason(await self._status())
             if reason is None:
                 by = self._move.stopped_by if self._move is not None else None
                 reason = StopReason(MoveInterrupted, f"{by} of this program" if by else
@@ -778,18 +793,18 @@ class UnitekDrive(Drive):
                                **({"side": reason.side} if issubclass(reason.error, LimitReached) else {}))
         return True
 
-    def _clear_faults(self) -> None:
+    async def _clear_faults(self) -> None:
         if self._want_enabled:
-            self.native.enable()
+            await self.io.enable()
 
-    def _store(self) -> None:
-        self.native.store_eeprom(0)
+    async def _store(self) -> None:
+        await self.io.store_eeprom(0)
 
-    def _position(self) -> float:
-        return float(self.native.read(Reg.POS_IST))
+    async def _position(self) -> float:
+        return float(await self.io.read(Reg.POS_IST))
 
-    def _velocity(self) -> float:
-        return self.native.read(Reg.SPEED_IST) * self._counts_per_s_per_num
+    async def _velocity(self) -> float:
+        return await self.io.read(Reg.SPEED_IST) * self._counts_per_s_per_num
 
     def _shows_stop(self, st: Status) -> bool:
         """The drive shows why it would be at rest: Ena gone while enabled, or the limit
@@ -798,14 +813,14 @@ class UnitekDrive(Drive):
             return True
         return bool((self._direction > 0 and st & Status.LIM_PLUS) or (self._direction < 0 and st & Status.LIM_MINUS))
 
-    def _is_idle(self) -> bool:
+    async def _is_idle(self) -> bool:
         # At rest whatever the reason (target, limit, fault, stop); never raises for a
         # fault: the outcome is judged afterwards (_stop_reason).
-        st = self._st()
-        if self.native.read(Reg.SPEED_IST) != 0:
+        st = await self._st()
+        if await self.io.read(Reg.SPEED_IST) != 0:
             self._seen_motion = True
             return False
-        position = self._position()
+        position = await self._position()
         if (self._activity == "position" and st & Status.TOL and self._target is not None
                 and abs(position - self._target) <= self._in_position_window()):
             return True
@@ -813,15 +828,15 @@ class UnitekDrive(Drive):
             return True
         if not self._seen_motion and time.monotonic() - self._started < self.start_grace:
             return False        # not started yet, or a reply older than the command
-        time.sleep(self.poll_interval)
-        if self.native.read(Reg.SPEED_IST) != 0:
+        await faces.sleep(self.poll_interval)     # the thread in the blocking face, the task in motorbus.aio
+        if await self.io.read(Reg.SPEED_IST) != 0:
             self._seen_motion = True
             return False
-        return abs(self._position() - position) <= max(self._tol_num, 1.0)
+        return abs(await self._position() - position) <= max(self._tol_num, 1.0)
 
-    def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
+    async def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
         st = Status(status.raw)
-        errors = self._errors()
+        errors = await self._errors()
         if errors and errors & 0xFFFF:
             return StopReason(MoveFaulted, f"{error_text(errors)} (ERR_WARN 0x8F = 0x{errors:08X})",
                               code=errors & 0xFFFF)
@@ -836,11 +851,11 @@ class UnitekDrive(Drive):
         return None
 
     def _in_position_window(self) -> float:
-        return self._tol_num
+        return self._tol_num        # the drive's Tol window as given to open(): no exchange
 
-    def _status(self) -> DriveStatus:
-        st = self._st()
-        speed = self.native.read(Reg.SPEED_IST)
+    async def _status(self) -> DriveStatus:
+        st = await self._st()
+        speed = await self.io.read(Reg.SPEED_IST)
         at_target = bool(st & Status.TOL)
         fault = self._want_enabled and not st & Status.ENA
         moving = speed != 0
