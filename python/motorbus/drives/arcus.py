@@ -402,31 +402,31 @@ class ArcusParams(_drive.Params):
         typ, lo, hi, unit, default, persists, writable, desc = row
         return _drive.ParamInfo(name, typ, lo, hi, unit, default, persists, writable, desc)
 
-    def _read(self, info: _drive.ParamInfo) -> Any:
-        c: ArcusClient = self._drive.native
+    async def _read(self, info: _drive.ParamInfo) -> Any:
+        io = self._drive.io
         if info.name == "SLR":
-            return c.snl_ratio
+            return await io.attr("snl_ratio")
         if info.name == "DN":
-            return int(c.device_name[-2:])
+            return int((await io.attr("device_name"))[-2:])
         if info.type == "str":
-            return c.command(info.name, True)
-        value = c.query(info.name)
+            return await io.command(info.name, True)
+        value = await io.query(info.name)
         return bool(value) if info.type == "bool" else value
 
-    def _write(self, info: _drive.ParamInfo, value: Any) -> None:
-        c: ArcusClient = self._drive.native
+    async def _write(self, info: _drive.ParamInfo, value: Any) -> None:
+        io = self._drive.io
         if info.type == "int" and isinstance(value, float) and not value.is_integer():
             raise _core.InvalidArgument(f"arcus: {info.name} takes an integer, not {value!r}")
         if info.type == "bool" and value not in (0, 1):
             raise _core.InvalidArgument(f"arcus: {info.name} takes True/False (1/0), not {value!r}")
         if info.name == "SLR":
-            c.snl_ratio = float(value)
+            await io.set_attr("snl_ratio", float(value))
         elif info.name == "DN":
-            c.set_device_name(int(value))
+            await io.set_device_name(int(value))
         else:
-            c.set(info.name, int(value))
+            await io.set(info.name, int(value))
         if info.name in ("SL", "SLT"):
-            self._drive._read_loop_settings()
+            await self._drive._read_loop_settings()
 
 
 #: SLS error values and the manual's words for them (Table 7.6, Table 7.7, §8 object 2003h).
@@ -485,58 +485,62 @@ class ArcusDrive(_drive.Drive):
         # What this Drive last told the drive, so a move costs one request like the
         # native client's (EO and ABS/INC are read once here and after enable/disable;
         # a script that changes them through drive.native should reopen the Drive).
+        # Read here, blocking: a Drive is built by open() (blocking in both faces:
+        # aio.open_drive runs it off the loop).
         self._enabled = self.native.enabled
         self._incremental: Optional[bool] = None
-        self._read_loop_settings()
+        faces.run(self._read_loop_settings())
 
-    def _read_loop_settings(self) -> None:
-        self._snl = self.native.snl_enabled
-        self._tolerance = self.native.snl_tolerance if self._snl else 0
+    async def _read_loop_settings(self) -> None:
+        # SL and SLT decide what position() reads and a move's window: read at open
+        # and again when params writes them (not on every move).
+        self._snl = bool(await self.io.attr("snl_enabled"))
+        self._tolerance = await self.io.attr("snl_tolerance") if self._snl else 0
 
     def _require_enabled(self) -> None:
         if not self._enabled:
             raise ArcusMotorDisabled(f"arcus {self.native.address:02d}: the motor is disabled (EO=0); "
                                      "call enable() first")
 
-    def _speed_for_this_move(self, velocity: Optional[float]) -> None:
+    async def _speed_for_this_move(self, velocity: Optional[float]) -> None:
         # HSPD for this move only (Drive writes the old value back when it ends);
         # nothing is written when the move runs at the drive's own speed.
         if velocity is None:
             return
         speed = max(1, int(round(abs(velocity))))
-        old = self.native.high_speed
+        old = await self.io.attr("high_speed")
         if old != speed:
-            self._for_this_move(lambda: old, self._set_high_speed, speed)
-
-    def _set_high_speed(self, value: int) -> None:
-        self.native.high_speed = value
+            await self._for_this_move(lambda: old, lambda value: self.io.set_attr("high_speed", value), speed)
 
     # ---- motion ----
-    def _enable(self) -> None:
-        self.native.enable(True)
+    # Coroutines over self.io (motorbus.faces): the same code serves drive.move_to(...)
+    # and `await aio.Drive(drive).move_to(...)`; the exchanges of the drives of one line
+    # share the line's worker (_io_link: the default, native.link, the LineLink).
+    async def _enable(self) -> None:
+        await self.io.enable(True)
         self._enabled = True
 
-    def _disable(self) -> None:
+    async def _disable(self) -> None:
         self._enabled = False
-        self.native.enable(False)
+        await self.io.enable(False)
 
-    def _use_mode(self, incremental: bool) -> None:
+    async def _use_mode(self, incremental: bool) -> None:
         if self._incremental is not incremental:
-            self.native.incremental_mode() if incremental else self.native.absolute_mode()
+            await (self.io.incremental_mode() if incremental else self.io.absolute_mode())
             self._incremental = incremental
 
-    def _move_to(self, target: float, velocity: Optional[float]) -> None:
+    async def _move_to(self, target: float, velocity: Optional[float]) -> None:
         self._require_enabled()
         goal = int(round(target))
-        self._speed_for_this_move(velocity)
-        self._use_mode(False)
+        await self._speed_for_this_move(velocity)
+        await self._use_mode(False)
         self._target, self._direction = goal, 0   # direction: worked out when velocity is read
         try:
-            self.native.move(goal)
+            await self.io.move(goal)
         except _core.ArcusUnknownCommand:
             # "?X..." also answers a move longer than the drive's largest (Table 11.0):
             # say which, in the Drive's words (read only on this path: a move stays one request).
-            here = self._position()
+            here = await self._position()
             if abs(goal - here) > _core.arcus.MAX_MOVE_DISTANCE:
                 raise _core.InvalidArgument(
                     f"arcus {self.native.address:02d}: a move from {here:g} to {goal} is "
@@ -544,29 +548,33 @@ class ArcusDrive(_drive.Drive):
                     f"{_core.arcus.MAX_MOVE_DISTANCE} in one X (Table 11.0): split it") from None
             raise
 
-    def _move_by(self, distance: float, velocity: Optional[float]) -> None:
+    async def _move_by(self, distance: float, velocity: Optional[float]) -> None:
         # An absolute X to the target Drive judges the move by (where the axis was read
         # plus the distance).  An X in INC mode would count from PX, the commanded
         # position, which StepNLoop leaves up to SLT away from EX: the move would end
         # within SLT of a target that is itself up to SLT off the one judged.
         move = self._move
-        target = move.target if move is not None and move.target is not None else self._position() + distance
-        self._move_to(target, velocity)
+        if move is not None and move.target is not None:
+            target = move.target
+        else:
+            target = await self._position() + distance
+        await self._move_to(target, velocity)
 
-    def _jog(self, velocity: float) -> None:
+    async def _jog(self, velocity: float) -> None:
         self._require_enabled()
-        self._speed_for_this_move(velocity)
+        await self._speed_for_this_move(velocity)
         self._direction = 1 if velocity > 0 else -1
         self._target = None
-        self.native.jog(self._direction)
+        await self.io.jog(self._direction)
 
-    def _stop(self) -> None:
-        self.native.stop()
+    # Stops overtake the exchanges queued on the line's worker (the awaitable face).
+    async def _stop(self) -> None:
+        await self.io.urgent.stop()
 
-    def _quick_stop(self) -> None:
-        self.native.abort()
+    async def _quick_stop(self) -> None:
+        await self.io.urgent.abort()
 
-    def _home(self, method: Any) -> None:
+    async def _home(self, method: Any) -> None:
         method = DEFAULT_HOME_METHOD if method is None else method
         if not isinstance(method, str) or method.strip().upper() not in HOME_METHODS:
             raise _core.InvalidArgument(f"arcus home method: one of {', '.join(HOME_METHODS)} (None = "
@@ -577,20 +585,20 @@ class ArcusDrive(_drive.Drive):
         self._homing = True
         self._target = None
         self._direction = 1 if method.endswith("+") else -1
-        self.native.action(method)
+        await self.io.action(method)
 
-    def _homing_done(self) -> bool:
-        if not self._is_idle():
+    async def _homing_done(self) -> bool:
+        if not await self._is_idle():
             return False
         self._homing = False
-        status = self._status()
+        status = await self._status()
         reason = self._stop_reason(status)
         if reason is not None and reason.error in (_drive.LimitReached, _drive.MoveStalled):
             error = ArcusHomingLimit if reason.error is _drive.LimitReached else ArcusHomingStalled
             move = self._move
             if move is not None:
-                raise faces.run(self._failure(move, _drive.StopReason(error, f"{reason.text}: homing failed", reason.code,
-                                                            reason.side), status=status))
+                raise await self._failure(move, _drive.StopReason(error, f"{reason.text}: homing failed",
+                                                                  reason.code, reason.side), status=status)
             raise error(f"arcus {self.native.address:02d}: homing failed: {reason.text}")
         # Nothing the drive shows tells a homing that found its switch from one a STOP
         # of another client on the line ended (docs/drives/arcus.md): it counts as homed.
@@ -598,33 +606,34 @@ class ArcusDrive(_drive.Drive):
         self._homed = reason is None and (move is None or move.stopped_by is None)
         return True
 
-    def _clear_faults(self) -> None:
-        self.native.clear()  # CLR: limit errors and the StepNLoop error status
+    async def _clear_faults(self) -> None:
+        await self.io.clear()  # CLR: limit errors and the StepNLoop error status
 
-    def _store(self) -> None:
-        self.native.store()
+    async def _store(self) -> None:
+        await self.io.store()
 
     # ---- readings ----
-    def _position(self) -> float:
-        return float(self.native.encoder if self._snl else self.native.position)
+    async def _position(self) -> float:
+        return float(await self.io.attr("encoder" if self._snl else "position"))
 
-    def _velocity(self) -> float:
-        if not self.native.moving:
+    async def _velocity(self) -> float:
+        if not await self.io.attr("moving"):
             return 0.0
         if self._direction == 0 and self._target is not None:
-            self._direction = 1 if self._target >= self._position() else -1
-        return float(self.native.speed * (self._direction or 1))
+            self._direction = 1 if self._target >= await self._position() else -1
+        return float(await self.io.attr("speed") * (self._direction or 1))
 
-    def _is_idle(self) -> bool:
+    async def _is_idle(self) -> bool:
         # At rest: no pulses (MST bits 0..2) and, under StepNLoop, no correction on
         # its way either (SLS 1..7, 13).  An error state (SLS 8..11) is at rest.
-        if self.native.status.moving:
+        if (await self.io.attr("status")).moving:
             return False
-        return not self._snl or self.native.snl_status not in _SNL_BUSY
+        return not self._snl or await self.io.attr("snl_status") not in _SNL_BUSY
 
     def _in_position_window(self) -> float:
         # StepNLoop calls a move "in position" within SLT encoder counts (Table 7.5);
-        # without it the drive counts pulses and stops on the target exactly.
+        # without it the drive counts pulses and stops on the target exactly.  No
+        # exchange (SLT is read at open and when params writes it): a plain function.
         return float(self._tolerance)
 
     def _stop_reason(self, status: _drive.DriveStatus) -> Optional[_drive.StopReason]:
@@ -652,19 +661,18 @@ class ArcusDrive(_drive.Drive):
                                      "ABORT or a new target: the DMX-CAN keeps no trace of it at rest)")
         return None
 
-    def _status(self) -> _drive.DriveStatus:
-        c = self.native
-        st = c.status
-        snl = c.snl_status
-        enabled = c.enabled
+    async def _status(self) -> _drive.DriveStatus:
+        st = await self.io.attr("status")
+        snl = await self.io.attr("snl_status")
+        enabled = await self.io.attr("enabled")
         moving = st.moving
         fault = st.limit_error or snl.is_error
-        pos = self._position()
+        pos = await self._position()
         at_target = not moving and not fault and (self._target is not None and abs(pos - self._target)
                                                   <= self._tolerance)
         flags = "|".join(f.name for f in MotorStatus if f in st) or "idle"
-        text = (f"arcus {c.address:02d}: {'enabled' if enabled else 'disabled'}, MST {flags}, SLS {snl.name}, "
-                f"{'EX' if self._snl else 'PX'}={int(pos)}")
+        text = (f"arcus {self.native.address:02d}: {'enabled' if enabled else 'disabled'}, MST {flags}, "
+                f"SLS {snl.name}, {'EX' if self._snl else 'PX'}={int(pos)}")
         return _drive.DriveStatus(enabled=enabled, moving=moving, homed=self._homed, fault=fault,
                                   at_target=at_target, limit_positive=bool(st & MotorStatus.PLUS_LIMIT),
                                   limit_negative=bool(st & MotorStatus.MINUS_LIMIT), raw=(st, snl), text=text)
@@ -672,10 +680,10 @@ class ArcusDrive(_drive.Drive):
     def _make_params(self) -> _drive.Params:
         return ArcusParams(self)
 
-    def _console(self, line: str) -> str:
+    async def _console(self, line: str) -> str:
         # The ASCII command as typed (HSPD, HSPD=5000, X1000, MST...), framed and
         # addressed by the client; the reply body, or the drive's refusal as an error.
-        return self.native.command(line)
+        return await self.io.command(line)
 
     def _close(self) -> None:
         self.native.close()
