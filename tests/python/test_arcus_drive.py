@@ -2,6 +2,7 @@
 simulator served on a pty in real time."""
 from __future__ import annotations
 
+import asyncio
 import os
 import time
 
@@ -9,6 +10,7 @@ import pytest
 
 import motorbus
 import motorbus._core as core
+from motorbus import aio
 from motorbus import drive as mdrive
 from motorbus import registry
 from motorbus.drives import arcus
@@ -277,3 +279,78 @@ def test_shared_line_is_not_closed_with_the_drive(served):
     assert c.id == "DriveMax-CAN"
     c.close()
     line.port.close()
+
+
+# ---- the awaitable face (motorbus.aio): the same hooks, awaited -------------------------------
+# What only this kind does: the homing error raised from _homing_done, the refusal of a
+# move longer than one X (the drive's "?X" caught and the position read on the worker),
+# HSPD put back after a cancelled move, and the drives of one RS-485 line moving at once.
+
+async def test_aio_homing_into_a_limit_raises_the_homing_error():
+    s = Served(plus_limit=600, home=(5000, 5400))
+    try:
+        x = await aio.open_drive("arcus", line=s.path, address="01", units=MM)
+        async with x:
+            await x.params.set("HSPD", 20000)
+            await x.enable()
+            with pytest.raises(arcus.ArcusHomingLimit, match="homing failed") as failed:
+                await x.home("H+", timeout=10)
+            assert failed.value.side == 1 and "MST bit 7" in failed.value.reason
+            st = await x.status()
+            assert st.last_move.state == "limit" and not st.homed and st.limit_positive
+            assert s.sim.motor_status & MotorStatus.PLUS_LIMIT_ERROR
+    finally:
+        s.close()
+
+
+async def test_aio_a_move_longer_than_one_x_is_refused_naming_it(served):
+    x = await aio.open_drive("arcus", line=served.path, address="01", units=MM)
+    async with x:
+        await x.enable()
+        with pytest.raises(motorbus.InvalidArgument, match=r"at most 262143 in one X \(Table 11.0\)"):
+            await x.move_to(3000)                    # 300000 counts
+        assert (await x.status()).last_move is None and served.sim.encoder_position == 0
+
+
+async def test_aio_cancelled_move_stops_the_shaft_and_puts_hspd_back(served):
+    x = await aio.open_drive("arcus", line=served.path, address="01", units=MM)
+    async with x:
+        await x.params.set("HSPD", 20000)
+        await x.params.set("ACC", 20)
+        await x.enable()
+        task = asyncio.create_task(x.move_to(1500, velocity=100.0))   # 10000 counts/s for this move
+        while served.sim.encoder_position < 500:     # under way (real time; no fixed sleep)
+            await asyncio.sleep(0.01)
+        task.cancel()
+        with pytest.raises(asyncio.CancelledError):
+            await task
+        # At rest, seen from the simulator: the STOP went out and the shaft stayed put.
+        assert not served.sim.busy
+        here = served.sim.encoder_position
+        await asyncio.sleep(0.1)
+        assert served.sim.encoder_position == here and 500 <= here < 150000
+        last = (await x.status()).last_move
+        assert last.state == "interrupted" and "cancellation" in last.reason
+        assert last.position == pytest.approx(here / 100, abs=0.2)
+        assert await x.params.get("HSPD") == 20000   # the move's velocity= is undone
+
+
+async def test_aio_two_drives_on_one_line_move_at_once():
+    sims = [make_sim("01", eo_boot=True), make_sim("02", eo_boot=True)]
+    server = core.serial.PtyLineServer(sims, 0, None)
+    line = open_line(server.slave_path)
+    try:
+        axes = [await aio.open_drive("arcus", line=line, address=a, units=MM) for a in ("01", "02")]
+        for x in axes:
+            await x.params.set("HSPD", 20000)
+            await x.enable()
+        await asyncio.gather(axes[0].move_to(12.0), axes[1].move_to(-7.5))
+        assert [s.encoder_position for s in sims] == [pytest.approx(1200, abs=20), pytest.approx(-750, abs=20)]
+        # Readings of both, many at once, queue on the line's one worker and all come back.
+        readings = await asyncio.gather(*(x.position() for _ in range(200) for x in axes))
+        assert set(readings[0::2]) == {await axes[0].position()} and set(readings[1::2]) == {await axes[1].position()}
+        for x in axes:
+            await x.aclose()
+    finally:
+        line.port.close()
+        server.close()
