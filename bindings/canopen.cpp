@@ -573,7 +573,38 @@ static void bind_sdo_client(py::module_& m) {
         .def_property_readonly("node_id", &SdoClient::node_id)
         .def_property_readonly("request_id", &SdoClient::request_id)
         .def_property_readonly("response_id", &SdoClient::response_id)
-        .def_property_readonly("counters", &SdoClient::counters);
+        .def_property_readonly("counters", &SdoClient::counters)
+        // Completion-based transfers (motorbus.canopen's awaitable face): they return
+        // at once, the GIL kept -- nothing here waits, and the C++ side completing
+        // them never takes it (cpp/motorbus/canopen/sdo_client.hpp).
+        .def("upload_async",
+             [](SdoClient& c, std::uint16_t i, std::uint8_t s, std::shared_ptr<Completions> done,
+                std::uint64_t token, bool block) {
+                 c.upload_async(i, s, block ? TransferMode::Block : TransferMode::Auto, std::move(done), token);
+             },
+             py::arg("index"), py::arg("subindex"), py::arg("completions"), py::arg("token"),
+             py::arg("block") = false, "Starts an upload; completes `token` on `completions` with its bytes.")
+        .def("download_async",
+             [](SdoClient& c, std::uint16_t i, std::uint8_t s, const py::object& data,
+                std::shared_ptr<Completions> done, std::uint64_t token, bool block, bool segmented) {
+                 Bytes b = from_buffer(data);
+                 c.download_async(i, s, b, mode_of(block, segmented), std::move(done), token);
+             },
+             py::arg("index"), py::arg("subindex"), py::arg("data"), py::arg("completions"), py::arg("token"),
+             py::arg("block") = false, py::arg("segmented") = false,
+             "Starts a download; completes `token` on `completions` with None.")
+        .def("check_deadline",
+             [](SdoClient& c) -> py::object {
+                 const Nanos next = c.check_deadline();
+                 return next == kNoDeadline ? py::object(py::none()) : py::object(py::int_(next));
+             },
+             "Fires the running async transfer's due timers; the next deadline (monotonic_ns) or None.")
+        .def("cancel_async", &SdoClient::cancel, py::arg("completions"), py::arg("token"),
+             "Withdraws an async transfer (the running one is aborted on the wire); False if already done.")
+        .def_property_readonly("async_pending", &SdoClient::async_pending)
+        .def("close", &SdoClient::close,
+             "Fails pending async transfers with ClosedError; later transfers raise ClosedError.")
+        .def_property_readonly("closed", &SdoClient::closed);
 
     // A PollSource reading objects by SDO through this client (motorbus.Poller).
     m.def("sdo_poll_source",

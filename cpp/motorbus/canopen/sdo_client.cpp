@@ -141,6 +141,14 @@ void SdoClientMachine::fail_peer_abort(std::span<const std::uint8_t> frame, Outb
     Bytes().swap(data_);
 }
 
+void SdoClientMachine::abandon(std::uint32_t code, Outbox& out) {
+    if (status_ == Status::Running) {
+        out.push_back(abort_transfer(mux_, code));
+        ++counters_.aborts_sent;
+    }
+    reset();
+}
+
 void SdoClientMachine::finish() {
     status_ = Status::Done;
     phase_ = Phase::None;
@@ -515,19 +523,29 @@ SdoClient::SdoClient(can::Bus& bus, std::uint8_t node_id, SdoClientOptions optio
     c.block_crc = options.block_crc;
     c.fallback_to_segmented = options.fallback_to_segmented;
     machine_.set_config(c);
+    sync_->owner = this;
     sub_ = bus_.subscribe_id(response_id_, false, [this](const can::Frame& f) { on_frame(f); });
-    // Link lost or bus closed: wake a waiting transfer now (run() sees which).
-    // Taking the mutex orders the wake-up after the waiter's predicate check;
-    // the one thread that must not take it is the one sending under it.
+    // Link lost or bus closed: wake a waiting transfer now (run() sees which) and
+    // end the running async one.  Taking the mutex orders the wake-up after the
+    // waiter's predicate check; the one thread that must not take it is the one
+    // sending under it (its send throws, and that path ends the transfer).
     link_watch_ = bus_.watch_link([s = sync_] {
+        FinishedList finished;
         if (s->sending.load() != std::this_thread::get_id()) {
-            std::lock_guard barrier(s->mutex);  // held for no work: only the ordering
+            std::lock_guard lock(s->mutex);
+            if (s->owner) s->owner->on_link_event_locked(finished);
         }
         s->cv.notify_all();
+        deliver(finished);
     });
 }
 
 SdoClient::~SdoClient() {
+    close();
+    {
+        std::lock_guard lock(mutex_);
+        sync_->owner = nullptr;  // a link watcher running after this does not reach us
+    }
     bus_.unwatch_link(link_watch_);
     bus_.unsubscribe(sub_);
 }
@@ -564,7 +582,8 @@ void SdoClient::send_out() {
 
 void SdoClient::on_frame(const can::Frame& f) {
     if (f.rtr || (f.flags & (can::kFlagError | can::kFlagLoopback))) return;
-    bool done, sooner;
+    bool done, sooner, wake_blocking = false;
+    FinishedList finished;
     {
         std::lock_guard lock(mutex_);
         const Nanos before = machine_.next_deadline();
@@ -578,24 +597,31 @@ void SdoClient::on_frame(const can::Frame& f) {
         } catch (const LinkDown&) {
             // The link is gone or the bus closed: the transfer ends with that now.
             outbox_.clear();
-            if (machine_.busy()) send_error_ = std::current_exception();
+            if (machine_.busy()) (async_current_ ? async_send_error_ : send_error_) = std::current_exception();
             sooner = true;
         } catch (const ClosedError&) {
             outbox_.clear();
-            if (machine_.busy()) send_error_ = std::current_exception();
+            if (machine_.busy()) (async_current_ ? async_send_error_ : send_error_) = std::current_exception();
             sooner = true;
         } catch (const std::exception&) {
             // The medium refused (full): the transfer runs into its timeout.
             outbox_.clear();
         }
         done = !machine_.busy();
+        if (async_current_) {
+            // An async transfer: complete it here, on the receive thread, and
+            // start the next one queued (or hand the channel to a blocking caller).
+            settle_async_locked(finished);
+            wake_blocking = blocking_waiting_ > 0 && !async_current_;
+        }
     }
+    deliver(finished);
     // Tell the caller after unlocking, so a spinning caller does not then
     // block on the mutex this thread still holds.
     if (done) {
         idle_.store(true, std::memory_order_release);
         cv_.notify_all();
-    } else if (sooner) {
+    } else if (sooner || wake_blocking) {
         cv_.notify_all();
     }
 }
@@ -611,7 +637,7 @@ void SdoClient::run(std::unique_lock<std::mutex>& lock, std::uint64_t link_losse
     // Why the bus will not bring our response: closed, or its link lost (or
     // interrupted) since the transfer started.  Checked by the wait's predicate.
     auto bus_gone = [&] {
-        return send_error_ || bus_.closed() || bus_.link_losses() != link_losses;
+        return send_error_ || closed_.load() || bus_.closed() || bus_.link_losses() != link_losses;
     };
     if (options_.spin.count() > 0 && machine_.busy()) {
         idle_.store(false, std::memory_order_relaxed);
@@ -646,6 +672,9 @@ void SdoClient::run(std::unique_lock<std::mutex>& lock, std::uint64_t link_losse
             std::snprintf(what, sizeof what, "SDO 0x%04X:%02X: ", machine_.multiplexer().index,
                           machine_.multiplexer().subindex);
             if (send_error_) std::rethrow_exception(send_error_);
+            if (closed_.load())
+                throw ClosedError(std::string(what) + "SDO client of node " + std::to_string(node_id_) +
+                                  " closed during the transfer");
             if (bus_.closed())
                 throw ClosedError(std::string(what) + "bus " + bus_.channel() + " closed during the transfer");
             const std::string why = bus_.link_loss_reason();
@@ -668,10 +697,26 @@ void SdoClient::run(std::unique_lock<std::mutex>& lock, std::uint64_t link_losse
     }
 }
 
+// The channel for one blocking transfer, and back: the queued async transfers
+// start again when it is released (normally or by an exception).
+struct SdoClient::ChannelGuard {
+    SdoClient& client;
+    std::unique_lock<std::mutex>& lock;
+    ChannelGuard(SdoClient& c, std::unique_lock<std::mutex>& l) : client(c), lock(l) { client.acquire_channel(lock); }
+    ~ChannelGuard() {
+        FinishedList finished;
+        if (!lock.owns_lock()) lock.lock();
+        client.release_channel_locked(finished);
+        lock.unlock();
+        deliver(finished);
+    }
+};
+
 Bytes SdoClient::upload(std::uint16_t index, std::uint8_t subindex, TransferMode mode) {
     std::lock_guard tl(transfer_mutex_);
+    std::unique_lock lock(mutex_);
+    ChannelGuard channel(*this, lock);
     for (unsigned attempt = 0;; ++attempt) {
-        std::unique_lock lock(mutex_);
         const std::uint64_t losses = bus_.link_losses();
         machine_.start_upload(index, subindex, mode, monotonic_ns(), outbox_);
         try {
@@ -690,10 +735,307 @@ void SdoClient::download(std::uint16_t index, std::uint8_t subindex,
                          std::span<const std::uint8_t> data, TransferMode mode) {
     std::lock_guard tl(transfer_mutex_);
     std::unique_lock lock(mutex_);
+    ChannelGuard channel(*this, lock);
     const std::uint64_t losses = bus_.link_losses();
     machine_.start_download(index, subindex, data, mode, monotonic_ns(), outbox_);
     run(lock, losses);
     machine_.reset();
+}
+
+// ---- async transfers --------------------------------------------------------
+
+void SdoClient::deliver(FinishedList& finished) {
+    for (auto& f : finished) {
+        if (f.error)
+            f.done->fail(f.token, std::move(f.error));
+        else
+            f.done->push(f.token, std::move(f.value));
+    }
+    finished.clear();
+}
+
+void SdoClient::upload_async(std::uint16_t index, std::uint8_t subindex, TransferMode mode,
+                             std::shared_ptr<Completions> done, std::uint64_t token) {
+    if (!done) throw InvalidArgument("SdoClient upload_async: no Completions to complete on");
+    AsyncTransfer t;
+    t.upload = true;
+    t.index = index;
+    t.subindex = subindex;
+    t.mode = mode;
+    t.done = std::move(done);
+    t.token = token;
+    submit_async(std::move(t));
+}
+
+void SdoClient::download_async(std::uint16_t index, std::uint8_t subindex, std::span<const std::uint8_t> data,
+                               TransferMode mode, std::shared_ptr<Completions> done, std::uint64_t token) {
+    if (!done) throw InvalidArgument("SdoClient download_async: no Completions to complete on");
+    AsyncTransfer t;
+    t.upload = false;
+    t.index = index;
+    t.subindex = subindex;
+    t.data.assign(data.begin(), data.end());
+    t.mode = mode;
+    t.done = std::move(done);
+    t.token = token;
+    submit_async(std::move(t));
+}
+
+void SdoClient::submit_async(AsyncTransfer t) {
+    FinishedList finished;
+    {
+        std::lock_guard lock(mutex_);
+        if (closed_.load()) {
+            finished.push_back({t.done, t.token, {},
+                                std::make_exception_ptr(ClosedError(
+                                    "SDO client of node " + std::to_string(node_id_) + " is closed"))});
+        } else {
+            async_queue_.push_back(std::move(t));
+            start_next_async_locked(finished);
+        }
+    }
+    deliver(finished);
+}
+
+// Starts `t` on the machine and sends its first request; the error when that
+// send failed (the transfer then never ran), else null.
+std::exception_ptr SdoClient::start_async_locked(AsyncTransfer& t) {
+    async_send_error_ = nullptr;
+    async_link_losses_ = bus_.link_losses();
+    if (t.upload)
+        machine_.start_upload(t.index, t.subindex, t.mode, monotonic_ns(), outbox_);
+    else
+        machine_.start_download(t.index, t.subindex, t.data, t.mode, monotonic_ns(), outbox_);
+    try {
+        send_out();
+    } catch (...) {
+        outbox_.clear();
+        machine_.reset();
+        return std::current_exception();
+    }
+    return nullptr;
+}
+
+void SdoClient::start_next_async_locked(FinishedList& out) {
+    while (!async_current_ && !blocking_running_ && blocking_waiting_ == 0 && !async_queue_.empty()) {
+        async_current_ = std::move(async_queue_.front());
+        async_queue_.pop_front();
+        if (auto e = start_async_locked(*async_current_)) {
+            out.push_back({async_current_->done, async_current_->token, {}, e});
+            async_current_.reset();
+        }
+    }
+}
+
+void SdoClient::fail_current_async_locked(std::exception_ptr e, FinishedList& out) {
+    out.push_back({async_current_->done, async_current_->token, {}, std::move(e)});
+    machine_.reset();
+    outbox_.clear();
+    async_current_.reset();
+    async_send_error_ = nullptr;
+    start_next_async_locked(out);
+}
+
+// The running async transfer, when the machine is done with it (or a send of
+// it failed): its completion, then the next transfer.
+void SdoClient::settle_async_locked(FinishedList& out) {
+    if (!async_current_) return;
+    if (machine_.busy()) {
+        if (async_send_error_) fail_current_async_locked(async_send_error_, out);
+        return;
+    }
+    AsyncTransfer& t = *async_current_;
+    if (machine_.status() == SdoClientMachine::Status::Failed) {
+        std::exception_ptr e = machine_.error();
+        bool timed_out = false;
+        try {
+            std::rethrow_exception(e);
+        } catch (const SdoTimeout&) {
+            timed_out = true;
+        } catch (...) {
+        }
+        if (timed_out && t.upload && t.attempt < options_.read_retries) {  // reads are idempotent
+            ++t.attempt;
+            machine_.reset();
+            if (auto se = start_async_locked(t)) fail_current_async_locked(se, out);
+            return;
+        }
+        return fail_current_async_locked(e, out);
+    }
+    out.push_back({t.done, t.token, t.upload ? std::any(machine_.take_result()) : std::any{}, nullptr});
+    machine_.reset();
+    async_current_.reset();
+    async_send_error_ = nullptr;
+    start_next_async_locked(out);
+}
+
+std::exception_ptr SdoClient::bus_gone_error() const {
+    char what[40];
+    std::snprintf(what, sizeof what, "SDO 0x%04X:%02X: ", machine_.multiplexer().index,
+                  machine_.multiplexer().subindex);
+    if (closed_.load())
+        return std::make_exception_ptr(ClosedError(std::string(what) + "SDO client of node " +
+                                                   std::to_string(node_id_) + " closed"));
+    if (bus_.closed())
+        return std::make_exception_ptr(
+            ClosedError(std::string(what) + "bus " + bus_.channel() + " closed during the transfer"));
+    if (bus_.link_losses() != async_link_losses_) {
+        const std::string why = bus_.link_loss_reason();
+        return std::make_exception_ptr(LinkDown(std::string(what) + "link of " + bus_.channel() +
+                                                " lost during the transfer" + (why.empty() ? "" : ": " + why)));
+    }
+    return nullptr;
+}
+
+void SdoClient::on_link_event_locked(FinishedList& out) {
+    if (!async_current_) return;
+    // No abort to send: the bus cannot carry it.  Queued transfers then start
+    // and fail at their first send if the bus is gone for good (ClosedError,
+    // LinkDown), or run normally after an interruption.
+    if (auto e = bus_gone_error()) fail_current_async_locked(e, out);
+}
+
+Nanos SdoClient::check_deadline() {
+    FinishedList finished;
+    Nanos next;
+    bool wake_blocking;
+    {
+        std::lock_guard lock(mutex_);
+        next = check_deadline_locked(finished);
+        wake_blocking = blocking_waiting_ > 0 && !async_current_;
+    }
+    deliver(finished);
+    if (wake_blocking) cv_.notify_all();
+    return next;
+}
+
+Nanos SdoClient::check_deadline_locked(FinishedList& out) {
+    if (!async_current_) return kNoDeadline;
+    if (auto e = bus_gone_error()) {
+        fail_current_async_locked(e, out);
+    } else if (machine_.busy() && monotonic_ns() >= machine_.next_deadline()) {
+        machine_.on_timer(monotonic_ns(), outbox_);  // C1: abort with the multiplexer, SdoTimeout
+        try {
+            send_out();
+        } catch (const std::exception&) {
+            outbox_.clear();
+        }
+        settle_async_locked(out);
+    }
+    return async_current_ ? machine_.next_deadline() : kNoDeadline;
+}
+
+bool SdoClient::cancel(const std::shared_ptr<Completions>& done, std::uint64_t token) {
+    FinishedList finished;
+    bool found = false, wake_blocking = false;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = std::find_if(async_queue_.begin(), async_queue_.end(),
+                               [&](const AsyncTransfer& t) { return t.done == done && t.token == token; });
+        if (it != async_queue_.end()) {
+            async_queue_.erase(it);
+            found = true;
+        } else if (async_current_ && async_current_->done == done && async_current_->token == token) {
+            // The server is told, so it does not keep the transfer open until its
+            // own timeout: the channel is usable for the next one at once.
+            machine_.abandon(ac::kGeneral, outbox_);
+            try {
+                send_out();
+            } catch (const std::exception&) {
+                outbox_.clear();
+            }
+            async_current_.reset();
+            async_send_error_ = nullptr;
+            start_next_async_locked(finished);
+            found = true;
+            wake_blocking = blocking_waiting_ > 0 && !async_current_;
+        }
+    }
+    deliver(finished);
+    if (wake_blocking) cv_.notify_all();
+    return found;
+}
+
+std::size_t SdoClient::async_pending() const {
+    std::lock_guard lock(mutex_);
+    return async_queue_.size() + (async_current_ ? 1 : 0);
+}
+
+void SdoClient::close() {
+    if (closed_.exchange(true)) return;
+    FinishedList finished;
+    {
+        std::lock_guard lock(mutex_);
+        auto e = std::make_exception_ptr(
+            ClosedError("SDO client of node " + std::to_string(node_id_) + " closed with the transfer pending"));
+        if (async_current_) {
+            machine_.abandon(ac::kGeneral, outbox_);
+            try {
+                send_out();
+            } catch (const std::exception&) {
+                outbox_.clear();
+            }
+            finished.push_back({async_current_->done, async_current_->token, {}, e});
+            async_current_.reset();
+        }
+        for (auto& t : async_queue_) finished.push_back({t.done, t.token, {}, e});
+        async_queue_.clear();
+    }
+    cv_.notify_all();  // a blocking transfer ends with ClosedError (run()'s bus_gone)
+    deliver(finished);
+}
+
+void SdoClient::acquire_channel(std::unique_lock<std::mutex>& lock) {
+    if (closed_.load())
+        throw ClosedError("SDO client of node " + std::to_string(node_id_) + " is closed");
+    if (async_current_) {
+        ++blocking_waiting_;
+        try {
+            while (async_current_) {
+                // Enforce the async transfer's deadline here: its loop may be gone.
+                const Nanos dl = machine_.next_deadline();
+                interruptible_wait_until(cv_, lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(dl)),
+                                         [&] {
+                                             return !async_current_ || closed_.load() ||
+                                                    monotonic_ns() >= machine_.next_deadline() ||
+                                                    bus_gone_error() != nullptr;
+                                         });
+                if (closed_.load())
+                    throw ClosedError("SDO client of node " + std::to_string(node_id_) + " closed");
+                if (async_current_) {
+                    FinishedList finished;
+                    check_deadline_locked(finished);
+                    if (!finished.empty()) {
+                        lock.unlock();
+                        deliver(finished);
+                        lock.lock();
+                    }
+                }
+            }
+        } catch (...) {
+            --blocking_waiting_;
+            FinishedList finished;  // the queue held back for us may run again
+            start_next_async_locked(finished);
+            if (!finished.empty()) {
+                lock.unlock();
+                deliver(finished);
+                lock.lock();
+            }
+            throw;
+        }
+        --blocking_waiting_;
+    }
+    blocking_running_ = true;
+}
+
+void SdoClient::release_channel_locked(FinishedList& out) {
+    if (!blocking_running_) {
+        // acquire_channel threw (closed, interrupted): the queue may start again.
+        start_next_async_locked(out);
+        return;
+    }
+    blocking_running_ = false;
+    start_next_async_locked(out);
 }
 
 template <class T>

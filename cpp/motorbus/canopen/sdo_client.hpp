@@ -18,14 +18,42 @@
 // A transfer waiting for its response ends at once with LinkDown when the
 // bus's link is lost (or interrupted: frames of the exchange may be gone) and
 // with ClosedError when the bus is closed, from any thread (Bus::watch_link).
+//
+// Completion-based transfers (the awaitable face, motorbus.aio):
+//
+//   auto done = std::make_shared<Completions>();
+//   sdo.upload_async(0x1000, 0, TransferMode::Auto, done, 7);   // returns at once
+//   ... done->fd() turns readable: done->drain() has {7, Bytes} or {7, error}
+//
+// The transfer runs on the bus's receive thread (on_frame) and ends with exactly
+// one completion: push(token, Bytes) for an upload, push(token, {}) for a
+// download, fail(token, error) with the errors the blocking call throws -- unless
+// the caller withdrew it with cancel().  Async transfers of one client queue in
+// the order they were asked (one transfer per SDO channel, CiA 301); a blocking
+// transfer on the same client waits for the running one and goes before the
+// queued ones, so the two never interleave on the wire.
+//
+// Deadlines: nothing in here sleeps for an async transfer.  Whoever waits for
+// the completion arms a timer at the deadline and calls check_deadline() then
+// (the asyncio face: loop.call_later per awaited transfer).  Why not a timer
+// thread: the goal is no thread per wait and no more threads while 127
+// transfers are awaited than without them; the event loop already is a timer
+// heap, and a C++ timer thread would also need a wake-up for every frame (each
+// restarts the response timeout).  A blocking transfer queued behind an async
+// one enforces that one's deadline itself while it waits (a loop that went away
+// cannot leave the channel stuck for blocking callers).
 #pragma once
+#include <any>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <thread>
@@ -36,6 +64,7 @@
 #include "motorbus/canopen/datatypes.hpp"
 #include "motorbus/canopen/sdo_codec.hpp"
 #include "motorbus/runtime/clock.hpp"
+#include "motorbus/runtime/completions.hpp"
 
 namespace motorbus::canopen {
 
@@ -105,6 +134,9 @@ public:
     void on_timer(Nanos now, Outbox& out);
     // Forget the transfer (after Done/Failed); the machine becomes Idle.
     void reset();
+    // Give up a Running transfer: the server is told (abort `code` with the
+    // multiplexer, appended to `out`) and the machine becomes Idle.
+    void abandon(std::uint32_t code, Outbox& out);
 
     Status status() const { return status_; }
     bool busy() const { return status_ == Status::Running; }
@@ -230,6 +262,30 @@ public:
         download(i, s, v, mode);
     }
 
+    // Completion-based transfers (see the top of this file).  Return at once;
+    // the transfer ends with one completion on `done` named `token`.
+    void upload_async(std::uint16_t index, std::uint8_t subindex, TransferMode mode,
+                      std::shared_ptr<Completions> done, std::uint64_t token);
+    void download_async(std::uint16_t index, std::uint8_t subindex, std::span<const std::uint8_t> data,
+                        TransferMode mode, std::shared_ptr<Completions> done, std::uint64_t token);
+    // Fires the running async transfer's timers that are due (timeout: abort sent,
+    // SdoTimeout completed or an idempotent read retried; block upload sub-block
+    // timer), and notices a bus that closed or lost its link.  Returns when to call
+    // again: the running async transfer's next deadline (monotonic_ns), or
+    // kNoDeadline when no async transfer is running (queued ones start later).
+    Nanos check_deadline();
+    // Withdraws an async transfer: a queued one is dropped; the running one is
+    // aborted on the wire (0x08000000, general error) and the next one starts.
+    // No completion follows.  False when `token` was not pending (already done).
+    bool cancel(const std::shared_ptr<Completions>& done, std::uint64_t token);
+    // Async transfers asked for and not yet completed (queued + running).
+    std::size_t async_pending() const;
+    // Fails every pending async transfer with ClosedError, aborts the running
+    // one on the wire, and refuses later transfers (ClosedError).  Idempotent;
+    // the destructor calls it.
+    void close();
+    bool closed() const { return closed_.load(); }
+
     std::uint8_t node_id() const { return node_id_; }
     std::uint32_t request_id() const { return request_id_; }
     std::uint32_t response_id() const { return response_id_; }
@@ -250,10 +306,48 @@ private:
     void send_out();
     void on_frame(const can::Frame& f);
 
+    // --- async transfers (all under mutex_) ---
+    struct AsyncTransfer {
+        bool upload = true;
+        std::uint16_t index = 0;
+        std::uint8_t subindex = 0;
+        Bytes data;
+        TransferMode mode = TransferMode::Auto;
+        std::shared_ptr<Completions> done;
+        std::uint64_t token = 0;
+        unsigned attempt = 0;
+    };
+    // A completion decided under the lock, delivered after it is released: a
+    // Completions wake-up hook may take a lock of its own (Python's GIL for a
+    // loop without add_reader), which must never be waited for under mutex_.
+    struct Finished {
+        std::shared_ptr<Completions> done;
+        std::uint64_t token;
+        std::any value;
+        std::exception_ptr error;
+    };
+    using FinishedList = std::vector<Finished>;
+    static void deliver(FinishedList& finished);
+    void submit_async(AsyncTransfer t);
+    std::exception_ptr start_async_locked(AsyncTransfer& t);
+    void start_next_async_locked(FinishedList& out);
+    void settle_async_locked(FinishedList& out);
+    void fail_current_async_locked(std::exception_ptr e, FinishedList& out);
+    Nanos check_deadline_locked(FinishedList& out);
+    void on_link_event_locked(FinishedList& out);
+    std::exception_ptr bus_gone_error() const;
+    // Blocking transfers: wait for the channel (an async transfer may be running).
+    void acquire_channel(std::unique_lock<std::mutex>& lock);
+    void release_channel_locked(FinishedList& out);
+    struct ChannelGuard;
+
     // The caller's wait: shared with the bus's link watcher, which may still
     // run once after the client is gone (Bus::unwatch_link).
     struct Sync {
-        std::mutex mutex;               // guards machine_, outbox_, send_error_
+        std::mutex mutex;               // guards machine_, outbox_, send_error_, owner
+        // The client, for the link watcher to fail its async transfers; null once
+        // the client is closing (the watcher may run once after that).
+        SdoClient* owner = nullptr;
         std::condition_variable cv;
         // The thread sending with `mutex` held: a link watcher it triggers
         // itself (its send found the link dead) must not lock `mutex` again.
@@ -276,6 +370,14 @@ private:
     can::SubscriptionId sub_ = 0;
     can::SubscriptionId link_watch_ = 0;
     std::atomic<bool> idle_{true};  // the machine is not Running (for the spin-wait)
+
+    std::deque<AsyncTransfer> async_queue_;           // mutex_: asked, not started
+    std::optional<AsyncTransfer> async_current_;      // mutex_: running on machine_
+    std::uint64_t async_link_losses_ = 0;             // mutex_: link_losses() when it started
+    std::exception_ptr async_send_error_;             // mutex_: a send of the running one failed
+    int blocking_waiting_ = 0;                        // mutex_: blocking callers wanting the channel
+    bool blocking_running_ = false;                   // mutex_: a blocking transfer owns machine_
+    std::atomic<bool> closed_{false};
 };
 
 }  // namespace motorbus::canopen
