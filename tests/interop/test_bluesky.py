@@ -32,7 +32,7 @@ from motorbus.drives.arcus import ArcusMotorDisabled  # noqa: E402
 from motorbus.ophyd import MotorbusMotor, MoveLimitError, devices_from_bench  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
-from test_drive_api import KINDS, OUT_OF_TREE  # noqa: E402  per-kind address, scale, fast profile, sim options
+from drive_kinds import KINDS, OUT_OF_TREE  # noqa: E402  per-kind address, scale, fast profile, sim options
 
 pytestmark = pytest.mark.threaded
 

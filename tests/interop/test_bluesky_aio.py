@@ -1,14 +1,16 @@
 """motorbus.ophyd on motorbus.aio: a bluesky plan moving 12 axes at once, with no executor.
 
-A simulated bench of 12 axes of two kinds whose logic is awaitable (the out-of-tree
-toy stepper on two RS-485 lines, DMAC modules on a third; each line a pty served
-by a line server), each axis an ophyd-async device.  One RunEngine plan sets all 12
-moving, reads every readback mid-move, stops two of them mid-move (``bps.stop``)
-and waits for the rest.  Asserted from outside (the simulators): the ten others
-stand on their targets, the two stopped ones rest short of theirs and were moving
-when the stop came.  Asserted on the RunEngine's loop: its default executor was
-never made (``run_in_executor`` is never called), no executor thread exists, and
-the link workers (motorbus.faces) number no more than the lines, not the axes.
+A simulated bench of 12 axes of four kinds whose logic is awaitable: the
+out-of-tree toy stepper and DMAC modules on two RS-485 lines (each line a pty
+served by a line server), CiA 402 and PMC007 drives on one CAN bus served over
+socketcand on 127.0.0.1; each axis an ophyd-async device.  One RunEngine plan sets
+all 12 moving, reads every readback mid-move, stops two of them mid-move
+(``bps.stop``: a toy stepper and a CiA 402 drive) and waits for the rest.
+Asserted from outside (the simulators): the ten others stand on their targets,
+the two stopped ones rest short of theirs and were moving when the stop came.
+Asserted on the RunEngine's loop: its default executor was never made
+(``run_in_executor`` is never called), no executor thread exists, and the link
+workers (motorbus.faces) number no more than the links, fewer than the axes.
 """
 from __future__ import annotations
 
@@ -33,28 +35,41 @@ from motorbus import Bench, aio, faces, registry  # noqa: E402
 from motorbus.ophyd import MotorbusMotor, devices_from_bench  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
-from test_drive_api import OUT_OF_TREE  # noqa: E402  where the toy kind's package is
+from drive_kinds import KINDS, OUT_OF_TREE  # noqa: E402  fast profiles, the simulators' shafts
 
 pytestmark = pytest.mark.threaded
 
-SCALE = 0.01                  # mm per native unit (a toy step, a DMAC 1/10000 rev)
+SCALE = 0.01                  # mm per native unit, every kind here
 FAST = 5.0                    # mm: the ten axes that arrive
-SLOW = 50.0                   # mm at SLOW_SPEED: the two stopped half way (5 s if never stopped)
+SLOW = 50.0                   # mm at SLOW_SPEED: the two stopped on the way (5 s if never stopped)
 SLOW_SPEED = 10.0             # mm/s, through the device's velocity signal
-#: line -> (kind, addresses): 8 toy steppers on two lines, 4 DMAC modules on a third.
-LINES = {"ra": ("toy", ["1", "2", "3", "4"]), "rb": ("toy", ["1", "2", "3", "4"]),
-         "rc": ("dmac", ["00", "01", "02", "03"])}
-STOPPED = ("ra_3", "rc_02")   # one of each kind
+#: (axis, kind, line or None, address): 4 toy steppers and 4 DMAC modules on two
+#: lines, 2 CiA 402 and 2 PMC007 drives on one CAN bus.
+AXES = ([(f"toy{a}", "toy", "ra", a) for a in "1234"] + [(f"dmac{a}", "dmac", "rb", a) for a in ("00", "01", "02", "03")]
+        + [(f"cia{n}", "cia402", None, n) for n in (5, 6)] + [(f"pmc{n}", "pmc007", None, n) for n in (7, 8)])
+STOPPED = ("toy3", "cia6")    # one on a line, one on the bus
 EXECUTOR_THREADS = ("asyncio_", "ThreadPoolExecutor")
 
 
+class _Params:
+    """Collects what a kind's fast profile (drive_kinds.KINDS setup) writes."""
+
+    def __init__(self) -> None:
+        self.params: dict = {}
+
+
 def _description() -> dict:
-    data: dict = {"line": {}, "axis": {}}
-    for line, (kind, addresses) in LINES.items():
-        data["line"][line] = {"port": f"/dev/ttyUSB-{line}"}     # sim=True serves a pty instead
-        for address in addresses:
-            data["axis"][f"{line}_{address}"] = {"kind": kind, "line": line, "address": address,
-                                                 "units": {"name": "mm", "scale": SCALE}}
+    data: dict = {"line": {"ra": {"port": "/dev/ttyUSB-ra"}, "rb": {"port": "/dev/ttyUSB-rb"}},
+                  "bus": {"can0": {"spec": "socketcan:can0"}}, "axis": {}}    # sim=True serves ptys, socketcand
+    for name, kind, line, address in AXES:
+        profile = _Params()
+        KINDS[kind].setup(profile)
+        axis = {"kind": kind, "address": address, "units": {"name": "mm", "scale": SCALE},
+                "params": profile.params}
+        axis.update({"line": line} if line else {"bus": "can0"})
+        if KINDS[kind].sim_options:
+            axis["sim"] = dict(KINDS[kind].sim_options)
+        data["axis"][name] = axis
     return data
 
 
@@ -66,6 +81,7 @@ def bench():
         mp.syspath_prepend(str(OUT_OF_TREE["toy"]))
         mp.setattr(registry, "_cache", {})       # the entry points read again, with the toy package's
         with Bench.from_dict(_description(), sim=True) as b:
+            b.apply()
             for drive in b.axes.values():
                 drive.clear_faults()
                 drive.enable()
@@ -73,13 +89,20 @@ def bench():
             b.stop_all()
 
 
-def _shaft(bench: Bench, name: str) -> tuple[float, bool]:
-    """(position in mm, moving) read on the simulator itself, not through any Drive."""
-    sim = bench.sims[name]
-    if bench.config[name].kind == "toy":
-        return sim.position * SCALE, sim.moving
-    state = sim.state()
-    return state.position * SCALE, state.speed != 0
+def _shaft(bench: Bench, name: str) -> float:
+    """Where the axis stands, in mm, read on its simulator (not through any Drive)."""
+    return KINDS[bench.config[name].kind].shaft(bench.sims[name]) * SCALE
+
+
+def _at_rest(bench: Bench, name: str) -> float:
+    """The shaft's position once it no longer moves (read twice, 0.1 s apart)."""
+    at = _shaft(bench, name)
+    for _ in range(50):
+        time.sleep(0.1)
+        now, at = at, _shaft(bench, name)
+        if now == at:
+            return at
+    raise AssertionError(f"{name} still moves: {at}")
 
 
 def _links_idle(timeout: float = 5.0) -> None:
@@ -138,15 +161,23 @@ def RE():
     RE.loop.call_soon_threadsafe(RE.loop.stop)
 
 
+def _links(bench: Bench) -> int:
+    """How many links the bench's drives talk over in the awaitable face (each drive's
+    ``io`` names the link its calls queue on: a serial line, a CANopen node's SDO client,
+    a bus): the most link workers its 12 axes may use at once."""
+    return len({id(d.io._link) for d in bench.axes.values()})
+
+
 def test_twelve_axes_move_at_once_with_readbacks_and_a_mid_move_stop_and_no_executor(bench, RE):
     _links_idle()
     motors = devices_from_bench(bench)
-    assert len(motors) == 12 and {bench.config[n].kind for n in motors} == {"toy", "dmac"}
-    # Both kinds' logic is awaitable (coroutine hooks over self.io), so nothing blocks the loop.
-    for kind in ("toy", "dmac"):
-        assert asyncio.iscoroutinefunction(registry.drive_plugin(kind)._move_to)
+    kinds = {bench.config[n].kind for n in motors}
+    assert len(motors) == 12 and kinds == {"toy", "dmac", "cia402", "pmc007"}
+    # Every kind's logic is awaitable (coroutine hooks over self.io), so nothing blocks the loop.
+    for kind in kinds:
+        assert asyncio.iscoroutinefunction(registry.drive_plugin(kind)._move_to), kind
     RE(ensure_connected(*motors.values()))
-    start = {n: _shaft(bench, n)[0] for n in motors}
+    start = {n: _shaft(bench, n) for n in motors}
     targets = {n: start[n] + (SLOW if n in STOPPED else FAST) for n in motors}
     threads_before = {t.ident for t in threading.enumerate()}
     seen: dict = {}
@@ -160,64 +191,63 @@ def test_twelve_axes_move_at_once_with_readbacks_and_a_mid_move_stop_and_no_exec
         yield from bps.sleep(0.5)
         # Readbacks while all of it runs: every device read on the loop, mid-move.
         seen["mid"] = yield from _read_all(motors)
-        seen["mid_shaft"] = {n: _shaft(bench, n) for n in STOPPED}
+        seen["at_stop"] = {n: _shaft(bench, n) for n in STOPPED}
         seen["links"] = faces.worker_threads()
         seen["threads"] = [t.name for t in threading.enumerate()]
-        seen["cut_done_before_stop"] = [statuses[n].done for n in STOPPED]
-        # The stopped moves fail their statuses: the RunEngine throws each FailedStatus in
+        seen["done_before_stop"] = [statuses[n].done for n in STOPPED]
+        # The stopped moves fail their statuses: the RunEngine throws a FailedStatus in
         # at whichever message comes next, which _pardoning collects.
         yield from _pardoning(_stop_and_wait(motors), seen.setdefault("cut_errors", []))
         return statuses
 
     statuses = RE(plan()).plan_result
-    seen["end"] = RE(_read_all(motors)).plan_result
+    end = RE(_read_all(motors)).plan_result
+
+    # No executor: the loop's default executor was never made nor asked for, no executor
+    # thread ran; the drive calls went to the link workers, one per link at most.
+    assert RE.executor_calls == []
+    assert RE.loop._default_executor is None
+    assert [n for n in seen["threads"] if n.startswith(EXECUTOR_THREADS)] == []
+    assert [t.name for t in threading.enumerate()
+            if t.ident not in threads_before and t.name.startswith(EXECUTOR_THREADS)] == []
+    assert 1 <= seen["links"] <= _links(bench) < len(motors), (seen["links"], _links(bench))
+    assert len([n for n in seen["threads"] if n.startswith("motorbus-link-")]) == seen["links"]
 
     # The ten others arrived: the simulators stand on their targets, the readbacks say so.
     for name in motors:
         if name in STOPPED:
             continue
         assert statuses[name].done and statuses[name].success, name
-        assert _shaft(bench, name) == (pytest.approx(targets[name], abs=SCALE / 2), False), name
-        assert seen["end"][name] == pytest.approx(targets[name], abs=SCALE / 2), name
+        assert _at_rest(bench, name) == pytest.approx(targets[name], abs=SCALE / 2), name
+        assert end[name] == pytest.approx(targets[name], abs=SCALE / 2), name
 
-    # The stop arrived while the two moved: their statuses were still running, their
-    # shafts turning half way, and their readbacks mid-move were on the way too.
-    assert seen["cut_done_before_stop"] == [False, False]
+    # The stop arrived while the two moved: their statuses were still running, and the
+    # shaft had gone on past the readback read a moment before.
+    assert seen["done_before_stop"] == [False, False]
     for name in STOPPED:
-        at, moving = seen["mid_shaft"][name]
-        assert moving and start[name] < at < targets[name], (name, at)
-        assert start[name] < seen["mid"][name] < targets[name], (name, seen["mid"][name])
-    # ...and they rest short of the target, stopped by this program's stop(), sent before
-    # ophyd-async cancelled the move (the cancellation's own stop would name itself).
+        assert start[name] < seen["mid"][name] < seen["at_stop"][name] < targets[name], (name, seen)
+    # They fail their statuses (the RunEngine throws in one FailedStatus of those that
+    # failed between two messages: it keeps one) and rest short of the target, stopped
+    # by this program's stop(), sent before ophyd-async cancelled the move (the
+    # cancellation's own stop would name itself).
     failed = {id(e.args[0]) for e in seen["cut_errors"]}
     assert failed and failed <= {id(statuses[n]) for n in STOPPED}, seen["cut_errors"]
     for name in STOPPED:
         status = statuses[name]
         assert status.done and not status.success
         assert "was stopped" in str(status.exception())
-        at, moving = _shaft(bench, name)
-        time.sleep(0.2)
-        assert _shaft(bench, name) == (at, False), name                  # at rest, and stays there
-        assert start[name] + 0.05 < at < start[name] + SLOW / 2, (name, at)  # stopped on the way
+        at = _at_rest(bench, name)
+        assert seen["at_stop"][name] <= at < start[name] + SLOW / 2, (name, at)
+        assert end[name] == pytest.approx(at, abs=SCALE / 2)
         last = bench[name].status.last_move
         assert last.state == "interrupted" and "stop() of this program" in last.reason, last
 
-    # No executor: the loop's default executor was never made nor asked for, no executor
-    # thread ran; the drive calls went to the link workers, one per line at most.
-    assert RE.executor_calls == []
-    assert RE.loop._default_executor is None
-    new = [n for n in seen["threads"] if n.startswith(EXECUTOR_THREADS)]
-    assert new == [] and not [t.name for t in threading.enumerate()
-                              if t.ident not in threads_before and t.name.startswith(EXECUTOR_THREADS)]
-    links = [n for n in seen["threads"] if n.startswith("motorbus-link-")]
-    assert 1 <= seen["links"] <= len(LINES) < len(motors)
-    assert len(links) == seen["links"]
 
 
 def test_devices_from_an_aio_bench_use_its_twins_and_a_cancelled_set_stops_the_motor(bench):
     """The devices of an aio.Bench go through the bench's own twins; cancelling the
     set's task (as a RunEngine abort does) stops the motor through the twin."""
-    name = "rb_2"
+    name = "pmc8"
 
     async def go():
         twins = aio.Bench(bench)
@@ -230,15 +260,14 @@ def test_devices_from_an_aio_bench_use_its_twins_and_a_cancelled_set_stops_the_m
         assert await m.user_setpoint.get_value() == pytest.approx(before)    # read at connect
         status = m.set(before + SLOW)
         await asyncio.sleep(0.3)
-        assert _shaft(bench, name)[1]
+        assert _shaft(bench, name) > before
         status.task.cancel()
         with pytest.raises(asyncio.CancelledError):
             await status
         return before
 
     before = asyncio.run(go())
-    at, moving = _shaft(bench, name)
-    assert not moving and before + 1.0 < at < before + SLOW / 2
+    assert before < _at_rest(bench, name) < before + SLOW / 2
     last = bench[name].status.last_move
     assert last.state == "interrupted" and "cancellation" in last.reason, last
 
@@ -246,20 +275,20 @@ def test_devices_from_an_aio_bench_use_its_twins_and_a_cancelled_set_stops_the_m
 def test_building_a_device_talks_to_nothing_and_any_loop_connects_it(bench):
     """No loop is taken and no exchange made when a device is built; two loops in turn
     each connect and read it."""
-    drive = bench["ra_1"]
-    closed = motorbus.open_drive("toy", line=bench.lines["ra"], address="1",
-                                 units=motorbus.Units("mm", SCALE))
+    closed = motorbus.open_drive("toy", line=bench.lines["ra"], address="1", units=motorbus.Units("mm", SCALE))
     closed.close()
     m = MotorbusMotor(closed, name="gone")        # built from a closed drive: nothing was asked of it
     with pytest.raises(motorbus.ClosedError):
         asyncio.run(m.connect())
 
-    m = MotorbusMotor(drive, name="ra_1")
+    m = MotorbusMotor(bench["toy1"], name="toy1")
     for _ in range(2):                            # two loops, one after the other
+
         async def read():
             await m.connect(force_reconnect=True)
             return await m.user_readback.get_value()
-        assert asyncio.run(read()) == pytest.approx(_shaft(bench, "ra_1")[0], abs=SCALE / 2)
+
+        assert asyncio.run(read()) == pytest.approx(_shaft(bench, "toy1"), abs=SCALE / 2)
 
 
 @pytest.mark.parametrize("what", [None, "x", 3.0])
