@@ -2,7 +2,9 @@
 
 An Arcus DMX-CAN on its serial line (a pty) and a CiA 402 drive on a CAN bus
 served over socketcand on 127.0.0.1, opened as a bench; each axis becomes an
-ophyd-async motor, and a real bluesky RunEngine scans x while reading z.
+ophyd-async motor, and a real bluesky RunEngine scans x while reading z.  Every
+drive call is awaited on the RunEngine's own event loop through the axis's
+motorbus.aio twin (no executor thread; docs/bluesky.md says how).
 
     pip install "motorbus[bluesky]"
     python examples/10_bluesky_scan.py
