@@ -29,7 +29,6 @@ device is staged (ophyd-async then reads its monitor, refreshed every
 """
 from __future__ import annotations
 
-import asyncio
 import math
 from functools import cached_property
 from typing import Any, Mapping, Optional, Union
@@ -186,6 +185,17 @@ class MotorbusMotor(StandardReadable, StandardMovable[float]):
             await self.user_setpoint.set(position)
             self._publish_position(position)
             self._placed = True
+
+    async def stop(self, success: bool = False) -> None:
+        try:
+            await super().stop(success=success)
+        except BaseException:
+            # ophyd-async sends the stop, then cancels the move: a stop that failed (a
+            # lost link...) must not leave the move running with its status pending. The
+            # cancelled move tries the twin's own ladder (stop, then quick stop).
+            if self._move_status is not None:
+                self._move_status.task.cancel()
+            raise
 
     @AsyncStatus.wrap
     async def stage(self) -> None:

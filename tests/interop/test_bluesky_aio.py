@@ -272,6 +272,34 @@ def test_devices_from_an_aio_bench_use_its_twins_and_a_cancelled_set_stops_the_m
     assert last.state == "interrupted" and "cancellation" in last.reason, last
 
 
+def test_a_stop_that_fails_still_ends_the_move(bench):
+    """The device's stop raises the kind's error, and the move is cancelled all the same:
+    the twin's cancellation stops the motor and the status ends."""
+    name = "toy2"
+
+    async def go():
+        m = MotorbusMotor(bench[name], name=name, velocity=SLOW_SPEED)
+        await m.connect()
+        before = await m.twin.position()
+
+        async def refused() -> None:
+            raise motorbus.LinkDown("toy2: the line is gone (as the test says)")
+
+        status = m.set(before + SLOW)
+        await asyncio.sleep(0.3)
+        m.twin.stop = refused
+        with pytest.raises(motorbus.LinkDown, match="as the test says"):
+            await m.stop()
+        with pytest.raises(RuntimeError, match="was stopped"):
+            await status
+        return before
+
+    before = asyncio.run(go())
+    assert before < _at_rest(bench, name) < before + SLOW / 2
+    last = bench[name].status.last_move
+    assert last.state == "interrupted" and "cancellation" in last.reason, last
+
+
 def test_building_a_device_talks_to_nothing_and_any_loop_connects_it(bench):
     """No loop is taken and no exchange made when a device is built; two loops in turn
     each connect and read it."""
