@@ -527,7 +527,8 @@ class Pmc007Params(Params):
     def _info(self, name: str) -> Optional[ParamInfo]:
         if name not in OBJECTS:
             return None
-        var = self._drive.native.variable(name).od     # the node's own entry (defaults for its node-ID)
+        # The node's own entry (defaults for its node-ID): a table lookup, no exchange.
+        var = self._drive._od[OBJECTS[name].index, OBJECTS[name].subindex]
         low, high = var.value_range or (None, None)
         return ParamInfo(name=name, type="str" if var.data_type == _core.canopen.DataType.VISIBLE_STRING else "int",
                          minimum=low, maximum=high, default=var.default,
@@ -657,6 +658,9 @@ class Pmc007Drive(Drive):
         self._speed_mode = False
         self._sdo_misses = 0
         self._ext_limits = _check_ext_limits(ext_limits)
+        #: The node's object dictionary (its C++ table for this node-ID), kept so that
+        #: describing a parameter reads a table, never the client, on the event loop.
+        self._od = getattr(native, "object_dictionary", None)
 
     # ---- Drive hooks, native units (steps) -------------------------------------------------
     # Coroutines over self.io (motorbus.faces): the same code serves drive.move_to(...) and
