@@ -244,6 +244,14 @@ def test_twelve_axes_move_at_once_with_readbacks_and_a_mid_move_stop_and_no_exec
 
 
 
+def _stopped_by_the_cancellation(bench: Bench, name: str, before: float) -> None:
+    """The axis rests short of its slow move's target, stopped by the twin when the
+    move's task was cancelled."""
+    assert before < _at_rest(bench, name) < before + SLOW / 2
+    last = bench[name].status.last_move
+    assert last.state == "interrupted" and "cancellation" in last.reason, last
+
+
 def test_devices_from_an_aio_bench_use_its_twins_and_a_cancelled_set_stops_the_motor(bench):
     """The devices of an aio.Bench go through the bench's own twins; cancelling the
     set's task (as a RunEngine abort does) stops the motor through the twin."""
@@ -266,10 +274,7 @@ def test_devices_from_an_aio_bench_use_its_twins_and_a_cancelled_set_stops_the_m
             await status
         return before
 
-    before = asyncio.run(go())
-    assert before < _at_rest(bench, name) < before + SLOW / 2
-    last = bench[name].status.last_move
-    assert last.state == "interrupted" and "cancellation" in last.reason, last
+    _stopped_by_the_cancellation(bench, name, asyncio.run(go()))
 
 
 def test_a_stop_that_fails_still_ends_the_move(bench):
@@ -294,10 +299,7 @@ def test_a_stop_that_fails_still_ends_the_move(bench):
             await status
         return before
 
-    before = asyncio.run(go())
-    assert before < _at_rest(bench, name) < before + SLOW / 2
-    last = bench[name].status.last_move
-    assert last.state == "interrupted" and "cancellation" in last.reason, last
+    _stopped_by_the_cancellation(bench, name, asyncio.run(go()))
 
 
 def test_building_a_device_talks_to_nothing_and_any_loop_connects_it(bench):
