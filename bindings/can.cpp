@@ -254,8 +254,17 @@ static void bind_async_receiver(py::module_& m) {
         "A bus's frames for an event loop (Bus.frames): its own subscription, filters and bounded queue.")
         .def(py::init([](std::shared_ptr<Bus> bus, const py::object& filters, std::size_t queue) {
                  not_none(bus, "bus");
-                 return std::make_shared<AsyncReceiver>(std::move(bus),
-                                                        motorbus::py_helpers::filters_from_py(filters), queue);
+                 // Destroyed without the GIL: its close() waits for the bus's dispatch, which may be
+                 // running another subscriber's Python callback (waiting for the GIL).
+                 auto* rx = new AsyncReceiver(std::move(bus), motorbus::py_helpers::filters_from_py(filters), queue);
+                 return std::shared_ptr<AsyncReceiver>(rx, [](AsyncReceiver* p) {
+                     if (Py_IsInitialized() && PyGILState_Check()) {
+                         py::gil_scoped_release nogil;
+                         delete p;
+                     } else {
+                         delete p;
+                     }
+                 });
              }),
              py::arg("bus"), py::arg("filters") = py::none(), py::arg("queue") = 1024)
         .def("take_or_arm",

@@ -10,16 +10,33 @@ Specs are URL-like strings, one scheme per registered backend (entry-point group
 
 or a python-can ``can.BusABC`` instance, which is wrapped so every motorbus
 client (SDO, drives, recorder) runs on it.
+
+Every bus also has an awaitable face (issue 25, docs/aio.md "Buses and
+streams"), methods of the same Bus objects, named after their blocking twins:
+
+    frame = await bus.arecv(timeout=1.0)        # recv(): the same queue and filters
+    frames = await bus.arecv_many(256)          # recv_many()
+    await bus.asend(frame)                      # send(), waiting on a full medium without blocking the loop
+    async for frame in bus: ...                 # bus.frames(): a stream of its own
+    async with bus.frames(filters=[{"can_id": 0x180, "can_mask": 0x780}], queue=64) as tpdos:
+        async for frame in tpdos: ...
+
+No thread waits for a frame: the bus's receive thread hands each burst to the
+loop's completion queue (an eventfd the loop watches) without the GIL.
 """
 from __future__ import annotations
 
+import asyncio
+import collections
+import math
 import threading
 import time
-from typing import Any
+import weakref
+from typing import Any, Callable, Optional
 
-from . import _core, registry
+from . import _core, faces, registry
 
-__all__ = ["open_bus", "parse_spec", "frame_to_message", "message_to_frame", "wall_time"]
+__all__ = ["open_bus", "parse_spec", "frame_to_message", "message_to_frame", "wall_time", "FrameStream"]
 
 # Offset from the monotonic clock of frame timestamps to the epoch, fixed once
 # so converted timestamps keep their spacing.
@@ -142,3 +159,234 @@ def _bridge(pcbus: Any, poll: float = 0.01, receive_own: bool = False) -> _core.
         raise _core.InvalidArgument(
             f"open_bus: expected a spec string or a can.BusABC, got {type(pcbus).__name__}")
     return _Bridge(pcbus, poll, receive_own).bus
+
+
+# ---------------------------------------------------------------------------
+# The awaitable face: methods of every _core.can.Bus (see the module doc)
+
+def _check_timeout(what: str, timeout: Any) -> Optional[float]:
+    if timeout is None:
+        return None
+    if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or math.isnan(timeout) or timeout < 0:
+        raise _core.InvalidArgument(f"{what} timeout: seconds >= 0 or None (wait forever), not {timeout!r}")
+    return None if math.isinf(timeout) else float(timeout)
+
+
+def _check_count(what: str, n: Any) -> int:
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise _core.InvalidArgument(f"{what}: a number of frames >= 1, not {n!r}")
+    return n
+
+
+async def _completed(bridge: faces.LoopBridge, token: int, future: asyncio.Future, timeout: Optional[float],
+                     withdraw: Callable[[], bool], keep: Callable[[list], None]) -> Optional[list]:
+    """Waits for the completion ``token`` of a frame waiter; None after ``timeout``.
+
+    The future is shielded: a cancelled (or timed-out) wait first withdraws its
+    waiter; if the waiter had already been served, its frames are on their way
+    and go to ``keep`` (the next read takes them first) instead of being lost."""
+    try:
+        if timeout is None:
+            return await asyncio.shield(future)
+        done, _ = await asyncio.wait((future,), timeout=timeout)
+        if done:
+            return future.result()
+    except asyncio.CancelledError:
+        if withdraw():
+            bridge.forget(token)
+        else:
+            future.add_done_callback(lambda f: keep(f.result()) if not f.cancelled() and f.exception() is None
+                                     else None)
+        raise
+    if withdraw():
+        bridge.forget(token)
+        return None
+    return await future          # served as the timeout struck: already on its way, take it
+
+
+# Frames a cancelled arecv() had already been given, per bus: the next arecv() starts with them.
+_leftovers: "weakref.WeakKeyDictionary[Any, collections.deque]" = weakref.WeakKeyDictionary()
+
+
+def _keep_for(bus: Any) -> Callable[[list], None]:
+    def keep(frames: list) -> None:
+        _leftovers.setdefault(bus, collections.deque()).extendleft(reversed(frames))
+    return keep
+
+
+async def _recv_batch(bus: Any, max_frames: int, timeout: Optional[float]) -> list:
+    kept = _leftovers.get(bus)
+    if kept:
+        return [kept.popleft() for _ in range(min(max_frames, len(kept)))]
+    bridge = faces.bridge_for()
+    token, future = bridge.expect()
+    try:
+        frames = bus._recv_or_wait(max_frames, bridge.completions, token)
+    except BaseException:
+        bridge.forget(token)
+        raise
+    if frames:
+        bridge.forget(token)
+        return frames
+    if timeout == 0:            # a poll: nothing queued now
+        if bus._cancel_wait(bridge.completions, token):
+            bridge.forget(token)
+            return []
+        return await future     # served in between: on its way
+    got = await _completed(bridge, token, future, timeout,
+                           lambda: bus._cancel_wait(bridge.completions, token), _keep_for(bus))
+    return [] if got is None else got
+
+
+async def _arecv(self: Any, timeout: Optional[float] = None) -> Optional[_core.can.Frame]:
+    """``await bus.arecv(timeout=None)``: the awaitable twin of ``recv()`` -- the
+    next frame of the same queue, through the same filters (``set_filters``),
+    or None after ``timeout`` seconds (None: wait forever).  ClosedError /
+    LinkDown as ``recv()``.  No thread waits: the bus's receive thread
+    completes the wait on the loop's completion queue."""
+    frames = await _recv_batch(self, 1, _check_timeout("Bus.arecv", timeout))
+    return frames[0] if frames else None
+
+
+async def _arecv_many(self: Any, max: int = 1024, timeout: Optional[float] = None) -> list:  # noqa: A002
+    """``await bus.arecv_many(max=1024, timeout=None)``: the awaitable twin of
+    ``recv_many()`` -- up to ``max`` frames, oldest first, as soon as there is
+    one; [] after ``timeout``."""
+    return await _recv_batch(self, _check_count("Bus.arecv_many max", max),
+                             _check_timeout("Bus.arecv_many", timeout))
+
+
+async def _asend(self: Any, frame: _core.can.Frame, timeout: float = 1.0) -> None:
+    """``await bus.asend(frame, timeout=1.0)``: the awaitable twin of ``send()``.
+
+    ``send()`` blocks while the medium is full (a virtual bus's transmit queue,
+    a socketcand server that stops reading); here the frame is offered without
+    waiting and, while the medium stays full, offered again after a short
+    sleep of the task (0.5 ms, doubling to 10 ms) until ``timeout``: then
+    TimeoutError, as ``send()``.  A medium with room costs no sleep."""
+    limit = _check_timeout("Bus.asend", timeout)
+    deadline = None if limit is None else time.monotonic() + limit
+    pause = 0.0005
+    while True:
+        try:
+            self.send(frame, 0.0)
+            return
+        except _core.TimeoutError:
+            if deadline is not None and time.monotonic() >= deadline:
+                raise _core.TimeoutError(f"bus {self.channel}: the medium stayed full for {timeout:g} s; "
+                                         f"frame {frame} not sent") from None
+        await asyncio.sleep(pause if deadline is None else max(0.0, min(pause, deadline - time.monotonic())))
+        pause = min(pause * 2, 0.01)
+
+
+class FrameStream:
+    """A bus's frames as an async iterator (``bus.frames(...)``, ``async for frame in bus``).
+
+    A subscription of its own (C++ ``can::AsyncReceiver``): it takes nothing
+    from ``recv()``'s queue, and every stream sees every frame its ``filters``
+    pass (python-can style dicts: ``{"can_id": 0x181, "can_mask": 0x7FF,
+    "extended": False}``; None = all).  The bus's receive thread appends to a
+    bounded queue of ``queue`` frames; when the loop is slower, the newest
+    frames are dropped and counted in ``overflows`` -- the bus thread never
+    waits.  The stream ends (StopAsyncIteration) after its queued frames when
+    the bus closes or ``close()`` is called; a link lost for good raises
+    LinkDown.  Cancelling the task that iterates leaves the bus usable; a
+    frame already handed to the cancelled wait is kept for the next one."""
+
+    def __init__(self, bus: Any, filters: Any = None, queue: int = 1024, batch: int = 256) -> None:
+        _check_count("Bus.frames queue", queue)
+        self._batch_max = _check_count("Bus.frames batch", batch)
+        self.bus = bus
+        self._rx = _core.can.AsyncReceiver(bus, filters, queue)
+        self._ready: collections.deque = collections.deque()
+
+    # ---- counters ----
+    @property
+    def overflows(self) -> int:
+        """Frames dropped because the queue was full (the newest of a burst)."""
+        return self._rx.counters.overflows
+
+    @property
+    def received(self) -> int:
+        """Frames that passed the filters since the stream began (delivered, queued or dropped)."""
+        return self._rx.counters.received
+
+    @property
+    def wakeups(self) -> int:
+        """Times the bus thread woke the loop (one per burst the loop was waiting for)."""
+        return self._rx.counters.wakeups
+
+    @property
+    def queued(self) -> int:
+        return self._rx.queued + len(self._ready)
+
+    # ---- reading ----
+    def __aiter__(self) -> "FrameStream":
+        return self
+
+    async def __anext__(self) -> _core.can.Frame:
+        if not self._ready:
+            try:
+                self._ready.extend(await self.batch())
+            except _core.ClosedError:
+                raise StopAsyncIteration from None
+        return self._ready.popleft()
+
+    async def batch(self, max: Optional[int] = None, timeout: Optional[float] = None) -> list:  # noqa: A002
+        """The queued frames (up to ``max``, default the stream's batch size) as soon as
+        there is one, oldest first; [] after ``timeout``.  ClosedError once ended."""
+        max_frames = self._batch_max if max is None else _check_count("FrameStream.batch max", max)
+        timeout = _check_timeout("FrameStream.batch", timeout)
+        if self._ready:
+            return [self._ready.popleft() for _ in range(min(max_frames, len(self._ready)))]
+        bridge = faces.bridge_for()
+        token, future = bridge.expect()
+        try:
+            frames = self._rx.take_or_arm(max_frames, bridge.completions, token)
+        except BaseException:
+            bridge.forget(token)
+            raise
+        if frames:
+            bridge.forget(token)
+            return frames
+        got = await _completed(bridge, token, future, timeout, self._rx.disarm,
+                               lambda frames: self._ready.extendleft(reversed(frames)))
+        return [] if got is None else got
+
+    # ---- ending ----
+    def close(self) -> None:
+        """Unsubscribes; the iteration ends after the frames already queued.  Idempotent."""
+        self._rx.close()
+
+    async def __aenter__(self) -> "FrameStream":
+        return self
+
+    async def __aexit__(self, *exc: Any) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        rx = getattr(self, "_rx", None)
+        if rx is not None:
+            rx.close()          # unsubscribe now (without the GIL), not whenever the C++ object goes
+
+    def __repr__(self) -> str:
+        return (f"<FrameStream on {self.bus.channel}: {self.received} received, {self.overflows} overflows, "
+                f"{self.queued} queued>")
+
+
+def _frames(self: Any, filters: Any = None, queue: int = 1024, batch: int = 256) -> FrameStream:
+    """``bus.frames(filters=None, queue=1024, batch=256)``: a :class:`FrameStream`
+    of this bus (an async iterator of Frames with its own filters and bounded queue)."""
+    return FrameStream(self, filters, queue, batch)
+
+
+def _aiter(self: Any) -> FrameStream:
+    return FrameStream(self)
+
+
+# Methods of every bus, whatever its backend: the Bus objects users already hold get their awaitable twins.
+_core.can.Bus.arecv = _arecv
+_core.can.Bus.arecv_many = _arecv_many
+_core.can.Bus.asend = _asend
+_core.can.Bus.frames = _frames
+_core.can.Bus.__aiter__ = _aiter

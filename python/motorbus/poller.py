@@ -33,18 +33,28 @@ its old ``<axis>.t`` and each such sample counts in ``stats[...]["stale"]``.  A 
 a group missed (its previous sample ran past a whole period) is a row of NaN
 for its axes, and is counted in ``stats``: never hidden.  A group whose link
 fails stops (its error is in ``stats``); the others go on.
+
+The awaitable face (docs/aio.md "Buses and streams"): ``async for chunk in
+poller.chunks(rows)`` yields the same frames as ``read()``, each of at least
+``rows`` new rows (fewer at the end).  No thread waits and the poll threads
+never take the GIL per sample: each group's thread pushes one completion to
+the loop's queue once its ring holds ``rows`` unread rows (or it stopped), and
+the loop takes the rows in one batch.  The ring is the bounded queue: a
+consumer more than ``capacity`` rows behind loses the oldest, counted in
+``stats[...]["overflowed"]`` (and :attr:`Poller.overflowed`).  Captured axes
+(``mode="capture"``: TPDOs, cyclic registers) stream the same way.
 """
 from __future__ import annotations
 
 import csv
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import AsyncIterator, Mapping
 from typing import Any, Iterable, Optional, Union
 
 import numpy as np
 
-from . import _core
+from . import _core, faces
 
 __all__ = ["Poller", "FIELDS", "load_frame"]
 
@@ -333,6 +343,58 @@ class Poller:
                     out[f"{axis}.{f}"] = c
                     col += 1
         return out
+
+    # ---- the awaitable face ----
+    async def chunks(self, rows: Optional[int] = None) -> AsyncIterator[dict[str, np.ndarray]]:
+        """``async for chunk in poller.chunks(rows)``: the samples as they come, each
+        chunk a frame as ``read()`` returns (numpy arrays per column) of at least
+        ``rows`` new rows (default: a tenth of a second of them), fewer for the
+        last one; ends when every group has stopped (``stop()``, or a link failed:
+        see ``stats``).  The ring is the bounded queue (``capacity`` rows; what a
+        slow consumer loses is counted in ``overflowed``).  Leaving the loop or
+        cancelling its task withdraws the wait; the poller goes on."""
+        if rows is None:
+            rows = max(1, int(round(self.rate_hz / 10)))
+        if isinstance(rows, bool) or not isinstance(rows, int) or not 1 <= rows <= self._capacity:
+            raise _core.InvalidArgument(f"Poller.chunks rows: a number of rows in 1..{self._capacity} (the ring's "
+                                        f"capacity), not {rows!r}")
+        if not self._started:
+            raise _core.InvalidArgument("Poller.chunks: the poller was not started (start() first)")
+        while True:
+            await self._rows_ready(rows)
+            ended = not self.running          # read before the last take: nothing can follow it
+            chunk = self.read()
+            if len(chunk["t"]):
+                yield chunk
+            if ended:
+                return
+
+    async def _rows_ready(self, rows: int) -> None:
+        """Until every running group's ring holds ``rows`` unread rows (or it stopped)."""
+        bridge = faces.bridge_for()
+        waits = []
+        try:
+            for g in self._groups:
+                if g.core is None:
+                    continue
+                token, future = bridge.expect()
+                if g.core.notify_when(rows, bridge.completions, token):
+                    bridge.forget(token)      # already so (or the group stopped)
+                else:
+                    waits.append((g, token, future))
+            for _, _, future in waits:
+                await future
+        except BaseException:                 # cancelled (or the generator closed): withdraw what waits
+            for g, token, future in waits:
+                if not future.done():
+                    g.core.cancel_notify()
+                    bridge.forget(token)
+            raise
+
+    @property
+    def overflowed(self) -> int:
+        """Rows the groups' rings lost because the reader (read(), chunks()) fell a ring behind."""
+        return sum(g.core.stats.overflowed for g in self._groups if g.core is not None)
 
     # ---- figures ----
     @property
