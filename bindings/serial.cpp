@@ -339,6 +339,18 @@ static void bind_line_link(py::module_& m) {
             "Sends request + terminator and returns the reply without its terminator. "
             "timeout None = the link's reply_timeout.")
         .def(
+            "transact_async",
+            [](LineLink& l, const py::object& request, std::shared_ptr<Completions> done, std::uint64_t token,
+               const py::object& timeout) {
+                std::string req = bytes_arg(request, "request");
+                std::optional<std::chrono::nanoseconds> t;
+                if (!timeout.is_none()) t = seconds_to_ns(timeout);
+                l.transact_async(std::move(req), t, std::move(done), token);
+            },
+            py::arg("request"), py::arg("completions"), py::arg("token"), py::arg("timeout") = py::none(),
+            "transact() for an event loop: returns at once; the reply (bytes) or the error arrives in "
+            "`completions` under `token`, from the link's own worker thread (motorbus.aio.transact awaits it).")
+        .def(
             "send",
             [](LineLink& l, const py::object& request) {
                 std::string req = bytes_arg(request, "request");

@@ -6,12 +6,12 @@ A kind writes its ``Drive`` hooks (``_enable``, ``_move_to``, ``_status``...) as
 ``self.io`` (the kind's native client seen through :class:`NativeIo`)::
 
     async def _enable(self):
-        if await self.io.is_dmac34():
+        if await self.io.has_brake():
             await self.io.brake(False)
         await self.io.power("ON")
 
     async def _position(self):
-        return float(await self.io.get("position"))      # a property of the client
+        return float(await self.io.attr("position"))     # a property of the client
 
 The two faces run the *same* coroutine:
 
@@ -252,11 +252,13 @@ class _Call:
 
 class NativeIo:
     """A native client's calls as awaitables: ``await io.read(v)`` is
-    ``native.read(v)``; ``await io.get("position")`` reads a property,
-    ``await io.set("high_speed", 5)`` writes one, ``await io.do(f, *args)`` runs
-    any function of the client; ``io.urgent`` is the same for calls that must
-    overtake queued ones (stops).  ``link``: what the calls' worker is shared
-    with (a serial line's drives share one)."""
+    ``native.read(v)``; ``await io.attr("position")`` reads a property,
+    ``await io.set_attr("high_speed", 5)`` writes one, ``await io.do(f, *args)``
+    runs any function (of the client, or a few of its calls in a row); ``io.urgent``
+    is the same for calls that must overtake queued ones (stops).  ``link``: what
+    the calls' worker is shared with (a serial line's drives share one).  (The
+    helpers' names are ones no native client uses: ``get``/``set``/``read`` are the
+    clients' own.)"""
 
     __slots__ = ("_native", "_link", "_urgent")
 
@@ -274,10 +276,10 @@ class NativeIo:
         link, urgent = self._link, self._urgent
         return lambda *args: _Call(link, method, args, urgent)
 
-    def get(self, name: str) -> _Call:
+    def attr(self, name: str) -> _Call:
         return _Call(self._link, getattr, (self._native, name), self._urgent)
 
-    def set(self, name: str, value: Any) -> _Call:
+    def set_attr(self, name: str, value: Any) -> _Call:
         return _Call(self._link, setattr, (self._native, name, value), self._urgent)
 
     def do(self, fn: Callable, *args: Any) -> _Call:

@@ -89,7 +89,8 @@ KINDS = {
     "unitek": Kind("unitek", "0x201", 0.01, fault=lambda sim, drive: sim.set_hardware_enable(False),
                    unfault=lambda sim: sim.set_hardware_enable(True), param="ACC_RAMP", value=200, jog=50.0,
                    setup=lambda drive: drive.params.__setitem__("ACC_RAMP", 20),  # ms to N max
-                   sim_options={"calibrated": True}, shaft=lambda sim: sim.position_num),
+                   # a short deceleration ramp (speed 0 is the stop): a stop lands well short of a far target
+                   sim_options={"calibrated": True, "dec_ramp_ms": 20}, shaft=lambda sim: sim.position_num),
     "pmc007": Kind("pmc007", "5", 0.01, fault=lambda sim, drive: sim.inject_error(1),  # UVLO
                    param="start_speed", value=500, jog=50.0, home="ext1", setup=_pmc007_setup),
     # The out-of-tree test kind (tests/plugin_kind/): registered only while its package is on the path.

@@ -27,7 +27,7 @@ from drive_kinds import KINDS, kind, rig  # noqa: F401  (fixtures)
 pytestmark = pytest.mark.parametrize("rig", ["transport"], indirect=True)
 
 #: Native attributes a hook may read on the loop thread: plain data, no exchange.
-PLAIN = {"address", "node_id", "link", "kind", "model", "is_dmac34_cached"}
+PLAIN = {"address", "node_id", "link", "kind", "model", "table"}
 
 
 class LoopThreadGuard:

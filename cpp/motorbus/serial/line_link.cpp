@@ -1,6 +1,8 @@
 // LineLink: request/reply framing over a Port (see port.hpp for the contract).
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
+#include <deque>
 #include <mutex>
 #include <thread>
 
@@ -42,6 +44,7 @@ struct LineLink::Impl {
     LineOptions options;
     LineFramer framer;
     FifoMutex mutex;  // one transaction at a time, in the order they were asked for
+    std::mutex worker_mutex;  // transact_async's worker: made once (never waits on a transaction)
     std::vector<std::uint8_t> pending;  // read but not yet framed
     std::string echo;                   // bytes we expect back from an echoing adapter
     std::size_t echo_pos = 0;
@@ -161,7 +164,71 @@ struct LineLink::Impl {
 LineLink::LineLink(std::shared_ptr<Port> port, LineOptions options)
     : impl_(std::make_unique<Impl>(std::move(port), std::move(options))) {}
 
-LineLink::~LineLink() = default;
+// transact_async's thread: one per link, so a loop awaiting a hundred transactions
+// costs one thread, not a hundred; the FifoMutex keeps them in order with the
+// blocking callers' transactions.
+struct LineLink::Worker {
+    struct Job {
+        std::string request;
+        std::optional<Duration> timeout;
+        std::shared_ptr<Completions> done;
+        std::uint64_t token;
+    };
+    std::mutex mutex;
+    std::condition_variable cv;
+    std::deque<Job> jobs;
+    bool stopping = false;
+    std::thread thread;
+
+    void serve(LineLink& link) {
+        std::unique_lock lk(mutex);
+        for (;;) {
+            cv.wait(lk, [&] { return stopping || !jobs.empty(); });
+            if (stopping) break;
+            Job job = std::move(jobs.front());
+            jobs.pop_front();
+            lk.unlock();
+            try {
+                std::string reply = link.transact(job.request, job.timeout);
+                job.done->push(job.token, std::vector<std::uint8_t>(reply.begin(), reply.end()));
+            } catch (...) {
+                job.done->fail(job.token, std::current_exception());
+            }
+            lk.lock();
+        }
+        for (auto& job : jobs)
+            job.done->fail(job.token, std::make_exception_ptr(ClosedError("LineLink: closed with the transaction queued")));
+        jobs.clear();
+    }
+};
+
+LineLink::~LineLink() {
+    if (worker_) {
+        {
+            std::lock_guard lk(worker_->mutex);
+            worker_->stopping = true;
+        }
+        worker_->cv.notify_all();
+        worker_->thread.join();    // a transaction in progress ends within its reply timeout
+    }
+}
+
+void LineLink::transact_async(std::string request, std::optional<Duration> timeout, std::shared_ptr<Completions> done,
+                              std::uint64_t token) {
+    if (!done) throw InvalidArgument("LineLink.transact_async: no completion queue");
+    {
+        std::lock_guard lk(impl_->worker_mutex);
+        if (!worker_) {
+            worker_ = std::make_unique<Worker>();
+            worker_->thread = std::thread([this] { worker_->serve(*this); });
+        }
+    }
+    {
+        std::lock_guard lk(worker_->mutex);
+        worker_->jobs.push_back(Worker::Job{std::move(request), timeout, std::move(done), token});
+    }
+    worker_->cv.notify_one();
+}
 
 std::string LineLink::transact(std::string_view request, std::optional<Duration> timeout) {
     auto& d = *impl_;

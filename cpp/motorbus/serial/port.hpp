@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "motorbus/errors.hpp"
+#include "motorbus/runtime/completions.hpp"
 
 namespace motorbus::serial {
 
@@ -153,6 +154,14 @@ public:
     // Sends `request` + terminator, returns the reply without its terminator.
     // Throws TimeoutError (partial reply discarded) or ProtocolError.
     std::string transact(std::string_view request, std::optional<Duration> timeout = {});
+    // Completion-based transact() for event loops: returns at once; the transaction
+    // runs on the link's own worker thread (one per link, started on first use, in
+    // the FIFO order of every transaction on the link) and ends with
+    // done->push(token, reply as std::vector<std::uint8_t>) or done->fail(token,
+    // the error transact() throws).  Jobs still queued when the link is destroyed
+    // fail with ClosedError.
+    void transact_async(std::string request, std::optional<Duration> timeout, std::shared_ptr<Completions> done,
+                        std::uint64_t token);
     // Sends without waiting for a reply (broadcasts).
     void send(std::string_view request);
     // Reads one reply line (e.g. unsolicited), nullopt on timeout.
@@ -169,7 +178,9 @@ public:
 
 private:
     struct Impl;
+    struct Worker;
     std::unique_ptr<Impl> impl_;
+    std::unique_ptr<Worker> worker_;   // transact_async's thread, made on first use
 };
 
 }  // namespace motorbus::serial

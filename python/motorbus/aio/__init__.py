@@ -4,7 +4,7 @@
     from motorbus import aio
 
     async def main():
-        async with await aio.open_drive("dmac", line="/dev/ttyUSB0", address="01") as x:
+        async with await aio.open_drive(KIND, line="/dev/ttyUSB0", address="01") as x:
             await x.enable()
             await x.move_to(25.0)                 # ends at the target or raises MoveFailed
             print(await x.position(), (await x.status()).text)
@@ -35,16 +35,16 @@ loop), so several loops in several threads can each drive their own axes.
 from __future__ import annotations
 
 import asyncio
-import math
 from collections.abc import Mapping
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Optional, Union
 
-from .. import _core, _stop_at_exit, faces
+from .. import _core, faces
 from ..bench import Bench as _SyncBench, StartReport
-from ..drive import Drive as _SyncDrive, DriveStatus, ParamInfo, Units, open_drive as _open_drive
+from ..drive import Drive as _SyncDrive, DriveStatus, MoveInterrupted, ParamInfo, StopReason, Units
+from ..drive import open_drive as _open_drive
 from ..stopping import STOP_WAYS, StopHow, check_stop_way
 
-__all__ = ["Drive", "Params", "Bench", "open_drive", "STOP_TIMEOUT"]
+__all__ = ["Drive", "Params", "Bench", "open_drive", "transact", "STOP_TIMEOUT"]
 
 #: Seconds an awaited move's cancellation waits for the motor to come to rest after
 #: its stop, unless the call gives ``stop_timeout``.
@@ -218,14 +218,19 @@ class Drive:
             pass
 
     async def _settle_cancelled(self) -> None:
+        """At rest after the cancellation's stop: the move's outcome recorded (a move or
+        jog judged as any other; a homing cut short is interrupted, whatever it had found)."""
         d = self.sync
         move = d._move
         try:
             await d._wait(d._is_idle, self.stop_timeout, "the stop after a cancellation")
         finally:
-            if move is not None and not move.judged and move.what != "home":
+            if move is not None and not move.judged:
                 try:
-                    await d._judge(move, raise_error=False)
+                    if move.what == "home":
+                        await d._failure(move, StopReason(MoveInterrupted, f"{move.stopped_by} of this program"))
+                    else:
+                        await d._judge(move, raise_error=False)
                 except Exception:  # noqa: BLE001 - recorded in last_move
                     pass
 
@@ -254,8 +259,9 @@ class Drive:
                 continue
 
     async def aclose(self) -> None:
-        """Forgets the drive (no stop), closing what ``open_drive`` opened."""
-        self.sync.close()
+        """Forgets the drive (no stop), closing what ``open_drive`` opened (off the loop:
+        closing a client may say goodbye to its drive)."""
+        await _blocking_once(self.sync.close)
 
 
 async def open_drive(kind: str, *, line: Any = None, bus: Any = None, address: Union[str, int],
@@ -264,6 +270,24 @@ async def open_drive(kind: str, *, line: Any = None, bus: Any = None, address: U
     awaitable twin of the drive it opens."""
     drive = await _blocking_once(_open_drive, kind, line=line, bus=bus, address=address, units=units, **options)
     return Drive(drive, stop_timeout=stop_timeout)
+
+
+async def transact(link: "_core.serial.LineLink", request: Union[str, bytes], *,
+                   timeout: Optional[float] = None) -> bytes:
+    """``link.transact(request)`` awaited: one request/reply on a serial line, the reply
+    without its terminator.  Completion-based: the transaction runs on the link's own C++
+    worker (one per link, in order with every other transaction on it) and its reply
+    wakes the loop through the loop's completion queue; the same errors as the blocking
+    call (``TimeoutError``, ``ReplyTooLong``, ``LinkDown``...).  A cancelled await drops
+    the reply (the transaction itself, a few ms, still completes on the line)."""
+    bridge = faces.bridge_for()
+    token, future = bridge.expect()
+    link.transact_async(request, bridge.completions, token, timeout)
+    try:
+        return await future
+    except asyncio.CancelledError:
+        bridge.forget(token)
+        raise
 
 
 class Bench:

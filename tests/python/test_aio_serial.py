@@ -1,0 +1,90 @@
+"""Serial line transactions awaited (``motorbus.aio.transact``): the completion-based
+C++ entry point ``LineLink.transact_async`` over a real pty, against a served line device."""
+from __future__ import annotations
+
+import asyncio
+import threading
+
+import pytest
+
+import motorbus
+from motorbus import aio, faces
+from motorbus._core.serial import LineLink, PtyLineServer
+from motorbus.serial import EchoLineDevice
+
+
+@pytest.fixture
+def link():
+    server = PtyLineServer([EchoLineDevice(prefix=b"P:")])
+    port = motorbus._core.serial.open_port(server.slave_path, 0)
+    link = LineLink(port, reply_timeout=1.0)
+    yield link
+    del link
+    port.close()
+    server.close()
+
+
+async def test_awaited_transactions_come_back_in_order_with_their_replies(link):
+    replies = await asyncio.gather(*(aio.transact(link, f"req{i}") for i in range(200)))
+    assert replies == [f"P:req{i}".encode() for i in range(200)]
+    # Every one went over the line, interleaved with blocking ones as they come.
+    assert link.transact("sync") == b"P:sync"
+    assert await aio.transact(link, b"\x01bytes") == b"P:\x01bytes"
+    assert link.counters.replies == 202
+
+
+async def test_a_burst_wakes_the_loop_in_batches_and_costs_one_thread(link):
+    before = threading.active_count()
+    bridge = faces.bridge_for()
+    wakeups = bridge.completions.wakeups
+    await asyncio.gather(*(aio.transact(link, f"x{i}") for i in range(300)))
+    assert threading.active_count() <= before + 1            # the link's one worker, whatever the count
+    assert bridge.completions.wakeups - wakeups <= 300       # never more wake-ups than replies
+
+
+async def test_no_reply_is_a_timeout_error_and_the_link_goes_on():
+    server = PtyLineServer([])                                # nobody answers
+    port = motorbus._core.serial.open_port(server.slave_path, 0)
+    link = LineLink(port, reply_timeout=0.05)
+    try:
+        with pytest.raises(motorbus.TimeoutError, match="no reply to 'hello'"):
+            await aio.transact(link, "hello")
+        with pytest.raises(motorbus.InvalidArgument):
+            await aio.transact(link, 123)
+    finally:
+        del link
+        port.close()
+        server.close()
+
+
+async def test_a_cancelled_await_leaves_the_link_usable(link):
+    task = asyncio.create_task(aio.transact(link, "slow"))
+    await asyncio.sleep(0)
+    task.cancel()
+    with pytest.raises(asyncio.CancelledError):
+        await task
+    assert await aio.transact(link, "next") == b"P:next"
+
+
+def test_a_link_closed_with_transactions_queued_fails_them_and_outlives_the_loop():
+    """The link's worker completes into a queue the loop may no longer watch: nothing
+    touches Python from the worker, and destroying the link fails what was still queued."""
+    server = PtyLineServer([])
+    port = motorbus._core.serial.open_port(server.slave_path, 0)
+    link = LineLink(port, reply_timeout=0.2)
+    done = motorbus._core.runtime.Completions()
+    for token in range(5):
+        link.transact_async(b"q", done, token)
+    del link                                                  # joins the worker: the first times out, the rest close
+    port.close()
+    server.close()
+    got = done.drain()
+    assert [t for t, _, _ in got] == [0, 1, 2, 3, 4]
+    errors = []
+    for _, value, failure in got:
+        assert value is None and failure is not None
+        with pytest.raises(motorbus.MotorbusError) as e:
+            failure.rethrow()
+        errors.append(type(e.value).__name__)
+    # At most the transaction in progress ran (and timed out); the rest were failed unrun.
+    assert set(errors[1:]) == {"ClosedError"} and errors[0] in ("TimeoutError", "ClosedError")
