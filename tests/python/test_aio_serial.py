@@ -88,3 +88,33 @@ def test_a_link_closed_with_transactions_queued_fails_them_and_outlives_the_loop
         errors.append(type(e.value).__name__)
     # At most the transaction in progress ran (and timed out); the rest were failed unrun.
     assert set(errors[1:]) == {"ClosedError"} and errors[0] in ("TimeoutError", "ClosedError")
+
+
+@pytest.mark.subprocess
+def test_an_interpreter_exiting_with_transactions_in_flight_exits_cleanly(tmp_path):
+    """pybind11#3274: C++ threads that outlive the loop and the interpreter.  A script
+    leaves awaited line transactions in flight (nobody answers) and returns from
+    asyncio.run and from the interpreter at once: the link's worker completes into a
+    queue no loop watches and touches no Python object, so the exit is clean."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "exit_in_flight.py"
+    script.write_text(
+        "import asyncio\n"
+        "import motorbus\n"
+        "from motorbus import aio\n"
+        "from motorbus._core.serial import LineLink, PtyLineServer\n"
+        "server = PtyLineServer([])\n"
+        "port = motorbus._core.serial.open_port(server.slave_path, 0)\n"
+        "link = LineLink(port, reply_timeout=0.3)\n"
+        "async def main():\n"
+        "    for i in range(20):\n"
+        "        asyncio.get_running_loop().create_task(aio.transact(link, f'q{i}'))\n"
+        "    await asyncio.sleep(0.05)\n"
+        "asyncio.run(main())\n"
+        "print('exiting with transactions in flight', flush=True)\n")
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "exiting with transactions in flight" in done.stdout
+    assert "Fatal Python error" not in done.stderr and "terminate called" not in done.stderr
