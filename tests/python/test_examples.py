@@ -121,3 +121,10 @@ def test_example_10_bluesky_scan_python():
     out = run_example("10_bluesky_scan.py")
     assert out.splitlines() == [f"event {i + 1}: x={i:.2f} z=2.50" for i in range(5)] + \
         ["run: success", "x stands at 4.00 mm"]
+
+
+def test_example_12_asyncio_python():
+    out = run_example("12_asyncio.py")
+    for kind in ("arcus", "dmac", "cia402"):
+        assert f"{kind}: at 4.00 mm" in out, out
+    assert "moving=False, last move interrupted" in out, out
