@@ -32,7 +32,7 @@ import math
 import threading
 import time
 import weakref
-from typing import Any, Callable, Optional
+from typing import Any, Callable, Coroutine, Optional
 
 from . import _core, faces, registry
 
@@ -238,25 +238,31 @@ async def _recv_batch(bus: Any, max_frames: int, timeout: Optional[float]) -> li
     return [] if got is None else got
 
 
-async def _arecv(self: Any, timeout: Optional[float] = None) -> Optional[_core.can.Frame]:
+def _arecv(self: Any, timeout: Optional[float] = None
+           ) -> "typing.Coroutine[typing.Any, typing.Any, typing.Optional[motorbus._core.can.Frame]]":
     """``await bus.arecv(timeout=None)``: the awaitable twin of ``recv()`` -- the
     next frame of the same queue, through the same filters (``set_filters``),
     or None after ``timeout`` seconds (None: wait forever).  ClosedError /
     LinkDown as ``recv()``.  No thread waits: the bus's receive thread
     completes the wait on the loop's completion queue."""
-    frames = await _recv_batch(self, 1, _check_timeout("Bus.arecv", timeout))
+    return _first(_recv_batch(self, 1, _check_timeout("Bus.arecv", timeout)))
+
+
+async def _first(batch: Coroutine) -> Optional[_core.can.Frame]:
+    frames = await batch
     return frames[0] if frames else None
 
 
-async def _arecv_many(self: Any, max: int = 1024, timeout: Optional[float] = None) -> list:  # noqa: A002
+def _arecv_many(self: Any, max: int = 1024, timeout: Optional[float] = None  # noqa: A002
+                ) -> "typing.Coroutine[typing.Any, typing.Any, list[motorbus._core.can.Frame]]":
     """``await bus.arecv_many(max=1024, timeout=None)``: the awaitable twin of
     ``recv_many()`` -- up to ``max`` frames, oldest first, as soon as there is
     one; [] after ``timeout``."""
-    return await _recv_batch(self, _check_count("Bus.arecv_many max", max),
-                             _check_timeout("Bus.arecv_many", timeout))
+    return _recv_batch(self, _check_count("Bus.arecv_many max", max), _check_timeout("Bus.arecv_many", timeout))
 
 
-async def _asend(self: Any, frame: _core.can.Frame, timeout: float = 1.0) -> None:
+def _asend(self: Any, frame: "motorbus._core.can.Frame", timeout: float = 1.0
+           ) -> "typing.Coroutine[typing.Any, typing.Any, None]":
     """``await bus.asend(frame, timeout=1.0)``: the awaitable twin of ``send()``.
 
     ``send()`` blocks while the medium is full (a virtual bus's transmit queue,
@@ -264,7 +270,10 @@ async def _asend(self: Any, frame: _core.can.Frame, timeout: float = 1.0) -> Non
     waiting and, while the medium stays full, offered again after a short
     sleep of the task (0.5 ms, doubling to 10 ms) until ``timeout``: then
     TimeoutError, as ``send()``.  A medium with room costs no sleep."""
-    limit = _check_timeout("Bus.asend", timeout)
+    return _send_co(self, frame, timeout, _check_timeout("Bus.asend", timeout))
+
+
+async def _send_co(self: Any, frame: _core.can.Frame, timeout: float, limit: Optional[float]) -> None:
     deadline = None if limit is None else time.monotonic() + limit
     pause = 0.0005
     while True:
@@ -374,13 +383,14 @@ class FrameStream:
                 f"{self.queued} queued>")
 
 
-def _frames(self: Any, filters: Any = None, queue: int = 1024, batch: int = 256) -> FrameStream:
+def _frames(self: Any, filters: Any = None, queue: int = 1024, batch: int = 256) -> "motorbus.bus.FrameStream":
     """``bus.frames(filters=None, queue=1024, batch=256)``: a :class:`FrameStream`
     of this bus (an async iterator of Frames with its own filters and bounded queue)."""
     return FrameStream(self, filters, queue, batch)
 
 
-def _aiter(self: Any) -> FrameStream:
+def _aiter(self: Any) -> "motorbus.bus.FrameStream":
+    """``async for frame in bus``: ``bus.frames()`` with its defaults."""
     return FrameStream(self)
 
 

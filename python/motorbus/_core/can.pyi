@@ -1,7 +1,8 @@
 from __future__ import annotations
 import collections.abc
+import motorbus._core.runtime
 import typing
-__all__: list[str] = ['Bus', 'BusCounters', 'ExternalBus', 'Frame', 'LogEntry', 'LogFormat', 'Recorder', 'SimulatedDevice', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'VirtualBus', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'play', 'read_log', 'slcan_encode', 'socketcan_unavailable_reason', 'wire_bits_worst_case']
+__all__: list[str] = ['AsyncReceiver', 'AsyncReceiverCounters', 'Bus', 'BusCounters', 'ExternalBus', 'Frame', 'LogEntry', 'LogFormat', 'Recorder', 'SimulatedDevice', 'SlcanBus', 'SlcanDecoder', 'SlcanDecoderCounters', 'SlcanEvent', 'SlcanEventKind', 'SlcanServer', 'SlcanServerStats', 'SlcanStats', 'SocketCanBus', 'SocketcandBus', 'SocketcandParserStats', 'SocketcandServer', 'SocketcandServerStats', 'VirtualBus', 'open_slcan', 'open_socketcan', 'open_socketcand', 'open_virtual', 'parse_candump_line', 'play', 'read_log', 'slcan_encode', 'socketcan_unavailable_reason', 'wire_bits_worst_case']
 class Frame:
     """
     A CAN frame. Invalid fields are refused at construction.
@@ -99,12 +100,53 @@ class Bus:
     """
     A CAN bus endpoint (open one with open_bus).
     """
+    def __aiter__(self) -> 'motorbus.bus.FrameStream':
+        """
+        ``async for frame in bus``: ``bus.frames()`` with its defaults.
+        """
     def __enter__(self) -> typing.Any:
         ...
     def __exit__(self, *args) -> None:
         ...
+    def _cancel_wait(self, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex) -> bool:
+        """
+        Withdraws a _recv_or_wait waiter: False when it already completed.
+        """
+    def _recv_or_wait(self, max: typing.SupportsInt | typing.SupportsIndex, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex) -> list[Frame]:
+        """
+        recv() for an event loop (Bus.arecv): up to max queued frames, or [] and a waiter completed with a list of Frames (or recv()'s error) under token.
+        """
+    def arecv(self, timeout: float | None = None) -> 'typing.Coroutine[typing.Any, typing.Any, typing.Optional[motorbus._core.can.Frame]]':
+        """
+        ``await bus.arecv(timeout=None)``: the awaitable twin of ``recv()`` -- the
+            next frame of the same queue, through the same filters (``set_filters``),
+            or None after ``timeout`` seconds (None: wait forever).  ClosedError /
+            LinkDown as ``recv()``.  No thread waits: the bus's receive thread
+            completes the wait on the loop's completion queue.
+        """
+    def arecv_many(self, max: int = 1024, timeout: float | None = None) -> 'typing.Coroutine[typing.Any, typing.Any, list[motorbus._core.can.Frame]]':
+        """
+        ``await bus.arecv_many(max=1024, timeout=None)``: the awaitable twin of
+            ``recv_many()`` -- up to ``max`` frames, oldest first, as soon as there is
+            one; [] after ``timeout``.
+        """
+    def asend(self, frame: 'motorbus._core.can.Frame', timeout: float = 1.0) -> 'typing.Coroutine[typing.Any, typing.Any, None]':
+        """
+        ``await bus.asend(frame, timeout=1.0)``: the awaitable twin of ``send()``.
+        
+            ``send()`` blocks while the medium is full (a virtual bus's transmit queue,
+            a socketcand server that stops reading); here the frame is offered without
+            waiting and, while the medium stays full, offered again after a short
+            sleep of the task (0.5 ms, doubling to 10 ms) until ``timeout``: then
+            TimeoutError, as ``send()``.  A medium with room costs no sleep.
+        """
     def close(self) -> None:
         ...
+    def frames(self, filters: typing.Any = None, queue: int = 1024, batch: int = 256) -> 'motorbus.bus.FrameStream':
+        """
+        ``bus.frames(filters=None, queue=1024, batch=256)``: a :class:`FrameStream`
+            of this bus (an async iterator of Frames with its own filters and bounded queue).
+        """
     def recv(self, timeout: typing.Any = None) -> Frame | None:
         ...
     def recv_many(self, max: typing.SupportsInt | typing.SupportsIndex = 1024, timeout: typing.Any = None) -> list[Frame]:
@@ -157,6 +199,55 @@ class ExternalBus(Bus):
     def feed(self, frame: Frame) -> None:
         ...
     def feed_parse_error(self) -> None:
+        ...
+class AsyncReceiverCounters:
+    """
+    A frame stream's counters, read-only.
+    """
+    def __repr__(self) -> str:
+        ...
+    @property
+    def overflows(self) -> int:
+        """
+        of those, dropped (the newest) with the queue full
+        """
+    @property
+    def received(self) -> int:
+        """
+        frames that passed the filters
+        """
+    @property
+    def wakeups(self) -> int:
+        """
+        completions pushed: one per burst the loop waited for
+        """
+class AsyncReceiver:
+    """
+    A bus's frames for an event loop (Bus.frames): its own subscription, filters and bounded queue.
+    """
+    def __init__(self, bus: Bus, filters: typing.Any = None, queue: typing.SupportsInt | typing.SupportsIndex = 1024) -> None:
+        ...
+    def close(self) -> None:
+        ...
+    def disarm(self) -> bool:
+        ...
+    def take(self, max: typing.SupportsInt | typing.SupportsIndex = 1024) -> list[Frame]:
+        ...
+    def take_or_arm(self, max: typing.SupportsInt | typing.SupportsIndex, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex) -> list[Frame]:
+        """
+        Up to max queued frames, or [] and armed: the next frames complete token as a list of Frames.
+        """
+    @property
+    def capacity(self) -> int:
+        ...
+    @property
+    def counters(self) -> AsyncReceiverCounters:
+        ...
+    @property
+    def ended(self) -> bool:
+        ...
+    @property
+    def queued(self) -> int:
         ...
 class LogEntry:
     """

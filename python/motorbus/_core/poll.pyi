@@ -1,5 +1,6 @@
 from __future__ import annotations
 import collections.abc
+import motorbus._core.runtime
 import numpy
 import numpy.typing
 import typing
@@ -103,6 +104,12 @@ class PollGroup:
     """
     def __init__(self, sources: collections.abc.Sequence[PollSource], period: typing.Any, capacity: typing.SupportsInt | typing.SupportsIndex = 65536, spin: typing.Any = 0.0, realtime: bool = False, priority: typing.SupportsInt | typing.SupportsIndex = 50, start_ns: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
+    def cancel_notify(self) -> bool:
+        ...
+    def notify_when(self, rows: typing.SupportsInt | typing.SupportsIndex, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex) -> bool:
+        """
+        For an event loop: False, and token completes (with the unread row count) once the ring holds rows unread rows or the thread ended; True when that is already so.
+        """
     def start(self) -> None:
         ...
     def stop(self) -> None:
