@@ -27,6 +27,7 @@ every vendor.  The vocabulary:
 from __future__ import annotations
 
 import abc
+import asyncio
 import dataclasses
 import enum
 import inspect
@@ -322,14 +323,17 @@ class _Move:
     """The move, jog or homing in progress: what was asked, in native units, and what
     must be put back when it ends (settings a ``velocity=`` changed for this move)."""
 
-    __slots__ = ("what", "target", "stopped_by", "restore", "judged")
+    __slots__ = ("what", "target", "stopped_by", "restore", "judged", "commanded")
 
     def __init__(self, what: str, target: Optional[float]) -> None:
         self.what = what
         self.target = target
         self.stopped_by: Optional[str] = None      # "stop()" / "quick_stop()" of this program
-        self.restore: list[Callable[[], None]] = []
+        self.restore: list[Callable[[], Any]] = []
         self.judged = False
+        # False while the command is being sent: a drive at rest then has not started
+        # this move yet, and a reading awaited meanwhile (another task) must not judge it.
+        self.commanded = False
 
 
 class Drive(abc.ABC):
@@ -778,16 +782,22 @@ class Drive(abc.ABC):
         self._last_move = MoveOutcome(what, None if target is None else self._units.to_user(target), None, "running")
         try:
             await _value(command())
+        except asyncio.CancelledError:
+            # Cancelled while the command was on its way: the drive may have taken it, so
+            # the move stays on record for the cancellation's stop to judge (motorbus.aio).
+            move.commanded = True
+            raise
         except BaseException:
             await self._restore(move)
             self._move, self._last_move = None, None
             raise
+        move.commanded = True
 
     async def _settle(self) -> None:
         """Judges an earlier move nobody waited for, if it has ended (its outcome goes to
         ``status.last_move``, not raised), and puts its settings back."""
         move = self._move
-        if move is not None and not move.judged:
+        if move is not None and not move.judged and move.commanded:
             try:
                 if move.what == "home" or not await _value(self._is_idle()):
                     await self._restore(move)     # superseded; a homing is not judged by rest alone
@@ -956,7 +966,7 @@ class Drive(abc.ABC):
 
     async def _settle_if_at_rest(self) -> None:
         move = self._move
-        if move is not None and not move.judged and move.what != "home":
+        if move is not None and not move.judged and move.commanded and move.what != "home":
             try:
                 if await _value(self._is_idle()):
                     await self._judge(move, raise_error=False)

@@ -176,6 +176,21 @@ async def test_cancelling_an_awaited_move_stops_the_motor(axis, kind, rig):
     assert await axis.position() == pytest.approx(1.0, abs=kind.scale)
 
 
+async def test_readbacks_while_a_move_starts_do_not_judge_it(axis, kind):
+    """Another task reading the status while the move's command is still on its way sees
+    a drive at rest that has not started yet: that must not end the move as interrupted."""
+    kind.setup(axis.sync)
+    await axis.enable()
+    move = asyncio.create_task(axis.move_to(5.0, timeout=30))
+    seen = set()
+    while not move.done():
+        seen.add((await axis.status()).last_move.state if (await axis.status()).last_move else None)
+    await move
+    assert seen <= {None, "running", "done"}, seen
+    assert (await axis.status()).last_move.state == "done"
+    assert await axis.position() == pytest.approx(5.0, abs=kind.scale)
+
+
 async def test_stop_on_cancel_false_leaves_the_motor_going(axis, kind, rig):
     kind.setup(axis.sync)
     await axis.enable()
