@@ -145,6 +145,7 @@ void SdoClientMachine::abandon(std::uint32_t code, Outbox& out) {
     if (status_ == Status::Running) {
         out.push_back(abort_transfer(mux_, code));
         ++counters_.aborts_sent;
+        skip_stale_ = true;
     }
     reset();
 }
@@ -174,14 +175,17 @@ bool SdoClientMachine::check_mux(std::span<const std::uint8_t> p, Outbox& out) {
 // abort) naming another object than ours: the response to another client on
 // the same COB-IDs (two processes asking one node).  Not inside a block
 // upload's sub-block, where byte 0 is a sequence number, not a specifier.
-bool SdoClientMachine::foreign(std::span<const std::uint8_t> p) const {
-    if (phase_ == Phase::BlkUpSub || p.size() < 4) return false;
+bool SdoClientMachine::names_object(std::span<const std::uint8_t> p) {
+    if (p.size() < 4) return false;
     const std::uint8_t cs = p[0];
-    const bool carries_mux = scs_of(cs) == Scs::InitiateUpload || scs_of(cs) == Scs::InitiateDownload ||
-                             scs_of(cs) == Scs::Abort ||
-                             (cs & 0xE1) == 0xC0 ||  // block upload initiate response (ss 0)
-                             (cs & 0xE3) == 0xA0;    // block download initiate response (ss 0)
-    if (!carries_mux) return false;
+    return scs_of(cs) == Scs::InitiateUpload || scs_of(cs) == Scs::InitiateDownload ||
+           scs_of(cs) == Scs::Abort ||
+           (cs & 0xE1) == 0xC0 ||  // block upload initiate response (ss 0)
+           (cs & 0xE3) == 0xA0;    // block download initiate response (ss 0)
+}
+
+bool SdoClientMachine::foreign(std::span<const std::uint8_t> p) const {
+    if (phase_ == Phase::BlkUpSub || !names_object(p)) return false;
     const auto m = multiplexer_of(p);
     return m && *m != mux_;
 }
@@ -197,6 +201,19 @@ void SdoClientMachine::on_frame(std::span<const std::uint8_t> p, Nanos now, Outb
         // timeout, so a busy neighbour cannot keep this transfer waiting forever.
         ++counters_.foreign_responses;
         return;
+    }
+    if (skip_stale_) {
+        // The transfer before this one was abandoned (cancelled) mid-way: the
+        // server's answer to its last request may still be on the way.  Until
+        // our initiate is answered, a frame that names no object (a segment, a
+        // sub-block) is that answer: ignored, not a protocol error.
+        const bool initiating = phase_ == Phase::UpInitiate || phase_ == Phase::DnInitiate ||
+                                phase_ == Phase::BlkUpInitiate || phase_ == Phase::BlkDnInitiate;
+        if (initiating && !names_object(p)) {
+            ++counters_.ignored_frames;
+            return;
+        }
+        skip_stale_ = false;
     }
     const bool in_segments = phase_ == Phase::BlkUpSub;
     if ((in_segments && p[0] == 0x80) || (!in_segments && scs_of(p[0]) == Scs::Abort))

@@ -135,7 +135,9 @@ public:
     // Forget the transfer (after Done/Failed); the machine becomes Idle.
     void reset();
     // Give up a Running transfer: the server is told (abort `code` with the
-    // multiplexer, appended to `out`) and the machine becomes Idle.
+    // multiplexer, appended to `out`) and the machine becomes Idle.  Until the
+    // next transfer's initiate is answered, frames naming no object (the
+    // abandoned transfer's last answer, still in flight) are ignored.
     void abandon(std::uint32_t code, Outbox& out);
 
     Status status() const { return status_; }
@@ -163,6 +165,7 @@ private:
     void touch(Nanos now);
     bool check_mux(std::span<const std::uint8_t> p, Outbox& out);
     bool foreign(std::span<const std::uint8_t> p) const;
+    static bool names_object(std::span<const std::uint8_t> p);  // an initiate response or an abort
     void finish();
     void send_next_download_segment(Outbox& out);
     void send_block_download_subblock(Outbox& out);
@@ -199,6 +202,7 @@ private:
     Nanos sub_deadline_ = kNoDeadline;
     Nanos started_ = 0;
     std::exception_ptr error_;
+    bool skip_stale_ = false;  // abandon(): not cleared by reset(), by the next answer naming an object
 };
 
 struct SdoClientOptions {

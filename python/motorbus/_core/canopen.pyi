@@ -5,7 +5,7 @@ import motorbus._core.can
 import motorbus._core.poll
 import motorbus._core.runtime
 import typing
-__all__: list[str] = ['ABORT_CODES', 'Cia402Device', 'Cia402Host', 'DataType', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'JitterStats', 'LocalNode', 'LocalNodeCounters', 'NmtCommand', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoCaptureSource', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'SdoClient', 'SdoClientCounters', 'SdoServerCounters', 'SyncProducer', 'Variable', 'abort_text', 'cia402_decode_statusword', 'cia402_next_step', 'decode_value', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'nmt_decode', 'nmt_encode', 'pdo_read_config', 'pdo_write_config', 'scan_network', 'sdo_poll_source', 'sync_encode', 'time_decode', 'time_encode']
+__all__: list[str] = ['ABORT_CODES', 'Cia402Device', 'Cia402Host', 'DataType', 'EmcyConsumer', 'EmcyError', 'EmcyProducer', 'HeartbeatConsumer', 'HeartbeatProducer', 'HeartbeatService', 'JitterStats', 'LocalNode', 'LocalNodeCounters', 'NmtCommand', 'NmtEventWait', 'NmtMaster', 'NodeHealth', 'NodeInfo', 'ObjectDictionary', 'PdoCaptureSource', 'PdoConfig', 'PdoCounters', 'PdoLayout', 'PdoProcedure', 'PdoReceiver', 'PdoSender', 'PdoService', 'SdoClient', 'SdoClientCounters', 'SdoServerCounters', 'SyncProducer', 'Variable', 'abort_text', 'cia402_decode_statusword', 'cia402_next_step', 'decode_value', 'emcy_code_text', 'emcy_decode', 'emcy_encode', 'encode_value', 'heartbeat_decode', 'heartbeat_encode', 'nmt_decode', 'nmt_encode', 'nmt_wait_async', 'pdo_read_config', 'pdo_write_config', 'scan_network', 'sdo_poll_source', 'sync_encode', 'time_decode', 'time_encode']
 class DataType:
     """
     CiA 301 basic data types (codes as in EDS files).
@@ -368,8 +368,24 @@ class SdoClient:
         """
         block_crc: block transfers offer and require CRC-16 (a server answering without it is refused, abort 0x05040004); False for a server without CRC, whose block data is then unchecked.
         """
+    def cancel_async(self, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex) -> bool:
+        """
+        Withdraws an async transfer (the running one is aborted on the wire); False if already done.
+        """
+    def check_deadline(self) -> typing.Any:
+        """
+        Fires the running async transfer's due timers; the next deadline (monotonic_ns) or None.
+        """
+    def close(self) -> None:
+        """
+        Fails pending async transfers with ClosedError; later transfers raise ClosedError.
+        """
     def download(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, data: typing.Any, block: bool = False, segmented: bool = False) -> None:
         ...
+    def download_async(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, data: typing.Any, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex, block: bool = False, segmented: bool = False) -> None:
+        """
+        Starts a download; completes `token` on `completions` with None.
+        """
     def read_domain(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex = 0, block: bool = False) -> bytes:
         ...
     def read_f32(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex = 0) -> float:
@@ -396,6 +412,10 @@ class SdoClient:
         ...
     def upload(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex = 0, block: bool = False) -> bytes:
         ...
+    def upload_async(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex, block: bool = False) -> None:
+        """
+        Starts an upload; completes `token` on `completions` with its bytes.
+        """
     def write_domain(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, data: typing.Any, block: bool = False) -> None:
         ...
     def write_f32(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsFloat | typing.SupportsIndex) -> None:
@@ -419,6 +439,12 @@ class SdoClient:
     def write_u64(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     def write_u8(self, index: typing.SupportsInt | typing.SupportsIndex, subindex: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def async_pending(self) -> int:
+        ...
+    @property
+    def closed(self) -> bool:
         ...
     @property
     def counters(self) -> SdoClientCounters:
@@ -777,6 +803,12 @@ class NmtMaster:
     @property
     def foreign_commands_ignored(self) -> int:
         ...
+class NmtEventWait:
+    """
+    An awaited NMT event of one node (motorbus.canopen.nmt's *_async waits).
+    """
+    def cancel(self) -> None:
+        ...
 class HeartbeatConsumer:
     """
     Per-node heartbeat supervision: started / lost / back / reset / state events.
@@ -1124,6 +1156,10 @@ def nmt_encode(command: NmtCommand, node: typing.SupportsInt | typing.SupportsIn
 @typing.overload
 def nmt_encode(command: typing.SupportsInt | typing.SupportsIndex, node: typing.SupportsInt | typing.SupportsIndex) -> motorbus._core.can.Frame:
     ...
+def nmt_wait_async(bus: motorbus._core.can.Bus, node: typing.SupportsInt | typing.SupportsIndex, want: typing.SupportsInt | typing.SupportsIndex, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex) -> NmtEventWait:
+    """
+    Completes `token` with the state byte of node's next boot-up (want 0), state `want`, or any heartbeat (want -1); cancel() the returned waiter when no longer wanted.
+    """
 def pdo_read_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex) -> PdoConfig:
     ...
 def pdo_write_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex, cob_id: typing.SupportsInt | typing.SupportsIndex | None = None, enabled: bool = True, transmission_type: typing.SupportsInt | typing.SupportsIndex | None = None, inhibit_100us: typing.SupportsInt | typing.SupportsIndex | None = None, event_timer_ms: typing.SupportsInt | typing.SupportsIndex | None = None, sync_start: typing.SupportsInt | typing.SupportsIndex | None = None, mapping: collections.abc.Iterable | None = None, procedure: typing.Any = 'cia301') -> None:

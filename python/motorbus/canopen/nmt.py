@@ -8,14 +8,22 @@
 
 Heartbeat supervision is in motorbus.canopen.heartbeat.
 
+Awaitable waits (any loop, no thread; the bus's receive thread completes them
+through the loop's completion queue):
+
+    await nmt.wait_for_state_async(5, "OPERATIONAL", timeout=1.0)   # True / False
+    await node.nmt.wait_for_bootup_async(10.0)      # motorbus.TimeoutError if none
+    await node.nmt.wait_for_heartbeat_async(10.0)   # the state it reports
+
 States are the strings INITIALISING, STOPPED, OPERATIONAL, PRE-OPERATIONAL and
 UNKNOWN (nothing heard, or a byte outside that set: never treated as running).
 """
 from __future__ import annotations
 
+import asyncio
 from typing import Callable, Optional
 
-from .. import _core
+from .. import _core, faces
 
 __all__ = ["NmtCommand", "NmtMaster", "NMT_STATES", "nmt_encode", "nmt_decode"]
 
@@ -23,12 +31,47 @@ NMT_STATES = ("INITIALISING", "STOPPED", "OPERATIONAL", "PRE-OPERATIONAL", "UNKN
 
 from .._core.canopen import nmt_encode, nmt_decode, NmtCommand  # noqa: E402,F401
 
+_STATE_NAMES = {0x00: "INITIALISING", 0x04: "STOPPED", 0x05: "OPERATIONAL", 0x7F: "PRE-OPERATIONAL"}
+_STATE_BYTES = {name: byte for byte, name in _STATE_NAMES.items()}
+_ANY_HEARTBEAT, _BOOT_UP = -1, 0
+
+
+def _state_byte(state: str) -> int:
+    key = str(state).strip().upper().replace("_", "-").replace(" ", "-")
+    if key not in _STATE_BYTES:
+        raise _core.InvalidArgument(f"NMT state {state!r}: one of INITIALISING, STOPPED, OPERATIONAL, PRE-OPERATIONAL")
+    return _STATE_BYTES[key]
+
+
+class _NmtEvent:
+    """One awaited NMT event: subscribed on creation (before any state check, so
+    nothing is missed in between), awaited with a timeout, unsubscribed after."""
+
+    def __init__(self, bus: _core.can.Bus, node: int, want: int) -> None:
+        self.bridge = faces.bridge_for()
+        self.token, self.future = self.bridge.expect()
+        self.waiter = _core.canopen.nmt_wait_async(bus, node, want, self.bridge.completions, self.token)
+
+    async def state(self, timeout: Optional[float]) -> Optional[str]:
+        """The state the event reported; None after ``timeout`` s (None = no limit)."""
+        try:
+            return _STATE_NAMES.get(await asyncio.wait_for(self.future, timeout), "UNKNOWN")
+        except asyncio.TimeoutError:
+            return None
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        self.waiter.cancel()
+        self.bridge.forget(self.token)
+
 
 class NmtMaster:
     """Commands nodes (node 0 = all) and tracks their states from heartbeats."""
 
     def __init__(self, bus: _core.can.Bus, own_node_id: Optional[int] = None) -> None:
         self._m = _core.canopen.NmtMaster(bus, own_node_id)
+        self.bus = bus
         self._cb: Optional[Callable[[int, str, str], None]] = None
 
     def send(self, command: "NmtCommand | int", node: int = 0) -> None:
@@ -71,6 +114,24 @@ class NmtMaster:
     def wait_for_heartbeat(self, node: int, timeout: float = 1.0) -> Optional[str]:
         """State reported by the next heartbeat or boot-up of ``node``; None on timeout."""
         return self._m.wait_for_heartbeat(node, timeout)
+
+    # ---- awaitable waits: the same answers without blocking the loop ----
+    async def wait_for_state_async(self, node: int, state: str, timeout: float = 1.0) -> bool:
+        """Awaitable :meth:`wait_for_state`: True once ``node`` reports ``state`` (at
+        once if it last did), False after ``timeout``."""
+        event = _NmtEvent(self.bus, node, _state_byte(state))
+        if self._m.state(node) == _STATE_NAMES[_state_byte(state)]:
+            event.close()
+            return True
+        return await event.state(timeout) is not None
+
+    async def wait_for_boot_async(self, node: int, timeout: float = 1.0) -> bool:
+        """Awaitable :meth:`wait_for_boot`: True when the node's next boot-up comes."""
+        return await _NmtEvent(self.bus, node, _BOOT_UP).state(timeout) is not None
+
+    async def wait_for_heartbeat_async(self, node: int, timeout: float = 1.0) -> Optional[str]:
+        """Awaitable :meth:`wait_for_heartbeat`: the state of the next heartbeat or boot-up; None on timeout."""
+        return await _NmtEvent(self.bus, node, _ANY_HEARTBEAT).state(timeout)
 
     @property
     def on_state_change(self) -> Optional[Callable[[int, str, str], None]]:
@@ -125,3 +186,20 @@ class NodeNmt:
         if state is None:
             raise _core.TimeoutError(f"node {self.node_id}: no heartbeat within {timeout} s")
         return state
+
+    async def wait_for_bootup_async(self, timeout: float = 10.0) -> None:
+        """Awaitable :meth:`wait_for_bootup` (motorbus.TimeoutError if none comes)."""
+        if not await self._m.wait_for_boot_async(self.node_id, timeout):
+            raise _core.TimeoutError(f"node {self.node_id}: no boot-up within {timeout} s")
+
+    async def wait_for_heartbeat_async(self, timeout: float = 10.0) -> str:
+        """Awaitable :meth:`wait_for_heartbeat` (motorbus.TimeoutError if none comes)."""
+        state = await self._m.wait_for_heartbeat_async(self.node_id, timeout)
+        if state is None:
+            raise _core.TimeoutError(f"node {self.node_id}: no heartbeat within {timeout} s")
+        return state
+
+    async def wait_for_state_async(self, state: str, timeout: float = 10.0) -> None:
+        """Waits until the node reports ``state`` (motorbus.TimeoutError if it does not)."""
+        if not await self._m.wait_for_state_async(self.node_id, state, timeout):
+            raise _core.TimeoutError(f"node {self.node_id}: not {state} within {timeout} s")

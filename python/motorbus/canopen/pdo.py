@@ -14,10 +14,11 @@ object with ``upload(index, sub) -> bytes`` and ``download(index, sub, data)``.
 """
 from __future__ import annotations
 
+import functools
 import threading
 from typing import Callable, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
-from .. import _core
+from .. import _core, faces
 
 __all__ = ["PdoMap", "pack", "unpack", "configure_pdo", "read_pdo_config", "PdoConfig", "PdoCounters",
            "PdoReceiver", "PdoService", "PdoSender", "PdoChannel", "PdoChannels"]
@@ -144,6 +145,28 @@ class PdoChannel:
         with self._lock:  # a new mapping or COB-ID: receivers are rebuilt on demand
             self._rx = self._tx = None
         return self.read()
+
+    # Awaitable twins.  The configuration sequence (read_pdo/write_pdo: 6-20 SDO
+    # transfers and the CiA 301 disable-map-enable order) is C++ logic over a
+    # blocking SDO access; awaited, it runs whole on the node's link worker
+    # (faces.NativeIo: one thread per link while busy, gone after an idle second),
+    # so it is written once and never copied into Python.  Its transfers queue on
+    # the node's SDO channel with the awaited ones, never interleaved.
+    async def read_async(self) -> PdoConfig:
+        """Awaitable :meth:`read`."""
+        client = self._node.sdo.client
+        self.config = await faces.NativeIo(client).do(
+            functools.partial(read_pdo_config, client, self._node.id, **self._kw()))
+        return self.config
+
+    async def configure_async(self, **kwargs) -> PdoConfig:
+        """Awaitable :meth:`configure` (same arguments); the configuration read back."""
+        client = self._node.sdo.client
+        await faces.NativeIo(client).do(
+            functools.partial(configure_pdo, client, self._node.id, **self._kw(), **kwargs))
+        with self._lock:
+            self._rx = self._tx = None
+        return await self.read_async()
 
     @property
     def cob_id(self) -> int:

@@ -5,24 +5,105 @@ objects of a remote node addressed as the `canopen` package does.
     node.sdo["Identity object"]["Vendor-ID"].raw     # by name (the node has an OD / EDS)
     node.sdo["Device name"].value           # typed: int, float, bool, str or bytes per the data type
     node.sdo[0x2000][0].write(1234, size=4) # no OD: the size of an integer must be given
+
+The awaitable face, on the same objects (any loop; no thread per transfer):
+
+    await node.sdo["Device name"].get()     # as .value
+    await node.sdo["Controlword"].set(0x0F) # as .value = 0x0F
+    await node.sdo[0x1018][1].get_raw()     # as .raw;  set_raw(v, size=) as write()
+    await node.sdo.upload_async(0x1F50, 1, block=True)   # any size, as upload()
+    await node.sdo.download_async(0x1F50, 1, data)       # as download()
+
+Each is the blocking call's logic run awaited (``.raw`` is ``faces.run(get_raw())``):
+one implementation of the typing, two faces.  The transfer itself runs in C++ on
+the bus's receive thread and completes through the loop's completion queue
+(``faces.LoopBridge``); the loop arms the response deadline (``call_later`` ->
+``SdoClient.check_deadline()``).  Cancelling the await withdraws the transfer (a
+running one is aborted on the wire, 0x08000000) and leaves the channel usable.
 """
 from __future__ import annotations
 
-from typing import Iterator, Optional, Union
+import asyncio
+from typing import Any, Callable, Iterator, Optional, Union
 
-from .. import _core
+from .. import _core, faces
 from .._core import SdoAbortError, SdoProtocolError, SdoTimeout  # noqa: F401
 from .._core.canopen import ABORT_CODES, SdoClient, SdoClientCounters, abort_text  # noqa: F401
 from .od import NotFound, ObjectDictionary, Variable
 
 __all__ = ["SdoClient", "SdoClientCounters", "SdoAbortError", "SdoTimeout", "SdoProtocolError", "abort_text",
-           "ABORT_CODES", "SdoVariables", "SdoObject", "SdoVariable"]
+           "ABORT_CODES", "SdoVariables", "SdoObject", "SdoVariable", "upload_async", "download_async"]
 
 # CiA 301 types whose value is an integer (BOOLEAN, INTEGERn, UNSIGNEDn):
 # `.raw` gives and takes an int for them, bytes for every other type.
 _INTEGER_TYPES = frozenset({0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x10}) | frozenset(range(0x12, 0x1C))
 
 Key = Union[int, str]
+
+_NS = 1e-9
+# The longest the loop sleeps before asking the client again when it reports no
+# deadline (the transfer is queued behind a blocking one) or an infinite timeout.
+_RECHECK_S = 1.0
+
+
+class _Deadline:
+    """The loop's timer for one awaited transfer: at the response deadline it calls
+    ``client.check_deadline()`` (which times out the running transfer, sending the
+    abort) and re-arms at the next deadline the client reports until the transfer
+    is done.  Timers live in the loop's heap: no thread per transfer."""
+
+    __slots__ = ("client", "future", "loop", "handle")
+
+    def __init__(self, client: SdoClient, future: asyncio.Future, loop: asyncio.AbstractEventLoop,
+                 delay: float) -> None:
+        self.client, self.future, self.loop = client, future, loop
+        self.handle = loop.call_later(min(delay, _RECHECK_S), self._fire)
+
+    def _fire(self) -> None:
+        if self.future.done():
+            return
+        nxt = self.client.check_deadline()
+        if self.future.done():
+            return
+        delay = _RECHECK_S if nxt is None else (nxt - _core.runtime.monotonic_ns()) * _NS
+        self.handle = self.loop.call_later(min(max(delay, 0.0), _RECHECK_S), self._fire)
+
+
+async def _awaited(client: SdoClient, start: Callable[[Any, int], None]) -> Any:
+    """Starts a completion-based transfer (``start(completions, token)``) and awaits its completion."""
+    bridge = faces.bridge_for()
+    token, future = bridge.expect()
+    completions = bridge.completions
+    try:
+        start(completions, token)
+    except BaseException:
+        bridge.forget(token)
+        raise
+    deadline = _Deadline(client, future, bridge.loop, client.timeout)
+    try:
+        return await future
+    except asyncio.CancelledError:
+        # Withdrawn: a queued transfer is dropped, a running one aborted on the
+        # wire, so the next transfer on this channel starts at once.
+        bridge.forget(token)
+        client.cancel_async(completions, token)
+        raise
+    finally:
+        deadline.handle.cancel()
+
+
+async def _upload(client: SdoClient, index: int, subindex: int, block: bool = False) -> bytes:
+    if faces.blocking():
+        return client.upload(index, subindex, block)
+    return await _awaited(client, lambda done, token: client.upload_async(index, subindex, done, token, block))
+
+
+async def _download(client: SdoClient, index: int, subindex: int, data: bytes, block: bool = False,
+                    segmented: bool = False) -> None:
+    if faces.blocking():
+        return client.download(index, subindex, data, block, segmented)
+    await _awaited(client, lambda done, token: client.download_async(index, subindex, data, done, token, block,
+                                                                      segmented))
 
 
 class SdoVariable:
@@ -48,43 +129,63 @@ class SdoVariable:
         """The object's bytes as uploaded."""
         return self._client.upload(self.index, self.subindex)
 
+    def _encode_raw(self, value: Union[int, bytes, bytearray], size: Optional[int], signed: bool) -> bytes:
+        if isinstance(value, (bytes, bytearray, memoryview)):
+            return bytes(value)
+        if size is not None:
+            try:
+                return int(value).to_bytes(size, "little", signed=signed)
+            except OverflowError:
+                raise _core.InvalidArgument(f"{self.name}: {value} does not fit {size} bytes") from None
+        if self._is_integer():
+            return self.od.encode(int(value))
+        raise _core.InvalidArgument(
+            f"{self.name}: no integer data type known for {value!r}: pass bytes or write(value, size=)")
+
     def write(self, value: Union[int, bytes, bytearray], size: Optional[int] = None, signed: bool = False) -> None:
         """Download bytes, or an int as ``size`` little-endian bytes (``size`` is
         needed when the data type is not known from a dictionary)."""
-        if isinstance(value, (bytes, bytearray, memoryview)):
-            data = bytes(value)
-        elif size is not None:
-            try:
-                data = int(value).to_bytes(size, "little", signed=signed)
-            except OverflowError:
-                raise _core.InvalidArgument(f"{self.name}: {value} does not fit {size} bytes") from None
-        elif self._is_integer():
-            data = self.od.encode(int(value))
-        else:
-            raise _core.InvalidArgument(
-                f"{self.name}: no integer data type known for {value!r}: pass bytes or write(value, size=)")
-        self._client.download(self.index, self.subindex, data)
+        faces.run(self.set_raw(value, size, signed))
 
-    @property
-    def raw(self) -> Union[int, bytes]:
-        """The int for integer types (signed per the type), else the bytes; bytes without an OD."""
-        data = self.read()
+    # ---- the logic, once, as coroutines: awaited directly, or run by faces.run ----
+    async def get_raw(self) -> Union[int, bytes]:
+        """Awaitable ``.raw``: the int for integer types, else the bytes."""
+        data = await _upload(self._client, self.index, self.subindex)
         if self._is_integer():
             return int(self.od.decode(data))
         return data
 
+    async def set_raw(self, value: Union[int, bytes, bytearray], size: Optional[int] = None,
+                      signed: bool = False) -> None:
+        """Awaitable ``write(value, size, signed)`` (``.raw = value``)."""
+        await _download(self._client, self.index, self.subindex, self._encode_raw(value, size, signed))
+
+    async def get(self):
+        """Awaitable ``.value``: typed by the OD data type."""
+        od = self._typed("read")
+        return od.decode(await _upload(self._client, self.index, self.subindex))
+
+    async def set(self, v) -> None:
+        """Awaitable ``.value = v``."""
+        await _download(self._client, self.index, self.subindex, self._typed("write").encode(v))
+
+    @property
+    def raw(self) -> Union[int, bytes]:
+        """The int for integer types (signed per the type), else the bytes; bytes without an OD."""
+        return faces.run(self.get_raw())
+
     @raw.setter
     def raw(self, value: Union[int, bytes]) -> None:
-        self.write(value)
+        faces.run(self.set_raw(value))
 
     @property
     def value(self):
         """Typed by the OD data type: int (signed or not), float, bool, str or bytes."""
-        return self._typed("read").decode(self.read())
+        return faces.run(self.get())
 
     @value.setter
     def value(self, v) -> None:
-        self._client.download(self.index, self.subindex, self._typed("write").encode(v))
+        faces.run(self.set(v))
 
     def _typed(self, what: str) -> Variable:
         """The dictionary entry whose C++ codec gives and takes the value."""
@@ -160,6 +261,19 @@ class SdoObject:
     def write(self, value, size: Optional[int] = None, signed: bool = False) -> None:
         self._var().write(value, size, signed)
 
+    # Awaitable twins (see SdoVariable): sub-index 0 of a VAR object.
+    async def get(self):
+        return await self._var().get()
+
+    async def set(self, v) -> None:
+        await self._var().set(v)
+
+    async def get_raw(self):
+        return await self._var().get_raw()
+
+    async def set_raw(self, value, size: Optional[int] = None, signed: bool = False) -> None:
+        await self._var().set_raw(value, size, signed)
+
 
 class SdoVariables:
     """``node.sdo``: the objects of a remote node over one SdoClient (one client
@@ -201,6 +315,15 @@ class SdoVariables:
     def download(self, index: int, subindex: int, data: bytes, block: bool = False, segmented: bool = False) -> None:
         self.client.download(index, subindex, data, block, segmented)
 
+    async def upload_async(self, index: int, subindex: int = 0, block: bool = False) -> bytes:
+        """Awaitable ``upload``: any size (expedited, segmented, or block with ``block=True``)."""
+        return await _upload(self.client, index, subindex, block)
+
+    async def download_async(self, index: int, subindex: int, data: bytes, block: bool = False,
+                             segmented: bool = False) -> None:
+        """Awaitable ``download``."""
+        await _download(self.client, index, subindex, bytes(data), block, segmented)
+
     @property
     def timeout(self) -> float:
         return self.client.timeout
@@ -208,3 +331,15 @@ class SdoVariables:
     @timeout.setter
     def timeout(self, t: float) -> None:
         self.client.timeout = t
+
+
+async def upload_async(client: SdoClient, index: int, subindex: int = 0, block: bool = False) -> bytes:
+    """``await upload_async(client, ...)``: ``client.upload`` awaited, for code that
+    holds a bare SdoClient (no node).  Under ``faces.run`` it is the blocking call."""
+    return await _upload(client, index, subindex, block)
+
+
+async def download_async(client: SdoClient, index: int, subindex: int, data: bytes, block: bool = False,
+                         segmented: bool = False) -> None:
+    """``client.download`` awaited (see :func:`upload_async`)."""
+    await _download(client, index, subindex, bytes(data), block, segmented)

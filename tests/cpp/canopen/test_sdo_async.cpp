@@ -263,6 +263,40 @@ TEST_F(AsyncFixture, CancelledTransferLeavesTheChannelUsable) {
     EXPECT_FALSE(w.got.count(1));
 }
 
+TEST_F(AsyncFixture, AfterACancelTheAbandonedTransfersLastAnswerIsIgnored) {
+    // A hand-played server on node 9: the answer to the cancelled transfer's
+    // segment request arrives after the next transfer's initiate went out.
+    sdo = std::make_unique<SdoClient>(*host, 9, SdoClientOptions{.timeout = 2s});
+    auto answer = [&](const std::string& h) {
+        auto b = test::H(h);
+        dev->send(can::Frame::make(0x589, std::span<const std::uint8_t>(b)));
+    };
+    auto sent = [&](std::size_t n) {
+        for (int i = 0; i < 2000 && requests(0x609).size() < n; ++i) std::this_thread::sleep_for(1ms);
+        return requests(0x609);
+    };
+    sdo->upload_async(0x2201, 0, TransferMode::Auto, w.done, 1);
+    sent(1);
+    answer("41 01 22 00 20 00 00 00");  // segmented, 32 bytes
+    EXPECT_EQ(sent(2)[1], "60 00 00 00 00 00 00 00");
+    EXPECT_TRUE(sdo->cancel(w.done, 1));
+    sdo->upload_async(0x1000, 0, TransferMode::Auto, w.done, 2);
+    auto r = sent(4);
+    EXPECT_EQ(r[2], "80 01 22 00 00 00 00 08");
+    EXPECT_EQ(r[3], "40 00 10 00 00 00 00 00");
+    answer("00 41 42 43 44 45 46 47");  // the stale segment
+    answer("43 00 10 00 92 01 02 00");
+    ASSERT_TRUE(w.wait_for(1, {sdo.get()}));
+    EXPECT_EQ(w.bytes(2), le32(0x00020192));
+    EXPECT_EQ(sdo->counters().ignored_frames, 1u);
+    // Strict again afterwards: a segment answering an initiate is a protocol error.
+    sdo->upload_async(0x1000, 0, TransferMode::Auto, w.done, 3);
+    sent(5);
+    answer("00 41 42 43 44 45 46 47");
+    ASSERT_TRUE(w.wait_for(2, {sdo.get()}));
+    w.error<SdoProtocolError>(3);
+}
+
 TEST_F(AsyncFixture, CloseFailsEveryPendingTransferWithClosedError) {
     sdo = std::make_unique<SdoClient>(*host, 9, SdoClientOptions{.timeout = 5s});
     for (std::uint64_t t = 1; t <= 5; ++t) sdo->upload_async(0x1000, 0, TransferMode::Auto, w.done, t);
