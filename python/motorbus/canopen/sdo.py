@@ -46,32 +46,77 @@ _NS = 1e-9
 _RECHECK_S = 1.0
 
 
-class _Deadline:
-    """The loop's timer for one awaited transfer: at the response deadline it calls
-    ``client.check_deadline()`` (which times out the running transfer, sending the
-    abort) and re-arms at the next deadline the client reports until the transfer
-    is done.  Timers live in the loop's heap: no thread per transfer."""
+class _Deadlines:
+    """The response deadlines of one loop's awaited transfers: one loop timer, armed
+    at the earliest deadline, that calls ``check_deadline()`` of every client with a
+    transfer awaited (which times the running one out, sending the abort) and
+    re-arms at the nearest deadline they report.  No thread, and no timer per
+    transfer: a read costs a dict update, not a timer heap push and cancel."""
 
-    __slots__ = ("client", "future", "loop", "handle")
+    __slots__ = ("loop", "pending", "handle", "when")
 
-    def __init__(self, client: SdoClient, future: asyncio.Future, loop: asyncio.AbstractEventLoop,
-                 delay: float) -> None:
-        self.client, self.future, self.loop = client, future, loop
-        self.handle = loop.call_later(min(delay, _RECHECK_S), self._fire)
+    def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
+        self.loop = loop
+        self.pending: dict = {}            # client -> awaited transfers not completed
+        self.handle: Optional[asyncio.TimerHandle] = None
+        self.when = float("inf")           # loop time the timer fires
+
+    def add(self, client: SdoClient) -> None:
+        n = self.pending.get(client, 0)
+        self.pending[client] = n + 1
+        if n == 0:                          # this client's deadline may come before the armed one
+            at = self.loop.time() + min(client.timeout, _RECHECK_S)
+            if at < self.when:
+                self._arm(at)
+
+    def done(self, client: SdoClient) -> None:
+        n = self.pending[client] - 1
+        if n:
+            self.pending[client] = n
+        else:
+            del self.pending[client]       # the timer may fire for nobody: cheaper than cancelling it
+
+    def _arm(self, at: float) -> None:
+        if self.handle is not None:
+            self.handle.cancel()
+        self.when = at
+        self.handle = self.loop.call_at(at, self._fire)
 
     def _fire(self) -> None:
-        if self.future.done():
+        self.handle, self.when = None, float("inf")
+        if not self.pending:
             return
-        nxt = self.client.check_deadline()
-        if self.future.done():
-            return
-        delay = _RECHECK_S if nxt is None else (nxt - _core.runtime.monotonic_ns()) * _NS
-        self.handle = self.loop.call_later(min(max(delay, 0.0), _RECHECK_S), self._fire)
+        nearest = _RECHECK_S
+        now = _core.runtime.monotonic_ns()
+        for client in list(self.pending):
+            nxt = client.check_deadline()
+            if nxt is not None:
+                nearest = min(nearest, max(0.0, (nxt - now) * _NS))
+        self._arm(self.loop.time() + nearest)
+
+
+# The running loop's bridge and deadlines, looked up once per loop rather than per
+# transfer (a loop that is running is never closed, so its bridge is current).
+_last: tuple = (None, None, None)
+
+
+def _loop_state() -> tuple:
+    global _last
+    loop = asyncio.get_running_loop()
+    last = _last
+    if last[0] is loop:
+        return last
+    bridge = faces.bridge_for(loop)
+    deadlines = getattr(bridge, "_sdo_deadlines", None)
+    if deadlines is None:
+        deadlines = bridge._sdo_deadlines = _Deadlines(loop)
+    _last = (loop, bridge, deadlines)
+    return _last
 
 
 async def _awaited(client: SdoClient, start: Callable[[Any, int], None]) -> Any:
     """Starts a completion-based transfer (``start(completions, token)``) and awaits its completion."""
-    bridge = faces.bridge_for()
+    _, bridge, deadlines = _loop_state()
     token, future = bridge.expect()
     completions = bridge.completions
     try:
@@ -79,7 +124,7 @@ async def _awaited(client: SdoClient, start: Callable[[Any, int], None]) -> Any:
     except BaseException:
         bridge.forget(token)
         raise
-    deadline = _Deadline(client, future, bridge.loop, client.timeout)
+    deadlines.add(client)
     try:
         return await future
     except asyncio.CancelledError:
@@ -89,7 +134,7 @@ async def _awaited(client: SdoClient, start: Callable[[Any, int], None]) -> Any:
         client.cancel_async(completions, token)
         raise
     finally:
-        deadline.handle.cancel()
+        deadlines.done(client)
 
 
 async def _upload(client: SdoClient, index: int, subindex: int, block: bool = False) -> bytes:
@@ -234,10 +279,13 @@ class SdoObject:
         return iter(od.subindices(self.index) if od is not None else ())
 
     def _var(self) -> SdoVariable:
-        if self.object_code not in (None, "VAR"):
-            raise _core.InvalidArgument(f"{self.name} (0x{self.index:04X}) is a {self.object_code}: "
-                                        f"pick a sub-object, e.g. [1]")
-        return self[0]
+        var = self.__dict__.get("_var0")
+        if var is None:
+            if self.object_code not in (None, "VAR"):
+                raise _core.InvalidArgument(f"{self.name} (0x{self.index:04X}) is a {self.object_code}: "
+                                            f"pick a sub-object, e.g. [1]")
+            var = self._var0 = self[0]
+        return var
 
     @property
     def raw(self):
