@@ -54,21 +54,11 @@ from .stopping import STOP_WAYS, StopHow, check_stop_way  # noqa: E402
 
 
 async def _value(result: Any) -> Any:
-    """A kind's hook's result: awaited when the hook is a coroutine function."""
+    """The result of a function that may be plain or a coroutine function (``_stop_reason``,
+    ``_in_position_window``, Params' ``_read``/``_write``, ``_for_this_move``'s read/write)."""
     if inspect.isawaitable(result):
         return await result
     return result
-
-
-class _Done:
-    """An awaitable that is already done (``_for_this_move`` in the blocking face)."""
-
-    def __await__(self) -> Any:
-        return None
-        yield  # noqa: unreachable - makes this a generator
-
-
-_DONE = _Done()
 
 
 class Capability(enum.Enum):
@@ -559,7 +549,7 @@ class Drive(abc.ABC):
     async def _move_to(self, target: float, velocity: Optional[float]) -> None: ...
 
     async def _move_by(self, distance: float, velocity: Optional[float]) -> None:
-        await _value(self._move_to(await _value(self._position()) + distance, velocity))
+        await self._move_to(await self._position() + distance, velocity)
 
     @abc.abstractmethod
     async def _jog(self, velocity: float) -> None: ...
@@ -575,7 +565,7 @@ class Drive(abc.ABC):
 
     async def _homing_done(self) -> bool:
         """True when a homing started by _home has finished (raise on a homing error)."""
-        return not (await _value(self._status())).moving
+        return not (await self._status()).moving
 
     @abc.abstractmethod
     async def _clear_faults(self) -> None: ...
@@ -595,7 +585,7 @@ class Drive(abc.ABC):
     async def _is_idle(self) -> bool:
         """True once the motor is at rest, whatever the reason (target, limit, fault,
         stop): the outcome is judged afterwards from ``_stop_reason`` and the position."""
-        return not (await _value(self._status())).moving
+        return not (await self._status()).moving
 
     def _stop_reason(self, status: DriveStatus) -> Optional[StopReason]:
         """Why the drive stopped, as far as it says (a fault, a limit, a stall, a stop
@@ -615,21 +605,17 @@ class Drive(abc.ABC):
         """How far from its target (native units) a move may end and count as arrived."""
         return self.in_position_window
 
-    def _for_this_move(self, read: Callable[[], Any], write: Callable[[Any], Any], value: Any) -> Any:
+    async def _for_this_move(self, read: Callable[[], Any], write: Callable[[Any], Any], value: Any) -> None:
         """For a vendor's ``_move_to`` (``await self._for_this_move(...)``): sets a drive
         setting (a speed) for the move being started and puts the old value back once it
-        has ended, however it ended.  ``read``/``write`` may be coroutine functions."""
-        async def set_for_move() -> None:
-            old = await _value(read())
-            await _value(write(value))
-            if self._move is not None:
-                self._move.restore.append(lambda: write(old))
-        if faces.blocking():        # done at once: also for a hook that does not await it
-            faces.run(set_for_move())
-            return _DONE
-        return set_for_move()
+        has ended, however it ended.  ``read``/``write`` may return awaitables (``self.io...``)
+        or values (a speed the kind already knows)."""
+        old = await _value(read())
+        await _value(write(value))
+        if self._move is not None:
+            self._move.restore.append(lambda: write(old))
 
-    def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
+    async def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         """The soft travel limits the drive itself enforces now, native units (None: no limit that side)."""
         return (None, None)
 
@@ -654,7 +640,7 @@ class Drive(abc.ABC):
     async def _co_enable(self) -> None:
         self._check_open()
         log.debug("%s: enable", self.name)
-        await _value(self._enable())
+        await self._enable()
 
     def disable(self) -> None:
         """Power stage off: the motor no longer holds position."""
@@ -663,7 +649,7 @@ class Drive(abc.ABC):
     async def _co_disable(self) -> None:
         self._check_open()
         log.debug("%s: disable", self.name)
-        await _value(self._disable())
+        await self._disable()
 
     def move_to(self, position: float, *, velocity: Optional[float] = None, wait: bool = True,
                 timeout: Optional[float] = None) -> None:
@@ -692,7 +678,7 @@ class Drive(abc.ABC):
         distance = self._units.to_native(self._number("distance", distance))
         speed = self._speed_arg(velocity)
         await self._settle()
-        target = await _value(self._position()) + distance
+        target = await self._position() + distance
         await self._start("move", target, lambda: self._move_by(distance, speed))
         if wait:
             await self._co_wait_idle(timeout)
@@ -720,7 +706,7 @@ class Drive(abc.ABC):
         log.debug("%s: stop", self.name)
         if self._move is not None and self._move.stopped_by is None:
             self._move.stopped_by = by
-        await _value(self._stop())
+        await self._stop()
 
     def quick_stop(self) -> None:
         """The fastest stop the drive has (an abort or the quick-stop ramp)."""
@@ -731,7 +717,7 @@ class Drive(abc.ABC):
         log.debug("%s: quick_stop", self.name)
         if self._move is not None and self._move.stopped_by is None:
             self._move.stopped_by = by
-        await _value(self._quick_stop())
+        await self._quick_stop()
 
     def home(self, method: Any = None, *, wait: bool = True, timeout: Optional[float] = None) -> None:
         """Run the drive's homing (``method``: the vendor's own, None = its default);
@@ -781,7 +767,7 @@ class Drive(abc.ABC):
         self._move = move
         self._last_move = MoveOutcome(what, None if target is None else self._units.to_user(target), None, "running")
         try:
-            await _value(command())
+            await command()
         except asyncio.CancelledError:
             # Cancelled while the command was on its way: the drive may have taken it, so
             # the move stays on record for the cancellation's stop to judge (motorbus.aio).
@@ -799,7 +785,7 @@ class Drive(abc.ABC):
         move = self._move
         if move is not None and not move.judged and move.commanded:
             try:
-                if move.what == "home" or not await _value(self._is_idle()):
+                if move.what == "home" or not await self._is_idle():
                     await self._restore(move)     # superseded; a homing is not judged by rest alone
                     move.judged = True
                     return
@@ -809,9 +795,9 @@ class Drive(abc.ABC):
 
     async def _judge(self, move: _Move, *, raise_error: bool) -> None:
         """The motor is at rest after ``move``: done, or the MoveFailed that says why."""
-        status = await _value(self._status())
+        status = await self._status()
         reason = await _value(self._stop_reason(status))
-        position = await _value(self._position())
+        position = await self._position()
         arrived = move.target is None or abs(position - move.target) <= await _value(self._in_position_window())
         if move.what == "home":
             failed = (reason is not None and reason.error is not LimitReached) or move.stopped_by is not None \
@@ -841,12 +827,12 @@ class Drive(abc.ABC):
         """Builds the error for ``move`` (and records it as the last outcome)."""
         if position is None:
             try:
-                position = await _value(self._position())
+                position = await self._position()
             except Exception:  # noqa: BLE001 - the error must still be raised
                 position = math.nan
         if status is None:
             try:
-                status = await _value(self._status())
+                status = await self._status()
             except Exception:  # noqa: BLE001
                 status = None
         u = self._units
@@ -894,7 +880,7 @@ class Drive(abc.ABC):
     async def _co_clear_faults(self) -> None:
         self._check_open()
         log.debug("%s: clear_faults", self.name)
-        await _value(self._clear_faults())
+        await self._clear_faults()
 
     def console(self, line: str) -> str:
         """Sends one request in the drive's own protocol and returns the answer as text:
@@ -907,7 +893,7 @@ class Drive(abc.ABC):
         self._check_open()
         if not isinstance(line, str):
             raise _core.InvalidArgument(f"{self.kind} console: a line of text, not {type(line).__name__}")
-        return await _value(self._console(line.strip()))
+        return await self._console(line.strip())
 
     def store(self) -> None:
         """Persist the parameters in the drive's non-volatile memory."""
@@ -916,7 +902,7 @@ class Drive(abc.ABC):
     async def _co_store(self) -> None:
         self._check_open()
         log.debug("%s: store", self.name)
-        await _value(self._store())
+        await self._store()
 
     def close(self) -> None:
         """Forget the drive (no stop); closes the line or bus if open_drive opened it."""
@@ -938,7 +924,7 @@ class Drive(abc.ABC):
 
     async def _co_position(self) -> float:
         self._check_open()
-        return self._units.to_user(await _value(self._position()))
+        return self._units.to_user(await self._position())
 
     @property
     def velocity(self) -> float:
@@ -947,7 +933,7 @@ class Drive(abc.ABC):
 
     async def _co_velocity(self) -> float:
         self._check_open()
-        return self._units.to_user(await _value(self._velocity()))
+        return self._units.to_user(await self._velocity())
 
     @property
     def status(self) -> DriveStatus:
@@ -958,7 +944,7 @@ class Drive(abc.ABC):
     async def _co_status(self) -> DriveStatus:
         self._check_open()
         await self._settle_if_at_rest()
-        st = await _value(self._status())
+        st = await self._status()
         last = self._last_move
         if last is not None and last.what == "move" and last.state != "done" and st.at_target:
             st = dataclasses.replace(st, at_target=False)     # halted short: not "at target"
@@ -968,7 +954,7 @@ class Drive(abc.ABC):
         move = self._move
         if move is not None and not move.judged and move.commanded and move.what != "home":
             try:
-                if await _value(self._is_idle()):
+                if await self._is_idle():
                     await self._judge(move, raise_error=False)
             except _core.DriveFault:    # judged and recorded in last_move
                 pass
@@ -985,7 +971,7 @@ class Drive(abc.ABC):
 
     async def _co_travel_limits(self) -> tuple[float, float]:
         self._check_open()
-        lo, hi = await _value(self._travel_limits())
+        lo, hi = await self._travel_limits()
         sign = 1.0 if self._units.scale > 0 else -1.0   # a negative scale swaps the ends
         a = -math.inf * sign if lo is None else self._units.to_user(lo)
         b = math.inf * sign if hi is None else self._units.to_user(hi)
@@ -1017,9 +1003,8 @@ class Drive(abc.ABC):
 
     def _halt(self, how: StopHow) -> None:
         if not self._closed:
-            _stop_at_exit.halt(how, lambda: faces.run(_value(self._stop())),
-                               lambda: faces.run(_value(self._quick_stop())),
-                               lambda: faces.run(_value(self._disable())))
+            _stop_at_exit.halt(how, lambda: faces.run(self._stop()), lambda: faces.run(self._quick_stop()),
+                               lambda: faces.run(self._disable()))
 
     # ---- helpers -------------------------------------------------------------------------
     def _check_open(self) -> None:
@@ -1046,7 +1031,7 @@ class Drive(abc.ABC):
         if limit < 0:
             raise _core.InvalidArgument(f"{self.name}: timeout must be >= 0, not {limit!r}")
         deadline = time.monotonic() + limit
-        while not await _value(done()):
+        while not await done():
             if time.monotonic() >= deadline:
                 raise _core.TimeoutError(f"{self.name}: {what} not finished after {limit:g} s")
             await faces.sleep(self.poll_interval)
@@ -1057,6 +1042,13 @@ class Drive(abc.ABC):
 
 
 registry.set_drive_base(Drive)
+
+#: The hooks that talk to the drive: coroutine functions in every kind (the registry
+#: refuses a kind that has one as a plain function).  ``_stop_reason`` and
+#: ``_in_position_window``, which judge what was read, may be either.
+Drive.COROUTINE_HOOKS = ("_enable", "_disable", "_move_to", "_move_by", "_jog", "_stop", "_quick_stop", "_home",
+                         "_homing_done", "_is_idle", "_clear_faults", "_store", "_position", "_velocity", "_status",
+                         "_travel_limits", "_console")
 
 #: The plugin hooks a kind may override (``Drive.provides``).
 HOOKS = ("open", "make_sim", "check_address", "store_options", "wire_line", "probe", "canopen_match", "synchronised_start",

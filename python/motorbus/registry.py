@@ -14,6 +14,8 @@ names a vendor outside the vendor's own module.
 """
 from __future__ import annotations
 
+import inspect
+
 import threading
 from dataclasses import dataclass
 from importlib import metadata
@@ -136,6 +138,12 @@ def drive_plugin(kind: str) -> "type[Drive]":
     if cls.transport not in ("serial", "can"):
         raise _core.InvalidArgument(f"drive kind {kind!r} ({cls.__qualname__}): transport 'serial' or 'can', "
                                     f"not {cls.transport!r}")
+    # A hook that talks to the drive as a plain function would block every task of an
+    # event loop (motorbus.aio) while it waits: say so when the kind is loaded.
+    plain = [h for h in _drive_base.COROUTINE_HOOKS if not inspect.iscoroutinefunction(getattr(cls, h))]
+    if plain:
+        raise _core.InvalidArgument(f"drive kind {kind!r} ({cls.__qualname__}): {', '.join(plain)} must be "
+                                    "coroutine functions (async def, exchanges awaited on self.io: docs/plugins.md)")
     return cls
 
 

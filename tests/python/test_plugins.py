@@ -179,6 +179,28 @@ def test_a_plugin_registered_at_run_time_is_served_by_sim_serve_code():
         registry._cache[registry.DRIVE_GROUP].pop("mykind", None)
 
 
+def test_a_kind_whose_exchanging_hooks_are_plain_functions_is_refused_naming_them():
+    """Hooks that talk to the drive are coroutines (one implementation serves the blocking
+    and the awaitable face); a plain one would block every task of an event loop."""
+    from motorbus.drives import cia402
+
+    class BlockingKindDrive(cia402.Cia402Drive):
+        kind = "blockingkind"
+
+        def _position(self):                  # a plain function: the old contract
+            return 0.0
+
+        def _stop(self):
+            pass
+
+    registry.register(registry.DRIVE_GROUP, "blockingkind", BlockingKindDrive)
+    try:
+        with pytest.raises(motorbus.InvalidArgument, match=r"'blockingkind'.*_stop, _position must be coroutine"):
+            registry.drive_plugin("blockingkind")
+    finally:
+        registry._cache[registry.DRIVE_GROUP].pop("blockingkind", None)
+
+
 def test_motorbus_drives_lists_every_kind():
     out = subprocess.run([sys.executable, "-m", "motorbus", "drives"], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
