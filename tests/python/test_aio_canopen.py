@@ -295,21 +295,29 @@ async def test_awaited_and_blocking_calls_share_a_client():
 
 
 def test_a_transfer_completing_after_its_loop_closed_does_not_crash():
-    r = Rig("virtual")
+    r = Rig("virtual", sdo_timeout=0.1)
     try:
-        node = r.remote[5]
-        r.ods[5][0x2201].raw = bytes(range(256)) * 400      # takes a few ms
+        node, silent = r.remote[5], r.network.add_node(9)      # nobody serves node 9
+        r.ods[5][0x2201].raw = bytes(range(256)) * 40       # 1 463 segments
         loop = asyncio.new_event_loop()
 
         async def start():
             asyncio.ensure_future(node.sdo.upload_async(0x2201, 0))
+            asyncio.ensure_future(silent.sdo.upload_async(0x1000, 0))
             await asyncio.sleep(0)
 
         loop.run_until_complete(start())
-        loop.close()                                          # the transfer runs on
+        loop.close()                                          # the transfers run on
         del loop
         gc.collect()
-        for _ in range(200):
+        assert silent.sdo.client.async_pending == 1          # its deadline was the loop's
+        # A blocking call behind it fires that deadline itself (the completion goes to
+        # the dead loop's queue, touching no Python), then times out on its own.
+        with pytest.raises(SdoTimeout):
+            silent.sdo.upload(0x1000)
+        assert silent.sdo.client.async_pending == 0
+        assert silent.sdo.client.counters.timeouts == 2
+        for _ in range(1000):
             if node.sdo.client.async_pending == 0:
                 break
             threading.Event().wait(0.01)
@@ -329,3 +337,29 @@ async def test_closing_the_network_fails_pending_awaits_with_closed_error():
     for p in pending:
         with pytest.raises(motorbus.ClosedError):
             await p
+
+
+async def test_a_simulated_pmc007_awaited_over_socketcand():
+    """The PMC007 simulator (C++, served on a virtual hub) through a socketcand server:
+    its identity read, a parameter written and read back, a bad value refused."""
+    from motorbus.drives import pmc007
+    name = f"aio-pmc007-{next(_hub)}"
+    clock = _core.runtime.SimClock(1_000_000_000)
+    sim_bus, server_bus = _core.can.open_virtual(name), _core.can.open_virtual(name)
+    sim = pmc007.make_sim(5, clock=clock, bus=sim_bus)
+    server = SocketcandServer(server_bus)
+    net = Network(f"socketcand:127.0.0.1:{server.port}/can0", sdo_timeout=0.5)
+    try:
+        node = net.add_node(5, _core.pmc007.object_dictionary())
+        assert await node.sdo["Manufacturer device name"].get() == "PMC007 (motorbus sim)"
+        await node.sdo[0x6003].set(1234)                     # Maximum speed
+        assert await node.sdo[0x6003].get() == 1234
+        assert sim.od[0x6003].value == 1234                  # the simulator holds it
+        values = await asyncio.gather(*[node.sdo[0x6003].get() for _ in range(50)])
+        assert values == [1234] * 50
+    finally:
+        net.close()
+        server.close()
+        sim.close()
+        server_bus.close()
+        sim_bus.close()
