@@ -34,6 +34,7 @@ from typing import Any, Iterator, Optional, Sequence, Union
 from .. import _core, faces
 from ..canopen.node import check_node_id
 from ..canopen.pdo import PdoMap, configure_pdo, read_pdo_config
+from ..canopen.sdo import download_async, upload_async
 from ..canopen.cia402 import Cia402, Cia402Device, Controlword, OpMode
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, MoveStalled,
                      ParamInfo, Params, StopReason, Units)
@@ -315,13 +316,18 @@ class Cia402Drive(Drive):
         bus have their own workers and their transfers overlap on the wire."""
         return self.native.sdo
 
+    # The adapter's own reads and writes are the CANopen layer's awaitable transfers: in the
+    # awaitable face they run in C++ on the bus's receive thread and complete through the
+    # loop's queue (no worker thread, however many axes wait); under faces.run, the
+    # blocking calls.  The state machine's calls (Cia402Host: enable, the set-point
+    # handshake, controlwords) go through self.io, on the node's worker.
     def _sdo_upload(self, index: int, sub: int) -> Any:
         """One SDO upload, awaitable (the one place an SDO read is sent)."""
-        return self.io.do(self._sdo.upload, index, sub)
+        return upload_async(self._sdo, index, sub)
 
     def _sdo_download(self, index: int, sub: int, data: bytes) -> Any:
         """One SDO download, awaitable (the one place an SDO write is sent)."""
-        return self.io.do(self._sdo.download, index, sub, data)
+        return download_async(self._sdo, index, sub, data)
 
     async def _read(self, index: int, sub: int = 0) -> Any:
         """One object, decoded by its dictionary entry (C++ codec), through the read that
