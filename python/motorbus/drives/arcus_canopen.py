@@ -313,11 +313,12 @@ class ArcusCanopenParams(Params):
             raise _core.InvalidArgument(
                 f"{self._drive.name}: parameter {info.name} ({r[2]}) is write-only: the DMX-CAN aborts a read of it "
                 f"(06010001); the mode in effect is 0x6061")
-        return await self._drive.io.read(r[0], r[1])
+        return await self._drive._read(r[0], r[1])        # Table 10.1's entry decodes it
 
     async def _write(self, info: ParamInfo, value: Any) -> None:
+        # Params has checked the access and the entry's range (the client's write checks)
         r = self._row(info.name)
-        await self._drive.io.write(r[0], r[1], int(value))
+        await self._drive._download(r[0], int(value), r[1])
 
 
 class ArcusCanopenDrive(Cia402Drive):
