@@ -24,8 +24,6 @@ from motorbus import aio, registry
 from motorbus.drive import LimitReached, MoveStalled
 from motorbus.sim import SimBench
 
-pytestmark = pytest.mark.threaded
-
 ADDRESS = {"cia402": "5", "arcus-canopen": "1"}
 FAR = 200_000          # native units, several seconds away at 20 000/s
 
