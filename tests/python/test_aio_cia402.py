@@ -8,7 +8,7 @@ from the simulator itself.
 * a cancelled move is halted, and the 6081h its ``velocity=`` changed is written back;
   a cancelled homing leaves the axis at rest and not homed;
 * two nodes of one bus move at once under ``gather``, and a node that does not answer
-  holds up no other node's exchanges (one worker per node);
+  holds up no other node's exchanges (each node's own SDO channel and worker);
 * ``aio.Bench.move_together`` starts two cia402 nodes on one SYNC;
 * the DMX-CAN's 200Eh store handshake (its client polls for 0.1 s) leaves the loop free.
 """
@@ -135,8 +135,8 @@ async def test_a_cancelled_homing_stops_and_leaves_the_axis_not_homed(rig):
 
 
 async def test_two_nodes_of_one_bus_move_at_once():
-    """One worker per node: under gather, both nodes' set-points and polls go out side by
-    side, so both shafts are seen turning at the same time."""
+    """Under gather, both nodes' set-points and polls go out side by side, so both shafts
+    are seen turning at the same time."""
     with SimBench(["cia402:5", "cia402:6"]) as bench:
         rigs = [Rig("cia402", bench, a) for a in ("5", "6")]
         try:
@@ -163,9 +163,9 @@ async def test_two_nodes_of_one_bus_move_at_once():
 
 
 async def test_a_silent_node_does_not_hold_up_another_nodes_exchanges():
-    """Each node's exchanges queue on that node's worker only: while reads of a node that
-    does not answer wait out their SDO timeouts, another node on the same Bus object
-    gives its readings."""
+    """Each node's exchanges queue on that node's own SDO channel and worker only: while
+    reads of a node that does not answer wait out their SDO timeouts, another node on the
+    same Bus object gives its readings."""
     with SimBench(["cia402:5"]) as bench:
         srv = bench.can.servers[0]
         bus = motorbus.open_bus(f"socketcand:{srv.host}:{srv.port}/can0")
@@ -182,8 +182,8 @@ async def test_a_silent_node_does_not_hold_up_another_nodes_exchanges():
             async def readings() -> None:
                 await asyncio.sleep(0.05)                # node 9's read is on the wire first
                 assert await asyncio.gather(*(present.position() for _ in range(20))) == [0.0] * 20
-                # Back while node 9's first request still waits for its answer (a worker
-                # shared by the two would have served node 5 only after that timeout).
+                # Back while node 9's first request still waits for its answer (reads queued
+                # behind node 9's would have come back only after that timeout).
                 done.append(("node 5 read", silent.sync.native.sdo.counters.timeouts))
 
             await asyncio.gather(lost(), readings())
