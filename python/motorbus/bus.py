@@ -214,28 +214,30 @@ def _keep_for(bus: Any) -> Callable[[list], None]:
     return keep
 
 
-async def _recv_batch(bus: Any, max_frames: int, timeout: Optional[float]) -> list:
-    kept = _leftovers.get(bus)
-    if kept:
-        return [kept.popleft() for _ in range(min(max_frames, len(kept)))]
+async def _frames_or_wait(take: Callable[[Any, int], list], withdraw: Callable[[Any, int], bool],
+                          keep: Callable[[list], None], timeout: Optional[float]) -> list:
+    """What ``take(completions, token)`` has now, or else the batch it completes
+    later (``[]`` after ``timeout``): the one wait of ``arecv`` and of a stream."""
     bridge = faces.bridge_for()
     token, future = bridge.expect()
     try:
-        frames = bus._recv_or_wait(max_frames, bridge.completions, token)
+        frames = take(bridge.completions, token)
     except BaseException:
         bridge.forget(token)
         raise
     if frames:
         bridge.forget(token)
         return frames
-    if timeout == 0:            # a poll: nothing queued now
-        if bus._cancel_wait(bridge.completions, token):
-            bridge.forget(token)
-            return []
-        return await future     # served in between: on its way
-    got = await _completed(bridge, token, future, timeout,
-                           lambda: bus._cancel_wait(bridge.completions, token), _keep_for(bus))
+    got = await _completed(bridge, token, future, timeout, lambda: withdraw(bridge.completions, token), keep)
     return [] if got is None else got
+
+
+async def _recv_batch(bus: Any, max_frames: int, timeout: Optional[float]) -> list:
+    kept = _leftovers.get(bus)
+    if kept:
+        return [kept.popleft() for _ in range(min(max_frames, len(kept)))]
+    return await _frames_or_wait(lambda done, token: bus._recv_or_wait(max_frames, done, token), bus._cancel_wait,
+                                 _keep_for(bus), timeout)
 
 
 def _arecv(self: Any, timeout: Optional[float] = None
@@ -348,19 +350,9 @@ class FrameStream:
         timeout = _check_timeout("FrameStream.batch", timeout)
         if self._ready:
             return [self._ready.popleft() for _ in range(min(max_frames, len(self._ready)))]
-        bridge = faces.bridge_for()
-        token, future = bridge.expect()
-        try:
-            frames = self._rx.take_or_arm(max_frames, bridge.completions, token)
-        except BaseException:
-            bridge.forget(token)
-            raise
-        if frames:
-            bridge.forget(token)
-            return frames
-        got = await _completed(bridge, token, future, timeout, self._rx.disarm,
-                               lambda frames: self._ready.extendleft(reversed(frames)))
-        return [] if got is None else got
+        return await _frames_or_wait(lambda done, token: self._rx.take_or_arm(max_frames, done, token),
+                                     lambda done, token: self._rx.disarm(),
+                                     lambda frames: self._ready.extendleft(reversed(frames)), timeout)
 
     # ---- ending ----
     def close(self) -> None:
