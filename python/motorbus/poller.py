@@ -348,13 +348,13 @@ class Poller:
     async def chunks(self, rows: Optional[int] = None) -> AsyncIterator[dict[str, np.ndarray]]:
         """``async for chunk in poller.chunks(rows)``: the samples as they come, each
         chunk a frame as ``read()`` returns (numpy arrays per column) of at least
-        ``rows`` new rows (default: a tenth of a second of them), fewer for the
+        ``rows`` new rows (default: a tenth of a second of them, at most the ring's ``capacity``), fewer for the
         last one; ends when every group has stopped (``stop()``, or a link failed:
         see ``stats``).  The ring is the bounded queue (``capacity`` rows; what a
         slow consumer loses is counted in ``overflowed``).  Leaving the loop or
         cancelling its task withdraws the wait; the poller goes on."""
-        if rows is None:
-            rows = max(1, int(round(self.rate_hz / 10)))
+        if rows is None:   # a tenth of a second, as far as the ring holds it
+            rows = min(self._capacity, max(1, int(round(self.rate_hz / 10))))
         if isinstance(rows, bool) or not isinstance(rows, int) or not 1 <= rows <= self._capacity:
             raise _core.InvalidArgument(f"Poller.chunks rows: a number of rows in 1..{self._capacity} (the ring's "
                                         f"capacity), not {rows!r}")

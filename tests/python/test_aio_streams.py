@@ -435,6 +435,8 @@ async def test_chunks_count_what_a_slow_consumer_lost_and_cancel_cleanly():
             assert poller.running
             again = poller.chunks(8)
             assert len((await asyncio.wait_for(again.__anext__(), 10))["t"]) >= 8
+            by_default = poller.chunks()                 # a tenth of a second (50 rows) > the ring: 16
+            assert len((await asyncio.wait_for(by_default.__anext__(), 10))["t"]) >= 16
             with pytest.raises(motorbus.InvalidArgument, match="rows"):
                 await poller.chunks(0).__anext__()
             with pytest.raises(motorbus.InvalidArgument, match="rows"):
