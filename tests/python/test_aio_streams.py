@@ -310,6 +310,33 @@ def test_two_loops_in_two_threads_each_get_every_frame():
     assert results[0][1] is not results[1][1]       # one completion queue per loop
 
 
+@pytest.mark.threaded
+def test_a_wait_that_outlives_its_loop_touches_no_python():
+    """A loop closed with waits still armed: the bus thread completes them into the dead loop's
+    queue (C++ only, nothing of Python), and the bus and the stream go on for a new loop."""
+    name = hub()
+    with open_virtual(name) as tx, open_virtual(name) as rx:
+        stream = rx.frames()
+        loop = asyncio.new_event_loop()
+        tasks = [loop.create_task(stream.batch()), loop.create_task(rx.arecv())]
+        loop.run_until_complete(asyncio.sleep(0.01))            # both armed
+        loop.close()                                             # abandoned, not cancelled
+        for t in tasks:
+            t._log_destroy_pending = False                       # abandoned on purpose
+        del tasks, loop
+        tx.send(frame_of(0))                                     # completes both dead waits
+        tx.send(frame_of(1))
+        wait_until(lambda: stream.received == 2)
+
+        async def later():
+            return await stream.batch(timeout=5), await rx.arecv(5)
+
+        from_stream, from_recv = asyncio.run(later())
+        check_sequence(from_stream, 1, start=1)                  # frame 0 went to the dead loop's wait
+        check_sequence([from_recv], 1, start=1)
+        stream.close()
+
+
 # ---- socketcand on 127.0.0.1 -----------------------------------------------------------------
 @pytest.mark.threaded
 async def test_async_for_over_socketcand(served):
