@@ -139,7 +139,10 @@ def ours_concurrent(n: int, seconds: float, served: bool) -> dict:
 
 
 def ours_single(seconds: float) -> dict:
-    """One node, sequential: the awaited read vs the blocking one, typed and bare."""
+    """One node, sequential: the awaited read vs the blocking one, typed and bare, and
+    the completion-based call waited for without asyncio.  The four are measured in
+    alternating slices inside one loop, so a change of the machine's load during
+    the run moves them together."""
     from motorbus import _core
     from motorbus.canopen import Network
     from motorbus.canopen import sdo as sdo_mod
@@ -151,58 +154,51 @@ def ours_single(seconds: float) -> dict:
     node = net.add_node(1, ods[1])
     var, client = node.sdo["Device type"], node.sdo.client
     want = DEVICE_TYPE + 1
-    r = {}
+    want_bytes = want.to_bytes(4, "little")
+    done = _core.runtime.Completions()
+    fd = done.fileno()
 
-    def blocking(fn):
-        lat = []
-        end = time.perf_counter() + seconds
-        while True:
-            t = time.perf_counter()
-            v = fn()
-            t2 = time.perf_counter()
-            lat.append(t2 - t)
-            if v != want:
-                raise SystemExit(f"blocking read {v!r}")
-            if t2 >= end:
-                return percentile(lat, 0.5) * 1e6
+    def completion_only():
+        # Without asyncio: the completion-based call, then a sleep on the eventfd
+        # (select) and the drain -- the thread wake-up an awaited read pays when
+        # its answer is not there at once.
+        client.upload_async(0x1000, 0, done, 1)
+        while not done.pending:
+            select.select([fd], [], [])
+        return done.drain()[0][1]
 
-    async def awaited(fn):
-        lat = []
-        end = time.perf_counter() + seconds
-        while True:
-            t = time.perf_counter()
-            v = await fn()
-            t2 = time.perf_counter()
-            lat.append(t2 - t)
-            if v != want:
-                raise SystemExit(f"awaited read {v!r}")
-            if t2 >= end:
-                return percentile(lat, 0.5) * 1e6
+    cases = {
+        "blocking_typed": (False, lambda: var.raw, want),
+        "awaited_typed": (True, var.get, want),
+        "blocking_bare": (False, lambda: client.upload(0x1000, 0), want_bytes),
+        "awaited_bare": (True, lambda: sdo_mod.upload_async(client, 0x1000, 0), want_bytes),
+        "completion_floor": (False, completion_only, want_bytes),
+    }
+    lat = {k: [] for k in cases}
+
+    async def measure():
+        slices = 10
+        for _ in range(slices):
+            for key, (is_async, fn, expect) in cases.items():
+                out = lat[key]
+                end = time.perf_counter() + seconds / slices
+                while True:
+                    t = time.perf_counter()
+                    v = (await fn()) if is_async else fn()
+                    t2 = time.perf_counter()
+                    out.append(t2 - t)
+                    if v != expect:
+                        raise SystemExit(f"{key}: read {v!r}")
+                    if t2 >= end:
+                        break
 
     try:
-        want_bytes = want.to_bytes(4, "little")
-        r["blocking_typed_us"] = blocking(lambda: var.raw)
-        r["awaited_typed_us"] = asyncio.run(awaited(var.get))
-        want, saved = want_bytes, want
-        r["blocking_bare_us"] = blocking(lambda: client.upload(0x1000, 0))
-        r["awaited_bare_us"] = asyncio.run(awaited(lambda: sdo_mod.upload_async(client, 0x1000, 0)))
-        want = saved
-        # Without asyncio: the completion-based call, then a sleep on the eventfd
-        # (select) and the drain -- the thread wake-up every awaited read pays.
-        done = _core.runtime.Completions()
-        fd = done.fileno()
-
-        def completion_only():
-            client.upload_async(0x1000, 0, done, 1)
-            while not done.pending:
-                select.select([fd], [], [])
-            return int.from_bytes(done.drain()[0][1], "little")
-        r["completion_floor_us"] = blocking(completion_only)
+        asyncio.run(measure())
     finally:
         net.close()
         nodes[0].close()
         dev.close()
-    return r
+    return {f"{k}_us": percentile(v, 0.5) * 1e6 for k, v in lat.items()}
 
 
 # ---- canopen-asyncio -------------------------------------------------------------------

@@ -363,3 +363,29 @@ async def test_a_simulated_pmc007_awaited_over_socketcand():
         sim.close()
         server_bus.close()
         sim_bus.close()
+
+
+async def test_a_loop_of_awaited_reads_does_not_starve_the_loop(vrig):
+    """An awaited read that is the loop's only one polls briefly for its answer
+    instead of sleeping; a task doing such reads back to back still yields to the
+    loop (every 16 answers), so a timer keeps firing meanwhile."""
+    node = vrig.remote[5]
+    loop = asyncio.get_running_loop()
+    fired = []
+
+    async def ticker():
+        while True:
+            await asyncio.sleep(0.0005)
+            fired.append(loop.time())
+
+    t = asyncio.create_task(ticker())
+    await asyncio.sleep(0.001)
+    start = loop.time()
+    for _ in range(2000):
+        assert await node.sdo["Offset"].get() == -5
+    took = loop.time() - start
+    t.cancel()
+    during = [x for x in fired if x >= start]
+    # Never more than a few ms between two ticks while the reads ran.
+    gaps = [b - a for a, b in zip([start] + during, during + [start + took])]
+    assert len(during) >= 3 and max(gaps) < 0.05, (len(during), max(gaps), took)

@@ -24,6 +24,8 @@ running one is aborted on the wire, 0x08000000) and leaves the channel usable.
 from __future__ import annotations
 
 import asyncio
+import os
+import time
 from typing import Any, Callable, Iterator, Optional, Union
 
 from .. import _core, faces
@@ -44,6 +46,24 @@ _NS = 1e-9
 # The longest the loop sleeps before asking the client again when it reports no
 # deadline (the transfer is queued behind a blocking one) or an infinite timeout.
 _RECHECK_S = 1.0
+#: How long an awaited transfer that is the loop's only one polls for its answer
+#: before the loop thread sleeps (0 = never): at most this long, other tasks wait.
+_SPIN_NS = 20_000
+_yield = getattr(os, "sched_yield", lambda: None)
+#: Answers a task may take by polling before it yields to the loop once (~100 us).
+_BUDGET = 16
+
+
+class _Yield:
+    """``await _YIELD``: lets the loop run one round (as ``asyncio.sleep(0)``, without its call)."""
+
+    __slots__ = ()
+
+    def __await__(self):
+        yield
+
+
+_YIELD = _Yield()
 
 
 class _Deadlines:
@@ -53,10 +73,11 @@ class _Deadlines:
     re-arms at the nearest deadline they report.  No thread, and no timer per
     transfer: a read costs a dict update, not a timer heap push and cancel."""
 
-    __slots__ = ("loop", "pending", "handle", "when")
+    __slots__ = ("loop", "pending", "handle", "when", "budget")
 
     def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
         self.loop = loop
+        self.budget = _BUDGET              # answers taken without yielding, before a yield
         self.pending: dict = {}            # client -> awaited transfers not completed
         self.handle: Optional[asyncio.TimerHandle] = None
         self.when = float("inf")           # loop time the timer fires
@@ -116,7 +137,7 @@ def _loop_state() -> tuple:
 
 async def _awaited(client: SdoClient, start: Callable[[Any, int], None]) -> Any:
     """Starts a completion-based transfer (``start(completions, token)``) and awaits its completion."""
-    _, bridge, deadlines = _loop_state()
+    loop, bridge, deadlines = _loop_state()
     token, future = bridge.expect()
     completions = bridge.completions
     try:
@@ -124,6 +145,28 @@ async def _awaited(client: SdoClient, start: Callable[[Any, int], None]) -> Any:
     except BaseException:
         bridge.forget(token)
         raise
+    if _SPIN_NS and not deadlines.pending and not getattr(loop, "_ready", True):
+        # The only SDO transfer this loop awaits, and no other callback is ready to
+        # run: its answer usually comes within a few microseconds, sooner than the
+        # loop thread can sleep and be woken for it (the blocking call spins 50 us
+        # for the same reason).  Poll the completion queue for at most _SPIN_NS
+        # before sleeping.  With other transfers in flight or other work ready the
+        # loop never spins.  A task whose answers keep coming this way still yields
+        # to the loop every _BUDGET of them (as tokio's cooperative budget), so a
+        # loop of awaited reads cannot starve the loop's timers and I/O.
+        end = time.perf_counter_ns() + _SPIN_NS
+        while not completions.pending:
+            if time.perf_counter_ns() >= end:
+                break
+            _yield()         # the receive threads need the core more than this thread
+        else:
+            bridge._drain()
+            if future.done():
+                deadlines.budget -= 1
+                if deadlines.budget <= 0:
+                    deadlines.budget = _BUDGET
+                    await _YIELD
+                return future.result()
     deadlines.add(client)
     try:
         return await future
@@ -137,18 +180,25 @@ async def _awaited(client: SdoClient, start: Callable[[Any, int], None]) -> Any:
         deadlines.done(client)
 
 
-async def _upload(client: SdoClient, index: int, subindex: int, block: bool = False) -> bytes:
+async def upload_async(client: SdoClient, index: int, subindex: int = 0, block: bool = False) -> bytes:
+    """``await upload_async(client, ...)``: ``client.upload`` awaited, for code that
+    holds a bare SdoClient (no node).  Under ``faces.run`` it is the blocking call."""
     if faces.blocking():
         return client.upload(index, subindex, block)
     return await _awaited(client, lambda done, token: client.upload_async(index, subindex, done, token, block))
 
 
-async def _download(client: SdoClient, index: int, subindex: int, data: bytes, block: bool = False,
-                    segmented: bool = False) -> None:
+async def download_async(client: SdoClient, index: int, subindex: int, data: bytes, block: bool = False,
+                         segmented: bool = False) -> None:
+    """``client.download`` awaited (see :func:`upload_async`)."""
+    data = bytes(data)
     if faces.blocking():
         return client.download(index, subindex, data, block, segmented)
     await _awaited(client, lambda done, token: client.download_async(index, subindex, data, done, token, block,
                                                                       segmented))
+
+
+_upload, _download = upload_async, download_async
 
 
 class SdoVariable:
@@ -370,7 +420,7 @@ class SdoVariables:
     async def download_async(self, index: int, subindex: int, data: bytes, block: bool = False,
                              segmented: bool = False) -> None:
         """Awaitable ``download``."""
-        await _download(self.client, index, subindex, bytes(data), block, segmented)
+        await _download(self.client, index, subindex, data, block, segmented)
 
     @property
     def timeout(self) -> float:
@@ -380,14 +430,3 @@ class SdoVariables:
     def timeout(self, t: float) -> None:
         self.client.timeout = t
 
-
-async def upload_async(client: SdoClient, index: int, subindex: int = 0, block: bool = False) -> bytes:
-    """``await upload_async(client, ...)``: ``client.upload`` awaited, for code that
-    holds a bare SdoClient (no node).  Under ``faces.run`` it is the blocking call."""
-    return await _upload(client, index, subindex, block)
-
-
-async def download_async(client: SdoClient, index: int, subindex: int, data: bytes, block: bool = False,
-                         segmented: bool = False) -> None:
-    """``client.download`` awaited (see :func:`upload_async`)."""
-    await _download(client, index, subindex, bytes(data), block, segmented)
