@@ -145,6 +145,7 @@ async def _awaited(client: SdoClient, start: Callable[[Any, int], None]) -> Any:
     except BaseException:
         bridge.forget(token)
         raise
+    # loop._ready: asyncio's own loops (the callbacks ready to run); other loops never poll.
     if _SPIN_NS and not deadlines.pending and not getattr(loop, "_ready", True):
         # The only SDO transfer this loop awaits, and no other callback is ready to
         # run: its answer usually comes within a few microseconds, sooner than the
