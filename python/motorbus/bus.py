@@ -36,7 +36,8 @@ from typing import Any, Callable, Coroutine, Optional
 
 from . import _core, faces, registry
 
-__all__ = ["open_bus", "parse_spec", "frame_to_message", "message_to_frame", "wall_time", "FrameStream"]
+__all__ = ["open_bus", "parse_spec", "frame_to_message", "message_to_frame", "wall_time", "FrameStream", "AioBus",
+           "aio_open_bus"]
 
 # Offset from the monotonic clock of frame timestamps to the epoch, fixed once
 # so converted timestamps keep their spacing.
@@ -384,6 +385,62 @@ def _frames(self: Any, filters: Any = None, queue: int = 1024, batch: int = 256)
 def _aiter(self: Any) -> "motorbus.bus.FrameStream":
     """``async for frame in bus``: ``bus.frames()`` with its defaults."""
     return FrameStream(self)
+
+
+class AioBus:
+    """The awaitable twin of a bus (``motorbus.aio.Bus``): the blocking verbs' own names,
+    awaited -- ``await twin.recv()``, ``recv_many()``, ``send()``, ``async for frame in
+    twin``, ``twin.frames(...)`` -- on the same bus (``twin.sync``; ``bus.arecv()`` etc. are
+    the same calls).  Everything else (``set_filters``, ``counters``, ``state``,
+    ``channel``, ``subscribe``...) is the bus's own.  ``async with twin:`` closes the bus."""
+
+    __slots__ = ("sync",)
+
+    def __init__(self, bus: Any) -> None:
+        if not isinstance(bus, _core.can.Bus):
+            raise _core.InvalidArgument(f"aio.Bus: a motorbus bus (open_bus), not {type(bus).__name__}")
+        self.sync = bus
+
+    def recv(self, timeout: Optional[float] = None) -> Coroutine:
+        return self.sync.arecv(timeout)
+
+    def recv_many(self, max: int = 1024, timeout: Optional[float] = None) -> Coroutine:  # noqa: A002
+        return self.sync.arecv_many(max, timeout)
+
+    def send(self, frame: _core.can.Frame, timeout: float = 1.0) -> Coroutine:
+        return self.sync.asend(frame, timeout)
+
+    def frames(self, filters: Any = None, queue: int = 1024, batch: int = 256) -> FrameStream:
+        return FrameStream(self.sync, filters, queue, batch)
+
+    def __aiter__(self) -> FrameStream:
+        return FrameStream(self.sync)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.sync, name)
+
+    async def __aenter__(self) -> "AioBus":
+        return self
+
+    async def __aexit__(self, *exc: Any) -> None:
+        await _opening(self.sync.close)      # close() joins the backend's threads
+
+    def __repr__(self) -> str:
+        return f"<aio.Bus {self.sync.channel} ({self.sync.state})>"
+
+
+async def aio_open_bus(spec: Any, **options: Any) -> AioBus:
+    """``await aio.open_bus(spec, **options)``: :func:`open_bus` off the loop (a
+    socketcand connect and handshake, an SLCAN adapter's setup may take seconds),
+    on one shared worker for such one-off steps; the bus's awaitable twin."""
+    return AioBus(await _opening(open_bus, spec, **options))
+
+
+_OPENING = object()      # the key of the worker that opens and closes buses
+
+
+def _opening(fn: Callable, *args: Any, **kwargs: Any) -> Any:
+    return faces.NativeIo(None, link=_OPENING).do(lambda: fn(*args, **kwargs))
 
 
 # Methods of every bus, whatever its backend: the Bus objects users already hold get their awaitable twins.

@@ -18,6 +18,7 @@ import motorbus
 from motorbus import Bench, Frame, Poller, faces
 from motorbus._core.can import open_virtual
 from motorbus.aio.discovery import discover as aio_discover
+from motorbus.bus import AioBus, aio_open_bus
 from motorbus.bus_server import BusServers
 from motorbus.drives import cia402
 from motorbus.socketcand import SocketcandServer, open_socketcand
@@ -260,6 +261,31 @@ async def test_closing_the_bus_ends_the_iteration_after_its_frames():
         rx.frames()._rx.take(1)                      # a stream made after the close is ended at once
     assert [f async for f in rx.frames()] == []
     tx.close()
+
+
+@pytest.mark.threaded
+async def test_the_awaitable_twin_has_the_blocking_names(served):
+    server, node = served
+    async with await aio_open_bus(f"socketcand:127.0.0.1:{server.port}/can0") as bus:   # opened off the loop
+        assert bus.channel == bus.sync.channel and bus.state == "active"
+        bus.set_filters([{"can_id": 0x181, "can_mask": 0x7FF}])             # the bus's own, as is
+        stream = bus.frames()
+        await asyncio.sleep(0.05)
+        node.send(Frame(0x701, b"\x05"))
+        node.send(Frame(0x181, b"\x01\x02"))
+        f = await bus.recv(5)
+        assert (f.id, f.data) == (0x181, b"\x01\x02")
+        got = []
+        while len(got) < 2:                                                 # the stream: unfiltered, both
+            got += await stream.batch(timeout=5)
+        assert [g.id for g in got] == [0x701, 0x181]
+        await bus.send(Frame(0x201, b"\xaa"))
+        assert node.recv(5).data == b"\xaa"
+        assert await bus.recv_many(10, timeout=0.02) == []
+        sync = bus.sync
+    assert sync.closed                                                     # async with closed it
+    with pytest.raises(motorbus.InvalidArgument, match="aio.Bus"):
+        AioBus("virtual:x")
 
 
 async def test_bad_arguments_are_named():
