@@ -1,5 +1,6 @@
 from __future__ import annotations
 import collections.abc
+import motorbus._core.runtime
 import typing
 __all__: list[str] = ['EchoLineDevice', 'LineCounters', 'LineDevice', 'LineLink', 'LineServerCounters', 'Port', 'PtyLineServer', 'PtyPair', 'Rfc2217Port', 'TcpPort', 'TtyPort', 'open_port']
 class LineCounters:
@@ -241,6 +242,10 @@ class LineLink:
     def transact(self, request: typing.Any, timeout: typing.Any = None) -> bytes:
         """
         Sends request + terminator and returns the reply without its terminator. timeout None = the link's reply_timeout.
+        """
+    def transact_async(self, request: typing.Any, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex, timeout: typing.Any = None) -> None:
+        """
+        transact() for an event loop: returns at once; the reply (bytes) or the error arrives in `completions` under `token`, from the link's own worker thread (motorbus.aio.transact awaits it).
         """
     @property
     def counters(self) -> LineCounters:
