@@ -43,8 +43,12 @@ from ..bench import Bench as _SyncBench, StartReport
 from ..drive import Drive as _SyncDrive, DriveStatus, MoveInterrupted, ParamInfo, StopReason, Units
 from ..drive import open_drive as _open_drive
 from ..stopping import STOP_WAYS, StopHow, check_stop_way
+# The awaitable twins that live beside their blocking originals (docs/aio.md):
+from ..bus import AioBus as Bus, FrameStream, aio_open_bus as open_bus  # noqa: E402,F401
+from .discovery import discover  # noqa: E402,F401
 
-__all__ = ["Drive", "Params", "Bench", "open_drive", "transact", "STOP_TIMEOUT"]
+__all__ = ["Drive", "Params", "Bench", "open_drive", "transact", "Bus", "open_bus", "FrameStream", "discover",
+           "STOP_TIMEOUT"]
 
 #: Seconds an awaited move's cancellation waits for the motor to come to rest after
 #: its stop, unless the call gives ``stop_timeout``.
