@@ -391,3 +391,18 @@ async def test_a_loop_of_awaited_reads_does_not_starve_the_loop(vrig):
     # Never more than a few ms between two ticks while the reads ran.
     gaps = [b - a for a, b in zip([start] + during, during + [start + took])]
     assert len(during) >= 3 and max(gaps) < 0.2, (len(during), max(gaps), took)
+
+
+async def test_closing_a_network_on_a_bus_it_does_not_own_fails_pending_awaits():
+    name = f"aio-canopen-close-{next(_hub)}"
+    with motorbus.open_bus(f"virtual:{name}") as bus:
+        network = Network(bus, sdo_timeout=5.0)
+        node = network.add_node(9)                            # nobody serves it
+        pending = asyncio.ensure_future(node.sdo.upload_async(0x1000))
+        await asyncio.sleep(0.01)
+        network.close()                                       # the bus stays open
+        with pytest.raises(motorbus.ClosedError):
+            await pending
+        with pytest.raises(motorbus.ClosedError):
+            node.sdo.upload(0x1000)
+        assert not bus.closed

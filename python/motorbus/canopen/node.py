@@ -110,9 +110,11 @@ class RemoteNode:
         return self._cia402
 
     def close(self) -> None:
-        """Stops this node's PDO receivers and closes its CiA 402 object (its
-        watchdog is disarmed; the motor is left as it is)."""
+        """Stops this node's PDO receivers, closes its CiA 402 object (its
+        watchdog is disarmed; the motor is left as it is), then its SDO client:
+        transfers still awaited end with ClosedError at once, later ones too."""
         self.tpdo._close()
         self.rpdo._close()
         if self._cia402 is not None:
             self._cia402.close()
+        self.sdo.client.close()
