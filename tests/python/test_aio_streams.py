@@ -94,8 +94,14 @@ async def test_async_for_on_the_virtual_bus_keeps_bytes_and_order():
         check_sequence(await streamed(stream, tx, 600), 600)
         assert stream.overflows == 0 and stream.received == 600
         assert stream.wakeups <= 600                 # never more than one per frame (test_a_burst...: one per burst)
-        # The stream is a subscription of its own: recv()'s queue still has every frame.
-        check_sequence(rx.recv_many(1000, timeout=0), 600)
+        # The stream is a subscription of its own: recv()'s queue still has every frame (the
+        # bus thread hands a frame to its subscribers before its recv() queue: wait for the last).
+        queued = []
+        while len(queued) < 600:
+            more = rx.recv_many(1000, timeout=2.0)
+            assert more, f"recv() queue stopped at {len(queued)} frames"
+            queued += more
+        check_sequence(queued, 600)
         stream.close()
 
 
