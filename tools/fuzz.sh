@@ -23,7 +23,7 @@ if [ -z "$BIN" ]; then
   BIN=build/asan
   if ! ls build/asan/fuzz_* >/dev/null 2>&1; then
     CC=clang CXX=clang++ cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DMOTORBUS_FUZZ=ON -DMOTORBUS_PYTHON=OFF >/dev/null
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DMOTORBUS_FUZZ=ON -DMOTORBUS_PYTHON=OFF >/dev/null
   fi
   cmake --build build/asan -j"$JOBS" >/dev/null
 fi
