@@ -39,6 +39,9 @@ class Kind:
     #: Where the simulator's shaft is, native units: read from the simulator itself, so a
     #: test sees the motor from outside the drive objects it commanded.
     shaft: Callable[[Any], float] = lambda sim: sim.position
+    #: A target (user units) far enough that the simulator does not get there before a
+    #: cancellation sent once the move runs lands, even on a loaded machine.
+    far: float = 400.0
 
 
 def _cia402_setup(drive: Any) -> None:
@@ -90,7 +93,8 @@ KINDS = {
                    unfault=lambda sim: sim.set_hardware_enable(True), param="ACC_RAMP", value=200, jog=50.0,
                    setup=lambda drive: drive.params.__setitem__("ACC_RAMP", 20),  # ms to N max
                    # a short deceleration ramp (speed 0 is the stop): a stop lands well short of a far target
-                   sim_options={"calibrated": True, "dec_ramp_ms": 20}, shaft=lambda sim: sim.position_num),
+                   sim_options={"calibrated": True, "dec_ramp_ms": 20}, shaft=lambda sim: sim.position_num,
+                   far=4000.0),   # fast: 400 mm came to its end before a cancellation on a loaded CI run
     "pmc007": Kind("pmc007", "5", 0.01, fault=lambda sim, drive: sim.inject_error(1),  # UVLO
                    param="start_speed", value=500, jog=50.0, home="ext1", setup=_pmc007_setup),
     # The out-of-tree test kind (tests/plugin_kind/): registered only while its package is on the path.

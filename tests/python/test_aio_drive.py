@@ -159,7 +159,7 @@ async def _moving(axis: aio.Drive) -> None:
 async def test_cancelling_an_awaited_move_stops_the_motor(axis, kind, rig):
     kind.setup(axis.sync)
     await axis.enable()
-    move = asyncio.create_task(axis.move_to(400.0, timeout=60))
+    move = asyncio.create_task(axis.move_to(kind.far, timeout=60))
     await _moving(axis)
     move.cancel()
     with pytest.raises(asyncio.CancelledError):
@@ -169,7 +169,7 @@ async def test_cancelling_an_awaited_move_stops_the_motor(axis, kind, rig):
     here = kind.shaft(rig.sim)
     await asyncio.sleep(0.1)
     assert kind.shaft(rig.sim) == here
-    assert here * kind.scale < 400.0
+    assert here * kind.scale < kind.far
     last = (await axis.status()).last_move
     assert last.state == "interrupted" and "cancellation" in last.reason
     await axis.move_to(1.0, timeout=20)                 # the axis takes the next move
