@@ -18,6 +18,8 @@ using motorbus::test::H;
 using motorbus::test::hex;
 using motorbus::test::LoopHub;
 
+using motorbus::test::pattern;
+
 namespace {
 
 std::shared_ptr<ObjectDictionary> make_od() {
@@ -37,12 +39,6 @@ std::shared_ptr<ObjectDictionary> make_od() {
     od->add_variable({.index = 0x2201, .name = "Blob", .type = DataType::Domain, .access = Access::RW,
                       .max_size = 1 << 20});
     return od;
-}
-
-Bytes pattern(std::size_t n) {
-    Bytes b(n);
-    for (std::size_t i = 0; i < n; ++i) b[i] = static_cast<std::uint8_t>((i * 31 + 7) ^ (i >> 8));
-    return b;
 }
 
 struct NodeFixture : ::testing::Test {

@@ -25,6 +25,8 @@ using namespace std::chrono_literals;
 using motorbus::test::hex;
 using motorbus::test::LoopHub;
 
+using motorbus::test::pattern;
+
 namespace {
 
 std::shared_ptr<ObjectDictionary> make_od(std::uint32_t device_type = 0x00020192) {
@@ -37,12 +39,6 @@ std::shared_ptr<ObjectDictionary> make_od(std::uint32_t device_type = 0x00020192
     od->add_variable({.index = 0x2201, .name = "Blob", .type = DataType::Domain, .access = Access::RW,
                       .max_size = 1 << 20});
     return od;
-}
-
-Bytes pattern(std::size_t n) {
-    Bytes b(n);
-    for (std::size_t i = 0; i < n; ++i) b[i] = static_cast<std::uint8_t>((i * 31 + 7) ^ (i >> 8));
-    return b;
 }
 
 Bytes le32(std::uint32_t v) { return {std::uint8_t(v), std::uint8_t(v >> 8), std::uint8_t(v >> 16), std::uint8_t(v >> 24)}; }

@@ -11,18 +11,15 @@
 #include "motorbus/can/virtual_bus.hpp"
 #include "motorbus/canopen/local_node.hpp"
 #include "motorbus/canopen/sdo_client.hpp"
+#include "test_sdo_util.hpp"
 
 using namespace motorbus;
 using namespace motorbus::canopen;
 using namespace std::chrono_literals;
 
-namespace {
+using motorbus::test::pattern;
 
-Bytes pattern(std::size_t n) {
-    Bytes b(n);
-    for (std::size_t i = 0; i < n; ++i) b[i] = static_cast<std::uint8_t>((i * 31 + 7) ^ (i >> 8));
-    return b;
-}
+namespace {
 
 std::string fresh_hub() {
     static std::atomic<int> n{0};

@@ -32,6 +32,13 @@ inline std::string hex(const Container& p) {
     return s;
 }
 
+// n bytes of a fixed, non-repeating pattern: transfers of any size compare byte for byte.
+inline std::vector<std::uint8_t> pattern(std::size_t n) {
+    std::vector<std::uint8_t> b(n);
+    for (std::size_t i = 0; i < n; ++i) b[i] = static_cast<std::uint8_t>((i * 31 + 7) ^ (i >> 8));
+    return b;
+}
+
 inline std::vector<std::string> hexes(const std::vector<canopen::sdo::Payload>& v) {
     std::vector<std::string> out;
     for (auto& p : v) out.push_back(hex(p));
