@@ -228,14 +228,20 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_forked_child)
 
 
+def ladder(how, stop, quick_stop, disable) -> tuple:
+    """The ways to try, in order, for a safety word: the asked one, then each harder one
+    (a failed stop falls back to the quick stop, then to disabling); none for None.  The
+    blocking ``halt`` below and motorbus.aio's awaited one both climb it."""
+    if how is None:
+        return ()
+    return {"stop": (stop, quick_stop, disable), "quick_stop": (quick_stop, disable), "disable": (disable,)}[how]
+
+
 def halt(how, stop, quick_stop, disable) -> None:
     """Applies one of the safety words ("stop", "quick_stop", "disable"; None does
     nothing) with the three ways a drive has; best effort while unwinding: a way
     that fails (the link may be gone) falls back to the next harder one."""
-    if how is None:
-        return
-    ladder = {"stop": (stop, quick_stop, disable), "quick_stop": (quick_stop, disable), "disable": (disable,)}[how]
-    for step in ladder:
+    for step in ladder(how, stop, quick_stop, disable):
         try:
             step()
             return

@@ -114,13 +114,11 @@ class LoopBridge:
         self._futures: dict[int, asyncio.Future] = {}
         self._tokens = itertools.count(1)
         self._from_threads: collections.deque = collections.deque()
-        self._watched = True
         try:
             loop.add_reader(self.completions.fileno(), self._drain)
         except NotImplementedError:
             # A loop that cannot watch a descriptor (Windows' proactor): the pushing
             # thread schedules the drain, once per burst.
-            self._watched = False
             self.completions.set_wakeup(lambda: loop.call_soon_threadsafe(self._drain))
 
     def expect(self) -> tuple[int, asyncio.Future]:
@@ -160,11 +158,6 @@ class LoopBridge:
             else:
                 future.set_exception(error)
 
-    def close(self) -> None:
-        if self._watched and not self.loop.is_closed():
-            self.loop.remove_reader(self.completions.fileno())
-        self.completions.set_wakeup(None)
-
 
 _bridges: "weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, LoopBridge]" = weakref.WeakKeyDictionary()
 _bridges_lock = threading.Lock()
@@ -175,7 +168,7 @@ def bridge_for(loop: Optional[asyncio.AbstractEventLoop] = None) -> LoopBridge:
     loop = loop or asyncio.get_running_loop()
     with _bridges_lock:
         bridge = _bridges.get(loop)
-        if bridge is None or bridge.loop.is_closed():
+        if bridge is None:
             bridge = _bridges[loop] = LoopBridge(loop)
     return bridge
 

@@ -156,20 +156,31 @@ async def _moving(axis: aio.Drive) -> None:
         await asyncio.sleep(0.005)
 
 
-async def test_cancelling_an_awaited_move_stops_the_motor(axis, kind, rig):
+def here_short_of(kind: Any, rig: Any) -> bool:
+    """The simulator's shaft (read from outside) stands short of the kind's far target."""
+    return kind.shaft(rig.sim) * kind.scale < kind.far
+
+
+async def _cancel_once_moving(axis: aio.Drive, kind: Any, target: float, **options: Any) -> None:
+    """Starts an awaited move to ``target``, cancels its task once the drive moves, and
+    checks that the await ends in CancelledError."""
     kind.setup(axis.sync)
     await axis.enable()
-    move = asyncio.create_task(axis.move_to(kind.far, timeout=60))
+    move = asyncio.create_task(axis.move_to(target, timeout=60, **options))
     await _moving(axis)
     move.cancel()
     with pytest.raises(asyncio.CancelledError):
         await move
+
+
+async def test_cancelling_an_awaited_move_stops_the_motor(axis, kind, rig):
+    await _cancel_once_moving(axis, kind, kind.far)
     # When the CancelledError arrives the shaft is already at rest, seen from outside
     # (the simulator itself, not a drive object), and stays there, short of the target.
     here = kind.shaft(rig.sim)
     await asyncio.sleep(0.1)
     assert kind.shaft(rig.sim) == here
-    assert here * kind.scale < kind.far
+    assert here_short_of(kind, rig)
     last = (await axis.status()).last_move
     assert last.state == "interrupted" and "cancellation" in last.reason
     await axis.move_to(1.0, timeout=20)                 # the axis takes the next move
@@ -184,7 +195,8 @@ async def test_readbacks_while_a_move_starts_do_not_judge_it(axis, kind):
     move = asyncio.create_task(axis.move_to(5.0, timeout=30))
     seen = set()
     while not move.done():
-        seen.add((await axis.status()).last_move.state if (await axis.status()).last_move else None)
+        last = (await axis.status()).last_move
+        seen.add(None if last is None else last.state)
     await move
     assert seen <= {None, "running", "done"}, seen
     assert (await axis.status()).last_move.state == "done"
@@ -192,18 +204,25 @@ async def test_readbacks_while_a_move_starts_do_not_judge_it(axis, kind):
 
 
 async def test_stop_on_cancel_false_leaves_the_motor_going(axis, kind, rig):
-    kind.setup(axis.sync)
-    await axis.enable()
-    move = asyncio.create_task(axis.move_to(60.0, timeout=60, stop_on_cancel=False))
-    await _moving(axis)
-    move.cancel()
-    with pytest.raises(asyncio.CancelledError):
-        await move
+    await _cancel_once_moving(axis, kind, 60.0, stop_on_cancel=False)
     here = kind.shaft(rig.sim)
     await asyncio.sleep(0.1)
     assert kind.shaft(rig.sim) != here              # fire-and-forget, as asked: still turning
     await axis.wait_idle(timeout=30)
     assert await axis.position() == pytest.approx(60.0, abs=kind.scale)
+
+
+@pytest.mark.parametrize("kind", ["toy"], indirect=True)
+async def test_a_cancelled_move_not_at_rest_within_stop_timeout_is_recorded_as_still_moving(axis, kind, rig):
+    """The toy's STOP ramps down over about half a second: with no time allowed for rest
+    the outcome must say the motor was still moving, not judge a shaft still turning."""
+    axis.stop_timeout = 0.0
+    await _cancel_once_moving(axis, kind, kind.far)
+    last = (await axis.status()).last_move
+    assert last.state == "timeout" and "no rest within 0 s" in last.reason, last
+    assert "still moving at" in str(last.error)
+    await axis.wait_idle(timeout=10)                    # the stop was sent: it does come to rest
+    assert here_short_of(kind, rig)
 
 
 async def test_a_thousand_awaits_at_once(axis, kind):

@@ -38,9 +38,9 @@ import asyncio
 from collections.abc import Mapping
 from typing import Any, Optional, Union
 
-from .. import _core, faces
+from .. import _core, _stop_at_exit, faces
 from ..bench import Bench as _SyncBench, StartReport
-from ..drive import Drive as _SyncDrive, DriveStatus, MoveInterrupted, ParamInfo, StopReason, Units
+from ..drive import Drive as _SyncDrive, DriveStatus, MoveInterrupted, MoveTimedOut, ParamInfo, StopReason, Units
 from ..drive import open_drive as _open_drive
 from ..stopping import STOP_WAYS, StopHow, check_stop_way
 # The awaitable twins that live beside their blocking originals (docs/aio.md):
@@ -205,38 +205,42 @@ class Drive:
 
     async def _stop_after_cancel(self) -> None:
         """The cancelled move's stop: sent at once (ahead of anything queued on the link),
-        then a bounded wait for rest; the move is recorded as interrupted by the
-        cancellation.  A second cancellation during this wait ends the wait, not the stop
-        (the stop was already sent)."""
+        then a bounded wait for rest; the move's outcome is recorded.  Shielded: a second
+        cancellation ends this wait, not the stop (already sent) nor the recording."""
         d = self.sync
+        by = "the cancellation of the awaiting task"
         try:
-            await asyncio.shield(d._co_stop(by="the cancellation of the awaiting task"))
+            await asyncio.shield(d._co_stop(by=by))
         except Exception:  # noqa: BLE001 - a failed stop falls back as the exit hook's ladder does
             try:
-                await asyncio.shield(d._co_quick_stop(by="the cancellation of the awaiting task"))
+                await asyncio.shield(d._co_quick_stop(by=by))
             except Exception:  # noqa: BLE001 - nothing more to do from here; the CancelledError goes on
                 return
         try:
-            await asyncio.wait_for(asyncio.shield(self._settle_cancelled()), self.stop_timeout)
-        except (asyncio.TimeoutError, Exception):  # noqa: BLE001 - the cancellation is what the caller gets
+            await asyncio.shield(self._settle_cancelled())
+        except Exception:  # noqa: BLE001 - recorded in last_move where it could be; the cancellation goes on
             pass
 
     async def _settle_cancelled(self) -> None:
-        """At rest after the cancellation's stop: the move's outcome recorded (a move or
-        jog judged as any other; a homing cut short is interrupted, whatever it had found)."""
+        """Waits up to ``stop_timeout`` for rest after the cancellation's stop and records
+        the move's outcome: judged as any other once at rest (a homing cut short is
+        interrupted, whatever it had found); not at rest in time, a MoveTimedOut saying
+        the motor was still moving -- never a judgement of a shaft still turning."""
         d = self.sync
         move = d._move
         try:
             await d._wait(d._is_idle, self.stop_timeout, "the stop after a cancellation")
-        finally:
+        except _core.TimeoutError:
             if move is not None and not move.judged:
-                try:
-                    if move.what == "home":
-                        await d._failure(move, StopReason(MoveInterrupted, f"{move.stopped_by} of this program"))
-                    else:
-                        await d._judge(move, raise_error=False)
-                except Exception:  # noqa: BLE001 - recorded in last_move
-                    pass
+                await d._failure(move, StopReason(MoveTimedOut, f"no rest within {self.stop_timeout:g} s of the "
+                                                                 "stop sent for the cancellation"), at_rest=False)
+            raise
+        if move is None or move.judged:
+            return
+        if move.what == "home":
+            await d._failure(move, StopReason(MoveInterrupted, f"{move.stopped_by} of this program"))
+        else:
+            await d._judge(move, raise_error=False)
 
     # ---- safety --------------------------------------------------------------------------------
     async def __aenter__(self) -> "Drive":
@@ -253,9 +257,7 @@ class Drive:
         """The ``on_error`` ladder of the blocking face, awaited: the asked stop, then the
         stronger ones if it fails."""
         d = self.sync
-        ladder = {"stop": (d._co_stop, d._co_quick_stop, d._co_disable),
-                  "quick_stop": (d._co_quick_stop, d._co_disable), "disable": (d._co_disable,), None: ()}[how]
-        for step in ladder:
+        for step in _stop_at_exit.ladder(how, d._co_stop, d._co_quick_stop, d._co_disable):
             try:
                 await asyncio.shield(step())
                 return
