@@ -6,9 +6,6 @@
 // to, and destroys the service with the GIL released, because unsubscribing
 // or joining a timer thread waits for a callback that may itself be waiting
 // for the GIL.  Counters and statuses are the C++ structs, read-only.
-#include <atomic>
-#include <utility>
-
 #include <pybind11/functional.h>
 #include <pybind11/native_enum.h>
 #include <pybind11/pybind11.h>
@@ -361,45 +358,6 @@ static void bind_codecs(py::module_& m) {
           }, py::arg("frame"), "Unix time in ms, or None.");
 }
 
-// One awaited NMT event of one node (motorbus.canopen's awaitable face): the
-// next frame on 0x700+n that is a boot-up (want 0), reports state `want`, or any
-// heartbeat (want -1).  It completes `token` with the state byte on the bus's
-// receive thread, without the GIL, and stops listening; cancel() stops it too.
-// A binding-level helper because NmtMaster (blocking waits on a condition
-// variable) has no completion-based entry point; it reads the same frames.
-class NmtEventWait : public std::enable_shared_from_this<NmtEventWait> {
-public:
-    NmtEventWait(BusPtr bus, std::uint8_t node, int want, std::shared_ptr<Completions> done, std::uint64_t token)
-        : bus_(std::move(bus)), node_(node), want_(want), done_(std::move(done)), token_(token) {}
-    void start() {
-        std::weak_ptr<NmtEventWait> self = weak_from_this();
-        sub_ = bus_->subscribe_id(0x700u + node_, false, [self](const can::Frame& f) {
-            if (auto s = self.lock()) s->on_frame(f);
-        });
-    }
-    void cancel() {
-        can::SubscriptionId sub = sub_.exchange(0);
-        if (sub) bus_->unsubscribe(sub);
-    }
-    ~NmtEventWait() { cancel(); }
-
-private:
-    void on_frame(const can::Frame& f) {
-        if (f.rtr || f.len < 1) return;
-        const std::uint8_t state = f.data[0] & 0x7F;  // the toggle bit of node guarding is not the state
-        const bool match = want_ < 0 || (want_ == 0 ? (f.len == 1 && f.data[0] == 0) : state == want_);
-        if (!match || fired_.exchange(true)) return;
-        done_->push(token_, static_cast<int>(state));
-    }
-    BusPtr bus_;
-    std::uint8_t node_;
-    int want_;
-    std::shared_ptr<Completions> done_;
-    std::uint64_t token_;
-    std::atomic<bool> fired_{false};
-    std::atomic<can::SubscriptionId> sub_{0};
-};
-
 static void bind_nmt(py::module_& m) {
     // ---- NMT master -----------------------------------------------------------
     // Wrapped by motorbus.canopen.nmt.NmtMaster, which carries the docstrings.
@@ -465,19 +423,19 @@ static void bind_nmt(py::module_& m) {
         "An awaited NMT event of one node (motorbus.canopen.nmt's *_async waits).")
         .def("cancel", [](NmtEventWait& w) { py::gil_scoped_release nogil; w.cancel(); });
     m.def("nmt_wait_async",
-          [](BusPtr bus, int node, int want, std::shared_ptr<Completions> done, std::uint64_t token) {
+          [](BusPtr bus, int node, const std::optional<std::string>& state, bool boot_up,
+             std::shared_ptr<Completions> done, std::uint64_t token) {
               not_none(bus, "bus");
               check_node(node, false);
-              if (want < -1 || want > 0x7F) throw InvalidArgument("nmt_wait_async want: -1 (any heartbeat), 0 (boot-up) or a state byte");
-              if (!done) throw InvalidArgument("nmt_wait_async: no Completions to complete on");
-              auto w = std::make_shared<NmtEventWait>(std::move(bus), static_cast<std::uint8_t>(node), want,
-                                                      std::move(done), token);
-              w->start();
-              return w;
+              auto want = boot_up ? NmtEventWait::Want::BootUp
+                                  : state ? NmtEventWait::Want::State : NmtEventWait::Want::AnyHeartbeat;
+              return NmtEventWait::start(std::move(bus), static_cast<std::uint8_t>(node), want,
+                                         state ? node_state_of(*state) : NodeState::Unknown, std::move(done), token);
           },
-          py::arg("bus"), py::arg("node"), py::arg("want"), py::arg("completions"), py::arg("token"),
-          "Completes `token` with the state byte of node's next boot-up (want 0), state `want`, or any "
-          "heartbeat (want -1); cancel() the returned waiter when no longer wanted.");
+          py::arg("bus"), py::arg("node"), py::arg("state") = py::none(), py::arg("boot_up") = false,
+          py::arg("completions"), py::arg("token"),
+          "Completes `token` with the state name of node's next boot-up (boot_up), heartbeat in `state`, or "
+          "any heartbeat; cancel() the returned waiter when no longer wanted (C++ canopen::NmtEventWait).");
 }
 
 static void bind_heartbeat(py::module_& m) {

@@ -196,6 +196,8 @@ async def test_nmt_waits(rig):
         await node.nmt.wait_for_bootup_async(0.1)
     assert await vrig.network.nmt.wait_for_heartbeat_async(5, 0.1) is None
     assert hb.heartbeats_sent == sent
+    with pytest.raises(motorbus.InvalidArgument, match="NMT state.*'RUNNING'"):
+        await node.nmt.wait_for_state_async("RUNNING", 0.1)
 
 
 async def test_pdo_configuration_awaited(rig):

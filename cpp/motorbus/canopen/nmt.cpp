@@ -204,4 +204,38 @@ std::optional<NodeState> NmtMaster::wait_for_heartbeat(std::uint8_t node, std::c
     return node_state_from_byte(static_cast<std::uint8_t>(raw_[node]));
 }
 
+NmtEventWait::NmtEventWait(std::shared_ptr<can::Bus> bus, std::uint8_t node, Want want, NodeState state,
+                           std::shared_ptr<Completions> done, std::uint64_t token)
+    : bus_(std::move(bus)), node_(node), want_(want), state_(state), done_(std::move(done)), token_(token) {
+    if (!bus_) throw InvalidArgument("NmtEventWait: no bus");
+    if (!done_) throw InvalidArgument("NmtEventWait: no Completions to complete on");
+    if (node == 0 || node > kMaxNodeId) throw InvalidArgument("node id must be 1-127");
+}
+
+std::shared_ptr<NmtEventWait> NmtEventWait::start(std::shared_ptr<can::Bus> bus, std::uint8_t node, Want want,
+                                                  NodeState state, std::shared_ptr<Completions> done,
+                                                  std::uint64_t token) {
+    auto w = std::make_shared<NmtEventWait>(std::move(bus), node, want, state, std::move(done), token);
+    std::weak_ptr<NmtEventWait> self = w;
+    w->sub_ = w->bus_->subscribe_id(kHeartbeatBase + node, false, [self](const can::Frame& f) {
+        if (auto s = self.lock()) s->on_frame(f);
+    });
+    return w;
+}
+
+void NmtEventWait::cancel() {
+    can::SubscriptionId sub = sub_.exchange(0);
+    if (sub) bus_->unsubscribe(sub);
+}
+
+NmtEventWait::~NmtEventWait() { cancel(); }
+
+void NmtEventWait::on_frame(const can::Frame& f) {
+    auto hb = decode_heartbeat(f);
+    if (!hb) return;
+    const bool match = want_ == Want::AnyHeartbeat || (want_ == Want::BootUp ? hb->is_boot_up() : hb->state == state_);
+    if (!match || fired_.exchange(true)) return;
+    done_->push(token_, std::string(to_string(hb->state)));
+}
+
 }  // namespace motorbus::canopen

@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -18,6 +19,7 @@
 // NmtCommand and the LocalNode's NmtState (without UNKNOWN) come from here.
 #include "motorbus/canopen/local_node.hpp"
 #include "motorbus/runtime/callback_slot.hpp"
+#include "motorbus/runtime/completions.hpp"
 
 namespace motorbus::canopen {
 
@@ -134,6 +136,37 @@ private:
     std::array<std::uint64_t, 128> heard_{};  // heartbeats + boot-ups per node
     std::atomic<std::uint64_t> foreign_ignored_{0};
     can::SubscriptionId hb_sub_ = 0, nmt_sub_ = 0;
+};
+
+// One awaited NMT event of one node, for event loops (motorbus.canopen's *_async
+// waits): the first heartbeat or boot-up of `node` -- the frames NmtMaster's waits
+// count, decoded by decode_heartbeat -- that matches `want` completes `token` on
+// the bus's receive thread with the state's name (std::string, as NmtMaster::state
+// names it), without the GIL; the wait then stops listening.  cancel() (or the
+// destructor) stops it too.  The wait holds the bus alive.
+class NmtEventWait : public std::enable_shared_from_this<NmtEventWait> {
+public:
+    enum class Want { AnyHeartbeat, BootUp, State };
+    static std::shared_ptr<NmtEventWait> start(std::shared_ptr<can::Bus> bus, std::uint8_t node, Want want,
+                                               NodeState state, std::shared_ptr<Completions> done,
+                                               std::uint64_t token);
+    void cancel();
+    ~NmtEventWait();
+
+    // Use start(): the subscription needs the shared pointer.
+    NmtEventWait(std::shared_ptr<can::Bus> bus, std::uint8_t node, Want want, NodeState state,
+                 std::shared_ptr<Completions> done, std::uint64_t token);
+
+private:
+    void on_frame(const can::Frame& f);
+    std::shared_ptr<can::Bus> bus_;
+    std::uint8_t node_;
+    Want want_;
+    NodeState state_;
+    std::shared_ptr<Completions> done_;
+    std::uint64_t token_;
+    std::atomic<bool> fired_{false};
+    std::atomic<can::SubscriptionId> sub_{0};
 };
 
 }  // namespace motorbus::canopen

@@ -1156,9 +1156,9 @@ def nmt_encode(command: NmtCommand, node: typing.SupportsInt | typing.SupportsIn
 @typing.overload
 def nmt_encode(command: typing.SupportsInt | typing.SupportsIndex, node: typing.SupportsInt | typing.SupportsIndex) -> motorbus._core.can.Frame:
     ...
-def nmt_wait_async(bus: motorbus._core.can.Bus, node: typing.SupportsInt | typing.SupportsIndex, want: typing.SupportsInt | typing.SupportsIndex, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex) -> NmtEventWait:
+def nmt_wait_async(bus: motorbus._core.can.Bus, node: typing.SupportsInt | typing.SupportsIndex, state: str | None = None, boot_up: bool = False, completions: motorbus._core.runtime.Completions, token: typing.SupportsInt | typing.SupportsIndex) -> NmtEventWait:
     """
-    Completes `token` with the state byte of node's next boot-up (want 0), state `want`, or any heartbeat (want -1); cancel() the returned waiter when no longer wanted.
+    Completes `token` with the state name of node's next boot-up (boot_up), heartbeat in `state`, or any heartbeat; cancel() the returned waiter when no longer wanted (C++ canopen::NmtEventWait).
     """
 def pdo_read_config(sdo: typing.Any, node: typing.SupportsInt | typing.SupportsIndex, tpdo: bool, number: typing.SupportsInt | typing.SupportsIndex) -> PdoConfig:
     ...

@@ -31,31 +31,26 @@ NMT_STATES = ("INITIALISING", "STOPPED", "OPERATIONAL", "PRE-OPERATIONAL", "UNKN
 
 from .._core.canopen import nmt_encode, nmt_decode, NmtCommand  # noqa: E402,F401
 
-_STATE_NAMES = {0x00: "INITIALISING", 0x04: "STOPPED", 0x05: "OPERATIONAL", 0x7F: "PRE-OPERATIONAL"}
-_STATE_BYTES = {name: byte for byte, name in _STATE_NAMES.items()}
-_ANY_HEARTBEAT, _BOOT_UP = -1, 0
-
-
-def _state_byte(state: str) -> int:
-    key = str(state).strip().upper().replace("_", "-").replace(" ", "-")
-    if key not in _STATE_BYTES:
-        raise _core.InvalidArgument(f"NMT state {state!r}: one of INITIALISING, STOPPED, OPERATIONAL, PRE-OPERATIONAL")
-    return _STATE_BYTES[key]
-
-
 class _NmtEvent:
-    """One awaited NMT event: subscribed on creation (before any state check, so
-    nothing is missed in between), awaited with a timeout, unsubscribed after."""
+    """One awaited NMT event (C++ ``canopen::NmtEventWait``): subscribed on creation
+    (before any state check, so nothing is missed in between), awaited with a timeout,
+    unsubscribed after.  ``state``: a heartbeat in that state; ``boot_up``: a boot-up;
+    neither: any heartbeat."""
 
-    def __init__(self, bus: _core.can.Bus, node: int, want: int) -> None:
+    def __init__(self, bus: _core.can.Bus, node: int, state: Optional[str] = None, boot_up: bool = False) -> None:
         self.bridge = faces.bridge_for()
         self.token, self.future = self.bridge.expect()
-        self.waiter = _core.canopen.nmt_wait_async(bus, node, want, self.bridge.completions, self.token)
+        try:
+            self.waiter = _core.canopen.nmt_wait_async(bus, node, state, boot_up, self.bridge.completions,
+                                                        self.token)
+        except BaseException:
+            self.bridge.forget(self.token)
+            raise
 
     async def state(self, timeout: Optional[float]) -> Optional[str]:
         """The state the event reported; None after ``timeout`` s (None = no limit)."""
         try:
-            return _STATE_NAMES.get(await asyncio.wait_for(self.future, timeout), "UNKNOWN")
+            return await asyncio.wait_for(self.future, timeout)
         except asyncio.TimeoutError:
             return None
         finally:
@@ -119,19 +114,19 @@ class NmtMaster:
     async def wait_for_state_async(self, node: int, state: str, timeout: float = 1.0) -> bool:
         """Awaitable :meth:`wait_for_state`: True once ``node`` reports ``state`` (at
         once if it last did), False after ``timeout``."""
-        event = _NmtEvent(self.bus, node, _state_byte(state))
-        if self._m.state(node) == _STATE_NAMES[_state_byte(state)]:
+        event = _NmtEvent(self.bus, node, state=state)
+        if self._m.wait_for_state(node, state, 0):      # the last state heard is it: no wait
             event.close()
             return True
         return await event.state(timeout) is not None
 
     async def wait_for_boot_async(self, node: int, timeout: float = 1.0) -> bool:
         """Awaitable :meth:`wait_for_boot`: True when the node's next boot-up comes."""
-        return await _NmtEvent(self.bus, node, _BOOT_UP).state(timeout) is not None
+        return await _NmtEvent(self.bus, node, boot_up=True).state(timeout) is not None
 
     async def wait_for_heartbeat_async(self, node: int, timeout: float = 1.0) -> Optional[str]:
         """Awaitable :meth:`wait_for_heartbeat`: the state of the next heartbeat or boot-up; None on timeout."""
-        return await _NmtEvent(self.bus, node, _ANY_HEARTBEAT).state(timeout)
+        return await _NmtEvent(self.bus, node).state(timeout)
 
     @property
     def on_state_change(self) -> Optional[Callable[[int, str, str], None]]:
