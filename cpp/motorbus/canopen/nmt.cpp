@@ -217,7 +217,7 @@ std::shared_ptr<NmtEventWait> NmtEventWait::start(std::shared_ptr<can::Bus> bus,
                                                   std::uint64_t token) {
     auto w = std::make_shared<NmtEventWait>(std::move(bus), node, want, state, std::move(done), token);
     std::weak_ptr<NmtEventWait> self = w;
-    w->sub_ = w->bus_->subscribe_id(kHeartbeatBase + node, false, [self](const can::Frame& f) {
+    w->sub_ = w->bus_->subscribe_id(kHeartbeatBase + w->node_, false, [self](const can::Frame& f) {
         if (auto s = self.lock()) s->on_frame(f);
     });
     return w;
