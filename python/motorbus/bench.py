@@ -49,7 +49,9 @@ from .stopping import STOP_WAYS, check_stop_way
 
 __all__ = ["Bench", "BenchFileError", "AxisConfig", "ParamDiff", "StartReport"]
 
-_SECTIONS = ("bus", "line", "axis")
+_SECTIONS = ("bus", "line", "axis", "epics")
+#: [epics]: read by `motorbus serve` (docs/serve.md, docs/epics.md); the bench itself ignores it.
+_EPICS_KEYS = {"prefix"}
 _BUS_KEYS = {"spec"}
 _LINE_KEYS = {"port", "baud", "timeout", "turnaround"}
 _AXIS_KEYS = {"kind", "line", "bus", "address", "units", "params", "options", "sim"}
@@ -348,8 +350,15 @@ class _Checker:
     def check(self) -> tuple[dict, dict, dict[str, AxisConfig]]:
         unknown = sorted(set(self.data) - set(_SECTIONS))
         if unknown:
-            raise self.fail("unknown section (a bench file has [bus.NAME], [line.NAME] and [axis.NAME])",
-                            unknown[0])
+            raise self.fail("unknown section (a bench file has [bus.NAME], [line.NAME], [axis.NAME] and "
+                            "[epics])", unknown[0])
+        epics = self.data.get("epics", {})
+        if not isinstance(epics, Mapping) or set(epics) - _EPICS_KEYS:
+            bad = sorted(set(epics) - _EPICS_KEYS)[0] if isinstance(epics, Mapping) else None
+            raise self.fail(f"unknown key ([epics] takes: {', '.join(sorted(_EPICS_KEYS))})" if bad else
+                            f"expected a table [epics], not a {type(epics).__name__}", "epics", *([bad] if bad else []))
+        if "prefix" in epics:
+            self.text(epics, "prefix", "epics")
         buses = self.tables("bus", _BUS_KEYS)
         for name, t in buses.items():
             t["spec"] = self.text(t, "spec", "bus", name)

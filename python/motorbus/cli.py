@@ -10,6 +10,7 @@
     motorbus demo
     motorbus status|move|home|stop|enable|disable|clear|config ... BENCH [--json] [--sim]   (cli_bench.py)
     motorbus monitor BENCH [--rate HZ] [--axis NAME]... [--ask] [--sim]   (python/motorbus/cli_monitor.py)
+    motorbus serve BENCH [--sim] [--prefix P] [--interface ADDR]... [--no-epics]   (cli_serve.py, docs/serve.md)
     motorbus --version;  motorbus -v|-vv|--trace COMMAND ...   (logging to stderr; --trace: frames and lines)
 
 The exit codes are one table (cli_bench.EXIT_CODES), printed at the end of ``motorbus --help``.
@@ -74,7 +75,14 @@ def _report(servers: Any) -> None:
         print(line, file=sys.stderr, flush=True)
 
 
+def _refuse_served(spec: str, what: str) -> None:
+    from .cli_bench import refuse_served_link
+
+    refuse_served_link(spec, what)
+
+
 def cmd_bus_dump(args: argparse.Namespace) -> int:
+    _refuse_served(args.spec, "a bus dump")
     bus = open_bus(args.spec)
     rec = _core.can.Recorder(bus, args.log) if args.log else None
     n = 0
@@ -95,6 +103,7 @@ def cmd_bus_dump(args: argparse.Namespace) -> int:
 
 
 def cmd_bus_play(args: argparse.Namespace) -> int:
+    _refuse_served(args.spec, "replaying frames onto its bus")
     entries, bad = _core.can.read_log(args.file)
     with open_bus(args.spec) as bus:
         n = _core.can.play(bus, entries, args.speed)
@@ -346,9 +355,10 @@ def build_parser() -> argparse.ArgumentParser:
     dl = sub.add_parser("drives", help="list the registered drive kinds", parents=[common])
     dl.set_defaults(func=cmd_drives)
 
-    from . import cli_bench, cli_monitor
+    from . import cli_bench, cli_monitor, cli_serve
     cli_bench.add_commands(sub, common)
     cli_monitor.add_commands(sub, common)
+    cli_serve.add_commands(sub, common)
 
     dm = sub.add_parser("demo", help="run the simulated bench demo")
     dm.add_argument("--quick", action="store_true", help="shorter moves (used by the tests)")

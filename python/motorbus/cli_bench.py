@@ -16,6 +16,11 @@ changes a drive and stop nothing when they leave (another program may be moving 
 bench).  A command naming axes opens only the lines and buses those axes are on.
 ``--sim`` runs the command against the bench's simulated twin: a fresh one per
 command (every axis replaced by its simulator, at its power-on state).
+
+While ``motorbus serve BENCH`` runs, every command above but ``scan`` and ``terminal``
+goes through it (``--server ADDR`` names a service, ``--no-server`` opens the transports
+here anyway); ``terminal``, and a ``scan`` of a line or bus it holds, are refused with
+exit code 4 (docs/serve.md).  The exit codes stay the Drive API's outcome codes.
 """
 from __future__ import annotations
 
@@ -54,7 +59,8 @@ EXIT_CODES: tuple[tuple[int, str], ...] = (
     (EXIT_DRIVE, "a drive refused a command or failed (the message says which axis and why)"),
     (EXIT_USAGE, "the command line or the bench file is wrong (file:line: key, or the argument)"),
     (EXIT_DIFFERENT, "config diff found differences"),
-    (EXIT_BUSY, "busy: a serial port is held by another process (the message names it)"),
+    (EXIT_BUSY, "busy: a serial port is held by another process, or the bench by its `motorbus serve` "
+                "(the message names it)"),
     (EXIT_LINK, "a line or bus cannot be reached, or a drive did not answer"),
     (EXIT_MOVE_INTERRUPTED, "move/home stopped short by a stop from another program or a drive stop input"),
     (EXIT_MOVE_LIMIT, "move/home stopped by a limit switch or soft limit"),
@@ -86,8 +92,15 @@ def is_busy(e: BaseException) -> bool:
     return isinstance(e, _core.LinkDown) and " is busy: " in str(e)
 
 
+def _served_elsewhere(e: BaseException) -> bool:
+    from .serve.lockfile import ServedElsewhere
+    return isinstance(e, ServedElsewhere)
+
+
 def exit_code(e: BaseException) -> int:
     """The exit code for an error that ended a command (see EXIT_CODES)."""
+    if _served_elsewhere(e):
+        return EXIT_BUSY       # the bench is held by its service, as a port held by another process
     if isinstance(e, MoveFailed):
         return OUTCOME_EXIT.get(e.outcome, EXIT_MOVE_FAILED)
     if isinstance(e, _core.InvalidArgument):       # BenchFileError too
@@ -101,7 +114,7 @@ def exit_code(e: BaseException) -> int:
 
 def error_text(e: BaseException) -> str:
     """One line for stderr: the error in its own words (the class name where it adds to them)."""
-    if isinstance(e, (MoveFailed, _core.InvalidArgument)) or is_busy(e):
+    if isinstance(e, (MoveFailed, _core.InvalidArgument)) or is_busy(e) or _served_elsewhere(e):
         return f"motorbus: {e}"
     return f"motorbus: {type(e).__name__}: {e}"
 
@@ -226,19 +239,129 @@ def _only_axes(data: Any, wanted: Sequence[str], source: str) -> Any:
     return out
 
 
+# ---- a bench served by `motorbus serve` ------------------------------------------------------------
+def service_address(args: argparse.Namespace) -> Optional[str]:
+    """Where this command's bench is served, or None to open its transports here:
+    ``--server ADDR`` as given; else the running service of the bench file
+    (serve.find_service), unless ``--no-server``, or ``--sim`` while the service owns the
+    hardware (then a fresh twin, as asked, and the hardware is left alone)."""
+    if getattr(args, "no_server", False):
+        _warn_served(args)
+        return None
+    server = getattr(args, "server", None)
+    if server:
+        return server
+    from .serve.lockfile import find_service
+
+    info = find_service(args.bench)
+    if info is None or (getattr(args, "sim", False) and not info.sim):
+        return None
+    if info.sim and not getattr(args, "sim", False):
+        _err(f"motorbus: note: {args.bench} is served by motorbus serve --sim (pid {info.pid}): "
+             f"this works its simulated twin")
+    log.info("%s: through motorbus serve (pid %d) at %s", args.bench, info.pid, info.socket)
+    return f"unix:{info.socket}"
+
+
+def _warn_served(args: argparse.Namespace) -> None:
+    info = _service_of(args)
+    if info is not None:
+        _err(f"motorbus: warning: {args.bench} is served by motorbus serve (pid {info.pid}); --no-server "
+             f"talks to the drives beside it (a serial port it holds is busy; a CAN node answers both)")
+
+
+def _service_of(args: argparse.Namespace) -> Any:
+    """The running service of args.bench that matters to a command opening transports here."""
+    from .serve.lockfile import find_service
+
+    try:
+        info = find_service(args.bench)
+    except OSError:
+        return None
+    if info is None or (getattr(args, "sim", False) and not info.sim):
+        return None
+    return info
+
+
+def refuse_if_served(args: argparse.Namespace, what: str) -> None:
+    """``what`` (a protocol console, raw SDO) needs the bench's own transports: while its
+    service runs, a ServedElsewhere naming the service's pid (exit code 4)."""
+    from .serve.lockfile import ServedElsewhere
+
+    info = _service_of(args)
+    if info is not None:
+        raise ServedElsewhere(args.bench, info.pid, what)
+
+
+def refuse_served_link(link: str, what: str) -> None:
+    """A bus spec or serial port that a running `motorbus serve` holds: ServedElsewhere."""
+    from .serve.lockfile import ServedElsewhere, served_link
+
+    info = served_link(link)
+    if info is not None:
+        raise ServedElsewhere(info.bench, info.pid, what)
+
+
+def connect_service(address: str) -> Any:
+    """A RemoteBench on the service at ``address`` (it quacks like a Bench)."""
+    from .serve.client import connect
+
+    return connect(address)
+
+
+class _Narrowed:
+    """A served bench seen through the axes a command named (``axes``): the service
+    serves every axis; the command works, and stops on its way out, only its own."""
+
+    def __init__(self, bench: Any, axes: Optional[Sequence[str]]) -> None:
+        self._bench = bench
+        names = list(dict.fromkeys(axes)) if axes else list(bench.axes)
+        for n in names:
+            bench[n]                 # an axis the service lacks: the bench's own InvalidArgument
+        self.axes = {n: bench[n] for n in names}
+
+    def __getitem__(self, name: str) -> Any:
+        return self._bench[name]
+
+    def stop_all(self, how: str = "stop") -> list:
+        failures = []
+        for name, d in self.axes.items():
+            try:
+                getattr(d, how)()
+            except _core.MotorbusError as e:
+                failures.append((name, e))
+        return failures
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._bench, name)
+
+
+def _open(args: argparse.Namespace, axes: Optional[Sequence[str]], **kw: Any) -> tuple[Any, bool]:
+    """(bench, served): through the bench's service when one runs (module doc), else
+    the transports opened here (only ``axes``' lines and buses)."""
+    address = service_address(args)
+    if address is not None:
+        return _Narrowed(connect_service(address), axes), True
+    return load_bench(args.bench, sim=args.sim, axes=axes, **kw), False
+
+
 def _run(args: argparse.Namespace, work: Callable[[Bench], int], *, axes: Optional[Sequence[str]] = None,
          stop_on_exit: bool = True) -> int:
     """Opens the bench (only ``axes`` when given), runs ``work``, maps errors to exit
     codes.  ``stop_on_exit``: every opened axis is stopped on the way out, as the Bench's
     ``with`` does; a command that only reads passes False and just closes (it must not
-    stop what another program is moving)."""
+    stop what another program is moving).  With the bench served (``motorbus serve``),
+    the same through the service: "opened" are the axes named."""
     try:
-        bench = load_bench(args.bench, sim=args.sim, axes=axes)
+        bench, served = _open(args, axes)
     except _core.MotorbusError as e:
         return _failed(args, e)
-    log.info("%s: opened %s%s (lines: %s; buses: %s)", bench.source, ", ".join(bench.axes),
-             " on its simulated twin" if bench.simulated else "", ", ".join(bench.lines) or "none",
-             ", ".join(bench.buses) or "none")
+    if served:
+        log.info("%s: served: %s", args.bench, ", ".join(bench.axes))
+    else:
+        log.info("%s: opened %s%s (lines: %s; buses: %s)", bench.source, ", ".join(bench.axes),
+                 " on its simulated twin" if bench.simulated else "", ", ".join(bench.lines) or "none",
+                 ", ".join(bench.buses) or "none")
     try:
         try:
             return work(bench)
@@ -258,6 +381,11 @@ def _failed(args: argparse.Namespace, e: BaseException) -> int:
     stdout (``{"error", "message", "exit_code"}``) so a script parsing stdout gets one."""
     code = exit_code(e)
     _err(error_text(e))
+    if is_busy(e) and getattr(args, "no_server", False):
+        info = _service_of(args)
+        if info is not None:
+            _err(f"motorbus: {args.bench} is served by motorbus serve (pid {info.pid}), which holds its "
+                 f"transports: drop --no-server to go through it, or stop the service")
     if getattr(args, "json", False):
         _json({"error": type(e).__name__, "message": str(e), "exit_code": code})
     return code
@@ -443,7 +571,7 @@ def cmd_stop(args: argparse.Namespace) -> int:
     def work(bench: Bench) -> int:
         how = "quick_stop" if args.quick else "stop"
         failed = []
-        for name, d in bench.axes.items():
+        for name, d in bench.axes.items():   # the named axes (all when none is named)
             try:
                 getattr(d, how)()
                 _say(f"{name}: stopped")
@@ -544,6 +672,11 @@ def cmd_scan(args: argparse.Namespace) -> int:
     if not args.serial and not args.can:
         _err("motorbus scan: give --serial PORT and/or --can SPEC")
         return EXIT_USAGE
+    try:
+        for link in [*(args.serial or ()), *(args.can or ())]:
+            refuse_served_link(link, f"a scan of {link}")
+    except _core.MotorbusError as e:
+        return _failed(args, e)
     if args.write:
         why = _check_writable(args.write)
         if why is not None:
@@ -581,6 +714,10 @@ def cmd_terminal(args: argparse.Namespace) -> int:
     """Reads lines (a prompt with history on a terminal, plain lines from a pipe), sends
     each in the axis's own protocol and prints the answer; errors are printed and the
     console goes on.  `quit`, `exit` or end of input leave (the axis is stopped)."""
+    try:
+        refuse_if_served(args, "a protocol console (terminal)")
+    except _core.MotorbusError as e:
+        return _failed(args, e)
     interactive = sys.stdin.isatty()
     history = os.path.expanduser("~/.motorbus_history")
     readline: Any = None
@@ -633,6 +770,17 @@ def cmd_terminal(args: argparse.Namespace) -> int:
     return _run(args, work, axes=[args.axis])
 
 
+def server_options(p: argparse.ArgumentParser) -> None:
+    """--server / --no-server: how a command reaches a bench that `motorbus serve` owns."""
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--server", metavar="ADDR", default=None,
+                   help="go through this motorbus serve (unix:PATH, or a bench file it serves); default: the "
+                        "running service of BENCH, if any")
+    g.add_argument("--no-server", action="store_true",
+                   help="open the bench's transports here even while motorbus serve owns them (its serial "
+                        "ports are then busy)")
+
+
 def add_commands(sub: Any, common: Any = None) -> None:
     """Adds the bench commands to the top-level parser's subparsers (``common``: a parent
     parser with the options every command takes, -v/--trace)."""
@@ -644,6 +792,8 @@ def add_commands(sub: Any, common: Any = None) -> None:
         p.add_argument("bench", metavar="BENCH", help="the bench file (TOML)")
         p.add_argument("--sim", action="store_true",
                        help="run against the bench's simulated twin (a fresh twin for this command only)")
+        if name != "terminal":
+            server_options(p)
         return p
 
     def with_json(p: argparse.ArgumentParser) -> None:
@@ -699,6 +849,7 @@ def add_commands(sub: Any, common: Any = None) -> None:
     p.add_argument("--all", action="store_true", help="read: every parameter the drive has, not just the file's")
     p.add_argument("--sim", action="store_true",
                    help="run against the bench's simulated twin (a fresh twin for this command only)")
+    server_options(p)
     with_json(p)
     p.set_defaults(func=cmd_config)
 
