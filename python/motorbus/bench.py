@@ -669,6 +669,15 @@ class Bench:
         """The same from an already-parsed description (``{"axis": {"x": {...}}, ...}``)."""
         return cls(data, sim=sim, source="<dict>", clock=clock)
 
+    @classmethod
+    def connect(cls, address: Any, *, timeout: float = 5.0) -> Any:
+        """The bench a running ``motorbus serve`` owns, from this program: a
+        ``motorbus.serve.client.RemoteBench`` whose axes are Drives that talk to the service
+        (``address``: the bench file, a socket path or ``"unix:/path.sock"``; docs/serve-protocol.md)."""
+        from .serve.client import connect
+
+        return connect(address, timeout=timeout)
+
     def _fail(self, message: str, *path: str) -> BenchFileError:
         return self._checker.fail(message, *path)
 

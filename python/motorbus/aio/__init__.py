@@ -314,6 +314,14 @@ class Bench:
                         stop_timeout: float = STOP_TIMEOUT) -> "Bench":
         return cls(await _blocking_once(_SyncBench.from_dict, data, sim=sim, clock=clock), stop_timeout=stop_timeout)
 
+    @classmethod
+    async def connect(cls, address: Any, *, timeout: float = 5.0) -> Any:
+        """``motorbus.Bench.connect``, awaited: the bench a running ``motorbus serve`` owns, its
+        axes awaitable twins of Drives that talk to the service (serve.client.AioRemoteBench)."""
+        from ..serve.client import aio_connect
+
+        return await aio_connect(address, timeout=timeout)
+
     @property
     def axes(self) -> dict[str, Drive]:
         return dict(self._axes)
