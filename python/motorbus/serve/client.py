@@ -314,7 +314,7 @@ class RemoteParams(Params):
         info = self._info(self._key(name))
         if info is None:
             # The service says it, in the kind's own words (an alias the table does not spell).
-            return faces.run(_RemoteCall(self._drive._conn, "params_describe", self._drive._axis, (name,), {}))
+            return self._drive._conn.call("params_describe", self._drive._axis, name)
         return info
 
     def __contains__(self, name: object) -> bool:

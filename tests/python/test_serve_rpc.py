@@ -1,0 +1,468 @@
+"""The native face of ``motorbus serve`` (serve/rpc.py + serve/client.py): a served bench used
+from other connections through ``Bench.connect`` / ``aio.Bench.connect``, the Drive API exactly.
+
+One service per module: ``start_rpc`` on an ``aio.Bench.from_dict(..., sim=True)`` (a serial
+arcus axis on a pty, two CANopen cia402 nodes and a unitek behind socketcand on 127.0.0.1) in a
+thread of its own with its own event loop, as ``motorbus serve`` runs it.  What the clients see
+is checked against the simulators themselves (the shaft, not the drive objects' word).
+"""
+from __future__ import annotations
+
+import asyncio
+import os
+import socket
+import threading
+import time
+from typing import Any
+
+import numpy as np
+import pytest
+
+import motorbus
+from motorbus import aio, registry
+from motorbus.serve import client as rclient
+from motorbus.serve import rpc
+from motorbus.serve.lockfile import ServedElsewhere
+
+MM = {"name": "mm", "scale": 0.01}
+BENCH = {
+    "line": {"l1": {"port": "/dev/null-arcus"}},
+    "bus": {"c1": {"spec": "virtual:cia"}, "c2": {"spec": "virtual:unitek"}},
+    "axis": {
+        "x": {"kind": "arcus", "line": "l1", "address": "01", "units": MM,
+              "params": {"HSPD": 20000, "LSPD": 2000, "ACC": 20}},
+        "z": {"kind": "cia402", "bus": "c1", "address": 5, "units": MM,
+              "params": {"0x6081": 20000, "0x6083": 400000, "0x6084": 400000}},
+        "f": {"kind": "cia402", "bus": "c1", "address": 6, "units": MM,     # the one the faults spoil
+              "params": {"0x6081": 20000, "0x6083": 400000, "0x6084": 400000}},
+        "u": {"kind": "unitek", "bus": "c2", "address": "0x201", "units": MM, "params": {"ACC_RAMP": 20},
+              "sim": {"calibrated": True, "dec_ramp_ms": 20}},
+    },
+}
+#: The simulator's shaft, native units (read from the simulator, not through any Drive).
+SHAFT = {"arcus": lambda sim: sim.pulse_position, "cia402": lambda sim: sim.position,
+         "unitek": lambda sim: sim.position_num}
+
+
+class Service:
+    """start_rpc on a simulated aio.Bench, on a loop in its own thread."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        self.loop = asyncio.new_event_loop()
+        self.ready = threading.Event()
+        self.error: Any = None
+        self.thread = threading.Thread(target=self._run, name="test-serve-loop", daemon=True)
+        self.thread.start()
+        assert self.ready.wait(60), "the service did not start"
+        if self.error is not None:
+            raise self.error
+
+    def _run(self) -> None:
+        asyncio.set_event_loop(self.loop)
+
+        async def start() -> None:
+            try:
+                self.bench = await aio.Bench.from_dict(BENCH, sim=True)
+                self.face = await rpc.start_rpc(self.bench, self.path,
+                                                info={"pid": os.getpid(), "bench": "/lab/test-bench.toml"})
+            except BaseException as e:  # noqa: BLE001 - said by the constructor
+                self.error = e
+            finally:
+                self.ready.set()
+
+        self.loop.run_until_complete(start())
+        self.loop.run_forever()
+
+    def run(self, coro: Any, timeout: float = 30.0) -> Any:
+        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout)
+
+    def shaft(self, axis: str) -> float:
+        """Where the simulated shaft is, user units."""
+        kind = self.bench.sync.config[axis].kind
+        return SHAFT[kind](self.bench.sync.sims[axis]) * 0.01
+
+    def fault(self, axis: str, name: str, **options: Any) -> None:
+        kind = self.bench.sync.config[axis].kind
+        registry.drive_plugin(kind).sim_faults()[name](self.bench.sync.sims[axis], **options)
+
+    def close(self) -> None:
+        async def stop() -> None:
+            await self.face.close()
+            await self.bench.stop_all()
+            await self.bench.aclose()
+        try:
+            self.run(stop())
+        finally:
+            self.loop.call_soon_threadsafe(self.loop.stop)
+            self.thread.join(10)
+
+
+@pytest.fixture(scope="module")
+def service(tmp_path_factory):
+    s = Service(str(tmp_path_factory.mktemp("serve") / "rpc.sock"))
+    yield s
+    s.close()
+
+
+@pytest.fixture(scope="module")
+def bench(service):
+    b = motorbus.Bench.connect(f"unix:{service.path}")
+    b.apply()                       # the file's fast profiles (and a round trip of apply)
+    for d in b.axes.values():
+        d.enable()
+    yield b
+    b.close()
+
+
+def wait_for(cond: Any, timeout: float = 10.0, what: str = "the condition") -> None:
+    deadline = time.monotonic() + timeout
+    while not cond():
+        assert time.monotonic() < deadline, f"{what} not within {timeout} s"
+        time.sleep(0.01)
+
+
+# ---- the bench as the service has it ------------------------------------------------------------
+def test_connect_gives_drives_of_the_served_bench(service, bench):
+    assert set(bench.axes) == {"x", "z", "f", "u"} and len(bench) == 4 and list(bench) == ["x", "z", "f", "u"]
+    assert bench.simulated and bench.source == "<dict>"
+    assert set(bench.lines) == {"l1"} and set(bench.buses) == {"c1", "c2"}
+    assert bench.config["u"].kind == "unitek" and bench.config["z"].address == "5"
+    assert bench.config["x"].units == motorbus.Units("mm", 0.01)
+    assert bench.info == {"pid": os.getpid(), "bench": "/lab/test-bench.toml"}
+    for name, d in bench.axes.items():
+        local = service.bench[name].sync
+        assert isinstance(d, motorbus.Drive) and d.name == name
+        assert d.kind == local.kind and d.units == local.units and d.capabilities == local.capabilities
+        assert isinstance(aio.Drive(d), aio.Drive)
+    with pytest.raises(motorbus.InvalidArgument, match="no axis 'nope'.*axes: x, z, f, u"):
+        bench["nope"]
+    assert bench.select(["u", "x"]) == {"u": bench["u"], "x": bench["x"]}
+    # The file's parameters were applied through the service: no difference left.
+    assert bench.diff() == []
+    assert bench.read_params(["z"]) == {"z": {"0x6081": 20000, "0x6083": 400000, "0x6084": 400000}}
+
+
+@pytest.mark.parametrize("axis", ["x", "z", "u"])
+def test_every_verb_round_trips(service, bench, axis):
+    d = bench[axis]
+    local = service.bench[axis].sync
+    d.enable()
+    st = d.status
+    assert isinstance(st, motorbus.DriveStatus) and st.enabled and not st.moving
+    d.move_to(3.0, timeout=10)
+    assert service.shaft(axis) == pytest.approx(3.0, abs=0.011)
+    assert d.position == pytest.approx(3.0, abs=0.011)
+    assert d.status.last_move.ok and d.status.last_move.target == pytest.approx(3.0)
+    d.move_by(-1.0, timeout=10)
+    assert service.shaft(axis) == pytest.approx(2.0, abs=0.011)
+    d.move_to(6.0, wait=False)
+    d.wait_idle(timeout=10)
+    assert service.shaft(axis) == pytest.approx(6.0, abs=0.011)
+    d.jog(20.0)
+    wait_for(lambda: service.shaft(axis) > 6.5, what=f"{axis} jogging")
+    assert d.status.moving and d.velocity > 0
+    d.stop()
+    d.wait_idle(timeout=10)          # a jog ended by this program's stop is a success
+    assert d.status.last_move.what == "jog" and d.status.last_move.ok
+    d.move_to(8.0, wait=False)
+    d.quick_stop()
+    with pytest.raises(motorbus.MoveInterrupted):
+        d.wait_idle(timeout=10)
+    d.clear_faults()
+    lo, hi = d.travel_limits
+    assert (lo, hi) == local.travel_limits and lo <= hi
+    # params: names, descriptions, reads and writes, all the service's Drive's
+    assert list(d.params) == list(local.params) and len(d.params) == len(local.params)
+    name = {"x": "HSPD", "z": "0x6081", "u": "ACC_RAMP"}[axis]
+    assert name in d.params and "no-such-param" not in d.params
+    assert d.params.describe(name) == local.params.describe(name)
+    old = d.params[name]
+    d.params[name] = old + 1
+    assert local.params[name] == old + 1
+    d.params[name] = old
+    with pytest.raises(motorbus.drive.UnknownParameter) as e:
+        d.params["no-such-param"]
+    assert isinstance(e.value, KeyError)
+    d.disable()
+    assert not d.status.enabled
+    d.enable()
+
+
+def test_home_and_store_go_through(service, bench):
+    z = bench["z"]
+    z.move_to(2.0, timeout=10)
+    z.home(19, timeout=20)
+    st = z.status
+    assert st.homed and st.last_move.what == "home" and st.last_move.ok
+    assert z.position == pytest.approx(0.0, abs=0.011)
+    z.store()                       # CiA 301 1010h on the simulator: no error
+    bench.store(["u"])              # the bench-wide verb, on one axis
+
+
+def test_bad_arguments_come_back_typed(bench):
+    with pytest.raises(motorbus.InvalidArgument, match="position must be a finite number"):
+        bench["z"].move_to("far")
+    with pytest.raises(motorbus.InvalidArgument, match="timeout must be >= 0"):
+        bench["z"].wait_idle(-1)
+    with pytest.raises(motorbus.InvalidArgument, match="Bench.stop_all how"):
+        bench.stop_all("brake")
+    with pytest.raises(motorbus.InvalidArgument, match="no axis 'q'"):
+        bench.move_together({"q": 1.0})
+
+
+# ---- outcomes: the exact MoveFailed subclass, with its fields ------------------------------------
+def test_a_drive_fault_during_a_move_is_a_move_faulted_with_its_fields(service, bench):
+    f = bench["f"]
+    f.enable()
+    result: dict = {}
+
+    def mover() -> None:
+        try:
+            f.move_to(300.0, timeout=20)
+        except BaseException as e:  # noqa: BLE001 - looked at below
+            result["error"] = e
+    t = threading.Thread(target=mover)
+    t.start()
+    wait_for(lambda: service.shaft("f") > 5.0, what="f moving")
+    service.fault("f", "fault", code=0x5441)
+    t.join(20)
+    e = result["error"]
+    assert type(e) is motorbus.MoveFaulted and isinstance(e, motorbus.DriveFault)
+    assert e.axis == "f" and e.target == pytest.approx(300.0) and e.units == "mm" and e.outcome == "fault"
+    assert e.position == pytest.approx(service.shaft("f"), abs=0.011) and e.position < 300.0
+    local = service.bench["f"].sync.status.last_move.error
+    assert (str(e), e.reason, e.code, e.status) == (str(local), local.reason, local.code, local.status)
+    assert f.status.fault and f.status.last_move.state == "fault"
+    f.clear_faults()
+    f.enable()
+    assert not f.status.fault
+
+
+def test_a_limit_switch_is_limit_reached_with_its_side(service, bench):
+    x = bench["x"]
+    x.move_to(0.0, timeout=10)
+    service.fault("x", "limit", direction=1)
+    try:
+        with pytest.raises(motorbus.LimitReached) as e:
+            x.move_to(50.0, timeout=10)
+        assert e.value.side == 1 and e.value.axis == "x" and e.value.target == pytest.approx(50.0)
+        assert e.value.outcome == "limit" and e.value.position == pytest.approx(service.shaft("x"), abs=0.011)
+    finally:
+        service.bench.sync.sims["x"].force_limit(1, None)   # released, then the latch cleared
+        x.clear_faults()
+        x.enable()
+    x.move_to(1.0, timeout=10)
+    assert service.shaft("x") == pytest.approx(1.0, abs=0.011)
+
+
+# ---- several programs at once -------------------------------------------------------------------
+def test_a_stop_from_another_connection_stops_a_move_this_one_awaits(service, bench):
+    z = bench["z"]
+    z.move_to(0.0, timeout=10)
+    other = motorbus.Bench.connect(f"unix:{service.path}")
+    result: dict = {}
+
+    def mover() -> None:
+        try:
+            z.move_to(400.0, timeout=20)
+        except BaseException as e:  # noqa: BLE001
+            result["error"] = e
+    t = threading.Thread(target=mover)
+    t.start()
+    try:
+        wait_for(lambda: service.shaft("z") > 5.0, what="z moving")
+        t_stop = time.monotonic()
+        other["z"].stop()            # overtakes: the first connection is waiting on its move
+        t.join(20)
+        assert not t.is_alive()
+        assert time.monotonic() - t_stop < 5.0
+        e = result["error"]
+        assert type(e) is motorbus.MoveInterrupted and e.axis == "z"
+        rest = service.shaft("z")
+        assert 5.0 < rest < 400.0 and not service.bench["z"].sync.status.moving
+        time.sleep(0.1)
+        assert service.shaft("z") == rest        # at rest, stopped for good
+    finally:
+        other.close()
+
+
+def test_a_dropped_client_stops_the_move_it_awaited_but_not_one_it_left_running(service, bench):
+    z, u = bench["z"], bench["u"]
+    z.move_to(0.0, timeout=10)
+    u.move_to(0.0, timeout=10)
+    conn = rclient.Connection(service.path)
+    awaited = threading.Thread(target=lambda: pytest.raises(Exception, conn.call, "move_to", "z", 400.0,
+                                                            timeout=20))
+    awaited.start()
+    conn.call("move_to", "u", 4000.0, wait=False)     # fire and forget: survives the program
+    wait_for(lambda: service.shaft("z") > 5.0, what="z moving")
+    conn.close()                                      # the program is gone
+    awaited.join(10)
+    wait_for(lambda: not service.bench["z"].sync.status.moving, what="z stopped after the drop")
+    rest = service.shaft("z")
+    assert 5.0 < rest < 400.0
+    last = service.bench["z"].sync.status.last_move
+    assert last.state == "interrupted" and "cancellation" in last.reason
+    assert service.bench["u"].sync.status.moving        # the move nobody awaited goes on
+    u.stop()
+    wait_for(lambda: not service.bench["u"].sync.status.moving)
+    wait_for(lambda: service.run(_counter(service, "clients")) == 1, what="the dropped client counted out")
+
+
+async def _counter(service: Service, name: str) -> int:
+    return service.face.counters[name]
+
+
+def test_move_together_and_stop_all(service, bench):
+    report = bench.move_together({"z": 4.0, "u": 5.0}, timeout=10)
+    assert isinstance(report, motorbus.bench.StartReport) and set(report.offsets) == {"z", "u"}
+    assert service.shaft("z") == pytest.approx(4.0, abs=0.011) and service.shaft("u") == pytest.approx(5.0, abs=0.011)
+    bench.move_together({"z": -2.0, "u": -2.0}, relative=True, wait=False)
+    assert bench.stop_all() == []
+    st = bench.status()
+    assert set(st) == {"x", "z", "f", "u"} and all(isinstance(s, motorbus.DriveStatus) for s in st.values())
+    for n in ("z", "u"):
+        wait_for(lambda n=n: not service.bench[n].sync.status.moving)
+
+
+def test_the_console_is_refused_naming_the_service(service, bench):
+    with pytest.raises(ServedElsewhere) as e:
+        bench["z"].console("r 6041")
+    assert str(e.value) == (f"/lab/test-bench.toml is served by motorbus serve (pid {os.getpid()}): a protocol "
+                            "console (axis 'z') needs the transports; stop the service first")
+    assert e.value.pid == os.getpid() and e.value.bench == "/lab/test-bench.toml"
+
+
+def test_an_exception_in_with_stops_what_this_program_moved_only(service, bench):
+    bench["u"].move_to(0.0, timeout=10)
+    bench["u"].move_to(4000.0, wait=False)          # another program's move (this module's bench)
+    with pytest.raises(RuntimeError, match="script failed"):
+        with motorbus.Bench.connect(f"unix:{service.path}") as mine:
+            mine["z"].move_to(400.0, wait=False)
+            wait_for(lambda: service.shaft("z") > 1.0, what="z moving")
+            raise RuntimeError("script failed")
+    wait_for(lambda: not service.bench["z"].sync.status.moving, what="z stopped by the with-block")
+    assert service.shaft("z") < 400.0
+    assert service.bench["u"].sync.status.moving      # not this program's: left running
+    bench["u"].stop()
+    wait_for(lambda: not service.bench["u"].sync.status.moving)
+    bench["z"].clear_faults()
+    bench["z"].enable()          # a CiA 402 quick stop leaves the drive in SWITCH ON DISABLED
+
+
+# ---- polls ---------------------------------------------------------------------------------------
+def test_a_1khz_poll_fanned_out_to_five_subscribers_is_one_poller(service, bench):
+    bench["z"].move_to(0.0, timeout=10)
+    clients = [motorbus.Bench.connect(f"unix:{service.path}") for _ in range(5)]
+    silent = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)   # subscribes, then never reads
+    try:
+        pollers = [c.poll(["z", "u"], ("position", "status"), rate_hz=1000) for c in clients]
+        silent.connect(service.path)
+        silent.sendall(rpc.frame(rpc.FRAME_JSON, rpc.dumps({"id": 1, "call": "poll", "args": [["z", "u"],
+                                                            ["position", "status"], 1000]})))
+        wait_for(lambda: service.run(_counter(service, "poll_subscribers")) == 6)
+        assert service.run(_counter(service, "pollers")) == 1
+        assert len(service.face._polls) == 1
+        time.sleep(0.1)                   # rows at rest first (a poll's first deadline is 20 ms after its start)
+        bench["z"].move_to(2.0, wait=False)
+        time.sleep(1.0)
+        bench["z"].wait_idle(timeout=10)
+        time.sleep(0.1)
+        for p in pollers:
+            fr = p.read()
+            assert p.columns == ["t", "z.t", "z.position", "z.status", "u.t", "u.position", "u.status"]
+            n = len(fr["t"])
+            assert n >= 700, f"{n} rows in ~1.1 s at 1 kHz"
+            assert np.allclose(np.diff(fr["t"]), 1e-3)               # one row per deadline, none lost
+            assert p.overflowed == 0
+            pos = fr["z.position"][~np.isnan(fr["z.position"])]
+            assert pos[0] == pytest.approx(0.0, abs=0.011)
+            assert pos[-1] == pytest.approx(2.0, abs=0.011)
+            assert np.all(np.diff(pos) >= -1e-9)                      # the move, sample by sample
+        # the same rows went to every subscriber: one poll, fanned out
+        first = [p.frame()["t"][:200] for p in pollers]
+        common = set(first[0]).intersection(*map(set, first[1:]))
+        assert len(common) >= 100
+        stats = pollers[0].stats
+        assert stats["subscription"]["subscribers"] == 6
+        for p in pollers:
+            p.stop()
+        silent.close()
+        wait_for(lambda: service.run(_counter(service, "pollers")) == 0, what="the Poller stopped")
+        assert service.run(_counter(service, "poll_subscribers")) == 0
+    finally:
+        silent.close()
+        for c in clients:
+            c.close()
+
+
+def test_a_slow_subscriber_loses_its_oldest_rows_counted():
+    class Conn:
+        class face:
+            counters = {"rows_dropped": 0}
+        wake = threading.Event()
+    sub = rpc._Sub(1, Conn(), None, ["t"])
+    for i in range(rpc.SUB_QUEUE_CHUNKS + 3):
+        sub.push(np.full((10, 1), float(i)))
+    assert len(sub.queue) == rpc.SUB_QUEUE_CHUNKS and sub.dropped == 30
+    assert sub.queue[0][0, 0] == 3.0 and Conn.face.counters["rows_dropped"] == 30
+
+
+# ---- the awaitable face --------------------------------------------------------------------------
+def test_the_awaitable_face(service, bench):
+    async def main() -> None:
+        async with await aio.Bench.connect(f"unix:{service.path}") as ab:
+            z = ab["z"]
+            assert isinstance(z, aio.Drive) and isinstance(z.sync, motorbus.Drive)
+            await z.move_to(1.0, timeout=10)
+            assert await z.position() == pytest.approx(1.0, abs=0.011)
+            assert service.shaft("z") == pytest.approx(1.0, abs=0.011)
+            assert (await z.status()).last_move.ok
+            assert await z.params.get("0x6081") == 20000
+            assert set(await ab.status()) == {"x", "z", "f", "u"}
+            # several calls at once on one connection
+            p1, p2, lim = await asyncio.gather(z.position(), ab["u"].position(), z.travel_limits())
+            assert p1 == pytest.approx(1.0, abs=0.011) and isinstance(lim, tuple)
+            # cancelling an awaited move stops the motor before the CancelledError goes on
+            task = asyncio.ensure_future(z.move_to(400.0, timeout=20))
+            while service.shaft("z") < 3.0:
+                await asyncio.sleep(0.01)
+            task.cancel()
+            with pytest.raises(asyncio.CancelledError):
+                await task
+            assert not service.bench["z"].sync.status.moving
+            rest = service.shaft("z")
+            assert 3.0 < rest < 400.0
+            # a typed error, awaited
+            with pytest.raises(motorbus.MoveInterrupted):
+                await asyncio.gather(z.move_to(50.0, timeout=10), _stop_soon(z, service))
+            # a poll, as chunks
+            poller = await ab.poll(["z"], ("position",), rate_hz=500)
+            got = 0
+            async for chunk in poller.chunks(50):
+                got += len(chunk["t"])
+                if got >= 100:
+                    break
+            poller.stop()
+            assert got >= 100
+    asyncio.run(main())
+    wait_for(lambda: service.run(_counter(service, "pollers")) == 0)
+
+
+async def _stop_soon(z: Any, service: Service) -> None:
+    while service.shaft("z") < 3.0 + 0.5 and not (await z.status()).moving:
+        await asyncio.sleep(0.005)
+    await asyncio.sleep(0.05)
+    await z.stop()
+
+
+def test_a_lost_service_is_link_down_and_a_missing_one_is_said(tmp_path):
+    with pytest.raises(motorbus.LinkDown, match="is the service running"):
+        motorbus.Bench.connect(f"unix:{tmp_path / 'none.sock'}")
+    bench_file = tmp_path / "b.toml"
+    bench_file.write_text('[line.l]\nport = "/dev/null"\n[axis.x]\nkind = "arcus"\nline = "l"\naddress = "01"\n')
+    with pytest.raises(motorbus.LinkDown, match="no motorbus serve runs for this bench"):
+        motorbus.Bench.connect(bench_file)
+    with pytest.raises(motorbus.InvalidArgument, match="no such bench file or socket"):
+        motorbus.Bench.connect(tmp_path / "absent.toml")
