@@ -19,6 +19,11 @@ What it does to the drives, by transport (docs/monitor.md says the same):
   and every axis is asked.
 
 An axis that does not answer keeps its row, with the error in place of its readings.
+
+While ``motorbus serve BENCH`` runs, the monitor goes through it (``--server ADDR``
+names one, ``--no-server`` does not): the service is the one program talking to the
+drives, so every axis, CAN ones too, is asked -- by the service, which any number of
+monitors share (docs/serve.md).
 """
 from __future__ import annotations
 
@@ -33,7 +38,8 @@ from typing import Any, Iterator, Optional
 
 from . import _core
 from .bench import Bench
-from .cli_bench import EXIT_OK, EXIT_USAGE, NotOpened, error_text, exit_code, load_bench
+from .cli_bench import (EXIT_OK, EXIT_USAGE, NotOpened, _Narrowed, connect_service, error_text, exit_code, load_bench,
+                        server_options, service_address)
 
 #: NMT states as a heartbeat carries them (CiA 301).
 _NMT = {0x00: "boot-up", 0x04: "stopped", 0x05: "operational", 0x7F: "pre-operational"}
@@ -124,8 +130,9 @@ def read_rows(bench: Bench, names: list[str], listeners: Optional[dict] = None) 
 def render(bench: Bench, names: list[str], rate: float, frame: int, listeners: Optional[dict] = None) -> Any:
     from rich.table import Table
 
-    sim = " (simulated twin)" if bench.simulated else ""
-    table = Table(title=f"{bench.source}{sim}", caption=f"{rate:g} Hz, frame {frame} — q or Ctrl-C quits",
+    sim = " (simulated twin)" if getattr(bench, "simulated", False) else ""
+    served = " through motorbus serve" if isinstance(bench, _Narrowed) else ""
+    table = Table(title=f"{getattr(bench, 'source', '')}{sim}{served}", caption=f"{rate:g} Hz, frame {frame} — q or Ctrl-C quits",
                   title_justify="left", caption_justify="left")
     for col, justify in (("axis", "left"), ("kind", "left"), ("position", "right"), ("velocity", "right"),
                          ("units", "left"), ("state", "left"), ("fault", "left"), ("drive says", "left")):
@@ -192,21 +199,28 @@ def cmd_monitor(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     # CAN axes are listened to, not asked, unless --ask (or the twin is this monitor's own).
     ask_can = args.ask or args.sim
+    served = False
     try:
-        bench = load_bench(args.bench, sim=args.sim, axes=args.axis,
-                           open_axis=lambda cfg: ask_can or cfg.bus is None)
+        address = service_address(args)
+        if address is not None:
+            # The service is the one program talking to the drives: it asks every axis.
+            bench, served = _Narrowed(connect_service(address), args.axis), True
+        else:
+            bench = load_bench(args.bench, sim=args.sim, axes=args.axis,
+                               open_axis=lambda cfg: ask_can or cfg.bus is None)
     except _core.MotorbusError as e:
         print(error_text(e), file=sys.stderr)
         return exit_code(e)
     listeners: dict = {}
     try:
-        for d in bench.axes.values():
-            # Watching must not change what it watches: no stop when the monitor leaves.
-            d.on_error = None
-            d.on_exit = None
+        if not served:
+            for d in bench.axes.values():
+                # Watching must not change what it watches: no stop when the monitor leaves.
+                d.on_error = None
+                d.on_exit = None
         names = list(bench.axes)
         for name in names:
-            if isinstance(bench[name], NotOpened):
+            if not served and isinstance(bench[name], NotOpened):
                 cfg = bench.config[name]
                 listeners[name] = Listener(bench.buses[cfg.bus], cfg)
         period = 1.0 / args.rate
@@ -245,4 +259,5 @@ def add_commands(sub: Any, common: Any = None) -> None:
                    help="also poll CAN axes (SDO/requests): only when no other program talks to those nodes; "
                         "by default a CAN axis is only listened to")
     p.add_argument("--sim", action="store_true", help="watch the bench's simulated twin (a fresh one, asked)")
+    server_options(p)
     p.set_defaults(func=cmd_monitor)

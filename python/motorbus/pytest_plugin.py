@@ -8,6 +8,11 @@ Installed with motorbus (entry point ``pytest11``); load it by hand with
   simulator behind the same kind of transport).  Without FILE, and when neither
   option is given: the ini option ``motorbus_bench``, else a built-in bench with
   one axis of every registered drive kind (named after the kind).
+* ``--bench-server [ADDR]``: the bench a running ``motorbus serve`` owns
+  (docs/serve.md): ADDR is its bench file or ``unix:/path.sock``; without ADDR, the
+  service of the ``--bench``/``--bench-sim``/ini bench file.  The fixtures' axes are
+  then the service's (RemoteDrive; ``poller`` a RemotePoller of its shared poll), and
+  other programs may use the bench meanwhile.
 
 Fixtures: ``bench`` (a :class:`motorbus.Bench`), ``axis`` (one Drive, by name:
 indirect parametrization or the ``axes`` marker), ``bus`` (a bench bus),
@@ -34,6 +39,7 @@ from typing import Any, Optional
 import pytest
 
 _FROM_DEFAULT = "\0default"          # --bench-sim given without a FILE
+_SERVER_OF_FILE = "\0file"           # --bench-server given without an ADDR
 _STOP_WAIT = 5.0                     # seconds an axis gets to come to rest after stop()
 
 
@@ -72,7 +78,13 @@ class BenchSession:
                 base = config.inipath.parent if config.inipath else config.rootpath
                 path = str((base / path).resolve())
         self.path: Optional[str] = path
-        self.explicit = bool(real or sim)
+        self.server: Optional[str] = config.getoption("motorbus_bench_server")
+        if self.server == _SERVER_OF_FILE:
+            if not path:
+                raise pytest.UsageError("--bench-server without ADDR: which bench? give ADDR (its bench file or "
+                                        "unix:/path.sock), or --bench FILE / the motorbus_bench ini option")
+            self.server = path
+        self.explicit = bool(real or sim or self.server)
         self.bench: Any = None
         self.identities: dict[str, dict] = {}
         self.open_error: Optional[BaseException] = None
@@ -81,6 +93,8 @@ class BenchSession:
 
     @property
     def label(self) -> str:
+        if self.server:
+            return f"{self.server} (through motorbus serve)"
         where = self.path or "built-in bench (one axis of every registered kind)"
         return f"{where} ({'simulated twin' if self.simulated else 'hardware'})"
 
@@ -94,7 +108,10 @@ class BenchSession:
                 from .bench import Bench
 
                 try:
-                    if self.path is None:
+                    if self.server:
+                        self.bench = _connect_server(self.server)
+                        self.simulated = bool(self.bench.simulated)
+                    elif self.path is None:
                         self.bench = Bench.from_dict(default_bench(), sim=True)
                     else:
                         self.bench = Bench.load(self.path, sim=self.simulated)
@@ -102,7 +119,9 @@ class BenchSession:
                     self.open_error = e
                     raise
                 self.reopen = False
-                self.identities = identify(self.bench)
+                # A served bench's drives answer through the service: identifying them would
+                # need its transports.
+                self.identities = {} if self.server else identify(self.bench)
             return self.bench
 
     def stop_all(self) -> list[str]:
@@ -113,8 +132,20 @@ class BenchSession:
         from .drive import MoveFailed, MoveTimedOut
 
         problems = []
-        failed = dict(bench.stop_all("stop"))
-        for name, drive in bench.axes.items():
+        if self.server:
+            # A served bench is shared: only what this session commanded is stopped, not
+            # what another program moves meanwhile.
+            axes = {n: d for n, d in bench.axes.items() if getattr(d, "commanded", False)}
+            failed = {}
+            for name, drive in axes.items():
+                try:
+                    drive.stop()
+                except Exception as e:  # noqa: BLE001 - then the harder stop
+                    failed[name] = e
+        else:
+            axes = bench.axes
+            failed = dict(bench.stop_all("stop"))
+        for name, drive in axes.items():
             if name in failed or drive.closed:
                 continue
             try:
@@ -148,6 +179,18 @@ class BenchSession:
                     self.bench.close()
                     self.bench = None
                     self.reopen = False
+
+
+def _connect_server(address: str) -> Any:
+    """The served bench at ``address``; a bench file with no service running says so."""
+    from . import _core
+    from .serve import find_service
+    from .serve.client import connect
+
+    if not address.startswith("unix:") and os.path.isfile(address) and find_service(address) is None:
+        raise _core.LinkDown(f"--bench-server {address}: no motorbus serve runs for this bench file "
+                             f"(start one: motorbus serve {address})")
+    return connect(address)
 
 
 _session_key = pytest.StashKey[BenchSession]()
@@ -224,6 +267,10 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     group.addoption("--bench-sim", dest="motorbus_bench_sim", metavar="FILE", nargs="?", const=_FROM_DEFAULT,
                     default=None, help="run them on FILE's simulated twin (the default; without FILE: the "
                                        "motorbus_bench ini option, else one axis of every registered kind)")
+    group.addoption("--bench-server", dest="motorbus_bench_server", metavar="ADDR", nargs="?",
+                    const=_SERVER_OF_FILE, default=None,
+                    help="run them on the bench a running `motorbus serve` owns: ADDR is its bench file or "
+                         "unix:/path.sock (without ADDR: the service of the --bench/--bench-sim/ini bench file)")
     parser.addini("motorbus_bench", "bench file for the motorbus fixtures when no --bench/--bench-sim FILE "
                                     "is given (its simulated twin unless --bench)", default="")
     parser.addini("motorbus_poll_rate", "sampling rate (Hz) of the poller fixture", default="100")
@@ -375,6 +422,10 @@ def poller(request: pytest.FixtureRequest, bench: Any, tmp_path: Path) -> Any:
     import motorbus
 
     poller_cls = getattr(motorbus, "Poller", None)
+    if _session(request.config).server:
+        # The service's shared poll (one Poller in the service however many subscribe).
+        def poller_cls(axes: Any, rate_hz: float) -> Any:
+            return bench.poll(list(axes), rate_hz=rate_hz)
     if poller_cls is None:
         pytest.skip("motorbus.Poller is not available in this motorbus (poller fixture)")
     names = _wanted_axes(request)
@@ -466,6 +517,9 @@ class SimFaults:
 def sim_faults(request: pytest.FixtureRequest, bench: Any) -> SimFaults:
     """Fault injection on the simulated twin (skipped on real hardware): see SimFaults."""
     s = _session(request.config)
+    if s.server:
+        pytest.skip(f"sim_faults: the bench is served ({s.label}); its simulators, if any, live in the "
+                    f"service's process")
     if not s.simulated:
         pytest.skip(f"sim_faults: the bench is real hardware ({s.label}); faults are injected on its "
                     f"simulated twin only (--bench-sim)")

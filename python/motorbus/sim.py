@@ -529,6 +529,10 @@ def _toml_document(data: Mapping[str, Any]) -> str:
     (inline tables below that level)."""
     out = []
     for section, tables in data.items():
+        if not all(isinstance(t, Mapping) for t in tables.values()):   # [epics]: keys, not tables
+            out.append(f"\n[{_toml_key(section)}]")
+            out.extend(f"{_toml_key(key)} = {_toml_value(value)}" for key, value in tables.items())
+            continue
         for name, table in tables.items():
             out.append(f"\n[{_toml_key(section)}.{_toml_key(name)}]")
             for key, value in table.items():

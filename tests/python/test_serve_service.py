@@ -1,0 +1,264 @@
+"""``motorbus serve``: the service process and what finds it (docs/serve.md).
+
+One lasting simulated twin (``motorbus sim serve --bench``, another process, as hardware
+is) and one ``motorbus serve`` of its bench file for the module, with Channel Access on
+this xdist worker's own port.  What is asserted is seen from outside the service: its
+lock file, the CLI's exit codes, a CA client using the environment the service printed,
+and at the end the twin read directly once SIGTERM has ended the service.
+"""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+import motorbus
+from motorbus.serve import ServedElsewhere, find_service, lock_path
+from motorbus.serve.client import RemoteBench, connect
+from motorbus.sim import ServedBench
+
+pytestmark = pytest.mark.subprocess
+pytest_plugins = ["pytester"]
+
+BENCH = textwrap.dedent("""\
+    [epics]
+    prefix = "T26S:"
+
+    [line.ser]
+    port = "/dev/null-ser"
+
+    [bus.can]
+    spec = "virtual:t26"
+
+    [axis.x]
+    kind = "arcus"
+    line = "ser"
+    address = "01"
+    units = { name = "mm", scale = 0.01 }
+    params = { HSPD = 20000, LSPD = 2000, ACC = 20 }
+
+    [axis.z]
+    kind = "cia402"
+    bus = "can"
+    address = 5
+    units = { name = "mm", scale = 0.01 }
+    params = { "0x6081" = 20000, "0x6083" = 400000, "0x6084" = 400000 }
+    """)
+
+
+def ca_port() -> int:
+    """This xdist worker's CA port (the contract: 20000 + 16*worker; +8 is this module's)."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
+    index = int(worker[2:]) if worker[2:].isdigit() else 0
+    return 20000 + 16 * index + 8
+
+
+def motorbus_cli(*args: str, timeout: float = 30.0, **kw) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "motorbus", *args], capture_output=True, text=True,
+                          timeout=timeout, **kw)
+
+
+class Service:
+    """``motorbus serve`` in a subprocess, its announce lines read up to ``ready``."""
+
+    def __init__(self, bench: str, *args: str) -> None:
+        self.err = open(f"{bench}.serve-stderr.txt", "w+")
+        self.proc = subprocess.Popen([sys.executable, "-m", "motorbus", "serve", bench, *args],
+                                     stdout=subprocess.PIPE, stderr=self.err, text=True)
+        self.lines: list[str] = []
+        for line in self.proc.stdout:
+            self.lines.append(line.rstrip("\n"))
+            if line.startswith("ready"):
+                break
+        else:
+            raise AssertionError(f"motorbus serve ended ({self.proc.wait()}): {self.stderr()}")
+
+    def stderr(self) -> str:
+        self.err.flush()
+        with open(self.err.name) as f:
+            return f.read()
+
+    def end(self, sig: int = signal.SIGTERM) -> int:
+        if self.proc.poll() is None:
+            self.proc.send_signal(sig)
+        try:
+            return self.proc.wait(timeout=20)
+        finally:
+            self.proc.stdout.close()
+            self.err.close()
+
+
+@pytest.fixture(scope="module")
+def twin(tmp_path_factory):
+    source = tmp_path_factory.mktemp("serve") / "bench.toml"
+    source.write_text(BENCH)
+    with ServedBench(str(source)) as served:
+        yield served
+
+
+@pytest.fixture(scope="module")
+def service(twin):
+    s = Service(twin.bench_file, "--ca-port", str(ca_port()))
+    try:
+        # The file's speeds, applied through the service (config apply goes through it too).
+        r = motorbus_cli("config", "apply", twin.bench_file)
+        assert r.returncode == 0, r.stderr
+        yield s
+    finally:
+        s.end()
+
+
+def test_lock_file_finds_the_service_and_its_announce(twin, service):
+    info = find_service(twin.bench_file)
+    assert info is not None and info.pid == service.proc.pid
+    assert info.bench == os.path.realpath(twin.bench_file) and not info.sim
+    assert os.path.basename(lock_path(twin.bench_file)) == ".bench.toml.serve.lock"
+    assert len(os.fsencode(info.socket)) <= 107 and os.path.exists(info.socket)
+    # The twin's serial line (a symlink in its link dir) and its bus are what the service holds.
+    assert os.path.join(twin.link_dir, "ser") in info.links and any(s.startswith("socketcand:") for s in info.links)
+    assert info.prefix == "T26S:" and info.ca_port == ca_port()          # the file's [epics] prefix
+    assert info.env["EPICS_CA_SERVER_PORT"] == str(ca_port())
+    assert f"rpc unix:{info.socket}" in service.lines
+    assert f"export EPICS_CA_SERVER_PORT={ca_port()}" in service.lines
+
+
+def test_a_second_service_of_the_bench_is_refused(twin, service):
+    r = motorbus_cli("serve", twin.bench_file, "--no-epics")
+    assert r.returncode == 4, r.stderr
+    assert f"is served by motorbus serve (pid {service.proc.pid}): a second motorbus serve needs the transports" \
+        in r.stderr
+    assert find_service(twin.bench_file).pid == service.proc.pid       # the first one is untouched
+
+
+def test_move_status_and_a_stop_from_another_program_through_the_service(twin, service):
+    r = motorbus_cli("move", twin.bench_file, "x", "2.5", "--json")
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["position"] == pytest.approx(2.5, abs=0.02)
+    # A long move, then `motorbus stop` from a third program: the mover's exit code is the
+    # Drive API's "interrupted" (10), and the axis is at rest short of the target.
+    mover = subprocess.Popen([sys.executable, "-m", "motorbus", "move", twin.bench_file, "z", "300", "--json"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    with connect(twin.bench_file) as bench:
+        deadline = time.monotonic() + 10
+        while not (bench["z"].status.moving and bench["z"].position > 5):
+            assert time.monotonic() < deadline and mover.poll() is None, mover.communicate()
+            time.sleep(0.02)
+        r = motorbus_cli("stop", twin.bench_file, "z")
+        assert r.returncode == 0 and "z: stopped" in r.stdout, r.stderr
+        out, err = mover.communicate(timeout=20)
+        assert mover.returncode == 10, err
+        result = json.loads(out)
+        assert result["outcome"] == "interrupted" and 5 < result["position"] < 300
+        assert not bench["z"].status.moving
+    r = motorbus_cli("status", twin.bench_file, "--json")
+    assert r.returncode == 0, r.stderr
+    axes = json.loads(r.stdout)["axes"]
+    assert axes["x"]["position"] == pytest.approx(2.5, abs=0.02)
+    assert axes["z"]["position"] == pytest.approx(result["position"], abs=0.05)
+
+
+def test_a_drive_fault_through_the_service_is_exit_code_12(twin, service):
+    mover = subprocess.Popen([sys.executable, "-m", "motorbus", "move", twin.bench_file, "z", "0"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    with connect(twin.bench_file) as bench:
+        deadline = time.monotonic() + 10
+        while not bench["z"].status.moving:
+            assert time.monotonic() < deadline and mover.poll() is None, mover.communicate()
+            time.sleep(0.02)
+        twin.inject("z", "fault")
+        out, err = mover.communicate(timeout=20)
+        assert mover.returncode == 12, err
+        bench["z"].clear_faults()
+
+
+def test_what_needs_the_transports_is_refused_while_served(twin, service):
+    pid = service.proc.pid
+    r = motorbus_cli("terminal", twin.bench_file, "x", input="VER\n")
+    assert r.returncode == 4
+    assert r.stderr.strip() == (f"motorbus: {os.path.realpath(twin.bench_file)} is served by motorbus serve "
+                                f"(pid {pid}): a protocol console (terminal) needs the transports; stop the "
+                                f"service first")
+    spec = next(s for s in find_service(twin.bench_file).links if s.startswith("socketcand:"))
+    r = motorbus_cli("bus", "dump", spec, "--count", "1")
+    assert r.returncode == 4 and f"(pid {pid}): a bus dump needs the transports" in r.stderr
+    # --no-server opens the transports here: the serial line is the service's (busy), and the
+    # message says which program holds it and how to go through it instead.
+    r = motorbus_cli("status", twin.bench_file, "--no-server")
+    assert r.returncode == 4
+    assert f"served by motorbus serve (pid {pid}), which holds its transports: drop --no-server" in r.stderr
+
+
+def test_channel_access_with_the_printed_environment(twin, service):
+    """The CA face of the same service: RBV is where the CLI moved x, read by caproto-get
+    with only the environment the service printed (and the lock file holds)."""
+    env = {**os.environ, **find_service(twin.bench_file).env}
+    r = subprocess.run([os.path.join(os.path.dirname(sys.executable), "caproto-get"), "--no-repeater", "-n",
+                        "T26S:x.RBV", "T26S:x.DMOV"], capture_output=True, text=True, timeout=20, env=env)
+    assert r.returncode == 0, r.stderr
+    values = dict(line.split(None, 1) for line in r.stdout.splitlines())
+    assert float(values["T26S:x.RBV"].strip("[]")) == pytest.approx(2.5, abs=0.02)
+    assert values["T26S:x.DMOV"].strip("[]") == "1"
+
+
+def test_pytest_plugin_bench_server(twin, service, pytester):
+    """``pytest --bench-server``: the bench, axis and poller fixtures come from the service."""
+    pytester.makepyfile(test_served="""
+        import time
+        import pytest
+        from motorbus.serve.client import RemoteBench, RemotePoller
+
+        def test_bench_is_the_service(bench):
+            assert isinstance(bench, RemoteBench) and set(bench.axes) == {"x", "z"}
+
+        @pytest.mark.axes("x")
+        def test_axis_and_poller(axis, poller):
+            assert isinstance(poller, RemotePoller)
+            axis.move_to(1.0)
+            assert axis.position == pytest.approx(1.0, abs=0.02)
+            seen, deadline = [], time.monotonic() + 5     # rows come in chunks from the service
+            while not (seen and abs(seen[-1] - 1.0) < 0.02) and time.monotonic() < deadline:
+                time.sleep(0.05)
+                seen.extend(poller.read()["x.position"])
+            assert seen[-1] == pytest.approx(1.0, abs=0.02)
+        """)
+    from importlib import metadata
+
+    # -p motorbus.pytest_plugin unless the installed motorbus declares it (loading it twice is an error)
+    plugin = [] if any(ep.value == "motorbus.pytest_plugin" for ep in metadata.entry_points(group="pytest11")) \
+        else ["-p", "motorbus.pytest_plugin"]
+    result = pytester.runpytest_subprocess(*plugin, "-p", "no:cacheprovider", "--bench-server", twin.bench_file,
+                                           timeout=60)
+    result.assert_outcomes(passed=2)
+    r = motorbus_cli("status", twin.bench_file, "--json")
+    assert json.loads(r.stdout)["axes"]["x"]["position"] == pytest.approx(1.0, abs=0.02)
+
+
+def test_sigterm_stops_a_moving_axis_then_ends_the_service(twin, service):
+    """Last: SIGTERM while z moves.  The service exits 0, frees the bench, and the twin,
+    read directly afterwards, is at rest short of the target."""
+    bench = connect(twin.bench_file)
+    try:
+        if not bench["z"].status.enabled:
+            bench["z"].enable()
+        start = bench["z"].position
+        bench["z"].move_to(start + 300, wait=False)
+        deadline = time.monotonic() + 10
+        while not bench["z"].position > start + 5:
+            assert time.monotonic() < deadline
+            time.sleep(0.02)
+    finally:
+        bench.close()             # closing stops nothing (a wait=False move goes on): the service's stop is under test
+    assert service.end(signal.SIGTERM) == 0, service.stderr()
+    assert find_service(twin.bench_file) is None
+    with motorbus.Bench.load(twin.bench_file) as direct:     # the transports are free again
+        z = direct["z"]
+        first = z.position
+        time.sleep(0.3)
+        assert not z.status.moving and z.position == first
+        assert start + 5 < first < start + 300
