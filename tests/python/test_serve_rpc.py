@@ -287,6 +287,26 @@ def test_a_stop_from_another_connection_stops_a_move_this_one_awaits(service, be
         other.close()
 
 
+def test_a_stop_from_another_thread_overtakes_the_move_this_connection_awaits(service, bench):
+    z = bench["z"]
+    z.move_to(0.0, timeout=10)
+    result: dict = {}
+
+    def mover() -> None:
+        try:
+            z.move_to(400.0, timeout=20)
+        except BaseException as e:  # noqa: BLE001
+            result["error"] = e
+    t = threading.Thread(target=mover)
+    t.start()
+    wait_for(lambda: service.shaft("z") > 5.0, what="z moving")
+    assert z.position > 5.0                  # a reading overtakes the waiting move too
+    z.stop()                                 # the same connection, another thread
+    t.join(20)
+    assert type(result["error"]) is motorbus.MoveInterrupted
+    assert 5.0 < service.shaft("z") < 400.0 and not service.bench["z"].sync.status.moving
+
+
 def test_a_dropped_client_stops_the_move_it_awaited_but_not_one_it_left_running(service, bench):
     z, u = bench["z"], bench["u"]
     z.move_to(0.0, timeout=10)
@@ -324,6 +344,61 @@ def test_move_together_and_stop_all(service, bench):
     assert set(st) == {"x", "z", "f", "u"} and all(isinstance(s, motorbus.DriveStatus) for s in st.values())
     for n in ("z", "u"):
         wait_for(lambda n=n: not service.bench[n].sync.status.moving)
+
+
+def test_a_failed_move_together_says_every_axis(service, bench):
+    z, f = bench["z"], bench["f"]
+    f.enable()
+    bench.move_together({"z": 0.0, "f": 0.0}, timeout=10)
+    result: dict = {}
+
+    def mover() -> None:
+        try:
+            bench.move_together({"z": 3.0, "f": 300.0}, timeout=20)
+        except BaseException as e:  # noqa: BLE001
+            result["error"] = e
+    t = threading.Thread(target=mover)
+    t.start()
+    wait_for(lambda: service.shaft("f") > 5.0, what="f moving")
+    service.fault("f", "fault")
+    t.join(20)
+    e = result["error"]
+    assert type(e) is motorbus.MoveFaulted and e.axis == "f"
+    assert set(e.failures) == {"f"} and type(e.failures["f"]) is motorbus.MoveFaulted
+    assert e.failures["f"].position == pytest.approx(e.position)
+    assert z.status.last_move.ok and service.shaft("z") == pytest.approx(3.0, abs=0.011)
+    f.clear_faults()
+    f.enable()
+
+
+def test_malformed_calls_are_typed_errors_and_counted(service, bench):
+    before = bench.counters()
+    raw = rclient.Connection(service.path)
+    try:
+        with pytest.raises(motorbus.InvalidArgument, match="no call 'fly'"):
+            raw.call("fly")
+        with pytest.raises(motorbus.InvalidArgument, match="no axis call 'fly'"):
+            raw.call("fly", "z")
+        with pytest.raises(motorbus.InvalidArgument, match="jog: missing a required argument: 'velocity'"):
+            raw.call("jog", "z")
+        with pytest.raises(motorbus.InvalidArgument, match="move_to: got an unexpected keyword argument 'speed'"):
+            raw.call("move_to", "z", 1.0, speed=3)
+        with pytest.raises(motorbus.InvalidArgument, match="no axis 'q'"):
+            raw.call("position", "q")
+        # a call the client library would never send: an id that cannot key a reply
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        sock.connect(service.path)
+        sock.sendall(rpc.frame(rpc.FRAME_JSON, rpc.dumps({"id": [1], "call": "info"})))
+        size, kind = rpc.HEADER.unpack(sock.recv(rpc.HEADER.size, socket.MSG_WAITALL))
+        reply = rpc.json.loads(sock.recv(size, socket.MSG_WAITALL))
+        sock.close()
+        assert kind == rpc.FRAME_JSON and reply["id"] is None
+        assert "an integer or a text" in rpc.decode_error(reply["error"]).args[0]
+    finally:
+        raw.close()
+    after = bench.counters()
+    assert after["calls"] - before["calls"] >= 7          # the six above and counters() itself
+    assert after["failed_calls"] - before["failed_calls"] == 6
 
 
 def test_the_console_is_refused_naming_the_service(service, bench):

@@ -26,6 +26,7 @@ import collections
 import contextlib
 import dataclasses
 import enum
+import inspect
 import itertools
 import json
 import logging
@@ -389,6 +390,8 @@ class RpcFace:
                 self._dispatch(conn, msg)
         except (asyncio.IncompleteReadError, ConnectionError, json.JSONDecodeError, UnicodeDecodeError):
             pass
+        except Exception:  # noqa: BLE001 - a bug must end this connection, not the service
+            log.exception("motorbus serve: a connection ended on an error")
         except asyncio.CancelledError:
             pass
         finally:
@@ -416,12 +419,23 @@ class RpcFace:
             await self._unsubscribe(conn, sid)
 
     def _dispatch(self, conn: _Conn, msg: Any) -> None:
-        if not isinstance(msg, dict) or "id" not in msg or not isinstance(msg.get("call"), str):
-            conn.reply({"id": msg.get("id") if isinstance(msg, dict) else None,
-                        "error": encode_error(_core.InvalidArgument(
-                            "motorbus serve: a call is {\"id\", \"call\", \"axis\"?, \"args\", \"kwargs\"}"))})
+        cid = msg.get("id") if isinstance(msg, dict) else None
+        why = None
+        if not isinstance(msg, dict) or not isinstance(msg.get("call"), str):
+            why = 'a call is {"id", "call", "axis"?, "args", "kwargs"}'
+        elif isinstance(cid, bool) or not isinstance(cid, (int, str)):
+            why = f"a call's id is an integer or a text, not {cid!r}"
+        elif cid in conn.calls:
+            why = f"call id {cid!r} is already in flight on this connection"
+        elif not isinstance(msg.get("args", []), list) or not isinstance(msg.get("kwargs", {}), dict):
+            why = "a call's args are a list and its kwargs an object"
+        if why is not None:
+            self.counters["calls"] += 1
+            self.counters["failed_calls"] += 1
+            conn.reply({"id": cid if isinstance(cid, (int, str)) else None,
+                        "error": encode_error(_core.InvalidArgument(f"motorbus serve: {why}"))})
             return
-        call, cid = msg["call"], msg["id"]
+        call = msg["call"]
         self.counters["calls"] += 1
         kwargs = msg.get("kwargs") or {}
         awaited = (call in _AWAITED_MOTION and kwargs.get("wait", True)) or call == "wait_idle" \
@@ -457,11 +471,13 @@ class RpcFace:
             if verb is None:
                 raise _core.InvalidArgument(f"motorbus serve: no axis call {call!r} (calls: "
                                             f"{', '.join(sorted(_AXIS_CALLS))})")
+            _check_arguments(call, verb, (self, d), args, kwargs)
             return await verb(self, d, *args, **kwargs)
         verb = _BENCH_CALLS.get(call)
         if verb is None:
             raise _core.InvalidArgument(f"motorbus serve: no call {call!r} (bench calls: "
                                         f"{', '.join(sorted(_BENCH_CALLS))}; axis calls take \"axis\")")
+        _check_arguments(call, verb, (self, conn), args, kwargs)
         return await verb(self, conn, *args, **kwargs)
 
     def describe(self) -> dict:
@@ -544,6 +560,15 @@ class RpcFace:
 
     def poll_key_count(self) -> int:
         return len(self._polls)
+
+
+def _check_arguments(call: str, verb: Any, head: tuple, args: list, kwargs: dict) -> None:
+    """Arguments the call does not take are the caller's mistake, said as one (not a TypeError
+    from deep inside the service)."""
+    try:
+        inspect.signature(verb).bind(*head, *args, **kwargs)
+    except TypeError as e:
+        raise _core.InvalidArgument(f"motorbus serve: {call}: {e}") from None
 
 
 def _has_console(drive: Any) -> bool:
