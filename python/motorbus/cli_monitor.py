@@ -28,6 +28,8 @@ monitors share (docs/serve.md).
 from __future__ import annotations
 
 import argparse
+import collections
+import math
 import os
 import select
 import sys
@@ -107,12 +109,80 @@ class Listener:
                 pass
 
 
-def read_rows(bench: Bench, names: list[str], listeners: Optional[dict] = None) -> list[tuple]:
+class ServedReadings:
+    """A monitor's readings of a served bench that cost the drives nothing per monitor:
+    the position from the service's shared poll (monitors asking the same axes and rate
+    share one Poller in the service), the velocity differentiated from it (every kind
+    polls its position; not every kind has a velocity object to poll: pmc007), the
+    status, which a poll holds only as the kind's raw word, asked at most ``STATUS_HZ``
+    times a second."""
+
+    STATUS_HZ = 2.0
+    VELOCITY_WINDOW = 0.1      # seconds of polled positions a velocity is taken over
+
+    def __init__(self, bench: Any, names: list[str], rate: float) -> None:
+        self._poll = bench.poll(names, fields=("position",), rate_hz=max(rate, 10.0), keep=1.0)
+        self._history: dict[str, collections.deque] = {n: collections.deque(maxlen=256) for n in names}
+        self._status: dict[str, Any] = {}
+        self._asked = -math.inf
+
+    def _take(self) -> None:
+        frame = self._poll.read()
+        for name, history in self._history.items():
+            ts = frame.get(f"{name}.t", frame.get("t"))
+            ps = frame.get(f"{name}.position")
+            if ts is None or ps is None:
+                continue
+            for t, p in zip(ts[-64:], ps[-64:]):
+                if math.isfinite(p):
+                    history.append((float(t), float(p)))
+
+    def _velocity(self, name: str) -> Optional[float]:
+        h = self._history[name]
+        if len(h) < 2:
+            return None
+        t1, p1 = h[-1]
+        for t0, p0 in reversed(h):
+            if t1 - t0 >= self.VELOCITY_WINDOW:
+                return (p1 - p0) / (t1 - t0)
+        t0, p0 = h[0]
+        return (p1 - p0) / (t1 - t0) if t1 > t0 else None
+
+    def row(self, name: str, d: Any) -> tuple:
+        self._take()
+        now = time.monotonic()
+        if now - self._asked >= 1.0 / self.STATUS_HZ:
+            self._asked = now
+            self._status = {}
+        if name not in self._status:
+            self._status[name] = d.status
+        st = self._status[name]
+        h = self._history[name]
+        pos, vel = (h[-1][1] if h else None), self._velocity(name)
+        return (name, d.kind, "…" if pos is None else _fmt(pos), "…" if vel is None else _fmt(vel), d.units.name,
+                _flags(st), "FAULT" if st.fault else "-", st.text or "-")
+
+    def close(self) -> None:
+        try:
+            self._poll.stop()
+        except _core.MotorbusError:
+            pass
+
+
+def read_rows(bench: Bench, names: list[str], listeners: Optional[dict] = None,
+              served: Optional[ServedReadings] = None) -> list[tuple]:
     """``(axis, kind, position, velocity, units, state, fault, drive says)`` per axis,
-    read now (or, for an axis only listened to, what it has sent); an axis that fails to
-    answer says why instead."""
+    read now (or, for an axis only listened to, what it has sent; through a service, from
+    its shared poll); an axis that fails to answer says why instead."""
     rows = []
     for name in names:
+        if served is not None:
+            d = bench[name]
+            try:
+                rows.append(served.row(name, d))
+            except _core.MotorbusError as e:
+                rows.append((name, d.kind, "?", "?", d.units.name, "-", "no answer", f"{type(e).__name__}: {e}"))
+            continue
         if listeners and name in listeners:
             cfg = bench.config[name]
             rows.append(listeners[name].row(name, cfg.kind, cfg.units.name if cfg.units else "native"))
@@ -127,17 +197,18 @@ def read_rows(bench: Bench, names: list[str], listeners: Optional[dict] = None) 
     return rows
 
 
-def render(bench: Bench, names: list[str], rate: float, frame: int, listeners: Optional[dict] = None) -> Any:
+def render(bench: Bench, names: list[str], rate: float, frame: int, listeners: Optional[dict] = None,
+           served: Optional[ServedReadings] = None) -> Any:
     from rich.table import Table
 
     sim = " (simulated twin)" if getattr(bench, "simulated", False) else ""
-    served = " through motorbus serve" if isinstance(bench, _Narrowed) else ""
-    table = Table(title=f"{getattr(bench, 'source', '')}{sim}{served}", caption=f"{rate:g} Hz, frame {frame} — q or Ctrl-C quits",
+    via = " through motorbus serve" if isinstance(bench, _Narrowed) else ""
+    table = Table(title=f"{getattr(bench, 'source', '')}{sim}{via}", caption=f"{rate:g} Hz, frame {frame} — q or Ctrl-C quits",
                   title_justify="left", caption_justify="left")
     for col, justify in (("axis", "left"), ("kind", "left"), ("position", "right"), ("velocity", "right"),
                          ("units", "left"), ("state", "left"), ("fault", "left"), ("drive says", "left")):
         table.add_column(col, justify=justify, no_wrap=col != "drive says")
-    for row in read_rows(bench, names, listeners):
+    for row in read_rows(bench, names, listeners, served):
         style = "bold red" if row[6] != "-" else None
         table.add_row(*row, style=style)
     return table
@@ -212,8 +283,11 @@ def cmd_monitor(args: argparse.Namespace) -> int:
         print(error_text(e), file=sys.stderr)
         return exit_code(e)
     listeners: dict = {}
+    readings: Optional[ServedReadings] = None
     try:
-        if not served:
+        if served:
+            readings = ServedReadings(bench, list(bench.axes), args.rate)
+        else:
             for d in bench.axes.values():
                 # Watching must not change what it watches: no stop when the monitor leaves.
                 d.on_error = None
@@ -228,8 +302,8 @@ def cmd_monitor(args: argparse.Namespace) -> int:
         console = Console()
         frame = 0
         try:
-            with _cbreak(sys.stdin), Live(render(bench, names, args.rate, frame, listeners), console=console,
-                                          auto_refresh=False, transient=False) as live:
+            first = render(bench, names, args.rate, frame, listeners, readings)
+            with _cbreak(sys.stdin), Live(first, console=console, auto_refresh=False, transient=False) as live:
                 next_t = time.monotonic()
                 while True:
                     next_t += period
@@ -239,14 +313,16 @@ def cmd_monitor(args: argparse.Namespace) -> int:
                     if time.monotonic() > next_t + period:   # slow drives: do not try to catch up
                         next_t = time.monotonic()
                     frame += 1
-                    live.update(render(bench, names, args.rate, frame, listeners), refresh=True)
+                    live.update(render(bench, names, args.rate, frame, listeners, readings), refresh=True)
         except KeyboardInterrupt:
             pass
         return EXIT_OK
     finally:
         for listener in listeners.values():
             listener.close()
-        bench.close()     # closes the links; stops nothing
+        if readings is not None:
+            readings.close()
+        bench.close()     # closes the links (a served bench: the connection); stops nothing
 
 
 def add_commands(sub: Any, common: Any = None) -> None:

@@ -307,7 +307,7 @@ class BenchService:
     def _sdo_counters(self) -> dict:
         sdo: dict = {}
         for name, d in self.bench.axes.items():
-            c = getattr(getattr(d.sync, "_sdo", None), "counters", None)
+            c = _sdo_client_counters(d.sync)
             if c is None:
                 continue
             sdo[name] = {k: int(getattr(c, k)) for k in ("transfers", "timeouts", "aborts_sent", "aborts_received",
@@ -318,6 +318,18 @@ class BenchService:
         """One line ``counters {json}`` (stderr by default; SIGUSR1 and the end of
         ``motorbus serve`` print it)."""
         print(f"counters {json.dumps(self.counters(), sort_keys=True)}", file=stream or sys.stderr, flush=True)
+
+
+def _sdo_client_counters(drive: Any) -> Any:
+    """The SdoClientCounters of a CANopen axis's SDO client (the Drive's own, or its native
+    client's), or None for a kind that talks no SDO."""
+    native = getattr(drive, "native", None)
+    sdo = getattr(native, "sdo", None)
+    for client in (getattr(drive, "_sdo", None), getattr(sdo, "client", None), sdo):
+        c = getattr(client, "counters", None)
+        if c is not None and hasattr(c, "foreign_responses"):
+            return c
+    return None
 
 
 def _info_dict(info: ServiceInfo) -> dict:
