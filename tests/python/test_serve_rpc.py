@@ -509,6 +509,8 @@ def test_the_awaitable_face(service, bench):
             assert not service.bench["z"].sync.status.moving
             rest = service.shaft("z")
             assert 3.0 < rest < 400.0
+            last = (await z.status()).last_move
+            assert last.state == "interrupted" and "the cancellation of the awaiting task" in last.reason
             # a typed error, awaited
             with pytest.raises(motorbus.MoveInterrupted):
                 await asyncio.gather(z.move_to(50.0, timeout=10), _stop_soon(z, service))
@@ -541,3 +543,16 @@ def test_a_lost_service_is_link_down_and_a_missing_one_is_said(tmp_path):
         motorbus.Bench.connect(bench_file)
     with pytest.raises(motorbus.InvalidArgument, match="no such bench file or socket"):
         motorbus.Bench.connect(tmp_path / "absent.toml")
+
+
+def test_zz_a_poll_whose_link_fails_ends_for_its_subscribers(service, bench):
+    # Last in the module: it cuts the arcus axis's served line.
+    with bench.poll(["x"], ("position",), rate_hz=200) as p:
+        wait_for(lambda: len(p.frame()["t"]) > 20, what="rows from x")
+        service.bench.sync.served_lines["l1"].close()
+        wait_for(lambda: not p.running, what="the poll's end said to its subscriber")
+        assert p.end_stats is not None
+        (group,) = p.end_stats.values()
+        assert group["axes"] == ["x"] and not group["running"] and group["error_type"]
+        assert len(p.read()["t"]) + len(p.frame()["t"]) > 20
+    wait_for(lambda: service.run(_counter(service, "pollers")) == 0)

@@ -221,6 +221,17 @@ class Connection:
             self._lost(why)
 
     def _on_reply(self, msg: dict) -> None:
+        if "event" in msg:                 # answers no call: a shared poll that ended by itself
+            if msg["event"] == "poll_ended":
+                sub = self._subs.get(msg.get("sub"))
+                if sub is not None:
+                    try:
+                        sub.end_error = rpc.decode(msg.get("error"))
+                        sub.end_stats = rpc.decode(msg.get("stats"))
+                    except Exception:  # noqa: BLE001 - the end still counts
+                        pass
+                    sub._end()
+            return
         with self._lock:
             waiter = self._pending.pop(msg.get("id"), None)
         if waiter is None:
@@ -397,11 +408,11 @@ class RemoteDrive(Drive):
 
     async def _co_stop(self, by: str = "stop()") -> None:
         self._check_open()
-        await self._rc("stop")
+        await self._rc("stop", **({} if by == "stop()" else {"by": by}))
 
     async def _co_quick_stop(self, by: str = "quick_stop()") -> None:
         self._check_open()
-        await self._rc("quick_stop")
+        await self._rc("quick_stop", **({} if by == "quick_stop()" else {"by": by}))
 
     async def _co_home(self, method: Any = None, *, wait: bool = True, timeout: Optional[float] = None) -> None:
         self._check_open()
@@ -537,6 +548,10 @@ class RemotePoller:
         self._retained_rows = 0
         self._waiter: Optional[tuple] = None
         self._ended = False
+        #: Why the service's poll ended by itself (a link failed), if it did; None otherwise.
+        self.end_error: Optional[BaseException] = None
+        #: The service's Poller's stats when it ended by itself (each group's error_type, error).
+        self.end_stats: Optional[dict] = None
 
     # -- fed by the reader thread --
     def _feed(self, rows: np.ndarray, dropped: int) -> None:

@@ -265,8 +265,9 @@ class _Sub:
     def push(self, rows: np.ndarray) -> None:
         if len(self.queue) >= SUB_QUEUE_CHUNKS:
             old = self.queue.popleft()
-            self.dropped += len(old)
-            self.conn.face.counters["rows_dropped"] += len(old)
+            n = 0 if isinstance(old, dict) else len(old)
+            self.dropped += n
+            self.conn.face.counters["rows_dropped"] += n
         self.queue.append(rows)
         self.conn.wake.set()
 
@@ -280,14 +281,29 @@ class _SharedPoll:
         self.task: Optional[asyncio.Task] = None
 
     async def run(self, rows: int) -> None:
+        error: Optional[BaseException] = None
         try:
             async for chunk in self.poller.chunks(rows):
                 for sub in list(self.subs.values()):
                     sub.push(np.column_stack([chunk[c] for c in sub.columns]))
         except asyncio.CancelledError:
             raise
-        except Exception:  # noqa: BLE001 - a poll that ends on its own ends its subscribers' streams
+        except Exception as e:  # noqa: BLE001 - a poll that ends on its own ends its subscribers' streams
             log.exception("motorbus serve: shared poll %s ended", self.key)
+            error = e
+        # The poll ended by itself (every group stopped: a link failed): each subscriber is told,
+        # after the rows it still has queued, so its poller's stream ends instead of waiting.
+        if self.face._polls.get(self.key) is self:      # a new subscriber gets a new Poller
+            del self.face._polls[self.key]
+            self.face.counters["pollers"] -= 1
+        try:
+            await asyncio.to_thread(self.poller.stop)
+        except Exception:  # noqa: BLE001 - what it could not close is in its stats
+            pass
+        groups = self.poller.stats
+        for sub in list(self.subs.values()):
+            sub.conn.event({"event": "poll_ended", "sub": sub.id, "stats": encode(groups),
+                            "error": None if error is None else encode_error(error)})
 
 
 class _Conn:
@@ -305,6 +321,15 @@ class _Conn:
         self.replies.append(frame(FRAME_JSON, dumps(payload)))
         self.wake.set()
 
+    def event(self, payload: dict) -> None:
+        """A message that answers no call (a poll that ended), sent after the rows queued
+        before it: it goes through the subscription's queue, in order."""
+        sub = self.subs.get(payload.get("sub"))
+        if sub is None or self.closed:
+            return
+        sub.queue.append(payload)
+        self.wake.set()
+
     async def write_loop(self) -> None:
         """Replies first, then a chunk per subscription, round after round: a slow reader
         delays only its own stream (its queue drops its oldest rows meanwhile)."""
@@ -318,6 +343,9 @@ class _Conn:
                 for s in list(self.subs.values()):
                     if s.queue:
                         rows = s.queue.popleft()
+                        if isinstance(rows, dict):          # an event, after the rows before it
+                            parts.append(frame(FRAME_JSON, dumps(rows)))
+                            continue
                         parts.append(rows_frame(s.id, rows, s.dropped))
                         s.sent += len(rows)
                         self.face.counters["rows_sent"] += len(rows)
@@ -558,9 +586,6 @@ class RpcFace:
                 await shared.task
         await asyncio.to_thread(shared.poller.stop)
 
-    def poll_key_count(self) -> int:
-        return len(self._polls)
-
 
 def _check_arguments(call: str, verb: Any, head: tuple, args: list, kwargs: dict) -> None:
     """Arguments the call does not take are the caller's mistake, said as one (not a TypeError
@@ -632,8 +657,10 @@ _AXIS_CALLS = {
     "move_to": _move_to,
     "move_by": _move_by,
     "jog": lambda f, d, velocity: d.jog(velocity),
-    "stop": lambda f, d: d.stop(),
-    "quick_stop": lambda f, d: d.quick_stop(),
+    # ``by``: who stopped it, for the move's outcome ("the cancellation of the awaiting task"
+    # when a client's aio face stops a move whose task was cancelled).
+    "stop": lambda f, d, by="stop()": d.sync._co_stop(by=str(by)),
+    "quick_stop": lambda f, d, by="quick_stop()": d.sync._co_quick_stop(by=str(by)),
     "home": _home,
     "wait_idle": lambda f, d, timeout=None: d.wait_idle(timeout),
     "clear_faults": lambda f, d: d.clear_faults(),
