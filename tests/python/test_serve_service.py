@@ -262,3 +262,56 @@ def test_sigterm_stops_a_moving_axis_then_ends_the_service(twin, service):
         time.sleep(0.3)
         assert not z.status.moving and z.position == first
         assert start + 5 < first < start + 300
+
+
+WATCHDOG_BENCH = textwrap.dedent("""\
+    [bus.can]
+    spec = "virtual:t26wd"
+
+    [axis.z]
+    kind = "cia402"
+    bus = "can"
+    address = 5
+    units = { name = "mm", scale = 0.01 }
+    params = { "0x6081" = 20000, "0x6083" = 400000, "0x6084" = 400000 }
+    options = { watchdog = { host_node = 127, period = 0.05 } }
+
+    [axis.p]
+    kind = "pmc007"
+    bus = "can"
+    address = 7
+    units = { name = "mm", scale = 0.01 }
+    params = { maximum_speed = 20000 }
+    """)
+
+
+def test_after_sigkill_only_the_drives_watchdogs_act(tmp_path):
+    """docs/serve.md's table, for two kinds: a killed service (no shutdown runs) leaves the
+    CiA 402 axis, whose heartbeat consumer the bench file arms, quick-stopped by the drive
+    itself; the PMC007, which has no communication watchdog, goes on with its move."""
+    source = tmp_path / "bench.toml"
+    source.write_text(WATCHDOG_BENCH)
+    with ServedBench(str(source)) as twin:
+        s = Service(twin.bench_file, "--no-epics")
+        try:
+            assert motorbus_cli("config", "apply", twin.bench_file).returncode == 0
+            bench = connect(twin.bench_file)
+            for name in ("z", "p"):
+                if not bench[name].status.enabled:
+                    bench[name].enable()
+                bench[name].move_to(300.0, wait=False)
+            deadline = time.monotonic() + 10
+            while not (bench["z"].position > 5 and bench["p"].position > 5):
+                assert time.monotonic() < deadline
+                time.sleep(0.02)
+            bench.close()
+        finally:
+            s.end(signal.SIGKILL)
+        assert find_service(twin.bench_file) is None     # the kernel let go of the dead service's lock
+        time.sleep(0.3)             # several consumer periods (50 ms heartbeat) after the last heartbeat
+        with motorbus.Bench.load(twin.bench_file) as direct:
+            z, p = direct["z"], direct["p"]
+            z_at, p_at = z.position, p.position
+            time.sleep(0.2)
+            assert not z.status.moving and z.position == z_at < 300 and not z.status.enabled
+            assert p.status.moving and p_at < p.position <= 300
