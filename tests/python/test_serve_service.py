@@ -315,3 +315,14 @@ def test_after_sigkill_only_the_drives_watchdogs_act(tmp_path):
             time.sleep(0.2)
             assert not z.status.moving and z.position == z_at < 300 and not z.status.enabled
             assert p.status.moving and p_at < p.position <= 300
+
+
+def test_example_13_served_bench():
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    r = subprocess.run([sys.executable, os.path.join(root, "examples", "13_served_bench.py")], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines() == [
+        "found the service: True, simulated twin: True", "5 parameter(s) written", "x at 5.00 mm, z at 5.00 mm",
+        "z: stopped", "z's move: interrupted (MoveInterrupted)", "z at rest short of 300 mm: True",
+        "the watcher saw z pass 20 mm: True", "terminal: exit code 4 (True)", "service ended with exit code 0"]
