@@ -326,3 +326,37 @@ def test_example_13_served_bench():
         "found the service: True, simulated twin: True", "5 parameter(s) written", "x at 5.00 mm, z at 5.00 mm",
         "z: stopped", "z's move: interrupted (MoveInterrupted)", "z at rest short of 300 mm: True",
         "the watcher saw z pass 20 mm: True", "terminal: exit code 4 (True)", "service ended with exit code 0"]
+
+
+def test_lock_and_the_missing_extra_in_process(tmp_path, monkeypatch):
+    """The lock alone: a second holder gets ServedElsewhere naming the first's pid, a released
+    lock is free at once; a socket path too long for sun_path is refused by name; and without
+    caproto, serving EPICS names the extra and --no-epics, before any transport opens."""
+    import asyncio
+    import importlib.util
+
+    from motorbus.serve.lockfile import ServiceLock, check_socket_path
+    from motorbus.serve.service import BenchService
+
+    bench = tmp_path / "b.toml"
+    bench.write_text(BENCH)
+    first, second = ServiceLock(bench), ServiceLock(bench)
+    first.acquire()
+    with pytest.raises(ServedElsewhere, match=rf"\(pid {os.getpid()}\): a second motorbus serve needs"):
+        second.acquire()
+    first.release()
+    second.acquire()
+    second.release()
+    with pytest.raises(motorbus.InvalidArgument, match="a Unix socket path holds at most 107"):
+        check_socket_path(str(tmp_path / ("s" * 120)))
+
+    real_find_spec = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "caproto"
+                        else real_find_spec(name, *a))
+    service = BenchService(bench, sim=True, socket_path=str(tmp_path / "s.sock"))
+    with pytest.raises(motorbus.InvalidArgument, match=r"motorbus\[epics\].*--no-epics"):
+        asyncio.run(service.start())
+    assert service.bench is None and find_service(bench) is None and not os.path.exists(tmp_path / "s.sock")
+    again = ServiceLock(bench)         # let go: the next service may take it
+    again.acquire()
+    again.release()
