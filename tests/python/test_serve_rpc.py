@@ -165,7 +165,7 @@ def test_every_verb_round_trips(service, bench, axis):
     d.stop()
     d.wait_idle(timeout=10)          # a jog ended by this program's stop is a success
     assert d.status.last_move.what == "jog" and d.status.last_move.ok
-    d.move_to(8.0, wait=False)
+    d.move_to({"u": 4000.0}.get(axis, 300.0), wait=False)    # far: not there before the quick stop
     d.quick_stop()
     with pytest.raises(motorbus.MoveInterrupted):
         d.wait_idle(timeout=10)
@@ -287,6 +287,22 @@ def test_a_stop_from_another_connection_stops_a_move_this_one_awaits(service, be
         other.close()
 
 
+def test_wait_idle_reports_this_clients_move_even_if_another_clients_reading_judged_it(service, bench):
+    z = bench["z"]
+    z.move_to(0.0, timeout=10)
+    z.move_to(300.0, wait=False)
+    wait_for(lambda: service.shaft("z") > 5.0, what="z moving")
+    with motorbus.Bench.connect(f"unix:{service.path}") as other, \
+            motorbus.Bench.connect(f"unix:{service.path}") as monitor:
+        other["z"].stop()
+        wait_for(lambda: not monitor["z"].status.moving, what="z at rest")
+        assert monitor["z"].status.last_move.state == "interrupted"     # judged by the monitor's reading
+    with pytest.raises(motorbus.MoveInterrupted) as e:
+        z.wait_idle(timeout=10)                                          # still this client's outcome
+    assert e.value.target == pytest.approx(300.0) and 5.0 < e.value.position < 300.0
+    z.wait_idle(timeout=10)                                              # once
+
+
 def test_a_stop_from_another_thread_overtakes_the_move_this_connection_awaits(service, bench):
     z = bench["z"]
     z.move_to(0.0, timeout=10)
@@ -324,9 +340,10 @@ def test_a_dropped_client_stops_the_move_it_awaited_but_not_one_it_left_running(
     assert 5.0 < rest < 400.0
     last = service.bench["z"].sync.status.last_move
     assert last.state == "interrupted" and "cancellation" in last.reason
-    assert service.bench["u"].sync.status.moving        # the move nobody awaited goes on
-    u.stop()
-    wait_for(lambda: not service.bench["u"].sync.status.moving)
+    # the move nobody awaited goes on to its target
+    wait_for(lambda: not service.bench["u"].sync.status.moving, timeout=30, what="u's move")
+    assert service.bench["u"].sync.status.last_move.state == "done"
+    assert service.shaft("u") == pytest.approx(4000.0, abs=0.011)
     wait_for(lambda: service.run(_counter(service, "clients")) == 1, what="the dropped client counted out")
 
 
@@ -419,9 +436,10 @@ def test_an_exception_in_with_stops_what_this_program_moved_only(service, bench)
             raise RuntimeError("script failed")
     wait_for(lambda: not service.bench["z"].sync.status.moving, what="z stopped by the with-block")
     assert service.shaft("z") < 400.0
-    assert service.bench["u"].sync.status.moving      # not this program's: left running
-    bench["u"].stop()
-    wait_for(lambda: not service.bench["u"].sync.status.moving)
+    # not this program's: left to reach its target
+    wait_for(lambda: not service.bench["u"].sync.status.moving, timeout=30, what="u's move")
+    assert service.bench["u"].sync.status.last_move.state == "done"
+    assert service.shaft("u") == pytest.approx(4000.0, abs=0.011)
     bench["z"].clear_faults()
     bench["z"].enable()          # a CiA 402 quick stop leaves the drive in SWITCH ON DISABLED
 

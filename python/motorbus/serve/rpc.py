@@ -59,6 +59,8 @@ MAX_FRAME = 64 * 1024 * 1024
 SUB_QUEUE_CHUNKS = 64
 #: Calls whose task is cancelled (stopping the motor) when the connection that awaits them closes.
 _AWAITED_MOTION = {"move_to", "move_by", "home"}
+#: Calls that start a motion whose outcome a later wait_idle of the same client reports.
+_STARTS = {"move_to", "move_by", "home", "jog"}
 
 
 # ---- values on the wire ----------------------------------------------------------------------
@@ -313,6 +315,9 @@ class _Conn:
         self.wake = asyncio.Event()
         self.calls: dict[Any, tuple[asyncio.Task, bool]] = {}   # id -> (task, cancelled when the client goes)
         self.subs: dict[int, _Sub] = {}
+        #: axis -> the motion this client started without waiting for it (drive._move), whose
+        #: outcome its next wait_idle on that axis reports.
+        self.started: dict[str, Any] = {}
         self.closed = False
 
     def reply(self, payload: dict) -> None:
@@ -500,13 +505,46 @@ class RpcFace:
                 raise _core.InvalidArgument(f"motorbus serve: no axis call {call!r} (calls: "
                                             f"{', '.join(sorted(_AXIS_CALLS))})")
             _check_arguments(call, verb, (self, d), args, kwargs)
-            return await verb(self, d, *args, **kwargs)
+            if call == "wait_idle":
+                return await self._wait_idle(conn, axis, d, *args, **kwargs)
+            value = await verb(self, d, *args, **kwargs)
+            if call in _STARTS:
+                if call == "jog" or not kwargs.get("wait", True):
+                    conn.started[axis] = d.sync._move      # its outcome is this client's wait_idle's
+                else:
+                    conn.started.pop(axis, None)           # reported by the call itself
+            return value
         verb = _BENCH_CALLS.get(call)
         if verb is None:
             raise _core.InvalidArgument(f"motorbus serve: no call {call!r} (bench calls: "
                                         f"{', '.join(sorted(_BENCH_CALLS))}; axis calls take \"axis\")")
         _check_arguments(call, verb, (self, conn), args, kwargs)
-        return await verb(self, conn, *args, **kwargs)
+        value = await verb(self, conn, *args, **kwargs)
+        if call == "move_together" and isinstance(args[0], Mapping):
+            for name in args[0]:
+                if kwargs.get("wait", True):
+                    conn.started.pop(name, None)
+                else:
+                    conn.started[name] = self.bench[name].sync._move
+        return value
+
+    async def _wait_idle(self, conn: _Conn, axis: str, d: Any, timeout: Optional[float] = None) -> None:
+        """``wait_idle`` as this client's own: after a move it started without waiting, it
+        raises that move's MoveFailed even if another client's reading (a monitor's status)
+        judged the move first -- on a local Drive nobody else reads it in between."""
+        mine = conn.started.get(axis)
+        try:
+            await d.wait_idle(timeout)
+        except MoveFailed:
+            conn.started.pop(axis, None)
+            raise
+        if mine is None:
+            return
+        conn.started.pop(axis, None)
+        drive = d.sync
+        last = drive._last_move
+        if drive._move is mine and mine.judged and last is not None and last.error is not None:
+            raise last.error
 
     def describe(self) -> dict:
         """What a client needs to build its RemoteBench without asking again."""
