@@ -563,7 +563,26 @@ def test_a_lost_service_is_link_down_and_a_missing_one_is_said(tmp_path):
         motorbus.Bench.connect(tmp_path / "absent.toml")
 
 
-def test_zz_a_poll_whose_link_fails_ends_for_its_subscribers(service, bench):
+def test_motorbus_ophyd_scans_a_served_bench(service, bench):
+    pytest.importorskip("bluesky")
+    pytest.importorskip("ophyd_async")
+    from bluesky import RunEngine
+    from bluesky.plans import scan
+    from ophyd_async.plan_stubs import ensure_connected
+
+    from motorbus.ophyd import devices_from_bench
+
+    assert isinstance(bench, motorbus.Bench)
+    motors = devices_from_bench(bench, ["z", "u"])
+    RE = RunEngine()
+    RE(ensure_connected(*motors.values()))
+    events: list = []
+    RE(scan([motors["u"]], motors["z"], 0.0, 2.0, 3), lambda name, doc: name == "event" and events.append(doc))
+    assert [e["data"]["z"] for e in events] == pytest.approx([0.0, 1.0, 2.0], abs=0.011)
+    assert service.shaft("z") == pytest.approx(2.0, abs=0.011)
+
+
+def test_last_a_poll_whose_link_fails_ends_for_its_subscribers(service, bench):
     # Last in the module: it cuts the arcus axis's served line.
     with bench.poll(["x"], ("position",), rate_hz=200) as p:
         wait_for(lambda: len(p.frame()["t"]) > 20, what="rows from x")

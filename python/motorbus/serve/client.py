@@ -33,6 +33,7 @@ from typing import Any, Iterable, Mapping, Optional, Sequence
 import numpy as np
 
 from .. import _core, faces
+from ..bench import Bench
 from ..drive import Capability, Drive, DriveStatus, Params, ParamInfo, Units
 from ..stopping import STOP_WAYS, check_stop_way
 from . import rpc
@@ -699,14 +700,19 @@ class RemotePoller:
 
 
 # ---- the bench -----------------------------------------------------------------------------------
-class RemoteBench:
+class RemoteBench(Bench):
     """A served bench, as :class:`motorbus.Bench` has it for everything that does not need the
     transports: ``axes`` (RemoteDrives), ``bench[name]``, ``select``, ``move_together``,
     ``stop_all``, ``status``, ``read_params``, ``diff``, ``apply``, ``store``, ``config``,
     ``source``, ``simulated``, ``lines``/``buses`` (names only: the service holds them),
-    ``poll()`` (a :class:`RemotePoller`), ``info`` (the service's), ``close()`` and ``with``."""
+    ``poll()`` (a :class:`RemotePoller`), ``info`` (the service's), ``close()`` and ``with``.
 
-    def __init__(self, conn: Connection, hello: Mapping[str, Any], service: Any = None) -> None:
+    A ``motorbus.Bench`` subclass, so code that checks for a Bench (``motorbus.ophyd``'s
+    ``devices_from_bench``) takes it; it opens nothing itself (the service holds the bench),
+    and every method of Bench is one of its own here."""
+
+    def __init__(self, conn: Connection, hello: Mapping[str, Any], service: Any = None) -> None:  # noqa: D107
+        # Bench.__init__ is not called: it would read a file and open transports.
         self._conn = conn
         self.address = conn.path
         #: What the service says of itself (pid, bench, socket, CA prefix and environment...).
@@ -726,6 +732,19 @@ class RemoteBench:
         for name, desc in hello["axes"].items():
             self.config[name] = desc.get("config")
             self._axes[name] = RemoteDrive(self, name, desc)
+
+    @classmethod
+    def load(cls, path: Any, **kw: Any) -> "Bench":
+        raise _core.InvalidArgument("RemoteBench.load: a served bench is reached with motorbus.Bench.connect(ADDRESS); "
+                                    "motorbus.Bench.load opens a bench file's transports itself")
+
+    @classmethod
+    def from_dict(cls, data: Any, **kw: Any) -> "Bench":
+        raise _core.InvalidArgument("RemoteBench.from_dict: a served bench is reached with "
+                                    "motorbus.Bench.connect(ADDRESS)")
+
+    def _fail(self, message: str, *path: str) -> Any:
+        return _core.InvalidArgument(f"{self.source}: {'.'.join(path)}: {message}")
 
     # ---- axes ------------------------------------------------------------------------------
     @property
