@@ -223,9 +223,19 @@ def running_services() -> list:
     for name in names:
         if not name.endswith(".bench"):
             continue
+        entry = os.path.join(d, name)
         try:
-            target = os.readlink(os.path.join(d, name))
+            target = os.readlink(entry)
         except OSError:
+            continue
+        if not os.path.exists(target):
+            # A killed service of a bench file since removed (a test's temporary bench): its
+            # entry and socket can never be found again; tidy them.
+            for stale in (entry, entry[:-len(".bench")] + ".sock"):
+                try:
+                    os.unlink(stale)
+                except OSError:
+                    pass
             continue
         info = find_service(target)
         if info is not None:
