@@ -445,8 +445,19 @@ def test_an_exception_in_with_stops_what_this_program_moved_only(service, bench)
 
 
 # ---- polls ---------------------------------------------------------------------------------------
-def test_a_1khz_poll_fanned_out_to_five_subscribers_is_one_poller(service, bench):
+async def _choke_last_subscriber(service: Service) -> Any:
+    """The newest subscription's connection, its send buffers made tiny: a reader that has
+    stopped reading fills them in a fraction of a second (instead of ~200 kB later)."""
+    conn = max((c for c in service.face._conns if c.subs), key=lambda c: max(c.subs))
+    conn.writer.get_extra_info("socket").setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 4096)
+    conn.writer.transport.set_write_buffer_limits(high=4096)
+    return conn
+
+
+def test_a_1khz_poll_fanned_out_to_five_subscribers_is_one_poller(service, bench, monkeypatch):
     bench["z"].move_to(0.0, timeout=10)
+    monkeypatch.setattr(rpc, "SUB_QUEUE_CHUNKS", 8)     # ~160 ms of rows may wait per subscriber
+    dropped_before = bench.counters()["rows_dropped"]
     clients = [motorbus.Bench.connect(f"unix:{service.path}") for _ in range(5)]
     silent = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)   # subscribes, then never reads
     try:
@@ -455,6 +466,7 @@ def test_a_1khz_poll_fanned_out_to_five_subscribers_is_one_poller(service, bench
         silent.sendall(rpc.frame(rpc.FRAME_JSON, rpc.dumps({"id": 1, "call": "poll", "args": [["z", "u"],
                                                             ["position", "status"], 1000]})))
         wait_for(lambda: service.run(_counter(service, "poll_subscribers")) == 6)
+        silent_conn = service.run(_choke_last_subscriber(service))
         assert service.run(_counter(service, "pollers")) == 1
         assert len(service.face._polls) == 1
         time.sleep(0.1)                   # rows at rest first (a poll's first deadline is 20 ms after its start)
@@ -473,6 +485,10 @@ def test_a_1khz_poll_fanned_out_to_five_subscribers_is_one_poller(service, bench
             assert pos[0] == pytest.approx(0.0, abs=0.011)
             assert pos[-1] == pytest.approx(2.0, abs=0.011)
             assert np.all(np.diff(pos) >= -1e-9)                      # the move, sample by sample
+        # the silent one lost its oldest rows, counted, and held up nobody
+        (silent_sub,) = silent_conn.subs.values()
+        assert silent_sub.dropped > 0 and len(silent_sub.queue) <= 8
+        assert bench.counters()["rows_dropped"] - dropped_before == silent_sub.dropped
         # the same rows went to every subscriber: one poll, fanned out
         first = [p.frame()["t"][:200] for p in pollers]
         common = set(first[0]).intersection(*map(set, first[1:]))
