@@ -487,8 +487,8 @@ def test_a_1khz_poll_fanned_out_to_five_subscribers_is_one_poller(service, bench
             assert np.all(np.diff(pos) >= -1e-9)                      # the move, sample by sample
         # the silent one lost its oldest rows, counted, and held up nobody
         (silent_sub,) = silent_conn.subs.values()
-        assert silent_sub.dropped > 0 and len(silent_sub.queue) <= 8
-        assert bench.counters()["rows_dropped"] - dropped_before == silent_sub.dropped
+        counted = bench.counters()["rows_dropped"] - dropped_before     # (it goes on dropping meanwhile)
+        assert 0 < counted <= silent_sub.dropped and len(silent_sub.queue) <= 8
         # the same rows went to every subscriber: one poll, fanned out
         first = [p.frame()["t"][:200] for p in pollers]
         common = set(first[0]).intersection(*map(set, first[1:]))
