@@ -444,6 +444,24 @@ def test_an_exception_in_with_stops_what_this_program_moved_only(service, bench)
     bench["z"].enable()          # a CiA 402 quick stop leaves the drive in SWITCH ON DISABLED
 
 
+def test_the_exit_hook_stops_what_this_program_moved_only(service, bench):
+    bench["u"].move_to(0.0, timeout=10)
+    bench["z"].move_to(0.0, timeout=10)
+    program = motorbus.Bench.connect(f"unix:{service.path}")
+    try:
+        bench["u"].move_to(4000.0, wait=False)               # another program's
+        program["z"].move_to(400.0, wait=False)              # this program's
+        wait_for(lambda: service.shaft("z") > 2.0, what="z moving")
+        for d in program.axes.values():                      # what the interpreter's exit does
+            d._stop_at_exit()
+        wait_for(lambda: not service.bench["z"].sync.status.moving, what="z stopped by the exit hook")
+        assert service.shaft("z") < 400.0 and program["z"].commanded and not program["u"].commanded
+        wait_for(lambda: not service.bench["u"].sync.status.moving, timeout=30, what="u's move")
+        assert service.shaft("u") == pytest.approx(4000.0, abs=0.011)   # not stopped: not this program's
+    finally:
+        program.close()
+
+
 # ---- polls ---------------------------------------------------------------------------------------
 async def _choke_last_subscriber(service: Service) -> Any:
     """The newest subscription's connection, its send buffers made tiny: a reader that has
@@ -566,6 +584,35 @@ async def _stop_soon(z: Any, service: Service) -> None:
         await asyncio.sleep(0.005)
     await asyncio.sleep(0.05)
     await z.stop()
+
+
+def test_closing_the_face_stops_what_its_clients_awaited_and_they_see_link_down(service, bench, tmp_path):
+    path = str(tmp_path / "second.sock")
+    face = service.run(rpc.start_rpc(service.bench, path, info={"pid": os.getpid()}))
+    remote = motorbus.Bench.connect(f"unix:{path}")
+    z = remote["z"]
+    bench["z"].move_to(0.0, timeout=10)
+    result: dict = {}
+
+    def mover() -> None:
+        try:
+            z.move_to(400.0, timeout=20)
+        except BaseException as e:  # noqa: BLE001
+            result["error"] = e
+    t = threading.Thread(target=mover)
+    t.start()
+    try:
+        wait_for(lambda: service.shaft("z") > 5.0, what="z moving")
+        service.run(face.close())
+        t.join(20)
+        assert isinstance(result["error"], motorbus.LinkDown) and "connection lost" in str(result["error"])
+        assert not service.bench["z"].sync.status.moving and 5.0 < service.shaft("z") < 400.0
+        assert not os.path.exists(path)
+        with pytest.raises(motorbus.LinkDown, match="connection lost"):
+            z.position
+    finally:
+        remote.close()
+    bench["z"].enable()
 
 
 def test_a_lost_service_is_link_down_and_a_missing_one_is_said(tmp_path):
