@@ -197,6 +197,7 @@ def test_what_needs_the_transports_is_refused_while_served(twin, service):
 def test_channel_access_with_the_printed_environment(twin, service):
     """The CA face of the same service: RBV is where the CLI moved x, read by caproto-get
     with only the environment the service printed (and the lock file holds)."""
+    assert motorbus_cli("move", twin.bench_file, "x", "2.5").returncode == 0
     env = {**os.environ, **find_service(twin.bench_file).env}
     r = subprocess.run([os.path.join(os.path.dirname(sys.executable), "caproto-get"), "--no-repeater", "-n",
                         "T26S:x.RBV", "T26S:x.DMOV"], capture_output=True, text=True, timeout=20, env=env)
@@ -219,6 +220,8 @@ def test_pytest_plugin_bench_server(twin, service, pytester):
         @pytest.mark.axes("x")
         def test_axis_and_poller(axis, poller):
             assert isinstance(poller, RemotePoller)
+            if not axis.status.enabled:
+                axis.enable()
             axis.move_to(1.0)
             assert axis.position == pytest.approx(1.0, abs=0.02)
             seen, deadline = [], time.monotonic() + 5     # rows come in chunks from the service
