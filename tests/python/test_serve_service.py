@@ -187,6 +187,9 @@ def test_what_needs_the_transports_is_refused_while_served(twin, service):
     spec = next(s for s in find_service(twin.bench_file).links if s.startswith("socketcand:"))
     r = motorbus_cli("bus", "dump", spec, "--count", "1")
     assert r.returncode == 4 and f"(pid {pid}): a bus dump needs the transports" in r.stderr
+    line = os.path.join(twin.link_dir, "ser")
+    r = motorbus_cli("scan", "--serial", os.path.realpath(line), "--quiet")    # the pty itself: the same line
+    assert r.returncode == 4 and f"(pid {pid}): a scan of {os.path.realpath(line)} needs the transports" in r.stderr
     # --no-server opens the transports here: the serial line is the service's (busy), and the
     # message says which program holds it and how to go through it instead.
     r = motorbus_cli("status", twin.bench_file, "--no-server")
