@@ -536,6 +536,40 @@ def test_a_slow_subscriber_loses_its_oldest_rows_counted():
     assert sub.queue[0][0, 0] == 3.0 and Conn.face.counters["rows_dropped"] == 30
 
 
+def test_errors_and_values_cross_the_wire_as_themselves():
+    from motorbus.bench import BenchFileError
+    from motorbus.drive import DriveStatus, MoveOutcome, UnknownParameter
+
+    def trip(v: Any) -> Any:
+        return rpc.decode(rpc.json.loads(rpc.dumps(rpc.encode(v))))
+
+    e = motorbus.LimitReached("x: stopped at 3 mm by the +limit switch, target 9 mm", side=1, axis="x", target=9.0,
+                              position=3.0, reason="the +limit switch", code=None, status=0x1234, units="mm")
+    e.add_note("also: y: ...")
+    back = trip(e)
+    assert type(back) is motorbus.LimitReached and str(back) == str(e) and back.__notes__ == ["also: y: ..."]
+    assert (back.side, back.axis, back.target, back.position, back.reason, back.status, back.units) == \
+        (1, "x", 9.0, 3.0, "the +limit switch", 0x1234, "mm")
+    assert isinstance(back, motorbus.DriveFault) and back.outcome == "limit"
+    t = trip(motorbus.MoveTimedOut("slow", axis="z", position=float("nan")))
+    assert isinstance(t, motorbus.TimeoutError) and np.isnan(t.position)
+    b = trip(BenchFileError("expected a number", source="b.toml", line=3, key="axis.x.address"))
+    assert type(b) is BenchFileError and str(b) == "b.toml:3: axis.x.address: expected a number" and b.line == 3
+    assert type(trip(UnknownParameter("arcus: no parameter 'Q'"))) is UnknownParameter
+    assert type(trip(motorbus.SdoAbortError("0x06020000"))) is motorbus.SdoAbortError
+
+    class Strange(Exception):
+        pass
+    odd = trip(Strange("what"))            # a class the client lacks, with no typed base: named in the text
+    assert type(odd) is motorbus.MotorbusError and str(odd) == "Strange: what"
+    assert type(trip(KeyError("k"))) is KeyError
+    st = DriveStatus(True, False, True, False, True, False, False, raw=(1, b"\x02"), text="ok",
+                     last_move=MoveOutcome("move", 1.0, 1.0, "done"))
+    assert trip(st) == st
+    assert trip({"lims": (-float("inf"), 2.5), "caps": frozenset({motorbus.Capability.HOMING})}) == \
+        {"lims": (-float("inf"), 2.5), "caps": frozenset({motorbus.Capability.HOMING})}
+
+
 # ---- the awaitable face --------------------------------------------------------------------------
 def test_the_awaitable_face(service, bench):
     async def main() -> None:

@@ -212,18 +212,26 @@ def decode_error(d: Mapping[str, Any]) -> BaseException:
     message = d.get("message", "")
     if cls is None or cls in (BaseException, Exception):
         cls, message = _core.MotorbusError, f"{d['type'].rsplit('.', 1)[-1]}: {message}"
-    try:
-        e = cls.__new__(cls)
-        e.args = (message,)
-    except Exception:  # noqa: BLE001 - a class that cannot be made bare
+    e: Optional[BaseException] = None
+    for make in (lambda: cls(message), lambda: cls.__new__(cls)):
+        # Its own constructor with the message (most take one), else made bare (ServedElsewhere
+        # takes other arguments); the message is set as it was either way.
+        try:
+            e = make()
+            e.args = (message,)
+            break
+        except Exception:  # noqa: BLE001 - the next way
+            e = None
+    if e is None:
         e = _core.MotorbusError(f"{d['type'].rsplit('.', 1)[-1]}: {message}")
     for k, x in d.get("fields", {}).items():
         try:
             setattr(e, k, decode(x))
         except Exception:  # noqa: BLE001
             continue
-    for n in d.get("notes", ()):
-        e.add_note(n)
+    notes = [str(n) for n in d.get("notes", ())]
+    if notes:
+        e.__notes__ = notes          # what add_note keeps (3.11+), set the same way on any version
     return e
 
 
