@@ -109,6 +109,14 @@ def check_socket_path(path: str) -> str:
                                     f"path holds at most {SUN_PATH_MAX} (give a shorter --socket)")
     d = os.path.dirname(os.path.abspath(path))
     os.makedirs(d, mode=0o700, exist_ok=True)
+    if os.path.abspath(d) == os.path.abspath(_runtime_dir()):
+        # /tmp/motorbus-<uid> is a name anyone could take first: only our own private
+        # directory may hold a socket other programs send motor commands to.
+        st = os.stat(d)
+        if st.st_uid != os.getuid() or st.st_mode & 0o077:
+            raise _core.InvalidArgument(f"{d} (where the service's socket goes) is not a private directory of "
+                                        f"this user (owner uid {st.st_uid}, mode {st.st_mode & 0o777:o}): remove "
+                                        f"it, or give --socket PATH")
     return path
 
 
