@@ -562,7 +562,8 @@ def test_errors_and_values_cross_the_wire_as_themselves():
         pass
     odd = trip(Strange("what"))            # a class the client lacks, with no typed base: named in the text
     assert type(odd) is motorbus.MotorbusError and str(odd) == "Strange: what"
-    assert type(trip(KeyError("k"))) is KeyError
+    k = trip(KeyError("k"))
+    assert type(k) is KeyError and str(k) == "'k'" and k.args == ("k",)
     st = DriveStatus(True, False, True, False, True, False, False, raw=(1, b"\x02"), text="ok",
                      last_move=MoveOutcome("move", 1.0, 1.0, "done"))
     assert trip(st) == st

@@ -195,9 +195,12 @@ def encode_error(e: BaseException) -> dict:
             fields[k] = encode(x)
         except Exception:  # noqa: BLE001 - a field that cannot be said is left out, not the error
             continue
-    return {"$": "error", "type": _qualname(cls), "bases": [_qualname(b) for b in cls.__mro__[1:]
-                                                              if issubclass(b, BaseException)],
-            "message": str(e), "fields": fields, "notes": [str(n) for n in getattr(e, "__notes__", ())]}
+    out = {"$": "error", "type": _qualname(cls), "bases": [_qualname(b) for b in cls.__mro__[1:]
+                                                             if issubclass(b, BaseException)],
+           "message": str(e), "fields": fields, "notes": [str(n) for n in getattr(e, "__notes__", ())]}
+    if all(x is None or isinstance(x, (str, int, float)) for x in e.args):
+        out["args"] = list(e.args)     # str() of some classes (KeyError) is not their argument
+    return out
 
 
 def decode_error(d: Mapping[str, Any]) -> BaseException:
@@ -210,15 +213,17 @@ def decode_error(d: Mapping[str, Any]) -> BaseException:
         if cls is not None:
             break
     message = d.get("message", "")
+    args = tuple(d["args"]) if isinstance(d.get("args"), list) else (message,)
     if cls is None or cls in (BaseException, Exception):
         cls, message = _core.MotorbusError, f"{d['type'].rsplit('.', 1)[-1]}: {message}"
+        args = (message,)
     e: Optional[BaseException] = None
     for make in (lambda: cls(message), lambda: cls.__new__(cls)):
         # Its own constructor with the message (most take one), else made bare (ServedElsewhere
         # takes other arguments); the message is set as it was either way.
         try:
             e = make()
-            e.args = (message,)
+            e.args = args
             break
         except Exception:  # noqa: BLE001 - the next way
             e = None
