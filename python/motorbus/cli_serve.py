@@ -39,6 +39,10 @@ def cmd_serve(args: argparse.Namespace) -> int:
             _say(f"ca {info.prefix}<axis> on {hosts} port {info.ca_port}")
             for key, value in info.env.items():
                 _say(f"export {key}={value}")
+        for name in ([] if info.sim else service.unarmed_watchdogs()):   # a --sim twin dies with the service
+            print(f"motorbus serve: note: axis {name}'s drive has a watchdog the bench file does not arm: a killed "
+                  f"service would leave it running (options = {{ watchdog = {{ host_node = 127, period = 0.1 }} }}, "
+                  f"docs/serve.md)", file=sys.stderr, flush=True)
         _say("ready (SIGTERM, SIGINT or SIGHUP stops every axis, then ends the service)")
         try:
             await service.run()

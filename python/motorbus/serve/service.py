@@ -148,6 +148,18 @@ class BenchService:
             await self._close_everything()
             raise
 
+    def unarmed_watchdogs(self) -> list:
+        """The axes whose drive has a link-loss watchdog (Capability.WATCHDOG) the bench file
+        does not arm (``options.watchdog``): a killed service leaves them running."""
+        from ..drive import Capability
+
+        out = []
+        for name, d in self.bench.axes.items():
+            cfg = self.bench.sync.config.get(name)
+            if Capability.WATCHDOG in d.capabilities and not (cfg is not None and cfg.options.get("watchdog")):
+                out.append(name)
+        return out
+
     def _links(self) -> list:
         """The bus specs and serial ports the bench opened (as opened: under sim, the
         twin's ptys and socketcand servers)."""
