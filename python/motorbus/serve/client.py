@@ -28,6 +28,7 @@ import os
 import socket
 import stat
 import threading
+from struct import error as struct_error
 from typing import Any, Iterable, Mapping, Optional, Sequence
 
 import numpy as np
@@ -273,9 +274,6 @@ class Connection:
         self._sock.close()
         if threading.current_thread() is not self._reader:
             self._reader.join(2.0)
-
-
-from struct import error as struct_error  # noqa: E402  (the reader's malformed-frame case)
 
 
 class _RemoteCall:
