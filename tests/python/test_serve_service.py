@@ -126,6 +126,9 @@ def test_lock_file_finds_the_service_and_its_announce(twin, service):
     assert info.env["EPICS_CA_SERVER_PORT"] == str(ca_port())
     assert f"rpc unix:{info.socket}" in service.lines
     assert f"export EPICS_CA_SERVER_PORT={ca_port()}" in service.lines
+    # z (cia402) has a watchdog this bench file does not arm; x (arcus) has none to arm.
+    notes = [line for line in service.stderr().splitlines() if "watchdog" in line]
+    assert len(notes) == 1 and notes[0].startswith("motorbus serve: note: axis z's drive has a watchdog")
 
 
 def test_a_second_service_of_the_bench_is_refused(twin, service):
@@ -301,6 +304,7 @@ def test_after_sigkill_only_the_drives_watchdogs_act(tmp_path):
         s = Service(twin.bench_file, "--no-epics")
         try:
             assert motorbus_cli("config", "apply", twin.bench_file).returncode == 0
+            assert "watchdog" not in s.stderr()        # armed by the file: no note
             bench = connect(twin.bench_file)
             for name in ("z", "p"):
                 if not bench[name].status.enabled:
