@@ -1,0 +1,251 @@
+"""The Channel Access face of ``motorbus serve``: every axis of an ``aio.Bench`` as an
+EPICS motor record, served by caproto on the service's event loop (docs/epics.md).
+
+    face = await start_ca(bench, prefix="lab2:", interfaces=["127.0.0.1"], port=5064,
+                          calibration_path="lab2.epics.json")
+    face.client_env()        # what a CA client on this host sets
+    await face.close()
+
+Per axis ``<prefix><axis>`` is a ``motor`` record (RTYP "motor", the fields ophyd's
+``EpicsMotor``, ophyd-async's ``Motor`` and pyepics' ``Motor`` use, with their types
+and enum strings) and ``<prefix><axis>_able`` its Enable/Disable bo; bench-wide
+``<prefix>allstop`` (bo release/stop), ``<prefix>alldone`` (bi moving/done) and
+``<prefix>moving`` (the number of axes moving), the names of the motor module's
+motorUtil.db.
+
+The record's behaviour is the motor record's (motorRecord.cc), over the awaitable Drive
+API: every drive call is awaited on the service's loop, so a slow drive delays only
+its own record.  The state machine of one axis is ``epics_axis.AxisRecord``.
+"""
+from __future__ import annotations
+
+import asyncio
+import logging
+import os
+from collections.abc import Sequence
+from typing import Any, Optional
+
+from .. import _core
+
+try:
+    import caproto  # noqa: F401
+except ImportError as e:  # pragma: no cover - the extra is missing
+    raise _core.InvalidArgument("motorbus serve's Channel Access face needs caproto, the optional extra "
+                                "motorbus[epics]: pip install 'motorbus[epics]'") from e
+
+from caproto import ChannelType
+from caproto.server import PVGroup, pvproperty
+
+from .calibration import CalibrationStore
+from .epics_axis import RESERVED, AxisRecord, PutRefused, check_axis_name
+
+__all__ = ["start_ca", "CaFace", "set_server_environment", "BenchRecords", "AxisRecord", "PutRefused",
+           "LATENCY_SETTINGS"]
+
+log = logging.getLogger(__name__)
+
+#: caproto's subscription batching (research brief, gotcha 5): by default an update waits up
+#: to 10 ms for company and a busy circuit up to 1 s; a put-callback move keeps a write in
+#: flight for its whole length, and every read on that circuit would wait 1 ms for it.
+LATENCY_SETTINGS = {
+    "CAPROTO_SERVER_HIGH_LOAD_TIMEOUT_SEC": ("HIGH_LOAD_TIMEOUT", 0.0005),
+    "CAPROTO_SERVER_MAX_LATENCY_SEC": ("MAX_LATENCY", 0.005),
+    "CAPROTO_SERVER_WRITE_LOCK_TIMEOUT_SEC": ("WRITE_LOCK_TIMEOUT", 0.0),
+}
+DEFAULT_PORT = 5064
+
+
+def _beacon_addresses(interfaces: Sequence[str]) -> list[str]:
+    """Where beacons go: the interfaces served, loopback for the wildcard (never the LAN
+    broadcast caproto defaults to: gotcha 6)."""
+    out = []
+    for iface in interfaces:
+        addr = "127.0.0.1" if iface in ("0.0.0.0", "") else iface
+        if addr not in out:
+            out.append(addr)
+    return out or ["127.0.0.1"]
+
+
+def set_server_environment(interfaces: Sequence[str] = ("127.0.0.1",), port: Optional[int] = None) -> None:
+    """Sets what caproto's server reads from the environment, before it starts: the
+    interfaces (``EPICS_CAS_INTF_ADDR_LIST``), beacons only to the served interfaces
+    (``EPICS_CAS_AUTO_BEACON_ADDR_LIST=NO``, ``EPICS_CAS_BEACON_ADDR_LIST``), the port
+    (``EPICS_CA_SERVER_PORT`` when given) and the latency settings of ``LATENCY_SETTINGS``
+    (environment and, caproto being imported, its module globals).  A value the user
+    already exported for a latency setting is kept."""
+    interfaces = list(interfaces) or ["127.0.0.1"]
+    os.environ["EPICS_CAS_INTF_ADDR_LIST"] = " ".join(interfaces)
+    os.environ["EPICS_CAS_AUTO_BEACON_ADDR_LIST"] = "NO"
+    os.environ["EPICS_CAS_BEACON_ADDR_LIST"] = " ".join(_beacon_addresses(interfaces))
+    if port is not None:
+        os.environ["EPICS_CA_SERVER_PORT"] = str(int(port))
+    import caproto.server.common as common
+
+    for env, (name, value) in LATENCY_SETTINGS.items():
+        chosen = float(os.environ.setdefault(env, repr(value)))
+        setattr(common, name, chosen)
+
+
+class _QuietRefusals(logging.Filter):
+    """caproto logs every failed put with its traceback (gotcha 3); a refused or failed
+    move is the record's answer, not a server error: one line, no traceback."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        exc = record.exc_info[1] if record.exc_info else None
+        if isinstance(exc, PutRefused):
+            record.exc_info = None
+            record.exc_text = None
+            record.msg, record.args = "put refused: %s", (exc,)
+            record.levelno, record.levelname = logging.INFO, "INFO"
+            return log.isEnabledFor(logging.INFO)
+        return True
+
+
+_QUIET = _QuietRefusals()
+
+
+class BenchRecords(PVGroup):
+    """The bench-wide records of motorUtil.db: ``allstop``, ``alldone``, ``moving``."""
+
+    allstop = pvproperty(name="allstop", value="release", dtype=ChannelType.ENUM, enum_strings=("release", "stop"),
+                         record="bo", doc="stop every axis")
+    alldone = pvproperty(name="alldone", value="done", dtype=ChannelType.ENUM, enum_strings=("moving", "done"),
+                         record="bi", read_only=True, doc="every axis done")
+    moving = pvproperty(name="moving", value=0, dtype=int, record="longout", read_only=True,
+                        doc="axes moving")
+
+    def __init__(self, *args: Any, face: "CaFace", **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.face = face
+
+    @allstop.putter
+    async def allstop(self, instance: Any, value: Any) -> Any:
+        if value in ("stop", 1):
+            await self.face.stop_all()
+        return "release"
+
+    async def refresh(self) -> None:
+        n = sum(1 for r in self.face.records.values() if r.fields["DMOV"].value == 0)
+        if self.moving.value != n:
+            await self.moving.write(n, verify_value=False)
+        done = "done" if n == 0 else "moving"
+        if self.alldone.value != done:
+            await self.alldone.write(done, verify_value=False)
+
+
+class CaFace:
+    """The running CA face (``start_ca``)."""
+
+    def __init__(self, bench: Any, prefix: str, interfaces: list[str], port: int,
+                 calibration: CalibrationStore) -> None:
+        self.bench = bench
+        self.prefix = prefix
+        self.interfaces = interfaces
+        self.port = port
+        self.calibration = calibration
+        self.records: dict[str, AxisRecord] = {}
+        self.counters: dict[str, int] = {"puts": 0, "failed_puts": 0, "moves": 0, "failed_moves": 0,
+                                         "stops": 0, "readback_errors": 0, "accel_errors": 0}
+        self.bench_records: Optional[BenchRecords] = None
+        self.pvdb: dict[str, Any] = {}
+        self.context: Any = None
+        self._server: Optional[asyncio.Task] = None
+        self._closed = False
+
+    def client_env(self) -> dict[str, str]:
+        """The environment a CA client on this host sets to find the service (and nothing else)."""
+        addrs = _beacon_addresses(self.interfaces)
+        env = {"EPICS_CA_AUTO_ADDR_LIST": "NO",
+               "EPICS_CA_ADDR_LIST": " ".join(f"{a}:{self.port}" if self.port != DEFAULT_PORT else a
+                                              for a in addrs)}
+        if self.port != DEFAULT_PORT:
+            env["EPICS_CA_SERVER_PORT"] = str(self.port)
+        return env
+
+    async def stop_all(self) -> None:
+        """``allstop``: every axis's STOP at once."""
+        await asyncio.gather(*(r.stop_axis("allstop") for r in self.records.values()), return_exceptions=True)
+
+    async def _dmov_changed(self) -> None:
+        if self.bench_records is not None:
+            await self.bench_records.refresh()
+
+    async def close(self) -> None:
+        """Stops serving (no axis is stopped: the service decides that) and ends every task."""
+        if self._closed:
+            return
+        self._closed = True
+        for r in self.records.values():
+            await r.shutdown()
+        if self._server is not None:
+            self._server.cancel()
+            try:
+                await self._server
+            except (asyncio.CancelledError, Exception):  # noqa: BLE001 - closing anyway
+                pass
+        logging.getLogger("caproto.circ").removeFilter(_QUIET)
+
+
+async def build_face(bench: Any, *, prefix: str, interfaces: Sequence[str] = ("127.0.0.1",),
+                     port: Optional[int] = None, calibration_path: Optional[str] = None) -> CaFace:
+    """The records of every axis, started (readbacks running), without a CA server: what
+    ``start_ca`` serves, and what tests drive through the putters directly."""
+    if not isinstance(prefix, str) or any(c.isspace() or c == "." for c in prefix):
+        raise _core.InvalidArgument(f"CA prefix: text without spaces or dots, not {prefix!r}")
+    names = list(bench.axes)
+    for name in names:
+        check_axis_name(name, names)
+    if port is None:
+        port = int(os.environ.get("EPICS_CA_SERVER_PORT", DEFAULT_PORT))
+    face = CaFace(bench, prefix, list(interfaces) or ["127.0.0.1"], int(port), CalibrationStore(calibration_path))
+    try:
+        for name in names:
+            record = AxisRecord(prefix=f"{prefix}{name}", axis=name, drive=bench[name], face=face)
+            await record.start()
+            face.records[name] = record
+            face.pvdb.update(record.pvdb)
+        face.bench_records = BenchRecords(prefix=prefix, face=face)
+        face.pvdb.update(face.bench_records.pvdb)
+        await face.bench_records.refresh()
+    except BaseException:
+        await face.close()
+        raise
+    return face
+
+
+async def start_ca(bench: Any, *, prefix: str, interfaces: Sequence[str] = ("127.0.0.1",),
+                   port: Optional[int] = None, calibration_path: Optional[str] = None) -> CaFace:
+    """Serves every axis of ``bench`` (an ``aio.Bench``) over Channel Access on
+    ``interfaces`` (loopback by default), UDP search port ``port`` (None:
+    ``EPICS_CA_SERVER_PORT`` or 5064); the calibration is read from and kept in
+    ``calibration_path``.  Returns once the server listens."""
+    from caproto.asyncio.server import Context
+
+    interfaces = list(interfaces) or ["127.0.0.1"]
+    set_server_environment(interfaces, port)
+    logging.getLogger("caproto.circ").addFilter(_QUIET)
+    face = await build_face(bench, prefix=prefix, interfaces=interfaces, port=port, calibration_path=calibration_path)
+    try:
+        ctx = Context(face.pvdb, interfaces=interfaces)
+        ctx.ca_server_port = face.port
+        face.context = ctx
+        face._server = asyncio.create_task(ctx.run(), name="motorbus-ca-server")
+        # Listening once every interface's UDP search socket is bound (run() binds TCP first).
+        for _ in range(500):
+            if face._server.done():
+                face._server.result()        # the bind error
+                raise _core.InvalidArgument("CA server ended at start")
+            if len(ctx.udp_socks) >= len(interfaces):
+                break
+            await asyncio.sleep(0.01)
+        else:
+            raise _core.TimeoutError("CA server: not listening after 5 s")
+    except BaseException:
+        await face.close()
+        raise
+    log.info("serving %d motor records on %s port %d (prefix %r)", len(face.records), ", ".join(interfaces),
+             face.port, prefix)
+    return face
+
+
+__all__ += ["build_face", "RESERVED"]

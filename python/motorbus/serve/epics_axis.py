@@ -1,0 +1,1013 @@
+"""One axis as an EPICS motor record (``motorbus serve``'s CA face; docs/epics.md).
+
+The record's semantics are motorRecord.cc's, over the awaitable Drive API:
+
+* coordinates: ``VAL = DVAL * DIR + OFF``; the dial position is the drive's position in
+  the bench's user units; ``RVAL = DVAL / MRES`` (the drive's native units);
+* a VAL put (DVAL, RVAL, RLV, TWF, TWR alike) posts DMOV=0 before anything moves and
+  completes (put-callback) when the axis is at rest at the end of the *motion episode*:
+  a second put while moving retargets (stop, then move on to the new target) and every
+  pending put completes at the final rest, with one DMOV pulse 1->0->1;
+* the episode's outcome decides the put: done, or interrupted by STOP/SPMG/allstop or
+  by another program's stop, completes normally (record semantics, VAL:=RBV after an
+  interruption); a limit switch sets HLS/LLS and fails the put; a fault, stall or
+  timeout puts RBV (the record) in STATE/MAJOR alarm, sets MSTA PROBLEM (SLIP_STALL
+  for a stall) and fails the put; the next successful move clears them.  The alarm
+  is posted before DMOV=1, the moment ophyd judges the move;
+* a target outside the soft limits sets LVIO=1, moves nothing and fails the put (a
+  real IOC completes it: a deliberate difference);
+* a readback task per axis posts RBV/DRBV/RRBV/MOVN/HLS/LLS/MSTA/TDIR on change, ~10 Hz
+  at rest and ~50 Hz while the axis moves; motion nobody commanded here (the service's
+  other face, another program) shows as MOVN=1/DMOV=0 too.
+
+A put task cancelled by caproto (its client left) leaves the motion alone: the episode
+is its own task, and puts only await it (shielded).
+"""
+from __future__ import annotations
+
+import asyncio
+import logging
+import math
+from typing import Any, Optional
+
+from caproto import AlarmSeverity, AlarmStatus, ChannelType, SkipWrite
+from caproto.server import PVGroup, pvproperty
+from caproto.server.records import MotorFields, register_record
+from caproto.server.server import PvpropertyDouble, PvpropertyDoubleRO
+
+from .. import _core
+from ..drive import Capability, LimitReached, MoveFailed, MoveFaulted, MoveInterrupted, MoveStalled, MoveTimedOut
+from .epics_kinds import KindMap, kind_map
+
+log = logging.getLogger("motorbus.serve.epics")
+
+#: PV names of the bench-wide records: no axis may take them.
+RESERVED = ("allstop", "alldone", "moving")
+
+#: Readback periods (s): at rest, and while a move is in flight.
+REST_PERIOD = 0.1
+MOVING_PERIOD = 0.02
+#: MSTA bits (motorRecord.html, "MSTA": bit = item - 1).
+MSTA_DIRECTION, MSTA_DONE, MSTA_PLUS_LS, MSTA_HOMELS = 1 << 0, 1 << 1, 1 << 2, 1 << 3
+MSTA_POSITION, MSTA_SLIP_STALL, MSTA_HOME, MSTA_PRESENT = 1 << 5, 1 << 6, 1 << 7, 1 << 8
+MSTA_PROBLEM, MSTA_MOVING, MSTA_GAIN_SUPPORT, MSTA_COMM_ERR = 1 << 9, 1 << 10, 1 << 11, 1 << 12
+MSTA_MINUS_LS, MSTA_HOMED = 1 << 13, 1 << 14
+#: A jog runs until JOGF/JOGR=0 (or a stop): its wait for rest has no useful timeout.
+JOG_WAIT = 30 * 86400.0
+
+
+class PutRefused(_core.InvalidArgument):
+    """A put the record refuses or a move it reports as failed: caproto answers the
+    client ECA_PUTFAIL with this message."""
+
+
+class SoftLimitViolation(PutRefused):
+    """The target is outside the record's soft limits (LVIO=1, nothing moved)."""
+
+
+class MoveFailedPut(PutRefused):
+    """The move ended in a failure (``error``: the Drive API's MoveFailed or drive error)."""
+
+    def __init__(self, message: str, error: BaseException) -> None:
+        super().__init__(message)
+        self.error = error
+
+
+def check_axis_name(name: str, names: Any = ()) -> None:
+    """An axis name usable as a PV name: no clash with the bench-wide records or another
+    axis's ``_able``, and only characters a record name may hold."""
+    if name in RESERVED:
+        raise _core.InvalidArgument(f"CA face: axis {name!r} clashes with the bench-wide record "
+                                    f"<prefix>{name} ({', '.join(RESERVED)} are taken)")
+    if name.endswith("_able") and name[:-len("_able")] in names:
+        raise _core.InvalidArgument(f"CA face: axis {name!r} clashes with the _able record of axis "
+                                    f"{name[:-len('_able')]!r}")
+    if not name or any(not (c.isalnum() or c in "_-:;<>[]") for c in name):
+        raise _core.InvalidArgument(f"CA face: axis {name!r}: a record name holds letters, digits and _-:;<>[] only")
+
+
+# ---- the record's caproto types ---------------------------------------------------------
+@register_record
+class MotorbusMotorFields(MotorFields):
+    """caproto's motor fields with what the real record sends: RTYP stays "motor" (pyepics
+    refuses anything else), MSTA is a ULONG in the record, which CA sends as DOUBLE."""
+
+    _record_type = "motor"
+    motor_status = pvproperty(name="MSTA", dtype=PvpropertyDoubleRO, read_only=True, doc="Motor Status")
+
+
+class MotorVal(PvpropertyDouble):
+    """VAL: HLM/LLM are its control limits (as in the record), but caproto would refuse an
+    out-of-limit put before the putter runs (gotcha 1): the putter is the judge (LVIO)."""
+
+    async def verify_value(self, value: Any) -> Any:
+        if self.putter is not None:
+            return await self.putter(self, value)
+        return value
+
+
+def _finite(value: Any, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise PutRefused(f"{what}: a finite number, not {value!r}")
+    return float(value)
+
+
+def _enum_index(value: Any, strings: tuple) -> int:
+    if isinstance(value, str):
+        if value in strings:
+            return strings.index(value)
+        raise PutRefused(f"one of {', '.join(strings)}, not {value!r}")
+    return int(value)
+
+
+# ---- one axis -----------------------------------------------------------------------------
+class AxisRecord(PVGroup):
+    """``<prefix><axis>`` (motor) and ``<prefix><axis>_able`` (bo) over one ``aio.Drive``."""
+
+    motor = pvproperty(name="", value=0.0, dtype=MotorVal, record="motor", precision=3, doc="motorbus axis")
+    able = pvproperty(name="_able", value="Enable", dtype=ChannelType.ENUM, enum_strings=("Enable", "Disable"),
+                      record="bo", doc="Enable/Disable the motor record's puts")
+
+    def __init__(self, *args: Any, axis: str, drive: Any, face: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.axis = axis
+        self.drive = drive
+        self.face = face
+        self.fields = self.motor.fields
+        self.kmap: KindMap = kind_map(drive.kind)
+        config = getattr(getattr(face.bench, "sync", None), "config", {})
+        self.address = str(config[axis].address) if axis in config else self.kmap.address(drive)
+        u = drive.units
+        self.scale = float(u.scale)
+        self.mres = abs(self.scale)
+        cal = face.calibration.get(axis)
+        self.off = float(cal.get("off", 0.0))
+        self.dir = int(cal.get("dir", 1))
+        self.foff = int(cal.get("foff", 0))
+        self._saved_limits = (cal.get("dllm"), cal.get("dhlm"))
+        self.velo: Optional[float] = cal.get("velo")
+        self.velo_explicit = "velo" in cal
+        self.accl = float(cal.get("accl", 0.2))
+        self.accl_explicit = "accl" in cal
+        self.jvel: Optional[float] = cal.get("jvel")
+        self.twv = float(cal.get("twv", 10 * self.mres))
+        self.travel = (-math.inf, math.inf)
+        self.dllm = self.dhlm = 0.0
+        self.set_mode = False
+        self.spmg = "Go"
+        self.disabled = False
+        # Readback state (dial units).
+        self.drbv = 0.0
+        self.native = 0.0
+        self.moving = False
+        self.tdir = 1
+        self.status: Any = None
+        self.comm_error = False
+        self.problem = False           # MSTA PROBLEM: the last move faulted / timed out
+        self.stalled = False           # MSTA SLIP_STALL
+        self.alarm_state = (AlarmStatus.NO_ALARM, AlarmSeverity.NO_ALARM)
+        # The motion episode: a future every pending put awaits, the task that runs it,
+        # what it is asked to do now, and a generation bumped by each new command.
+        self.episode: Optional[asyncio.Future] = None
+        self.runner: Optional[asyncio.Task] = None
+        self.want: tuple = ("move", 0.0)
+        self.generation = 0
+        self.stop_requested = ""
+        self.resume = asyncio.Event()
+        self.external = False           # motion nobody commanded through this record
+        self.accel_applied: Optional[tuple] = None
+        self._readback: Optional[asyncio.Task] = None
+        self._tasks: set = set()
+        f = self.fields
+        for name, putter in {
+            "STOP": self._put_stop, "SPMG": self._put_spmg, "HOMF": self._put_homf, "HOMR": self._put_homr,
+            "JOGF": self._put_jogf, "JOGR": self._put_jogr, "TWF": self._put_twf, "TWR": self._put_twr,
+            "TWV": self._put_twv, "RLV": self._put_rlv, "DVAL": self._put_dval, "RVAL": self._put_rval,
+            "OFF": self._put_off, "DIR": self._put_dir, "FOFF": self._put_foff, "SET": self._put_set,
+            "SSET": self._put_sset, "SUSE": self._put_suse, "HLM": self._put_hlm, "LLM": self._put_llm,
+            "DHLM": self._put_dhlm, "DLLM": self._put_dllm, "VELO": self._put_velo, "ACCL": self._put_accl,
+            "JVEL": self._put_jvel, "CNEN": self._put_cnen, "MRES": self._read_only, "UREV": self._read_only,
+            "SREV": self._read_only, "ERES": self._read_only, "VMAX": self._read_only, "EGU": self._read_only,
+            "RDBD": self._read_only, "S": self._put_s, "SYNC": self._put_sync, "DISP": self._put_disp,
+        }.items():
+            f[name].putter = self._guarded(name, putter)
+
+    # ---- helpers ------------------------------------------------------------------------------
+    def _guarded(self, name: str, putter: Any) -> Any:
+        """A field's putter: refused while the record is disabled (``_able``), counted."""
+        async def put(instance: Any, value: Any) -> Any:
+            self.face.counters["puts"] += 1
+            try:
+                if self.disabled and name != "DISP":
+                    raise PutRefused(f"{self.axis}: the record is disabled ({self.able.pvname} = Disable)")
+                return await putter(instance, value)
+            except SkipWrite:
+                raise
+            except PutRefused:
+                self.face.counters["failed_puts"] += 1
+                raise
+        return put
+
+    async def _set(self, name: str, value: Any, **metadata: Any) -> None:
+        """Posts a field the server owns, only when it changed."""
+        fld = self.fields[name]
+        if fld.value != value or metadata:
+            await fld.write(value, verify_value=False, **metadata)
+
+    def user(self, dial: float) -> float:
+        return dial * self.dir + self.off
+
+    def dial(self, user: float) -> float:
+        return (user - self.off) * self.dir
+
+    def raw(self, dial: float) -> int:
+        native = self.drive.units.to_native(dial)
+        return int(round(native)) if math.isfinite(native) and abs(native) < 2**31 else 0
+
+    def _spawn(self, coro: Any, name: str) -> asyncio.Task:
+        task = asyncio.create_task(coro, name=f"motorbus-ca-{self.axis}-{name}")
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+        return task
+
+    def _persist(self, **values: Any) -> None:
+        try:
+            self.face.calibration.update(self.axis, **values)
+        except Exception as e:  # noqa: BLE001 - the record goes on; the log says what was not kept
+            log.warning("%s: calibration not saved: %s", self.axis, e)
+
+    # ---- start ---------------------------------------------------------------------------------
+    async def start(self) -> None:
+        """Reads what the drive says (travel limits, position, status, speeds), fills the
+        fields and starts the readback task."""
+        d = self.drive
+        try:
+            self.travel = await d.travel_limits()
+        except Exception as e:  # noqa: BLE001 - a drive that cannot say has none we know of
+            log.info("%s: travel limits unread (%s): none assumed", self.axis, e)
+        lo, hi = self.travel
+        dllm, dhlm = self._saved_limits
+        self.dllm = float(dllm) if dllm is not None else (lo if math.isfinite(lo) else 0.0)
+        self.dhlm = float(dhlm) if dhlm is not None else (hi if math.isfinite(hi) else 0.0)
+        self._clamp_limits()
+        speed, vmax = await self.kmap.speeds(d)
+        if self.velo is None:
+            self.velo = speed if speed else max(self.mres * 1000.0, 1e-9)
+        if self.jvel is None:
+            self.jvel = self.velo
+        self.vmax = vmax or 0.0
+        f = self.fields
+        egu = d.units.name[:15]
+        prec = max(0, min(9, int(math.ceil(-math.log10(self.mres))) if self.mres < 1 else 0))
+        for fld in f.values():
+            if hasattr(fld, "precision"):
+                fld._data["precision"] = prec
+        self.motor._data["precision"] = prec
+        await f["PREC"].write(prec, verify_value=False)
+        for name in ("VAL", "RBV", "DVAL", "DRBV", "HLM", "LLM", "DHLM", "DLLM", "OFF", "TWV", "RLV", "RDBD",
+                     "MRES", "ERES", "DIFF", "LVAL", "LDVL"):
+            fld = self.motor if name == "VAL" else f[name]
+            fld._data["units"] = egu
+        for name in ("VELO", "VMAX", "VBAS", "JVEL", "HVEL", "BVEL"):
+            f[name]._data["units"] = f"{egu}/sec"
+        f["JAR"]._data["units"] = f"{egu}/s/s"
+        for name in ("ACCL", "BACC"):
+            f[name]._data["units"] = "sec"
+        f["UREV"]._data["units"] = f"{egu}/rev"
+        await f["EGU"].write(egu, verify_value=False)
+        await f["DESC"].write(f"{d.kind} {self.address}"[:40], verify_value=False)
+        await f["MRES"].write(self.mres, verify_value=False)
+        await f["ERES"].write(self.mres, verify_value=False)
+        await f["RRES"].write(1.0, verify_value=False)
+        await f["SREV"].write(200, verify_value=False)
+        await f["UREV"].write(self.mres * 200, verify_value=False)
+        await f["RDBD"].write(max(self.mres, await self.kmap.deadband(d)), verify_value=False)
+        await f["VMAX"].write(self.vmax, verify_value=False)
+        await f["VBAS"].write(0.0, verify_value=False)
+        await f["VELO"].write(self.velo, verify_value=False, upper_ctrl_limit=self.vmax, lower_ctrl_limit=0.0)
+        await f["S"].write(self.velo / (self.mres * 200), verify_value=False)
+        await f["ACCL"].write(self.accl, verify_value=False)
+        await f["JVEL"].write(self.jvel, verify_value=False)
+        await f["HVEL"].write(self.velo, verify_value=False)
+        await f["TWV"].write(self.twv, verify_value=False)
+        await f["DIR"].write("Neg" if self.dir < 0 else "Pos", verify_value=False)
+        await f["FOFF"].write("Frozen" if self.foff else "Variable", verify_value=False)
+        await f["SET"].write("Use", verify_value=False)
+        await f["SPMG"].write("Go", verify_value=False)
+        await f["LSPG"].write("Go", verify_value=False)
+        await f["OFF"].write(self.off, verify_value=False)
+        await f["LVIO"].write(0, verify_value=False)      # caproto's default is 1 (gotcha 9)
+        await f["DMOV"].write(1, verify_value=False)
+        await f["CNEN"].write("Enable", verify_value=False)
+        await f["OUT"].write(f"motorbus {d.kind} {self.address}"[:39], verify_value=False)
+        await f["DTYP"].write(0, verify_value=False)
+        await f["HLSV"].write("NO_ALARM", verify_value=False)
+        await self._post_limits()
+        await self._read_once(post=True)
+        await self._sync_targets()
+        await f["UDF"].write(0, verify_value=False)
+        self._readback = self._spawn(self._readback_loop(), "readback")
+
+    async def shutdown(self) -> None:
+        for task in list(self._tasks):
+            task.cancel()
+        for task in list(self._tasks):
+            try:
+                await task
+            except (asyncio.CancelledError, Exception):  # noqa: BLE001 - closing
+                pass
+        if self.episode is not None and not self.episode.done():
+            self.episode.set_exception(PutRefused(f"{self.axis}: the CA face closed"))
+
+    # ---- limits --------------------------------------------------------------------------------
+    def _clamp_limits(self) -> None:
+        """DHLM/DLLM inside the drive's travel limits (a side the drive does not limit is free)."""
+        lo, hi = self.travel
+        if self.dhlm == 0.0 and self.dllm == 0.0 and not (math.isfinite(lo) or math.isfinite(hi)):
+            return
+        if math.isfinite(hi):
+            self.dhlm = min(self.dhlm, hi) if self.dhlm or self.dllm else hi
+            self.dllm = min(self.dllm, hi)
+        if math.isfinite(lo):
+            self.dllm = max(self.dllm, lo) if self.dhlm or self.dllm else lo
+            self.dhlm = max(self.dhlm, lo)
+
+    def user_limits(self) -> tuple[float, float]:
+        """(LLM, HLM) from (DLLM, DHLM): DIR=Neg swaps them."""
+        a, b = self.user(self.dllm), self.user(self.dhlm)
+        return (min(a, b), max(a, b))
+
+    async def _post_limits(self) -> None:
+        llm, hlm = self.user_limits()
+        f = self.fields
+        await self._set("DHLM", self.dhlm)
+        await self._set("DLLM", self.dllm)
+        await self._set("HLM", hlm)
+        await self._set("LLM", llm)
+        md = dict(upper_ctrl_limit=hlm, lower_ctrl_limit=llm, upper_disp_limit=hlm, lower_disp_limit=llm)
+        await self.motor.write_metadata(**md)
+        await f["RBV"].write_metadata(**md)
+        dmd = dict(upper_ctrl_limit=self.dhlm, lower_ctrl_limit=self.dllm, upper_disp_limit=self.dhlm,
+                   lower_disp_limit=self.dllm)
+        await f["DVAL"].write_metadata(**dmd)
+        await f["DRBV"].write_metadata(**dmd)
+        await self._set("HOPR", hlm)
+        await self._set("LOPR", llm)
+
+    def violates(self, dial: float) -> bool:
+        """The record's soft-limit test (cc 2396-2445): none when DHLM == DLLM == 0; always
+        when DLLM > DHLM; otherwise a target outside, unless it moves back toward the range."""
+        if self.dhlm == 0.0 and self.dllm == 0.0:
+            return False
+        if self.dllm > self.dhlm:
+            return True
+        if dial > self.dhlm:
+            return not (self.drbv > self.dhlm and dial < self.drbv)
+        if dial < self.dllm:
+            return not (self.drbv < self.dllm and dial > self.drbv)
+        return False
+
+    # ---- readback ------------------------------------------------------------------------------
+    async def _read_once(self, post: bool = True) -> None:
+        d = self.drive
+        try:
+            pos = await d.position()
+            st = await d.status()
+        except Exception as e:  # noqa: BLE001 - a link problem shows as COMM_ERR, the loop goes on
+            self.face.counters["readback_errors"] += 1
+            if not self.comm_error:
+                log.warning("%s: readback failed: %s", self.axis, e)
+            self.comm_error = True
+            if post:
+                await self._set("MSTA", float(self._msta()))
+            return
+        self.comm_error = False
+        native = d.units.to_native(pos)
+        if self.moving or st.moving:
+            if native > self.native:
+                self.tdir = 1
+            elif native < self.native:
+                self.tdir = 0
+        self.drbv, self.native, self.moving, self.status = pos, native, bool(st.moving), st
+        if post:
+            await self._post_readback()
+
+    def _switches(self) -> tuple[int, int]:
+        """(RHLS, RLLS): the dial-sense switches (the drive's native + is dial + unless the
+        bench's units scale is negative)."""
+        st = self.status
+        if st is None:
+            return (0, 0)
+        plus, minus = int(bool(st.limit_positive)), int(bool(st.limit_negative))
+        return (plus, minus) if self.scale > 0 else (minus, plus)
+
+    def _msta(self) -> int:
+        st = self.status
+        rhls, rlls = self._switches()
+        bits = 0
+        if self.tdir:
+            bits |= MSTA_DIRECTION
+        if not self.moving:
+            bits |= MSTA_DONE
+        if rhls:
+            bits |= MSTA_PLUS_LS
+        if rlls:
+            bits |= MSTA_MINUS_LS
+        if Capability.ENCODER in self.drive.capabilities:
+            bits |= MSTA_POSITION | MSTA_PRESENT
+        if self.stalled:
+            bits |= MSTA_SLIP_STALL
+        if self.problem or (st is not None and st.fault):
+            bits |= MSTA_PROBLEM
+        if self.moving:
+            bits |= MSTA_MOVING
+        if self.comm_error:
+            bits |= MSTA_COMM_ERR
+        if st is not None and st.homed:
+            bits |= MSTA_HOMED
+        return bits
+
+    async def _post_readback(self) -> None:
+        rhls, rlls = self._switches()
+        hls, lls = (rhls, rlls) if self.dir > 0 else (rlls, rhls)
+        rbv = self.user(self.drbv)
+        raw = int(round(self.native)) if math.isfinite(self.native) and abs(self.native) < 2**31 else 0
+        await self._set("DRBV", self.drbv)
+        await self._set("RRBV", raw)
+        await self._set("RMP", raw)
+        await self._set("REP", raw)
+        await self._set("RHLS", rhls)
+        await self._set("RLLS", rlls)
+        await self._set("HLS", hls)
+        await self._set("LLS", lls)
+        await self._set("TDIR", self.tdir)
+        await self._set("MOVN", int(self.moving))
+        await self._set("MSTA", float(self._msta()))
+        await self._set("ATHM", 0)
+        if self.status is not None:
+            await self._set("CNEN", "Enable" if self.status.enabled else "Disable")
+        dval = self.fields["DVAL"].value
+        await self._set("DIFF", dval - self.drbv)
+        await self._set("RDIF", self.raw(dval) - raw)
+        await self._set("RBV", rbv)
+
+    async def _readback_loop(self) -> None:
+        while True:
+            busy = self.moving or (self.episode is not None and not self.episode.done())
+            await asyncio.sleep(MOVING_PERIOD if busy else REST_PERIOD)
+            await self._read_once()
+            in_episode = self.episode is not None and not self.episode.done()
+            if not in_episode:
+                if self.moving and not self.external:
+                    # Motion commanded elsewhere (the RPC face, a stop input's ramp...): the
+                    # record shows it as moving.
+                    self.external = True
+                    await self._dmov(0)
+                elif self.external and not self.moving:
+                    self.external = False
+                    await self._sync_targets()
+                    await self._dmov(1)
+
+    async def _dmov(self, value: int) -> None:
+        await self._set("DMOV", value)
+        await self._set("MIP", 0 if value else 1)
+        await self.face._dmov_changed()
+
+    async def _sync_targets(self) -> None:
+        """VAL := RBV, DVAL := DRBV, RVAL := RRBV (and the last-value fields)."""
+        await self._post_targets(self.drbv)
+
+    async def _post_targets(self, dial: float) -> None:
+        user, raw = self.user(dial), self.raw(dial)
+        if self.motor.value != user:
+            await self.motor.write(user, verify_value=False)
+        await self._set("DVAL", dial)
+        await self._set("RVAL", raw)
+        await self._set("LVAL", user)
+        await self._set("LDVL", dial)
+        await self._set("LRVL", raw)
+
+    # ---- alarms --------------------------------------------------------------------------------
+    async def _alarm(self, status: AlarmStatus, severity: AlarmSeverity) -> None:
+        """The record's alarm: VAL's (SEVR/STAT follow it) and the fields' (RBV's)."""
+        self.alarm_state = (status, severity)
+        await self.motor.alarm.write(status=status, severity=severity)
+        await self.fields["RBV"].alarm.write(status=status, severity=severity)
+
+    def _restore_val_alarm_later(self) -> None:
+        """caproto sets VAL's alarm to WRITE/MAJOR after a failed put (gotcha 3): the
+        record's own alarm is put back once it has."""
+        async def restore() -> None:
+            for _ in range(50):
+                await asyncio.sleep(0.002)
+                if self.motor.alarm.status == AlarmStatus.WRITE:
+                    break
+            status, severity = self.alarm_state
+            await self.motor.alarm.write(status=status, severity=severity)
+        self._spawn(restore(), "alarm")
+
+    # ---- the motion episode ------------------------------------------------------------------
+    async def command(self, what: str, arg: Any) -> asyncio.Future:
+        """Starts (or retargets) the episode: ``("move", dial)``, ``("home", forward)``,
+        ``("jog", +1/-1)``.  Returns the episode's future (resolved at the final rest)."""
+        self.generation += 1
+        self.want = (what, arg)
+        self.stop_requested = ""
+        if self.episode is None or self.episode.done():
+            loop = asyncio.get_running_loop()
+            self.episode = loop.create_future()
+            self.episode.add_done_callback(lambda fut: fut.cancelled() or fut.exception())
+            self.external = False
+            await self._dmov(0)           # before anything moves: ophyd's MoveStatus starts here
+            self.runner = self._spawn(self._run(self.episode), "episode")
+        else:
+            # Retarget while moving: stop, the episode goes on to the new target at rest.
+            try:
+                await self.drive.stop()
+            except Exception as e:  # noqa: BLE001 - the runner reports what the drive says next
+                log.info("%s: stop for a retarget failed: %s", self.axis, e)
+        return self.episode
+
+    async def _run(self, episode: asyncio.Future) -> None:
+        error: Optional[BaseException] = None
+        try:
+            while True:
+                gen = self.generation
+                what, arg = self.want
+                error = None
+                try:
+                    await self._do(what, arg)
+                except Exception as e:  # noqa: BLE001 - every failure is the episode's outcome
+                    error = e
+                    if not isinstance(e, (MoveFailed, _core.MotorbusError, OSError)):
+                        log.exception("%s: %s %r", self.axis, what, arg)
+                if self.generation != gen and not self.stop_requested:
+                    continue                   # retargeted: on to the new target
+                if (self.spmg == "Pause" and isinstance(error, MoveInterrupted)
+                        and self.stop_requested == "SPMG"):
+                    self.resume.clear()
+                    await self.resume.wait()   # Go/Move: the move to VAL resumes
+                    if self.spmg == "Stop":
+                        break
+                    self.stop_requested = ""
+                    continue
+                break
+        except asyncio.CancelledError:
+            if not episode.done():
+                episode.set_exception(PutRefused(f"{self.axis}: the CA face closed during the move"))
+            raise
+        try:
+            await self._end(episode, what, error)
+        finally:
+            if not episode.done():      # _end failed (a link lost while reading back): still an end
+                episode.set_exception(MoveFailedPut(f"{self.axis}: {error or 'the end of the move'}",
+                                                    error or PutRefused("no readback")))
+
+    async def _do(self, what: str, arg: Any) -> None:
+        d = self.drive
+        self.face.counters["moves"] += 1
+        if self.status is not None and not self.status.enabled and what != "sync":
+            # The motor module's auto power-on: a commanded motion enables the drive first
+            # (CNEN=Disable switches it off again).
+            await d.enable()
+        if what == "move":
+            await self._apply_accel()
+            velocity = self.velo if (self.velo_explicit and self.kmap.velocity) else None
+            distance = abs(arg - self.drbv)
+            timeout = None
+            if self.velo:
+                timeout = max(d.sync.default_timeout, 3 * distance / self.velo + 4 * self.accl + 10.0)
+            await d.move_to(arg, velocity=velocity, timeout=timeout, stop_on_cancel=False)
+        elif what == "home":
+            await d.home(self.kmap.home_method(d, forward=arg), stop_on_cancel=False)
+        elif what == "jog":
+            await d.jog(arg * self.dir * (self.jvel or self.velo or self.mres))
+            await d.wait_idle(JOG_WAIT, stop_on_cancel=False)
+        elif what == "sync":
+            return
+        else:  # pragma: no cover
+            raise _core.InvalidArgument(f"unknown episode step {what!r}")
+
+    async def _apply_accel(self) -> None:
+        """ACCL (seconds to VELO) on the kind's acceleration parameters, when it changed."""
+        if not self.accl_explicit:
+            return
+        key = (self.accl, self.velo)
+        if key == self.accel_applied:
+            return
+        try:
+            await self.kmap.apply_accel(self.drive, self.accl, self.velo or 0.0)
+            self.accel_applied = key
+        except Exception as e:  # noqa: BLE001 - ACCL not honoured: the move goes on at the drive's ramp
+            self.face.counters["accel_errors"] += 1
+            self.accel_applied = key
+            log.warning("%s: ACCL %g s not applied: %s", self.axis, self.accl, e)
+
+    async def _end(self, episode: asyncio.Future, what: str, error: Optional[BaseException]) -> None:
+        """At the final rest: readbacks, the outcome's alarm and fields, *then* DMOV=1,
+        then the pending puts complete."""
+        await self._read_once(post=False)
+        put_error: Optional[BaseException] = None
+        interrupted = isinstance(error, MoveInterrupted) or (error is None and self.stop_requested)
+        if error is None or isinstance(error, MoveInterrupted):
+            if error is None and what != "jog" or what == "home":
+                self.problem = self.stalled = False
+                if self.alarm_state[1] != AlarmSeverity.NO_ALARM:
+                    await self._alarm(AlarmStatus.NO_ALARM, AlarmSeverity.NO_ALARM)
+        elif isinstance(error, LimitReached):
+            self.face.counters["failed_moves"] += 1
+            hlsv = self.fields["HLSV"].value
+            if hlsv and hlsv != "NO_ALARM":
+                side_high = (error.side > 0) == (self.scale > 0) == (self.dir > 0)
+                sev = AlarmSeverity(["NO_ALARM", "MINOR", "MAJOR", "INVALID"].index(hlsv))
+                await self._alarm(AlarmStatus.HIGH if side_high else AlarmStatus.LOW, sev)
+            put_error = MoveFailedPut(f"{self.axis}: {error}", error)
+        else:
+            self.face.counters["failed_moves"] += 1
+            if isinstance(error, MoveStalled):
+                self.stalled = True
+                self.problem = True
+                await self._alarm(AlarmStatus.STATE, AlarmSeverity.MAJOR_ALARM)
+            elif isinstance(error, (MoveFaulted, MoveTimedOut)) or isinstance(error, MoveFailed):
+                self.problem = True
+                await self._alarm(AlarmStatus.STATE, AlarmSeverity.MAJOR_ALARM)
+            else:       # the link: LinkDown, a closed drive, a drive's refusal
+                self.problem = True
+                status = AlarmStatus.COMM if isinstance(error, (_core.LinkDown, _core.TimeoutError)) \
+                    else AlarmStatus.STATE
+                await self._alarm(status, AlarmSeverity.MAJOR_ALARM)
+            put_error = MoveFailedPut(f"{self.axis}: {error}", error)
+        await self._post_readback()
+        if what != "move" or interrupted or put_error is not None:
+            await self._sync_targets()       # VAL := RBV (STOP, homing, jog, a failed move)
+        if what == "home":
+            await self._set("HOMF", 0)
+            await self._set("HOMR", 0)
+        if what == "jog":
+            await self._set("JOGF", 0)
+            await self._set("JOGR", 0)
+        if self.spmg == "Move":
+            self.spmg = "Pause"
+            await self._set("SPMG", "Pause")
+        await self._dmov(1)
+        if not episode.done():
+            if put_error is None:
+                episode.set_result(None)
+            else:
+                episode.set_exception(put_error)
+
+    async def _await_episode(self, episode: asyncio.Future) -> None:
+        """A put waits for the episode's end; shielded: a put cancelled by caproto (its
+        client gone) leaves the motion alone, as a real IOC does."""
+        try:
+            await asyncio.shield(episode)
+        except MoveFailedPut:
+            self._restore_val_alarm_later()
+            raise
+
+    async def stop_axis(self, by: str = "STOP") -> None:
+        """STOP / allstop / SPMG Stop|Pause: the drive's stop at once; the episode ends at
+        rest as interrupted (a normal completion) with VAL := RBV."""
+        self.face.counters["stops"] += 1
+        self.stop_requested = by
+        try:
+            await self.drive.stop()
+        except Exception as e:  # noqa: BLE001 - nothing more to do from here; the readback shows the rest
+            log.warning("%s: stop failed: %s", self.axis, e)
+        if self.episode is None or self.episode.done():
+            # At rest: the record syncs its targets (cc 1856-1910), with a DMOV pulse.
+            await self._read_once()
+            await self._sync_targets()
+
+    # ---- VAL and the moves -----------------------------------------------------------------------
+    @motor.putter
+    async def motor(self, instance: Any, value: Any) -> Any:
+        self.face.counters["puts"] += 1
+        try:
+            if self.disabled:
+                raise PutRefused(f"{self.axis}: the record is disabled ({self.able.pvname} = Disable)")
+            value = _finite(value, f"{self.axis}.VAL")
+            await self._move_user(value)
+        except SkipWrite:
+            raise
+        except PutRefused:
+            self.face.counters["failed_puts"] += 1
+            raise
+        raise SkipWrite()
+
+    async def _move_user(self, value: float) -> None:
+        """A VAL put: calibration in SET mode, else a move (put-completion at the end)."""
+        if self.set_mode and not self.fields["IGSET"].value:
+            await self._calibrate(value)
+            return
+        await self._move_dial(self.dial(value))
+
+    async def _move_dial(self, dial: float) -> None:
+        if self.spmg == "Stop":
+            # Stop mode refuses motion: the put completes, nothing moves, VAL := RBV.
+            await self._dmov(0)
+            await self._sync_targets()
+            await self._dmov(1)
+            return
+        if self.violates(dial):
+            await self._set("LVIO", 1)
+            await self._dmov(0)
+            await self._dmov(1)
+            self._restore_val_alarm_later()
+            llm, hlm = self.user_limits()
+            raise SoftLimitViolation(f"{self.axis}: target {self.user(dial):g} is outside the soft limits "
+                                     f"[{llm:g}, {hlm:g}] (LVIO): nothing moved")
+        await self._set("LVIO", 0)
+        await self._post_targets(dial)
+        if self.spmg == "Pause":
+            return                      # stored; Go moves there
+        episode = await self.command("move", dial)
+        await self._await_episode(episode)
+
+    async def _calibrate(self, value: float) -> None:
+        """SET mode: the VAL put changes the calibration, nothing moves (a DMOV pulse)."""
+        await self._dmov(0)
+        try:
+            if self.foff:
+                raise PutRefused(f"{self.axis}: SET with FOFF=Frozen would load the drive's position register, "
+                                 "which motorbus does not do: set FOFF=Variable (the offset absorbs it)")
+            await self._read_once(post=False)
+            self.off = value - self.drbv * self.dir
+            self._persist(off=self.off)
+            await self._set("OFF", self.off)
+            await self._post_limits()
+            await self._post_targets(self.drbv)
+            await self._post_readback()
+        finally:
+            await self._dmov(1)
+
+    async def _put_dval(self, instance: Any, value: Any) -> Any:
+        dial = _finite(value, f"{self.axis}.DVAL")
+        if self.set_mode:
+            raise PutRefused(f"{self.axis}: DVAL in SET mode would load the drive's position register, which "
+                             "motorbus does not do: calibrate with VAL (the offset absorbs it)")
+        await self._move_dial(dial)
+        raise SkipWrite()
+
+    async def _put_rval(self, instance: Any, value: Any) -> Any:
+        if self.set_mode:
+            raise PutRefused(f"{self.axis}: RVAL in SET mode would load the drive's position register, which "
+                             "motorbus does not do: calibrate with VAL (the offset absorbs it)")
+        await self._move_dial(self.drive.units.to_user(_finite(value, f"{self.axis}.RVAL")))
+        raise SkipWrite()
+
+    async def _put_rlv(self, instance: Any, value: Any) -> Any:
+        rel = _finite(value, f"{self.axis}.RLV")
+        await instance.write(rel, verify_value=False)
+        await self._move_user_or_set(self.motor.value + rel)
+        await instance.write(0.0, verify_value=False)
+        raise SkipWrite()
+
+    async def _move_user_or_set(self, value: float) -> None:
+        await self._move_user(value)
+
+    async def _tweak(self, instance: Any, value: Any, sign: int) -> Any:
+        if not value:
+            return 0
+        await instance.write(0, verify_value=False)     # TWF/TWR read back 0 at once
+        await self._move_user(self.motor.value + sign * self.twv)
+        raise SkipWrite()
+
+    async def _put_twf(self, instance: Any, value: Any) -> Any:
+        return await self._tweak(instance, value, 1)
+
+    async def _put_twr(self, instance: Any, value: Any) -> Any:
+        return await self._tweak(instance, value, -1)
+
+    async def _put_twv(self, instance: Any, value: Any) -> Any:
+        self.twv = _finite(value, f"{self.axis}.TWV")
+        self._persist(twv=self.twv)
+        return self.twv
+
+    async def _put_stop(self, instance: Any, value: Any) -> Any:
+        if value:
+            await self.stop_axis("STOP")
+        return 0
+
+    async def _put_spmg(self, instance: Any, value: Any) -> Any:
+        strings = ("Stop", "Pause", "Move", "Go")
+        mode = strings[_enum_index(value, strings)]
+        await self._set("LSPG", self.spmg)
+        old, self.spmg = self.spmg, mode
+        active = self.episode is not None and not self.episode.done()
+        if mode in ("Stop", "Pause"):
+            if active or self.moving:
+                await self.stop_axis("SPMG")
+            if mode == "Stop" and active:
+                self.resume.set()          # a paused episode ends (Stop refuses motion)
+        elif old in ("Pause", "Stop") or not active:
+            if active:
+                self.resume.set()          # the paused move resumes toward VAL
+            elif abs(self.dial(self.motor.value) - self.drbv) > self.mres and old == "Pause":
+                # A target stored while paused: go there now (no put waits for it).
+                self._spawn(self._go_to_val(), "go")
+        return mode
+
+    async def _go_to_val(self) -> None:
+        try:
+            episode = await self.command("move", self.dial(self.motor.value))
+            await asyncio.shield(episode)
+        except (PutRefused, MoveFailed, _core.MotorbusError):
+            pass
+
+    async def _home(self, instance: Any, value: Any, forward: bool) -> Any:
+        if value != 1:
+            raise PutRefused(f"{self.axis}: {'HOMF' if forward else 'HOMR'} takes 1 (start the homing), "
+                             f"not {value!r}")
+        if self.episode is not None and not self.episode.done():
+            if self.want[0] == "home":
+                raise PutRefused(f"{self.axis}: a homing is already running")
+            await self.stop_axis("HOME")
+        await instance.write(1, verify_value=False)
+        episode = await self.command("home", forward)
+        await self._set("LVIO", 0)
+        try:
+            await self._await_episode(episode)
+        finally:
+            await instance.write(0, verify_value=False)
+        raise SkipWrite()
+
+    async def _put_homf(self, instance: Any, value: Any) -> Any:
+        return await self._home(instance, value, True)
+
+    async def _put_homr(self, instance: Any, value: Any) -> Any:
+        return await self._home(instance, value, False)
+
+    async def _jog(self, instance: Any, value: Any, sign: int) -> Any:
+        if value:
+            if self.spmg in ("Stop", "Pause"):
+                raise PutRefused(f"{self.axis}: SPMG is {self.spmg}: no motion")
+            await instance.write(1, verify_value=False)
+            await self.command("jog", sign)
+            raise SkipWrite()       # the jog runs until 0 (or a stop); this put completes now
+        if self.episode is not None and not self.episode.done() and self.want[0] == "jog":
+            await self.stop_axis("JOG")
+            await asyncio.shield(self.episode)
+        return 0
+
+    async def _put_jogf(self, instance: Any, value: Any) -> Any:
+        return await self._jog(instance, value, 1)
+
+    async def _put_jogr(self, instance: Any, value: Any) -> Any:
+        return await self._jog(instance, value, -1)
+
+    # ---- calibration and settings ---------------------------------------------------------------
+    async def _recalibrated(self) -> None:
+        await self._post_limits()
+        await self._post_targets(self.fields["DVAL"].value)
+        await self._post_readback()
+
+    async def _put_off(self, instance: Any, value: Any) -> Any:
+        self.off = _finite(value, f"{self.axis}.OFF")
+        self._persist(off=self.off)
+        await instance.write(self.off, verify_value=False)
+        await self._recalibrated()
+        raise SkipWrite()
+
+    async def _put_dir(self, instance: Any, value: Any) -> Any:
+        strings = ("Pos", "Neg")
+        new = -1 if _enum_index(value, strings) else 1
+        if new != self.dir:
+            # The user position stays where it is: OFF absorbs the sign change (cc: DIR put).
+            user_rbv = self.user(self.drbv)
+            self.dir = new
+            self.off = user_rbv - self.drbv * self.dir
+            self._persist(dir=self.dir, off=self.off)
+            await self._set("OFF", self.off)
+        await instance.write(strings[0 if new > 0 else 1], verify_value=False)
+        await self._recalibrated()
+        raise SkipWrite()
+
+    async def _put_foff(self, instance: Any, value: Any) -> Any:
+        strings = ("Variable", "Frozen")
+        self.foff = _enum_index(value, strings)
+        self._persist(foff=self.foff)
+        return strings[self.foff]
+
+    async def _put_set(self, instance: Any, value: Any) -> Any:
+        strings = ("Use", "Set")
+        self.set_mode = bool(_enum_index(value, strings))
+        return strings[int(self.set_mode)]
+
+    async def _put_sset(self, instance: Any, value: Any) -> Any:
+        if value:
+            self.set_mode = True
+            await self._set("SET", "Set")
+        return 0
+
+    async def _put_suse(self, instance: Any, value: Any) -> Any:
+        if value:
+            self.set_mode = False
+            await self._set("SET", "Use")
+        return 0
+
+    async def _user_limit(self, value: Any, high: bool) -> None:
+        v = self.dial(_finite(value, f"{self.axis}.{'HLM' if high else 'LLM'}"))
+        if high == (self.dir > 0):
+            self.dhlm = v
+        else:
+            self.dllm = v
+        await self._limits_changed()
+
+    async def _limits_changed(self) -> None:
+        self._clamp_limits()
+        self._persist(dhlm=self.dhlm, dllm=self.dllm)
+        await self._post_limits()
+        # VAL outside the new limits sets LVIO (the record's check on a limit change).
+        await self._set("LVIO", int(self.violates(self.dial(self.motor.value))))
+
+    async def _put_hlm(self, instance: Any, value: Any) -> Any:
+        await self._user_limit(value, True)
+        raise SkipWrite()
+
+    async def _put_llm(self, instance: Any, value: Any) -> Any:
+        await self._user_limit(value, False)
+        raise SkipWrite()
+
+    async def _put_dhlm(self, instance: Any, value: Any) -> Any:
+        self.dhlm = _finite(value, f"{self.axis}.DHLM")
+        await self._limits_changed()
+        raise SkipWrite()
+
+    async def _put_dllm(self, instance: Any, value: Any) -> Any:
+        self.dllm = _finite(value, f"{self.axis}.DLLM")
+        await self._limits_changed()
+        raise SkipWrite()
+
+    async def _put_velo(self, instance: Any, value: Any) -> Any:
+        v = _finite(value, f"{self.axis}.VELO")
+        if v <= 0:
+            raise PutRefused(f"{self.axis}.VELO: a speed > 0 {self.drive.units.name}/s, not {v!r}")
+        if self.vmax and v > self.vmax:
+            v = self.vmax                # the record clamps VELO to [VBAS, VMAX]
+        self.velo, self.velo_explicit = v, True
+        self._persist(velo=v)
+        await self._set("S", v / (self.mres * 200))
+        return v
+
+    async def _put_s(self, instance: Any, value: Any) -> Any:
+        s = _finite(value, f"{self.axis}.S")
+        await self._put_velo(self.fields["VELO"], s * self.mres * 200)
+        await self._set("VELO", self.velo)
+        return self.velo / (self.mres * 200)
+
+    async def _put_accl(self, instance: Any, value: Any) -> Any:
+        a = _finite(value, f"{self.axis}.ACCL")
+        if a <= 0:
+            raise PutRefused(f"{self.axis}.ACCL: seconds to VELO > 0, not {a!r}")
+        self.accl, self.accl_explicit = a, True
+        self._persist(accl=a)
+        return a
+
+    async def _put_jvel(self, instance: Any, value: Any) -> Any:
+        v = _finite(value, f"{self.axis}.JVEL")
+        if v <= 0:
+            raise PutRefused(f"{self.axis}.JVEL: a speed > 0, not {v!r}")
+        self.jvel = v
+        self._persist(jvel=v)
+        return v
+
+    async def _put_cnen(self, instance: Any, value: Any) -> Any:
+        strings = ("Disable", "Enable")
+        on = _enum_index(value, strings)
+        try:
+            if on:
+                await self.drive.enable()
+            else:
+                await self.drive.disable()
+        except (_core.MotorbusError, OSError) as e:
+            raise PutRefused(f"{self.axis}: CNEN={strings[on]}: {e}") from None
+        return strings[on]
+
+    async def _put_sync(self, instance: Any, value: Any) -> Any:
+        if value:
+            await self._read_once()
+            await self._sync_targets()
+        return 0
+
+    async def _put_disp(self, instance: Any, value: Any) -> Any:
+        self.disabled = bool(value)
+        await self._set_able("Disable" if self.disabled else "Enable")
+        return value
+
+    async def _set_able(self, text: str) -> None:
+        if self.able.value != text:
+            await self.able.write(text, verify_value=False)
+
+    async def _read_only(self, instance: Any, value: Any) -> Any:
+        name = instance.pvspec.name
+        raise PutRefused(f"{self.axis}.{name}: set by the bench file (units, kind) and the drive, not over CA")
+
+    @able.putter
+    async def able(self, instance: Any, value: Any) -> Any:
+        strings = ("Enable", "Disable")
+        idx = _enum_index(value, strings)
+        self.disabled = bool(idx)
+        await self._set("DISP", idx)
+        return strings[idx]
+
