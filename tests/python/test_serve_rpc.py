@@ -323,28 +323,37 @@ def test_a_stop_from_another_thread_overtakes_the_move_this_connection_awaits(se
     assert 5.0 < service.shaft("z") < 400.0 and not service.bench["z"].sync.status.moving
 
 
-def test_a_dropped_client_stops_the_move_it_awaited_but_not_one_it_left_running(service, bench):
-    z, u = bench["z"], bench["u"]
-    z.move_to(0.0, timeout=10)
-    u.move_to(0.0, timeout=10)
-    conn = rclient.Connection(service.path)
-    awaited = threading.Thread(target=lambda: pytest.raises(Exception, conn.call, "move_to", "z", 400.0,
-                                                            timeout=20))
-    awaited.start()
-    conn.call("move_to", "u", 4000.0, wait=False)     # fire and forget: survives the program
-    wait_for(lambda: service.shaft("z") > 5.0, what="z moving")
-    conn.close()                                      # the program is gone
-    awaited.join(10)
-    wait_for(lambda: not service.bench["z"].sync.status.moving, what="z stopped after the drop")
-    rest = service.shaft("z")
-    assert 5.0 < rest < 400.0
-    last = service.bench["z"].sync.status.last_move
-    assert last.state == "interrupted" and "cancellation" in last.reason
-    # the move nobody awaited goes on to its target
+def test_a_dropped_client_stops_the_moves_it_awaited_but_not_one_it_left_running(service, bench):
+    x, z, u = bench["x"], bench["z"], bench["u"]
+    for d in (x, z, u):
+        d.move_to(0.0, timeout=10)
+    conn = rclient.Connection(service.path)          # the program that will die
+    watcher = rclient.Connection(service.path)       # another one that only waits on u, and dies too
+
+    def calling(c: Any, *args: Any, **kwargs: Any) -> threading.Thread:
+        t = threading.Thread(target=lambda: pytest.raises(Exception, c.call, *args, **kwargs))
+        t.start()
+        return t
+    waits = [calling(conn, "move_to", "z", 400.0, timeout=20)]       # awaited
+    conn.call("move_to", "x", 300.0, wait=False)
+    waits.append(calling(conn, "wait_idle", "x", 20))                 # its own move, awaited through wait_idle
+    conn.call("move_to", "u", 4000.0, wait=False)                     # fire and forget: survives the program
+    waits.append(calling(watcher, "wait_idle", "u", 30))              # someone else's move: not the watcher's to stop
+    wait_for(lambda: service.shaft("z") > 5.0 and service.shaft("x") > 5.0, what="z and x moving")
+    conn.close()                                      # the programs are gone
+    watcher.close()
+    for t in waits:
+        t.join(10)
+    for name, far in (("z", 400.0), ("x", 300.0)):
+        wait_for(lambda name=name: not service.bench[name].sync.status.moving, what=f"{name} stopped after the drop")
+        assert 5.0 < service.shaft(name) < far
+        last = service.bench[name].sync.status.last_move
+        assert last.state == "interrupted" and "cancellation" in last.reason, (name, last)
+    # the move nobody (of its own) awaited goes on to its target
     wait_for(lambda: not service.bench["u"].sync.status.moving, timeout=30, what="u's move")
     assert service.bench["u"].sync.status.last_move.state == "done"
     assert service.shaft("u") == pytest.approx(4000.0, abs=0.011)
-    wait_for(lambda: service.run(_counter(service, "clients")) == 1, what="the dropped client counted out")
+    wait_for(lambda: service.run(_counter(service, "clients")) == 1, what="the dropped clients counted out")
 
 
 async def _counter(service: Service, name: str) -> int:

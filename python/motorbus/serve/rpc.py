@@ -484,8 +484,9 @@ class RpcFace:
         call = msg["call"]
         self.counters["calls"] += 1
         kwargs = msg.get("kwargs") or {}
-        awaited = (call in _AWAITED_MOTION and kwargs.get("wait", True)) or call == "wait_idle" \
-            or (call == "move_together" and kwargs.get("wait", True))
+        awaited = (call in _AWAITED_MOTION and kwargs.get("wait", True)) \
+            or (call == "move_together" and kwargs.get("wait", True)) \
+            or (call == "wait_idle" and self._started_here(conn, msg.get("axis")))
         task = asyncio.ensure_future(self._run_call(conn, cid, call, msg))
         conn.calls[cid] = (task, awaited)
         task.add_done_callback(lambda _t: conn.calls.pop(cid, None))
@@ -540,6 +541,15 @@ class RpcFace:
                 else:
                     conn.started[name] = self.bench[name].sync._move
         return value
+
+    def _started_here(self, conn: _Conn, axis: Any) -> bool:
+        """A wait_idle stops the motor when its client goes only if that client started the
+        motion it waits for (a program waiting on another's move does not own it)."""
+        mine = conn.started.get(axis) if isinstance(axis, str) else None
+        if mine is None:
+            return False
+        d = self.bench.axes.get(axis)
+        return d is not None and d.sync._move is mine
 
     async def _wait_idle(self, conn: _Conn, axis: str, d: Any, timeout: Optional[float] = None) -> None:
         """``wait_idle`` as this client's own: after a move it started without waiting, it
