@@ -370,3 +370,48 @@ def test_lock_and_the_missing_extra_in_process(tmp_path, monkeypatch):
     again = ServiceLock(bench)         # let go: the next service may take it
     again.acquire()
     again.release()
+
+
+SLOW_STOP_BENCH = textwrap.dedent("""\
+    [bus.can]
+    spec = "virtual:t26slow"
+
+    [axis.z]
+    kind = "cia402"
+    bus = "can"
+    address = 5
+    units = { name = "mm", scale = 0.01 }
+    params = { "0x6081" = 20000, "0x6083" = 400000, "0x6084" = 2000, "0x6085" = 400000 }
+    """)
+
+
+def test_a_second_signal_quick_stops_what_still_brakes(tmp_path):
+    """The shutdown's stop brakes at 6084h = 2000 inc/s² (10 s from full speed); a second
+    SIGTERM does not wait for that: a quick stop (6085h), and the service ends at once."""
+    source = tmp_path / "bench.toml"
+    source.write_text(SLOW_STOP_BENCH)
+    with ServedBench(str(source)) as twin:
+        s = Service(twin.bench_file, "--no-epics")
+        try:
+            assert motorbus_cli("config", "apply", twin.bench_file).returncode == 0
+            bench = connect(twin.bench_file)
+            bench["z"].enable()
+            bench["z"].move_to(1000.0, wait=False)
+            deadline = time.monotonic() + 10
+            while bench["z"].velocity < 190:      # at speed (200 mm/s)
+                assert time.monotonic() < deadline
+                time.sleep(0.02)
+            bench.close()
+            s.proc.send_signal(signal.SIGTERM)
+            time.sleep(0.5)                       # braking: far from rest yet
+            assert s.proc.poll() is None
+            t = time.monotonic()
+            s.proc.send_signal(signal.SIGTERM)
+            assert s.proc.wait(timeout=20) == 0 and time.monotonic() - t < 3
+            assert "z: a second signal: quick stop" in s.stderr()
+        finally:
+            s.end()
+        with motorbus.Bench.load(twin.bench_file) as direct:
+            at = direct["z"].position
+            time.sleep(0.2)
+            assert not direct["z"].status.moving and direct["z"].position == at < 1000

@@ -14,7 +14,8 @@ process's one event loop (contract: no blocking drive call on the loop).
 Shutdown (a signal or ``request_stop()``): every axis is stopped at once, the faces are
 closed (no new command can start a motor), every axis is stopped again (one that a
 client started in between), each is given ``STOP_WAIT`` seconds to come to rest
-(quick stop for one that does not), then the bench and the lock are let go.  After a
+(quick stop for one that does not; a second signal quick-stops every axis still
+moving at once), then the bench and the lock are let go.  After a
 SIGKILL none of this runs: only the drives' own watchdogs act (docs/serve.md says per
 kind what a killed service leaves).
 """
@@ -97,6 +98,7 @@ class BenchService:
         self.info: Optional[ServiceInfo] = None
         self._lock = ServiceLock(self.bench_path)
         self._stop: Optional[asyncio.Event] = None
+        self._hurry: Optional[asyncio.Event] = None
         self._signal: Optional[int] = None
         self._signals_installed: list[int] = []
         self._loop: Optional[asyncio.AbstractEventLoop] = None
@@ -109,6 +111,7 @@ class BenchService:
         another service holds it, and leaves nothing behind when any step fails."""
         self._loop = asyncio.get_running_loop()
         self._stop = asyncio.Event()
+        self._hurry = asyncio.Event()
         self._install_signals()         # before any transport opens: a signal meanwhile still stops cleanly
         self._lock.acquire()
         try:
@@ -206,6 +209,8 @@ class BenchService:
         if signum is not None and self._signal is None:
             self._signal = signum
         if self._stop is not None:
+            if self._stop.is_set() and self._hurry is not None:
+                self._hurry.set()     # a second signal: quick stops now, no more waiting for rest
             self._stop.set()
 
     @property
@@ -242,19 +247,40 @@ class BenchService:
         await self._close_everything()
 
     async def _settle(self) -> None:
+        """Each axis gets STOP_WAIT s to come to rest after the shutdown's stop; one that does
+        not -- or every axis still moving when a second signal comes -- gets a quick stop."""
         from ..drive import MoveFailed
+
+        async def at_rest(d: Any) -> bool:
+            """True at rest (or its move ended, as it may), False on the second signal."""
+            wait = asyncio.ensure_future(d.wait_idle(timeout=STOP_WAIT, stop_on_cancel=False))
+            hurried = asyncio.ensure_future(self._hurry.wait()) if self._hurry is not None else None
+            try:
+                await asyncio.wait({wait} | ({hurried} if hurried else set()), return_when=asyncio.FIRST_COMPLETED)
+            finally:
+                if hurried is not None:
+                    hurried.cancel()
+            if not wait.done():
+                wait.cancel()
+                return False
+            wait.result()
+            return True
 
         async def one(name: str, d: Any) -> None:
             try:
-                await d.wait_idle(timeout=STOP_WAIT, stop_on_cancel=False)
+                if await at_rest(d):
+                    return
+                why = "a second signal"
             except MoveFailed as e:
-                # The move the stop cut short; only a motor still moving needs more.
+                # The move the stop cut short ended as it says; only a motor still moving needs more.
                 if type(e).__name__ != "MoveTimedOut":
                     return
-                log.warning("serve: %s: not at rest %g s after the stop: quick stop", name, STOP_WAIT)
-                await self._safely(d.quick_stop(), f"{name}: quick stop")
+                why = f"not at rest {STOP_WAIT:g} s after the stop"
             except Exception as e:  # noqa: BLE001 - a link gone: nothing more this process can do
                 log.warning("serve: %s: waiting for rest: %s: %s", name, type(e).__name__, e)
+                return
+            log.warning("serve: %s: %s: quick stop", name, why)
+            await self._safely(d.quick_stop(), f"{name}: quick stop")
 
         await asyncio.gather(*(one(n, d) for n, d in self.bench.axes.items() if not d.closed))
 
