@@ -172,8 +172,11 @@ class BenchService:
         return [str(x) for x in links if x]
 
     def _clear_stale_socket(self) -> None:
-        """A socket file left by a service that died (we hold the lock: no live service
-        uses it) is removed; anything else at that path is not ours to remove."""
+        """Checked before the bench opens: a socket file left by a service that died is
+        removed; one a live process answers on (another bench's service given the same
+        --socket) or a file that is not a socket is refused, not removed."""
+        import socket
+
         try:
             st = os.lstat(self.socket_path)
         except FileNotFoundError:
@@ -181,7 +184,17 @@ class BenchService:
         if not stat.S_ISSOCK(st.st_mode):
             raise _core.InvalidArgument(f"motorbus serve: --socket {self.socket_path}: exists and is not a "
                                         f"socket (give another path)")
-        os.unlink(self.socket_path)
+        probe = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        try:
+            probe.settimeout(1.0)
+            probe.connect(self.socket_path)
+        except OSError:
+            os.unlink(self.socket_path)       # nobody answers: a dead service's
+            return
+        finally:
+            probe.close()
+        raise _core.InvalidArgument(f"motorbus serve: --socket {self.socket_path}: another service answers there "
+                                    f"(give another path)")
 
     def _install_signals(self) -> None:
         assert self._loop is not None
