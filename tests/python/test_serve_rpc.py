@@ -533,6 +533,28 @@ def test_a_1khz_poll_fanned_out_to_five_subscribers_is_one_poller(service, bench
             c.close()
 
 
+def test_rows_that_overtake_a_subscription_are_kept_for_it(service, bench, monkeypatch):
+    first = bench.poll(["z"], ("position",), rate_hz=1000)       # the shared poll runs already
+    try:
+        wait_for(lambda: len(first.frame()["t"]) > 50, what="rows")
+        late = motorbus.Bench.connect(f"unix:{service.path}")
+        slow_init = rclient.RemotePoller.__init__
+
+        def registering_late(self: Any, *a: Any, **kw: Any) -> None:
+            time.sleep(0.3)             # rows arrive before the subscriber is registered
+            slow_init(self, *a, **kw)
+        monkeypatch.setattr(rclient.RemotePoller, "__init__", registering_late)
+        asked = motorbus._core.runtime.monotonic_ns() / 1e9
+        p = late.poll(["z"], ("position",), rate_hz=1000)
+        time.sleep(0.1)
+        t = p.read()["t"]
+        assert len(t) > 300 and t[0] < asked + 0.1          # nothing lost while it registered
+        assert np.allclose(np.diff(t), 1e-3)
+        late.close()
+    finally:
+        first.stop()
+
+
 def test_a_slow_subscriber_loses_its_oldest_rows_counted():
     class Conn:
         class face:

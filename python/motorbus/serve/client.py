@@ -116,6 +116,8 @@ class Connection:
         self._lock = threading.Lock()
         self._send_lock = threading.Lock()
         self._subs: dict[int, "RemotePoller"] = {}
+        self._early: dict[int, collections.deque] = {}   # rows of a subscription not registered yet
+        self._ended_subs: set[int] = set()
         self.closed = False
         self.lost: Optional[str] = None
         sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
@@ -213,7 +215,15 @@ class Connection:
                 elif kind == rpc.FRAME_ROWS:
                     sid, n, cols, dropped = rpc.ROWS_HEADER.unpack_from(payload)
                     rows = np.frombuffer(payload, dtype="<f8", offset=rpc.ROWS_HEADER.size).reshape(n, cols)
-                    sub = self._subs.get(sid)
+                    with self._lock:
+                        sub = self._subs.get(sid)
+                        if sub is None and sid not in self._ended_subs:
+                            # Rows can overtake the subscriber's registration (the reply that
+                            # names it and the first rows may come in one burst): kept for it.
+                            early = self._early.setdefault(sid, collections.deque(maxlen=64))
+                            early.append((rows, dropped))
+                            while len(self._early) > 16:
+                                self._early.pop(next(iter(self._early)))
                     if sub is not None:
                         sub._feed(rows, dropped)
         except (OSError, ConnectionError, ValueError, struct_error) as e:
@@ -677,7 +687,10 @@ class RemotePoller:
         """Ends this subscription (the service stops its Poller when no subscriber is left)."""
         if self._ended and self.sub not in self._conn._subs:
             return
-        self._conn._subs.pop(self.sub, None)
+        with self._conn._lock:
+            self._conn._subs.pop(self.sub, None)
+            self._conn._ended_subs.add(self.sub)
+            self._conn._early.pop(self.sub, None)
         self._end()
         if not self._conn.closed and self._conn.lost is None:
             try:
@@ -833,7 +846,11 @@ class RemoteBench(Bench):
 
     def _subscribed(self, reply: Mapping[str, Any], capacity: Optional[int], keep: Optional[float]) -> RemotePoller:
         p = RemotePoller(self, reply, capacity=capacity, keep=keep)
-        self._conn._subs[p.sub] = p
+        conn = self._conn
+        with conn._lock:       # the early rows first, then the reader's (it needs this lock to find p)
+            for rows, dropped in conn._early.pop(p.sub, ()):
+                p._feed(rows, dropped)
+            conn._subs[p.sub] = p
         self._pollers.append(p)
         return p
 
