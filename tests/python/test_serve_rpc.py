@@ -555,6 +555,12 @@ def test_rows_that_overtake_a_subscription_are_kept_for_it(service, bench, monke
         first.stop()
 
 
+def test_a_local_poller_on_a_served_axis_says_where_to_poll(bench):
+    with pytest.raises(motorbus.InvalidArgument, match=r"served by motorbus serve: poll it through the service, "
+                                                        r"bench.poll\(\['z'\]"):
+        motorbus.Poller({"z": bench["z"]}, rate_hz=100)
+
+
 def test_a_slow_subscriber_loses_its_oldest_rows_counted():
     class Conn:
         class face:

@@ -515,6 +515,12 @@ class RemoteDrive(Drive):
     def _make_params(self) -> Params:
         return RemoteParams(self)
 
+    def poll_fields(self, fields: tuple) -> Any:
+        """A served axis is polled by its service, not by this process: ``motorbus.Poller`` on a
+        RemoteDrive says where to ask instead."""
+        raise _core.InvalidArgument(f"Poller: axis {self.name!r} is served by motorbus serve: poll it through "
+                                    f"the service, bench.poll([{self.name!r}], ...) (one shared Poller there)")
+
     # ---- safety: what this program commanded -----------------------------------------------
     def _halt(self, how: Any) -> None:
         """The with-block's and the exit hook's stop: only an axis this program moved (another
