@@ -397,6 +397,21 @@ def test_a_failed_move_together_says_every_axis(service, bench):
     f.enable()
 
 
+def test_the_plain_axis_calls_and_info(service, bench):
+    raw = rclient.Connection(service.path)
+    try:
+        local = service.bench["z"].sync
+        assert raw.call("units", "z") == motorbus.Units("mm", 0.01)
+        assert raw.call("kind", "z") == "cia402"
+        assert raw.call("capabilities", "z") == local.capabilities
+        assert raw.call("last_move", "z") == local.status.last_move
+        assert raw.call("info") == {"pid": os.getpid(), "bench": "/lab/test-bench.toml"}
+        hello = raw.call("hello")
+        assert hello["protocol"] == rpc.PROTOCOL and set(hello["axes"]) == {"x", "z", "f", "u"}
+    finally:
+        raw.close()
+
+
 def test_malformed_calls_are_typed_errors_and_counted(service, bench):
     before = bench.counters()
     raw = rclient.Connection(service.path)
