@@ -138,3 +138,21 @@ def test_03_streaming(kernel):
     assert number(out, r"SPEED_IST mean period ([\d.]+) ms") == pytest.approx(1.0, abs=0.1)
     assert number(out, r"SPEED_IST samples \d+, lost (\d+)") == 0
     assert number(out, r"SPEED_IST peak ([\d.]+) rpm") > 0
+
+
+def test_04_served_bench(kernel):
+    pytest.importorskip("caproto")
+    pytest.importorskip("epics")
+    out, _ = run("04_served_bench.ipynb", kernel)
+    assert "served axes: x, y, z, r, p, u" in out
+    for name in "xyzrpu":
+        assert f"position {name}: 5.00 mm" in out            # move_together through the service
+    assert "poll columns: ['x.position', 'z.position']" in out
+    assert number(out, r"poll samples: (\d+)") >= 5          # a 200 Hz poll over the move's ~0.1 s and more
+    assert "last x: 15.0" in out
+    assert "motorbus stop exit code: 0" in out
+    assert "the move here: MoveInterrupted short of 200: True" in out   # the stop from the other program
+    assert 5.0 < number(out, r"x.RBV over CA: ([\d.]+) mm") < 200.0   # where the stop left it, read over CA
+    assert "z moved by caput with completion: 1" in out
+    assert "z as this notebook sees it: 7.5" in out and "z DMOV: 1" in out
+    assert "service exit code: 0" in out
