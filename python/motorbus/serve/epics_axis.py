@@ -36,7 +36,7 @@ from caproto.server.records import MotorFields, register_record
 from caproto.server.server import PvpropertyDouble, PvpropertyDoubleRO
 
 from .. import _core
-from ..drive import Capability, LimitReached, MoveFailed, MoveFaulted, MoveInterrupted, MoveStalled, MoveTimedOut
+from ..drive import Capability, LimitReached, MoveFailed, MoveInterrupted, MoveStalled
 from .epics_kinds import KindMap, kind_map
 
 log = logging.getLogger("motorbus.serve.epics")
@@ -56,12 +56,12 @@ MSTA_MINUS_LS, MSTA_HOMED = 1 << 13, 1 << 14
 JOG_WAIT = 30 * 86400.0
 
 
-class PutRefused(_core.InvalidArgument):
+class PutRefused(_core.MotorbusError):
     """A put the record refuses or a move it reports as failed: caproto answers the
     client ECA_PUTFAIL with this message."""
 
 
-class SoftLimitViolation(PutRefused):
+class SoftLimitViolation(PutRefused, _core.InvalidArgument):
     """The target is outside the record's soft limits (LVIO=1, nothing moved)."""
 
 
@@ -203,8 +203,9 @@ class AxisRecord(PVGroup):
                 return await putter(instance, value)
             except SkipWrite:
                 raise
-            except PutRefused:
+            except Exception:
                 self.face.counters["failed_puts"] += 1
+                self._restore_alarms_later(instance)
                 raise
         return put
 
@@ -306,6 +307,7 @@ class AxisRecord(PVGroup):
         await self._read_once(post=True)
         await self._sync_targets()
         await f["UDF"].write(0, verify_value=False)
+        await self._alarm(AlarmStatus.NO_ALARM, AlarmSeverity.NO_ALARM)     # SEVR/STAT as enum strings
         self._readback = self._spawn(self._readback_loop(), "readback")
 
     async def shutdown(self) -> None:
@@ -494,16 +496,16 @@ class AxisRecord(PVGroup):
         await self.motor.alarm.write(status=status, severity=severity)
         await self.fields["RBV"].alarm.write(status=status, severity=severity)
 
-    def _restore_val_alarm_later(self) -> None:
-        """caproto sets VAL's alarm to WRITE/MAJOR after a failed put (gotcha 3): the
-        record's own alarm is put back once it has."""
+    def _restore_alarms_later(self, instance: Any) -> None:
+        """caproto sets the alarm of a field whose put failed to WRITE/MAJOR (gotcha 3) --
+        VAL's is the record's, every other field's is RBV's: the record's own alarm is put
+        back once caproto has written its own."""
         async def restore() -> None:
             for _ in range(50):
                 await asyncio.sleep(0.002)
-                if self.motor.alarm.status == AlarmStatus.WRITE:
+                if instance.alarm.status == AlarmStatus.WRITE:
                     break
-            status, severity = self.alarm_state
-            await self.motor.alarm.write(status=status, severity=severity)
+            await self._alarm(*self.alarm_state)
         self._spawn(restore(), "alarm")
 
     # ---- the motion episode ------------------------------------------------------------------
@@ -550,6 +552,8 @@ class AxisRecord(PVGroup):
                     if self.spmg == "Stop":
                         break
                     self.stop_requested = ""
+                    if self.want[0] == "move":   # to VAL as it is now (a put while paused moved it)
+                        self.want = ("move", self.dial(self.motor.value))
                     continue
                 break
         except asyncio.CancelledError:
@@ -609,11 +613,15 @@ class AxisRecord(PVGroup):
         await self._read_once(post=False)
         put_error: Optional[BaseException] = None
         interrupted = isinstance(error, MoveInterrupted) or (error is None and self.stop_requested)
-        if error is None or isinstance(error, MoveInterrupted):
-            if error is None and what != "jog" or what == "home":
-                self.problem = self.stalled = False
-                if self.alarm_state[1] != AlarmSeverity.NO_ALARM:
-                    await self._alarm(AlarmStatus.NO_ALARM, AlarmSeverity.NO_ALARM)
+        if error is None:
+            # A successful move clears what an earlier failure left (the record recomputes
+            # its alarm on every process, so it clears with its cause).
+            self.problem = self.stalled = False
+            if (self.alarm_state[1] != AlarmSeverity.NO_ALARM or self.motor.alarm.severity
+                    or self.fields["RBV"].alarm.severity):
+                await self._alarm(AlarmStatus.NO_ALARM, AlarmSeverity.NO_ALARM)
+        elif isinstance(error, MoveInterrupted):
+            pass                               # a stop: a normal end in the record's terms
         elif isinstance(error, LimitReached):
             self.face.counters["failed_moves"] += 1
             hlsv = self.fields["HLSV"].value
@@ -621,14 +629,14 @@ class AxisRecord(PVGroup):
                 side_high = (error.side > 0) == (self.scale > 0) == (self.dir > 0)
                 sev = AlarmSeverity(["NO_ALARM", "MINOR", "MAJOR", "INVALID"].index(hlsv))
                 await self._alarm(AlarmStatus.HIGH if side_high else AlarmStatus.LOW, sev)
-            put_error = MoveFailedPut(f"{self.axis}: {error}", error)
+            put_error = MoveFailedPut(str(error) if str(error).startswith(self.axis) else f"{self.axis}: {error}", error)
         else:
             self.face.counters["failed_moves"] += 1
             if isinstance(error, MoveStalled):
                 self.stalled = True
                 self.problem = True
                 await self._alarm(AlarmStatus.STATE, AlarmSeverity.MAJOR_ALARM)
-            elif isinstance(error, (MoveFaulted, MoveTimedOut)) or isinstance(error, MoveFailed):
+            elif isinstance(error, MoveFailed):      # MoveFaulted, MoveTimedOut, a kind's own
                 self.problem = True
                 await self._alarm(AlarmStatus.STATE, AlarmSeverity.MAJOR_ALARM)
             else:       # the link: LinkDown, a closed drive, a drive's refusal
@@ -636,7 +644,7 @@ class AxisRecord(PVGroup):
                 status = AlarmStatus.COMM if isinstance(error, (_core.LinkDown, _core.TimeoutError)) \
                     else AlarmStatus.STATE
                 await self._alarm(status, AlarmSeverity.MAJOR_ALARM)
-            put_error = MoveFailedPut(f"{self.axis}: {error}", error)
+            put_error = MoveFailedPut(str(error) if str(error).startswith(self.axis) else f"{self.axis}: {error}", error)
         await self._post_readback()
         if what != "move" or interrupted or put_error is not None:
             await self._sync_targets()       # VAL := RBV (STOP, homing, jog, a failed move)
@@ -662,7 +670,6 @@ class AxisRecord(PVGroup):
         try:
             await asyncio.shield(episode)
         except MoveFailedPut:
-            self._restore_val_alarm_later()
             raise
 
     async def stop_axis(self, by: str = "STOP") -> None:
@@ -690,8 +697,9 @@ class AxisRecord(PVGroup):
             await self._move_user(value)
         except SkipWrite:
             raise
-        except PutRefused:
+        except Exception:
             self.face.counters["failed_puts"] += 1
+            self._restore_alarms_later(instance)
             raise
         raise SkipWrite()
 
@@ -713,7 +721,6 @@ class AxisRecord(PVGroup):
             await self._set("LVIO", 1)
             await self._dmov(0)
             await self._dmov(1)
-            self._restore_val_alarm_later()
             llm, hlm = self.user_limits()
             raise SoftLimitViolation(f"{self.axis}: target {self.user(dial):g} is outside the soft limits "
                                      f"[{llm:g}, {hlm:g}] (LVIO): nothing moved")
@@ -873,10 +880,11 @@ class AxisRecord(PVGroup):
         strings = ("Pos", "Neg")
         new = -1 if _enum_index(value, strings) else 1
         if new != self.dir:
-            # The user position stays where it is: OFF absorbs the sign change (cc: DIR put).
-            user_rbv = self.user(self.drbv)
+            # motorRecord.cc's DIR special: FOFF=Variable keeps VAL (OFF absorbs the sign
+            # change), FOFF=Frozen keeps OFF (VAL and RBV change sign around it).
             self.dir = new
-            self.off = user_rbv - self.drbv * self.dir
+            if not self.foff:
+                self.off = self.motor.value - self.fields["DVAL"].value * self.dir
             self._persist(dir=self.dir, off=self.off)
             await self._set("OFF", self.off)
         await instance.write(strings[0 if new > 0 else 1], verify_value=False)
@@ -977,6 +985,10 @@ class AxisRecord(PVGroup):
         on = _enum_index(value, strings)
         try:
             if on:
+                # A latched fault keeps most drives from enabling: CNEN=Enable is the
+                # record's way to reset one (the motor record has no reset field).
+                if self.status is not None and self.status.fault:
+                    await self.drive.clear_faults()
                 await self.drive.enable()
             else:
                 await self.drive.disable()
