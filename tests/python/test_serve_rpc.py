@@ -654,14 +654,14 @@ def test_the_awaitable_face(service, bench):
             with pytest.raises(motorbus.MoveInterrupted):
                 await asyncio.gather(z.move_to(50.0, timeout=10), _stop_soon(z, service))
             # a poll, as chunks
-            poller = await ab.poll(["z"], ("position",), rate_hz=500)
             got = 0
-            async for chunk in poller.chunks(50):
-                got += len(chunk["t"])
-                if got >= 100:
-                    break
-            poller.stop()
-            assert got >= 100
+            async with await ab.poll(["z"], ("position",), rate_hz=500) as poller:
+                async for chunk in poller.chunks(50):
+                    assert len(chunk["t"]) >= 50
+                    got += len(chunk["t"])
+                    if got >= 100:
+                        break
+            assert got >= 100 and not poller.running
     asyncio.run(main())
     wait_for(lambda: service.run(_counter(service, "pollers")) == 0)
 

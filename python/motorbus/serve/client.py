@@ -689,22 +689,40 @@ class RemotePoller:
 
         Poller.save(self, path)   # it needs only frame()
 
-    def stop(self) -> None:
-        """Ends this subscription (the service stops its Poller when no subscriber is left)."""
+    def _detach(self) -> bool:
+        """Ends the subscription here; True when the service is still to be told."""
         if self._ended and self.sub not in self._conn._subs:
-            return
+            return False
         with self._conn._lock:
             self._conn._subs.pop(self.sub, None)
             self._conn._ended_subs.add(self.sub)
             self._conn._early.pop(self.sub, None)
         self._end()
-        if not self._conn.closed and self._conn.lost is None:
+        return not self._conn.closed and self._conn.lost is None
+
+    def stop(self) -> None:
+        """Ends this subscription (the service stops its Poller when no subscriber is left)."""
+        if self._detach():
             try:
                 self._conn.call("unpoll", None, self.sub)
             except (_core.LinkDown, _core.ClosedError):
                 pass
 
     close = stop
+
+    async def astop(self) -> None:
+        """``stop()``, awaited (the awaitable face: the loop does not wait on the service)."""
+        if self._detach():
+            try:
+                await self._conn.acall("unpoll", None, self.sub)
+            except (_core.LinkDown, _core.ClosedError):
+                pass
+
+    async def __aenter__(self) -> "RemotePoller":
+        return self
+
+    async def __aexit__(self, *exc: Any) -> None:
+        await self.astop()
 
     def __enter__(self) -> "RemotePoller":
         return self
