@@ -251,10 +251,8 @@ def service_address(args: argparse.Namespace) -> Optional[str]:
     server = getattr(args, "server", None)
     if server:
         return server
-    from .serve.lockfile import find_service
-
-    info = find_service(args.bench)
-    if info is None or (getattr(args, "sim", False) and not info.sim):
+    info = _service_of(args)
+    if info is None:
         return None
     if info.sim and not getattr(args, "sim", False):
         _err(f"motorbus: note: {args.bench} is served by motorbus serve --sim (pid {info.pid}): "
@@ -316,9 +314,12 @@ class _Narrowed:
     def __init__(self, bench: Any, axes: Optional[Sequence[str]]) -> None:
         self._bench = bench
         names = list(dict.fromkeys(axes)) if axes else list(bench.axes)
-        for n in names:
-            bench[n]                 # an axis the service lacks: the bench's own InvalidArgument
-        self.axes = {n: bench[n] for n in names}
+        try:
+            # An axis the service lacks: the bench's own InvalidArgument naming its axes.
+            self.axes = {n: bench[n] for n in names}
+        except BaseException:
+            bench.close()
+            raise
 
     def __getitem__(self, name: str) -> Any:
         return self._bench[name]
