@@ -86,7 +86,7 @@ def main() -> None:
                     mover.join()
                     rows = poller.frame()["z.position"]
                 print(f"z's move: {watched[0]}")
-                print(f"z at rest short of 300 mm: {not bench['z'].status.moving and bench['z'].position < 300}")
+                print(f"z at rest short of 900 mm: {not bench['z'].status.moving and bench['z'].position < 900}")
                 # (NaN: a missed deadline, or one before the first value arrived: docs/poller.md)
                 print(f"the watcher saw z pass 20 mm: {bool(np.nanmax(rows) > 20)}")
 
@@ -100,8 +100,8 @@ def main() -> None:
 
 def _long_move(z: "motorbus.Drive") -> str:
     try:
-        z.move_to(300.0)
-        return "reached 300 mm"
+        z.move_to(900.0)          # 4.5 s at 200 mm/s
+        return "reached 900 mm"
     except motorbus.MoveInterrupted as e:
         return f"interrupted ({type(e).__name__})"
 

@@ -145,7 +145,7 @@ def test_move_status_and_a_stop_from_another_program_through_the_service(twin, s
     assert json.loads(r.stdout)["position"] == pytest.approx(2.5, abs=0.02)
     # A long move, then `motorbus stop` from a third program: the mover's exit code is the
     # Drive API's "interrupted" (10), and the axis is at rest short of the target.
-    mover = subprocess.Popen([sys.executable, "-m", "motorbus", "move", twin.bench_file, "z", "300", "--json"],
+    mover = subprocess.Popen([sys.executable, "-m", "motorbus", "move", twin.bench_file, "z", "900", "--json"],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     with connect(twin.bench_file) as bench:
         deadline = time.monotonic() + 10
@@ -157,7 +157,7 @@ def test_move_status_and_a_stop_from_another_program_through_the_service(twin, s
         out, err = mover.communicate(timeout=20)
         assert mover.returncode == 10, err
         result = json.loads(out)
-        assert result["outcome"] == "interrupted" and 5 < result["position"] < 300
+        assert result["outcome"] == "interrupted" and 5 < result["position"] < 900
         assert not bench["z"].status.moving
     r = motorbus_cli("status", twin.bench_file, "--json")
     assert r.returncode == 0, r.stderr
@@ -334,7 +334,7 @@ def test_example_13_served_bench():
     assert r.returncode == 0, r.stderr
     assert r.stdout.splitlines() == [
         "found the service: True, simulated twin: True", "5 parameter(s) written", "x at 5.00 mm, z at 5.00 mm",
-        "z: stopped", "z's move: interrupted (MoveInterrupted)", "z at rest short of 300 mm: True",
+        "z: stopped", "z's move: interrupted (MoveInterrupted)", "z at rest short of 900 mm: True",
         "the watcher saw z pass 20 mm: True", "terminal: exit code 4 (True)", "service ended with exit code 0"]
 
 

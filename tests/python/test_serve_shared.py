@@ -123,7 +123,7 @@ def test_a_poll_five_monitors_a_mover_and_a_stopper_share_one_served_bench(tmp_p
 
             # The third program's stop: a long move of the CANopen axis, stopped by `motorbus stop`.
             z = bench["cia402"]
-            z.move_to(300.0, wait=False)
+            z.move_to(900.0, wait=False)   # 4.5 s: `motorbus stop` starts well within it
             deadline = time.monotonic() + 10
             while z.position < 5:
                 assert time.monotonic() < deadline, "the long move did not start"
@@ -135,7 +135,7 @@ def test_a_poll_five_monitors_a_mover_and_a_stopper_share_one_served_bench(tmp_p
                 z.wait_idle(timeout=10)
             at = z.position
             time.sleep(0.2)
-            assert not z.status.moving and z.position == at and 5 < at < 300
+            assert not z.status.moving and z.position == at and 5 < at < 900
         assert failures == []
 
         for m in monitors:
