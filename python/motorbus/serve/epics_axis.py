@@ -158,6 +158,7 @@ class AxisRecord(PVGroup):
         self.disabled = False
         # Readback state (dial units).
         self.drbv = 0.0
+        self.rest_drbv = 0.0            # where the axis last came to rest (uncommanded moves)
         self.native = 0.0
         self.moving = False
         self.tdir = 1
@@ -457,18 +458,27 @@ class AxisRecord(PVGroup):
         while True:
             busy = self.moving or (self.episode is not None and not self.episode.done())
             await asyncio.sleep(MOVING_PERIOD if busy else REST_PERIOD)
-            await self._read_once()
-            in_episode = self.episode is not None and not self.episode.done()
-            if not in_episode:
-                if self.moving and not self.external:
-                    # Motion commanded elsewhere (the RPC face, a stop input's ramp...): the
-                    # record shows it as moving.
-                    self.external = True
-                    await self._dmov(0)
-                elif self.external and not self.moving:
-                    self.external = False
-                    await self._sync_targets()
-                    await self._dmov(1)
+            try:
+                await self._read_once()
+                await self._uncommanded()
+            except Exception:  # noqa: BLE001 - the readback must go on whatever happened
+                log.exception("%s: readback", self.axis)
+
+    async def _uncommanded(self) -> None:
+        """Motion nobody commanded through this record (the service's other face, another
+        program, a stop input's ramp): MOVN=1/DMOV=0 while it lasts, VAL := RBV at rest."""
+        if self.episode is not None and not self.episode.done() or self.comm_error:
+            return
+        if self.moving and not self.external:
+            self.external = True
+            await self._dmov(0)
+        elif self.external and not self.moving:
+            self.external = False
+            await self._sync_targets()
+            await self._dmov(1)
+        elif not self.moving and abs(self.drbv - self.rest_drbv) > max(self.mres, self.fields["RDBD"].value):
+            # A move shorter than a readback period: never seen moving, but it moved.
+            await self._sync_targets()
 
     async def _dmov(self, value: int) -> None:
         await self._set("DMOV", value)
@@ -477,6 +487,7 @@ class AxisRecord(PVGroup):
 
     async def _sync_targets(self) -> None:
         """VAL := RBV, DVAL := DRBV, RVAL := RRBV (and the last-value fields)."""
+        self.rest_drbv = self.drbv
         await self._post_targets(self.drbv)
 
     async def _post_targets(self, dial: float) -> None:
@@ -531,12 +542,14 @@ class AxisRecord(PVGroup):
         return self.episode
 
     async def _run(self, episode: asyncio.Future) -> None:
-        error: Optional[BaseException] = None
+        """The episode: one command after another (a put while moving replaces the command
+        and stops the drive: the interrupted move is followed by the new one), until the
+        axis is at rest with nothing more asked; then the outcome (``_end``)."""
         try:
             while True:
                 gen = self.generation
                 what, arg = self.want
-                error = None
+                error: Optional[BaseException] = None
                 try:
                     await self._do(what, arg)
                 except Exception as e:  # noqa: BLE001 - every failure is the episode's outcome
@@ -545,27 +558,26 @@ class AxisRecord(PVGroup):
                         log.exception("%s: %s %r", self.axis, what, arg)
                 if self.generation != gen and not self.stop_requested:
                     continue                   # retargeted: on to the new target
-                if (self.spmg == "Pause" and isinstance(error, MoveInterrupted)
-                        and self.stop_requested == "SPMG"):
-                    self.resume.clear()
-                    await self.resume.wait()   # Go/Move: the move to VAL resumes
+                if isinstance(error, MoveInterrupted) and self.stop_requested == "SPMG" and self.spmg != "Stop":
+                    await self.resume.wait()   # paused: Go/Move resumes the move to VAL
                     if self.spmg == "Stop":
-                        break
-                    self.stop_requested = ""
-                    if self.want[0] == "move":   # to VAL as it is now (a put while paused moved it)
-                        self.want = ("move", self.dial(self.motor.value))
-                    continue
-                break
+                        pass                   # Stop while paused: the episode ends here
+                    else:
+                        self.stop_requested = ""
+                        if self.want[0] == "move":   # to VAL as it is now (a put while paused moved it)
+                            self.want = ("move", self.dial(self.motor.value))
+                        continue
+                if await self._end(episode, what, error, gen):
+                    return
+                # A put arrived while the episode was ending: it goes on.
         except asyncio.CancelledError:
             if not episode.done():
                 episode.set_exception(PutRefused(f"{self.axis}: the CA face closed during the move"))
             raise
-        try:
-            await self._end(episode, what, error)
-        finally:
+        except BaseException as e:
             if not episode.done():      # _end failed (a link lost while reading back): still an end
-                episode.set_exception(MoveFailedPut(f"{self.axis}: {error or 'the end of the move'}",
-                                                    error or PutRefused("no readback")))
+                episode.set_exception(MoveFailedPut(f"{self.axis}: the end of the move: {e}", e))
+            raise
 
     async def _do(self, what: str, arg: Any) -> None:
         d = self.drive
@@ -607,9 +619,10 @@ class AxisRecord(PVGroup):
             self.accel_applied = key
             log.warning("%s: ACCL %g s not applied: %s", self.axis, self.accl, e)
 
-    async def _end(self, episode: asyncio.Future, what: str, error: Optional[BaseException]) -> None:
+    async def _end(self, episode: asyncio.Future, what: str, error: Optional[BaseException], gen: int) -> bool:
         """At the final rest: readbacks, the outcome's alarm and fields, *then* DMOV=1,
-        then the pending puts complete."""
+        then the pending puts complete.  False (nothing resolved) when a new command
+        arrived meanwhile: the episode goes on."""
         await self._read_once(post=False)
         put_error: Optional[BaseException] = None
         interrupted = isinstance(error, MoveInterrupted) or (error is None and self.stop_requested)
@@ -646,6 +659,8 @@ class AxisRecord(PVGroup):
                 await self._alarm(status, AlarmSeverity.MAJOR_ALARM)
             put_error = MoveFailedPut(str(error) if str(error).startswith(self.axis) else f"{self.axis}: {error}", error)
         await self._post_readback()
+        if self.generation != gen:
+            return False
         if what != "move" or interrupted or put_error is not None:
             await self._sync_targets()       # VAL := RBV (STOP, homing, jog, a failed move)
         if what == "home":
@@ -654,15 +669,20 @@ class AxisRecord(PVGroup):
         if what == "jog":
             await self._set("JOGF", 0)
             await self._set("JOGR", 0)
+        if self.generation != gen:
+            return False
         if self.spmg == "Move":
             self.spmg = "Pause"
+            self.resume.clear()
             await self._set("SPMG", "Pause")
+        self.rest_drbv = self.drbv
         await self._dmov(1)
         if not episode.done():
             if put_error is None:
                 episode.set_result(None)
             else:
                 episode.set_exception(put_error)
+        return True
 
     async def _await_episode(self, episode: asyncio.Future) -> None:
         """A put waits for the episode's end; shielded: a put cancelled by caproto (its
@@ -724,6 +744,8 @@ class AxisRecord(PVGroup):
             llm, hlm = self.user_limits()
             raise SoftLimitViolation(f"{self.axis}: target {self.user(dial):g} is outside the soft limits "
                                      f"[{llm:g}, {hlm:g}] (LVIO): nothing moved")
+        # Reserved now: an episode ending meanwhile sees a command coming and goes on.
+        self.generation += 1
         await self._set("LVIO", 0)
         await self._post_targets(dial)
         if self.spmg == "Pause":
@@ -803,6 +825,7 @@ class AxisRecord(PVGroup):
         old, self.spmg = self.spmg, mode
         active = self.episode is not None and not self.episode.done()
         if mode in ("Stop", "Pause"):
+            self.resume.clear()
             if active or self.moving:
                 await self.stop_axis("SPMG")
             if mode == "Stop" and active:
