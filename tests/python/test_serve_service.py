@@ -167,7 +167,7 @@ def test_move_status_and_a_stop_from_another_program_through_the_service(twin, s
 
 
 def test_a_drive_fault_through_the_service_is_exit_code_12(twin, service):
-    mover = subprocess.Popen([sys.executable, "-m", "motorbus", "move", twin.bench_file, "z", "0"],
+    mover = subprocess.Popen([sys.executable, "-m", "motorbus", "move", twin.bench_file, "z", "800"],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     with connect(twin.bench_file) as bench:
         deadline = time.monotonic() + 10
