@@ -309,6 +309,13 @@ class UnknownParameter(_core.InvalidArgument, KeyError):
         return str(self.args[0]) if self.args else ""
 
 
+def stopped_by_text(by: str) -> str:
+    """The outcome's words for who stopped a move: a bare verb ("stop()") was this program's;
+    a stop that came from elsewhere names its origin itself ("stop() of the program with pid
+    42 through motorbus serve", "STOP of the EPICS record lab:x")."""
+    return by if " of " in by else f"{by} of this program"
+
+
 class _Move:
     """The move, jog or homing in progress: what was asked, in native units, and what
     must be put back when it ends (settings a ``velocity=`` changed for this move)."""
@@ -811,7 +818,7 @@ class Drive(abc.ABC):
             return
         if reason is None:
             if move.stopped_by is not None:
-                reason = StopReason(MoveInterrupted, f"{move.stopped_by} of this program")
+                reason = StopReason(MoveInterrupted, stopped_by_text(move.stopped_by))
             elif move.what == "home":
                 reason = StopReason(MoveInterrupted, "an end of the homing before the drive was homed (a stop "
                                                      "from another program or a stop input?)")

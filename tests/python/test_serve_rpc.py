@@ -279,6 +279,8 @@ def test_a_stop_from_another_connection_stops_a_move_this_one_awaits(service, be
         assert time.monotonic() - t_stop < 5.0
         e = result["error"]
         assert type(e) is motorbus.MoveInterrupted and e.axis == "z"
+        # whose stop it was: the outcome every program reads names the stopping program
+        assert f"stop() of the program with pid {os.getpid()} through motorbus serve" in e.reason, e.reason
         rest = service.shaft("z")
         assert 5.0 < rest < 400.0 and not service.bench["z"].sync.status.moving
         time.sleep(0.1)

@@ -40,7 +40,8 @@ from typing import Any, Optional, Union
 
 from .. import _core, _stop_at_exit, faces
 from ..bench import Bench as _SyncBench, StartReport
-from ..drive import Drive as _SyncDrive, DriveStatus, MoveInterrupted, MoveTimedOut, ParamInfo, StopReason, Units
+from ..drive import (Drive as _SyncDrive, DriveStatus, MoveInterrupted, MoveTimedOut, ParamInfo, StopReason, Units,
+                     stopped_by_text)
 from ..drive import open_drive as _open_drive
 from ..stopping import STOP_WAYS, StopHow, check_stop_way
 # The awaitable twins that live beside their blocking originals (docs/aio.md):
@@ -238,7 +239,7 @@ class Drive:
         if move is None or move.judged:
             return
         if move.what == "home":
-            await d._failure(move, StopReason(MoveInterrupted, f"{move.stopped_by} of this program"))
+            await d._failure(move, StopReason(MoveInterrupted, stopped_by_text(move.stopped_by)))
         else:
             await d._judge(move, raise_error=False)
 

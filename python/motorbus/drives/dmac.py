@@ -35,7 +35,7 @@ from .._core.dmac import (  # noqa: F401
     ramp_time as dmac_ramp_time, speed_profile as dmac_speed_profile,
 )
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFailed, MoveFaulted, MoveInterrupted,
-                     MoveTimedOut, ParamInfo, Params, StopReason)
+                     MoveTimedOut, ParamInfo, Params, StopReason, stopped_by_text)
 
 from .._core.dmac import (  # noqa: E402,F401
     Sim as DmacSim, SimState as DmacSimState, Radix as DmacRadix, ReadReply as DmacReadReply,
@@ -732,7 +732,7 @@ class DmacDrive(Drive):
         move = self._move
         if reason is None:
             by = move.stopped_by if move is not None else None
-            reason = StopReason(MoveInterrupted, f"{by} of this program" if by else
+            reason = StopReason(MoveInterrupted, stopped_by_text(by) if by else
                                 "a STOP or HALT from another client on the line")
         error = {LimitReached: HomingLimitReached, MoveFaulted: HomingFaulted}.get(reason.error, HomingInterrupted)
         text = f"{reason.text}, while waiting for {waiting_for}"

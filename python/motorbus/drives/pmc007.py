@@ -48,7 +48,7 @@ from .._core.pmc007 import (  # noqa: F401
     position_profile as pmc007_position_profile, speed_profile as pmc007_speed_profile,
 )
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, MoveStalled,
-                     ParamInfo, Params, StopReason, Units)
+                     ParamInfo, Params, StopReason, Units, stopped_by_text)
 
 __all__ = ["ControllerStatus", "ErrorStatus", "Pmc007", "Pmc007Drive", "make_sim", "OBJECTS",
            "EDS_PATH", "assemble", "disassemble", "BAUD_RATES", "GEAR_ACCELERATION", "STALL_EXAMPLES",
@@ -791,7 +791,7 @@ class Pmc007Drive(Drive):
             failure = self._stop_reason_of(err, ControllerStatus(st & ~self._homing), True)
         elif not st & ControllerStatus.BUSY:
             by = self._move.stopped_by if self._move is not None else None
-            failure = StopReason(MoveInterrupted, f"{by} of this program" if by else
+            failure = StopReason(MoveInterrupted, stopped_by_text(by) if by else
                                  f"a stop before the {_EXT_INPUTS[self._homing][0]} input fired (another "
                                  "program's stop?)")
         if failure is None:

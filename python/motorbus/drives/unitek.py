@@ -57,7 +57,7 @@ from ..stopping import check_stop_way
 # The drive's speed ramps (ACC 0x35 / DEC 0xED): the vendor's own module re-exports the model.
 from .._core.unitek import RampParams as UnitekRampParams, speed_profile as unitek_speed_profile  # noqa: F401
 from ..drive import (Capability, Drive, DriveStatus, LimitReached, MoveFaulted, MoveInterrupted, ParamInfo, Params,
-                     StopReason, Units)
+                     StopReason, Units, stopped_by_text)
 from ..registry import PollSpec
 
 __all__ = ["FrameError", "UnknownRegister", "CyclicLimit", "Reg", "Status", "ModeBit", "Unitek", "UnitekDrive", "UnitekSim", "Stream", "make_sim",
@@ -785,7 +785,7 @@ class UnitekDrive(Drive):
             reason = await self._stop_reason(await self._status())
             if reason is None:
                 by = self._move.stopped_by if self._move is not None else None
-                reason = StopReason(MoveInterrupted, f"{by} of this program" if by else
+                reason = StopReason(MoveInterrupted, stopped_by_text(by) if by else
                                     "a stop before the position 0 (a speed command 0 from another program)")
             raise reason.error(f"{self.name}: homing (a move to 0) stopped at {position:g} num by {reason.text}",
                                axis=self.name, position=self._units.to_user(position), reason=reason.text,

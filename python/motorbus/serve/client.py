@@ -43,6 +43,12 @@ __all__ = ["connect", "aio_connect", "RemoteBench", "RemoteDrive", "RemoteParams
            "AioRemoteBench", "resolve"]
 
 
+def _from_here(by: str) -> str:
+    """A stop sent to the service names this program, so the outcome the service records
+    (which every program waiting on the move reads) says whose stop it was."""
+    return f"{by} of the program with pid {os.getpid()} through motorbus serve" if " of " not in by else by
+
+
 def resolve(address: Any) -> tuple[str, Optional[Any]]:
     """The socket path of ``address`` ("unix:/path.sock", a socket path, or a bench file whose
     service runs) and the service's ServiceInfo when it was found through its bench file."""
@@ -417,11 +423,11 @@ class RemoteDrive(Drive):
 
     async def _co_stop(self, by: str = "stop()") -> None:
         self._check_open()
-        await self._rc("stop", **({} if by == "stop()" else {"by": by}))
+        await self._rc("stop", by=_from_here(by))
 
     async def _co_quick_stop(self, by: str = "quick_stop()") -> None:
         self._check_open()
-        await self._rc("quick_stop", **({} if by == "quick_stop()" else {"by": by}))
+        await self._rc("quick_stop", by=_from_here(by))
 
     async def _co_home(self, method: Any = None, *, wait: bool = True, timeout: Optional[float] = None) -> None:
         self._check_open()
