@@ -154,13 +154,11 @@ class CaFace:
 
     def client_env(self) -> dict[str, str]:
         """The environment a CA client on this host sets to find the service (and nothing else)."""
+        # Explicit even at the default port: a client's environment may say otherwise.
         addrs = _beacon_addresses(self.interfaces)
-        env = {"EPICS_CA_AUTO_ADDR_LIST": "NO",
-               "EPICS_CA_ADDR_LIST": " ".join(f"{a}:{self.port}" if self.port != DEFAULT_PORT else a
-                                              for a in addrs)}
-        if self.port != DEFAULT_PORT:
-            env["EPICS_CA_SERVER_PORT"] = str(self.port)
-        return env
+        return {"EPICS_CA_AUTO_ADDR_LIST": "NO",
+                "EPICS_CA_ADDR_LIST": " ".join(f"{a}:{self.port}" for a in addrs),
+                "EPICS_CA_SERVER_PORT": str(self.port)}
 
     async def stop_all(self) -> None:
         """``allstop``: every axis's STOP at once."""
