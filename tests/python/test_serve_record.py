@@ -155,6 +155,11 @@ async def test_every_axis_is_a_motor_record_with_the_clients_fields(face, bench)
         pos = await bench[axis].position()
         assert r.motor.value == pytest.approx(pos) and f["RBV"].value == pytest.approx(pos)
         assert int(f["MSTA"].value) & MSTA_DONE
+        if (await bench[axis].travel_limits()) == (-math.inf, math.inf):
+            # No travel limits: a 32-bit position register's range (pyepics tests targets against them).
+            reach = (2**31 - 1) * 0.01
+            assert (f["LLM"].value, f["HLM"].value) == (pytest.approx(-reach), pytest.approx(reach))
+            assert (r.motor.lower_ctrl_limit, r.motor.upper_ctrl_limit) == (f["LLM"].value, f["HLM"].value)
 
 
 async def test_axis_names_that_clash_are_refused():

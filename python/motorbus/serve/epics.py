@@ -22,6 +22,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import os
+import time
 from collections.abc import Sequence
 from typing import Any, Optional
 
@@ -53,6 +54,8 @@ LATENCY_SETTINGS = {
     "CAPROTO_SERVER_WRITE_LOCK_TIMEOUT_SEC": ("WRITE_LOCK_TIMEOUT", 0.0),
 }
 DEFAULT_PORT = 5064
+#: The longest a put's completion waits for the monitor updates before it (``flush_monitors``).
+FLUSH_LIMIT = 0.02
 
 
 def _beacon_addresses(interfaces: Sequence[str]) -> list[str]:
@@ -92,6 +95,12 @@ class _QuietRefusals(logging.Filter):
 
     def filter(self, record: logging.LogRecord) -> bool:
         exc = record.exc_info[1] if record.exc_info else None
+        if isinstance(exc, OSError) and isinstance(exc.__cause__, ConnectionRefusedError) \
+                and str(record.msg).startswith("Failed to send beacon"):
+            # No CA repeater listens on this host (none is needed to be found): the kernel
+            # answers each beacon with "port unreachable", and caproto would log a traceback
+            # every beacon period.
+            return False
         if isinstance(exc, PutRefused):
             record.exc_info = None
             record.exc_text = None
@@ -102,6 +111,8 @@ class _QuietRefusals(logging.Filter):
 
 
 _QUIET = _QuietRefusals()
+#: caproto's loggers of failed puts (circuits) and of beacons (the context).
+_QUIETENED = ("caproto.circ", "caproto.ctx")
 
 
 class BenchRecords(PVGroup):
@@ -164,6 +175,25 @@ class CaFace:
         """``allstop``: every axis's STOP at once."""
         await asyncio.gather(*(r.stop_axis("allstop") for r in self.records.values()), return_exceptions=True)
 
+    async def flush_monitors(self) -> None:
+        """Waits (at most ``FLUSH_LIMIT`` s) until the monitor updates posted so far have
+        left for the clients: a put's completion must not overtake them, or a client that
+        reads after the put (pyepics: LVIO, RBV, ``get_position()``) reads the old values.
+        caproto sends a put's answer directly but batches monitor updates (gotcha 5)."""
+        ctx = self.context
+        if ctx is None:
+            return
+        import caproto.server.common as common
+
+        deadline = time.monotonic() + FLUSH_LIMIT
+        await asyncio.sleep(0)
+        while time.monotonic() < deadline:
+            if ctx.subscription_queue.empty() and all(c.subscription_queue.empty() for c in list(ctx.circuits)):
+                break
+            await asyncio.sleep(0.0002)
+        # The circuit's loop sends once its queue stays empty for HIGH_LOAD_TIMEOUT.
+        await asyncio.sleep(common.HIGH_LOAD_TIMEOUT + 0.0003)
+
     async def _dmov_changed(self) -> None:
         if self.bench_records is not None:
             await self.bench_records.refresh()
@@ -181,7 +211,8 @@ class CaFace:
                 await self._server
             except (asyncio.CancelledError, Exception):  # noqa: BLE001 - closing anyway
                 pass
-        logging.getLogger("caproto.circ").removeFilter(_QUIET)
+        for name in _QUIETENED:
+            logging.getLogger(name).removeFilter(_QUIET)
 
 
 async def build_face(bench: Any, *, prefix: str, interfaces: Sequence[str] = ("127.0.0.1",),
@@ -221,7 +252,8 @@ async def start_ca(bench: Any, *, prefix: str, interfaces: Sequence[str] = ("127
 
     interfaces = list(interfaces) or ["127.0.0.1"]
     set_server_environment(interfaces, port)
-    logging.getLogger("caproto.circ").addFilter(_QUIET)
+    for name in _QUIETENED:
+        logging.getLogger(name).addFilter(_QUIET)
     face = await build_face(bench, prefix=prefix, interfaces=interfaces, port=port, calibration_path=calibration_path)
     try:
         ctx = Context(face.pvdb, interfaces=interfaces)

@@ -52,6 +52,8 @@ MSTA_DIRECTION, MSTA_DONE, MSTA_PLUS_LS, MSTA_HOMELS = 1 << 0, 1 << 1, 1 << 2, 1
 MSTA_POSITION, MSTA_SLIP_STALL, MSTA_HOME, MSTA_PRESENT = 1 << 5, 1 << 6, 1 << 7, 1 << 8
 MSTA_PROBLEM, MSTA_MOVING, MSTA_GAIN_SUPPORT, MSTA_COMM_ERR = 1 << 9, 1 << 10, 1 << 11, 1 << 12
 MSTA_MINUS_LS, MSTA_HOMED = 1 << 13, 1 << 14
+#: The soft limits of a drive with no travel limit: a 32-bit position register's range (native units).
+POSITION_REGISTER = 2**31 - 1
 #: A jog runs until JOGF/JOGR=0 (or a stop): its wait for rest has no useful timeout.
 JOG_WAIT = 30 * 86400.0
 
@@ -208,6 +210,8 @@ class AxisRecord(PVGroup):
                 self.face.counters["failed_puts"] += 1
                 self._restore_alarms_later(instance)
                 raise
+            finally:
+                await self.face.flush_monitors()
         return put
 
     async def _set(self, name: str, value: Any, **metadata: Any) -> None:
@@ -249,8 +253,12 @@ class AxisRecord(PVGroup):
             log.info("%s: travel limits unread (%s): none assumed", self.axis, e)
         lo, hi = self.travel
         dllm, dhlm = self._saved_limits
-        self.dllm = float(dllm) if dllm is not None else (lo if math.isfinite(lo) else 0.0)
-        self.dhlm = float(dhlm) if dhlm is not None else (hi if math.isfinite(hi) else 0.0)
+        # Where the drive has no travel limit, the range of a 32-bit position register: a
+        # real bound, and clients that test targets against HLM/LLM (pyepics' Motor refuses
+        # every target but 0 when both are 0) move out of the box.
+        reach = abs(d.units.to_user(float(POSITION_REGISTER)))
+        self.dllm = float(dllm) if dllm is not None else (lo if math.isfinite(lo) else -reach)
+        self.dhlm = float(dhlm) if dhlm is not None else (hi if math.isfinite(hi) else reach)
         self._clamp_limits()
         speed, vmax = await self.kmap.speeds(d)
         if self.velo is None:
@@ -324,16 +332,15 @@ class AxisRecord(PVGroup):
 
     # ---- limits --------------------------------------------------------------------------------
     def _clamp_limits(self) -> None:
-        """DHLM/DLLM inside the drive's travel limits (a side the drive does not limit is free)."""
+        """DHLM/DLLM inside the drive's travel limits (a side the drive does not limit is
+        free; DHLM = DLLM = 0, the record's "no soft limits", stays so)."""
         lo, hi = self.travel
-        if self.dhlm == 0.0 and self.dllm == 0.0 and not (math.isfinite(lo) or math.isfinite(hi)):
+        if self.dhlm == 0.0 and self.dllm == 0.0:
             return
         if math.isfinite(hi):
-            self.dhlm = min(self.dhlm, hi) if self.dhlm or self.dllm else hi
-            self.dllm = min(self.dllm, hi)
+            self.dhlm, self.dllm = min(self.dhlm, hi), min(self.dllm, hi)
         if math.isfinite(lo):
-            self.dllm = max(self.dllm, lo) if self.dhlm or self.dllm else lo
-            self.dhlm = max(self.dhlm, lo)
+            self.dllm, self.dhlm = max(self.dllm, lo), max(self.dhlm, lo)
 
     def user_limits(self) -> tuple[float, float]:
         """(LLM, HLM) from (DLLM, DHLM): DIR=Neg swaps them."""
@@ -721,6 +728,8 @@ class AxisRecord(PVGroup):
             self.face.counters["failed_puts"] += 1
             self._restore_alarms_later(instance)
             raise
+        finally:
+            await self.face.flush_monitors()
         raise SkipWrite()
 
     async def _move_user(self, value: float) -> None:
