@@ -27,7 +27,7 @@ from motorbus import _core, aio, registry  # noqa: E402
 from motorbus.drive import LimitReached, MoveFaulted  # noqa: E402
 from motorbus.pytest_plugin import default_bench  # noqa: E402
 from motorbus.serve import calibration, epics  # noqa: E402
-from motorbus.serve.epics_axis import (MSTA_COMM_ERR, MSTA_DONE, MSTA_HOMED, MSTA_PLUS_LS, MSTA_PROBLEM,  # noqa: E402
+from motorbus.serve.epics_axis import (PUT_NOTIFY, MSTA_COMM_ERR, MSTA_DONE, MSTA_HOMED, MSTA_PLUS_LS, MSTA_PROBLEM,  # noqa: E402
                                        MoveFailedPut, PutRefused, SoftLimitViolation, check_axis_name)
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
@@ -150,6 +150,7 @@ async def test_every_axis_is_a_motor_record_with_the_clients_fields(face, bench)
         assert tuple(r.able.enum_strings) == ("Enable", "Disable") and r.able.value == "Enable"
         assert f["LVIO"].value == 0 and f["DMOV"].value == 1 and f["MOVN"].value == 0
         assert f["EGU"].value == "mm" and f["MRES"].value == pytest.approx(0.01) and f["PREC"].value == 2
+        await f["DESC"].read(ChannelType.STRING)          # what a client reads: the getter runs
         assert f["DESC"].value.startswith(bench[axis].kind + " ")
         assert f["VELO"].value > 0 and f["SREV"].value == 200 and f["UREV"].value == pytest.approx(2.0)
         pos = await bench[axis].position()
@@ -230,6 +231,17 @@ async def test_a_target_outside_the_soft_limits_sets_lvio_and_fails_the_put(face
     assert r.motor.value == pytest.approx(1.0) and f["DVAL"].value == pytest.approx(1.0)
     assert await bench["unitek"].position() == pytest.approx(1.0)
     await until(lambda: r.motor.alarm.severity == AlarmSeverity.NO_ALARM, what="VAL's alarm put back")
+    # A plain put (no put-callback: ophyd's move) is not answered with an error, as an IOC
+    # would not: LVIO says it.
+    await f["LVIO"].write(0, verify_value=False)
+
+    async def plain_put() -> None:
+        PUT_NOTIFY.set(False)
+        await r.motor.write(9.0)
+
+    await asyncio.create_task(plain_put())
+    assert f["LVIO"].value == 1 and r.motor.value == pytest.approx(1.0)
+    assert r.motor.alarm.severity == AlarmSeverity.NO_ALARM
     await r.motor.write(-2.0)
     assert f["LVIO"].value == 0 and await bench["unitek"].position() == pytest.approx(-2.0)
     await f["HLM"].write(0.0)

@@ -38,7 +38,7 @@ from caproto import ChannelType
 from caproto.server import PVGroup, pvproperty
 
 from .calibration import CalibrationStore
-from .epics_axis import RESERVED, AxisRecord, PutRefused, check_axis_name
+from .epics_axis import PUT_NOTIFY, RESERVED, AxisRecord, PutRefused, check_axis_name
 
 __all__ = ["start_ca", "CaFace", "set_server_environment", "BenchRecords", "AxisRecord", "PutRefused",
            "LATENCY_SETTINGS"]
@@ -215,6 +215,30 @@ class CaFace:
             logging.getLogger(name).removeFilter(_QUIET)
 
 
+def _context_class() -> Any:
+    """caproto's asyncio server whose circuits tell each write task whether its client waits
+    for the put's completion (``PUT_NOTIFY``): a plain put of a target the record refuses is
+    not answered with an error, as a real IOC would not."""
+    from caproto import WriteNotifyRequest, WriteRequest
+    from caproto.asyncio.server import Context, VirtualCircuit
+
+    class Circuit(VirtualCircuit):
+        async def _process_command(self, command: Any) -> Any:
+            if not isinstance(command, (WriteRequest, WriteNotifyRequest)):
+                return await super()._process_command(command)
+            # The write task is created inside: it inherits this context.
+            token = PUT_NOTIFY.set(isinstance(command, WriteNotifyRequest))
+            try:
+                return await super()._process_command(command)
+            finally:
+                PUT_NOTIFY.reset(token)
+
+    class MotorbusContext(Context):
+        CircuitClass = Circuit
+
+    return MotorbusContext
+
+
 async def build_face(bench: Any, *, prefix: str, interfaces: Sequence[str] = ("127.0.0.1",),
                      port: Optional[int] = None, calibration_path: Optional[str] = None) -> CaFace:
     """The records of every axis, started (readbacks running), without a CA server: what
@@ -248,15 +272,13 @@ async def start_ca(bench: Any, *, prefix: str, interfaces: Sequence[str] = ("127
     ``interfaces`` (loopback by default), UDP search port ``port`` (None:
     ``EPICS_CA_SERVER_PORT`` or 5064); the calibration is read from and kept in
     ``calibration_path``.  Returns once the server listens."""
-    from caproto.asyncio.server import Context
-
     interfaces = list(interfaces) or ["127.0.0.1"]
     set_server_environment(interfaces, port)
     for name in _QUIETENED:
         logging.getLogger(name).addFilter(_QUIET)
     face = await build_face(bench, prefix=prefix, interfaces=interfaces, port=port, calibration_path=calibration_path)
     try:
-        ctx = Context(face.pvdb, interfaces=interfaces)
+        ctx = _context_class()(face.pvdb, interfaces=interfaces)
         ctx.ca_server_port = face.port
         face.context = ctx
         face._server = asyncio.create_task(ctx.run(), name="motorbus-ca-server")

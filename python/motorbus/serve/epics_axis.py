@@ -26,6 +26,7 @@ is its own task, and puts only await it (shielded).
 from __future__ import annotations
 
 import asyncio
+import contextvars
 import logging
 import math
 from typing import Any, Optional
@@ -73,6 +74,19 @@ class MoveFailedPut(PutRefused):
     def __init__(self, message: str, error: BaseException) -> None:
         super().__init__(message)
         self.error = error
+
+
+#: Whether the put being served is a put-callback (WriteNotify: True) or a plain put
+#: (False); None outside a CA circuit (a test awaiting a putter). Set by the CA face's
+#: circuit for each write task.
+PUT_NOTIFY: contextvars.ContextVar = contextvars.ContextVar("motorbus_ca_put_notify", default=None)
+
+
+def _told_by_alarm_only(error: BaseException) -> bool:
+    """A refused target or a failed move answered to a *plain* put: nobody waits for that
+    put, a real record completes it, and libca would print a warning block for an error
+    answer; the record's fields (LVIO, HLS/LLS, the alarm) say what happened."""
+    return isinstance(error, (SoftLimitViolation, MoveFailedPut)) and PUT_NOTIFY.get() is False
 
 
 def check_axis_name(name: str, names: Any = ()) -> None:
@@ -206,8 +220,10 @@ class AxisRecord(PVGroup):
                 return await putter(instance, value)
             except SkipWrite:
                 raise
-            except Exception:
+            except Exception as e:
                 self.face.counters["failed_puts"] += 1
+                if _told_by_alarm_only(e):
+                    raise SkipWrite() from None
                 self._restore_alarms_later(instance)
                 raise
             finally:
@@ -285,7 +301,9 @@ class AxisRecord(PVGroup):
             f[name]._data["units"] = "sec"
         f["UREV"]._data["units"] = f"{egu}/rev"
         await f["EGU"].write(egu, verify_value=False)
-        await f["DESC"].write(f"{d.kind} {self.address}"[:40], verify_value=False)
+        # DESC reads the VAL channel's doc (caproto links them).
+        self.motor.__doc__ = f"{d.kind} {self.address}"[:40]
+        await f["DESC"].write(self.motor.__doc__, verify_value=False)
         await f["MRES"].write(self.mres, verify_value=False)
         await f["ERES"].write(self.mres, verify_value=False)
         await f["RRES"].write(1.0, verify_value=False)
@@ -724,8 +742,10 @@ class AxisRecord(PVGroup):
             await self._move_user(value)
         except SkipWrite:
             raise
-        except Exception:
+        except Exception as e:
             self.face.counters["failed_puts"] += 1
+            if _told_by_alarm_only(e):
+                raise SkipWrite() from None
             self._restore_alarms_later(instance)
             raise
         finally:
