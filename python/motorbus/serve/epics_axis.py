@@ -420,6 +420,12 @@ class AxisRecord(PVGroup):
         if post:
             await self._post_readback()
 
+    def _at_rest(self, pos: float) -> None:
+        native = self.drive.units.to_native(pos)
+        if native != self.native:
+            self.tdir = int(native > self.native)
+        self.drbv, self.native, self.moving = pos, native, False
+
     def _switches(self) -> tuple[int, int]:
         """(RHLS, RLLS): the dial-sense switches (the drive's native + is dial + unless the
         bench's units scale is negative)."""
@@ -648,7 +654,13 @@ class AxisRecord(PVGroup):
         """At the final rest: readbacks, the outcome's alarm and fields, *then* DMOV=1,
         then the pending puts complete.  False (nothing resolved) when a new command
         arrived meanwhile: the episode goes on."""
-        await self._read_once(post=False)
+        last = getattr(self.drive.sync, "_last_move", None)
+        if error is None and what == "move" and last is not None and last.ok and last.position is not None:
+            # The Drive judged the move at rest there a moment ago: no exchange before DMOV=1
+            # (the readback task refreshes the status within its period).
+            self._at_rest(last.position)
+        else:
+            await self._read_once(post=False)
         put_error: Optional[BaseException] = None
         interrupted = isinstance(error, MoveInterrupted) or (error is None and self.stop_requested)
         if error is None:
