@@ -185,6 +185,17 @@ async def test_a_put_completes_at_rest_on_target(face, bench, watch):
     assert f["MOVN"].value == 0 and f["DMOV"].value == 1 and f["TDIR"].value == 1
 
 
+async def test_one_dmov_pulse_per_move_and_none_after(face, bench, watch):
+    """Back-to-back moves: exactly one 1->0->1 per put and nothing after the last (a stray
+    pulse would end the next ophyd MoveStatus early)."""
+    r, w = face.records["unitek"], watch("unitek")
+    for i in range(8):
+        await r.motor.write(0.5 * (i % 2))
+        await asyncio.sleep(0.03)
+    await asyncio.sleep(0.25)
+    assert w.values == [0, 1] * 8
+
+
 async def test_a_zero_length_move_pulses_dmov(face, bench, watch):
     for axis in ("cia402", "unitek"):
         r, w = face.records[axis], watch(axis)

@@ -203,14 +203,14 @@ class CaFace:
         if self._closed:
             return
         self._closed = True
-        for r in self.records.values():
-            await r.shutdown()
-        if self._server is not None:
+        if self._server is not None:          # first: no put starts while the records close
             self._server.cancel()
             try:
                 await self._server
             except (asyncio.CancelledError, Exception):  # noqa: BLE001 - closing anyway
                 pass
+        for r in self.records.values():
+            await r.shutdown()
         for name in _QUIETENED:
             logging.getLogger(name).removeFilter(_QUIET)
 

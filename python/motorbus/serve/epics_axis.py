@@ -192,6 +192,7 @@ class AxisRecord(PVGroup):
         self.stop_requested = ""
         self.resume = asyncio.Event()
         self.external = False           # motion nobody commanded through this record
+        self._seq = 0                   # bumped at each episode's end (stale readbacks)
         self.accel_applied: Optional[tuple] = None
         self._readback: Optional[asyncio.Task] = None
         self._tasks: set = set()
@@ -398,9 +399,14 @@ class AxisRecord(PVGroup):
     # ---- readback ------------------------------------------------------------------------------
     async def _read_once(self, post: bool = True) -> None:
         d = self.drive
+        seq = self._seq
         try:
             pos = await d.position()
             st = await d.status()
+            if seq != self._seq:
+                # The episode ended while this read was on its way: its "moving" is older
+                # than the rest the episode saw (it would start a spurious DMOV pulse).
+                return
         except Exception as e:  # noqa: BLE001 - a link problem shows as COMM_ERR, the loop goes on
             self.face.counters["readback_errors"] += 1
             if not self.comm_error:
@@ -654,6 +660,7 @@ class AxisRecord(PVGroup):
         """At the final rest: readbacks, the outcome's alarm and fields, *then* DMOV=1,
         then the pending puts complete.  False (nothing resolved) when a new command
         arrived meanwhile: the episode goes on."""
+        self._seq += 1                   # readbacks already on their way are older than this rest
         last = getattr(self.drive.sync, "_last_move", None)
         if error is None and what == "move" and last is not None and last.ok and last.position is not None:
             # The Drive judged the move at rest there a moment ago: no exchange before DMOV=1
