@@ -22,122 +22,35 @@ The record's semantics are motorRecord.cc's, over the awaitable Drive API:
 
 A put task cancelled by caproto (its client left) leaves the motion alone: the episode
 is its own task, and puts only await it (shielded).
+
+The calibration and settings fields are ``epics_settings.SettingsFields`` (a mixin of
+``AxisRecord``); the caproto types, refusals and constants are in ``epics_types``.
 """
 from __future__ import annotations
 
 import asyncio
-import contextvars
 import logging
 import math
 from typing import Any, Optional
 
 from caproto import AlarmSeverity, AlarmStatus, ChannelType, SkipWrite
 from caproto.server import PVGroup, pvproperty
-from caproto.server.records import MotorFields, register_record
-from caproto.server.server import PvpropertyDouble, PvpropertyDoubleRO
 
 from .. import _core
 from ..drive import Capability, LimitReached, MoveFailed, MoveInterrupted, MoveStalled
 from .epics_kinds import KindMap, kind_map
+from .epics_settings import SettingsFields
+from .epics_types import (JOG_WAIT, MOVING_PERIOD, MSTA_COMM_ERR, MSTA_DIRECTION, MSTA_DONE,  # noqa: F401
+                          MSTA_HOMED, MSTA_MINUS_LS, MSTA_MOVING, MSTA_PLUS_LS, MSTA_POSITION, MSTA_PRESENT,
+                          MSTA_PROBLEM, MSTA_SLIP_STALL, POSITION_REGISTER, PUT_NOTIFY, RESERVED, REST_PERIOD,
+                          MotorbusMotorFields, MotorVal, MoveFailedPut, PutRefused, SoftLimitViolation,
+                          _enum_index, _finite, _told_by_alarm_only, check_axis_name)
 
 log = logging.getLogger("motorbus.serve.epics")
 
-#: PV names of the bench-wide records: no axis may take them.
-RESERVED = ("allstop", "alldone", "moving")
-
-#: Readback periods (s): at rest, and while a move is in flight.
-REST_PERIOD = 0.1
-MOVING_PERIOD = 0.02
-#: MSTA bits (motorRecord.html, "MSTA": bit = item - 1).
-MSTA_DIRECTION, MSTA_DONE, MSTA_PLUS_LS, MSTA_HOMELS = 1 << 0, 1 << 1, 1 << 2, 1 << 3
-MSTA_POSITION, MSTA_SLIP_STALL, MSTA_HOME, MSTA_PRESENT = 1 << 5, 1 << 6, 1 << 7, 1 << 8
-MSTA_PROBLEM, MSTA_MOVING, MSTA_GAIN_SUPPORT, MSTA_COMM_ERR = 1 << 9, 1 << 10, 1 << 11, 1 << 12
-MSTA_MINUS_LS, MSTA_HOMED = 1 << 13, 1 << 14
-#: The soft limits of a drive with no travel limit: a 32-bit position register's range (native units).
-POSITION_REGISTER = 2**31 - 1
-#: A jog runs until JOGF/JOGR=0 (or a stop): its wait for rest has no useful timeout.
-JOG_WAIT = 30 * 86400.0
-
-
-class PutRefused(_core.MotorbusError):
-    """A put the record refuses or a move it reports as failed: caproto answers the
-    client ECA_PUTFAIL with this message."""
-
-
-class SoftLimitViolation(PutRefused, _core.InvalidArgument):
-    """The target is outside the record's soft limits (LVIO=1, nothing moved)."""
-
-
-class MoveFailedPut(PutRefused):
-    """The move ended in a failure (``error``: the Drive API's MoveFailed or drive error)."""
-
-    def __init__(self, message: str, error: BaseException) -> None:
-        super().__init__(message)
-        self.error = error
-
-
-#: Whether the put being served is a put-callback (WriteNotify: True) or a plain put
-#: (False); None outside a CA circuit (a test awaiting a putter). Set by the CA face's
-#: circuit for each write task.
-PUT_NOTIFY: contextvars.ContextVar = contextvars.ContextVar("motorbus_ca_put_notify", default=None)
-
-
-def _told_by_alarm_only(error: BaseException) -> bool:
-    """A refused target or a failed move answered to a *plain* put: nobody waits for that
-    put, a real record completes it, and libca would print a warning block for an error
-    answer; the record's fields (LVIO, HLS/LLS, the alarm) say what happened."""
-    return isinstance(error, (SoftLimitViolation, MoveFailedPut)) and PUT_NOTIFY.get() is False
-
-
-def check_axis_name(name: str, names: Any = ()) -> None:
-    """An axis name usable as a PV name: no clash with the bench-wide records or another
-    axis's ``_able``, and only characters a record name may hold."""
-    if name in RESERVED:
-        raise _core.InvalidArgument(f"CA face: axis {name!r} clashes with the bench-wide record "
-                                    f"<prefix>{name} ({', '.join(RESERVED)} are taken)")
-    if name.endswith("_able") and name[:-len("_able")] in names:
-        raise _core.InvalidArgument(f"CA face: axis {name!r} clashes with the _able record of axis "
-                                    f"{name[:-len('_able')]!r}")
-    if not name or any(not (c.isalnum() or c in "_-:;<>[]") for c in name):
-        raise _core.InvalidArgument(f"CA face: axis {name!r}: a record name holds letters, digits and _-:;<>[] only")
-
-
-# ---- the record's caproto types ---------------------------------------------------------
-@register_record
-class MotorbusMotorFields(MotorFields):
-    """caproto's motor fields with what the real record sends: RTYP stays "motor" (pyepics
-    refuses anything else), MSTA is a ULONG in the record, which CA sends as DOUBLE."""
-
-    _record_type = "motor"
-    motor_status = pvproperty(name="MSTA", dtype=PvpropertyDoubleRO, read_only=True, doc="Motor Status")
-
-
-class MotorVal(PvpropertyDouble):
-    """VAL: HLM/LLM are its control limits (as in the record), but caproto would refuse an
-    out-of-limit put before the putter runs (gotcha 1): the putter is the judge (LVIO)."""
-
-    async def verify_value(self, value: Any) -> Any:
-        if self.putter is not None:
-            return await self.putter(self, value)
-        return value
-
-
-def _finite(value: Any, what: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise PutRefused(f"{what}: a finite number, not {value!r}")
-    return float(value)
-
-
-def _enum_index(value: Any, strings: tuple) -> int:
-    if isinstance(value, str):
-        if value in strings:
-            return strings.index(value)
-        raise PutRefused(f"one of {', '.join(strings)}, not {value!r}")
-    return int(value)
-
 
 # ---- one axis -----------------------------------------------------------------------------
-class AxisRecord(PVGroup):
+class AxisRecord(SettingsFields, PVGroup):
     """``<prefix><axis>`` (motor) and ``<prefix><axis>_able`` (bo) over one ``aio.Drive``."""
 
     motor = pvproperty(name="", value=0.0, dtype=MotorVal, record="motor", precision=3, doc="motorbus axis")
@@ -348,53 +261,6 @@ class AxisRecord(PVGroup):
                 pass
         if self.episode is not None and not self.episode.done():
             self.episode.set_exception(PutRefused(f"{self.axis}: the CA face closed"))
-
-    # ---- limits --------------------------------------------------------------------------------
-    def _clamp_limits(self) -> None:
-        """DHLM/DLLM inside the drive's travel limits (a side the drive does not limit is
-        free; DHLM = DLLM = 0, the record's "no soft limits", stays so)."""
-        lo, hi = self.travel
-        if self.dhlm == 0.0 and self.dllm == 0.0:
-            return
-        if math.isfinite(hi):
-            self.dhlm, self.dllm = min(self.dhlm, hi), min(self.dllm, hi)
-        if math.isfinite(lo):
-            self.dllm, self.dhlm = max(self.dllm, lo), max(self.dhlm, lo)
-
-    def user_limits(self) -> tuple[float, float]:
-        """(LLM, HLM) from (DLLM, DHLM): DIR=Neg swaps them."""
-        a, b = self.user(self.dllm), self.user(self.dhlm)
-        return (min(a, b), max(a, b))
-
-    async def _post_limits(self) -> None:
-        llm, hlm = self.user_limits()
-        f = self.fields
-        await self._set("DHLM", self.dhlm)
-        await self._set("DLLM", self.dllm)
-        await self._set("HLM", hlm)
-        await self._set("LLM", llm)
-        md = dict(upper_ctrl_limit=hlm, lower_ctrl_limit=llm, upper_disp_limit=hlm, lower_disp_limit=llm)
-        await self.motor.write_metadata(**md)
-        await f["RBV"].write_metadata(**md)
-        dmd = dict(upper_ctrl_limit=self.dhlm, lower_ctrl_limit=self.dllm, upper_disp_limit=self.dhlm,
-                   lower_disp_limit=self.dllm)
-        await f["DVAL"].write_metadata(**dmd)
-        await f["DRBV"].write_metadata(**dmd)
-        await self._set("HOPR", hlm)
-        await self._set("LOPR", llm)
-
-    def violates(self, dial: float) -> bool:
-        """The record's soft-limit test (cc 2396-2445): none when DHLM == DLLM == 0; always
-        when DLLM > DHLM; otherwise a target outside, unless it moves back toward the range."""
-        if self.dhlm == 0.0 and self.dllm == 0.0:
-            return False
-        if self.dllm > self.dhlm:
-            return True
-        if dial > self.dhlm:
-            return not (self.drbv > self.dhlm and dial < self.drbv)
-        if dial < self.dllm:
-            return not (self.drbv < self.dllm and dial > self.drbv)
-        return False
 
     # ---- readback ------------------------------------------------------------------------------
     async def _read_once(self, post: bool = True) -> None:
@@ -801,23 +667,6 @@ class AxisRecord(PVGroup):
         episode = await self.command("move", dial)
         await self._await_episode(episode)
 
-    async def _calibrate(self, value: float) -> None:
-        """SET mode: the VAL put changes the calibration, nothing moves (a DMOV pulse)."""
-        await self._dmov(0)
-        try:
-            if self.foff:
-                raise PutRefused(f"{self.axis}: SET with FOFF=Frozen would load the drive's position register, "
-                                 "which motorbus does not do: set FOFF=Variable (the offset absorbs it)")
-            await self._read_once(post=False)
-            self.off = value - self.drbv * self.dir
-            self._persist(off=self.off)
-            await self._set("OFF", self.off)
-            await self._post_limits()
-            await self._post_targets(self.drbv)
-            await self._post_readback()
-        finally:
-            await self._dmov(1)
-
     async def _put_dval(self, instance: Any, value: Any) -> Any:
         dial = _finite(value, f"{self.axis}.DVAL")
         if self.set_mode:
@@ -836,12 +685,9 @@ class AxisRecord(PVGroup):
     async def _put_rlv(self, instance: Any, value: Any) -> Any:
         rel = _finite(value, f"{self.axis}.RLV")
         await instance.write(rel, verify_value=False)
-        await self._move_user_or_set(self.motor.value + rel)
+        await self._move_user(self.motor.value + rel)
         await instance.write(0.0, verify_value=False)
         raise SkipWrite()
-
-    async def _move_user_or_set(self, value: float) -> None:
-        await self._move_user(value)
 
     async def _tweak(self, instance: Any, value: Any, sign: int) -> Any:
         if not value:
@@ -933,158 +779,6 @@ class AxisRecord(PVGroup):
 
     async def _put_jogr(self, instance: Any, value: Any) -> Any:
         return await self._jog(instance, value, -1)
-
-    # ---- calibration and settings ---------------------------------------------------------------
-    async def _recalibrated(self) -> None:
-        await self._post_limits()
-        await self._post_targets(self.fields["DVAL"].value)
-        await self._post_readback()
-
-    async def _put_off(self, instance: Any, value: Any) -> Any:
-        self.off = _finite(value, f"{self.axis}.OFF")
-        self._persist(off=self.off)
-        await instance.write(self.off, verify_value=False)
-        await self._recalibrated()
-        raise SkipWrite()
-
-    async def _put_dir(self, instance: Any, value: Any) -> Any:
-        strings = ("Pos", "Neg")
-        new = -1 if _enum_index(value, strings) else 1
-        if new != self.dir:
-            # motorRecord.cc's DIR special: FOFF=Variable keeps VAL (OFF absorbs the sign
-            # change), FOFF=Frozen keeps OFF (VAL and RBV change sign around it).
-            self.dir = new
-            if not self.foff:
-                self.off = self.motor.value - self.fields["DVAL"].value * self.dir
-            self._persist(dir=self.dir, off=self.off)
-            await self._set("OFF", self.off)
-        await instance.write(strings[0 if new > 0 else 1], verify_value=False)
-        await self._recalibrated()
-        raise SkipWrite()
-
-    async def _put_foff(self, instance: Any, value: Any) -> Any:
-        strings = ("Variable", "Frozen")
-        self.foff = _enum_index(value, strings)
-        self._persist(foff=self.foff)
-        return strings[self.foff]
-
-    async def _put_set(self, instance: Any, value: Any) -> Any:
-        strings = ("Use", "Set")
-        self.set_mode = bool(_enum_index(value, strings))
-        return strings[int(self.set_mode)]
-
-    async def _put_sset(self, instance: Any, value: Any) -> Any:
-        if value:
-            self.set_mode = True
-            await self._set("SET", "Set")
-        return 0
-
-    async def _put_suse(self, instance: Any, value: Any) -> Any:
-        if value:
-            self.set_mode = False
-            await self._set("SET", "Use")
-        return 0
-
-    async def _user_limit(self, value: Any, high: bool) -> None:
-        v = self.dial(_finite(value, f"{self.axis}.{'HLM' if high else 'LLM'}"))
-        if high == (self.dir > 0):
-            self.dhlm = v
-        else:
-            self.dllm = v
-        await self._limits_changed()
-
-    async def _limits_changed(self) -> None:
-        self._clamp_limits()
-        self._persist(dhlm=self.dhlm, dllm=self.dllm)
-        await self._post_limits()
-        # VAL outside the new limits sets LVIO (the record's check on a limit change).
-        await self._set("LVIO", int(self.violates(self.dial(self.motor.value))))
-
-    async def _put_hlm(self, instance: Any, value: Any) -> Any:
-        await self._user_limit(value, True)
-        raise SkipWrite()
-
-    async def _put_llm(self, instance: Any, value: Any) -> Any:
-        await self._user_limit(value, False)
-        raise SkipWrite()
-
-    async def _put_dhlm(self, instance: Any, value: Any) -> Any:
-        self.dhlm = _finite(value, f"{self.axis}.DHLM")
-        await self._limits_changed()
-        raise SkipWrite()
-
-    async def _put_dllm(self, instance: Any, value: Any) -> Any:
-        self.dllm = _finite(value, f"{self.axis}.DLLM")
-        await self._limits_changed()
-        raise SkipWrite()
-
-    async def _put_velo(self, instance: Any, value: Any) -> Any:
-        v = _finite(value, f"{self.axis}.VELO")
-        if v <= 0:
-            raise PutRefused(f"{self.axis}.VELO: a speed > 0 {self.drive.units.name}/s, not {v!r}")
-        if self.vmax and v > self.vmax:
-            v = self.vmax                # the record clamps VELO to [VBAS, VMAX]
-        self.velo, self.velo_explicit = v, True
-        self._persist(velo=v)
-        await self._set("S", v / (self.mres * 200))
-        return v
-
-    async def _put_s(self, instance: Any, value: Any) -> Any:
-        s = _finite(value, f"{self.axis}.S")
-        await self._put_velo(self.fields["VELO"], s * self.mres * 200)
-        await self._set("VELO", self.velo)
-        return self.velo / (self.mres * 200)
-
-    async def _put_accl(self, instance: Any, value: Any) -> Any:
-        a = _finite(value, f"{self.axis}.ACCL")
-        if a <= 0:
-            raise PutRefused(f"{self.axis}.ACCL: seconds to VELO > 0, not {a!r}")
-        self.accl, self.accl_explicit = a, True
-        self._persist(accl=a)
-        return a
-
-    async def _put_jvel(self, instance: Any, value: Any) -> Any:
-        v = _finite(value, f"{self.axis}.JVEL")
-        if v <= 0:
-            raise PutRefused(f"{self.axis}.JVEL: a speed > 0, not {v!r}")
-        self.jvel = v
-        self._persist(jvel=v)
-        return v
-
-    async def _put_cnen(self, instance: Any, value: Any) -> Any:
-        strings = ("Disable", "Enable")
-        on = _enum_index(value, strings)
-        try:
-            if on:
-                # A latched fault keeps most drives from enabling: CNEN=Enable is the
-                # record's way to reset one (the motor record has no reset field).
-                if self.status is not None and self.status.fault:
-                    await self.drive.clear_faults()
-                await self.drive.enable()
-            else:
-                await self.drive.disable()
-        except (_core.MotorbusError, OSError) as e:
-            raise PutRefused(f"{self.axis}: CNEN={strings[on]}: {e}") from None
-        return strings[on]
-
-    async def _put_sync(self, instance: Any, value: Any) -> Any:
-        if value:
-            await self._read_once()
-            await self._sync_targets()
-        return 0
-
-    async def _put_disp(self, instance: Any, value: Any) -> Any:
-        self.disabled = bool(value)
-        await self._set_able("Disable" if self.disabled else "Enable")
-        return value
-
-    async def _set_able(self, text: str) -> None:
-        if self.able.value != text:
-            await self.able.write(text, verify_value=False)
-
-    async def _read_only(self, instance: Any, value: Any) -> Any:
-        name = instance.pvspec.name
-        raise PutRefused(f"{self.axis}.{name}: set by the bench file (units, kind) and the drive, not over CA")
 
     @able.putter
     async def able(self, instance: Any, value: Any) -> Any:
