@@ -46,12 +46,15 @@ __all__ = ["start_ca", "CaFace", "set_server_environment", "BenchRecords", "Axis
 log = logging.getLogger(__name__)
 
 #: caproto's subscription batching (research brief, gotcha 5): by default an update waits up
-#: to 10 ms for company and a busy circuit up to 1 s; a put-callback move keeps a write in
-#: flight for its whole length, and every read on that circuit would wait 1 ms for it.
+#: to 10 ms for company and a busy circuit up to 1 s.  The write lock: a read or subscribe
+#: on a circuit waits up to this long for the write in flight, so that a read after a
+#: plain put sees it (as an IOC, which processes a put before the next request); a
+#: put-callback move releases the lock at once (``_context_class``), a plain put's putter
+#: returns once the move is started.
 LATENCY_SETTINGS = {
     "CAPROTO_SERVER_HIGH_LOAD_TIMEOUT_SEC": ("HIGH_LOAD_TIMEOUT", 0.0005),
     "CAPROTO_SERVER_MAX_LATENCY_SEC": ("MAX_LATENCY", 0.005),
-    "CAPROTO_SERVER_WRITE_LOCK_TIMEOUT_SEC": ("WRITE_LOCK_TIMEOUT", 0.0),
+    "CAPROTO_SERVER_WRITE_LOCK_TIMEOUT_SEC": ("WRITE_LOCK_TIMEOUT", 0.003),
 }
 DEFAULT_PORT = 5064
 #: The longest a put's completion waits for the monitor updates before it (``flush_monitors``).
@@ -227,11 +230,16 @@ def _context_class() -> Any:
             if not isinstance(command, (WriteRequest, WriteNotifyRequest)):
                 return await super()._process_command(command)
             # The write task is created inside: it inherits this context.
-            token = PUT_NOTIFY.set(isinstance(command, WriteNotifyRequest))
+            notify = isinstance(command, WriteNotifyRequest)
+            token = PUT_NOTIFY.set(notify)
             try:
                 return await super()._process_command(command)
             finally:
                 PUT_NOTIFY.reset(token)
+                if notify:
+                    # Its client waits for the completion before it reads; other reads on
+                    # the circuit (monitors' gets in other threads) need not wait for a move.
+                    self.write_event.set()
 
     class MotorbusContext(Context):
         CircuitClass = Circuit

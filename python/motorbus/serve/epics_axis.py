@@ -131,17 +131,20 @@ class AxisRecord(SettingsFields, PVGroup):
             try:
                 if self.disabled and name != "DISP":
                     raise PutRefused(f"{self.axis}: the record is disabled ({self.able.pvname} = Disable)")
-                return await putter(instance, value)
+                stored = await putter(instance, value)
+                # Committed here rather than by caproto after the putter returns, so that
+                # its monitor update is on its way before the put's completion.
+                await instance.write(value if stored is None else stored, verify_value=False)
             except SkipWrite:
-                raise
+                pass
             except Exception as e:
                 self.face.counters["failed_puts"] += 1
-                if _told_by_alarm_only(e):
-                    raise SkipWrite() from None
-                self._restore_alarms_later(instance)
-                raise
+                if not _told_by_alarm_only(e):
+                    self._restore_alarms_later(instance)
+                    raise
             finally:
                 await self.face.flush_monitors()
+            raise SkipWrite()
         return put
 
     async def _set(self, name: str, value: Any, **metadata: Any) -> None:
@@ -596,11 +599,12 @@ class AxisRecord(SettingsFields, PVGroup):
 
     async def _await_episode(self, episode: asyncio.Future) -> None:
         """A put waits for the episode's end; shielded: a put cancelled by caproto (its
-        client gone) leaves the motion alone, as a real IOC does."""
-        try:
-            await asyncio.shield(episode)
-        except MoveFailedPut:
-            raise
+        client gone) leaves the motion alone, as a real IOC does.  A plain put (no
+        put-callback) does not wait: nobody waits for its answer, and a write in flight
+        would hold back every read on its circuit (caproto's write lock)."""
+        if PUT_NOTIFY.get() is False:
+            return
+        await asyncio.shield(episode)
 
     async def stop_axis(self, by: str = "STOP") -> None:
         """STOP / allstop / SPMG Stop|Pause: the drive's stop at once; the episode ends at
@@ -750,10 +754,7 @@ class AxisRecord(SettingsFields, PVGroup):
         await instance.write(1, verify_value=False)
         episode = await self.command("home", forward)
         await self._set("LVIO", 0)
-        try:
-            await self._await_episode(episode)
-        finally:
-            await instance.write(0, verify_value=False)
+        await self._await_episode(episode)     # the episode's end reads HOMF/HOMR 0
         raise SkipWrite()
 
     async def _put_homf(self, instance: Any, value: Any) -> Any:
