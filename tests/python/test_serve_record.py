@@ -260,6 +260,22 @@ async def test_a_target_outside_the_soft_limits_sets_lvio_and_fails_the_put(face
     assert face.counters["failed_puts"] >= 1
 
 
+async def test_a_plain_put_returns_once_the_move_is_started(face, bench):
+    """ophyd's move and `caput` without -c: nobody waits for the answer, and a write in
+    flight would hold back every read on the client's circuit."""
+    r, f = face.records["cia402"], face.records["cia402"].fields
+    await r.motor.write(0.0)
+
+    async def plain_put() -> None:
+        PUT_NOTIFY.set(False)
+        await r.motor.write(6.0)
+
+    await asyncio.wait_for(asyncio.create_task(plain_put()), 1.0)
+    assert f["DMOV"].value == 0 and r.motor.value == 6.0
+    await until(lambda: f["DMOV"].value == 1, timeout=10, what="rest")
+    assert await bench["cia402"].position() == pytest.approx(6.0)
+
+
 async def test_stop_resets_and_sets_val_to_rbv(face, bench):
     r, f = face.records["cia402"], face.records["cia402"].fields
     task = asyncio.create_task(r.motor.write(60.0))
@@ -524,6 +540,10 @@ def _port() -> int:
     return 20000 + 16 * index + 7
 
 
+#: The caproto settings exported before this module ran (a user's own value is kept).
+ca_user_env = {k for k in os.environ if k.startswith("CAPROTO_SERVER_")}
+
+
 async def test_served_over_ca_on_loopback_without_broadcast_beacons(bench):
     from caproto import _utils
 
@@ -536,6 +556,11 @@ async def test_served_over_ca_on_loopback_without_broadcast_beacons(bench):
                        "EPICS_CA_SERVER_PORT": str(port)}
         beacons = _utils.get_beacon_address_list()
         assert beacons and all(host == "127.0.0.1" for host, _ in beacons)
+        import caproto.server.common as common
+        for env, (name, default) in epics.LATENCY_SETTINGS.items():   # the exported value, else ours
+            assert getattr(common, name) == float(os.environ[env])
+        assert common.MAX_LATENCY <= 0.005 or "CAPROTO_SERVER_MAX_LATENCY_SEC" in ca_user_env
+        assert os.environ["EPICS_CAS_INTF_ADDR_LIST"] == "127.0.0.1"
 
         def client() -> tuple:
             from caproto.sync.client import read, write
