@@ -557,8 +557,8 @@ async def test_served_over_ca_on_loopback_without_broadcast_beacons(bench):
         beacons = _utils.get_beacon_address_list()
         assert beacons and all(host == "127.0.0.1" for host, _ in beacons)
         import caproto.server.common as common
-        for env, (name, default) in epics.LATENCY_SETTINGS.items():   # the exported value, else ours
-            assert getattr(common, name) == float(os.environ[env])
+        for variable, (name, _default) in epics.LATENCY_SETTINGS.items():   # the exported value, else ours
+            assert getattr(common, name) == float(os.environ[variable])
         assert common.MAX_LATENCY <= 0.005 or "CAPROTO_SERVER_MAX_LATENCY_SEC" in ca_user_env
         assert os.environ["EPICS_CAS_INTF_ADDR_LIST"] == "127.0.0.1"
 
