@@ -3,14 +3,12 @@
 libca (pyepics, aioca, hence ophyd and ophyd-async) reads the EPICS environment once per
 process, when its first context is made, so :func:`configure` runs at conftest import,
 before any test module imports a client.  Every pytest-xdist worker gets its own CA port
-(``20000 + 16 * worker``, the team's rule): caproto binds the UDP search port with
+(``20000 + 16 * worker``, the team's rule; the next free pair above it when another
+pytest session on this machine holds it): caproto binds the UDP search port with
 SO_REUSEPORT, and two servers on one port would share unicast searches by a hash of the
 client address, sending a client to the wrong server for good.  Nothing leaves loopback:
 no automatic address list, beacons to 127.0.0.1 only (caproto's default is
-255.255.255.255, LAN broadcast).
-
-``MOTORBUS_TEST_CA_PORT_BASE`` moves the whole range (two pytest runs on one machine,
-outside xdist, would otherwise both be worker 0).
+255.255.255.255, LAN broadcast).  ``MOTORBUS_TEST_CA_PORT_BASE`` moves the whole range.
 """
 from __future__ import annotations
 
@@ -30,8 +28,37 @@ def worker_index() -> int:
     return int(worker[2:]) if worker.startswith("gw") and worker[2:].isdigit() else 0
 
 
+#: Offsets in the worker's range this helper may take (server port, repeater port = +1);
+#: 7 and up are left to modules that pick their own (tests/python/test_serve_*.py).
+OFFSETS = (0, 2, 4)
+_chosen: Optional[int] = None
+
+
+def _free(port: int) -> bool:
+    """Nobody holds the UDP port (caproto's search socket, a repeater) or the TCP port.
+    The probe binds without SO_REUSEADDR/SO_REUSEPORT, so a server holding the port with
+    them still makes it fail."""
+    for kind in (socket.SOCK_DGRAM, socket.SOCK_STREAM):
+        s = socket.socket(socket.AF_INET, kind)
+        try:
+            s.bind(("127.0.0.1", port))
+        except OSError:
+            return False
+        finally:
+            s.close()
+    return True
+
+
 def server_port() -> int:
-    return int(os.environ.get("MOTORBUS_TEST_CA_PORT_BASE", "20000")) + PORTS_PER_WORKER * worker_index()
+    """This process's CA server port: the first free pair of the worker's range
+    (``20000 + 16 * worker + offset``), chosen once.  Two pytest sessions on one machine
+    (both worker 0) then do not share a port; sharing one would split the searches between
+    their servers by the kernel's SO_REUSEPORT hash."""
+    global _chosen
+    if _chosen is None:
+        base = int(os.environ.get("MOTORBUS_TEST_CA_PORT_BASE", "20000")) + PORTS_PER_WORKER * worker_index()
+        _chosen = next((base + k for k in OFFSETS if _free(base + k) and _free(base + k + 1)), base)
+    return _chosen
 
 
 def repeater_port() -> int:
@@ -45,7 +72,7 @@ def environment() -> dict[str, str]:
         "EPICS_CA_SERVER_PORT": port,            # caproto's server binds TCP and UDP search here
         "EPICS_CA_REPEATER_PORT": repeater,
         "EPICS_CA_AUTO_ADDR_LIST": "NO",
-        "EPICS_CA_ADDR_LIST": "127.0.0.1",
+        "EPICS_CA_ADDR_LIST": f"127.0.0.1:{port}",   # the port named: libca and caproto honour host:port
         "EPICS_CAS_INTF_ADDR_LIST": "127.0.0.1",
         "EPICS_CAS_AUTO_BEACON_ADDR_LIST": "NO",
         "EPICS_CAS_BEACON_ADDR_LIST": "127.0.0.1",
@@ -57,7 +84,10 @@ def environment() -> dict[str, str]:
 
 def configure() -> None:
     """Sets this worker's CA environment in os.environ (forced: a developer's facility
-    EPICS_CA_ADDR_LIST must not send test searches off this machine)."""
+    EPICS_CA_ADDR_LIST must not send test searches off this machine).  Called at conftest
+    import and again by each module's server fixture: a CA server started by an earlier
+    module of the worker (``start_ca`` sets ``EPICS_CA_SERVER_PORT`` to its own port) must
+    not leave its port to the clients of the next."""
     os.environ.update(environment())
 
 
