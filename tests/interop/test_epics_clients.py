@@ -551,6 +551,18 @@ def test_pyepics_motor_move_wait_limits_set_position_able(twin, pyepics_motor):
     finally:
         m.put("LLM", llm, wait=True)
         m.put("HLM", hlm, wait=True)
+    # Disabled through the _able record: a move is refused, nothing moves; enabled again, it moves.
+    stands = at_rest(twin, axis)
+    assert epics.caput(pv(axis) + "_able", "Disable", wait=True) == 1
+    try:
+        assert epics.caget(pv(axis) + "_able", use_monitor=False) == 1
+        m.move(stands + 1.0, wait=True, timeout=10)
+        time.sleep(0.1)
+        assert at_rest(twin, axis) == pytest.approx(stands, abs=tolerance(axis))
+    finally:
+        epics.caput(pv(axis) + "_able", "Enable", wait=True)
+    assert m.move(stands + 1.0, wait=True, timeout=30) == 0
+    assert at_rest(twin, axis) == pytest.approx(stands + 1.0, abs=tolerance(axis))
     stands = at_rest(twin, axis)
     off = m.get("OFF")
     m.set_position(50.0)
