@@ -585,6 +585,19 @@ async def test_served_over_ca_on_loopback_without_broadcast_beacons(bench):
         await served.close()
 
 
+async def test_a_second_server_on_the_same_udp_port_is_warned_about(bench, caplog):
+    port = _port() + 1
+    first = await epics.start_ca(bench, prefix="W1:", port=port)
+    try:
+        assert "shared_udp_port" not in first.counters
+        second = await epics.start_ca(bench, prefix="W2:", port=port)
+        await second.close()
+        assert second.counters["shared_udp_port"] == 1
+        assert f"UDP port {port} on 127.0.0.1 is already taken" in caplog.text
+    finally:
+        await first.close()
+
+
 async def test_a_slow_or_silent_drive_does_not_freeze_another_axis(face, bench):
     """Last (it spoils the twin): the pmc007's bus delays every frame by 0.2 s (each of its
     SDO exchanges takes that long) and the arcus line goes silent; the cia402 record moves

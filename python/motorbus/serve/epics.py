@@ -218,6 +218,26 @@ class CaFace:
             logging.getLogger(name).removeFilter(_QUIET)
 
 
+def _udp_port_shared(interfaces: Sequence[str], port: int) -> list[str]:
+    """The interfaces whose UDP ``port`` another socket already holds (another CA server on
+    this host: caproto would bind beside it with SO_REUSEPORT, and the kernel would then
+    hand each client's searches to one of the two servers only -- gotcha 7)."""
+    import errno
+    import socket
+
+    taken = []
+    for iface in interfaces:
+        probe = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            probe.bind((iface, port))
+        except OSError as e:
+            if e.errno == errno.EADDRINUSE:
+                taken.append(iface)
+        finally:
+            probe.close()
+    return taken
+
+
 def _context_class() -> Any:
     """caproto's asyncio server whose circuits tell each write task whether its client waits
     for the put's completion (``PUT_NOTIFY``): a plain put of a target the record refuses is
@@ -285,6 +305,12 @@ async def start_ca(bench: Any, *, prefix: str, interfaces: Sequence[str] = ("127
     for name in _QUIETENED:
         logging.getLogger(name).addFilter(_QUIET)
     face = await build_face(bench, prefix=prefix, interfaces=interfaces, port=port, calibration_path=calibration_path)
+    shared = _udp_port_shared(interfaces, face.port)
+    if shared:
+        log.warning("UDP port %d on %s is already taken by another CA server on this host: a client's searches "
+                    "may reach only one of the two (give this service its own port: --ca-port)", face.port,
+                    ", ".join(shared))
+        face.counters["shared_udp_port"] = 1
     try:
         ctx = _context_class()(face.pvdb, interfaces=interfaces)
         ctx.ca_server_port = face.port
