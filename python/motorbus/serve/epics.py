@@ -282,9 +282,14 @@ async def build_face(bench: Any, *, prefix: str, interfaces: Sequence[str] = ("1
     try:
         for name in names:
             record = AxisRecord(prefix=f"{prefix}{name}", axis=name, drive=bench[name], face=face)
-            await record.start()
             face.records[name] = record
             face.pvdb.update(record.pvdb)
+        # Every axis reads its drive at once: the links work in parallel (a bench of 64 axes
+        # on a few lines starts in the time of its busiest line, not of all its exchanges).
+        started = await asyncio.gather(*(r.start() for r in face.records.values()), return_exceptions=True)
+        for outcome in started:
+            if isinstance(outcome, BaseException):
+                raise outcome
         face.bench_records = BenchRecords(prefix=prefix, face=face)
         face.pvdb.update(face.bench_records.pvdb)
         await face.bench_records.refresh()
