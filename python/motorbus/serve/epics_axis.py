@@ -43,6 +43,7 @@ from .epics_settings import SettingsFields
 from .epics_types import (JOG_WAIT, MOVING_PERIOD, MSTA_COMM_ERR, MSTA_DIRECTION, MSTA_DONE,  # noqa: F401
                           MSTA_HOMED, MSTA_MINUS_LS, MSTA_MOVING, MSTA_PLUS_LS, MSTA_POSITION, MSTA_PRESENT,
                           MSTA_PROBLEM, MSTA_SLIP_STALL, POSITION_REGISTER, PUT_NOTIFY, RESERVED, REST_PERIOD,
+                          STATUS_EVERY,
                           MotorbusMotorFields, MotorVal, MoveFailedPut, PutRefused, SoftLimitViolation,
                           _enum_index, _finite, _told_by_alarm_only, check_axis_name)
 
@@ -266,12 +267,17 @@ class AxisRecord(SettingsFields, PVGroup):
             self.episode.set_exception(PutRefused(f"{self.axis}: the CA face closed"))
 
     # ---- readback ------------------------------------------------------------------------------
-    async def _read_once(self, post: bool = True) -> None:
+    async def _read_once(self, post: bool = True, full: bool = True) -> None:
+        """Position and status from the drive (``full=False``: the status only when the
+        position moved, or when the last one is too old)."""
         d = self.drive
         seq = self._seq
         try:
             pos = await d.position()
-            st = await d.status()
+            if full or pos != self.drbv or self.status is None:
+                st = await d.status()
+            else:
+                st = self.status
             if seq != self._seq:
                 # The episode ended while this read was on its way: its "moving" is older
                 # than the rest the episode saw (it would start a spurious DMOV pulse).
@@ -361,11 +367,16 @@ class AxisRecord(SettingsFields, PVGroup):
         await self._set("RBV", rbv)
 
     async def _readback_loop(self) -> None:
+        n = 0
         while True:
             busy = self.moving or (self.episode is not None and not self.episode.done())
             await asyncio.sleep(MOVING_PERIOD if busy else REST_PERIOD)
+            n += 1
             try:
-                await self._read_once()
+                # At rest the status (several exchanges on most kinds) is read every
+                # STATUS_EVERY periods, or at once when the position changed: a bench of
+                # many axes on one line leaves room for the commands.
+                await self._read_once(full=busy or n % STATUS_EVERY == 0)
                 await self._uncommanded()
             except Exception:  # noqa: BLE001 - the readback must go on whatever happened
                 log.exception("%s: readback", self.axis)

@@ -21,6 +21,8 @@ RESERVED = ("allstop", "alldone", "moving")
 #: Readback periods (s): at rest, and while a move is in flight.
 REST_PERIOD = 0.1
 MOVING_PERIOD = 0.02
+#: At rest, the status is read every this many periods (and whenever the position moved).
+STATUS_EVERY = 3
 #: MSTA bits (motorRecord.html, "MSTA": bit = item - 1).
 MSTA_DIRECTION, MSTA_DONE, MSTA_PLUS_LS, MSTA_HOMELS = 1 << 0, 1 << 1, 1 << 2, 1 << 3
 MSTA_POSITION, MSTA_SLIP_STALL, MSTA_HOME, MSTA_PRESENT = 1 << 5, 1 << 6, 1 << 7, 1 << 8
