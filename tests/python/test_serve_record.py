@@ -9,6 +9,7 @@ DMOV transitions were posted in which order, what the alarm was when DMOV=1 went
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import json
 import math
 import os
@@ -194,6 +195,15 @@ async def test_one_dmov_pulse_per_move_and_none_after(face, bench, watch):
         await asyncio.sleep(0.03)
     await asyncio.sleep(0.25)
     assert w.values == [0, 1] * 8
+    # A status kept from mid-move (the readback reads it only every third period at rest)
+    # must not make the axis look moving again (cia402: its position stands still at rest).
+    c, wc = face.records["cia402"], watch("cia402")
+    await c.motor.write(c.motor.value + 0.5)
+    await asyncio.sleep(0.05)
+    for _ in range(20):               # kept whatever the readback's phase
+        c.status = dataclasses.replace(c.status, moving=True)
+        await asyncio.sleep(0.02)
+    assert wc.values == [0, 1] and c.fields["MOVN"].value == 0
 
 
 async def test_a_zero_length_move_pulses_dmov(face, bench, watch):

@@ -274,10 +274,8 @@ class AxisRecord(SettingsFields, PVGroup):
         seq = self._seq
         try:
             pos = await d.position()
-            if full or pos != self.drbv or self.status is None:
-                st = await d.status()
-            else:
-                st = self.status
+            fresh = full or pos != self.drbv or self.status is None
+            st = await d.status() if fresh else None
             if seq != self._seq:
                 # The episode ended while this read was on its way: its "moving" is older
                 # than the rest the episode saw (it would start a spurious DMOV pulse).
@@ -292,12 +290,14 @@ class AxisRecord(SettingsFields, PVGroup):
             return
         self.comm_error = False
         native = d.units.to_native(pos)
-        if self.moving or st.moving:
+        if self.moving or (st is not None and st.moving):
             if native > self.native:
                 self.tdir = 1
             elif native < self.native:
                 self.tdir = 0
-        self.drbv, self.native, self.moving, self.status = pos, native, bool(st.moving), st
+        self.drbv, self.native = pos, native
+        if st is not None:          # "moving" only from a status read now, never a kept one
+            self.moving, self.status = bool(st.moving), st
         if post:
             await self._post_readback()
 
