@@ -14,7 +14,9 @@ RS-485 lines) and the CA face on 127.0.0.1.  Its CPU is read from /proc/<pid>/st
    then with the 10 monitoring clients, then with the 10 polling clients.  (All 64 moving
    at once keep the simulators alone busy for a full core of the 2-core VM.)
 
-The simulators live in the service process (``--sim``), so every phase includes their
+The 10 clients are separate processes at nice 10 (on a 2-core VM they compete with the
+service for the cores; the "late rounds" of the pollers show when they lose).  The
+simulators live in the service process (``--sim``), so every phase includes their
 CPU, and the clients' cost is what they add to the phase without clients.  For scale, it
 first runs the same twin with no CA face at all (``--serve --no-face``), at rest and with
 the same moves issued in-process through motorbus.aio.  The service's stderr goes to
@@ -224,9 +226,10 @@ class Mover:
         self.thread.join(5)
 
 
-def spawn(args: list[str], env: dict, stderr: Any = None) -> subprocess.Popen:
+def spawn(args: list[str], env: dict, stderr: Any = None, nice: int = 0) -> subprocess.Popen:
     return subprocess.Popen([sys.executable, __file__, *args], env=env, stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, stderr=stderr, text=True)
+                            stdout=subprocess.PIPE, stderr=stderr, text=True,
+                            preexec_fn=(lambda: os.nice(nice)) if nice else None)
 
 
 def measure(pid: int, seconds: float) -> float:
@@ -283,7 +286,10 @@ def main() -> None:
         import epics  # noqa: F401
 
         def with_clients(mode: str, label: str) -> None:
-            clients = [spawn(["--client", mode, "--seconds", str(args.seconds + 4)], env) for _ in range(CLIENTS)]
+            # The clients run at nice 10: on this 2-core VM they would otherwise take the cores
+            # the service needs, and its CPU share would show the contention, not its demand.
+            clients = [spawn(["--client", mode, "--seconds", str(args.seconds + 4)], env, nice=10)
+                       for _ in range(CLIENTS)]
             try:
                 for c in clients:
                     json.loads(c.stdout.readline())          # connected

@@ -36,6 +36,8 @@ from typing import Any, Optional
 
 SCALE = 0.01          # mm per native unit
 STEP = 1.0            # mm per move: short, so the run is about latency, not travel
+VELO = 100.0          # mm/s, both sides (the CA face passes VELO as move_to's velocity)
+NO_VELOCITY = {"unitek"}
 PORT = 24064          # CA port of the served twin (not 5064: nothing else on this host is touched)
 PREFIX = "MBBENCH:"
 
@@ -163,13 +165,15 @@ def reference(kind: str, n: int) -> dict[str, list[float]]:
             _, shaft = PROFILES[kind]
             watcher = Watcher(lambda: shaft(sim) * SCALE)
             out: dict[str, list[float]] = {"start": [], "done": []}
+            # UNITEK takes no per-move speed (an NDrive parameter); the CA face then ignores VELO too.
+            speed = {} if kind in NO_VELOCITY else {"velocity": VELO}
             here = await drive.position()
             for i in range(n + 2):
                 target = round(here + (STEP if i % 2 == 0 else -STEP), 2)
                 watcher.arm()
                 await asyncio.sleep(0.002)
                 t0 = time.monotonic()
-                await drive.move_to(target, wait=True)
+                await drive.move_to(target, wait=True, **speed)
                 t_done = time.monotonic()
                 await asyncio.sleep(0.005)
                 ev = watcher.disarm()
@@ -214,7 +218,7 @@ def over_ca(kind: str, n: int, port: int) -> dict[str, list[float]]:
         for p in (val, dmov, rbv):
             if not p.wait_for_connection(10):
                 raise SystemExit(f"{p.pvname}: no connection on 127.0.0.1:{port}")
-        epics.caput(name + ".VELO", epics.caget(name + ".VMAX"), wait=True)
+        epics.caput(name + ".VELO", VELO, wait=True)      # the face moves with velocity=VELO, as the reference
         out: dict[str, list[float]] = {"start": [], "dmov": [], "complete": []}
         here = rbv.get()
         for i in range(n + 2):
