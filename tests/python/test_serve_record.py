@@ -454,7 +454,8 @@ async def test_motion_from_another_program_shows_as_moving(face, bench):
 
     f["DMOV"].write = spy
     try:
-        await bench["cia402"].move_to(6.0)            # not through the record (the RPC face, say)
+        # Not through the record (the RPC face, say), slow enough for the 10 Hz rest readback.
+        await bench["cia402"].move_to(6.0, velocity=10.0)
         await until(lambda: f["DMOV"].value == 1 and r.motor.value == pytest.approx(6.0), what="synced")
     finally:
         f["DMOV"].write = orig
@@ -464,14 +465,17 @@ async def test_motion_from_another_program_shows_as_moving(face, bench):
 
 async def test_allstop_stops_every_axis(face, bench):
     b = face.bench_records
-    tasks = [asyncio.create_task(face.records[a].motor.write(40.0)) for a in ("cia402", "arcus")]
+    for a in ("cia402", "arcus"):
+        await face.records[a].fields["VELO"].write(20.0)     # slow: stopped long before the target
+    tasks = [asyncio.create_task(face.records[a].motor.write(300.0)) for a in ("cia402", "arcus")]
     await until(lambda: all(face.records[a].fields["MOVN"].value for a in ("cia402", "arcus")), what="moving")
     assert b.alldone.value == "moving" and b.moving.value >= 2
     await b.allstop.write("stop")
     assert b.allstop.value == "release"
     await asyncio.wait_for(asyncio.gather(*tasks), 10)
     for a in ("cia402", "arcus"):
-        assert await bench[a].position() < 40.0
+        assert await bench[a].position() < 300.0
+        await face.records[a].fields["VELO"].write(100.0)
     await until(lambda: b.alldone.value == "done" and b.moving.value == 0, what="all done")
 
 
@@ -509,7 +513,7 @@ async def test_a_fault_during_a_move_is_a_major_alarm_and_a_failed_put_until_a_g
     r, f = face.records["cia402"], face.records["cia402"].fields
     await r.motor.write(0.0)
     w = watch("cia402")
-    task = asyncio.create_task(r.motor.write(50.0))
+    task = asyncio.create_task(r.motor.write(300.0))
     await until(lambda: f["RBV"].value > 1.0, what="moving")
     registry.drive_plugin("cia402").sim_faults()["fault"](bench.sync.sims["cia402"])
     with pytest.raises(MoveFailedPut) as e:
@@ -627,6 +631,7 @@ async def test_a_slow_or_silent_drive_does_not_freeze_another_axis(face, bench):
             seen.add(round(cia.fields["RBV"].value, 2))
             await asyncio.sleep(0.005)
 
+    await cia.fields["VELO"].write(20.0)             # a 1 s move: RBV is seen along the way
     sampler = asyncio.create_task(sample())
     start = time.monotonic()
     await cia.motor.write(cia.motor.value + 20.0)

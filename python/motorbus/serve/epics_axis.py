@@ -542,7 +542,10 @@ class AxisRecord(SettingsFields, PVGroup):
         arrived meanwhile: the episode goes on."""
         self._seq += 1                   # readbacks already on their way are older than this rest
         last = getattr(self.drive.sync, "_last_move", None)
-        if error is None and what == "move" and last is not None and last.ok and last.position is not None:
+        kept = self.status
+        clean = kept is not None and not (kept.fault or kept.limit_positive or kept.limit_negative)
+        if error is None and what == "move" and last is not None and last.ok and last.position is not None \
+                and clean:
             # The Drive judged the move at rest there a moment ago: no exchange before DMOV=1
             # (the readback task refreshes the status within its period).
             self._at_rest(last.position)

@@ -214,6 +214,7 @@ class SettingsFields:
                 await self.drive.disable()
         except (_core.MotorbusError, OSError) as e:
             raise PutRefused(f"{self.axis}: CNEN={strings[on]}: {e}") from None
+        await self._read_once()          # the fault it cleared, the state it set
         return strings[on]
 
     async def _put_sync(self, instance: Any, value: Any) -> Any:
