@@ -294,7 +294,9 @@ def main() -> None:
                 for c in clients:
                     json.loads(c.stdout.readline())          # connected
                 time.sleep(1.0)
+                puts0 = mover.puts if mover is not None else 0
                 results[label] = measure(pid, args.seconds)
+                moved = f", {(mover.puts - puts0) / args.seconds:.0f} moves/s" if mover is not None else ""
                 tails = [c.communicate(timeout=60)[0] for c in clients]
             finally:
                 for c in clients:
@@ -303,7 +305,7 @@ def main() -> None:
             events = sum(json.loads(t.strip().splitlines()[-1])["events"] for t in tails)
             late = [json.loads(line)["late"] for t in tails for line in t.strip().splitlines() if '"late"' in line]
             notes[label] = f"{events / args.seconds:.0f} updates or values/s received" + (
-                f", {sum(late)} of {CLIENTS * int(args.seconds * RATE)} rounds late" if late else "")
+                f", {sum(late)} of {CLIENTS * int(args.seconds * RATE)} rounds late" if late else "") + moved
 
         with_clients("monitor", "CA face, at rest, 10 monitoring clients")
         with_clients("poll", "CA face, at rest, 10 clients polling at 10 Hz")
