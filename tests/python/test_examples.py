@@ -128,3 +128,18 @@ def test_example_12_asyncio_python():
     for kind in ("arcus", "dmac", "cia402"):
         assert f"{kind}: at 4.00 mm" in out, out
     assert "moving=False, last move interrupted" in out, out
+
+
+def test_example_14_epics_bluesky_python():
+    import pytest
+    for module in ("caproto", "epics", "ophyd", "bluesky"):
+        pytest.importorskip(module)
+    out = run_example("14_epics_bluesky.py")
+    assert "pyepics: z at 2.50 mm, DMOV=1" in out
+    assert "pyepics: move to 20 refused by the soft limit: True (LVIO=1), z still at 2.50" in out
+    assert [line for line in out.splitlines() if line.startswith("event")] == \
+        [f"event {i + 1}: x={i:.2f} z=2.50" for i in range(5)]
+    assert "run: success" in out and "ophyd: x stands at 4.00 mm" in out
+    # a STOP from elsewhere mid-move: ophyd's status fails (the record's STATE/MINOR at DMOV=1)
+    assert "ophyd: the stopped move failed (" in out and "x at rest short of 40: True" in out
+    assert "service ended: 0" in out

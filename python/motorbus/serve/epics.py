@@ -159,6 +159,7 @@ class CaFace:
         self.calibration = calibration
         self.records: dict[str, AxisRecord] = {}
         self.counters: dict[str, int] = {"puts": 0, "failed_puts": 0, "moves": 0, "failed_moves": 0,
+                                         "interrupted_moves": 0,
                                          "stops": 0, "readback_errors": 0, "accel_errors": 0}
         self.bench_records: Optional[BenchRecords] = None
         self.pvdb: dict[str, Any] = {}

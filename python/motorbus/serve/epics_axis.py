@@ -561,7 +561,15 @@ class AxisRecord(SettingsFields, PVGroup):
                     or self.fields["RBV"].alarm.severity):
                 await self._alarm(AlarmStatus.NO_ALARM, AlarmSeverity.NO_ALARM)
         elif isinstance(error, MoveInterrupted):
-            pass                               # a stop: a normal end in the record's terms
+            # A deliberate difference from motorRecord.cc, which ends a stopped move as a
+            # normal completion: a move cut short by STOP, allstop, SPMG Stop or another
+            # program's stop did not reach its target, and every client must see that (the
+            # project's rule: a move ends at its target or fails saying why).  STATE/MINOR --
+            # a stop is not a fault -- is what ophyd judges at DMOV=1, and the put-callback
+            # fails with the Drive API's reason; MSTA stays clean; the next good move clears it.
+            self.face.counters["interrupted_moves"] += 1
+            await self._alarm(AlarmStatus.STATE, AlarmSeverity.MINOR_ALARM)
+            put_error = MoveFailedPut(str(error) if str(error).startswith(self.axis) else f"{self.axis}: {error}", error)
         elif isinstance(error, LimitReached):
             self.face.counters["failed_moves"] += 1
             hlsv = self.fields["HLSV"].value
@@ -622,11 +630,12 @@ class AxisRecord(SettingsFields, PVGroup):
 
     async def stop_axis(self, by: str = "STOP") -> None:
         """STOP / allstop / SPMG Stop|Pause: the drive's stop at once; the episode ends at
-        rest as interrupted (a normal completion) with VAL := RBV."""
+        rest as interrupted (STATE/MINOR and a failed put-callback) with VAL := RBV."""
         self.face.counters["stops"] += 1
         self.stop_requested = by
         try:
-            await self.drive.stop()
+            # ``by`` names the record in the outcome every program reads (drive.stopped_by_text)
+            await self.drive.sync._co_stop(by=f"{by} of the EPICS record {self.prefix}")
         except Exception as e:  # noqa: BLE001 - nothing more to do from here; the readback shows the rest
             log.warning("%s: stop failed: %s", self.axis, e)
         if self.episode is None or self.episode.done():
