@@ -14,6 +14,11 @@ NOT_THREADED = {
     # The command line and the served twin, run as child processes; the client paths they
     # reach are the in-process outcome tests' (test_outcomes_*), which do run under ASan.
     "test_cli", "test_cli_outcomes", "test_sim_serve_bench", "test_move_outcomes",
+    # motorbus serve: the service as a child process (test_serve_service, test_serve_shared), and
+    # its CA face, pure Python over caproto, with CA clients (test_serve_record,
+    # test_epics_clients); the service's C++ paths (shared Poller fan-out, SDO, links) run under
+    # ASan in-process in test_serve_rpc.
+    "test_serve_service", "test_serve_shared", "test_serve_record", "test_epics_clients",
 }
 
 
