@@ -115,6 +115,21 @@ def bench(service):
     b.close()
 
 
+def in_thread(call) -> tuple[threading.Thread, dict]:
+    """Runs a blocking call (a move another connection will cut short) in a thread; its
+    error, if any, lands in the dict under "error"."""
+    result: dict = {}
+
+    def run() -> None:
+        try:
+            call()
+        except BaseException as e:  # noqa: BLE001 - the test looks at it
+            result["error"] = e
+    t = threading.Thread(target=run)
+    t.start()
+    return t, result
+
+
 def wait_for(cond: Any, timeout: float = 10.0, what: str = "the condition") -> None:
     deadline = time.monotonic() + timeout
     while not cond():
@@ -215,15 +230,7 @@ def test_bad_arguments_come_back_typed(bench):
 def test_a_drive_fault_during_a_move_is_a_move_faulted_with_its_fields(service, bench):
     f = bench["f"]
     f.enable()
-    result: dict = {}
-
-    def mover() -> None:
-        try:
-            f.move_to(300.0, timeout=20)
-        except BaseException as e:  # noqa: BLE001 - looked at below
-            result["error"] = e
-    t = threading.Thread(target=mover)
-    t.start()
+    t, result = in_thread(lambda: f.move_to(300.0, timeout=20))
     wait_for(lambda: service.shaft("f") > 5.0, what="f moving")
     service.fault("f", "fault", code=0x5441)
     t.join(20)
@@ -261,15 +268,7 @@ def test_a_stop_from_another_connection_stops_a_move_this_one_awaits(service, be
     z = bench["z"]
     z.move_to(0.0, timeout=10)
     other = motorbus.Bench.connect(f"unix:{service.path}")
-    result: dict = {}
-
-    def mover() -> None:
-        try:
-            z.move_to(400.0, timeout=20)
-        except BaseException as e:  # noqa: BLE001
-            result["error"] = e
-    t = threading.Thread(target=mover)
-    t.start()
+    t, result = in_thread(lambda: z.move_to(400.0, timeout=20))
     try:
         wait_for(lambda: service.shaft("z") > 5.0, what="z moving")
         t_stop = time.monotonic()
@@ -308,15 +307,7 @@ def test_wait_idle_reports_this_clients_move_even_if_another_clients_reading_jud
 def test_a_stop_from_another_thread_overtakes_the_move_this_connection_awaits(service, bench):
     z = bench["z"]
     z.move_to(0.0, timeout=10)
-    result: dict = {}
-
-    def mover() -> None:
-        try:
-            z.move_to(400.0, timeout=20)
-        except BaseException as e:  # noqa: BLE001
-            result["error"] = e
-    t = threading.Thread(target=mover)
-    t.start()
+    t, result = in_thread(lambda: z.move_to(400.0, timeout=20))
     wait_for(lambda: service.shaft("z") > 5.0, what="z moving")
     assert z.position > 5.0                  # a reading overtakes the waiting move too
     z.stop()                                 # the same connection, another thread
@@ -378,15 +369,7 @@ def test_a_failed_move_together_says_every_axis(service, bench):
     z, f = bench["z"], bench["f"]
     f.enable()
     bench.move_together({"z": 0.0, "f": 0.0}, timeout=10)
-    result: dict = {}
-
-    def mover() -> None:
-        try:
-            bench.move_together({"z": 3.0, "f": 300.0}, timeout=20)
-        except BaseException as e:  # noqa: BLE001
-            result["error"] = e
-    t = threading.Thread(target=mover)
-    t.start()
+    t, result = in_thread(lambda: bench.move_together({"z": 3.0, "f": 300.0}, timeout=20))
     wait_for(lambda: service.shaft("f") > 5.0, what="f moving")
     service.fault("f", "fault")
     t.join(20)
@@ -681,15 +664,7 @@ def test_closing_the_face_stops_what_its_clients_awaited_and_they_see_link_down(
     remote = motorbus.Bench.connect(f"unix:{path}")
     z = remote["z"]
     bench["z"].move_to(0.0, timeout=10)
-    result: dict = {}
-
-    def mover() -> None:
-        try:
-            z.move_to(400.0, timeout=20)
-        except BaseException as e:  # noqa: BLE001
-            result["error"] = e
-    t = threading.Thread(target=mover)
-    t.start()
+    t, result = in_thread(lambda: z.move_to(400.0, timeout=20))
     try:
         wait_for(lambda: service.shaft("z") > 5.0, what="z moving")
         service.run(face.close())
