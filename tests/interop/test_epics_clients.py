@@ -21,6 +21,7 @@ the face under test.
 from __future__ import annotations
 
 import asyncio
+import atexit
 import importlib.util
 import os
 import re
@@ -44,7 +45,7 @@ for _name in ("ophyd_async", "ophyd", "bluesky"):
 import epicscorelibs.path.pyepics  # noqa: E402,F401  before epics: pyepics then loads the wheel's libca, aioca's
 import epics  # noqa: E402
 import pytest_asyncio  # noqa: E402
-from aioca import CANothing, camonitor, caput  # noqa: E402
+from aioca import CANothing, camonitor, caput, purge_channel_caches  # noqa: E402
 
 import ca_env  # noqa: E402
 from motorbus.pytest_plugin import default_bench  # noqa: E402
@@ -94,8 +95,13 @@ def twin():
     ca_env.start_repeater()
     served = ca_env.ServedTwin(bench_data(), prefix=PREFIX).start()
     assert sorted(served.bench.axes) == BUILTIN
+    # Served until the process exits, closed after libca's context: pyepics destroys that
+    # context at exit (finalize_libca, registered when the first client starts, after
+    # this), and once aioca has used it too, ca_context_destroy blocks 30 s if the server
+    # has gone first.  atexit runs the last registered first.
+    atexit.register(served.close)
     yield served
-    served.close()
+    asyncio.run_coroutine_threadsafe(served.bench.stop_all(), served.loop).result(30)
 
 
 def pv(axis: str, field: str = "") -> str:
@@ -148,6 +154,12 @@ async def wait_for_motion_async(twin, axis: str, start: float, move, timeout: fl
     raise AssertionError(f"{axis} never started moving from {start}")
 
 
+def far(axis: str) -> float:
+    """How far (mm) a move goes that a test cuts short: 1.5 s at SLOW; UNITEK takes no
+    per-move speed (VELO does nothing there) and runs fast, so drive_kinds' far target."""
+    return KINDS[axis].far if axis == "unitek" else 30.0
+
+
 def tolerance(axis: str) -> float:
     """How close a move lands, mm: the sims stop within a count or two."""
     return 3 * KINDS[axis].scale
@@ -194,7 +206,10 @@ async def motors(twin):
         m = Motor(pv(axis), name=axis.replace("-", "_"))
         await m.connect(timeout=10)      # every signal's CA type and enum strings checked here
         found[axis] = m
-    return found
+    yield found
+    # Channels closed while their server still runs: left open, libca's context teardown
+    # at exit waits out their disconnection (30 s).
+    purge_channel_caches()
 
 
 class Pulses:
@@ -263,7 +278,7 @@ async def test_ophyd_async_stop_mid_move(twin, motors, axis):
     m = motors[axis]
     await _settle_velocity(m, SLOW)
     start = at_rest(twin, axis)
-    target = round(start + 30.0, 2)       # 1.5 s at SLOW
+    target = round(start + far(axis), 2)       # 1.5 s at SLOW
     # A STOP from another writer (no client-side cancel): the record stops the drive and
     # the pending put completes at the stop; VAL := RBV.
     moving = asyncio.ensure_future(m.set(target))
@@ -277,12 +292,12 @@ async def test_ophyd_async_stop_mid_move(twin, motors, axis):
     assert await m.motor_done_move.get_value() == 1
     # ophyd-async's own stop(): the device reports the cut-short move as failed.
     start = stopped
-    moving = asyncio.ensure_future(m.set(round(start - 30.0, 2)))
+    moving = asyncio.ensure_future(m.set(round(start - far(axis), 2)))
     await wait_for_motion_async(twin, axis, start, moving)
     await m.stop()
     with pytest.raises(RuntimeError, match="stopped"):
         await asyncio.wait_for(moving, 10)
-    assert start - 30.0 + 1.0 < at_rest(twin, axis) < start - 0.05
+    assert start - far(axis) + 1.0 < at_rest(twin, axis) < start - 0.05
 
 
 @pytest.mark.asyncio(loop_scope="module")
@@ -393,14 +408,14 @@ async def test_ophyd_async_fault_during_move_fails_the_move(twin, motors, axis):
     start = at_rest(twin, axis)
     # The move as the device makes it (a put-callback on VAL, aioca), awaited directly:
     # ophyd-async's Signal.set loses a failed put (test_ophyd_async_set_loses_a_failed_put).
-    moving = asyncio.ensure_future(caput(pv(axis), round(start - 30.0, 2), wait=True, timeout=30))
+    moving = asyncio.ensure_future(caput(pv(axis), round(start - far(axis), 2), wait=True, timeout=60))
     await wait_for_motion_async(twin, axis, start, moving)
     provoke_fault(twin, axis)
     try:
         with pytest.raises(CANothing) as failed:       # the put failed: not a success
             await asyncio.wait_for(moving, 15)
         assert failed.value.errorcode == ECA_PUTFAIL
-        assert at_rest(twin, axis) > start - 30.0 + 1.0
+        assert at_rest(twin, axis) > start - far(axis) + 1.0
         if axis in LIMIT_FAULT:
             # A limit switch is no alarm unless HLSV says so (the record's rule): LLS tells.
             assert await m.low_limit_switch.get_value() == 1
@@ -496,7 +511,7 @@ def test_ophyd_epics_motor_fault_fails_its_move_status(twin, epics_motors):
     m = epics_motors["cia402"]
     m.velocity.put(SLOW, wait=True)
     start = at_rest(twin, "cia402")
-    status = m.move(round(start - 30.0, 2), wait=False)
+    status = m.move(round(start - far("cia402"), 2), wait=False)
     wait_for_motion(twin, "cia402", start)
     provoke_fault(twin, "cia402")
     try:
@@ -523,8 +538,8 @@ def pyepics_motor(twin):
     m.put("VELO", fast(m.get("VMAX")), wait=True)
     # pyepics checks every move against LLM <= target <= HLM, so 0/0 (the record's "no
     # limits") refuses all of them: soft limits as an IOC's database would set them.
-    m.put("LLM", -1000.0, wait=True)
-    m.put("HLM", 1000.0, wait=True)
+    m.put("LLM", -10000.0, wait=True)
+    m.put("HLM", 10000.0, wait=True)
     yield m
     m.put("LLM", 0.0, wait=True)
     m.put("HLM", 0.0, wait=True)
@@ -584,7 +599,7 @@ def test_pyepics_motor_sees_a_fault_in_rbv_severity(twin, pyepics_motor):
     start = at_rest(twin, axis)
     done = threading.Event()
     result: list = []
-    mover = threading.Thread(target=lambda: (result.append(m.move(start - 30.0, wait=True, timeout=30)),
+    mover = threading.Thread(target=lambda: (result.append(m.move(start - far(axis), wait=True, timeout=60)),
                                              done.set()))
     mover.start()
     wait_for_motion(twin, axis, start)
@@ -598,7 +613,7 @@ def test_pyepics_motor_sees_a_fault_in_rbv_severity(twin, pyepics_motor):
         assert rbv.get_ctrlvars(timeout=5) is not None
         assert rbv.severity == 2
         assert epics.caget(pv(axis, "SEVR")) == 2
-        assert at_rest(twin, axis) > start - 30.0 + 1.0
+        assert at_rest(twin, axis) > start - far(axis) + 1.0
     finally:
         remove_fault(twin, axis)
     m.put("VELO", fast(m.get("VMAX")), wait=True)
