@@ -279,12 +279,17 @@ async def test_ophyd_async_stop_mid_move(twin, motors, axis):
     await _settle_velocity(m, SLOW)
     start = at_rest(twin, axis)
     target = round(start + far(axis), 2)       # 1.5 s at SLOW
-    # A STOP from another writer (no client-side cancel): the record stops the drive and
-    # the pending put completes at the stop; VAL := RBV.
-    moving = asyncio.ensure_future(m.set(target))
+    # A STOP from another writer (no client-side cancel): the drive stops, VAL := RBV, and
+    # the pending put-callback (the device's move, awaited through aioca: ophyd-async's own
+    # set loses failures) fails, a cut-short move being a failed one for CA clients
+    # (docs/epics.md, a deliberate difference from the record).
+    moving = asyncio.ensure_future(caput(pv(axis), target, wait=True, timeout=60))
     await wait_for_motion_async(twin, axis, start, moving)
     await caput(pv(axis, "STOP"), 1)
-    await asyncio.wait_for(moving, 10)
+    with pytest.raises(CANothing) as failed:
+        await asyncio.wait_for(moving, 10)
+    assert failed.value.errorcode == ECA_PUTFAIL
+    assert int(await _get(pv(axis, "STOP"))) == 0       # reset at once
     stopped = at_rest(twin, axis)
     assert start + 0.05 < stopped < target - 1.0
     assert await m.user_setpoint.get_value() == pytest.approx(stopped, abs=tolerance(axis))
