@@ -182,6 +182,20 @@ class ServedTwin:
     def sims(self) -> dict:
         return self.bench.sync.sims
 
+    def quiesce(self) -> None:
+        """Every axis stopped and the records' readbacks ended, the CA server left serving
+        (closed at exit, see test_epics_clients.twin): an idle twin for the rest of this
+        worker's session -- no polling, so its link workers end and later modules of the
+        worker see no thread of it."""
+        async def still() -> None:
+            await self.bench.stop_all()
+            tasks = [r._readback for r in self.face.records.values()]
+            for task in tasks:
+                task.cancel()
+            await asyncio.gather(*tasks, return_exceptions=True)
+
+        self.run(still())
+
     def close(self) -> None:
         async def shut() -> None:
             try:

@@ -101,7 +101,7 @@ def twin():
     # has gone first.  atexit runs the last registered first.
     atexit.register(served.close)
     yield served
-    asyncio.run_coroutine_threadsafe(served.bench.stop_all(), served.loop).result(30)
+    served.quiesce()
 
 
 def pv(axis: str, field: str = "") -> str:
