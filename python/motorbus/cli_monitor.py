@@ -113,7 +113,7 @@ class ServedReadings:
     """A monitor's readings of a served bench that cost the drives nothing per monitor:
     the position from the service's shared poll (monitors asking the same axes and rate
     share one Poller in the service), the velocity differentiated from it (every kind
-    polls its position; not every kind has a velocity object to poll: pmc007), the
+    polls its position; not every kind has a velocity to poll), the
     status, which a poll holds only as the kind's raw word, asked at most ``STATUS_HZ``
     times a second."""
 

@@ -35,7 +35,7 @@ import logging
 import math
 import os
 import time
-from collections.abc import Iterator, MutableMapping
+from collections.abc import Iterator, Mapping, MutableMapping
 from dataclasses import dataclass
 from typing import Any, Callable, Optional, Union
 
@@ -377,6 +377,12 @@ class Drive(abc.ABC):
     #: How far from its target (native units) a move may come to rest and still count as
     #: arrived, when the kind does not read it from the drive (``_in_position_window``).
     in_position_window: float = 0.0
+    #: ``move_to(velocity=)`` sets the speed of that move (False: the kind's position speed
+    #: is a drive setting only its own tools change, and ``velocity=`` is refused).
+    per_move_velocity: bool = True
+    #: The homing methods for "home forward" and "home reverse" (the motor record's HOMF
+    #: and HOMR); None: the kind's default method.
+    homing_directions: tuple = (None, None)
     #: The file, in ``sim serve --store-dir``'s folder, that keeps a served drive's stored
     #: parameters (``"mykind-{address}.flash"``: formatted with the canonical address and
     #: handed to ``make_sim`` as ``store_path`` by ``store_options``); "" = the kind keeps none.
@@ -625,6 +631,44 @@ class Drive(abc.ABC):
     async def _travel_limits(self) -> tuple[Optional[float], Optional[float]]:
         """The soft travel limits the drive itself enforces now, native units (None: no limit that side)."""
         return (None, None)
+
+    # ---- speed and ramps, for callers that set them as a motion controller does ----------------
+    # (the EPICS motor record's VELO/VMAX/ACCL, docs/epics.md).  A kind says where its
+    # position-move speed lives and how its ramps are written; the defaults say "not known".
+
+    async def _move_speed(self) -> tuple[Optional[float], Optional[float]]:
+        """(the speed a position move runs at now, its declared maximum), native units per
+        second; None where the kind does not say."""
+        return (None, None)
+
+    async def _set_accel_time(self, seconds: float, speed: float, top: Optional[float]) -> bool:
+        """Writes the kind's ramp settings so that a move reaches ``speed`` (native units/s)
+        from rest in ``seconds`` (``top``: the maximum of ``_move_speed``, for drives whose
+        ramps are times to their maximum).  The drive keeps them.  False: the kind has no
+        ramp it can set this way."""
+        return False
+
+    async def _speed_param(self, name: str, per_unit: float = 1.0) -> tuple[Optional[float], Optional[float]]:
+        """For ``_move_speed``: a speed parameter's value and declared maximum, each times
+        ``per_unit`` (native units/s per the parameter's unit)."""
+        if name not in self.params:
+            return (None, None)
+        now = abs(float(await self.params._co_get(name))) * per_unit
+        top = self.params.describe(name).maximum
+        return (now or None, None if top is None else abs(float(top)) * per_unit)
+
+    async def _set_params_clamped(self, values: Mapping[str, float]) -> None:
+        """For ``_set_accel_time``: writes each parameter the drive has, clamped into its
+        declared range (rounded for an integer one)."""
+        for name, value in values.items():
+            if name not in self.params:
+                continue
+            info = self.params.describe(name)
+            if info.minimum is not None:
+                value = max(value, info.minimum)
+            if info.maximum is not None:
+                value = min(value, info.maximum)
+            await self.params._co_set(name, int(round(value)) if info.type == "int" else value)
 
     def _make_params(self) -> Params:
         return Params(self)
@@ -1055,7 +1099,7 @@ registry.set_drive_base(Drive)
 #: ``_in_position_window``, which judge what was read, may be either.
 Drive.COROUTINE_HOOKS = ("_enable", "_disable", "_move_to", "_move_by", "_jog", "_stop", "_quick_stop", "_home",
                          "_homing_done", "_is_idle", "_clear_faults", "_store", "_position", "_velocity", "_status",
-                         "_travel_limits", "_console")
+                         "_travel_limits", "_console", "_move_speed", "_set_accel_time")
 
 #: The plugin hooks a kind may override (``Drive.provides``).
 HOOKS = ("open", "make_sim", "check_address", "store_options", "wire_line", "probe", "canopen_match", "synchronised_start",

@@ -568,6 +568,34 @@ def _port() -> int:
 #: The caproto settings exported before this module ran (a user's own value is kept).
 ca_user_env = {k for k in os.environ if k.startswith("CAPROTO_SERVER_")}
 
+# ---- the kinds' speed and ramp hooks the record's VELO/VMAX/ACCL go through ----------------------------
+@pytest.mark.parametrize("axis, param", [("arcus", "ACC"), ("unitek", "ACC_RAMP")])
+async def test_accel_time_in_ms_ramps(bench, axis, param):
+    d = bench[axis].sync
+    assert await d._set_accel_time(0.05, 1000.0, None) is True
+    assert await bench[axis].params.get(param) == 50             # 0.05 s to speed: a 50 ms ramp
+
+
+async def test_pmc007_accel_time_picks_the_nearest_gear(bench):
+    d = bench["pmc007"].sync
+    await d._set_accel_time(1e-6, 1000.0, None)                    # as steep as it gets: the fastest gear
+    assert await bench["pmc007"].params.get("0x6008") == 1
+    await d._set_accel_time(1e3, 1000.0, None)                     # as gentle as it gets: the slowest
+    assert await bench["pmc007"].params.get("0x6008") == 8 and await bench["pmc007"].params.get("0x6009") == 8
+    await d._set_accel_time(1e-6, 1000.0, None)                    # back to the fastest for what follows
+
+
+async def test_move_speed_and_per_move_velocity_per_kind(bench):
+    for axis in ("cia402", "arcus", "pmc007"):
+        now, top = await bench[axis].sync._move_speed()
+        # the declared maximum; the speed now (None where the drive holds 0: not set yet)
+        assert top and top > 0 and (now is None or 0 < now <= top), (axis, now, top)
+        assert bench[axis].sync.per_move_velocity
+    assert await bench["unitek"].sync._move_speed() == (None, None)   # its speed is an NDrive setting
+    assert not bench["unitek"].sync.per_move_velocity
+    assert bench["arcus"].sync.homing_directions == ("H+", "H-")
+
+
 
 async def test_served_over_ca_on_loopback_without_broadcast_beacons(bench):
     from caproto import _utils
@@ -656,3 +684,4 @@ async def test_a_slow_or_silent_drive_does_not_freeze_another_axis(face, bench):
     assert arcus.fields["DMOV"].value == 1
     bench.sync.served_buses["pmc007-link"].set_faults(delay=0.0)
     await asyncio.wait_for(slow, 60)
+

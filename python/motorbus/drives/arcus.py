@@ -574,6 +574,18 @@ class ArcusDrive(_drive.Drive):
     async def _quick_stop(self) -> None:
         await self.io.urgent.abort()
 
+    # Speed and ramps as a motion controller sets them (the EPICS record's VELO/ACCL):
+    # HSPD is the position speed in pulses/s, ACC/DEC the ramp times in ms.
+    homing_directions = ("H+", "H-")
+
+    async def _move_speed(self) -> tuple[Optional[float], Optional[float]]:
+        return await self._speed_param("HSPD")
+
+    async def _set_accel_time(self, seconds: float, speed: float, top: Optional[float]) -> bool:
+        ms = max(1.0, seconds * 1000.0)
+        await self._set_params_clamped({"ACC": ms, "DEC": ms})
+        return True
+
     async def _home(self, method: Any) -> None:
         method = DEFAULT_HOME_METHOD if method is None else method
         if not isinstance(method, str) or method.strip().upper() not in HOME_METHODS:

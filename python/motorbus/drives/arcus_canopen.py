@@ -403,6 +403,13 @@ class ArcusCanopenDrive(Cia402Drive):
         except ValueError:
             return "?"
 
+    # Speed and ramps (the EPICS record's VELO/ACCL): 6081h in pulses/s as on CiA 402, but
+    # this drive's 6083h/6084h are ramp times in ms (its StepNLoop firmware), not pulses/s².
+    async def _set_accel_time(self, seconds: float, speed: float, top: Optional[float]) -> bool:
+        ms = max(1.0, seconds * 1000.0)
+        await self._set_params_clamped({"0x6083": ms, "0x6084": ms})
+        return True
+
     async def _home(self, method: Any) -> None:
         await self._operation_enabled()
         await self._use_mode(OpMode.HOMING)

@@ -479,6 +479,16 @@ class Cia402Drive(Drive):
     async def _quick_stop(self) -> None:
         await self.io.urgent.write_controlword(int(Controlword.QUICK_STOP))
 
+    # Speed and ramps (the EPICS record's VELO/ACCL): profile velocity 6081h, and the
+    # profile acceleration/deceleration 6083h/6084h in position units per s².
+    async def _move_speed(self) -> tuple[Optional[float], Optional[float]]:
+        return await self._speed_param("0x6081")
+
+    async def _set_accel_time(self, seconds: float, speed: float, top: Optional[float]) -> bool:
+        rate = max(1.0, speed / seconds)
+        await self._set_params_clamped({"0x6083": rate, "0x6084": rate})
+        return True
+
     async def _home(self, method: Any) -> None:
         await self._operation_enabled()
         await self._use_mode(OpMode.HOMING)

@@ -697,6 +697,16 @@ class DmacDrive(Drive):
     async def _in5(self) -> bool:
         return bool(await self.io.attr("inputs") & (1 << 4))
 
+    # Speed and ramps (the EPICS record's VELO/ACCL): #HIGH_SPEED is in 0.01 rpm, 0.6 of it
+    # per increment/s at 10 000 increments per turn; #ACCEL_TIME/#DECEL_TIME in ms.
+    async def _move_speed(self) -> tuple[Optional[float], Optional[float]]:
+        return await self._speed_param("#HIGH_SPEED", 10000.0 / 6000.0)
+
+    async def _set_accel_time(self, seconds: float, speed: float, top: Optional[float]) -> bool:
+        ms = max(1.0, seconds * 1000.0)
+        await self._set_params_clamped({"#ACCEL_TIME": ms, "#DECEL_TIME": ms})
+        return True
+
     async def _home(self, method: Any) -> None:
         method = "reference" if method is None else method
         if method not in self.HOME_METHODS:

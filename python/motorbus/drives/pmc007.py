@@ -29,6 +29,7 @@ next call after a link loss raises (SdoTimeout).  ``has_watchdog`` is False.
 from __future__ import annotations
 
 import enum
+import math
 import re
 import threading
 import time
@@ -748,6 +749,17 @@ class Pmc007Drive(Drive):
     async def _quick_stop(self) -> None:
         await self.io.urgent.stop()
         await self._leave_speed_mode(urgent=True)
+
+    # Speed and ramps (the EPICS record's VELO/ACCL): maximum_speed in steps/s; the drive
+    # accelerates by gears (1 fastest .. 8, 6008h/6009h): the gear nearest speed/seconds.
+    async def _move_speed(self) -> tuple[Optional[float], Optional[float]]:
+        return await self._speed_param("maximum_speed")
+
+    async def _set_accel_time(self, seconds: float, speed: float, top: Optional[float]) -> bool:
+        want = speed / seconds if seconds > 0 else math.inf
+        gear = min(GEAR_ACCELERATION, key=lambda g: abs(math.log(GEAR_ACCELERATION[g] / max(want, 1e-9))))
+        await self._set_params_clamped({"0x6008": gear, "0x6009": gear})
+        return True
 
     async def _home(self, method: Any) -> None:
         inputs = {None: ControllerStatus.EXT1, "ext1": ControllerStatus.EXT1, "ext2": ControllerStatus.EXT2,

@@ -767,6 +767,16 @@ class UnitekDrive(Drive):
     async def _quick_stop(self) -> None:
         await self._stop()      # the protocol has no faster stop than speed command 0 (but disable)
 
+    # Speed and ramps (the EPICS record's VELO/ACCL): the positioning speed is an NDrive
+    # setting (velocity= is refused); ACC_RAMP is the ramp in ms to the drive's maximum speed,
+    # so the time to reach ``speed`` scales by top/speed where both are known.
+    per_move_velocity = False
+
+    async def _set_accel_time(self, seconds: float, speed: float, top: Optional[float]) -> bool:
+        ms = seconds * 1000.0 * (top / speed if top and speed else 1.0)
+        await self._set_params_clamped({"ACC_RAMP": max(1.0, ms)})
+        return True
+
     async def _home(self, method: Any) -> None:
         if method not in (None, "calibrated"):
             raise _core.InvalidArgument(f"unitek home: method None or 'calibrated', not {method!r}")

@@ -38,7 +38,7 @@ from caproto.server import PVGroup, pvproperty
 
 from .. import _core
 from ..drive import Capability, LimitReached, MoveFailed, MoveInterrupted, MoveStalled
-from .epics_kinds import KindMap, kind_map
+from .epics_kinds import DriveSettings
 from .epics_settings import SettingsFields
 from .epics_types import (JOG_WAIT, MOVING_PERIOD, MSTA_COMM_ERR, MSTA_DIRECTION, MSTA_DONE,  # noqa: F401
                           MSTA_HOMED, MSTA_MINUS_LS, MSTA_MOVING, MSTA_PLUS_LS, MSTA_POSITION, MSTA_PRESENT,
@@ -64,9 +64,9 @@ class AxisRecord(SettingsFields, PVGroup):
         self.drive = drive
         self.face = face
         self.fields = self.motor.fields
-        self.kmap: KindMap = kind_map(drive.kind)
+        self.drive_settings = DriveSettings(drive)
         config = getattr(getattr(face.bench, "sync", None), "config", {})
-        self.address = str(config[axis].address) if axis in config else self.kmap.address(drive)
+        self.address = str(config[axis].address) if axis in config else self.drive_settings.address()
         u = drive.units
         self.scale = float(u.scale)
         self.mres = abs(self.scale)
@@ -194,7 +194,7 @@ class AxisRecord(SettingsFields, PVGroup):
         self.dllm = float(dllm) if dllm is not None else (lo if math.isfinite(lo) else -reach)
         self.dhlm = float(dhlm) if dhlm is not None else (hi if math.isfinite(hi) else reach)
         self._clamp_limits()
-        speed, vmax = await self.kmap.speeds(d)
+        speed, vmax = await self.drive_settings.speeds()
         if self.velo is None:
             self.velo = speed if speed else max(self.mres * 1000.0, 1e-9)
         if self.jvel is None:
@@ -227,7 +227,7 @@ class AxisRecord(SettingsFields, PVGroup):
         await f["RRES"].write(1.0, verify_value=False)
         await f["SREV"].write(200, verify_value=False)
         await f["UREV"].write(self.mres * 200, verify_value=False)
-        await f["RDBD"].write(max(self.mres, await self.kmap.deadband(d)), verify_value=False)
+        await f["RDBD"].write(max(self.mres, await self.drive_settings.deadband()), verify_value=False)
         await f["VMAX"].write(self.vmax, verify_value=False)
         await f["VBAS"].write(0.0, verify_value=False)
         await f["VELO"].write(self.velo, verify_value=False, upper_ctrl_limit=self.vmax, lower_ctrl_limit=0.0)
@@ -505,14 +505,14 @@ class AxisRecord(SettingsFields, PVGroup):
             await d.enable()
         if what == "move":
             await self._apply_accel()
-            velocity = self.velo if (self.velo_explicit and self.kmap.velocity) else None
+            velocity = self.velo if (self.velo_explicit and self.drive_settings.velocity) else None
             distance = abs(arg - self.drbv)
             timeout = None
             if self.velo:
                 timeout = max(d.sync.default_timeout, 3 * distance / self.velo + 4 * self.accl + 10.0)
             await d.move_to(arg, velocity=velocity, timeout=timeout, stop_on_cancel=False)
         elif what == "home":
-            await d.home(self.kmap.home_method(d, forward=arg), stop_on_cancel=False)
+            await d.home(self.drive_settings.home_method(forward=arg), stop_on_cancel=False)
         elif what == "jog":
             await d.jog(arg * self.dir * (self.jvel or self.velo or self.mres))
             await d.wait_idle(JOG_WAIT, stop_on_cancel=False)
@@ -529,7 +529,7 @@ class AxisRecord(SettingsFields, PVGroup):
         if key == self.accel_applied:
             return
         try:
-            await self.kmap.apply_accel(self.drive, self.accl, self.velo or 0.0)
+            await self.drive_settings.apply_accel(self.accl, self.velo or 0.0)
             self.accel_applied = key
         except Exception as e:  # noqa: BLE001 - ACCL not honoured: the move goes on at the drive's ramp
             self.face.counters["accel_errors"] += 1
