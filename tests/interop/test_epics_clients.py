@@ -461,7 +461,7 @@ def test_beacons_and_searches_stay_on_loopback(twin):
 
 # -- ophyd EpicsMotor in a bluesky scan ---------------------------------------------------------
 
-OPHYD_AXES = ("cia402", "dmac")      # one CAN kind, one serial kind
+OPHYD_AXES = tuple(BUILTIN)         # one scan steps every simulated kind together
 
 
 @pytest.fixture(scope="module")
@@ -598,6 +598,25 @@ def test_pyepics_motor_move_wait_limits_set_position_able(twin, pyepics_motor):
         m.put("OFF", off, wait=True)
 
 
+@pytest.mark.parametrize("axis", BUILTIN)
+def test_pyepics_motor_moves_and_refuses_past_the_soft_limit_on_every_kind(twin, axis):
+    m = epics.Motor(pv(axis), timeout=10)
+    m.put("VELO", fast(m.get("VMAX")), wait=True)
+    here = m.get_position(readback=True)
+    llm, hlm = m.get("LLM"), m.get("HLM")
+    m.put("LLM", here - 5.0, wait=True)
+    m.put("HLM", here + 5.0, wait=True)
+    try:
+        assert m.move(round(here + STEP, 2), wait=True, timeout=30) == 0
+        assert at_rest(twin, axis) == pytest.approx(here + STEP, abs=tolerance(axis))
+        assert m.get("DMOV") == 1
+        assert m.move(here + 10.0, wait=True, ignore_limits=True) == -4     # the record refused it: LVIO
+        assert at_rest(twin, axis) == pytest.approx(here + STEP, abs=tolerance(axis))
+    finally:
+        m.put("LLM", llm, wait=True)
+        m.put("HLM", hlm, wait=True)
+
+
 def test_pyepics_motor_sees_a_fault_in_rbv_severity(twin, pyepics_motor):
     m, axis = pyepics_motor, PYEPICS_AXIS
     m.put("VELO", SLOW, wait=True)
@@ -636,8 +655,8 @@ def _tool(name: str) -> str:
     return str(Path(sys.executable).with_name(name))
 
 
-def test_caproto_put_completes_at_the_end_of_motion_and_monitor_sees_dmov_pulse(twin):
-    axis = CLI_AXIS
+@pytest.mark.parametrize("axis", BUILTIN)
+def test_caproto_put_completes_at_the_end_of_motion_and_monitor_sees_dmov_pulse(twin, axis):
     epics.caput(pv(axis, "VELO"), fast(epics.caget(pv(axis, "VMAX"))), wait=True)
     here = at_rest(twin, axis)
     target = round(here + 5.0, 2)
