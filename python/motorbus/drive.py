@@ -849,7 +849,10 @@ class Drive(abc.ABC):
         status = await self._status()
         reason = await _value(self._stop_reason(status))
         position = await self._position()
-        arrived = move.target is None or abs(position - move.target) <= await _value(self._in_position_window())
+        # A target in user units is a float in native units (8.88 mm at 0.01 mm = 887.9999999999999
+        # steps, which the kind sends as step 888): that rounding is not a distance from the target.
+        arrived = move.target is None or abs(position - move.target) <= (
+            await _value(self._in_position_window()) + 1e-9 * max(1.0, abs(move.target)))
         if move.what == "home":
             failed = (reason is not None and reason.error is not LimitReached) or move.stopped_by is not None \
                 or not status.homed
