@@ -310,10 +310,11 @@ class UnknownParameter(_core.InvalidArgument, KeyError):
 
 
 def stopped_by_text(by: str) -> str:
-    """The outcome's words for who stopped a move: a bare verb ("stop()") was this program's;
-    a stop that came from elsewhere names its origin itself ("stop() of the program with pid
-    42 through motorbus serve", "STOP of the EPICS record lab:x")."""
-    return by if " of " in by else f"{by} of this program"
+    """The outcome's words for who stopped a move: a bare call ("stop()", "quick_stop()") is
+    this program's; anything else names its origin itself ("stop() of the program with pid
+    42 through motorbus serve", "STOP of the EPICS record lab:x", "the cancellation of the
+    awaiting task")."""
+    return f"{by} of this program" if by.endswith("()") else by
 
 
 class _Move:

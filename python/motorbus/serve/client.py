@@ -46,7 +46,7 @@ __all__ = ["connect", "aio_connect", "RemoteBench", "RemoteDrive", "RemoteParams
 def _from_here(by: str) -> str:
     """A stop sent to the service names this program, so the outcome the service records
     (which every program waiting on the move reads) says whose stop it was."""
-    return f"{by} of the program with pid {os.getpid()} through motorbus serve" if " of " not in by else by
+    return f"{by} of the program with pid {os.getpid()} through motorbus serve" if by.endswith("()") else by
 
 
 def resolve(address: Any) -> tuple[str, Optional[Any]]:
