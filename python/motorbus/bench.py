@@ -950,36 +950,49 @@ class Bench:
     def read_params(self, names: Optional[Sequence[str]] = None, *, all_params: bool = False) -> dict[str, dict]:
         """``{axis: {param: value}}`` read from the drives: the file's parameters,
         or every parameter the drive has with ``all_params``."""
+        return faces.run(self._co_read_params(names, all_params=all_params))
+
+    async def _co_read_params(self, names: Optional[Sequence[str]] = None, *,
+                              all_params: bool = False) -> dict[str, dict]:
         out = {}
         for axis, d in self.select(names).items():
             wanted = list(d.params) if all_params else list(self.config[axis].params)
-            out[axis] = {p: d.params[p] for p in wanted}
+            out[axis] = {p: await d.params._co_get(p) for p in wanted}
         return out
 
     def diff(self, names: Optional[Sequence[str]] = None) -> list[ParamDiff]:
         """The file's parameters whose drive value differs."""
+        return faces.run(self._co_diff(names))
+
+    async def _co_diff(self, names: Optional[Sequence[str]] = None) -> list[ParamDiff]:
         out = []
         for axis, d in self.select(names).items():
             for p, want in self.config[axis].params.items():
-                have = d.params[p]
+                have = await d.params._co_get(p)
                 if not _same(have, want):
                     out.append(ParamDiff(axis, p, want, have))
         return out
 
     def apply(self, names: Optional[Sequence[str]] = None) -> list[ParamDiff]:
         """Writes the file's parameters that differ; returns what it changed."""
-        changed = self.diff(names)
+        return faces.run(self._co_apply(names))
+
+    async def _co_apply(self, names: Optional[Sequence[str]] = None) -> list[ParamDiff]:
+        changed = await self._co_diff(names)
         for c in changed:
             try:
-                self[c.axis].params[c.name] = c.file_value
+                await self[c.axis].params._co_set(c.name, c.file_value)
             except _core.InvalidArgument as e:
                 raise self._fail(str(e), "axis", c.axis, "params", c.name) from None
         return changed
 
     def store(self, names: Optional[Sequence[str]] = None) -> None:
         """Persists the parameters on each drive (its own STORE/save)."""
+        faces.run(self._co_store(names))
+
+    async def _co_store(self, names: Optional[Sequence[str]] = None) -> None:
         for d in self.select(names).values():
-            d.store()
+            await d._co_store()
 
     # ---- lifetime --------------------------------------------------------------------------
     def close(self) -> None:

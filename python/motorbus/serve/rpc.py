@@ -778,48 +778,23 @@ async def _b_status(face: RpcFace, conn: _Conn) -> dict:
     return await face.bench.status()
 
 
-def _select(face: RpcFace, names: Optional[list]) -> dict:
-    return {n: face.bench[n] for n in names} if names else face.bench.axes
-
-
+# The bench's configuration verbs are the Bench's own coroutines (Bench._co_diff...), awaited
+# on the service's loop: each parameter read and write goes through the axis' link worker.
 async def _b_read_params(face: RpcFace, conn: _Conn, names: Optional[list] = None, *,
                          all_params: bool = False) -> dict:
-    out = {}
-    for axis, d in _select(face, names).items():
-        wanted = list(d.params) if all_params else list(face.bench.sync.config[axis].params)
-        out[axis] = {p: await d.params.get(p) for p in wanted}
-    return out
-
-
-async def _diff(face: RpcFace, names: Optional[list]) -> list:
-    from ..bench import ParamDiff, _same
-
-    out = []
-    for axis, d in _select(face, names).items():
-        for p, want in face.bench.sync.config[axis].params.items():
-            have = await d.params.get(p)
-            if not _same(have, want):
-                out.append(ParamDiff(axis, p, want, have))
-    return out
+    return await face.bench.sync._co_read_params(names, all_params=all_params)
 
 
 async def _b_diff(face: RpcFace, conn: _Conn, names: Optional[list] = None) -> list:
-    return await _diff(face, names)
+    return await face.bench.sync._co_diff(names)
 
 
 async def _b_apply(face: RpcFace, conn: _Conn, names: Optional[list] = None) -> list:
-    changed = await _diff(face, names)
-    for c in changed:
-        try:
-            await face.bench[c.axis].params.set(c.name, c.file_value)
-        except _core.InvalidArgument as e:
-            raise face.bench.sync._fail(str(e), "axis", c.axis, "params", c.name) from None
-    return changed
+    return await face.bench.sync._co_apply(names)
 
 
 async def _b_store(face: RpcFace, conn: _Conn, names: Optional[list] = None) -> None:
-    for d in _select(face, names).values():
-        await d.store()
+    await face.bench.sync._co_store(names)
 
 
 async def _b_poll(face: RpcFace, conn: _Conn, axes: Optional[list] = None, fields: Any = None,
