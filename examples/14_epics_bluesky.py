@@ -106,8 +106,12 @@ def clients() -> None:
           f"z still at {z.get_position(readback=True):.2f}")
 
     # ophyd + bluesky: EpicsMotor in a RunEngine scan, z read at every point.
-    x = EpicsMotor("lab:x", name="x")
-    zr = EpicsMotor("lab:z", name="z")
+    # settle_time: ophyd's EpicsMotor can lose the next move's status when the RunEngine
+    # sends it before ophyd's own DMOV callback has finished with the previous one, and
+    # the scan then waits forever (ophyd#782, open upstream).  A short settle closes that
+    # window; a real motor wants one anyway.
+    x = EpicsMotor("lab:x", name="x", settle_time=0.05)
+    zr = EpicsMotor("lab:z", name="z", settle_time=0.05)
     for m in (x, zr):
         m.wait_for_connection(timeout=10)
     x.user_setpoint.set(0.0).wait(10)                  # the record's own put completion

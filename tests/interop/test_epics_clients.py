@@ -479,7 +479,9 @@ def epics_motors(twin):
 
     found = {}
     for axis in OPHYD_AXES:
-        m = EpicsMotor(pv(axis), name=axis)
+        # settle_time: without it ophyd can drop the next move's status when the RunEngine
+        # issues it inside ophyd's own DMOV callback (ophyd#782), and a scan hangs.
+        m = EpicsMotor(pv(axis), name=axis, settle_time=0.05)
         m.wait_for_connection(timeout=10)
         found[axis] = m
     return found
