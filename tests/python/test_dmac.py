@@ -317,3 +317,45 @@ def test_codec_records_and_radix_enum():
     assert "VariableInfo(name='#HIGH_SPEED'" in repr(v)
     with pytest.raises(motorbus.InvalidArgument):
         dmac.format_value(1, "octal")
+
+
+class _TimePasses(LineDevice):
+    """A device between two modules on the line whose turn takes a millisecond: the
+    line server hands a line to its devices one after the other, and a real clock moves
+    on meanwhile."""
+
+    def __init__(self, clock):
+        super().__init__()
+        self.clock = clock
+
+    def on_line(self, line):
+        self.clock.advance(1 * MS)
+        return b""
+
+
+def test_one_synchro_top_starts_every_module_at_the_same_millisecond():
+    # On the wire the broadcast SYNCHRO TOP reaches both modules at once; each module
+    # takes the instant the line ended, not the instant its own turn came.
+    clock = SimClock()
+    a, b = make_sim("01", clock=clock), make_sim("02", clock=clock)
+    with PtyLineServer([a, _TimePasses(clock), b]) as server:
+        link = open_line(server.slave_path, timeout=0.5)
+        sleep = lambda s: clock.advance(int(s * 1e9))  # noqa: E731
+        clients = [DmacClient(link, address=n, sleep=sleep) for n in (1, 2)]
+        for c in clients:
+            c.brake(False)
+        synchro(link, "ON")
+        for c in clients:
+            c.move_to(200000)                 # held until the TOP
+        clock.advance(50 * MS)
+        assert a.state().position == b.state().position == 0
+        synchro(link, "TOP")
+        synchro(link, "OFF")
+        assert clients[1].position == 0       # an answer: the server has handled the TOP
+        clock.advance(300 * MS)
+        sa, sb = a.state(), b.state()
+        assert sa.now_ms == sb.now_ms
+        assert 0 < sa.position < 200000       # mid-move, where a 1 ms skew would show
+        assert sa.position == sb.position and sa.speed == sb.speed
+        for c in clients:
+            c.close()

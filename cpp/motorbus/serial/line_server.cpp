@@ -152,6 +152,7 @@ void PtyLineServer::run() {
                 else
                     ++c_.overlong_lines;
                 std::string replies;
+                for (const auto& d : devices) d->line_ends();
                 for (const auto& d : devices) replies += call(*d, *line);
                 if (replies.empty()) continue;
                 if (baud_) std::this_thread::sleep_until(rx_done);

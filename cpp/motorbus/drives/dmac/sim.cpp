@@ -217,7 +217,7 @@ void Sim::coast(double tau) {
     }
 }
 
-std::int64_t Sim::target_ms() const { return (clock_->now() - epoch_ns_) / kNsPerMs; }
+std::int64_t Sim::ms_at(Nanos t) const { return (t - epoch_ns_) / kNsPerMs; }
 
 bool Sim::idle_locked() const {
     const bool timers = vars_[static_cast<std::size_t>(Var::Timer1)] ||
@@ -230,9 +230,9 @@ bool Sim::ultrasync_locked() const {
     return chain_ && vars_[static_cast<std::size_t>(Var::InterpolMode)] == -1;
 }
 
-void Sim::catch_up_locked() {
+void Sim::catch_up_locked(Nanos at) {
     if (!chain_) {
-        catch_up_self_locked(target_ms());
+        catch_up_self_locked(ms_at(at));
         return;
     }
     // Chained modules live on one time line: each step ticks every module whose
@@ -240,8 +240,8 @@ void Sim::catch_up_locked() {
     // A module with nothing evolving jumps to now on its own (the chain only ever
     // releases modules that interpolate, which are never idle).
     const auto& ms = chain_->members;
-    std::vector<std::int64_t> target;  // read once: a real clock moves on while this loop runs
-    for (auto* m : ms) target.push_back(m->target_ms());
+    std::vector<std::int64_t> target;  // one instant: a real clock moves on while this loop runs
+    for (auto* m : ms) target.push_back(m->ms_at(at));
     for (;;) {
         Nanos next = std::numeric_limits<Nanos>::max();
         for (std::size_t i = 0; i < ms.size(); ++i) {
@@ -698,7 +698,10 @@ std::string Sim::on_line(std::string_view line) {
     {
         std::lock_guard lock(*mutex_);
         try {
-            catch_up_locked();
+            // The command acts when the line ended on the wire: a SYNCHRO TOP heard by
+            // two modules starts both at one millisecond, however the server orders them.
+            catch_up_locked(line_end_.value_or(clock_->now()));
+            line_end_.reset();
             reply = handle_locked(line);
         } catch (...) {
             // Hostile input must never take the device down: flag and stay silent.
@@ -715,9 +718,15 @@ std::string Sim::on_line(std::string_view line) {
     return reply;
 }
 
+void Sim::line_ends() {
+    std::lock_guard lock(*mutex_);
+    line_end_ = clock_->now();
+}
+
 std::string Sim::on_overlong() {
     std::lock_guard lock(*mutex_);
-    catch_up_locked();
+    catch_up_locked(line_end_.value_or(clock_->now()));
+    line_end_.reset();
     ++lines_rejected_;
     // Beyond kOverlongWindow the address is lost with the line: every module flags it.
     flag(error::kSyntax);

@@ -100,6 +100,7 @@ public:
 
     // ---- LineDevice -------------------------------------------------------
     std::string on_line(std::string_view line) override;
+    void line_ends() override;
     std::string request_terminator() const override { return options_.request_terminator; }
     // A frame longer than 256 characters sets the syntax error bit of the
     // module it addresses and is not answered (its commands are not run).
@@ -149,9 +150,10 @@ public:
 private:
     struct Pending;  // a move armed by SYNCHRO ON, started by SYNCHRO TOP
     struct Chain;    // IN6/OUT1 UltraSYNC wiring between modules
-    void catch_up_locked();
+    void catch_up_locked() { catch_up_locked(clock_->now()); }
+    void catch_up_locked(Nanos at);  // every module of the chain up to the instant `at`
     void catch_up_self_locked(std::int64_t target_ms);
-    std::int64_t target_ms() const;
+    std::int64_t ms_at(Nanos t) const;
     bool idle_locked() const;
     bool ultrasync_locked() const;
     void next_segment_locked();  // the current FIFO segment is done: start the next or stop
@@ -205,6 +207,7 @@ private:
     std::shared_ptr<Chain> chain_;
     Nanos epoch_ns_ = 0;
     std::int64_t now_ms_ = 0;
+    std::optional<Nanos> line_end_;  // when the line being handled ended on the wire (line_ends)
 
     std::array<std::int32_t, kVarCount> vars_{};
     std::uint32_t error_ = 0;
