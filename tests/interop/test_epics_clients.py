@@ -53,7 +53,7 @@ from motorbus.pytest_plugin import default_bench  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "python"))
 from drive_kinds import KINDS, OUT_OF_TREE  # noqa: E402  fast profiles, the simulators' shafts
 
-pytestmark = [pytest.mark.threaded, pytest.mark.timeout(120)]
+pytestmark = pytest.mark.timeout(120)   # not `threaded`: see NOT_THREADED in tests/conftest.py
 
 ECA_PUTFAIL = 160             # libca caerr.h: DEFMSG(CA_K_WARNING, 20), "Channel write request failed"
 BUILTIN = sorted(k for k in KINDS if k not in OUT_OF_TREE)
