@@ -49,6 +49,13 @@ def silent(ser, text: str) -> bytes:
     return got
 
 
+def handled(ser, addr: int) -> None:
+    """Returns once the server has handled every line sent before: an answered READ comes
+    after them on the one line.  Time is advanced only then -- a loaded machine may take
+    longer than silent()'s 50 ms to hand a line to the simulator."""
+    assert ask(ser, f"{addr:02d}READ #POSITION").startswith(f"{addr:02d}#POS=".encode())
+
+
 def prepare(ser, sims, clock, ex):
     send = ex["send"]
     addr = int(send[:2])
@@ -62,6 +69,7 @@ def prepare(ser, sims, clock, ex):
     elif "#STATUS" in send:
         # busy + movement + power on + S-curve
         assert silent(ser, f"{addr:02d}S_CURVE ON, MOVE_SPEED 20000") == b""
+        handled(ser, addr)
         clock.advance(10_000_000)
     elif "#ERROR" in send:
         for bit in range(32):
@@ -71,6 +79,7 @@ def prepare(ser, sims, clock, ex):
         sims[addr].set_supply_voltage(ex["value"])
     elif "#SPEED" in send:
         assert silent(ser, f"{addr:02d}MOVE_SPEED {ex['value']}") == b""
+        handled(ser, addr)
         clock.advance(2_000_000_000)
     elif send.startswith(f"{addr:02d}READ_SEQ"):
         n = int(send.split()[-1])
