@@ -189,7 +189,8 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
                         last = d.status.last_move
                         if last is not None and not last.ok:
                             failed[n] = (last.state, f"{last.state}: {last.reason}")
-            time.sleep(0.05)
+            if poller is not None:
+                _polled_past(poller, _core.runtime.monotonic_ns() / 1e9)
         frame = poller.frame() if poller is not None else {"t": np.zeros(0)}
         stats = poller.stats if poller is not None else {}
         frame_path = os.path.join(out, "demo_frame.npz")
@@ -260,6 +261,19 @@ def main(quick: bool = False, out: Optional[str] = None, bench_file: Optional[st
 def _why(e: BaseException) -> str:
     """One line: the error's class and message (a MoveFailed names axis, place and reason)."""
     return " ".join(f"{type(e).__name__}: {e}".split())
+
+
+def _polled_past(poller: Poller, t: float, timeout: float = 2.0) -> None:
+    """Until every poll group has a row taken after ``t`` (every axis at rest by then): on a
+    loaded machine the poll thread can lag the end of the moves by more than a few
+    milliseconds, and the plot's last sample must be where each axis came to rest."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        frame = poller.frame()
+        times = [v for k, v in frame.items() if k == "t" or k.endswith(".t")]
+        if times and all(len(v) and v[-1] >= t for v in times):
+            return
+        time.sleep(0.02)
 
 
 def _candumps(path: str, buses: int) -> list[str]:
