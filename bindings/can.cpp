@@ -103,7 +103,9 @@ static void bind_frames(py::module_& m) {
         .field("overruns", &BusCounters::overruns, "adapter/medium reported overrun or line too long")
         .field("parse_errors", &BusCounters::parse_errors, "malformed input from the medium, discarded")
         .field("bus_errors", &BusCounters::bus_errors, "error frames / BEL / error states reported")
-        .field("ignored", &BusCounters::ignored, "well-formed input not used (status lines etc.)");
+        .field("ignored", &BusCounters::ignored, "well-formed input not used (status lines etc.)")
+        .field("rx_bits", &BusCounters::rx_bits, "wire bits of the frames received (worst-case stuffing; own echoes left out)")
+        .field("tx_bits", &BusCounters::tx_bits, "wire bits of the frames sent (worst-case stuffing)");
 }
 
 static void bind_buses(py::module_& m) {

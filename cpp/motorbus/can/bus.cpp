@@ -43,6 +43,7 @@ void Bus::send(const Frame& frame, Duration timeout) {
         throw LinkDown("bus " + channel_ + " is bus-off: frame not sent");
     do_send(frame, deadline_after(timeout));
     tx_frames_.fetch_add(1, std::memory_order_relaxed);
+    tx_bits_.fetch_add(wire_bits_worst_case(frame), std::memory_order_relaxed);
     if (options_.receive_own) {
         Frame own = frame;
         own.flags |= kFlagLoopback;
@@ -236,6 +237,10 @@ void Bus::unsubscribe(SubscriptionId sid) {
 void Bus::dispatch_batch(std::span<const Frame> frames) {
     if (frames.empty()) return;
     rx_frames_.fetch_add(frames.size(), std::memory_order_relaxed);
+    std::uint64_t bits = 0;
+    for (const auto& f : frames)
+        if (!(f.flags & kFlagLoopback)) bits += wire_bits_worst_case(f);
+    rx_bits_.fetch_add(bits, std::memory_order_relaxed);
     std::shared_ptr<const Table> table;
     {
         std::lock_guard lock(table_mutex_);
@@ -297,6 +302,8 @@ BusCounters Bus::counters() const {
     c.parse_errors = parse_errors_.load();
     c.bus_errors = bus_errors_.load();
     c.ignored = ignored_.load();
+    c.rx_bits = rx_bits_.load();
+    c.tx_bits = tx_bits_.load();
     return c;
 }
 

@@ -48,6 +48,11 @@ struct BusCounters {
     std::uint64_t parse_errors = 0;  // malformed input from the medium, discarded
     std::uint64_t bus_errors = 0;    // error frames / BEL / error states reported
     std::uint64_t ignored = 0;       // well-formed input we do not use (status lines etc.)
+    // The wire bits of those frames (wire_bits_worst_case each, our own echoes left out):
+    // their rate over the bit rate is the bus load this program sees, counted where the
+    // frames pass anyway rather than by a listener per frame in Python.
+    std::uint64_t rx_bits = 0;
+    std::uint64_t tx_bits = 0;
 };
 
 using FrameCallback = std::function<void(const Frame&)>;
@@ -240,7 +245,7 @@ private:
     std::string last_link_loss_;  // watch_mutex_
 
     std::atomic<std::uint64_t> rx_frames_{0}, tx_frames_{0}, rx_dropped_{0}, tx_dropped_{0},
-        overruns_{0}, parse_errors_{0}, bus_errors_{0}, ignored_{0};
+        overruns_{0}, parse_errors_{0}, bus_errors_{0}, ignored_{0}, rx_bits_{0}, tx_bits_{0};
 };
 
 }  // namespace motorbus::can
