@@ -77,6 +77,11 @@ class BusCounters:
         malformed input from the medium, discarded
         """
     @property
+    def rx_bits(self) -> int:
+        """
+        wire bits of the frames received (worst-case stuffing; own echoes left out)
+        """
+    @property
     def rx_dropped(self) -> int:
         """
         received frames dropped because the recv() queue was full
@@ -85,6 +90,11 @@ class BusCounters:
     def rx_frames(self) -> int:
         """
         frames received from the medium
+        """
+    @property
+    def tx_bits(self) -> int:
+        """
+        wire bits of the frames sent (worst-case stuffing)
         """
     @property
     def tx_dropped(self) -> int:
