@@ -19,6 +19,21 @@ def test_open_bus_virtual_roundtrip_and_counters():
     assert a.closed and a.state == "closed"
 
 
+def test_counters_count_wire_bits_of_what_passes_but_not_own_echoes():
+    # 0x123 with 2 bytes: 47 + 16 bits + (34 + 16 - 1) // 4 = 12 stuff bits (worst case) = 75;
+    # an 8-byte extended frame: 67 + 64 + (54 + 64 - 1) // 4 = 29 -> 160.
+    std, ext = Frame(0x123, b"\x01\x02"), Frame(0x1ABCDE, bytes(8), extended=True)
+    assert motorbus._core.can.wire_bits_worst_case(std) == 75
+    assert motorbus._core.can.wire_bits_worst_case(ext) == 160
+    with motorbus.open_bus("virtual:py-bits", receive_own=True) as a, motorbus.open_bus("virtual:py-bits") as b:
+        a.send(std)
+        b.send(ext)
+        assert b.recv(1.0) == std
+        assert a.recv(1.0) is not None and a.recv(1.0) is not None     # the echo of std, then ext
+        assert a.counters.tx_bits == 75 and b.counters.rx_bits == 75
+        assert b.counters.tx_bits == 160 and a.counters.rx_bits == 160   # the echo is not on the wire twice
+
+
 def test_bad_specs_name_the_problem():
     with pytest.raises(motorbus.InvalidArgument, match=r"unknown bus scheme .nope. \(registered: .*virtual"):
         motorbus.open_bus("nope:x")
