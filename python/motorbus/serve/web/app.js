@@ -25,6 +25,7 @@ let lastT = null, lastRecv = 0, frozenNow = null;
 let connection = "connecting", socket = null;
 let counterKeys = "", counterCells = [];
 let dirty = true, lastDraw = -Infinity;
+let jogReleases = [];      // one per jog button: the window losing focus ends every jog
 
 // ---- cheap DOM writes: at 20 Hz most values do not change, so skip the write (and the relayout) --------
 function setText(node, text) {
@@ -108,6 +109,7 @@ function build(b) {
   const body = $("#axes tbody");
   body.replaceChildren();
   rows.clear();
+  jogReleases = [];
   (b.axes || []).forEach((ax, i) => body.append(makeRow(ax, i, !!b.allow_motion)));
 
   // One lane per axis in the position plot (see drawPositions); its height follows the axis count.
@@ -181,7 +183,7 @@ function jogButton(r, sign, speed) {
     motion(r, "jog", { velocity: sign * v }, `JOG ${r.name} ${sign * v} ${r.units}/s`);
   });
   for (const ev of ["pointerup", "pointercancel", "lostpointercapture"]) b.addEventListener(ev, release);
-  window.addEventListener("blur", release);
+  jogReleases.push(release);
   return b;
 }
 
@@ -358,37 +360,49 @@ function prepare(canvas) {
   const ctx = canvas.getContext("2d");
   ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
   ctx.clearRect(0, 0, w, h);
-  ctx.font = "12px system-ui, sans-serif";
   return { ctx, w, h };
 }
 
-function timeAxis(ctx, w, h, span) {
-  ctx.strokeStyle = "#e3e6ea";
-  ctx.fillStyle = "#5b636d";
-  ctx.textAlign = "center";
-  ctx.textBaseline = "top";
+function label(ctx, str, x, y, align, baseline, colour = "#5b636d", font = "11px system-ui, sans-serif") {
+  Object.assign(ctx, { textAlign: align, textBaseline: baseline, fillStyle: colour, font });
+  ctx.fillText(str, x, y);
+}
+function hline(ctx, x0, x1, y, colour) {
+  ctx.strokeStyle = colour;
+  ctx.beginPath(); ctx.moveTo(x0, y); ctx.lineTo(x1, y); ctx.stroke();
+}
+
+// Time grid and labels, and the t -> x mapping both plots share (right edge = the service's "now").
+function timeAxis(ctx, w, h) {
+  const span = bench.history_s || 60, now = serviceNow(), t0 = now - span;
   const step = (w - GUTTER) / (span / 10) >= 45 ? 10 : 20;  // labels 10 s apart unless they would collide
+  ctx.strokeStyle = "#e3e6ea";
   for (let s = 0; s <= span; s += step) {
     const x = GUTTER + (w - GUTTER) * (1 - s / span);
     ctx.beginPath(); ctx.moveTo(x, 0); ctx.lineTo(x, h - AXIS_H); ctx.stroke();
-    ctx.fillText(s === 0 ? "now" : `−${s} s`, Math.min(x, w - 14), h - AXIS_H + 4);
+    label(ctx, s === 0 ? "now" : `−${s} s`, Math.min(x, w - 14), h - AXIS_H + 4, "center", "top");
   }
+  return { now, X: (t) => GUTTER + (w - GUTTER) * ((t - t0) / span) };
 }
 
-// One polyline of a series; null samples break it. The last value runs on to "now": no update = no change.
-function trace(ctx, values, X, Y, now) {
+// One polyline of a series, clipped to its box; null samples break it. The last value runs on to "now":
+// the service sends nothing while nothing changes.
+function trace(ctx, box, colour, values, X, Y, now) {
+  ctx.save();
+  ctx.beginPath(); ctx.rect(...box); ctx.clip();
+  Object.assign(ctx, { strokeStyle: colour, lineWidth: 2 });
   ctx.beginPath();
-  let pen = false, last = null;
+  let last = null;
   for (let k = 0; k < values.length; k++) {
     const v = values[k];
-    if (v == null) { pen = false; last = null; continue; }
+    if (v == null) { last = null; continue; }
     const x = X(hist.t[k]), y = Y(v);
-    if (pen) ctx.lineTo(x, y); else ctx.moveTo(x, y);
-    pen = true;
+    if (last != null) ctx.lineTo(x, y); else ctx.moveTo(x, y);
     last = y;
   }
   if (last != null) ctx.lineTo(X(now), last);
   ctx.stroke();
+  ctx.restore();
 }
 
 // Positions: one horizontal lane per axis, each scaled to its own min..max over the window, the range
@@ -396,72 +410,43 @@ function trace(ctx, values, X, Y, now) {
 // on a shared scale flatten the small movers into a line; lanes also never draw on top of each other.
 function drawPositions() {
   const { ctx, w, h } = prepare($("#plot"));
-  const span = bench.history_s || 60, now = serviceNow(), t0 = now - span;
-  const X = (t) => GUTTER + (w - GUTTER) * ((t - t0) / span);
-  timeAxis(ctx, w, h, span);
+  const { now, X } = timeAxis(ctx, w, h);
   const axes = bench.axes || [], laneH = (h - AXIS_H) / Math.max(1, axes.length);
   axes.forEach((ax, i) => {
     const top = i * laneH, bottom = top + laneH, values = hist.axes[ax.name] || [];
     let lo = Infinity, hi = -Infinity;
     for (const v of values) if (v != null) { if (v < lo) lo = v; if (v > hi) hi = v; }
-    if (i > 0) { ctx.strokeStyle = "#c9ced4"; ctx.beginPath(); ctx.moveTo(0, top); ctx.lineTo(w, top); ctx.stroke(); }
-    ctx.fillStyle = colourOf(i);
-    ctx.textAlign = "left";
-    ctx.textBaseline = "middle";
-    ctx.font = "bold 13px system-ui, sans-serif";
-    ctx.fillText(`${ax.name}  ${withUnits(current.axes[ax.name], ax.units || "")}`, 6, top + laneH / 2);
-    ctx.font = "11px system-ui, sans-serif";
+    if (i > 0) hline(ctx, 0, w, top, "#c9ced4");
+    label(ctx, `${ax.name}  ${withUnits(current.axes[ax.name], ax.units || "")}`, 6, top + laneH / 2,
+      "left", "middle", colourOf(i), "bold 13px system-ui, sans-serif");
     if (!isFinite(lo)) return;
     const mid = (lo + hi) / 2, half = Math.max((hi - lo) / 2, 0.005);  // a still axis: a flat line mid-lane
     const ylo = mid - half * 1.15, yhi = mid + half * 1.15;
     const Y = (v) => bottom - 6 - (laneH - 12) * ((v - ylo) / (yhi - ylo));
-    ctx.fillStyle = "#5b636d";
-    ctx.textAlign = "right";
-    ctx.textBaseline = "top";
-    ctx.fillText(num(hi), GUTTER - 6, top + 3);
-    ctx.textBaseline = "bottom";
-    ctx.fillText(num(lo), GUTTER - 6, bottom - 3);
-    ctx.save();
-    ctx.beginPath(); ctx.rect(GUTTER, top, w - GUTTER, laneH); ctx.clip();
-    ctx.strokeStyle = colourOf(i);
-    ctx.lineWidth = 2;
-    trace(ctx, values, X, Y, now);
-    ctx.restore();
+    label(ctx, num(hi), GUTTER - 6, top + 3, "right", "top");
+    label(ctx, num(lo), GUTTER - 6, bottom - 3, "right", "bottom");
+    trace(ctx, [GUTTER, top, w - GUTTER, laneH], colourOf(i), values, X, Y, now);
   });
 }
 
 // Bus load: one shared 0..top % axis (same unit for every bus), top a round number above the peak.
 function drawBusload() {
   const { ctx, w, h } = prepare($("#busload"));
-  const span = bench.history_s || 60, now = serviceNow(), t0 = now - span;
-  const X = (t) => GUTTER + (w - GUTTER) * ((t - t0) / span);
+  const { now, X } = timeAxis(ctx, w, h);
   const buses = bench.buses || [];
   let peak = 0;
   for (const b of buses) for (const v of hist.buses[b.name] || []) if (v != null && v > peak) peak = v;
   const top = [1, 2, 5, 10, 20, 50, 100].find((s) => s >= peak * 1.1) || Math.ceil(peak / 50) * 50;
-  const plotH = h - AXIS_H - 8, Y = (v) => 8 + plotH * (1 - v / top);
-  timeAxis(ctx, w, h, span);
-  ctx.fillStyle = "#5b636d";
-  ctx.textAlign = "right";
-  ctx.textBaseline = "middle";
+  const Y = (v) => 8 + (h - AXIS_H - 8) * (1 - v / top);
   for (const f of [0, 0.5, 1]) {
-    ctx.strokeStyle = "#e3e6ea";
-    ctx.beginPath(); ctx.moveTo(GUTTER, Y(top * f)); ctx.lineTo(w, Y(top * f)); ctx.stroke();
-    ctx.fillText(`${top * f} %`, GUTTER - 6, Y(top * f));
+    hline(ctx, GUTTER, w, Y(top * f), "#e3e6ea");
+    label(ctx, `${top * f} %`, GUTTER - 6, Y(top * f), "right", "middle");
   }
-  if (!buses.length) { ctx.textAlign = "left"; ctx.fillText("no CAN bus on this bench", GUTTER + 10, h / 2); return; }
+  if (!buses.length) label(ctx, "no CAN bus on this bench", GUTTER + 10, h / 2, "left", "middle");
   buses.forEach((b, i) => {
-    ctx.fillStyle = colourOf(i);
-    ctx.textAlign = "left";
-    ctx.font = "bold 13px system-ui, sans-serif";
-    ctx.fillText(`${b.name}  ${num(current.buses[b.name], 1)} %`, 6, 16 + i * 18);
-    ctx.font = "12px system-ui, sans-serif";
-    ctx.save();
-    ctx.beginPath(); ctx.rect(GUTTER, 0, w - GUTTER, h - AXIS_H); ctx.clip();
-    ctx.strokeStyle = colourOf(i);
-    ctx.lineWidth = 2;
-    trace(ctx, hist.buses[b.name] || [], X, Y, now);
-    ctx.restore();
+    label(ctx, `${b.name}  ${num(current.buses[b.name], 1)} %`, 6, 16 + i * 18, "left", "middle",
+      colourOf(i), "bold 13px system-ui, sans-serif");
+    trace(ctx, [GUTTER, 0, w - GUTTER, h - AXIS_H], colourOf(i), hist.buses[b.name] || [], X, Y, now);
   });
 }
 
@@ -486,5 +471,6 @@ fetch("api/bench", { cache: "no-store" })
   .then((b) => { if (b && !helloSeen) build(b); })
   .catch(() => { /* the websocket's retries report the service's absence */ });
 window.addEventListener("resize", () => { dirty = true; });
+window.addEventListener("blur", () => jogReleases.forEach((release) => release()));
 connect();
 requestAnimationFrame(frame);
