@@ -6,7 +6,8 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 BUILD  := build/dev
 JOBS   ?= $(shell nproc)
-APT_PACKAGES := cmake ninja-build g++ libeigen3-dev libgtest-dev clang libclang-rt-14-dev ccache tmux ser2net
+APT_PACKAGES := cmake ninja-build g++ libeigen3-dev libgtest-dev clang libclang-rt-14-dev ccache tmux ser2net \
+  chromium chromium-driver
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # ccache (when installed) with paths relative to the checkout, so a fresh clone
 # in another directory reuses earlier compilations.  Whether it is installed is

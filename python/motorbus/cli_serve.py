@@ -1,6 +1,7 @@
 """``motorbus serve BENCH [--sim] [--prefix P] [--interface ADDR]... [--ca-port N]
-[--socket PATH] [--no-epics]``: one process owns the bench and serves every axis
-(docs/serve.md; the CA face: docs/epics.md).
+[--socket PATH] [--no-epics] [--http [HOST:]PORT [--allow-motion]]``: one process owns the
+bench and serves every axis (docs/serve.md; the CA face: docs/epics.md; the web page:
+docs/web.md).
 
 It prints one line per face and the environment a Channel Access client sets, then
 serves until SIGTERM, SIGINT or SIGHUP, which stop every axis before it exits (exit
@@ -23,10 +24,15 @@ def _say(line: str) -> None:
 
 def cmd_serve(args: argparse.Namespace) -> int:
     from .serve.service import BenchService
+    from .serve.web import parse_http_address
 
+    if args.allow_motion and args.http is None:
+        raise _core.InvalidArgument("motorbus serve --allow-motion: lets the web page move axes; give --http too")
     service = BenchService(args.bench, sim=args.sim, prefix=args.prefix,
                            interfaces=tuple(args.interface or ("127.0.0.1",)), ca_port=args.ca_port,
-                           socket_path=args.socket, epics=not args.no_epics)
+                           socket_path=args.socket, epics=not args.no_epics,
+                           http=None if args.http is None else parse_http_address(args.http),
+                           allow_motion=args.allow_motion)
 
     async def main() -> int:
         info = await service.start()
@@ -34,6 +40,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
         axes = ", ".join(service.bench.axes)
         _say(f"serving {info.bench}{' (simulated twin)' if info.sim else ''}, pid {info.pid}: {axes}")
         _say(f"rpc unix:{info.socket}")
+        if info.http is not None:
+            _say(f"http {info.http}{' (the page may move axes: --allow-motion)' if service.allow_motion else ''}")
         if info.prefix is not None:
             hosts = ", ".join(info.interfaces)
             _say(f"ca {info.prefix}<axis> on {hosts} port {info.ca_port}")
@@ -77,6 +85,11 @@ def add_commands(sub: Any, common: Any = None) -> None:
                         "/tmp/motorbus-UID, named by the bench file)")
     p.add_argument("--no-epics", action="store_true",
                    help="no Channel Access: serve motorbus's own programs only (caproto not needed)")
+    p.add_argument("--http", default=None, metavar="[HOST:]PORT",
+                   help="serve a live web page of the bench on PORT (default host 127.0.0.1: this host only; "
+                        "0.0.0.0 for every network); its STOP buttons always work")
+    p.add_argument("--allow-motion", action="store_true",
+                   help="let the web page move, jog, home, enable and clear axes too (default: it only stops)")
     p.set_defaults(func=cmd_serve)
 
 

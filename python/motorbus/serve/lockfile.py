@@ -59,6 +59,7 @@ class ServiceInfo:
     interfaces: list = field(default_factory=list)
     env: dict = field(default_factory=dict)    # what a CA client on this host sets
     links: list = field(default_factory=list)  # the bus specs and serial ports it holds (raw access refused)
+    http: Optional[str] = None       # the web page's URL (None: served without --http)
 
     def to_json(self) -> str:
         return json.dumps(dataclasses.asdict(self), indent=1, sort_keys=True)

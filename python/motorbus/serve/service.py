@@ -69,6 +69,15 @@ def _require_caproto() -> None:
         raise _core.InvalidArgument(f"motorbus serve: {EPICS_EXTRA_HINT}")
 
 
+WEB_EXTRA_HINT = ("serving the web page (--http) needs aiohttp, the optional extra motorbus[web]: "
+                  "pip install 'motorbus[web]'")
+
+
+def _require_aiohttp() -> None:
+    if importlib.util.find_spec("aiohttp") is None:
+        raise _core.InvalidArgument(f"motorbus serve: {WEB_EXTRA_HINT}")
+
+
 class BenchService:
     """Owns ``bench_path``'s bench (or, ``sim=True``, its simulated twin, which then lasts
     as long as the service) and serves it: over Channel Access (``epics=True``, needs
@@ -76,7 +85,8 @@ class BenchService:
 
     def __init__(self, bench_path: Any, *, sim: bool = False, prefix: Optional[str] = None,
                  interfaces: Sequence[str] = ("127.0.0.1",), ca_port: Optional[int] = None,
-                 socket_path: Optional[str] = None, epics: bool = True) -> None:
+                 socket_path: Optional[str] = None, epics: bool = True, http: Optional[tuple] = None,
+                 allow_motion: bool = False) -> None:
         self.bench_path = os.path.realpath(os.fspath(bench_path))
         if not os.path.isfile(self.bench_path):
             raise _core.InvalidArgument(f"motorbus serve: {os.fspath(bench_path)}: no such bench file")
@@ -92,9 +102,12 @@ class BenchService:
         self.interfaces = interfaces
         self.ca_port = ca_port
         self.socket_path = check_socket_path(socket_path or default_socket_path(self.bench_path))
+        self.http = http                # (host, port) of the web face (serve.web), None: no page
+        self.allow_motion = allow_motion
         self.bench: Any = None          # the aio.Bench
         self.ca: Any = None             # serve.epics.CaFace
         self.rpc: Any = None            # serve.rpc.RpcFace
+        self.web: Any = None            # serve.web.WebFace
         self.info: Optional[ServiceInfo] = None
         self._lock = ServiceLock(self.bench_path)
         self._stop: Optional[asyncio.Event] = None
@@ -115,6 +128,8 @@ class BenchService:
         self._install_signals()         # before any transport opens: a signal meanwhile still stops cleanly
         self._lock.acquire()
         try:
+            if self.http is not None:
+                _require_aiohttp()
             if self.epics:
                 _require_caproto()
                 if self.prefix is None:
@@ -143,6 +158,12 @@ class BenchService:
             from . import rpc
 
             self.rpc = await rpc.start_rpc(self.bench, self.socket_path, info=_info_dict(info))
+            if self.http is not None:
+                from . import web
+
+                self.web = await web.start_web(self.bench, *self.http, bench_path=self.bench_path, sim=self.sim,
+                                               allow_motion=self.allow_motion, counters=self.counters)
+                info.http = self.web.url
             self._lock.publish(info)
             register(self.bench_path)
             self.info = info
@@ -304,7 +325,7 @@ class BenchService:
             log.warning("serve: %s: %s: %s", what, type(e).__name__, e)
 
     async def _close_faces(self) -> None:
-        for attr in ("rpc", "ca"):
+        for attr in ("web", "rpc", "ca"):      # the page first: its sockets say the service is going
             face = getattr(self, attr)
             setattr(self, attr, None)
             if face is None:
@@ -350,6 +371,8 @@ class BenchService:
             out["rpc"] = dict(getattr(self.rpc, "counters", {}) or {})
         if self.ca is not None:
             out["ca"] = dict(getattr(self.ca, "counters", {}) or {})
+        if self.web is not None:
+            out["web"] = dict(self.web.counters)
         if self.bench is not None:
             out["sdo"] = self._sdo_counters()
         out.setdefault("sdo", {})
