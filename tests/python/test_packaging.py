@@ -50,6 +50,11 @@ def test_pip_install_into_a_clean_venv_then_every_command(tmp_path):
     for sub in (["bus", "serve"], ["bus", "dump"], ["bus", "play"], ["sim", "serve"], ["demo"]):
         _run([mb, *sub, "--help"], 120, tmp_path)
     _run([py, "-m", "motorbus", "--help"], 120, tmp_path)
+    # the web page's assets ship in the wheel (motorbus serve --http serves them from the package)
+    out = _run([py, "-c", "from importlib import resources; w = resources.files('motorbus.serve') / 'web'; "
+                          "print(sorted((n, len((w / n).read_bytes()) > 0) for n in ('index.html', 'app.js', "
+                          "'style.css')))"], 120, tmp_path)
+    assert out.strip() == "[('app.js', True), ('index.html', True), ('style.css', True)]", out
     # the python-can interface entry point of the installed distribution
     _run([py, "-c", "import can; b = can.Bus(interface='motorbus', channel='virtual:pkg'); "
                     "print(b.channel_info); b.shutdown()"], 120, tmp_path)

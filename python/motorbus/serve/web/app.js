@@ -1,4 +1,4 @@
-// motorbus live web view: one page showing a served bench (docs: issue 27 contract).
+// motorbus live web view: one page showing a served bench (docs/web.md: what it shows, its API).
 // Plain ES2020, no framework, no network beyond this service: it must work offline in a lab.
 // Data: the websocket's "hello" (layout + the last 60 s), then "update"s at up to 20 Hz.
 // STOP buttons are plain fetch POSTs so they work whatever the websocket is doing.
