@@ -25,7 +25,6 @@ from selenium.webdriver.chrome.service import Service  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "python"))
-from drive_kinds import KINDS  # noqa: E402
 from served_web import ServedWeb, wait_until  # noqa: E402
 
 from motorbus.drive import MoveInterrupted  # noqa: E402
@@ -73,20 +72,6 @@ def browser(served):
     driver.quit()
 
 
-def shaft_mm(s, axis: str) -> float:
-    cfg = s.bench.sync.config[axis]
-    return KINDS[cfg.kind].shaft(s.sims[axis]) * cfg.units.scale
-
-
-def rest_mm(s, axis: str, timeout: float = 15.0) -> float:
-    deadline = time.monotonic() + timeout
-    at = shaft_mm(s, axis)
-    while time.monotonic() < deadline:
-        time.sleep(0.05)
-        now, at = at, shaft_mm(s, axis)
-        if now == at:
-            return at
-    raise AssertionError(f"{axis} still moves")
 
 
 def row(driver, axis: str):
@@ -128,7 +113,7 @@ def test_the_page_loads_with_every_axis_of_the_demo_bench(served, browser):
 
 
 def test_a_position_moves_on_the_page_while_the_axis_moves(served, browser):
-    start = rest_mm(served, "x")
+    start = served.rest_mm("x")
     target = round(start + 60.0, 2)
     move = served.submit(served.bench["x"].move_to(target))      # another program moves x
     seen = []
@@ -147,38 +132,38 @@ def test_a_position_moves_on_the_page_while_the_axis_moves(served, browser):
 
 
 def test_stop_on_the_page_stops_the_simulated_axis(served, browser):
-    start = rest_mm(served, "y")
+    start = served.rest_mm("y")
     move = served.submit(served.bench["y"].move_to(start + 400.0))     # 8 s at the demo's speed
-    wait_until(lambda: abs(shaft_mm(served, "y") - start) > 2.0, what="y moving")
+    wait_until(lambda: abs(served.shaft_mm("y") - start) > 2.0, what="y moving")
     wait_until(lambda: "moving" in cell(browser, "y", "state"), what="the page showing y moving")
     row(browser, "y").find_element(By.CSS_SELECTOR, "button.stop").click()
     with pytest.raises(MoveInterrupted, match=r"STOP on the web page \(127\.0\.0\.1\)"):
         move.result(15)
-    at = rest_mm(served, "y")
+    at = served.rest_mm("y")
     assert start + 2.0 < at < start + 390.0
     time.sleep(0.3)
-    assert shaft_mm(served, "y") == at                     # stopped, asserted on the simulator
+    assert served.shaft_mm("y") == at                     # stopped, asserted on the simulator
     wait_until(lambda: cell(browser, "y", "outcome").startswith("interrupted"), what="y's outcome on the page")
     assert "web page" in cell(browser, "y", "outcome")
 
 
 def test_stop_all_on_the_page_stops_every_moving_axis(served, browser):
-    starts = {a: rest_mm(served, a) for a in ("x", "z")}
+    starts = {a: served.rest_mm(a) for a in ("x", "z")}
     moves = {a: served.submit(served.bench[a].move_to(starts[a] + 600.0)) for a in starts}
     for a in starts:
-        wait_until(lambda a=a: abs(shaft_mm(served, a) - starts[a]) > 1.0, what=f"{a} moving")
+        wait_until(lambda a=a: abs(served.shaft_mm(a) - starts[a]) > 1.0, what=f"{a} moving")
     browser.find_element(By.ID, "stop-all").click()
     for a, m in moves.items():
         with pytest.raises(MoveInterrupted, match="STOP ALL on the web page"):
             m.result(15)
-        assert rest_mm(served, a) < starts[a] + 590.0
+        assert served.rest_mm(a) < starts[a] + 590.0
 
 
 def test_a_fault_appears_on_the_page_with_its_reason(served, browser):
     sim = served.sims["z"]
-    start = rest_mm(served, "z")
+    start = served.rest_mm("z")
     move = served.submit(served.bench["z"].move_to(start + 600.0))
-    wait_until(lambda: abs(shaft_mm(served, "z") - start) > 1.0, what="z moving")
+    wait_until(lambda: abs(served.shaft_mm("z") - start) > 1.0, what="z moving")
     sim.inject_fault(0x5441)                 # a CiA 402 drive fault: 0x5441 (EMCY code of the sim)
     with pytest.raises(Exception):
         move.result(15)
@@ -189,7 +174,7 @@ def test_a_fault_appears_on_the_page_with_its_reason(served, browser):
     assert outcome.startswith("fault"), outcome
     # The screenshot: z faulted, the others' traces in the plot (looked at: docs/web.md shows it).
     SHOTS.mkdir(parents=True, exist_ok=True)
-    x0 = rest_mm(served, "x")
+    x0 = served.rest_mm("x")
     mover = served.submit(served.bench["x"].move_to(x0 - 40.0))
     time.sleep(0.4)
     shot = SHOTS / "web_page.png"
@@ -203,12 +188,12 @@ def test_a_fault_appears_on_the_page_with_its_reason(served, browser):
 
 
 def test_move_from_the_page_with_allow_motion(served, browser):
-    start = rest_mm(served, "rot")
+    start = served.rest_mm("rot")
     box = row(browser, "rot").find_element(By.CSS_SELECTOR, "input.target")
     box.clear()
     box.send_keys(f"{start + 90.0:.3f}")
     row(browser, "rot").find_element(By.CSS_SELECTOR, "button.move").click()
-    wait_until(lambda: abs(shaft_mm(served, "rot") - (start + 90.0)) < 0.05, timeout=20, what="rot at target")
+    wait_until(lambda: abs(served.shaft_mm("rot") - (start + 90.0)) < 0.05, timeout=20, what="rot at target")
     wait_until(lambda: cell(browser, "rot", "outcome").startswith("done"), what="rot's outcome")
     assert console_errors(browser) == []
 

@@ -61,6 +61,24 @@ class ServedWeb:
     def sims(self) -> dict:
         return self.service.bench.sync.sims
 
+    def shaft_mm(self, axis: str) -> float:
+        """Where the axis' motor stands, in its units, read on its simulator (not the drive's word)."""
+        from drive_kinds import KINDS
+
+        cfg = self.bench.sync.config[axis]
+        return KINDS[cfg.kind].shaft(self.sims[axis]) * cfg.units.scale
+
+    def rest_mm(self, axis: str, timeout: float = 15.0) -> float:
+        """Where the shaft stands once two reads 50 ms apart agree."""
+        deadline = time.monotonic() + timeout
+        at = self.shaft_mm(axis)
+        while time.monotonic() < deadline:
+            time.sleep(0.05)
+            now, at = at, self.shaft_mm(axis)
+            if now == at:
+                return at
+        raise AssertionError(f"{axis} still moves")
+
     def run(self, coro: Any, timeout: float = 30.0) -> Any:
         """Runs a coroutine on the service's loop; returns its result."""
         return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout)

@@ -25,7 +25,6 @@ import motorbus  # noqa: E402
 from motorbus.drive import MoveInterrupted  # noqa: E402
 from motorbus.serve.web import UPDATE_HZ, parse_http_address  # noqa: E402
 
-from drive_kinds import KINDS  # noqa: E402
 from served_web import ServedWeb, wait_until  # noqa: E402
 
 DEMO_AXES = ["x", "y", "rot", "z", "tilt", "feed", "spindle"]
@@ -55,21 +54,6 @@ def get(url: str) -> tuple[int, bytes, str]:
         return r.status, r.read(), r.headers.get("Content-Type", "")
 
 
-def shaft_mm(s, axis: str) -> float:
-    cfg = s.bench.sync.config[axis]
-    return KINDS[cfg.kind].shaft(s.sims[axis]) * cfg.units.scale
-
-
-def rest_mm(s, axis: str, timeout: float = 15.0) -> float:
-    """Where the shaft stands once two reads 50 ms apart agree."""
-    deadline = time.monotonic() + timeout
-    at = shaft_mm(s, axis)
-    while time.monotonic() < deadline:
-        time.sleep(0.05)
-        now, at = at, shaft_mm(s, axis)
-        if now == at:
-            return at
-    raise AssertionError(f"{axis} still moves")
 
 
 async def _updates(url: str, n: int, *, seconds: float = 10.0) -> tuple[dict, list]:
@@ -160,15 +144,15 @@ def test_bus_load_of_each_can_bus_comes_from_its_bit_counters(served):
 
 
 def test_stop_post_stops_the_moving_axis_and_names_the_page(served):
-    start = rest_mm(served, "x")
+    start = served.rest_mm("x")
     move = served.submit(served.bench["x"].move_to(start + 200.0))
-    wait_until(lambda: abs(shaft_mm(served, "x") - start) > 1.0, what="x moving")
+    wait_until(lambda: abs(served.shaft_mm("x") - start) > 1.0, what="x moving")
     status, reply = post(served.url + "api/axes/x/stop")
     assert status == 200 and reply == {"ok": True, "stopped": ["x"]}
     with pytest.raises(MoveInterrupted) as e:
         move.result(15)
     assert "STOP on the web page (127.0.0.1)" in str(e.value)
-    at = rest_mm(served, "x")
+    at = served.rest_mm("x")
     assert start + 1.0 < at < start + 199.0
     # Every program reads the same outcome, the page too.
     _, updates = asyncio.run(_updates(served.url, 6))
@@ -178,37 +162,37 @@ def test_stop_post_stops_the_moving_axis_and_names_the_page(served):
 
 
 def test_stop_all_post_stops_every_moving_axis(served):
-    starts = {a: rest_mm(served, a) for a in ("x", "z")}
+    starts = {a: served.rest_mm(a) for a in ("x", "z")}
     moves = {a: served.submit(served.bench[a].move_to(starts[a] + 600.0)) for a in starts}
     for a in starts:
-        wait_until(lambda a=a: abs(shaft_mm(served, a) - starts[a]) > 0.5, what=f"{a} moving")
+        wait_until(lambda a=a: abs(served.shaft_mm(a) - starts[a]) > 0.5, what=f"{a} moving")
     status, reply = post(served.url + "api/stop", None)
     assert status == 200 and reply["stopped"] == DEMO_AXES
     for a, m in moves.items():
         with pytest.raises(MoveInterrupted, match="STOP ALL on the web page"):
             m.result(15)
-        assert rest_mm(served, a) < starts[a] + 599.0
+        assert served.rest_mm(a) < starts[a] + 599.0
 
 
 def test_motion_verbs_move_jog_and_home_with_allow_motion(served):
-    start = rest_mm(served, "z")
+    start = served.rest_mm("z")
     status, reply = post(served.url + "api/axes/z/move", {"target": round(start + 3.0, 2)})
     assert status == 202 and reply == {"ok": True}
     wait_until(lambda: served.run(_last_state(served, "z")) == "done", what="z's move done")
-    assert rest_mm(served, "z") == pytest.approx(start + 3.0, abs=0.02)
+    assert served.rest_mm("z") == pytest.approx(start + 3.0, abs=0.02)
     status, _ = post(served.url + "api/axes/z/move", {"distance": -1.0})
     assert status == 202
     wait_until(lambda: served.run(_last_state(served, "z")) == "done" and
-               abs(rest_mm(served, "z") - (start + 2.0)) < 0.02, what="z's relative move")
+               abs(served.rest_mm("z") - (start + 2.0)) < 0.02, what="z's relative move")
     status, _ = post(served.url + "api/axes/y/jog", {"velocity": 10.0})
     assert status == 202
-    y0 = shaft_mm(served, "y")
-    wait_until(lambda: shaft_mm(served, "y") > y0 + 0.5, what="y jogging")
+    y0 = served.shaft_mm("y")
+    wait_until(lambda: served.shaft_mm("y") > y0 + 0.5, what="y jogging")
     status, _ = post(served.url + "api/axes/y/jog", {"velocity": 0})
     assert status == 202
-    y1 = rest_mm(served, "y")
+    y1 = served.rest_mm("y")
     time.sleep(0.2)
-    assert shaft_mm(served, "y") == y1
+    assert served.shaft_mm("y") == y1
 
 
 async def _last_state(s, axis: str):
@@ -229,13 +213,13 @@ async def _last_state(s, axis: str):
     ("api/axes/z/move", b"x" * 10_000, "application/json", 413, None),
 ])
 def test_bad_requests_get_a_typed_answer_and_move_nothing(served, path, body, ctype, code, words):
-    before = {a: shaft_mm(served, a) for a in ("z",)}
+    before = {a: served.shaft_mm(a) for a in ("z",)}
     status, reply = post(served.url + path, body, ctype) if code != 413 else _post_raw(served.url + path, body)
     assert status == code, reply
     if words is not None:
         assert reply["ok"] is False and words in reply["error"]
     time.sleep(0.05)
-    assert shaft_mm(served, "z") == before["z"]
+    assert served.shaft_mm("z") == before["z"]
 
 
 def _post_raw(url: str, body: bytes) -> tuple[int, dict]:
