@@ -114,7 +114,7 @@ def test_the_page_loads_with_every_axis_of_the_demo_bench(served, browser):
 
 def test_a_position_moves_on_the_page_while_the_axis_moves(served, browser):
     start = served.rest_mm("x")
-    target = round(start + 60.0, 2)
+    target = round(start + 150.0, 2)             # 3 s at the demo's 50 mm/s
     move = served.submit(served.bench["x"].move_to(target))      # another program moves x
     seen = []
     deadline = time.monotonic() + 20

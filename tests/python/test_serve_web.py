@@ -120,7 +120,7 @@ def test_updates_are_coalesced_to_at_most_update_hz(served):
         async with aiohttp.ClientSession() as session:
             async with session.ws_connect(served.url.replace("http", "ws", 1) + "ws") as ws:
                 await ws.receive()
-                mover = served.submit(served.bench["y"].move_by(40.0))    # changes every sample
+                mover = served.submit(served.bench["y"].move_by(100.0))   # 2 s: changes at every sample
                 n, t0 = 0, time.monotonic()
                 while time.monotonic() - t0 < 1.0:
                     await ws.receive(timeout=2)
