@@ -271,7 +271,7 @@ class Sampler:
 
 def _product(drive: Any) -> str:
     """What the drive is, from its kind's description without the details (the kind's
-    own words, not asked of the drive: "Arcus DMX-CAN integrated stepper")."""
+    own words, not asked of the drive: the product, before its details)."""
     text = getattr(type(drive), "description", "") or drive.kind
     text = re.sub(r"\s*\([^)]*\)", "", text)
     return re.split(r"[,;]", text, maxsplit=1)[0].strip() or drive.kind
