@@ -16,14 +16,17 @@ every registered kind's probe (its Drive class's ``probe`` / ``canopen_match``):
   CANopen kinds' ``canopen_match``; then the probes of CAN kinds that are not
   CANopen.
 
-Discovery never moves a motor and never writes a parameter: probes only read.
+Every line and bus is probed at the same time (a thread each): a scan takes as long as
+its slowest place, not the sum of them.  Discovery never moves a motor and never writes a parameter: probes only read.
 ``timeout`` is a budget for the whole run: what is left unprobed when it runs out
 is reported in ``Discovery.skipped``.  ``progress=True`` draws a bar on a
 terminal and plain lines otherwise (or pass a callable taking one line).
 """
 from __future__ import annotations
 
+import concurrent.futures
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional, Sequence, Union
@@ -66,6 +69,7 @@ class _Progress:
 
     def __init__(self, progress: Union[bool, Callable[[str], None]], total: int) -> None:
         self.total, self.done = max(1, total), 0
+        self._lock = threading.Lock()       # every line and bus is probed from a thread of its own
         self.say: Optional[Callable[[str], None]] = None
         self.tty = False
         if callable(progress):
@@ -82,17 +86,19 @@ class _Progress:
 
     def step(self, text: str, n: int = 1) -> None:
         """One unit of work done: redraws the bar (a terminal only: a log gets notes)."""
-        self.done = min(self.total, self.done + n)
-        if self.tty:
-            self._draw(text)
+        with self._lock:
+            self.done = min(self.total, self.done + n)
+            if self.tty:
+                self._draw(text)
 
     def note(self, text: str) -> None:
         """A line worth keeping (what is being swept, what answered)."""
-        if self.tty:
-            sys.stderr.write("\r" + " " * 100 + "\r" + text + "\n")
-            self._draw("")
-        elif self.say:
-            self.say(text)
+        with self._lock:
+            if self.tty:
+                sys.stderr.write("\r" + " " * 100 + "\r" + text + "\n")
+                self._draw("")
+            elif self.say:
+                self.say(text)
 
     def finish(self, text: str) -> None:
         if self.tty:
@@ -121,75 +127,103 @@ def discover(lines: Sequence[str] = (), buses: Sequence[Any] = (), *, kinds: Opt
     bar = _Progress(progress, total)
     t0 = time.monotonic()
     deadline = t0 + timeout
-    found: list[Found] = []
-    skipped: list[str] = []
-    probes = 0
-
-    for port in lines:
-        # One RS-485 line runs one protocol at one baud rate: once drives of a kind
-        # answered at a rate, the other rates and kinds are not swept on that line.
-        settled = False
-        for plugin in serial:
-            if settled:
-                skipped.append(f"{port} {plugin.kind}: the line already answered another kind")
-                continue
-            for baud in plugin.probe_bauds or (plugin.default_baud,):
-                if settled:
-                    break
-                if time.monotonic() >= deadline:
-                    skipped.append(f"{port} {plugin.kind} @{baud}")
-                    continue
-                bar.note(f"{port}: {plugin.kind} at {baud} baud, {len(plugin.probe_addresses)} addresses")
-                try:
-                    opened = _core.serial.open_port(port, baud)
-                    link = _core.serial.LineLink(opened, reply_timeout=reply_timeout + _wire_time(baud),
-                                                 **(plugin.line_settings or {}))
-                except _core.MotorbusError as e:
-                    skipped.append(f"{port}: {e}")
-                    break
-                try:
-                    for address in plugin.probe_addresses:
-                        if time.monotonic() >= deadline:
-                            skipped.append(f"{port} {plugin.kind} @{baud} from {address}")
-                            break
-                        probes += 1
-                        ident = _safe_probe(plugin, link, address)
-                        bar.step(f"{port} {plugin.kind} {address} @{baud}")
-                        if ident is not None:
-                            settled = True
-                            found.append(Found(plugin.kind, address, line=port, baud=baud, identity=ident))
-                            bar.note(f"{port}: {plugin.kind} {address} at {baud} baud answered: {ident}")
-                finally:
-                    opened.close()
-
-    for spec in buses:
-        bus = open_bus(spec) if isinstance(spec, str) else spec
-        label = spec if isinstance(spec, str) else getattr(bus, "channel", "bus")
-        try:
-            if canopen and time.monotonic() < deadline:
-                nodes = _core.canopen.scan_network(bus, sdo_timeout=sdo_timeout, listen=0.0)
-                bar.step(f"{label}: CANopen scan, {len(nodes)} node(s)")
-                bar.note(f"{label}: CANopen scan found node(s) {[n.node for n in nodes]}")
-                for node in nodes:
-                    scores = sorted(((p.canopen_match(node) or 0, p.kind) for p in canopen), reverse=True)
-                    if scores and scores[0][0] > 0:
-                        found.append(Found(scores[0][1], str(node.node), bus=label, identity=_node_identity(node)))
-            for plugin in can_probes:
-                for address in plugin.probe_addresses:
-                    if time.monotonic() >= deadline:
-                        skipped.append(f"{label} {plugin.kind} from {address}")
-                        break
-                    probes += 1
-                    ident = _safe_probe(plugin, bus, address)
-                    bar.step(f"{label} {plugin.kind} {address}")
-                    if ident is not None:
-                        found.append(Found(plugin.kind, address, bus=label, identity=ident))
-        finally:
-            if isinstance(spec, str):
-                bus.close()
+    # Each line and each bus is its own wire: they are probed at the same time, one thread
+    # each, so a scan of several ports takes as long as the slowest one, not their sum.
+    # The results are merged in the order the places were given.
+    jobs = [(_probe_line, port, serial) for port in lines] + [(_probe_bus, spec, (canopen, can_probes))
+                                                               for spec in buses]
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, len(jobs)),
+                                               thread_name_prefix="discover") as pool:
+        futures = [pool.submit(fn, place, plugins_, bar=bar, deadline=deadline, reply_timeout=reply_timeout,
+                               sdo_timeout=sdo_timeout) for fn, place, plugins_ in jobs]
+        results = [f.result() for f in futures]
+    found: list[Found] = [x for r in results for x in r.found]
+    skipped: list[str] = [x for r in results for x in r.skipped]
+    probes = sum(r.probes for r in results)
     seconds = time.monotonic() - t0
     bar.finish(f"found {len(found)} drive(s) in {seconds:.1f} s" + (f", {len(skipped)} skipped" if skipped else ""))
     return Discovery(found, seconds, probes, skipped)
+
+
+@dataclass
+class _Place:
+    """What probing one line or bus gave."""
+
+    found: list = field(default_factory=list)
+    skipped: list = field(default_factory=list)
+    probes: int = 0
+
+
+def _probe_line(port: str, serial: list, *, bar: _Progress, deadline: float, reply_timeout: float,
+                sdo_timeout: float) -> _Place:
+    out = _Place()
+    # One RS-485 line runs one protocol at one baud rate: once drives of a kind
+    # answered at a rate, the other rates and kinds are not swept on that line.
+    settled = False
+    for plugin in serial:
+        if settled:
+            out.skipped.append(f"{port} {plugin.kind}: the line already answered another kind")
+            continue
+        for baud in plugin.probe_bauds or (plugin.default_baud,):
+            if settled:
+                break
+            if time.monotonic() >= deadline:
+                out.skipped.append(f"{port} {plugin.kind} @{baud}")
+                continue
+            bar.note(f"{port}: {plugin.kind} at {baud} baud, {len(plugin.probe_addresses)} addresses")
+            try:
+                opened = _core.serial.open_port(port, baud)
+                link = _core.serial.LineLink(opened, reply_timeout=reply_timeout + _wire_time(baud),
+                                             **(plugin.line_settings or {}))
+            except _core.MotorbusError as e:
+                out.skipped.append(f"{port}: {e}")
+                break
+            try:
+                for address in plugin.probe_addresses:
+                    if time.monotonic() >= deadline:
+                        out.skipped.append(f"{port} {plugin.kind} @{baud} from {address}")
+                        break
+                    out.probes += 1
+                    ident = _safe_probe(plugin, link, address)
+                    bar.step(f"{port} {plugin.kind} {address} @{baud}")
+                    if ident is not None:
+                        settled = True
+                        out.found.append(Found(plugin.kind, address, line=port, baud=baud, identity=ident))
+                        bar.note(f"{port}: {plugin.kind} {address} at {baud} baud answered: {ident}")
+            finally:
+                opened.close()
+    return out
+
+
+def _probe_bus(spec: Any, plugins: tuple, *, bar: _Progress, deadline: float, reply_timeout: float,
+               sdo_timeout: float) -> _Place:
+    canopen, can_probes = plugins
+    out = _Place()
+    bus = open_bus(spec) if isinstance(spec, str) else spec
+    label = spec if isinstance(spec, str) else getattr(bus, "channel", "bus")
+    try:
+        if canopen and time.monotonic() < deadline:
+            nodes = _core.canopen.scan_network(bus, sdo_timeout=sdo_timeout, listen=0.0)
+            bar.step(f"{label}: CANopen scan, {len(nodes)} node(s)")
+            bar.note(f"{label}: CANopen scan found node(s) {[n.node for n in nodes]}")
+            for node in nodes:
+                scores = sorted(((p.canopen_match(node) or 0, p.kind) for p in canopen), reverse=True)
+                if scores and scores[0][0] > 0:
+                    out.found.append(Found(scores[0][1], str(node.node), bus=label, identity=_node_identity(node)))
+        for plugin in can_probes:
+            for address in plugin.probe_addresses:
+                if time.monotonic() >= deadline:
+                    out.skipped.append(f"{label} {plugin.kind} from {address}")
+                    break
+                out.probes += 1
+                ident = _safe_probe(plugin, bus, address)
+                bar.step(f"{label} {plugin.kind} {address}")
+                if ident is not None:
+                    out.found.append(Found(plugin.kind, address, bus=label, identity=ident))
+    finally:
+        if isinstance(spec, str):
+            bus.close()
+    return out
 
 
 def _wire_time(baud: int) -> float:
