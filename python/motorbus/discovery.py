@@ -112,6 +112,7 @@ def discover(lines: Sequence[str] = (), buses: Sequence[Any] = (), *, kinds: Opt
              progress: Union[bool, Callable[[str], None]] = False) -> Discovery:
     """Probes ``lines`` (port paths) and ``buses`` (``open_bus`` specs or open Buses)."""
     plugins = registry.drive_plugins()
+    lines = list(dict.fromkeys(lines))     # a port given twice is one wire: probed once, not from two threads
     if kinds is not None:
         unknown = sorted(set(kinds) - set(plugins))
         if unknown:
