@@ -316,3 +316,20 @@ def test_cli_allow_motion_needs_http(tmp_path):
     r = subprocess.run([sys.executable, "-m", "motorbus", "serve", str(tmp_path / "b.toml"), "--allow-motion"],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "--allow-motion" in r.stderr and "--http" in r.stderr
+
+
+def test_a_port_already_taken_is_refused_by_name_and_leaves_nothing_open(served, tmp_path):
+    from urllib.parse import urlsplit
+
+    from motorbus.serve.lockfile import find_service
+    from motorbus.serve.service import BenchService
+
+    port = urlsplit(served.url).port
+    other = ServedWeb(str(tmp_path))           # its copy of the demo bench, not started
+    other.loop.close()
+    service = BenchService(other.bench_path, sim=True, epics=False, socket_path=other.socket_path,
+                           http=("127.0.0.1", port))
+    with pytest.raises(motorbus.InvalidArgument, match=rf"--http 127.0.0.1:{port}: cannot listen there"):
+        asyncio.run(service.start())
+    assert service.bench is None and find_service(other.bench_path) is None
+    get(served.url + "api/bench")              # the first service serves on
