@@ -6,8 +6,10 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 BUILD  := build/dev
 JOBS   ?= $(shell nproc)
-APT_PACKAGES := cmake ninja-build g++ libeigen3-dev libgtest-dev clang libclang-rt-14-dev ccache tmux ser2net \
-  chromium chromium-driver
+APT_PACKAGES := cmake ninja-build g++ libeigen3-dev libgtest-dev clang libclang-rt-14-dev ccache tmux ser2net
+# Only the tests and benchmarks need a browser (the web page's, driven by selenium): `make demo` does not
+# install one.
+TEST_APT_PACKAGES := chromium chromium-driver
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # ccache (when installed) with paths relative to the checkout, so a fresh clone
 # in another directory reuses earlier compilations.  Whether it is installed is
@@ -17,7 +19,7 @@ export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := 1
 CCACHE_LAUNCHER = $$(command -v ccache >/dev/null && echo -Ccmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache)
 
-.PHONY: demo test deps venv build cpp-test py-test sanitize fuzz fuzz-smoke bench soak stubs clean
+.PHONY: demo test deps test-deps venv build cpp-test py-test sanitize fuzz fuzz-smoke bench soak stubs clean
 
 demo: build
 	$(PY) -m motorbus demo
@@ -26,10 +28,15 @@ test: build cpp-test py-test sanitize fuzz-smoke stubs-check
 	@echo "== all test stages passed"
 
 deps: $(VENV)/.deps
+# The Debian packages of $(1) that are missing, installed (nothing asked when all are there).
+define apt_install
+@missing=$$(for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+if [ -n "$$missing" ]; then echo "installing: $$missing"; \
+  $(SUDO) apt-get update -qq && $(SUDO) DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; fi
+endef
+
 $(VENV)/.deps: requirements-dev.txt
-	@missing=$$(for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
-	if [ -n "$$missing" ]; then echo "installing: $$missing"; \
-	  $(SUDO) apt-get update -qq && $(SUDO) DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; fi
+	$(call apt_install,$(APT_PACKAGES))
 	[ -x $(PY) ] || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -r requirements-dev.txt
@@ -49,7 +56,10 @@ cpp-test: build
 # motion and transports (a worker uses ~40% of a core), so three on a 2-core machine cut the
 # wall time further than two.
 PYTEST_WORKERS ?= 3
-py-test: build
+test-deps: deps
+	$(call apt_install,$(TEST_APT_PACKAGES))
+
+py-test: build test-deps
 	$(PY) -m pytest -q -p no:cacheprovider -n $(PYTEST_WORKERS) --dist loadfile
 
 # C++ suites and the threaded Python tests under ASan+UBSan; C++ suites under TSan.
@@ -66,7 +76,7 @@ fuzz-smoke: deps
 soak: build
 	MOTORBUS_SOAK=1 $(PY) -m pytest -q -p no:cacheprovider tests/reliability
 
-bench: build
+bench: build test-deps
 	bash tools/bench.sh $(PY)
 
 stubs: build

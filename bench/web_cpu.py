@@ -147,7 +147,7 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=10.0, help="seconds per phase")
     args = ap.parse_args()
     if not (shutil.which("chromium") or os.path.exists("/usr/bin/chromium")):
-        print(json.dumps({"bench": "web_cpu", "error": "chromium not installed (make deps)"}))
+        print(json.dumps({"bench": "web_cpu", "error": "chromium not installed (make test-deps)"}))
         return
     tmp = tempfile.mkdtemp()
     bench = os.path.join(tmp, "demo_bench.toml")

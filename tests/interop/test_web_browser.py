@@ -1,6 +1,6 @@
 """The page of ``motorbus serve --http`` in a real browser: Debian's chromium, headless,
-driven by selenium through Debian's chromedriver (both installed by the Makefile's deps;
-nothing is downloaded).  One service of the demo bench's simulated twin and one browser
+driven by selenium through Debian's chromedriver (both installed by ``make test-deps``,
+which ``make test`` and ``make bench`` run; nothing is downloaded).  One service of the demo bench's simulated twin and one browser
 for the module; what the page makes happen is asserted on the simulators (the shafts),
 not on what the page says.
 
@@ -40,7 +40,7 @@ pytestmark = pytest.mark.timeout(180)
 
 def _browser_missing() -> str:
     missing = [p for p in (CHROMIUM, CHROMEDRIVER) if not os.access(p, os.X_OK)]
-    return f"{', '.join(missing)} not installed (make deps installs Debian's chromium and chromium-driver)" \
+    return f"{', '.join(missing)} not installed (make test-deps installs Debian's chromium and chromium-driver)" \
         if missing else ""
 
 
