@@ -154,6 +154,24 @@ class _Place:
     skipped: list = field(default_factory=list)
     probes: int = 0
 
+    def sweep(self, plugin: Any, link: Any, where: str, bar: _Progress, deadline: float,
+              **place: Any) -> bool:
+        """Probes each of the kind's addresses over ``link`` until the budget runs out; each
+        answer is a Found at ``place`` (line and baud, or bus).  True when one answered."""
+        answered = False
+        for address in plugin.probe_addresses:
+            if time.monotonic() >= deadline:
+                self.skipped.append(f"{where} from {address}")
+                break
+            self.probes += 1
+            ident = _safe_probe(plugin, link, address)
+            bar.step(f"{where} {address}")
+            if ident is not None:
+                answered = True
+                self.found.append(Found(plugin.kind, address, identity=ident, **place))
+                bar.note(f"{where}: {address} answered: {ident}")
+        return answered
+
 
 def _probe_line(port: str, serial: list, *, bar: _Progress, deadline: float, reply_timeout: float,
                 sdo_timeout: float) -> _Place:
@@ -180,17 +198,7 @@ def _probe_line(port: str, serial: list, *, bar: _Progress, deadline: float, rep
                 out.skipped.append(f"{port}: {e}")
                 break
             try:
-                for address in plugin.probe_addresses:
-                    if time.monotonic() >= deadline:
-                        out.skipped.append(f"{port} {plugin.kind} @{baud} from {address}")
-                        break
-                    out.probes += 1
-                    ident = _safe_probe(plugin, link, address)
-                    bar.step(f"{port} {plugin.kind} {address} @{baud}")
-                    if ident is not None:
-                        settled = True
-                        out.found.append(Found(plugin.kind, address, line=port, baud=baud, identity=ident))
-                        bar.note(f"{port}: {plugin.kind} {address} at {baud} baud answered: {ident}")
+                settled = out.sweep(plugin, link, f"{port} {plugin.kind} @{baud}", bar, deadline, line=port, baud=baud)
             finally:
                 opened.close()
     return out
@@ -212,15 +220,7 @@ def _probe_bus(spec: Any, plugins: tuple, *, bar: _Progress, deadline: float, re
                 if scores and scores[0][0] > 0:
                     out.found.append(Found(scores[0][1], str(node.node), bus=label, identity=_node_identity(node)))
         for plugin in can_probes:
-            for address in plugin.probe_addresses:
-                if time.monotonic() >= deadline:
-                    out.skipped.append(f"{label} {plugin.kind} from {address}")
-                    break
-                out.probes += 1
-                ident = _safe_probe(plugin, bus, address)
-                bar.step(f"{label} {plugin.kind} {address}")
-                if ident is not None:
-                    out.found.append(Found(plugin.kind, address, bus=label, identity=ident))
+            out.sweep(plugin, bus, f"{label} {plugin.kind}", bar, deadline, bus=label)
     finally:
         if isinstance(spec, str):
             bus.close()
