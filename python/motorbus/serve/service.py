@@ -64,18 +64,14 @@ def file_prefix(bench_path: Any) -> Optional[str]:
     return value.strip() if isinstance(value, str) and value.strip() else None
 
 
-def _require_caproto() -> None:
-    if importlib.util.find_spec("caproto") is None:
-        raise _core.InvalidArgument(f"motorbus serve: {EPICS_EXTRA_HINT}")
+def _require(module: str, hint: str) -> None:
+    """An optional extra's module, checked before any transport opens."""
+    if importlib.util.find_spec(module) is None:
+        raise _core.InvalidArgument(f"motorbus serve: {hint}")
 
 
 WEB_EXTRA_HINT = ("serving the web page (--http) needs aiohttp, the optional extra motorbus[web]: "
                   "pip install 'motorbus[web]'")
-
-
-def _require_aiohttp() -> None:
-    if importlib.util.find_spec("aiohttp") is None:
-        raise _core.InvalidArgument(f"motorbus serve: {WEB_EXTRA_HINT}")
 
 
 class BenchService:
@@ -129,9 +125,9 @@ class BenchService:
         self._lock.acquire()
         try:
             if self.http is not None:
-                _require_aiohttp()
+                _require("aiohttp", WEB_EXTRA_HINT)
             if self.epics:
-                _require_caproto()
+                _require("caproto", EPICS_EXTRA_HINT)
                 if self.prefix is None:
                     self.prefix = file_prefix(self.bench_path) or default_prefix(self.bench_path)
             self._clear_stale_socket()
