@@ -232,7 +232,7 @@ def _post_raw(url: str, body: bytes) -> tuple[int, dict]:
 
 
 def test_a_page_that_goes_away_leaves_nothing_and_several_are_served(served):
-    async def many() -> tuple[int, int]:
+    async def many() -> int:
         import aiohttp
 
         async with aiohttp.ClientSession() as session:
@@ -244,10 +244,10 @@ def test_a_page_that_goes_away_leaves_nothing_and_several_are_served(served):
             for ws in sockets[:4]:
                 await ws.close()
             sockets[4]._response.connection.transport.abort()      # one just vanishes (no close frame)
-        return during, 0
+        return during
 
     base = served.service.web.counters["browsers"]
-    during, _ = asyncio.run(many())
+    during = asyncio.run(many())
     assert during == base + 5
     wait_until(lambda: served.service.web.counters["browsers"] == base, what="the pages' sockets gone")
     web = served.service.web
@@ -333,3 +333,22 @@ def test_a_port_already_taken_is_refused_by_name_and_leaves_nothing_open(served,
         asyncio.run(service.start())
     assert service.bench is None and find_service(other.bench_path) is None
     get(served.url + "api/bench")              # the first service serves on
+
+
+def test_positions_of_a_poll_that_ended_are_not_shown_as_current(tmp_path):
+    s = ServedWeb(str(tmp_path)).start()
+    try:
+        poller = s.service.web.sampler._poller
+
+        async def end_poll() -> None:               # what a failed link does to the poll
+            await asyncio.to_thread(poller.stop)
+
+        s.run(end_poll())
+        wait_until(lambda: s.service.web.sampler.poll_error is not None, what="the sampler seeing the poll end")
+        time.sleep(0.5)                              # a status round after it
+        _, updates = asyncio.run(_updates(s.url, 2))
+        for name, a in updates[-1]["axes"].items():
+            assert a["position"] is None and a["velocity"] is None, name
+            assert a["error"].startswith("the position poll ended"), (name, a["error"])
+    finally:
+        s.close()

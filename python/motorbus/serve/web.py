@@ -62,7 +62,7 @@ DEFAULT_BITRATE = 500_000
 STATUS_TIMEOUT = 2.0
 #: Bodies larger than this are refused (a JSON POST of the page is a few dozen bytes).
 MAX_BODY = 4096
-#: What the page's jog buttons may ask, for ``POST .../jog``: user units per second, finite.
+#: The commands that move or power an axis: refused (403) without --allow-motion.
 MOTION_VERBS = ("move", "jog", "home", "enable", "disable", "clear")
 
 _ASSETS = {"index.html": "text/html", "app.js": "text/javascript", "style.css": "text/css"}
@@ -140,6 +140,7 @@ class Sampler:
         self._changed = asyncio.Event()
         self._tasks: list[asyncio.Task] = []
         self._poller: Any = None
+        self.poll_error: Optional[str] = None     # set when the position poll ended
         self._counter_cache: tuple[float, dict] = (-math.inf, {})
 
     def now(self) -> float:
@@ -173,6 +174,19 @@ class Sampler:
         return self.version
 
     async def _read_positions(self) -> None:
+        try:
+            await self._follow_poll()
+        finally:
+            # The poll ended (a link failed: its stats say why): the last positions are no
+            # longer where the axes are, so the page shows none, and the reason.
+            why = "; ".join(f"{g}: {st.get('error_type')}: {st.get('error')}"
+                            for g, st in (self._poller.stats or {}).items() if st.get("error")) \
+                if self._poller is not None else ""
+            self.poll_error = f"the position poll ended{': ' + why if why else ''}"
+            for a in self.axes.values():
+                a.update(position=None, velocity=None, error=self.poll_error)
+
+    async def _follow_poll(self) -> None:
         async for chunk in self._poller.chunks(1):
             for name in self.names:
                 ts, ps = chunk.get(f"{name}.t", chunk.get("t")), chunk.get(f"{name}.position")
@@ -216,7 +230,7 @@ class Sampler:
             return
         a.update(enabled=st.enabled, moving=st.moving, at_target=st.at_target, homed=st.homed,
                  limit_positive=st.limit_positive, limit_negative=st.limit_negative, fault=st.fault,
-                 text=st.text or "", error=None, last_move=_outcome(st.last_move))
+                 text=st.text or "", error=self.poll_error, last_move=_outcome(st.last_move))
 
     def _read_bus_loads(self) -> None:
         now = time.monotonic()
@@ -349,9 +363,8 @@ class WebFace:
         gone), the commands it started are let go, the sampler and the server end."""
         from aiohttp import WSCloseCode
 
-        for ws in list(self._sockets):
-            with contextlib.suppress(Exception):
-                await asyncio.wait_for(ws.close(code=WSCloseCode.GOING_AWAY, message=b"service ends"), 1.0)
+        await asyncio.gather(*(asyncio.wait_for(ws.close(code=WSCloseCode.GOING_AWAY, message=b"service ends"), 1.0)
+                               for ws in list(self._sockets)), return_exceptions=True)   # together: 1 s at most
         for t in list(self._commands):
             t.cancel()
         await self.sampler.close()
